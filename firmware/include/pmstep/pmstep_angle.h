@@ -1,0 +1,58 @@
+/**
+ * @file pmstep_angle.h
+ * @brief Rotor angle reconstruction from current integrals, controller (6):
+ *   c-hat = -(L p / k_M)(i_a - i_a(t_c) - phi1) + 1,  phi1' = -(R/L) i_a + u_a/L
+ *   s-hat = -(L p / k_M)(i_b - i_b(t_c) - phi2),      phi2' = -(R/L) i_b + u_b/L
+ * with phi1(t_c) = phi2(t_c) = 0. Each period the applied (zero-order-held)
+ * voltage is integrated exactly and the sampled current by the trapezoid rule;
+ * the sums are compensated (Kahan) so float32 round-off does not drift.
+ */
+#ifndef PMSTEP_ANGLE_H
+#define PMSTEP_ANGLE_H
+
+#include "pmstep/pmstep_types.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct {
+    float phi_a;            /**< phi1, A */
+    float phi_b;            /**< phi2, A */
+    float phi_a_compensation; /**< Kahan running compensation of phi1 */
+    float phi_b_compensation; /**< Kahan running compensation of phi2 */
+    float i_a_start_a;      /**< i_a(t_c) */
+    float i_b_start_a;      /**< i_b(t_c) */
+    float i_a_prev_a;       /**< i_a at the previous sample */
+    float i_b_prev_a;       /**< i_b at the previous sample */
+} pmstep_angle_t;
+
+/** Constants derived once from the configuration. */
+typedef struct {
+    float voltage_gain;     /**< T_s / L, A per V */
+    float current_gain;     /**< R T_s / (2 L), trapezoid weight */
+    float flux_to_angle;    /**< L p / k_M, per A */
+} pmstep_angle_coeffs_t;
+
+void pmstep_angle_coeffs_init(pmstep_angle_coeffs_t *coeffs, const pmstep_config_t *cfg);
+
+/** Starts the integrals at t_c: phi = 0, remembers i(t_c). */
+void pmstep_angle_start(pmstep_angle_t *angle, float i_a_a, float i_b_a);
+
+/**
+ * Integrates phi1, phi2 over the period that just ended.
+ * @param[in] i_a_a, i_b_a   currents sampled at the end of the period
+ * @param[in] u_a_v, u_b_v   voltages applied during the period
+ */
+void pmstep_angle_update(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs,
+                         float i_a_a, float i_b_a, float u_a_v, float u_b_v);
+
+/** c-hat and s-hat for the currents sampled now (the same as given to the last update). */
+void pmstep_angle_estimate(const pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs,
+                           float i_a_a, float i_b_a, float *cos_hat, float *sin_hat);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PMSTEP_ANGLE_H */

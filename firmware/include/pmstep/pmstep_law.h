@@ -1,0 +1,69 @@
+/**
+ * @file pmstep_law.h
+ * @brief Adaptive speed and current law of controller (6) (and (13) with a known
+ *        load): i_q*, its derivative, phi_d, phi_q, u_d, u_q and the inverse Park
+ *        transform with the estimated angle (c-hat, s-hat).
+ *
+ * sat_kappa(x) = x / sqrt(1 + (x/kappa)^2): smooth, odd, |sat| < kappa, slope 1 at 0.
+ * It needs one square root (a single FPU instruction on Cortex-M4F) and no libm call.
+ */
+#ifndef PMSTEP_LAW_H
+#define PMSTEP_LAW_H
+
+#include "pmstep/pmstep_types.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct {
+    float j_over_km;          /**< J/k_M */
+    float f_over_j_per_s;     /**< F/J */
+    float inv_j;              /**< 1/J */
+    float speed_gain_per_s;   /**< k_w */
+    float current_gain_per_s; /**< K_i */
+    float r_over_l_per_s;     /**< R/L */
+    float km_over_l;          /**< k_M/L */
+    float inductance_h;       /**< L */
+    float pole_pairs;         /**< p */
+    float kappa_rad_s;        /**< kappa */
+    bool linear_speed_term;   /**< Remark 1 (13): k_w (w-hat - w*) without saturation */
+} pmstep_law_coeffs_t;
+
+/** References at one sample. */
+typedef struct {
+    float speed_ref_rad_s, speed_ref_rate, speed_ref_accel; /**< w*, w*', w*'' */
+    float i_d_ref_a, i_d_ref_rate;                          /**< i_d*, i_d*' */
+} pmstep_law_refs_t;
+
+void pmstep_law_coeffs_init(pmstep_law_coeffs_t *coeffs, const pmstep_config_t *cfg);
+
+/** Smooth saturation and its derivative. */
+void pmstep_sat(float x, float kappa, float *sat, float *sat_slope);
+
+/** Park transform with (c, s): d = c a + s b, q = -s a + c b. */
+void pmstep_park(float cos_hat, float sin_hat, float a, float b, float *d, float *q);
+
+/** i_q* = (J/k_M)[(F/J) w* - k_w sat(w-hat - w*) + T/J + w*'], T = T_L-hat or T_L*. */
+float pmstep_law_iq_ref(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs,
+                        float speed_hat_rad_s, float load_nm);
+
+/** i_q*' = (J/k_M)[(F/J) w*' - k_w sat'(e)(w-hat' - w*') + T'/J + w*'']. */
+float pmstep_law_iq_ref_rate(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs,
+                             float speed_hat_rad_s, float speed_hat_rate, float load_rate);
+
+/**
+ * phi_d = -(R/L) i_d* + p w-hat i_q - i_d*',  phi_q = -(R/L) i_q* - p w-hat i_d - (k_M/L) w-hat - i_q*',
+ * u_d = L[-phi_d - K_i (i_d - i_d*)], u_q = L[-phi_q - K_i (i_q - i_q*)],
+ * u_a = c u_d - s u_q, u_b = s u_d + c u_q.
+ */
+void pmstep_law_voltages(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs,
+                         float cos_hat, float sin_hat, float i_d_a, float i_q_a,
+                         float speed_hat_rad_s, float i_q_ref_a, float i_q_ref_rate,
+                         float *u_a_v, float *u_b_v);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PMSTEP_LAW_H */

@@ -1,0 +1,79 @@
+/**
+ * @file pmstep_observer.h
+ * @brief Current, speed and load-torque observer of controller (6), and the
+ *        speed observer of Remark 1 (13) when the load is known.
+ *
+ * (6):  i_a-hat' = -(R/L) i_a-hat + (k_M/L) w-hat s-hat + u_a/L + K_e i~_a + p w-hat i~_b
+ *       i_b-hat' = -(R/L) i_b-hat - (k_M/L) w-hat c-hat + u_b/L + K_e i~_b - p w-hat i~_a
+ *       w-hat'   = -(F/J) w-hat - T_L-hat/J + (k_M/J) i_q + g_w eps
+ *       T_L-hat' = -g_T eps,   eps = (k_M/L)(s-hat i~_a - c-hat i~_b)
+ * (13): w-hat'   = -(F/J) w-hat + (k_M/J) i_q - T_L^* / J + (1/lambda)[p i_q i~_d - p i_d i~_q - (k_M/L) i~_q]
+ * Discretised by forward Euler at the control period.
+ */
+#ifndef PMSTEP_OBSERVER_H
+#define PMSTEP_OBSERVER_H
+
+#include "pmstep/pmstep_types.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct {
+    float i_a_hat_a;
+    float i_b_hat_a;
+    float speed_hat_rad_s;
+    float load_hat_nm;
+} pmstep_observer_t;
+
+typedef struct {
+    float r_over_l_per_s;     /**< R/L */
+    float inv_l_per_h;        /**< 1/L */
+    float km_over_l;          /**< k_M/L, A/(rad) per s... (V s/rad)/H */
+    float km_over_j;          /**< k_M/J */
+    float f_over_j_per_s;     /**< F/J */
+    float inv_j;              /**< 1/J */
+    float observer_gain_per_s;/**< K_e */
+    float pole_pairs;         /**< p */
+    float speed_injection_gain; /**< g_w = (2 g^2 + r F l J^2)/(g^2 l + r F l^2 J^2) */
+    float load_injection_gain;  /**< g_T = (2 g^2 F + l J g + l J^2 r F^2)/(g^2 l + r F l^2 J^2) */
+    float inv_lambda;         /**< 1/lambda, Remark 1 */
+} pmstep_observer_coeffs_t;
+
+/** Signals the mechanical part of the observer needs at one sample. */
+typedef struct {
+    float i_a_a, i_b_a;       /**< measured currents */
+    float cos_hat, sin_hat;   /**< angle estimate */
+    float i_d_a, i_q_a;       /**< Park of the currents with (c-hat, s-hat) */
+    float i_d_err_a, i_q_err_a; /**< i_d - i_d*, i_q - i_q* (Remark 1 only) */
+    float known_load_nm;      /**< T_L* (Remark 1 only) */
+} pmstep_observer_input_t;
+
+/** Time derivatives of the speed and load estimates. */
+typedef struct {
+    float speed_hat_rate_rad_s2;
+    float load_hat_rate_nm_per_s;
+} pmstep_observer_mech_rates_t;
+
+void pmstep_observer_coeffs_init(pmstep_observer_coeffs_t *coeffs, const pmstep_config_t *cfg);
+
+/** Starts at t_c: i-hat = i(t_c), w-hat = 0, T_L-hat = 0. */
+void pmstep_observer_start(pmstep_observer_t *obs, float i_a_a, float i_b_a);
+
+/** w-hat' and T_L-hat' of (6) (adaptive: known_load = false) or (13) (known_load = true). */
+pmstep_observer_mech_rates_t pmstep_observer_mech_rates(const pmstep_observer_t *obs,
+                                                        const pmstep_observer_coeffs_t *coeffs,
+                                                        const pmstep_observer_input_t *in,
+                                                        bool known_load);
+
+/** Forward-Euler step of all four states, with the voltage applied over the next period. */
+void pmstep_observer_advance(pmstep_observer_t *obs, const pmstep_observer_coeffs_t *coeffs,
+                             const pmstep_observer_input_t *in,
+                             const pmstep_observer_mech_rates_t *mech,
+                             float u_a_v, float u_b_v, float period_s);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PMSTEP_OBSERVER_H */

@@ -1,0 +1,85 @@
+/* Adaptive speed and current law of controller (6); (13) when the load is known. */
+#include "pmstep/pmstep_law.h"
+
+#include <math.h> /* sqrtf: one vsqrt.f32 / sqrtss with -fno-math-errno, no libm call */
+
+void pmstep_law_coeffs_init(pmstep_law_coeffs_t *coeffs, const pmstep_config_t *cfg)
+{
+    coeffs->j_over_km = cfg->inertia_kg_m2 / cfg->torque_constant_nm_per_a;
+    coeffs->f_over_j_per_s = cfg->friction_nm_s_per_rad / cfg->inertia_kg_m2;
+    coeffs->inv_j = 1.0f / cfg->inertia_kg_m2;
+    coeffs->speed_gain_per_s = cfg->speed_gain_per_s;
+    coeffs->current_gain_per_s = cfg->current_gain_per_s;
+    coeffs->r_over_l_per_s = cfg->resistance_ohm / cfg->inductance_h;
+    coeffs->km_over_l = cfg->torque_constant_nm_per_a / cfg->inductance_h;
+    coeffs->inductance_h = cfg->inductance_h;
+    coeffs->pole_pairs = (float)cfg->pole_pairs;
+    coeffs->kappa_rad_s = cfg->sat_kappa_rad_per_s;
+    coeffs->linear_speed_term = cfg->known_load_mode;
+}
+
+void pmstep_sat(float x, float kappa, float *sat, float *sat_slope)
+{
+    const float ratio = x / kappa;
+    const float inv_root = 1.0f / sqrtf(1.0f + ratio * ratio);
+    *sat = x * inv_root;
+    *sat_slope = inv_root * inv_root * inv_root;
+}
+
+void pmstep_park(float cos_hat, float sin_hat, float a, float b, float *d, float *q)
+{
+    *d = cos_hat * a + sin_hat * b;
+    *q = -sin_hat * a + cos_hat * b;
+}
+
+/* k_w sat(e) and k_w sat'(e) for (6); k_w e and k_w for (13). */
+static void speed_term(const pmstep_law_coeffs_t *coeffs, float error, float *term, float *slope)
+{
+    if (coeffs->linear_speed_term) {
+        *term = coeffs->speed_gain_per_s * error;
+        *slope = coeffs->speed_gain_per_s;
+    } else {
+        float sat;
+        float sat_slope;
+        pmstep_sat(error, coeffs->kappa_rad_s, &sat, &sat_slope);
+        *term = coeffs->speed_gain_per_s * sat;
+        *slope = coeffs->speed_gain_per_s * sat_slope;
+    }
+}
+
+float pmstep_law_iq_ref(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs,
+                        float speed_hat_rad_s, float load_nm)
+{
+    float term;
+    float slope;
+    speed_term(coeffs, speed_hat_rad_s - refs->speed_ref_rad_s, &term, &slope);
+    return coeffs->j_over_km * (coeffs->f_over_j_per_s * refs->speed_ref_rad_s - term
+                                + load_nm * coeffs->inv_j + refs->speed_ref_rate);
+}
+
+float pmstep_law_iq_ref_rate(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs,
+                             float speed_hat_rad_s, float speed_hat_rate, float load_rate)
+{
+    float term;
+    float slope;
+    speed_term(coeffs, speed_hat_rad_s - refs->speed_ref_rad_s, &term, &slope);
+    return coeffs->j_over_km * (coeffs->f_over_j_per_s * refs->speed_ref_rate
+                                - slope * (speed_hat_rate - refs->speed_ref_rate)
+                                + load_rate * coeffs->inv_j + refs->speed_ref_accel);
+}
+
+void pmstep_law_voltages(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs,
+                         float cos_hat, float sin_hat, float i_d_a, float i_q_a,
+                         float speed_hat_rad_s, float i_q_ref_a, float i_q_ref_rate,
+                         float *u_a_v, float *u_b_v)
+{
+    const float pw = coeffs->pole_pairs * speed_hat_rad_s;
+    const float phi_d = -coeffs->r_over_l_per_s * refs->i_d_ref_a + pw * i_q_a - refs->i_d_ref_rate;
+    const float phi_q = -coeffs->r_over_l_per_s * i_q_ref_a - pw * i_d_a
+                        - coeffs->km_over_l * speed_hat_rad_s - i_q_ref_rate;
+    const float u_d = coeffs->inductance_h * (-phi_d - coeffs->current_gain_per_s * (i_d_a - refs->i_d_ref_a));
+    const float u_q = coeffs->inductance_h * (-phi_q - coeffs->current_gain_per_s * (i_q_a - i_q_ref_a));
+    /* Inverse Park with the estimated angle. */
+    *u_a_v = cos_hat * u_d - sin_hat * u_q;
+    *u_b_v = sin_hat * u_d + cos_hat * u_q;
+}
