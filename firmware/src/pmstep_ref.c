@@ -64,14 +64,19 @@ void pmstep_ref_reset(pmstep_ref_t *ref, float value)
     ref->diff12 = 0.0f;
     ref->diff23 = 0.0f;
     ref->value = value;
+    ref->value_compensation = 0.0f;
     ref->setpoint = value;
     ref->target = value;
     ref->ramp_rate_per_s = 0.0f;
+    ref->ramp_origin = value;
+    ref->ramp_periods = 0u;
 }
 
 void pmstep_ref_set_target(pmstep_ref_t *ref, float target, float ramp_rate_per_s)
 {
     ref->target = target;
+    ref->ramp_origin = ref->setpoint;
+    ref->ramp_periods = 0u;
     if (ramp_rate_per_s > 0.0f) {
         ref->ramp_rate_per_s = ramp_rate_per_s;
     } else {
@@ -96,27 +101,34 @@ void pmstep_ref_advance(const pmstep_ref_coeffs_t *coeffs, pmstep_ref_t *ref, fl
     float next = ref->target;
     float change;
     float error;
+    float increment;
     float d1;
     float d2;
     float y;
 
-    if (ref->ramp_rate_per_s > 0.0f) {
-        const float max_change = ref->ramp_rate_per_s * period_s;
-        if (next > start + max_change) {
-            next = start + max_change;
-        } else if (next < start - max_change) {
-            next = start - max_change;
+    if (ref->ramp_rate_per_s > 0.0f && next != start) {
+        const float travel = ref->ramp_rate_per_s * ((float)(ref->ramp_periods + 1u) * period_s);
+        if (next > ref->ramp_origin + travel) {
+            next = ref->ramp_origin + travel;
+        } else if (next < ref->ramp_origin - travel) {
+            next = ref->ramp_origin - travel;
         }
+        ref->ramp_periods++;
     }
     change = next - start;
 
-    error = start - ref->value;
+    error = (start - ref->value) + ref->value_compensation;
     d1 = coeffs->phi[0][0] * ref->diff12 + coeffs->phi[0][1] * ref->diff23
          + coeffs->gamma0[0] * error + coeffs->gamma1[0] * change;
     d2 = coeffs->phi[1][0] * ref->diff12 + coeffs->phi[1][1] * ref->diff23
          + coeffs->gamma0[1] * error + coeffs->gamma1[1] * change;
-    y = ref->value + (coeffs->phi[2][0] * ref->diff12 + coeffs->phi[2][1] * ref->diff23
-                      + coeffs->gamma0[2] * error + coeffs->gamma1[2] * change);
+    increment = coeffs->phi[2][0] * ref->diff12 + coeffs->phi[2][1] * ref->diff23
+                + coeffs->gamma0[2] * error + coeffs->gamma1[2] * change;
+    {
+        const float corrected = increment - ref->value_compensation;
+        y = ref->value + corrected;
+        ref->value_compensation = (y - ref->value) - corrected;
+    }
     ref->diff12 = d1;
     ref->diff23 = d2;
     ref->value = y;

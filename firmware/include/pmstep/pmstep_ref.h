@@ -32,9 +32,12 @@ typedef struct {
     float diff12;        /**< x1 - x2 */
     float diff23;        /**< x2 - x3 */
     float value;         /**< x3 = y */
+    float value_compensation; /**< Kahan compensation of y: y increments are far below its ulp near rest */
     float setpoint;      /**< r at the present sample */
     float target;        /**< value r ramps towards */
     float ramp_rate_per_s; /**< |dr/dt| limit; 0 means a step */
+    float ramp_origin;   /**< set-point when the target was set */
+    uint32_t ramp_periods; /**< periods since then: r = origin +/- rate * n T_s, never accumulated */
 } pmstep_ref_t;
 
 /** Filter output at one sample. */

@@ -1,0 +1,317 @@
+/* Core lifecycle: validation codes, mode machine timing, alignment voltages,
+ * commands, voltage limit, delay bookkeeping and every fault path. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <string.h>
+
+#include "pmstep/pmstep.h"
+
+static pmstep_meas_t nominal_meas(void)
+{
+    pmstep_meas_t m;
+    m.i_a_a = 0.0f;
+    m.i_b_a = 0.0f;
+    m.bus_voltage_v = 48.0f;
+    m.load_torque_nm = 0.0f;
+    return m;
+}
+
+/* ---- validation: each cause has its own code and text ---- */
+
+typedef void (*config_edit_t)(pmstep_config_t *cfg);
+static void bad_r(pmstep_config_t *c) { c->resistance_ohm = 0.0f; }
+static void bad_l(pmstep_config_t *c) { c->inductance_h = -1e-3f; }
+static void bad_j(pmstep_config_t *c) { c->inertia_kg_m2 = 0.0f; }
+static void bad_km(pmstep_config_t *c) { c->torque_constant_nm_per_a = 0.0f; }
+static void bad_f(pmstep_config_t *c) { c->friction_nm_s_per_rad = -0.1f; }
+static void bad_p(pmstep_config_t *c) { c->pole_pairs = 0; }
+static void bad_period(pmstep_config_t *c) { c->period_s = 0.0f; }
+static void bad_k_omega(pmstep_config_t *c) { c->speed_gain_per_s = 0.0f; }
+static void bad_k_e(pmstep_config_t *c) { c->observer_gain_per_s = -1.0f; }
+static void bad_k_i(pmstep_config_t *c) { c->current_gain_per_s = 0.0f; }
+static void bad_gamma(pmstep_config_t *c) { c->adapt_gamma = 0.0f; }
+static void bad_lambda(pmstep_config_t *c) { c->adapt_lambda = 0.0f; }
+static void bad_r_gain(pmstep_config_t *c) { c->adapt_r = 0.0f; }
+static void bad_kappa(pmstep_config_t *c) { c->sat_kappa_rad_per_s = 0.0f; }
+static void long_period(pmstep_config_t *c) { c->period_s = 1e-3f; } /* (500 + 100) * 1e-3 >= 0.5 */
+static void bad_condition4(pmstep_config_t *c) { c->c_align_voltage_v = 1.0f; } /* margin 18.5 - 32.1 < 0 */
+static void bad_condition4_slow_motor(pmstep_config_t *c) { c->torque_constant_nm_per_a = 0.2f; } /* 44.4 - 64 < 0 */
+static void bad_align_voltage(pmstep_config_t *c) { c->s_align_voltage_v = 40.0f; } /* above min bus 30 V */
+static void zero_align_voltage(pmstep_config_t *c) { c->c_align_voltage_v = 0.0f; }
+static void bad_align_current(pmstep_config_t *c) { c->max_phase_current_a = 7.0f; } /* 24 V / 3 Ohm = 8 A */
+static void bad_align_time(pmstep_config_t *c) { c->c_align_time_s = c->s_align_time_s; }
+static void bad_bandwidth(pmstep_config_t *c) { c->reference_bandwidth_rad_per_s = 20000.0f; }
+static void bad_limits(pmstep_config_t *c) { c->max_bus_voltage_v = 20.0f; }
+static void bad_delay(pmstep_config_t *c) { c->computational_delay_periods = 2u; }
+static void nan_param(pmstep_config_t *c) { c->inertia_kg_m2 = NAN; }
+
+static void every_invalid_configuration_has_its_code(void **state)
+{
+    static const struct {
+        config_edit_t edit;
+        pmstep_status_t expected;
+    } cases[] = {
+        {bad_r, PMSTEP_ERR_RESISTANCE},
+        {bad_l, PMSTEP_ERR_INDUCTANCE},
+        {bad_j, PMSTEP_ERR_INERTIA},
+        {bad_km, PMSTEP_ERR_TORQUE_CONSTANT},
+        {bad_f, PMSTEP_ERR_FRICTION},
+        {bad_p, PMSTEP_ERR_POLE_PAIRS},
+        {bad_period, PMSTEP_ERR_PERIOD},
+        {bad_k_omega, PMSTEP_ERR_GAIN},
+        {bad_k_e, PMSTEP_ERR_GAIN},
+        {bad_k_i, PMSTEP_ERR_GAIN},
+        {bad_gamma, PMSTEP_ERR_GAIN},
+        {bad_lambda, PMSTEP_ERR_GAIN},
+        {bad_r_gain, PMSTEP_ERR_GAIN},
+        {bad_kappa, PMSTEP_ERR_GAIN},
+        {long_period, PMSTEP_ERR_PERIOD_TOO_LONG},
+        {bad_condition4, PMSTEP_ERR_ALIGNMENT_CONDITION},
+        {bad_condition4_slow_motor, PMSTEP_ERR_ALIGNMENT_CONDITION},
+        {bad_align_voltage, PMSTEP_ERR_ALIGNMENT_VOLTAGE},
+        {zero_align_voltage, PMSTEP_ERR_ALIGNMENT_VOLTAGE},
+        {bad_align_current, PMSTEP_ERR_ALIGNMENT_CURRENT},
+        {bad_align_time, PMSTEP_ERR_ALIGNMENT_TIME},
+        {bad_bandwidth, PMSTEP_ERR_REFERENCE_BANDWIDTH},
+        {bad_limits, PMSTEP_ERR_LIMITS},
+        {bad_delay, PMSTEP_ERR_DELAY},
+        {nan_param, PMSTEP_ERR_NONFINITE_PARAMETER},
+    };
+    size_t n;
+    pmstep_t inst;
+    pmstep_config_t good = pmstep_paper_config();
+    (void)state;
+    assert_int_equal(pmstep_init(&inst, &good), PMSTEP_OK);
+    assert_int_equal(pmstep_init(NULL, &good), PMSTEP_ERR_NULL_ARGUMENT);
+    assert_int_equal(pmstep_init(&inst, NULL), PMSTEP_ERR_NULL_ARGUMENT);
+    for (n = 0; n < sizeof cases / sizeof cases[0]; ++n) {
+        pmstep_config_t cfg = pmstep_paper_config();
+        pmstep_status_t status;
+        cases[n].edit(&cfg);
+        status = pmstep_init(&inst, &cfg);
+        print_message("case %u: %d (%s)\n", (unsigned)n, (int)status, pmstep_status_str(status));
+        assert_int_equal(status, cases[n].expected);
+        assert_true(strcmp(pmstep_status_str(status), "unknown status") != 0);
+    }
+}
+
+static double condition4_margin(double k_m, double u_cs, double u_cc)
+{
+    const double p = 6.0, l = 0.006, r = 3.0;
+    return k_m * u_cc / (p * l * r) - (u_cs * u_cs + u_cc * u_cc) / (2.0 * r * r);
+}
+
+static void condition4_cases_are_on_the_right_side(void **state)
+{
+    /* Keeps the table above honest: paper values 444.4 - 64 > 0, the two bad cases < 0. */
+    (void)state;
+    assert_true(fabs(condition4_margin(2.0, 24.0, 24.0) - (444.444 - 64.0)) < 1e-3);
+    assert_true(condition4_margin(2.0, 24.0, 1.0) < 0.0);
+    assert_true(condition4_margin(0.2, 24.0, 24.0) < 0.0);
+    assert_true(condition4_margin(2.0, 24.0, 2.0) > 0.0);
+}
+
+/* ---- mode machine ---- */
+
+static void alignment_timing_and_voltages(void **state)
+{
+    pmstep_config_t cfg = pmstep_paper_config();
+    pmstep_t inst;
+    pmstep_output_t out;
+    pmstep_meas_t meas = nominal_meas();
+    uint32_t k;
+    const uint32_t s_steps = 6000u;  /* 0.3 s / 50 us */
+    const uint32_t c_steps = 12000u; /* 0.6 s / 50 us */
+    (void)state;
+    assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
+
+    pmstep_step(&inst, &meas, &out); /* IDLE: bridge off */
+    assert_int_equal(out.mode, PMSTEP_MODE_IDLE);
+    assert_false(out.bridge_enable);
+    assert_true(out.u_a_v == 0.0f && out.u_b_v == 0.0f);
+
+    assert_int_equal(pmstep_start(&inst), PMSTEP_OK);
+    assert_int_equal(pmstep_start(&inst), PMSTEP_ERR_BAD_MODE);
+    for (k = 0; k < c_steps + 2u; ++k) {
+        pmstep_step(&inst, &meas, &out);
+        assert_true(out.bridge_enable);
+        if (k < s_steps) { /* (3) */
+            assert_int_equal(out.mode, PMSTEP_MODE_S_ALIGN);
+            assert_true(out.u_a_v == 0.0f && out.u_b_v == 24.0f);
+        } else if (k < c_steps) { /* (5) */
+            assert_int_equal(out.mode, PMSTEP_MODE_C_ALIGN);
+            assert_true(out.u_a_v == 24.0f && out.u_b_v == 0.0f);
+        } else {
+            assert_int_equal(out.mode, PMSTEP_MODE_RUN);
+            assert_true(out.cos_hat == 1.0f || k > c_steps);
+        }
+    }
+    assert_int_equal(pmstep_stop(&inst), PMSTEP_OK);
+    pmstep_step(&inst, &meas, &out);
+    assert_int_equal(out.mode, PMSTEP_MODE_IDLE);
+    assert_false(out.bridge_enable);
+}
+
+static void commands_validate_their_values(void **state)
+{
+    pmstep_config_t cfg = pmstep_paper_config();
+    pmstep_t inst;
+    (void)state;
+    assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
+    assert_int_equal(pmstep_set_speed_target(&inst, 10.0f, 50.0f), PMSTEP_OK);
+    assert_int_equal(pmstep_set_speed_target(&inst, NAN, 50.0f), PMSTEP_ERR_BAD_COMMAND_VALUE);
+    assert_int_equal(pmstep_set_speed_target(&inst, 10.0f, 0.0f), PMSTEP_ERR_BAD_COMMAND_VALUE);
+    assert_int_equal(pmstep_set_speed_target(&inst, 10.0f, INFINITY), PMSTEP_ERR_BAD_COMMAND_VALUE);
+    assert_int_equal(pmstep_set_id_target(&inst, INFINITY), PMSTEP_ERR_BAD_COMMAND_VALUE);
+    assert_int_equal(pmstep_set_id_target(&inst, -0.5f), PMSTEP_OK);
+    assert_int_equal(pmstep_clear_fault(&inst), PMSTEP_ERR_BAD_MODE);
+    assert_int_equal(pmstep_start(NULL), PMSTEP_ERR_NULL_ARGUMENT);
+}
+
+/* ---- faults: zero output, bridge off, code and step latched, only clear leaves ---- */
+
+typedef void (*meas_edit_t)(pmstep_meas_t *m);
+static void nan_current(pmstep_meas_t *m) { m->i_b_a = NAN; }
+static void inf_bus(pmstep_meas_t *m) { m->bus_voltage_v = INFINITY; }
+static void over_current(pmstep_meas_t *m) { m->i_a_a = -15.5f; }
+static void under_voltage(pmstep_meas_t *m) { m->bus_voltage_v = 25.0f; }
+static void over_voltage(pmstep_meas_t *m) { m->bus_voltage_v = 65.0f; }
+
+static void each_fault_latches_with_zero_output(void **state)
+{
+    static const struct {
+        meas_edit_t edit;
+        pmstep_fault_t expected;
+        uint32_t at_step;
+    } cases[] = {
+        {nan_current, PMSTEP_FAULT_MEASUREMENT_NONFINITE, 10u},
+        {inf_bus, PMSTEP_FAULT_MEASUREMENT_NONFINITE, 7000u},
+        {over_current, PMSTEP_FAULT_OVERCURRENT, 12005u},
+        {under_voltage, PMSTEP_FAULT_BUS_UNDERVOLTAGE, 3u},
+        {over_voltage, PMSTEP_FAULT_BUS_OVERVOLTAGE, 12500u},
+    };
+    size_t n;
+    (void)state;
+    for (n = 0; n < sizeof cases / sizeof cases[0]; ++n) {
+        pmstep_config_t cfg = pmstep_paper_config();
+        pmstep_t inst;
+        pmstep_output_t out;
+        uint32_t k;
+        assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
+        assert_int_equal(pmstep_start(&inst), PMSTEP_OK);
+        for (k = 1; k <= cases[n].at_step + 100u; ++k) {
+            pmstep_meas_t meas = nominal_meas();
+            if (k == cases[n].at_step) {
+                cases[n].edit(&meas);
+            }
+            pmstep_step(&inst, &meas, &out);
+        }
+        assert_int_equal(out.mode, PMSTEP_MODE_FAULT);
+        assert_int_equal(out.fault, cases[n].expected);
+        assert_int_equal(out.fault_step, cases[n].at_step);
+        assert_false(out.bridge_enable);
+        assert_true(out.u_a_v == 0.0f && out.u_b_v == 0.0f);
+        assert_true(strcmp(pmstep_fault_str(out.fault), "unknown fault") != 0);
+        /* Nothing but an explicit clear leaves FAULT. */
+        assert_int_equal(pmstep_start(&inst), PMSTEP_ERR_BAD_MODE);
+        assert_int_equal(pmstep_stop(&inst), PMSTEP_ERR_BAD_MODE);
+        assert_int_equal(pmstep_clear_fault(&inst), PMSTEP_OK);
+        {
+            pmstep_meas_t meas = nominal_meas();
+            pmstep_step(&inst, &meas, &out);
+        }
+        assert_int_equal(out.mode, PMSTEP_MODE_IDLE);
+        assert_int_equal(out.fault, PMSTEP_FAULT_NONE);
+    }
+}
+
+static void nonfinite_known_load_faults_only_in_known_load_mode(void **state)
+{
+    pmstep_config_t cfg = pmstep_paper_config();
+    pmstep_t inst;
+    pmstep_output_t out;
+    pmstep_meas_t meas = nominal_meas();
+    (void)state;
+    meas.load_torque_nm = NAN;
+    assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
+    assert_int_equal(pmstep_start(&inst), PMSTEP_OK);
+    pmstep_step(&inst, &meas, &out);
+    assert_int_equal(out.fault, PMSTEP_FAULT_NONE);
+    cfg.known_load_mode = true;
+    assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
+    assert_int_equal(pmstep_start(&inst), PMSTEP_OK);
+    pmstep_step(&inst, &meas, &out);
+    assert_int_equal(out.fault, PMSTEP_FAULT_MEASUREMENT_NONFINITE);
+}
+
+/* Steps to RUN with the rotor "held" at cos p theta = 1 (currents of the c-aligned state). */
+static void step_to_run(pmstep_t *inst, pmstep_output_t *out, float bus_v)
+{
+    uint32_t k;
+    pmstep_meas_t meas = nominal_meas();
+    meas.bus_voltage_v = bus_v;
+    meas.i_a_a = 8.0f;
+    assert_int_equal(pmstep_start(inst), PMSTEP_OK);
+    for (k = 0; k <= 12000u; ++k) {
+        pmstep_step(inst, &meas, out);
+    }
+    assert_int_equal(out->mode, PMSTEP_MODE_RUN);
+}
+
+static void voltage_limited_to_bus_keeping_direction(void **state)
+{
+    pmstep_config_t cfg = pmstep_paper_config();
+    pmstep_t inst;
+    pmstep_output_t out;
+    pmstep_meas_t meas = nominal_meas();
+    (void)state;
+    assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
+    step_to_run(&inst, &out, 48.0f);
+    /* A wild current sample makes the law ask for far more than the bus. */
+    meas.i_a_a = -14.0f;
+    meas.i_b_a = 14.0f;
+    meas.bus_voltage_v = 31.0f;
+    pmstep_step(&inst, &meas, &out);
+    assert_int_equal(out.fault, PMSTEP_FAULT_NONE);
+    assert_true(out.voltage_limited);
+    assert_true(fabsf(out.u_a_v) <= 31.0f && fabsf(out.u_b_v) <= 31.0f);
+    assert_true(fabsf(fmaxf(fabsf(out.u_a_v), fabsf(out.u_b_v)) - 31.0f) < 1e-4f);
+}
+
+static void delay_one_period_integrates_the_applied_voltage(void **state)
+{
+    /* With one period of delay, the first RUN period still applies the c-alignment voltage:
+     * phi1 must integrate u_cc = 24 V over it, not the newly computed voltage. */
+    pmstep_config_t cfg = pmstep_paper_config();
+    pmstep_t inst;
+    pmstep_output_t out;
+    pmstep_meas_t meas = nominal_meas();
+    (void)state;
+    cfg.computational_delay_periods = 1u;
+    assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
+    step_to_run(&inst, &out, 48.0f);
+    meas.i_a_a = 8.0f;
+    pmstep_step(&inst, &meas, &out);
+    /* phi1 = T/L (24 - R (8 + 8)/2) = 0 exactly for the held c-aligned state. */
+    assert_true(fabsf(inst.angle.phi_a) < 1e-6f);
+    assert_true(fabsf(out.cos_hat - 1.0f) < 1e-6f);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(every_invalid_configuration_has_its_code),
+        cmocka_unit_test(condition4_cases_are_on_the_right_side),
+        cmocka_unit_test(alignment_timing_and_voltages),
+        cmocka_unit_test(commands_validate_their_values),
+        cmocka_unit_test(each_fault_latches_with_zero_output),
+        cmocka_unit_test(nonfinite_known_load_faults_only_in_known_load_mode),
+        cmocka_unit_test(voltage_limited_to_bus_keeping_direction),
+        cmocka_unit_test(delay_one_period_integrates_the_applied_voltage),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Installs the Debian packages the build and tests need, only those missing.
+# Usage: tools/install_deps.sh            (as root, or with sudo available)
+set -euo pipefail
+
+packages=(
+  cmake ninja-build gcc g++ pkg-config     # host build
+  libcmocka-dev                            # C unit tests
+  libinih-dev libcjson-dev                 # SIL scenario files (INI) and JSON summaries
+  gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi  # Cortex-M4F build
+  qemu-system-arm                          # processor-in-the-loop on an emulated Cortex-M4
+  libeigen3-dev libboost-dev               # C++ test oracle and gain checker
+)
+
+missing=()
+for pkg in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$pkg")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install_deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+echo "install_deps: installing ${missing[*]}"
+if [ "$(id -u)" -eq 0 ]; then
+  SUDO=""
+elif command -v sudo >/dev/null 2>&1; then
+  SUDO="sudo"
+else
+  echo "install_deps: not root and no sudo; run: apt-get install ${missing[*]}" >&2
+  exit 1
+fi
+$SUDO apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+echo "install_deps: done"
