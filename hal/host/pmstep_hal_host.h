@@ -1,0 +1,44 @@
+/**
+ * @file pmstep_hal_host.h
+ * @brief Host port of the HAL contract: the "hardware" is the plant model of
+ *        sil/. Measurements are the plant's currents at the sampling instant and
+ *        a fixed bus voltage; the output drives an averaged inverter (phase
+ *        voltage held over the period, limited to +/- bus). Bridge off is
+ *        modelled as zero phase voltage.
+ *
+ * Computational delay: with 1 period, the voltage of the step at sample k is
+ * applied during [k+1, k+2], as on an MCU that writes duties for the next
+ * carrier period. Set the core's computational_delay_periods to match.
+ */
+#ifndef PMSTEP_HAL_HOST_H
+#define PMSTEP_HAL_HOST_H
+
+#include "pmstep_hal.h"
+#include "sil/plant.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct {
+    plant_t *plant;
+    double bus_voltage_v;
+    unsigned delay_periods;      /**< 0 or 1 */
+    double pending_a_v;          /**< computed, waiting for the next period (delay 1) */
+    double pending_b_v;
+    double applied_a_v;          /**< voltage the plant sees over the coming period */
+    double applied_b_v;
+    unsigned long inverter_limited_periods; /**< periods the inverter had to clip to +/- bus */
+} pmstep_hal_host_t;
+
+/** Binds the port to @p plant; the port state is global, as a real port's registers are. */
+void pmstep_hal_host_bind(plant_t *plant, double bus_voltage_v, unsigned delay_periods);
+
+/** The port's state (for the runner and tests). */
+const pmstep_hal_host_t *pmstep_hal_host_state(void);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PMSTEP_HAL_HOST_H */

@@ -1,0 +1,69 @@
+/**
+ * @file runner.h
+ * @brief Runs a scenario: the real control core (pmstep_step through the host
+ *        HAL port) in closed loop with the plant model, one control period at a
+ *        time, and gathers the metrics of the run.
+ */
+#ifndef SIL_RUNNER_H
+#define SIL_RUNNER_H
+
+#include <stdbool.h>
+
+#include "sil/scenario.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** One control period, at sample time t_k (plant state before the period). */
+typedef struct {
+    long step;
+    double t_s;
+    double theta_rad, omega_rad_s, i_a_a, i_b_a;
+    double cos_ptheta, sin_ptheta;   /**< true electrical angle */
+    double u_a_v, u_b_v;             /**< voltage the plant sees over [t_k, t_k+1] */
+    double load_nm;                  /**< true T_L */
+    const pmstep_output_t *out;      /**< the step's output (estimates, mode, fault) */
+} sil_sample_t;
+
+/** Called once per period; return false to stop the run early. */
+typedef bool (*sil_sample_fn)(const sil_sample_t *sample, void *user);
+
+typedef struct {
+    long steps;
+    double sim_time_s;
+    double wall_time_s;
+    double plant_time_s;             /**< wall time inside the plant integration */
+    double firmware_time_s;          /**< wall time inside read + pmstep_step + apply */
+    double real_time_factor;         /**< simulated s per wall s */
+    /* Alignment residuals, from the plant at the sample nearest t_s and t_c. */
+    double cos_ptheta_at_ts, sin_ptheta_at_ts, i_b_residual_at_ts_a;
+    double cos_ptheta_at_tc, sin_ptheta_at_tc, i_a_residual_at_tc_a;
+    /* Speed error |omega - omega*| on the load transient [t_c, t_c + W) and on tracking [t_c + W, end]. */
+    double transient_max_speed_error_rad_s, transient_rms_speed_error_rad_s;
+    double tracking_max_speed_error_rad_s, tracking_rms_speed_error_rad_s;
+    double final_load_hat_nm, final_load_nm, final_load_error_nm;
+    double max_cos_error, max_sin_error;   /**< |c-hat - cos p theta|, |s-hat - sin p theta| in RUN */
+    double max_phase_voltage_v;            /**< max |u_a|, |u_b| applied */
+    double max_phase_current_a;
+    long voltage_limited_periods;          /**< periods the core scaled its voltage to the bus */
+    long inverter_limited_periods;         /**< periods the inverter model clipped */
+    pmstep_mode_t final_mode;
+    pmstep_fault_t fault;
+    long fault_step;
+    double fault_time_s;
+    pmstep_status_t init_status;
+} sil_summary_t;
+
+/**
+ * Runs @p sc. @p on_sample may be NULL. @p progress prints a progress line to
+ * stderr. @return 0, or -1 when pmstep_init rejected the configuration
+ * (summary->init_status says why).
+ */
+int sil_run(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user, bool progress, sil_summary_t *summary);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* SIL_RUNNER_H */

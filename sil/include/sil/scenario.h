@@ -1,0 +1,72 @@
+/**
+ * @file scenario.h
+ * @brief A SIL scenario: plant, firmware configuration, initial state, speed
+ *        set-point profile, load profile, run settings. Read from an INI file
+ *        (parsed by inih) and `section.key=value` overrides; every key and
+ *        value is checked, and any error names the key (and line).
+ */
+#ifndef SIL_SCENARIO_H
+#define SIL_SCENARIO_H
+
+#include <stddef.h>
+#include <stdio.h>
+
+#include "pmstep/pmstep.h"
+#include "sil/plant.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define SIL_SPEED_POINTS_MAX 64
+#define SIL_ERROR_MAX 256
+
+typedef struct {
+    char name[64];
+    plant_params_t motor;            /**< [motor]: the plant (may differ from [controller]) */
+    plant_load_t load;               /**< [load] */
+    pmstep_config_t controller;      /**< [controller]: what the firmware is told */
+    double duration_s;               /**< run.duration_s */
+    int substeps;                    /**< run.substeps: RK4 steps per control period */
+    double bus_voltage_v;            /**< run.bus_voltage_v */
+    double theta0_rad;               /**< run.theta0_deg (stored in rad) */
+    double omega0_rad_s;             /**< run.omega0_rad_s */
+    double i_a0_a;                   /**< run.i_a0_a */
+    double i_b0_a;                   /**< run.i_b0_a */
+    int decimation;                  /**< run.decimation: a CSV row every N periods */
+    double transient_window_s;       /**< run.transient_window_s: [t_c, t_c + W) is the load transient */
+    int speed_points;                /**< [speed] points = t:v, ... (rad/s, piecewise linear) */
+    double speed_time_s[SIL_SPEED_POINTS_MAX];
+    double speed_value_rad_s[SIL_SPEED_POINTS_MAX];
+    double id_target_a;              /**< speed.id_target_a */
+} sil_scenario_t;
+
+/** The paper's Section III: t_s = 0.3 s, t_c = 0.6 s, 2 Nm at 0.63 s, theta0 = 30 deg, 2.4 s, 20 kHz. */
+void sil_scenario_paper(sil_scenario_t *sc);
+
+/**
+ * Sets `section.key` from text. @return 0, or -1 with a message in @p err
+ * naming the key (unknown key, malformed or out-of-range value).
+ */
+int sil_scenario_set(sil_scenario_t *sc, const char *key, const char *value, char *err, size_t err_size);
+
+/** Applies `section.key=value`. @return 0 or -1 with a message. */
+int sil_scenario_set_assignment(sil_scenario_t *sc, const char *assignment, char *err, size_t err_size);
+
+/**
+ * Loads an INI file on top of @p sc (start from sil_scenario_paper() for defaults).
+ * @return 0, or -1 with "file:line: message" in @p err.
+ */
+int sil_scenario_load(sil_scenario_t *sc, const char *path, char *err, size_t err_size);
+
+/** Checks relations between keys (after all keys are set). @return 0 or -1 with a message. */
+int sil_scenario_check(const sil_scenario_t *sc, char *err, size_t err_size);
+
+/** Writes every key with its present value in INI form (a template users can edit). */
+void sil_scenario_print(const sil_scenario_t *sc, FILE *file);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* SIL_SCENARIO_H */

@@ -1,0 +1,257 @@
+/* pmstep-sil: runs a scenario through the real control core and the plant model,
+ * writes a CSV time series and a JSON summary, prints the summary. */
+#include <cjson/cJSON.h>
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "sil/runner.h"
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: pmstep-sil [--scenario FILE|paper] [--set section.key=value]... [--out DIR]\n"
+            "                  [--no-csv] [--quiet] [--print-scenario]\n"
+            "  --scenario   INI scenario file on top of the built-in paper scenario (default: paper)\n"
+            "  --set        override one key after the file, e.g. --set run.period_s=25e-6\n"
+            "  --out        output folder for run.csv and summary.json (default: out/<scenario name>)\n"
+            "  --no-csv     skip the time series (benchmarks)\n"
+            "  --quiet      no progress line, no printed summary\n"
+            "  --print-scenario  print every key with its value (INI) and exit\n");
+}
+
+typedef struct {
+    FILE *file;
+    int decimation;
+} csv_ctx_t;
+
+static bool write_row(const sil_sample_t *x, void *user)
+{
+    csv_ctx_t *csv = (csv_ctx_t *)user;
+    const pmstep_output_t *o = x->out;
+    if (x->step % csv->decimation != 0) {
+        return true;
+    }
+    fprintf(csv->file, "%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d\n", x->t_s,
+            x->theta_rad, x->omega_rad_s, (double)o->speed_ref_rad_s, x->i_a_a, x->i_b_a, x->u_a_v, x->u_b_v,
+            (double)o->cos_hat, (double)o->sin_hat, x->cos_ptheta, x->sin_ptheta, (double)o->speed_hat_rad_s,
+            (double)o->load_hat_nm, x->load_nm, (int)o->mode, (int)o->fault);
+    return true;
+}
+
+static cJSON *summary_json(const sil_scenario_t *sc, const sil_summary_t *s)
+{
+    cJSON *root = cJSON_CreateObject();
+    cJSON *align = cJSON_CreateObject();
+    cJSON *speed = cJSON_CreateObject();
+    cJSON *angle = cJSON_CreateObject();
+    cJSON *timing = cJSON_CreateObject();
+    cJSON *fault = cJSON_CreateObject();
+    cJSON_AddStringToObject(root, "scenario", sc->name);
+    cJSON_AddNumberToObject(root, "pole_pairs", sc->motor.pole_pairs);
+    cJSON_AddNumberToObject(root, "control_period_s", (double)sc->controller.period_s);
+    cJSON_AddNumberToObject(root, "substeps", sc->substeps);
+    cJSON_AddNumberToObject(root, "delay_periods", sc->controller.computational_delay_periods);
+    cJSON_AddNumberToObject(root, "s_align_time_s", (double)sc->controller.s_align_time_s);
+    cJSON_AddNumberToObject(root, "c_align_time_s", (double)sc->controller.c_align_time_s);
+    cJSON_AddNumberToObject(root, "transient_window_s", sc->transient_window_s);
+    cJSON_AddNumberToObject(root, "theta0_deg", sc->theta0_rad * 180.0 / 3.14159265358979323846);
+
+    cJSON_AddNumberToObject(align, "cos_ptheta_at_ts", s->cos_ptheta_at_ts);
+    cJSON_AddNumberToObject(align, "sin_ptheta_at_ts", s->sin_ptheta_at_ts);
+    cJSON_AddNumberToObject(align, "i_b_minus_ucs_over_r_at_ts_a", s->i_b_residual_at_ts_a);
+    cJSON_AddNumberToObject(align, "cos_ptheta_at_tc", s->cos_ptheta_at_tc);
+    cJSON_AddNumberToObject(align, "sin_ptheta_at_tc", s->sin_ptheta_at_tc);
+    cJSON_AddNumberToObject(align, "i_a_minus_ucc_over_r_at_tc_a", s->i_a_residual_at_tc_a);
+    cJSON_AddItemToObject(root, "alignment", align);
+
+    cJSON_AddNumberToObject(speed, "transient_max_abs_error_rad_s", s->transient_max_speed_error_rad_s);
+    cJSON_AddNumberToObject(speed, "transient_rms_error_rad_s", s->transient_rms_speed_error_rad_s);
+    cJSON_AddNumberToObject(speed, "tracking_max_abs_error_rad_s", s->tracking_max_speed_error_rad_s);
+    cJSON_AddNumberToObject(speed, "tracking_rms_error_rad_s", s->tracking_rms_speed_error_rad_s);
+    cJSON_AddItemToObject(root, "speed", speed);
+
+    cJSON_AddNumberToObject(root, "final_load_hat_nm", s->final_load_hat_nm);
+    cJSON_AddNumberToObject(root, "final_load_nm", s->final_load_nm);
+    cJSON_AddNumberToObject(root, "final_load_abs_error_nm", s->final_load_error_nm);
+    cJSON_AddNumberToObject(angle, "max_abs_cos_error", s->max_cos_error);
+    cJSON_AddNumberToObject(angle, "max_abs_sin_error", s->max_sin_error);
+    cJSON_AddItemToObject(root, "angle_estimate", angle);
+    cJSON_AddNumberToObject(root, "max_abs_phase_voltage_v", s->max_phase_voltage_v);
+    cJSON_AddNumberToObject(root, "max_abs_phase_current_a", s->max_phase_current_a);
+    cJSON_AddNumberToObject(root, "voltage_limited_periods", (double)s->voltage_limited_periods);
+    cJSON_AddNumberToObject(root, "inverter_clipped_periods", (double)s->inverter_limited_periods);
+    cJSON_AddStringToObject(root, "final_mode", pmstep_mode_str(s->final_mode));
+
+    cJSON_AddNumberToObject(fault, "code", (double)s->fault);
+    cJSON_AddStringToObject(fault, "text", pmstep_fault_str(s->fault));
+    cJSON_AddNumberToObject(fault, "step", (double)s->fault_step);
+    cJSON_AddNumberToObject(fault, "time_s", s->fault_time_s);
+    cJSON_AddItemToObject(root, "fault", fault);
+
+    cJSON_AddNumberToObject(timing, "steps", (double)s->steps);
+    cJSON_AddNumberToObject(timing, "simulated_s", s->sim_time_s);
+    cJSON_AddNumberToObject(timing, "wall_s", s->wall_time_s);
+    cJSON_AddNumberToObject(timing, "plant_wall_s", s->plant_time_s);
+    cJSON_AddNumberToObject(timing, "firmware_wall_s", s->firmware_time_s);
+    cJSON_AddNumberToObject(timing, "real_time_factor", s->real_time_factor);
+    cJSON_AddItemToObject(root, "timing", timing);
+    return root;
+}
+
+static int make_dirs(const char *path)
+{
+    char buf[1024];
+    size_t n;
+    if (strlen(path) >= sizeof buf) {
+        return -1;
+    }
+    strcpy(buf, path);
+    for (n = 1; buf[n] != '\0'; ++n) {
+        if (buf[n] == '/') {
+            buf[n] = '\0';
+            if (mkdir(buf, 0777) != 0 && errno != EEXIST) {
+                return -1;
+            }
+            buf[n] = '/';
+        }
+    }
+    if (mkdir(buf, 0777) != 0 && errno != EEXIST) {
+        return -1;
+    }
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    static sil_scenario_t sc;
+    sil_summary_t summary;
+    char err[SIL_ERROR_MAX];
+    char out_dir[512] = "";
+    char path[1100];
+    const char *scenario_file = NULL;
+    bool write_csv = true, quiet = false, print_only = false;
+    csv_ctx_t csv = {NULL, 1};
+    cJSON *json;
+    char *text;
+    FILE *f;
+    int i;
+
+    sil_scenario_paper(&sc);
+    /* The scenario file first, then every --set in order. */
+    for (i = 1; i < argc; ++i) {
+        if (strcmp(argv[i], "--scenario") == 0 && i + 1 < argc) {
+            scenario_file = argv[++i];
+        } else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
+            usage(stdout);
+            return 0;
+        }
+    }
+    if (scenario_file != NULL && strcmp(scenario_file, "paper") != 0) {
+        if (sil_scenario_load(&sc, scenario_file, err, sizeof err) != 0) {
+            fprintf(stderr, "pmstep-sil: %s\n", err);
+            return 2;
+        }
+    }
+    for (i = 1; i < argc; ++i) {
+        if (strcmp(argv[i], "--scenario") == 0) {
+            if (i + 1 >= argc) {
+                fprintf(stderr, "pmstep-sil: --scenario needs a file\n");
+                return 2;
+            }
+            ++i;
+        } else if (strcmp(argv[i], "--set") == 0) {
+            if (i + 1 >= argc) {
+                fprintf(stderr, "pmstep-sil: --set needs section.key=value\n");
+                return 2;
+            }
+            if (sil_scenario_set_assignment(&sc, argv[++i], err, sizeof err) != 0) {
+                fprintf(stderr, "pmstep-sil: --set: %s\n", err);
+                return 2;
+            }
+        } else if (strcmp(argv[i], "--out") == 0) {
+            if (i + 1 >= argc) {
+                fprintf(stderr, "pmstep-sil: --out needs a folder\n");
+                return 2;
+            }
+            snprintf(out_dir, sizeof out_dir, "%s", argv[++i]);
+        } else if (strcmp(argv[i], "--no-csv") == 0) {
+            write_csv = false;
+        } else if (strcmp(argv[i], "--quiet") == 0) {
+            quiet = true;
+        } else if (strcmp(argv[i], "--print-scenario") == 0) {
+            print_only = true;
+        } else {
+            fprintf(stderr, "pmstep-sil: unknown argument '%s'\n", argv[i]);
+            usage(stderr);
+            return 2;
+        }
+    }
+    if (print_only) {
+        sil_scenario_print(&sc, stdout);
+        return 0;
+    }
+    if (sil_scenario_check(&sc, err, sizeof err) != 0) {
+        fprintf(stderr, "pmstep-sil: %s\n", err);
+        return 2;
+    }
+    if (out_dir[0] == '\0') {
+        snprintf(out_dir, sizeof out_dir, "out/%s", sc.name);
+    }
+    if (make_dirs(out_dir) != 0) {
+        fprintf(stderr, "pmstep-sil: cannot create folder '%s': %s\n", out_dir, strerror(errno));
+        return 2;
+    }
+    if (write_csv) {
+        snprintf(path, sizeof path, "%s/run.csv", out_dir);
+        csv.file = fopen(path, "w");
+        if (csv.file == NULL) {
+            fprintf(stderr, "pmstep-sil: cannot write '%s': %s\n", path, strerror(errno));
+            return 2;
+        }
+        csv.decimation = sc.decimation;
+        fprintf(csv.file, "t_s,theta_rad,omega_rad_s,omega_ref_rad_s,i_a_a,i_b_a,u_a_v,u_b_v,cos_hat,sin_hat,"
+                          "cos_ptheta,sin_ptheta,omega_hat_rad_s,load_hat_nm,load_nm,mode,fault\n");
+    }
+    if (!quiet) {
+        fprintf(stderr, "pmstep-sil: scenario '%s', %.3f s at %.0f Hz, %d RK4 substeps, delay %u\n", sc.name,
+                sc.duration_s, 1.0 / (double)sc.controller.period_s, sc.substeps,
+                (unsigned)sc.controller.computational_delay_periods);
+    }
+    if (sil_run(&sc, write_csv ? write_row : NULL, &csv, !quiet, &summary) != 0) {
+        fprintf(stderr, "pmstep-sil: the firmware rejected the configuration: %s (status %d)\n",
+                pmstep_status_str(summary.init_status), (int)summary.init_status);
+        if (csv.file != NULL) {
+            fclose(csv.file);
+        }
+        return 2;
+    }
+    if (csv.file != NULL && fclose(csv.file) != 0) {
+        fprintf(stderr, "pmstep-sil: error writing run.csv\n");
+        return 2;
+    }
+    json = summary_json(&sc, &summary);
+    text = cJSON_Print(json);
+    snprintf(path, sizeof path, "%s/summary.json", out_dir);
+    f = fopen(path, "w");
+    if (f == NULL || text == NULL) {
+        fprintf(stderr, "pmstep-sil: cannot write '%s'\n", path);
+        return 2;
+    }
+    fprintf(f, "%s\n", text);
+    fclose(f);
+    if (!quiet) {
+        printf("%s\n", text);
+        fprintf(stderr, "pmstep-sil: wrote %s%s/summary.json\n", write_csv ? "run.csv and " : "", out_dir);
+    }
+    cJSON_free(text);
+    cJSON_Delete(json);
+    if (summary.fault != PMSTEP_FAULT_NONE) {
+        fprintf(stderr, "pmstep-sil: FAULT latched at t = %.6f s: %s\n", summary.fault_time_s,
+                pmstep_fault_str(summary.fault));
+        return 3;
+    }
+    return 0;
+}

@@ -1,0 +1,102 @@
+/* Model (1) of the paper, RK4 with voltages held over the control period. */
+#include "sil/plant.h"
+
+#include <math.h>
+
+plant_params_t plant_paper_params(void)
+{
+    plant_params_t p;
+    p.resistance_ohm = 3.0;
+    p.inductance_h = 0.006;
+    p.inertia_kg_m2 = 0.01;
+    p.friction_nm_s_per_rad = 0.0;
+    p.torque_constant_nm_per_a = 2.0;
+    p.pole_pairs = 6;
+    return p;
+}
+
+double plant_load_torque(const plant_load_t *load, double t_s, double omega_rad_s)
+{
+    switch (load->kind) {
+    case PLANT_LOAD_NONE:
+        return 0.0;
+    case PLANT_LOAD_CONSTANT:
+        return load->torque_nm;
+    case PLANT_LOAD_STEP:
+        return t_s >= load->step_time_s ? load->torque_nm : 0.0;
+    case PLANT_LOAD_PROPORTIONAL:
+        return load->coefficient_nm_s_per_rad * omega_rad_s;
+    case PLANT_LOAD_TABLE: {
+        int k;
+        const int n = load->table_points;
+        if (n <= 0) {
+            return 0.0;
+        }
+        if (t_s <= load->table_time_s[0]) {
+            return load->table_torque_nm[0];
+        }
+        for (k = 1; k < n; ++k) {
+            if (t_s < load->table_time_s[k]) {
+                const double t0 = load->table_time_s[k - 1];
+                const double w = (t_s - t0) / (load->table_time_s[k] - t0);
+                return load->table_torque_nm[k - 1] + w * (load->table_torque_nm[k] - load->table_torque_nm[k - 1]);
+            }
+        }
+        return load->table_torque_nm[n - 1];
+    }
+    }
+    return 0.0;
+}
+
+void plant_derivative(const plant_params_t *params, const plant_load_t *load, double t_s,
+                      const plant_state_t *x, double u_a_v, double u_b_v, plant_state_t *dx)
+{
+    const double angle = (double)params->pole_pairs * x->theta_rad;
+    const double s = sin(angle);
+    const double c = cos(angle);
+    const double inv_l = 1.0 / params->inductance_h;
+    const double inv_j = 1.0 / params->inertia_kg_m2;
+    const double k_m = params->torque_constant_nm_per_a;
+    const double load_nm = plant_load_torque(load, t_s, x->omega_rad_s);
+
+    dx->theta_rad = x->omega_rad_s;
+    dx->omega_rad_s = inv_j * (-params->friction_nm_s_per_rad * x->omega_rad_s
+                               + k_m * (-x->i_a_a * s + x->i_b_a * c) - load_nm);
+    dx->i_a_a = inv_l * (-params->resistance_ohm * x->i_a_a + k_m * x->omega_rad_s * s + u_a_v);
+    dx->i_b_a = inv_l * (-params->resistance_ohm * x->i_b_a - k_m * x->omega_rad_s * c + u_b_v);
+}
+
+static plant_state_t axpy(const plant_state_t *x, double h, const plant_state_t *dx)
+{
+    plant_state_t y;
+    y.theta_rad = x->theta_rad + h * dx->theta_rad;
+    y.omega_rad_s = x->omega_rad_s + h * dx->omega_rad_s;
+    y.i_a_a = x->i_a_a + h * dx->i_a_a;
+    y.i_b_a = x->i_b_a + h * dx->i_b_a;
+    return y;
+}
+
+void plant_advance(plant_t *plant, double u_a_v, double u_b_v, double period_s, int substeps)
+{
+    const double h = period_s / (double)substeps;
+    const double t0 = plant->time_s;
+    int n;
+    for (n = 0; n < substeps; ++n) {
+        const double t = t0 + (double)n * h;
+        const plant_state_t x = plant->x;
+        plant_state_t k1, k2, k3, k4, y;
+        plant_derivative(&plant->params, &plant->load, t, &x, u_a_v, u_b_v, &k1);
+        y = axpy(&x, 0.5 * h, &k1);
+        plant_derivative(&plant->params, &plant->load, t + 0.5 * h, &y, u_a_v, u_b_v, &k2);
+        y = axpy(&x, 0.5 * h, &k2);
+        plant_derivative(&plant->params, &plant->load, t + 0.5 * h, &y, u_a_v, u_b_v, &k3);
+        y = axpy(&x, h, &k3);
+        plant_derivative(&plant->params, &plant->load, t + h, &y, u_a_v, u_b_v, &k4);
+        plant->x.theta_rad = x.theta_rad + h / 6.0 * (k1.theta_rad + 2.0 * (k2.theta_rad + k3.theta_rad) + k4.theta_rad);
+        plant->x.omega_rad_s = x.omega_rad_s + h / 6.0 * (k1.omega_rad_s + 2.0 * (k2.omega_rad_s + k3.omega_rad_s) + k4.omega_rad_s);
+        plant->x.i_a_a = x.i_a_a + h / 6.0 * (k1.i_a_a + 2.0 * (k2.i_a_a + k3.i_a_a) + k4.i_a_a);
+        plant->x.i_b_a = x.i_b_a + h / 6.0 * (k1.i_b_a + 2.0 * (k2.i_b_a + k3.i_b_a) + k4.i_b_a);
+    }
+    /* Time from the period count, not accumulated substeps. */
+    plant->time_s = t0 + period_s;
+}

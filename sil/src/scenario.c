@@ -1,0 +1,393 @@
+/* Scenario keys: one table gives each key its field, type and range. Files are
+ * parsed by inih; this file only converts and checks values. */
+#include "sil/scenario.h"
+
+#include <ini.h>
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define PI 3.14159265358979323846
+
+typedef enum { KEY_DOUBLE, KEY_FLOAT, KEY_INT, KEY_UINT, KEY_BOOL, KEY_ANGLE_DEG, KEY_SPEED_POINTS,
+               KEY_LOAD_POINTS, KEY_LOAD_KIND } key_type_t;
+
+/* Range of a numeric key: min/max, each inclusive or exclusive. */
+typedef struct {
+    const char *name;
+    key_type_t type;
+    size_t offset;
+    double min;
+    int min_exclusive;
+    double max;
+    int max_exclusive;
+    const char *help;
+} key_t_;
+
+#define OFF(field) offsetof(sil_scenario_t, field)
+#define BIG 1e12
+
+static const key_t_ keys[] = {
+    {"motor.resistance_ohm", KEY_DOUBLE, OFF(motor.resistance_ohm), 0, 1, BIG, 0, "plant R (Ohm)"},
+    {"motor.inductance_h", KEY_DOUBLE, OFF(motor.inductance_h), 0, 1, BIG, 0, "plant L (H)"},
+    {"motor.inertia_kg_m2", KEY_DOUBLE, OFF(motor.inertia_kg_m2), 0, 1, BIG, 0, "plant J (kg m^2)"},
+    {"motor.friction_nm_s_per_rad", KEY_DOUBLE, OFF(motor.friction_nm_s_per_rad), 0, 0, BIG, 0, "plant F (Nm s/rad)"},
+    {"motor.torque_constant_nm_per_a", KEY_DOUBLE, OFF(motor.torque_constant_nm_per_a), 0, 1, BIG, 0, "plant k_M (Nm/A)"},
+    {"motor.pole_pairs", KEY_INT, OFF(motor.pole_pairs), 1, 0, 1000, 0, "plant p"},
+
+    {"controller.resistance_ohm", KEY_FLOAT, OFF(controller.resistance_ohm), -BIG, 0, BIG, 0, "R the firmware assumes (Ohm)"},
+    {"controller.inductance_h", KEY_FLOAT, OFF(controller.inductance_h), -BIG, 0, BIG, 0, "L (H)"},
+    {"controller.inertia_kg_m2", KEY_FLOAT, OFF(controller.inertia_kg_m2), -BIG, 0, BIG, 0, "J (kg m^2)"},
+    {"controller.friction_nm_s_per_rad", KEY_FLOAT, OFF(controller.friction_nm_s_per_rad), -BIG, 0, BIG, 0, "F (Nm s/rad)"},
+    {"controller.torque_constant_nm_per_a", KEY_FLOAT, OFF(controller.torque_constant_nm_per_a), -BIG, 0, BIG, 0, "k_M (Nm/A)"},
+    {"controller.pole_pairs", KEY_INT, OFF(controller.pole_pairs), -1000, 0, 1000, 0, "p"},
+    {"controller.s_align_time_s", KEY_FLOAT, OFF(controller.s_align_time_s), -BIG, 0, BIG, 0, "t_s (s)"},
+    {"controller.c_align_time_s", KEY_FLOAT, OFF(controller.c_align_time_s), -BIG, 0, BIG, 0, "t_c (s)"},
+    {"controller.s_align_voltage_v", KEY_FLOAT, OFF(controller.s_align_voltage_v), -BIG, 0, BIG, 0, "u_cs (V)"},
+    {"controller.c_align_voltage_v", KEY_FLOAT, OFF(controller.c_align_voltage_v), -BIG, 0, BIG, 0, "u_cc (V)"},
+    {"controller.speed_gain_per_s", KEY_FLOAT, OFF(controller.speed_gain_per_s), -BIG, 0, BIG, 0, "k_omega (1/s)"},
+    {"controller.observer_gain_per_s", KEY_FLOAT, OFF(controller.observer_gain_per_s), -BIG, 0, BIG, 0, "K_e (1/s)"},
+    {"controller.current_gain_per_s", KEY_FLOAT, OFF(controller.current_gain_per_s), -BIG, 0, BIG, 0, "K_i (1/s)"},
+    {"controller.adapt_gamma", KEY_FLOAT, OFF(controller.adapt_gamma), -BIG, 0, BIG, 0, "gamma"},
+    {"controller.adapt_lambda", KEY_FLOAT, OFF(controller.adapt_lambda), -BIG, 0, BIG, 0, "lambda"},
+    {"controller.adapt_r", KEY_FLOAT, OFF(controller.adapt_r), -BIG, 0, BIG, 0, "r"},
+    {"controller.sat_kappa_rad_per_s", KEY_FLOAT, OFF(controller.sat_kappa_rad_per_s), -BIG, 0, BIG, 0, "kappa (rad/s)"},
+    {"controller.reference_bandwidth_rad_per_s", KEY_FLOAT, OFF(controller.reference_bandwidth_rad_per_s), -BIG, 0, BIG, 0, "varpi_0 (rad/s)"},
+    {"controller.known_load_mode", KEY_BOOL, OFF(controller.known_load_mode), 0, 0, 1, 0, "Remark 1: load torque measured (true/false)"},
+    {"controller.max_phase_current_a", KEY_FLOAT, OFF(controller.max_phase_current_a), -BIG, 0, BIG, 0, "overcurrent trip (A)"},
+    {"controller.min_bus_voltage_v", KEY_FLOAT, OFF(controller.min_bus_voltage_v), -BIG, 0, BIG, 0, "undervoltage trip (V)"},
+    {"controller.max_bus_voltage_v", KEY_FLOAT, OFF(controller.max_bus_voltage_v), -BIG, 0, BIG, 0, "overvoltage trip (V)"},
+
+    {"run.duration_s", KEY_DOUBLE, OFF(duration_s), 0, 1, 3600, 0, "simulated time (s)"},
+    {"run.period_s", KEY_FLOAT, OFF(controller.period_s), 0, 1, 0.01, 0, "control period T_s (s)"},
+    {"run.substeps", KEY_INT, OFF(substeps), 1, 0, 10000, 0, "RK4 steps per control period"},
+    {"run.delay_periods", KEY_UINT, OFF(controller.computational_delay_periods), 0, 0, 1, 0, "computational delay (0 or 1 period)"},
+    {"run.bus_voltage_v", KEY_DOUBLE, OFF(bus_voltage_v), 0, 1, 10000, 0, "DC bus (V)"},
+    {"run.theta0_deg", KEY_ANGLE_DEG, OFF(theta0_rad), -1e6, 0, 1e6, 0, "initial rotor angle (mechanical deg)"},
+    {"run.omega0_rad_s", KEY_DOUBLE, OFF(omega0_rad_s), -1e4, 0, 1e4, 0, "initial speed (rad/s)"},
+    {"run.i_a0_a", KEY_DOUBLE, OFF(i_a0_a), -1e4, 0, 1e4, 0, "initial current a (A)"},
+    {"run.i_b0_a", KEY_DOUBLE, OFF(i_b0_a), -1e4, 0, 1e4, 0, "initial current b (A)"},
+    {"run.decimation", KEY_INT, OFF(decimation), 1, 0, 100000000, 0, "a CSV row every N periods"},
+    {"run.transient_window_s", KEY_DOUBLE, OFF(transient_window_s), 0, 0, 3600, 0, "load-transient window after t_c (s)"},
+
+    {"speed.points", KEY_SPEED_POINTS, 0, 0, 0, 0, 0, "set-point t:omega pairs (s:rad/s), piecewise linear"},
+    {"speed.id_target_a", KEY_DOUBLE, OFF(id_target_a), -1e4, 0, 1e4, 0, "i_d* (A)"},
+
+    {"load.type", KEY_LOAD_KIND, 0, 0, 0, 0, 0, "none | constant | step | proportional | table"},
+    {"load.torque_nm", KEY_DOUBLE, OFF(load.torque_nm), -1e6, 0, 1e6, 0, "constant / step load (Nm)"},
+    {"load.step_time_s", KEY_DOUBLE, OFF(load.step_time_s), 0, 0, 3600, 0, "time of the step (s)"},
+    {"load.coefficient_nm_s_per_rad", KEY_DOUBLE, OFF(load.coefficient_nm_s_per_rad), -1e6, 0, 1e6, 0, "proportional load T_L = c omega"},
+    {"load.points", KEY_LOAD_POINTS, 0, 0, 0, 0, 0, "table t:T_L pairs (s:Nm), piecewise linear"},
+};
+
+static const char *const load_kind_names[] = {"none", "constant", "step", "proportional", "table"};
+
+static int fail(char *err, size_t err_size, const char *fmt, ...)
+{
+    va_list args;
+    va_start(args, fmt);
+    vsnprintf(err, err_size, fmt, args);
+    va_end(args);
+    return -1;
+}
+
+/* Whole-string number: no trailing text, finite. */
+static int parse_number(const char *text, double *value)
+{
+    char *end;
+    errno = 0;
+    *value = strtod(text, &end);
+    if (end == text || errno == ERANGE || !isfinite(*value)) {
+        return -1;
+    }
+    while (*end == ' ' || *end == '\t') {
+        ++end;
+    }
+    return *end == '\0' ? 0 : -1;
+}
+
+/* "t:v, t:v, ..." with strictly increasing t >= 0. */
+static int parse_points(const char *key, const char *text, double *times, double *values, int max_points,
+                        int *count, char *err, size_t err_size)
+{
+    char buffer[4096];
+    char *cursor;
+    int n = 0;
+    if (strlen(text) >= sizeof buffer) {
+        return fail(err, err_size, "%s: value too long", key);
+    }
+    strcpy(buffer, text);
+    cursor = buffer;
+    while (*cursor != '\0') {
+        char *comma = strchr(cursor, ',');
+        char *colon;
+        if (comma != NULL) {
+            *comma = '\0';
+        }
+        colon = strchr(cursor, ':');
+        if (colon == NULL) {
+            return fail(err, err_size, "%s: point %d '%s' is not time:value", key, n + 1, cursor);
+        }
+        *colon = '\0';
+        if (n >= max_points) {
+            return fail(err, err_size, "%s: more than %d points", key, max_points);
+        }
+        if (parse_number(cursor, &times[n]) != 0 || parse_number(colon + 1, &values[n]) != 0) {
+            return fail(err, err_size, "%s: point %d has a malformed number", key, n + 1);
+        }
+        if (times[n] < 0.0 || (n > 0 && !(times[n] > times[n - 1]))) {
+            return fail(err, err_size, "%s: point %d: times must be >= 0 and strictly increasing", key, n + 1);
+        }
+        ++n;
+        if (comma == NULL) {
+            break;
+        }
+        cursor = comma + 1;
+    }
+    if (n == 0) {
+        return fail(err, err_size, "%s: no points", key);
+    }
+    *count = n;
+    return 0;
+}
+
+static int in_range(const key_t_ *k, double v)
+{
+    if (k->min_exclusive ? !(v > k->min) : !(v >= k->min)) {
+        return 0;
+    }
+    if (k->max_exclusive ? !(v < k->max) : !(v <= k->max)) {
+        return 0;
+    }
+    return 1;
+}
+
+int sil_scenario_set(sil_scenario_t *sc, const char *key, const char *value, char *err, size_t err_size)
+{
+    size_t n;
+    char *base = (char *)sc;
+    for (n = 0; n < sizeof keys / sizeof keys[0]; ++n) {
+        const key_t_ *k = &keys[n];
+        double v = 0.0;
+        if (strcmp(k->name, key) != 0) {
+            continue;
+        }
+        switch (k->type) {
+        case KEY_SPEED_POINTS:
+            return parse_points(key, value, sc->speed_time_s, sc->speed_value_rad_s, SIL_SPEED_POINTS_MAX,
+                                &sc->speed_points, err, err_size);
+        case KEY_LOAD_POINTS:
+            return parse_points(key, value, sc->load.table_time_s, sc->load.table_torque_nm, PLANT_LOAD_TABLE_MAX,
+                                &sc->load.table_points, err, err_size);
+        case KEY_LOAD_KIND: {
+            size_t j;
+            for (j = 0; j < sizeof load_kind_names / sizeof load_kind_names[0]; ++j) {
+                if (strcmp(value, load_kind_names[j]) == 0) {
+                    sc->load.kind = (plant_load_kind_t)j;
+                    return 0;
+                }
+            }
+            return fail(err, err_size, "%s: '%s' is not one of none, constant, step, proportional, table", key, value);
+        }
+        case KEY_BOOL:
+            if (strcmp(value, "true") == 0 || strcmp(value, "1") == 0) {
+                *(bool *)(base + k->offset) = true;
+            } else if (strcmp(value, "false") == 0 || strcmp(value, "0") == 0) {
+                *(bool *)(base + k->offset) = false;
+            } else {
+                return fail(err, err_size, "%s: '%s' is not true or false", key, value);
+            }
+            return 0;
+        default:
+            break;
+        }
+        if (parse_number(value, &v) != 0) {
+            return fail(err, err_size, "%s: '%s' is not a finite number", key, value);
+        }
+        if (!in_range(k, v)) {
+            return fail(err, err_size, "%s = %s is out of range: must be %s %g and %s %g (%s)", key, value,
+                        k->min_exclusive ? ">" : ">=", k->min, k->max_exclusive ? "<" : "<=", k->max, k->help);
+        }
+        if ((k->type == KEY_INT || k->type == KEY_UINT) && v != floor(v)) {
+            return fail(err, err_size, "%s: '%s' is not an integer", key, value);
+        }
+        switch (k->type) {
+        case KEY_DOUBLE: *(double *)(base + k->offset) = v; break;
+        case KEY_FLOAT: *(float *)(base + k->offset) = (float)v; break;
+        case KEY_INT: *(int32_t *)(base + k->offset) = (int32_t)v; break;
+        case KEY_UINT: *(uint32_t *)(base + k->offset) = (uint32_t)v; break;
+        case KEY_ANGLE_DEG: *(double *)(base + k->offset) = v * PI / 180.0; break;
+        default: break;
+        }
+        return 0;
+    }
+    return fail(err, err_size, "unknown key '%s' (run with --print-scenario to list the keys)", key);
+}
+
+int sil_scenario_set_assignment(sil_scenario_t *sc, const char *assignment, char *err, size_t err_size)
+{
+    char key[128];
+    const char *eq = strchr(assignment, '=');
+    size_t len;
+    if (eq == NULL) {
+        return fail(err, err_size, "--set '%s': expected section.key=value", assignment);
+    }
+    len = (size_t)(eq - assignment);
+    if (len == 0 || len >= sizeof key) {
+        return fail(err, err_size, "--set '%s': bad key", assignment);
+    }
+    memcpy(key, assignment, len);
+    key[len] = '\0';
+    return sil_scenario_set(sc, key, eq + 1, err, err_size);
+}
+
+typedef struct {
+    sil_scenario_t *sc;
+    char message[SIL_ERROR_MAX];
+    int failed;
+} load_ctx_t;
+
+static int on_ini_entry(void *user, const char *section, const char *name, const char *value)
+{
+    load_ctx_t *ctx = (load_ctx_t *)user;
+    char key[160];
+    char message[SIL_ERROR_MAX];
+    if (ctx->failed) {
+        return 0; /* keep the first error */
+    }
+    if (strcmp(section, "scenario") == 0 && strcmp(name, "name") == 0) {
+        snprintf(ctx->sc->name, sizeof ctx->sc->name, "%s", value);
+        return 1;
+    }
+    snprintf(key, sizeof key, "%s.%s", section, name);
+    if (sil_scenario_set(ctx->sc, key, value, message, sizeof message) != 0) {
+        snprintf(ctx->message, sizeof ctx->message, "%s", message);
+        ctx->failed = 1;
+        return 0;
+    }
+    return 1;
+}
+
+int sil_scenario_load(sil_scenario_t *sc, const char *path, char *err, size_t err_size)
+{
+    load_ctx_t ctx;
+    int line;
+    ctx.sc = sc;
+    ctx.message[0] = '\0';
+    ctx.failed = 0;
+    line = ini_parse(path, on_ini_entry, &ctx);
+    if (line == -1) {
+        return fail(err, err_size, "%s: cannot open", path);
+    }
+    if (line == -2) {
+        return fail(err, err_size, "%s: out of memory", path);
+    }
+    if (line > 0) {
+        if (ctx.failed) {
+            return fail(err, err_size, "%s:%d: %s", path, line, ctx.message);
+        }
+        return fail(err, err_size, "%s:%d: malformed line (expected [section] or key = value)", path, line);
+    }
+    return 0;
+}
+
+int sil_scenario_check(const sil_scenario_t *sc, char *err, size_t err_size)
+{
+    if (sc->load.kind == PLANT_LOAD_TABLE && sc->load.table_points == 0) {
+        return fail(err, err_size, "load.type = table needs load.points");
+    }
+    if (sc->speed_points == 0) {
+        return fail(err, err_size, "speed.points: no set-point profile");
+    }
+    return 0;
+}
+
+static void print_points(FILE *file, const double *t, const double *v, int n)
+{
+    int k;
+    for (k = 0; k < n; ++k) {
+        fprintf(file, "%s%.9g:%.9g", k ? ", " : "", t[k], v[k]);
+    }
+    fputc('\n', file);
+}
+
+/* Shortest decimal that reads back as the same float. */
+static void print_float(FILE *file, float value)
+{
+    char text[32];
+    int digits;
+    for (digits = 6; digits < 9; ++digits) {
+        snprintf(text, sizeof text, "%.*g", digits, (double)value);
+        if (strtof(text, NULL) == value) {
+            break;
+        }
+    }
+    snprintf(text, sizeof text, "%.*g", digits, (double)value);
+    fprintf(file, "%s\n", text);
+}
+
+void sil_scenario_print(const sil_scenario_t *sc, FILE *file)
+{
+    const char *section = "";
+    size_t n;
+    const char *base = (const char *)sc;
+    fprintf(file, "[scenario]\nname = %s\n", sc->name);
+    for (n = 0; n < sizeof keys / sizeof keys[0]; ++n) {
+        const key_t_ *k = &keys[n];
+        const char *dot = strchr(k->name, '.');
+        const size_t section_len = (size_t)(dot - k->name);
+        if (strncmp(section, k->name, section_len) != 0 || section[section_len] != '\0') {
+            static char current[32];
+            memcpy(current, k->name, section_len);
+            current[section_len] = '\0';
+            section = current;
+            fprintf(file, "\n[%s]\n", section);
+        }
+        fprintf(file, "; %s\n%s = ", k->help, dot + 1);
+        switch (k->type) {
+        case KEY_DOUBLE: fprintf(file, "%.9g\n", *(const double *)(base + k->offset)); break;
+        case KEY_FLOAT: print_float(file, *(const float *)(base + k->offset)); break;
+        case KEY_INT: fprintf(file, "%d\n", (int)*(const int32_t *)(base + k->offset)); break;
+        case KEY_UINT: fprintf(file, "%u\n", (unsigned)*(const uint32_t *)(base + k->offset)); break;
+        case KEY_BOOL: fprintf(file, "%s\n", *(const bool *)(base + k->offset) ? "true" : "false"); break;
+        case KEY_ANGLE_DEG: fprintf(file, "%.9g\n", *(const double *)(base + k->offset) * 180.0 / PI); break;
+        case KEY_SPEED_POINTS: print_points(file, sc->speed_time_s, sc->speed_value_rad_s, sc->speed_points); break;
+        case KEY_LOAD_POINTS:
+            if (sc->load.table_points > 0) {
+                print_points(file, sc->load.table_time_s, sc->load.table_torque_nm, sc->load.table_points);
+            } else {
+                fprintf(file, "0:0\n");
+            }
+            break;
+        case KEY_LOAD_KIND: fprintf(file, "%s\n", load_kind_names[sc->load.kind]); break;
+        }
+    }
+}
+
+void sil_scenario_paper(sil_scenario_t *sc)
+{
+    static const double times[] = {0.0, 0.65, 0.85, 1.2, 1.5, 1.8, 2.0, 2.4};
+    static const double speeds[] = {0.0, 0.0, 10.0, 10.0, -10.0, -10.0, 0.0, 0.0};
+    int k;
+    memset(sc, 0, sizeof *sc);
+    snprintf(sc->name, sizeof sc->name, "paper");
+    sc->motor = plant_paper_params();
+    sc->controller = pmstep_paper_config();
+    sc->load.kind = PLANT_LOAD_STEP;
+    sc->load.torque_nm = 2.0;
+    sc->load.step_time_s = 0.63;
+    sc->duration_s = 2.4;
+    sc->substeps = 10;
+    sc->bus_voltage_v = 48.0;
+    sc->theta0_rad = 30.0 * PI / 180.0;
+    sc->decimation = 10;
+    sc->transient_window_s = 0.2;
+    sc->speed_points = (int)(sizeof times / sizeof times[0]);
+    for (k = 0; k < sc->speed_points; ++k) {
+        sc->speed_time_s[k] = times[k];
+        sc->speed_value_rad_s[k] = speeds[k];
+    }
+    sc->id_target_a = 0.0;
+}
