@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs the Debian packages the build and tests need, only those missing.
-# Usage: tools/install_deps.sh            (as root, or with sudo available)
+# Usage: tools/install_deps.sh [extra packages]   (as root, or with sudo available)
 set -euo pipefail
 
 packages=(
@@ -10,6 +10,7 @@ packages=(
   gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi  # Cortex-M4F build
   qemu-system-arm                          # processor-in-the-loop on an emulated Cortex-M4
   libeigen3-dev libboost-dev               # C++ test oracle and gain checker
+  "$@"
 )
 
 missing=()

@@ -106,6 +106,7 @@ int sil_run(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user, bool 
         sample.u_a_v = port->applied_a_v;
         sample.u_b_v = port->applied_b_v;
         sample.out = &out;
+        sample.inst = &inst;
 
         /* Metrics. */
         if (k == ts_step) {

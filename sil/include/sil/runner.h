@@ -24,6 +24,8 @@ typedef struct {
     double u_a_v, u_b_v;             /**< voltage the plant sees over [t_k, t_k+1] */
     double load_nm;                  /**< true T_L */
     const pmstep_output_t *out;      /**< the step's output (estimates, mode, fault) */
+    pmstep_t *inst;                  /**< the core's instance, for tests that inspect or perturb its state
+                                          (a change takes effect from the next period) */
 } sil_sample_t;
 
 /** Called once per period; return false to stop the run early. */
