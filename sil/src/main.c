@@ -13,13 +13,15 @@ static void usage(FILE *f)
 {
     fprintf(f,
             "usage: pmstep-sil [--scenario FILE|paper] [--set section.key=value]... [--out DIR]\n"
-            "                  [--no-csv] [--quiet] [--print-scenario]\n"
+            "                  [--no-csv] [--quiet] [--print-scenario] [--record FILE]\n"
             "  --scenario   INI scenario file on top of the built-in paper scenario (default: paper)\n"
             "  --set        override one key after the file, e.g. --set run.period_s=25e-6\n"
             "  --out        output folder for run.csv and summary.json (default: out/<scenario name>)\n"
             "  --no-csv     skip the time series (benchmarks)\n"
             "  --quiet      no progress line, no printed summary\n"
-            "  --print-scenario  print every key with its value (INI) and exit\n");
+            "  --print-scenario  print every key with its value (INI) and exit\n"
+            "  --record     write the core's inputs and outputs of every period to FILE (binary,\n"
+            "               see sil/include/sil/runner.h), for replay on a target (tests/pil/)\n");
 }
 
 typedef struct {
@@ -132,6 +134,9 @@ int main(int argc, char **argv)
     char out_dir[512] = "";
     char path[1100];
     const char *scenario_file = NULL;
+    const char *record_path = NULL;
+    FILE *record = NULL;
+    int run_status;
     bool write_csv = true, quiet = false, print_only = false;
     csv_ctx_t csv = {NULL, 1};
     cJSON *json;
@@ -183,6 +188,12 @@ int main(int argc, char **argv)
             quiet = true;
         } else if (strcmp(argv[i], "--print-scenario") == 0) {
             print_only = true;
+        } else if (strcmp(argv[i], "--record") == 0) {
+            if (i + 1 >= argc) {
+                fprintf(stderr, "pmstep-sil: --record needs a file\n");
+                return 2;
+            }
+            record_path = argv[++i];
         } else {
             fprintf(stderr, "pmstep-sil: unknown argument '%s'\n", argv[i]);
             usage(stderr);
@@ -215,12 +226,33 @@ int main(int argc, char **argv)
         fprintf(csv.file, "t_s,theta_rad,omega_rad_s,omega_ref_rad_s,i_a_a,i_b_a,u_a_v,u_b_v,cos_hat,sin_hat,"
                           "cos_ptheta,sin_ptheta,omega_hat_rad_s,load_hat_nm,load_nm,mode,fault\n");
     }
+    if (record_path != NULL) {
+        record = fopen(record_path, "wb");
+        if (record == NULL) {
+            fprintf(stderr, "pmstep-sil: cannot write '%s': %s\n", record_path, strerror(errno));
+            if (csv.file != NULL) {
+                fclose(csv.file);
+            }
+            return 2;
+        }
+    }
     if (!quiet) {
         fprintf(stderr, "pmstep-sil: scenario '%s', %.3f s at %.0f Hz, %d RK4 substeps, delay %u\n", sc.name,
                 sc.duration_s, 1.0 / (double)sc.controller.period_s, sc.substeps,
                 (unsigned)sc.controller.computational_delay_periods);
     }
-    if (sil_run(&sc, write_csv ? write_row : NULL, &csv, !quiet, &summary) != 0) {
+    run_status = sil_run_record(&sc, write_csv ? write_row : NULL, &csv, !quiet, &summary, record);
+    if (record != NULL && fclose(record) != 0 && run_status == 0) {
+        run_status = -2;
+    }
+    if (run_status == -2) {
+        fprintf(stderr, "pmstep-sil: error writing the record '%s'\n", record_path);
+        if (csv.file != NULL) {
+            fclose(csv.file);
+        }
+        return 2;
+    }
+    if (run_status != 0) {
         fprintf(stderr, "pmstep-sil: the firmware rejected the configuration: %s (status %d)\n",
                 pmstep_status_str(summary.init_status), (int)summary.init_status);
         if (csv.file != NULL) {

@@ -8,6 +8,7 @@
 #define SIL_RUNNER_H
 
 #include <stdbool.h>
+#include <stdio.h>
 
 #include "sil/scenario.h"
 
@@ -63,6 +64,58 @@ typedef struct {
  * (summary->init_status says why).
  */
 int sil_run(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user, bool progress, sil_summary_t *summary);
+
+/*
+ * Record of a run, for replaying the core's inputs on a target (processor in the
+ * loop, tests/pil/). The file is a stream of little-endian 32-bit words; a float
+ * is stored as its IEEE-754 binary32 bit pattern, so a replay sees the very bits
+ * the host core saw.
+ *
+ *   header  SIL_RECORD_MAGIC, SIL_RECORD_VERSION, SIL_RECORD_CONFIG_WORDS,
+ *           SIL_RECORD_IN_WORDS, SIL_RECORD_OUT_WORDS,
+ *           the pmstep_config_t fields in declaration order (SIL_RECORD_CONFIG_WORDS
+ *           words: float bits, int32_t/uint32_t as integers, bool as 0/1),
+ *           i_d* (float, A) given to pmstep_set_id_target()
+ *   entries a tag word, then its payload:
+ *     SIL_RECORD_TAG_SPEED_TARGET  target (float, rad/s), ramp rate (float, rad/s^2):
+ *                                  a pmstep_set_speed_target() call before the next step
+ *     SIL_RECORD_TAG_PERIOD        the step's input, pmstep_meas_t (SIL_RECORD_IN_* order),
+ *                                  then its output, pmstep_output_t (SIL_RECORD_OUT_* order)
+ *     SIL_RECORD_TAG_END           the number of periods
+ *
+ * The run it records: pmstep_init(config), pmstep_set_id_target(i_d*), pmstep_start(),
+ * then the entries in order.
+ */
+#define SIL_RECORD_MAGIC 0x52534D50u /* "PMSR" */
+#define SIL_RECORD_VERSION 1u
+#define SIL_RECORD_CONFIG_WORDS 24u
+#define SIL_RECORD_TAG_SPEED_TARGET 1u
+#define SIL_RECORD_TAG_PERIOD 2u
+#define SIL_RECORD_TAG_END 3u
+
+/** Word order of a period's input (pmstep_meas_t). */
+enum {
+    SIL_RECORD_IN_I_A = 0, SIL_RECORD_IN_I_B, SIL_RECORD_IN_BUS, SIL_RECORD_IN_LOAD,
+    SIL_RECORD_IN_WORDS
+};
+
+/** Word order of a period's output (pmstep_output_t); integers and bools as integers. */
+enum {
+    SIL_RECORD_OUT_U_A = 0, SIL_RECORD_OUT_U_B, SIL_RECORD_OUT_BRIDGE_ENABLE, SIL_RECORD_OUT_VOLTAGE_LIMITED,
+    SIL_RECORD_OUT_MODE, SIL_RECORD_OUT_FAULT, SIL_RECORD_OUT_FAULT_STEP,
+    SIL_RECORD_OUT_COS_HAT, SIL_RECORD_OUT_SIN_HAT, SIL_RECORD_OUT_SPEED_HAT, SIL_RECORD_OUT_LOAD_HAT,
+    SIL_RECORD_OUT_I_A_HAT, SIL_RECORD_OUT_I_B_HAT, SIL_RECORD_OUT_SPEED_REF, SIL_RECORD_OUT_SPEED_REF_DOT,
+    SIL_RECORD_OUT_I_D, SIL_RECORD_OUT_I_Q, SIL_RECORD_OUT_I_D_REF, SIL_RECORD_OUT_I_Q_REF,
+    SIL_RECORD_OUT_WORDS
+};
+
+/**
+ * sil_run() that also writes the record described above to @p record (binary
+ * stream; NULL records nothing). @return 0, -1 when pmstep_init rejected the
+ * configuration, -2 when writing the record failed.
+ */
+int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user, bool progress,
+                   sil_summary_t *summary, FILE *record);
 
 #ifdef __cplusplus
 }
