@@ -9,6 +9,7 @@ packages=(
   libinih-dev libcjson-dev                 # SIL scenario files (INI) and JSON summaries
   gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi  # Cortex-M4F build
   qemu-system-arm                          # processor-in-the-loop on an emulated Cortex-M4
+  python3                                  # benchmark scripts (tools/bench_sil.py, tools/bench_target.py)
   libeigen3-dev libboost-dev               # C++ test oracle and gain checker
   "$@"
 )

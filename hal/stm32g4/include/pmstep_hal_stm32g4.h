@@ -1,0 +1,200 @@
+/**
+ * @file pmstep_hal_stm32g4.h
+ * @brief STM32G431 port of the HAL contract (pmstep_hal.h): Cortex-M4F at 170 MHz,
+ *        TIM1 centre-aligned PWM on two H-bridges (one channel per half-bridge,
+ *        complementary outputs with dead time, break input), ADC1/ADC2 injected
+ *        conversions triggered by TIM1 at the carrier peak, the ADC interrupt
+ *        running read -> pmstep_step() -> apply, a bridge-enable output and a
+ *        fault input. Register-level, no vendor library (see stm32g4_regs.h).
+ *
+ * Phase a is the H-bridge between half-bridges a+ (TIM1_CH1/CH1N) and a- (CH2/CH2N),
+ * phase b the one between b+ (CH3/CH3N) and b- (CH4/CH4N):
+ *     u_a = (d_a+ - d_a-) V_bus,   u_b = (d_b+ - d_b-) V_bus,
+ * with the duty d of a half-bridge the fraction of the period its high side is on.
+ *
+ * Timing: TIM1 counts up and down (centre-aligned mode 1), so the carrier period is
+ * 2 ARR / f_TIM1. Channel 5 (internal) makes TRGO2 rise at the counter peak, the
+ * centre of the interval where every low side conducts; ADC1 (i_a, then the bus)
+ * and ADC2 (i_b) convert on that edge; ADC1's end of injected sequence interrupts.
+ * The interrupt writes the duties into preloaded compare registers that take
+ * effect at the next update event, one period after the samples: configure the
+ * core with computational_delay_periods = 1.
+ */
+#ifndef PMSTEP_HAL_STM32G4_H
+#define PMSTEP_HAL_STM32G4_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "pmstep_hal.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Status of the port's set-up calls: 0 = ok, negative = one named cause. */
+typedef enum {
+    PMSTEP_STM32G4_OK = 0,
+    PMSTEP_STM32G4_ERR_NULL_ARGUMENT = -1,
+    PMSTEP_STM32G4_ERR_CLOCK_CONFIG = -2,   /**< PLL factors out of range, or SYSCLK above 170 MHz */
+    PMSTEP_STM32G4_ERR_CLOCK_TIMEOUT = -3,  /**< PLL lock, regulator or clock switch did not complete */
+    PMSTEP_STM32G4_ERR_PWM_FREQUENCY = -4,  /**< the carrier frequency gives ARR outside 2..65535 */
+    PMSTEP_STM32G4_ERR_DEAD_TIME = -5,      /**< dead time longer than TIM1 can insert */
+    PMSTEP_STM32G4_ERR_DUTY_RANGE = -6,     /**< duty_min/duty_max not 0 <= min < max <= 1 */
+    PMSTEP_STM32G4_ERR_ADC_CONFIG = -7,     /**< channel or sample-time code out of range */
+    PMSTEP_STM32G4_ERR_ADC_TIMEOUT = -8,    /**< ADC calibration or enable did not complete */
+    PMSTEP_STM32G4_ERR_PIN = -9             /**< a pin's port, number or alternate function out of range */
+} pmstep_stm32g4_status_t;
+
+/** Why the port holds the bridge off, independently of the core. */
+typedef enum {
+    PMSTEP_STM32G4_FAULT_NONE = 0,
+    PMSTEP_STM32G4_FAULT_INPUT = 1, /**< the gate driver's fault input was asserted */
+    PMSTEP_STM32G4_FAULT_BREAK = 2  /**< TIM1 break: the outputs were cut by hardware */
+} pmstep_stm32g4_fault_t;
+
+/** A pin: port 0 = GPIOA .. 6 = GPIOG, pin 0..15, alternate function 0..15 (when used). */
+typedef struct {
+    uint8_t port;
+    uint8_t pin;
+    uint8_t af;
+} pmstep_stm32g4_pin_t;
+
+/** Clock tree: HSI16 -> PLL; SYSCLK = 16 MHz / pll_m * pll_n / pll_r (HCLK = PCLK1 = PCLK2 = SYSCLK). */
+typedef struct {
+    uint32_t pll_m; /**< 1..16 (VCO input 2.66..16 MHz) */
+    uint32_t pll_n; /**< 8..127 (VCO output 96..344 MHz) */
+    uint32_t pll_r; /**< 2, 4, 6 or 8 */
+} pmstep_stm32g4_clock_t;
+
+typedef struct {
+    pmstep_stm32g4_clock_t clock;
+
+    /* PWM */
+    uint32_t pwm_frequency_hz;        /**< carrier (= control) frequency, e.g. 20000 */
+    uint32_t dead_time_ns;            /**< inserted between complementary outputs */
+    float duty_min;                   /**< per half-bridge, e.g. 0 (bootstrap drivers may need > 0) */
+    float duty_max;                   /**< per half-bridge, e.g. 1 (bootstrap drivers may need < 1) */
+    pmstep_stm32g4_pin_t pwm_high[4]; /**< TIM1_CH1..CH4: a+, a-, b+, b- high sides */
+    pmstep_stm32g4_pin_t pwm_low[4];  /**< TIM1_CH1N..CH4N: the low sides */
+    pmstep_stm32g4_pin_t break_input; /**< TIM1_BKIN */
+    bool break_active_high;
+    uint8_t break_filter;             /**< BKF code 0..15 */
+
+    /* ADC: ADC1 injected rank 1 = i_a, rank 2 = bus; ADC2 injected rank 1 = i_b */
+    uint8_t adc1_channel_i_a;
+    uint8_t adc1_channel_bus;
+    uint8_t adc2_channel_i_b;
+    uint8_t adc_sample_time;          /**< SMP code 0..7 for the three channels */
+    pmstep_stm32g4_pin_t adc_pins[3]; /**< i_a, bus, i_b inputs (set to analog) */
+    float i_a_offset_counts;          /**< counts at 0 A */
+    float i_a_gain_a_per_count;       /**< A per count (sign included) */
+    float i_b_offset_counts;
+    float i_b_gain_a_per_count;
+    float bus_offset_counts;          /**< counts at 0 V */
+    float bus_gain_v_per_count;       /**< V per count */
+
+    /* GPIO */
+    pmstep_stm32g4_pin_t enable_pin;  /**< gate driver enable (push-pull output) */
+    bool enable_active_high;
+    pmstep_stm32g4_pin_t fault_pin;   /**< gate driver fault (input with pull-up when active low) */
+    bool fault_active_high;
+} pmstep_stm32g4_config_t;
+
+/**
+ * A board: Nucleo-G431RB-like pins (to check against your schematic and the
+ * datasheet's alternate-function table, DS12589), 20 kHz, 500 ns dead time,
+ * 12-bit ADC with a 3.3 V reference, current sensors of 0.1 V/A centred at
+ * 1.65 V, bus divider 1:20.
+ */
+pmstep_stm32g4_config_t pmstep_stm32g4_default_config(void);
+
+/* ---- pure functions (no register access; unit-tested on the host) ---- */
+
+/** Physical value from an ADC sample: (counts - offset) * gain. */
+float pmstep_stm32g4_counts_to_si(uint32_t counts, float offset_counts, float gain_per_count);
+
+/**
+ * Duties of the two half-bridges of one H-bridge for the voltage @p u_v across it,
+ * against the measured bus: d+ = 1/2 + u/(2 V_bus), d- = 1/2 - u/(2 V_bus), each
+ * clamped to [duty_min, duty_max]. A bus that is not positive (or NaN) or a NaN
+ * voltage gives 1/2 and 1/2 (zero volts).
+ */
+void pmstep_stm32g4_duties(float u_v, float bus_v, float duty_min, float duty_max, float *d_plus, float *d_minus);
+
+/** Compare value for a duty: round(duty * arr), within 0..arr. */
+uint32_t pmstep_stm32g4_duty_to_ccr(float duty, uint32_t arr);
+
+/**
+ * TIM1 BDTR.DTG for at least @p dead_time_ns with the timer clock @p tim_clock_hz
+ * (t_DTS = 1/f_TIM, CKD = 0), by the four ranges of RM0440 §28.6.20:
+ * DTG[7]=0: n t; 10x: (64+x) 2t; 110x: (32+x) 8t; 111x: (32+x) 16t.
+ * @return PMSTEP_STM32G4_OK or PMSTEP_STM32G4_ERR_DEAD_TIME.
+ */
+pmstep_stm32g4_status_t pmstep_stm32g4_dead_time_dtg(uint32_t dead_time_ns, uint32_t tim_clock_hz, uint8_t *dtg);
+
+/** Dead time (ns, rounded down) that a DTG code gives at @p tim_clock_hz. */
+uint32_t pmstep_stm32g4_dtg_to_ns(uint8_t dtg, uint32_t tim_clock_hz);
+
+/** SYSCLK (Hz) of a clock configuration, or 0 when it is out of range. */
+uint32_t pmstep_stm32g4_sysclk_hz(const pmstep_stm32g4_clock_t *clock);
+
+/** Flash wait states for @p hclk_hz in range 1 boost mode (RM0440 §3.3.3, Table 9). */
+uint32_t pmstep_stm32g4_flash_latency(uint32_t hclk_hz);
+
+/** TIM1 ARR for a centre-aligned carrier: round(f_TIM / (2 f_pwm)); 0 when outside 2..65535. */
+uint32_t pmstep_stm32g4_pwm_arr(uint32_t tim_clock_hz, uint32_t pwm_frequency_hz);
+
+/** Text for a status code. */
+const char *pmstep_stm32g4_status_str(pmstep_stm32g4_status_t status);
+
+/* ---- drivers (register access) ---- */
+
+/** Clock tree to SYSCLK (170 MHz with the default config): boost mode, flash latency, PLL. */
+pmstep_stm32g4_status_t pmstep_stm32g4_clock_init(const pmstep_stm32g4_clock_t *clock);
+
+/** GPIO: TIM1 pins, break input, ADC inputs (analog), enable output (driver off), fault input. */
+pmstep_stm32g4_status_t pmstep_stm32g4_gpio_init(const pmstep_stm32g4_config_t *cfg);
+
+/** TIM1: centre-aligned PWM, dead time, break, ADC trigger; outputs off (MOE = 0), counter stopped. */
+pmstep_stm32g4_status_t pmstep_stm32g4_pwm_init(const pmstep_stm32g4_config_t *cfg, uint32_t tim_clock_hz);
+
+/** ADC1/ADC2: power-up, calibration, injected sequences on TIM1_TRGO2, JEOS interrupt of ADC1. */
+pmstep_stm32g4_status_t pmstep_stm32g4_adc_init(const pmstep_stm32g4_config_t *cfg);
+
+/**
+ * The whole port for @p inst (whose configuration must use computational_delay_periods = 1
+ * and period_s = pmstep_stm32g4_period_s()): GPIO, TIM1, ADC, interrupts; bridge off.
+ * Call after pmstep_stm32g4_clock_init() with the same @p cfg, which must outlive the port.
+ */
+pmstep_stm32g4_status_t pmstep_stm32g4_init(const pmstep_stm32g4_config_t *cfg, pmstep_t *inst);
+
+/** Control period (s) that TIM1 runs at: 2 ARR / f_TIM1. 0 if the configuration is invalid. */
+float pmstep_stm32g4_period_s(const pmstep_stm32g4_config_t *cfg);
+
+/** Starts the TIM1 counter: from here on the ADC interrupt runs every period. */
+void pmstep_stm32g4_start(void);
+
+/** The port's own fault (bridge held off while not NONE). */
+pmstep_stm32g4_fault_t pmstep_stm32g4_fault(void);
+
+/** Clears the port's fault if the fault input is no longer asserted. @return true if cleared. */
+bool pmstep_stm32g4_clear_fault(void);
+
+/** Whether the port has the bridge switching (MOE set and driver enabled). */
+bool pmstep_stm32g4_bridge_on(void);
+
+/** Longest control interrupt so far, in CPU cycles (DWT cycle counter). */
+uint32_t pmstep_stm32g4_isr_cycles_max(void);
+
+/** ADC1 and ADC2 interrupt: the control period. */
+void ADC1_2_IRQHandler(void);
+
+/** TIM1 break interrupt: latches PMSTEP_STM32G4_FAULT_BREAK. */
+void TIM1_BRK_TIM15_IRQHandler(void);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PMSTEP_HAL_STM32G4_H */

@@ -1,0 +1,236 @@
+/*
+ * The HAL contract on the STM32G431: the ADC interrupt reads the injected samples,
+ * runs pmstep_step() and writes the duties; the bridge goes off (TIM1 MOE = 0,
+ * driver enable inactive, duties 50 %) when the core says so, when the gate
+ * driver's fault input is asserted, or on a TIM1 break. A port fault also stops the
+ * core (pmstep_stop), so it re-aligns after a restart instead of integrating
+ * voltages that were never applied.
+ */
+#include <stddef.h>
+
+#include "pmstep_hal_stm32g4.h"
+#include "stm32g4_regs.h"
+
+static struct {
+    const pmstep_stm32g4_config_t *cfg;
+    pmstep_t *inst;
+    uint32_t arr;
+    float bus_voltage_v;  /* this period's sample, for the duties */
+    pmstep_output_t out;
+    volatile pmstep_stm32g4_fault_t fault;
+    volatile bool bridge_on;
+    volatile uint32_t isr_cycles_max;
+} port;
+
+static bool fault_input_asserted(void)
+{
+    const pmstep_stm32g4_config_t *cfg = port.cfg;
+    const bool high = (STM32G4_GPIO(cfg->fault_pin.port)->IDR & STM32G4_BIT(cfg->fault_pin.pin)) != 0u;
+    return high == cfg->fault_active_high;
+}
+
+static void enable_pin(bool on)
+{
+    const pmstep_stm32g4_config_t *cfg = port.cfg;
+    const bool level = on == cfg->enable_active_high;
+    STM32G4_GPIO(cfg->enable_pin.port)->BSRR = level ? STM32G4_BIT(cfg->enable_pin.pin)
+                                                     : STM32G4_BIT(16u + cfg->enable_pin.pin);
+}
+
+static void bridge_off(void)
+{
+    stm32g4_tim_t *const tim = STM32G4_TIM1;
+    tim->BDTR &= ~TIM_BDTR_MOE; /* outputs to their idle (off) levels at once */
+    enable_pin(false);
+    tim->CCR1 = port.arr / 2u;
+    tim->CCR2 = port.arr / 2u;
+    tim->CCR3 = port.arr / 2u;
+    tim->CCR4 = port.arr / 2u;
+    port.bridge_on = false;
+}
+
+static void bridge_on(void)
+{
+    enable_pin(true);
+    STM32G4_TIM1->BDTR |= TIM_BDTR_MOE;
+    port.bridge_on = true;
+}
+
+static void latch_fault(pmstep_stm32g4_fault_t fault)
+{
+    if (port.fault == PMSTEP_STM32G4_FAULT_NONE) {
+        port.fault = fault;
+    }
+    bridge_off();
+}
+
+void pmstep_hal_read_measurements(pmstep_meas_t *meas)
+{
+    const pmstep_stm32g4_config_t *cfg = port.cfg;
+    meas->i_a_a = pmstep_stm32g4_counts_to_si(STM32G4_ADC1->JDR[0], cfg->i_a_offset_counts, cfg->i_a_gain_a_per_count);
+    meas->bus_voltage_v = pmstep_stm32g4_counts_to_si(STM32G4_ADC1->JDR[1], cfg->bus_offset_counts,
+                                                      cfg->bus_gain_v_per_count);
+    meas->i_b_a = pmstep_stm32g4_counts_to_si(STM32G4_ADC2->JDR[0], cfg->i_b_offset_counts, cfg->i_b_gain_a_per_count);
+    meas->load_torque_nm = 0.0f; /* no torque sensor on this board (known_load_mode unsupported) */
+    port.bus_voltage_v = meas->bus_voltage_v;
+    if (fault_input_asserted()) {
+        latch_fault(PMSTEP_STM32G4_FAULT_INPUT);
+    }
+}
+
+void pmstep_hal_apply_output(const pmstep_output_t *out)
+{
+    const pmstep_stm32g4_config_t *cfg = port.cfg;
+    stm32g4_tim_t *const tim = STM32G4_TIM1;
+    float d_plus;
+    float d_minus;
+    if (port.fault != PMSTEP_STM32G4_FAULT_NONE || !out->bridge_enable) {
+        bridge_off();
+        return;
+    }
+    /* Preloaded: these take effect at the next update event (the next carrier peak). */
+    pmstep_stm32g4_duties(out->u_a_v, port.bus_voltage_v, cfg->duty_min, cfg->duty_max, &d_plus, &d_minus);
+    tim->CCR1 = pmstep_stm32g4_duty_to_ccr(d_plus, port.arr);
+    tim->CCR2 = pmstep_stm32g4_duty_to_ccr(d_minus, port.arr);
+    pmstep_stm32g4_duties(out->u_b_v, port.bus_voltage_v, cfg->duty_min, cfg->duty_max, &d_plus, &d_minus);
+    tim->CCR3 = pmstep_stm32g4_duty_to_ccr(d_plus, port.arr);
+    tim->CCR4 = pmstep_stm32g4_duty_to_ccr(d_minus, port.arr);
+    if (!port.bridge_on) {
+        bridge_on();
+    }
+}
+
+/* The core stops (IDLE) after a port fault, unless it is already off. */
+static void stop_core_on_port_fault(void)
+{
+    if (port.fault != PMSTEP_STM32G4_FAULT_NONE && port.out.mode != PMSTEP_MODE_IDLE
+        && port.out.mode != PMSTEP_MODE_FAULT) {
+        (void)pmstep_stop(port.inst);
+        port.out.mode = PMSTEP_MODE_IDLE;
+    }
+}
+
+void ADC1_2_IRQHandler(void)
+{
+    const uint32_t start = STM32G4_DWT->CYCCNT;
+    uint32_t cycles;
+    STM32G4_ADC1->ISR = ADC_ISR_JEOC | ADC_ISR_JEOS; /* write 1 to clear */
+    if (port.inst == NULL) {
+        return;
+    }
+    pmstep_hal_control_period(port.inst, &port.out);
+    stop_core_on_port_fault();
+    cycles = STM32G4_DWT->CYCCNT - start;
+    if (cycles > port.isr_cycles_max) {
+        port.isr_cycles_max = cycles;
+    }
+}
+
+void TIM1_BRK_TIM15_IRQHandler(void)
+{
+    stm32g4_tim_t *const tim = STM32G4_TIM1;
+    if ((tim->SR & TIM_SR_BIF) != 0u) {
+        tim->SR = ~TIM_SR_BIF;       /* write 0 to clear */
+        tim->DIER &= ~TIM_DIER_BIE;  /* the flag comes back while the input stays active */
+        latch_fault(PMSTEP_STM32G4_FAULT_BREAK);
+        if (port.inst != NULL) {
+            stop_core_on_port_fault();
+        }
+    }
+}
+
+pmstep_stm32g4_fault_t pmstep_stm32g4_fault(void)
+{
+    return port.fault;
+}
+
+bool pmstep_stm32g4_clear_fault(void)
+{
+    stm32g4_tim_t *const tim = STM32G4_TIM1;
+    if (port.cfg == NULL || fault_input_asserted()) {
+        return false;
+    }
+    tim->SR = ~TIM_SR_BIF;
+    if ((tim->SR & TIM_SR_BIF) != 0u) { /* break input still active */
+        return false;
+    }
+    port.fault = PMSTEP_STM32G4_FAULT_NONE;
+    tim->DIER |= TIM_DIER_BIE;
+    return true;
+}
+
+bool pmstep_stm32g4_bridge_on(void)
+{
+    return port.bridge_on;
+}
+
+uint32_t pmstep_stm32g4_isr_cycles_max(void)
+{
+    return port.isr_cycles_max;
+}
+
+float pmstep_stm32g4_period_s(const pmstep_stm32g4_config_t *cfg)
+{
+    uint32_t sysclk_hz;
+    uint32_t arr;
+    if (cfg == NULL) {
+        return 0.0f;
+    }
+    sysclk_hz = pmstep_stm32g4_sysclk_hz(&cfg->clock);
+    arr = pmstep_stm32g4_pwm_arr(sysclk_hz, cfg->pwm_frequency_hz);
+    return arr == 0u ? 0.0f : (float)(2u * arr) / (float)sysclk_hz;
+}
+
+static void nvic_enable(uint32_t irq, uint8_t priority)
+{
+    stm32g4_nvic_t *const nvic = STM32G4_NVIC;
+    nvic->IPR[irq] = priority;
+    /* Write-one-to-set; the read-modify-write keeps the fake register block of the host tests
+     * (plain RAM) showing every enabled line, and changes nothing on the hardware. */
+    nvic->ISER[irq / 32u] |= STM32G4_BIT(irq % 32u);
+}
+
+pmstep_stm32g4_status_t pmstep_stm32g4_init(const pmstep_stm32g4_config_t *cfg, pmstep_t *inst)
+{
+    uint32_t sysclk_hz;
+    pmstep_stm32g4_status_t st;
+    if (cfg == NULL || inst == NULL) {
+        return PMSTEP_STM32G4_ERR_NULL_ARGUMENT;
+    }
+    sysclk_hz = pmstep_stm32g4_sysclk_hz(&cfg->clock);
+    if (sysclk_hz == 0u) {
+        return PMSTEP_STM32G4_ERR_CLOCK_CONFIG;
+    }
+    port.cfg = cfg;
+    port.inst = NULL; /* no control period until everything is set up */
+    port.fault = PMSTEP_STM32G4_FAULT_NONE;
+    port.bridge_on = false;
+    port.isr_cycles_max = 0u;
+    port.arr = pmstep_stm32g4_pwm_arr(sysclk_hz, cfg->pwm_frequency_hz);
+
+    st = pmstep_stm32g4_gpio_init(cfg);
+    if (st == PMSTEP_STM32G4_OK) {
+        st = pmstep_stm32g4_pwm_init(cfg, sysclk_hz); /* TIM1 runs at PCLK2 = SYSCLK */
+    }
+    if (st == PMSTEP_STM32G4_OK) {
+        st = pmstep_stm32g4_adc_init(cfg);
+    }
+    if (st != PMSTEP_STM32G4_OK) {
+        return st;
+    }
+    /* Cycle counter for the interrupt's duration (ARMv7-M DWT). */
+    STM32G4_DEMCR |= DEMCR_TRCENA;
+    STM32G4_DWT->CYCCNT = 0u;
+    STM32G4_DWT->CTRL |= DWT_CTRL_CYCCNTENA;
+    bridge_off();
+    port.inst = inst;
+    /* Break above control (lower number = higher priority; 4 priority bits, RM0440 §14.1). */
+    nvic_enable(STM32G4_IRQ_TIM1_BRK_TIM15, 0x00u);
+    nvic_enable(STM32G4_IRQ_ADC1_2, 0x10u);
+    return PMSTEP_STM32G4_OK;
+}
+
+void pmstep_stm32g4_start(void)
+{
+    STM32G4_TIM1->CR1 |= TIM_CR1_CEN;
+}

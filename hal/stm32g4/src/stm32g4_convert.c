@@ -1,0 +1,185 @@
+/* Pure functions of the STM32G4 port: unit conversions, duty mapping, timer and clock
+ * arithmetic. No register access, so the host tests call them directly. */
+#include <stddef.h>
+
+#include "pmstep_hal_stm32g4.h"
+
+#define HSI16_HZ 16000000u
+#define SYSCLK_MAX_HZ 170000000u
+
+float pmstep_stm32g4_counts_to_si(uint32_t counts, float offset_counts, float gain_per_count)
+{
+    return ((float)counts - offset_counts) * gain_per_count;
+}
+
+static float clamp(float x, float lo, float hi)
+{
+    return x < lo ? lo : (x > hi ? hi : x);
+}
+
+void pmstep_stm32g4_duties(float u_v, float bus_v, float duty_min, float duty_max, float *d_plus, float *d_minus)
+{
+    float half_ratio;
+    if (!(bus_v > 0.0f) || u_v != u_v) { /* no bus, NaN bus or NaN voltage: zero volts */
+        *d_plus = clamp(0.5f, duty_min, duty_max);
+        *d_minus = *d_plus;
+        return;
+    }
+    half_ratio = 0.5f * (u_v / bus_v);
+    *d_plus = clamp(0.5f + half_ratio, duty_min, duty_max);
+    *d_minus = clamp(0.5f - half_ratio, duty_min, duty_max);
+}
+
+uint32_t pmstep_stm32g4_duty_to_ccr(float duty, uint32_t arr)
+{
+    const float counts = duty * (float)arr + 0.5f;
+    if (!(counts > 0.0f)) {
+        return 0u;
+    }
+    if (counts >= (float)arr) {
+        return arr;
+    }
+    return (uint32_t)counts;
+}
+
+pmstep_stm32g4_status_t pmstep_stm32g4_dead_time_dtg(uint32_t dead_time_ns, uint32_t tim_clock_hz, uint8_t *dtg)
+{
+    /* Timer clock periods needed, rounded up so the dead time is at least the one asked for. */
+    const uint64_t ticks = ((uint64_t)dead_time_ns * tim_clock_hz + 999999999u) / 1000000000u;
+    if (dtg == NULL || tim_clock_hz == 0u) {
+        return PMSTEP_STM32G4_ERR_NULL_ARGUMENT;
+    }
+    if (ticks <= 127u) {
+        *dtg = (uint8_t)ticks;
+    } else if (ticks <= 2u * (64u + 63u)) {
+        *dtg = (uint8_t)(0x80u | (uint32_t)((ticks + 1u) / 2u - 64u));
+    } else if (ticks <= 8u * (32u + 31u)) {
+        *dtg = (uint8_t)(0xC0u | (uint32_t)((ticks + 7u) / 8u - 32u));
+    } else if (ticks <= 16u * (32u + 31u)) {
+        *dtg = (uint8_t)(0xE0u | (uint32_t)((ticks + 15u) / 16u - 32u));
+    } else {
+        return PMSTEP_STM32G4_ERR_DEAD_TIME;
+    }
+    return PMSTEP_STM32G4_OK;
+}
+
+uint32_t pmstep_stm32g4_dtg_to_ns(uint8_t dtg, uint32_t tim_clock_hz)
+{
+    uint64_t ticks;
+    if ((dtg & 0x80u) == 0u) {
+        ticks = dtg;
+    } else if ((dtg & 0xC0u) == 0x80u) {
+        ticks = 2u * (64u + (dtg & 0x3Fu));
+    } else if ((dtg & 0xE0u) == 0xC0u) {
+        ticks = 8u * (32u + (dtg & 0x1Fu));
+    } else {
+        ticks = 16u * (32u + (dtg & 0x1Fu));
+    }
+    return tim_clock_hz == 0u ? 0u : (uint32_t)(ticks * 1000000000u / tim_clock_hz);
+}
+
+uint32_t pmstep_stm32g4_sysclk_hz(const pmstep_stm32g4_clock_t *clock)
+{
+    uint32_t vco_in_hz;
+    uint32_t vco_out_hz;
+    uint32_t sysclk_hz;
+    if (clock == NULL || clock->pll_m < 1u || clock->pll_m > 16u || clock->pll_n < 8u || clock->pll_n > 127u
+        || (clock->pll_r != 2u && clock->pll_r != 4u && clock->pll_r != 6u && clock->pll_r != 8u)) {
+        return 0u;
+    }
+    /* PLL input 2.66..16 MHz, VCO 96..344 MHz (datasheet DS12589, PLL characteristics). */
+    vco_in_hz = HSI16_HZ / clock->pll_m;
+    vco_out_hz = vco_in_hz * clock->pll_n;
+    sysclk_hz = vco_out_hz / clock->pll_r;
+    if (vco_in_hz < 2660000u || vco_out_hz < 96000000u || vco_out_hz > 344000000u || sysclk_hz > SYSCLK_MAX_HZ) {
+        return 0u;
+    }
+    return sysclk_hz;
+}
+
+uint32_t pmstep_stm32g4_flash_latency(uint32_t hclk_hz)
+{
+    return hclk_hz == 0u ? 0u : (hclk_hz - 1u) / 34000000u;
+}
+
+uint32_t pmstep_stm32g4_pwm_arr(uint32_t tim_clock_hz, uint32_t pwm_frequency_hz)
+{
+    uint64_t arr;
+    if (pwm_frequency_hz == 0u) {
+        return 0u;
+    }
+    arr = ((uint64_t)tim_clock_hz + pwm_frequency_hz) / (2u * (uint64_t)pwm_frequency_hz);
+    return (arr < 2u || arr > 65535u) ? 0u : (uint32_t)arr;
+}
+
+const char *pmstep_stm32g4_status_str(pmstep_stm32g4_status_t status)
+{
+    switch (status) {
+    case PMSTEP_STM32G4_OK:
+        return "ok";
+    case PMSTEP_STM32G4_ERR_NULL_ARGUMENT:
+        return "null argument";
+    case PMSTEP_STM32G4_ERR_CLOCK_CONFIG:
+        return "PLL factors out of range or SYSCLK above 170 MHz";
+    case PMSTEP_STM32G4_ERR_CLOCK_TIMEOUT:
+        return "PLL lock, regulator or clock switch timed out";
+    case PMSTEP_STM32G4_ERR_PWM_FREQUENCY:
+        return "PWM frequency gives TIM1 ARR outside 2..65535";
+    case PMSTEP_STM32G4_ERR_DEAD_TIME:
+        return "dead time longer than TIM1 can insert";
+    case PMSTEP_STM32G4_ERR_DUTY_RANGE:
+        return "duty range must be 0 <= duty_min < duty_max <= 1";
+    case PMSTEP_STM32G4_ERR_ADC_CONFIG:
+        return "ADC channel or sample time out of range";
+    case PMSTEP_STM32G4_ERR_ADC_TIMEOUT:
+        return "ADC calibration or enable timed out";
+    case PMSTEP_STM32G4_ERR_PIN:
+        return "pin port, number or alternate function out of range";
+    }
+    return "unknown status";
+}
+
+pmstep_stm32g4_config_t pmstep_stm32g4_default_config(void)
+{
+    /* 12-bit ADC, 3.3 V reference: 3.3/4096 V per count. */
+    const float volts_per_count = 3.3f / 4096.0f;
+    pmstep_stm32g4_config_t c;
+    c.clock.pll_m = 4u;  /* 16 MHz / 4 = 4 MHz */
+    c.clock.pll_n = 85u; /* x 85 = 340 MHz VCO */
+    c.clock.pll_r = 2u;  /* / 2 = 170 MHz */
+    c.pwm_frequency_hz = 20000u;
+    c.dead_time_ns = 500u;
+    c.duty_min = 0.0f;
+    c.duty_max = 1.0f;
+    /* TIM1 pins (DS12589 alternate functions; check against your board). */
+    c.pwm_high[0] = (pmstep_stm32g4_pin_t){0u, 8u, 6u};   /* PA8  TIM1_CH1  AF6: a+ */
+    c.pwm_high[1] = (pmstep_stm32g4_pin_t){0u, 9u, 6u};   /* PA9  TIM1_CH2  AF6: a- */
+    c.pwm_high[2] = (pmstep_stm32g4_pin_t){0u, 10u, 6u};  /* PA10 TIM1_CH3  AF6: b+ */
+    c.pwm_high[3] = (pmstep_stm32g4_pin_t){0u, 11u, 11u}; /* PA11 TIM1_CH4  AF11: b- */
+    c.pwm_low[0] = (pmstep_stm32g4_pin_t){0u, 7u, 6u};    /* PA7  TIM1_CH1N AF6 */
+    c.pwm_low[1] = (pmstep_stm32g4_pin_t){1u, 0u, 6u};    /* PB0  TIM1_CH2N AF6 */
+    c.pwm_low[2] = (pmstep_stm32g4_pin_t){1u, 1u, 6u};    /* PB1  TIM1_CH3N AF6 */
+    c.pwm_low[3] = (pmstep_stm32g4_pin_t){2u, 5u, 6u};    /* PC5  TIM1_CH4N AF6 */
+    c.break_input = (pmstep_stm32g4_pin_t){0u, 6u, 6u};   /* PA6  TIM1_BKIN AF6 */
+    c.break_active_high = false;
+    c.break_filter = 4u;
+    c.adc1_channel_i_a = 1u; /* PA0 ADC12_IN1 */
+    c.adc1_channel_bus = 3u; /* PA2 ADC1_IN3 */
+    c.adc2_channel_i_b = 2u; /* PA1 ADC12_IN2 */
+    c.adc_sample_time = 2u;  /* 12.5 ADC clock cycles */
+    c.adc_pins[0] = (pmstep_stm32g4_pin_t){0u, 0u, 0u};
+    c.adc_pins[1] = (pmstep_stm32g4_pin_t){0u, 2u, 0u};
+    c.adc_pins[2] = (pmstep_stm32g4_pin_t){0u, 1u, 0u};
+    /* Current sensors: 0.1 V/A around 1.65 V. Bus: 1:20 divider. */
+    c.i_a_offset_counts = 2048.0f;
+    c.i_a_gain_a_per_count = volts_per_count / 0.1f;
+    c.i_b_offset_counts = 2048.0f;
+    c.i_b_gain_a_per_count = volts_per_count / 0.1f;
+    c.bus_offset_counts = 0.0f;
+    c.bus_gain_v_per_count = volts_per_count * 20.0f;
+    c.enable_pin = (pmstep_stm32g4_pin_t){1u, 5u, 0u}; /* PB5 */
+    c.enable_active_high = true;
+    c.fault_pin = (pmstep_stm32g4_pin_t){2u, 6u, 0u};  /* PC6, open-drain nFAULT */
+    c.fault_active_high = false;
+    return c;
+}

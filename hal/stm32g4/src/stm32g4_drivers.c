@@ -1,0 +1,316 @@
+/*
+ * Register drivers of the STM32G431 port: clock tree, GPIO, TIM1 PWM, ADC1/ADC2.
+ * Every wait on the hardware is bounded and returns a timeout status.
+ * Register and bit references: stm32g4_regs.h (RM0440 Rev 8).
+ */
+#include <stddef.h>
+
+#include "pmstep_hal_stm32g4.h"
+#include "stm32g4_regs.h"
+
+/* Iterations of a wait loop before giving up: far above any documented delay. */
+#define WAIT_LIMIT 1000000u
+
+static bool wait_set(volatile uint32_t *reg, uint32_t mask, uint32_t value)
+{
+    uint32_t n;
+    for (n = 0; n < WAIT_LIMIT; ++n) {
+        STM32G4_WAIT_HOOK(); /* nothing on the target; the host tests' hardware model */
+        if ((*reg & mask) == value) {
+            return true;
+        }
+    }
+    return false;
+}
+
+/* Busy wait of at least @p cycles CPU cycles (each turn takes more than one cycle). */
+static void delay_cycles(uint32_t cycles)
+{
+    volatile uint32_t n;
+    for (n = 0; n < cycles; ++n) {
+    }
+}
+
+/* ---- clock tree: RM0440 §7.2.6 (PLL), §6.1.5 (range 1 boost), §3.3.3 (flash latency) ---- */
+pmstep_stm32g4_status_t pmstep_stm32g4_clock_init(const pmstep_stm32g4_clock_t *clock)
+{
+    stm32g4_rcc_t *const rcc = STM32G4_RCC;
+    stm32g4_pwr_t *const pwr = STM32G4_PWR;
+    stm32g4_flash_t *const flash = STM32G4_FLASH;
+    const uint32_t sysclk_hz = pmstep_stm32g4_sysclk_hz(clock);
+    uint32_t latency;
+    uint32_t reg;
+
+    if (clock == NULL) {
+        return PMSTEP_STM32G4_ERR_NULL_ARGUMENT;
+    }
+    if (sysclk_hz == 0u) {
+        return PMSTEP_STM32G4_ERR_CLOCK_CONFIG;
+    }
+    latency = pmstep_stm32g4_flash_latency(sysclk_hz);
+
+    /* Voltage range 1; boost mode (R1MODE = 0) above 150 MHz, with HCLK = SYSCLK / 2 while
+     * switching (the sequence of RM0440 §6.1.5). */
+    rcc->APB1ENR1 |= RCC_APB1ENR1_PWREN;
+    (void)rcc->APB1ENR1; /* the enable takes effect before PWR is written */
+    pwr->CR1 = (pwr->CR1 & ~PWR_CR1_VOS_MASK) | PWR_CR1_VOS_RANGE1;
+    if (!wait_set(&pwr->SR2, PWR_SR2_VOSF, 0u)) {
+        return PMSTEP_STM32G4_ERR_CLOCK_TIMEOUT;
+    }
+    rcc->CFGR = (rcc->CFGR & ~RCC_CFGR_HPRE_MASK) | (RCC_CFGR_HPRE_DIV2 << RCC_CFGR_HPRE_POS);
+    if (sysclk_hz > 150000000u) {
+        pwr->CR5 &= ~PWR_CR5_R1MODE;
+    } else {
+        pwr->CR5 |= PWR_CR5_R1MODE;
+    }
+
+    /* Flash wait states before the clock rises; prefetch and caches on. */
+    flash->ACR = (flash->ACR & ~FLASH_ACR_LATENCY_MASK) | latency | FLASH_ACR_PRFTEN | FLASH_ACR_ICEN
+                 | FLASH_ACR_DCEN;
+    if (!wait_set(&flash->ACR, FLASH_ACR_LATENCY_MASK, latency)) {
+        return PMSTEP_STM32G4_ERR_CLOCK_TIMEOUT;
+    }
+
+    /* HSI16 (on after reset) -> PLL; the PLL is configured while off. */
+    rcc->CR |= RCC_CR_HSION;
+    if (!wait_set(&rcc->CR, RCC_CR_HSIRDY, RCC_CR_HSIRDY)) {
+        return PMSTEP_STM32G4_ERR_CLOCK_TIMEOUT;
+    }
+    rcc->CR &= ~RCC_CR_PLLON;
+    if (!wait_set(&rcc->CR, RCC_CR_PLLRDY, 0u)) {
+        return PMSTEP_STM32G4_ERR_CLOCK_TIMEOUT;
+    }
+    reg = RCC_PLLCFGR_PLLSRC_HSI16 | ((clock->pll_m - 1u) << RCC_PLLCFGR_PLLM_POS)
+          | (clock->pll_n << RCC_PLLCFGR_PLLN_POS) | ((clock->pll_r / 2u - 1u) << RCC_PLLCFGR_PLLR_POS)
+          | RCC_PLLCFGR_PLLREN;
+    rcc->PLLCFGR = reg;
+    rcc->CR |= RCC_CR_PLLON;
+    if (!wait_set(&rcc->CR, RCC_CR_PLLRDY, RCC_CR_PLLRDY)) {
+        return PMSTEP_STM32G4_ERR_CLOCK_TIMEOUT;
+    }
+
+    /* Switch SYSCLK to the PLL, wait at least 1 us, then HCLK = SYSCLK, PCLK1 = PCLK2 = HCLK
+     * (so TIM1 runs at SYSCLK). */
+    rcc->CFGR = (rcc->CFGR & ~RCC_CFGR_SW_MASK) | (RCC_CFGR_SW_PLL << RCC_CFGR_SW_POS);
+    if (!wait_set(&rcc->CFGR, RCC_CFGR_SWS_MASK, RCC_CFGR_SW_PLL << RCC_CFGR_SWS_POS)) {
+        return PMSTEP_STM32G4_ERR_CLOCK_TIMEOUT;
+    }
+    delay_cycles(200u);
+    rcc->CFGR = (rcc->CFGR & ~(RCC_CFGR_HPRE_MASK | RCC_CFGR_PPRE1_MASK | RCC_CFGR_PPRE2_MASK))
+                | (RCC_CFGR_HPRE_DIV1 << RCC_CFGR_HPRE_POS);
+    return PMSTEP_STM32G4_OK;
+}
+
+/* ---- GPIO: RM0440 §9.4 ---- */
+static bool pin_valid(const pmstep_stm32g4_pin_t *p)
+{
+    return p->port < STM32G4_GPIO_PORTS && p->pin < 16u && p->af < 16u;
+}
+
+static void pin_configure(const pmstep_stm32g4_pin_t *p, uint32_t mode, uint32_t pull)
+{
+    stm32g4_gpio_t *const gpio = STM32G4_GPIO(p->port);
+    const uint32_t shift2 = 2u * p->pin;
+    STM32G4_RCC->AHB2ENR |= STM32G4_BIT(RCC_AHB2ENR_GPIOAEN_POS + p->port);
+    (void)STM32G4_RCC->AHB2ENR;
+    if (mode == GPIO_MODE_AF) {
+        const uint32_t shift4 = 4u * (p->pin % 8u);
+        gpio->AFR[p->pin / 8u] = (gpio->AFR[p->pin / 8u] & ~(0xFu << shift4)) | ((uint32_t)p->af << shift4);
+        gpio->OSPEEDR = (gpio->OSPEEDR & ~(3u << shift2)) | (GPIO_SPEED_VERY_HIGH << shift2);
+    }
+    gpio->OTYPER &= ~STM32G4_BIT(p->pin); /* push-pull */
+    gpio->PUPDR = (gpio->PUPDR & ~(3u << shift2)) | (pull << shift2);
+    gpio->MODER = (gpio->MODER & ~(3u << shift2)) | (mode << shift2);
+}
+
+/* Drives the enable pin to its inactive level (driver off). */
+static void enable_pin_off(const pmstep_stm32g4_config_t *cfg)
+{
+    stm32g4_gpio_t *const gpio = STM32G4_GPIO(cfg->enable_pin.port);
+    gpio->BSRR = cfg->enable_active_high ? STM32G4_BIT(16u + cfg->enable_pin.pin) : STM32G4_BIT(cfg->enable_pin.pin);
+}
+
+pmstep_stm32g4_status_t pmstep_stm32g4_gpio_init(const pmstep_stm32g4_config_t *cfg)
+{
+    unsigned k;
+    if (cfg == NULL) {
+        return PMSTEP_STM32G4_ERR_NULL_ARGUMENT;
+    }
+    for (k = 0; k < 4u; ++k) {
+        if (!pin_valid(&cfg->pwm_high[k]) || !pin_valid(&cfg->pwm_low[k])) {
+            return PMSTEP_STM32G4_ERR_PIN;
+        }
+    }
+    for (k = 0; k < 3u; ++k) {
+        if (!pin_valid(&cfg->adc_pins[k])) {
+            return PMSTEP_STM32G4_ERR_PIN;
+        }
+    }
+    if (!pin_valid(&cfg->break_input) || !pin_valid(&cfg->enable_pin) || !pin_valid(&cfg->fault_pin)) {
+        return PMSTEP_STM32G4_ERR_PIN;
+    }
+    /* Enable output first, at its off level, so the driver never sees a floating enable. */
+    enable_pin_off(cfg);
+    pin_configure(&cfg->enable_pin, GPIO_MODE_OUTPUT, 0u);
+    pin_configure(&cfg->fault_pin, GPIO_MODE_INPUT, cfg->fault_active_high ? GPIO_PULL_DOWN : GPIO_PULL_UP);
+    for (k = 0; k < 4u; ++k) {
+        pin_configure(&cfg->pwm_high[k], GPIO_MODE_AF, GPIO_PULL_DOWN);
+        pin_configure(&cfg->pwm_low[k], GPIO_MODE_AF, GPIO_PULL_DOWN);
+    }
+    pin_configure(&cfg->break_input, GPIO_MODE_AF, cfg->break_active_high ? GPIO_PULL_DOWN : GPIO_PULL_UP);
+    for (k = 0; k < 3u; ++k) {
+        pin_configure(&cfg->adc_pins[k], GPIO_MODE_ANALOG, 0u);
+    }
+    return PMSTEP_STM32G4_OK;
+}
+
+/* ---- TIM1: RM0440 §28.3 (functional description), §28.6 (registers) ---- */
+pmstep_stm32g4_status_t pmstep_stm32g4_pwm_init(const pmstep_stm32g4_config_t *cfg, uint32_t tim_clock_hz)
+{
+    stm32g4_tim_t *const tim = STM32G4_TIM1;
+    const uint32_t pwm_channel = (TIM_OCM_PWM1 << TIM_CCMR_OCM_POS) | TIM_CCMR_OCPE;
+    uint32_t arr;
+    uint8_t dtg;
+    pmstep_stm32g4_status_t st;
+    unsigned k;
+
+    if (cfg == NULL) {
+        return PMSTEP_STM32G4_ERR_NULL_ARGUMENT;
+    }
+    if (!(cfg->duty_min >= 0.0f && cfg->duty_max <= 1.0f && cfg->duty_min < cfg->duty_max)) {
+        return PMSTEP_STM32G4_ERR_DUTY_RANGE;
+    }
+    arr = pmstep_stm32g4_pwm_arr(tim_clock_hz, cfg->pwm_frequency_hz);
+    if (arr == 0u) {
+        return PMSTEP_STM32G4_ERR_PWM_FREQUENCY;
+    }
+    st = pmstep_stm32g4_dead_time_dtg(cfg->dead_time_ns, tim_clock_hz, &dtg);
+    if (st != PMSTEP_STM32G4_OK) {
+        return st;
+    }
+    if (cfg->break_filter > 15u) {
+        return PMSTEP_STM32G4_ERR_PIN;
+    }
+
+    STM32G4_RCC->APB2ENR |= RCC_APB2ENR_TIM1EN;
+    (void)STM32G4_RCC->APB2ENR;
+
+    tim->CR1 = 0u; /* counter stopped while configuring */
+    tim->BDTR = 0u;
+    /* Centre-aligned mode 1, ARR preloaded; an update only from counter events (URS). */
+    tim->CR1 = TIM_CR1_CMS_CENTER1 | TIM_CR1_ARPE | TIM_CR1_URS;
+    tim->PSC = 0u;
+    tim->ARR = arr;
+    /* One update event per carrier period. RCR written before the counter starts: the update
+     * (and the compare-preload transfer) happens at the overflow, the counter peak
+     * (RM0440 §28.3.3 "Repetition counter"). */
+    tim->RCR = 1u;
+    /* CH1..CH4: PWM mode 1 (high side on while CNT < CCR), compare preload. CH5: PWM mode 2 with
+     * CCR5 = ARR, so OC5REF rises when the counter reaches its peak. */
+    tim->CCMR1 = (pwm_channel << TIM_CCMR_OC_LOW_POS) | (pwm_channel << TIM_CCMR_OC_HIGH_POS);
+    tim->CCMR2 = (pwm_channel << TIM_CCMR_OC_LOW_POS) | (pwm_channel << TIM_CCMR_OC_HIGH_POS);
+    tim->CCMR3 = ((TIM_OCM_PWM2 << TIM_CCMR_OCM_POS) | TIM_CCMR_OCPE) << TIM_CCMR_OC_LOW_POS;
+    tim->CCR1 = arr / 2u;
+    tim->CCR2 = arr / 2u;
+    tim->CCR3 = arr / 2u;
+    tim->CCR4 = arr / 2u;
+    tim->CCR5 = arr;
+    {
+        uint32_t ccer = TIM_CCER_CC5E;
+        for (k = 1u; k <= 4u; ++k) {
+            ccer |= TIM_CCER_CCE(k) | TIM_CCER_CCNE(k); /* both outputs, active high */
+        }
+        tim->CCER = ccer;
+    }
+    /* TRGO2 = OC5REFC: the ADC trigger. Idle levels (OISx, OISxN) 0: every switch off when MOE = 0. */
+    tim->CR2 = TIM_CR2_MMS2_OC5REFC << TIM_CR2_MMS2_POS;
+    /* Break: BKIN pin enabled (AF1.BKINE, not inverted), filter, polarity in BDTR.BKP. Off state
+     * (OSSI, OSSR): outputs driven to their idle levels rather than released. MOE = 0: the bridge
+     * stays off until the port turns it on; AOE = 0: after a break only software turns it on. */
+    tim->AF1 = (tim->AF1 & ~TIM_AF1_BKINP) | TIM_AF1_BKINE;
+    tim->BDTR = (uint32_t)dtg | TIM_BDTR_OSSI | TIM_BDTR_OSSR | TIM_BDTR_BKE
+                | (cfg->break_active_high ? TIM_BDTR_BKP : 0u) | ((uint32_t)cfg->break_filter << TIM_BDTR_BKF_POS);
+    /* Load PSC, ARR, RCR and the compare values now; clear the flags this sets. */
+    tim->EGR = TIM_EGR_UG;
+    tim->SR = 0u;
+    tim->DIER = TIM_DIER_BIE;
+    return PMSTEP_STM32G4_OK;
+}
+
+/* ---- ADC1/ADC2: RM0440 §21.4.6 (regulator), §21.4.8 (calibration), §21.4.9 (enable),
+ * §21.4.21 (injected conversions) ---- */
+static void adc_cr_set(stm32g4_adc_t *adc, uint32_t bits)
+{
+    adc->CR = (adc->CR & ~ADC_CR_RS_BITS) | bits;
+}
+
+static void adc_sample_time(stm32g4_adc_t *adc, uint32_t channel, uint32_t code)
+{
+    if (channel < 10u) {
+        adc->SMPR1 = (adc->SMPR1 & ~(7u << (3u * channel))) | (code << (3u * channel));
+    } else {
+        adc->SMPR2 = (adc->SMPR2 & ~(7u << (3u * (channel - 10u)))) | (code << (3u * (channel - 10u)));
+    }
+}
+
+static bool adc_calibrate_and_enable(stm32g4_adc_t *adc)
+{
+    adc->CR = (adc->CR & ~(ADC_CR_RS_BITS | ADC_CR_ADCALDIF)); /* single-ended calibration */
+    adc_cr_set(adc, ADC_CR_ADCAL);
+    if (!wait_set(&adc->CR, ADC_CR_ADCAL, 0u)) {
+        return false;
+    }
+    adc->ISR = ADC_ISR_ADRDY;
+    adc_cr_set(adc, ADC_CR_ADEN);
+    if (!wait_set(&adc->ISR, ADC_ISR_ADRDY, ADC_ISR_ADRDY)) {
+        return false;
+    }
+    adc->ISR = ADC_ISR_ADRDY;
+    return true;
+}
+
+pmstep_stm32g4_status_t pmstep_stm32g4_adc_init(const pmstep_stm32g4_config_t *cfg)
+{
+    stm32g4_adc_t *const adc1 = STM32G4_ADC1;
+    stm32g4_adc_t *const adc2 = STM32G4_ADC2;
+    const uint32_t trigger = (ADC12_JEXTSEL_TIM1_TRGO2 << ADC_JSQR_JEXTSEL_POS)
+                             | (ADC_JSQR_JEXTEN_RISING << ADC_JSQR_JEXTEN_POS);
+
+    if (cfg == NULL) {
+        return PMSTEP_STM32G4_ERR_NULL_ARGUMENT;
+    }
+    if (cfg->adc1_channel_i_a < 1u || cfg->adc1_channel_i_a > ADC_CHANNEL_MAX || cfg->adc1_channel_bus < 1u
+        || cfg->adc1_channel_bus > ADC_CHANNEL_MAX || cfg->adc2_channel_i_b < 1u
+        || cfg->adc2_channel_i_b > ADC_CHANNEL_MAX || cfg->adc_sample_time > 7u) {
+        return PMSTEP_STM32G4_ERR_ADC_CONFIG;
+    }
+    STM32G4_RCC->AHB2ENR |= RCC_AHB2ENR_ADC12EN;
+    (void)STM32G4_RCC->AHB2ENR;
+    STM32G4_ADC12->CCR = (STM32G4_ADC12->CCR & ~ADC_CCR_CKMODE_MASK) | ADC_CCR_CKMODE_HCLK_DIV4;
+
+    /* Out of deep power-down, regulator on, t_ADCVREG_STUP = 20 us (DS12589): 4000 turns of
+     * the delay loop are more than 3400 cycles at 170 MHz. */
+    adc1->CR = adc1->CR & ~(ADC_CR_RS_BITS | ADC_CR_DEEPPWD);
+    adc2->CR = adc2->CR & ~(ADC_CR_RS_BITS | ADC_CR_DEEPPWD);
+    adc_cr_set(adc1, ADC_CR_ADVREGEN);
+    adc_cr_set(adc2, ADC_CR_ADVREGEN);
+    delay_cycles(4000u);
+    if (!adc_calibrate_and_enable(adc1) || !adc_calibrate_and_enable(adc2)) {
+        return PMSTEP_STM32G4_ERR_ADC_TIMEOUT;
+    }
+
+    adc_sample_time(adc1, cfg->adc1_channel_i_a, cfg->adc_sample_time);
+    adc_sample_time(adc1, cfg->adc1_channel_bus, cfg->adc_sample_time);
+    adc_sample_time(adc2, cfg->adc2_channel_i_b, cfg->adc_sample_time);
+    /* ADC1: i_a then the bus; ADC2: i_b, on the same TIM1_TRGO2 edge (i_a and i_b together). */
+    adc1->JSQR = (1u << ADC_JSQR_JL_POS) | trigger | ((uint32_t)cfg->adc1_channel_i_a << ADC_JSQR_JSQ1_POS)
+                 | ((uint32_t)cfg->adc1_channel_bus << ADC_JSQR_JSQ2_POS);
+    adc2->JSQR = (0u << ADC_JSQR_JL_POS) | trigger | ((uint32_t)cfg->adc2_channel_i_b << ADC_JSQR_JSQ1_POS);
+    adc1->ISR = ADC_ISR_JEOC | ADC_ISR_JEOS;
+    adc2->ISR = ADC_ISR_JEOC | ADC_ISR_JEOS;
+    adc1->IER = ADC_IER_JEOSIE;
+    /* Armed: each trigger converts the injected sequence. */
+    adc_cr_set(adc1, ADC_CR_JADSTART);
+    adc_cr_set(adc2, ADC_CR_JADSTART);
+    return PMSTEP_STM32G4_OK;
+}

@@ -1,0 +1,374 @@
+#!/usr/bin/env python3
+"""Cost of the control step on a Cortex-M4F, measured on QEMU's mps2-an386.
+
+The replay image (hal/qemu_mps2/pil/pil_replay.c, built by the qemu-pil preset with the
+STM32G431 image's flags: -Os and link-time optimisation) runs every period of the paper
+scenario, recorded by the host SIL, through the real pmstep_step() from the port's
+control interrupt. Two measurements:
+
+  exact    a QEMU TCG plugin (hal/qemu_mps2/tools/pil_insn_plugin.c) counts every guest
+           instruction executed between the first instruction of pmstep_step() and the
+           instruction its call returns to: the instructions of each step, callees
+           included. Min, mean and max per mode.
+  SysTick  the image reads SysTick around each step; with -icount shift=0 one instruction
+           is 1 ns of virtual time and SysTick (25 MHz) advances every 40 instructions, so
+           the mean over thousands of steps is the mean instruction count (cross-check).
+
+Cycles at 170 MHz, two estimates:
+  1 cycle/instruction   the issue's convention (600 instructions = 3.5 us)
+  Cortex-M4 timings     each executed instruction weighted by the Cortex-M4 TRM's
+                        cycle counts (ARM DDI 0439B, tables 3-1 and 7-1: single loads and
+                        stores 2, or 1 right after another single load/store, as neighbouring
+                        ones pipeline; LDM/STM/PUSH/POP and VLDM/VSTM/VPUSH/VPOP 1+N,
+                        VDIV/VSQRT 14, VMLA-type 3, SDIV/UDIV 12, other ALU/FPU 1) plus a
+                        pipeline refill of P cycles (default 2, 1..3 on the M4) for every
+                        taken branch or return, counted by the plugin; memory without wait
+                        states (code in CCM SRAM, or flash with every fetch an ART hit).
+                        "Right after" is by address, so a load at a branch target may get
+                        the pipelined cost; --no-pipelining charges every load/store 2.
+
+Footprint: the core library's text + rodata (arm-none-eabi-size), the instance
+sizeof(pmstep_t) printed by the image, the step's stack measured in the image (painted
+stack below the interrupt's SP), and a static bound from -fstack-usage and the call
+graph of the non-LTO library (arm-m4f preset).
+
+usage: tools/bench_target.py [--no-build] [--branch-penalty P] [--no-pipelining] [--json FILE]
+"""
+import argparse
+import collections
+import json
+import os
+import re
+import shutil
+import struct
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+PIL = ROOT / "build" / "qemu-pil"
+BENCH = PIL / "bench"
+SIL = ROOT / "build" / "host-release" / "sil" / "pmstep-sil"
+ARM_M4F = ROOT / "build" / "arm-m4f"
+REPLAY = PIL / "hal" / "qemu_mps2" / "pmstep-pil-replay.elf"
+PLUGIN_SRC = ROOT / "hal" / "qemu_mps2" / "tools" / "pil_insn_plugin.c"
+MODES = ["IDLE", "S_ALIGN", "C_ALIGN", "RUN", "FAULT"]
+CPU_HZ = 170e6
+CONTROL_HZ = 20e3
+OUT_WORDS = 19  # SIL_RECORD_OUT_WORDS
+OUT_MODE = 4    # SIL_RECORD_OUT_MODE
+
+
+def run(cmd, **kw):
+    kw.setdefault("check", True)
+    return subprocess.run([str(c) for c in cmd], **kw)
+
+
+def build():
+    for preset in ("qemu-pil", "host-release", "arm-m4f"):
+        run(["cmake", "--preset", preset], cwd=ROOT, stdout=subprocess.DEVNULL)
+        run(["cmake", "--build", "--preset", preset], cwd=ROOT, stdout=subprocess.DEVNULL)
+
+
+def qemu(image, args, extra=()):
+    semi = "enable=on,target=native," + ",".join("arg=" + str(a) for a in [image.name, *args])
+    return run(["qemu-system-arm", "-M", "mps2-an386", "-cpu", "cortex-m4", "-nographic", "-monitor", "none",
+                "-serial", "none", *extra, "-semihosting-config", semi, "-kernel", image],
+               stdout=subprocess.PIPE, text=True)
+
+
+def step_addresses(elf):
+    """Entry of pmstep_step and the instruction after its call in the control interrupt."""
+    nm = run(["arm-none-eabi-nm", elf], stdout=subprocess.PIPE, text=True).stdout
+    entry = next(int(l.split()[0], 16) for l in nm.splitlines() if l.split()[-1] == "pmstep_step")
+    dis = run(["arm-none-eabi-objdump", "-d", "--no-show-raw-insn", elf], stdout=subprocess.PIPE, text=True).stdout
+    block = dis.split("<Irq10_Handler>:", 1)[1]
+    lines = [l for l in block.splitlines() if re.match(r"^\s+[0-9a-f]+:", l)]
+    for i, l in enumerate(lines):
+        if re.search(r"\bbl\s+[0-9a-f]+ <pmstep_step>", l):
+            return entry, int(lines[i + 1].split(":")[0], 16)
+    sys.exit("bench_target: no call of pmstep_step in the control interrupt")
+
+
+def record_outputs(path):
+    """Host outputs (tuples of words) from the SIL record."""
+    w = struct.unpack("<%dI" % (os.path.getsize(path) // 4), Path(path).read_bytes())
+    i, outs = 5 + 24 + 1, []
+    while True:
+        tag = w[i]
+        if tag == 1:
+            i += 3
+        elif tag == 2:
+            outs.append(w[i + 5:i + 5 + OUT_WORDS])
+            i += 5 + OUT_WORDS
+        elif tag == 3:
+            return outs
+        else:
+            sys.exit("bench_target: bad record")
+
+
+def target_outputs(path):
+    w = struct.unpack("<%dI" % (os.path.getsize(path) // 4), Path(path).read_bytes())
+    n = (len(w) - 5) // OUT_WORDS
+    return [w[3 + OUT_WORDS * k:3 + OUT_WORDS * (k + 1)] for k in range(n)]
+
+
+def mode_ranges(modes):
+    """Contiguous [first, last) step ranges per mode."""
+    ranges = {}
+    for k, m in enumerate(modes):
+        first, last = ranges.get(m, (k, k))
+        ranges[m] = (min(first, k), k + 1)
+    return ranges
+
+
+# ---- cycle model (Cortex-M4 TRM, ARM DDI 0439B) ----
+CONDS = {"eq", "ne", "cs", "cc", "hs", "lo", "mi", "pl", "vs", "vc", "hi", "ls", "ge", "lt", "gt", "le", "al"}
+BASES = ["ldrsb", "ldrsh", "ldrb", "ldrh", "ldrd", "ldr", "strb", "strh", "strd", "str", "ldmia", "ldmdb", "ldm",
+         "stmia", "stmdb", "stm", "push", "pop", "vldr", "vstr", "vldmia", "vldmdb", "vstmia", "vstmdb", "vpush",
+         "vpop", "vdiv", "vsqrt", "vmla", "vmls", "vnmla", "vnmls", "vfma", "vfms", "vfnma", "vfnms", "vmov",
+         "sdiv", "udiv", "mla", "mls"]
+
+
+def register_count(ops):
+    n = 0
+    for part in re.findall(r"\{([^}]*)\}", ops):
+        for item in part.split(","):
+            item = item.strip()
+            m = re.match(r"([rsd])(\d+)\s*-\s*[rsd](\d+)", item)
+            if m:
+                k = int(m.group(3)) - int(m.group(2)) + 1
+                n += 2 * k if m.group(1) == "d" else k
+            elif item:
+                n += 2 if item.startswith("d") else 1
+    return n
+
+
+def base_mnemonic(mnemonic):
+    m = mnemonic.split(".")[0]
+    if m not in BASES and len(m) > 2 and m[-2:] in CONDS and not m.startswith("b"):
+        m = m[:-2]  # conditional form inside an IT block
+    return m
+
+
+def single_load_store(mnemonic):
+    m = base_mnemonic(mnemonic)
+    return m in ("vldr", "vstr") or (re.match(r"^(ldr|str)", m) is not None and m not in ("ldrd", "strd"))
+
+
+def base_cycles(mnemonic, ops):
+    m = base_mnemonic(mnemonic)
+    if m in ("vdiv", "vsqrt"):
+        return 14
+    if m in ("vmla", "vmls", "vnmla", "vnmls", "vfma", "vfms", "vfnma", "vfnms"):
+        return 3
+    if m in ("vldr", "vstr"):
+        return 2
+    if m in ("vpush", "vpop", "vldmia", "vldmdb", "vstmia", "vstmdb"):
+        return 1 + register_count(ops)
+    if m == "vmov":
+        return 2 if ops.count(",") >= 2 else 1
+    if m.startswith("v"):
+        return 1
+    if m in ("ldm", "ldmia", "ldmdb", "stm", "stmia", "stmdb", "push", "pop"):
+        return 1 + register_count(ops)
+    if m in ("ldrd", "strd"):
+        return 3
+    if re.match(r"^(ldr|str)", m):
+        return 2
+    if m in ("sdiv", "udiv"):
+        return 12
+    if m in ("mla", "mls"):
+        return 2
+    return 1
+
+
+def disassembly(elf):
+    dis = run(["arm-none-eabi-objdump", "-d", "--no-show-raw-insn", elf], stdout=subprocess.PIPE, text=True).stdout
+    insns = {}
+    for l in dis.splitlines():
+        m = re.match(r"^\s+([0-9a-f]+):\s+(\S+)\s*(.*)$", l)
+        if m:
+            insns[int(m.group(1), 16)] = (m.group(2), m.group(3))
+    return insns
+
+
+def model_cycles(profile_path, insns, penalty, pipelining):
+    cycles = taken = 0
+    mix = collections.Counter()
+    addresses = sorted(insns)
+    previous = {a: addresses[i - 1] for i, a in enumerate(addresses) if i > 0}
+    for l in Path(profile_path).read_text().splitlines():
+        if l.startswith("#"):
+            continue
+        pc, _size, count, jumps = l.split()
+        pc, count, jumps = int(pc, 16), int(count), int(jumps)
+        mnemonic, ops = insns.get(pc, ("?", ""))
+        c = base_cycles(mnemonic, ops)
+        if pipelining and single_load_store(mnemonic) and pc in previous \
+                and single_load_store(insns[previous[pc]][0]):
+            c = 1
+        cycles += count * c
+        taken += jumps
+        mix[mnemonic.split(".")[0]] += count
+    return cycles + penalty * taken, taken, mix
+
+
+# ---- static stack bound: -fstack-usage of the non-LTO library + its call graph ----
+def static_stack(root_function="pmstep_step"):
+    su_dir = ARM_M4F / "firmware" / "CMakeFiles" / "pmstep_core.dir" / "src"
+    lib = ARM_M4F / "firmware" / "libpmstep_core.a"
+    frames = {}
+    for su in su_dir.glob("*.su"):
+        for l in su.read_text().splitlines():
+            name, size, _kind = l.rsplit("\t", 2)
+            frames[name.rsplit(":", 1)[1]] = int(size)
+    dis = run(["arm-none-eabi-objdump", "-dr", lib], stdout=subprocess.PIPE, text=True).stdout
+    calls, current = collections.defaultdict(set), None
+    for l in dis.splitlines():
+        m = re.match(r"^[0-9a-f]+ <([^>]+)>:$", l)
+        if m:
+            current = m.group(1)
+            continue
+        m = re.search(r"R_ARM_THM_(?:CALL|JUMP24)\s+(\S+)", l)
+        if m and current:
+            calls[current].add(m.group(1))
+    unknown = set()
+
+    def depth(f, seen=()):
+        if f not in frames:
+            unknown.add(f)
+            return 0, [f]
+        best, path = 0, []
+        for g in calls.get(f, ()):
+            if g in seen:
+                continue
+            d, p = depth(g, seen + (f,))
+            if d > best:
+                best, path = d, p
+        return frames[f] + best, [f] + path
+
+    total, path = depth(root_function)
+    return total, path, sorted(unknown)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--no-build", action="store_true", help="use the existing build/qemu-pil, host-release, arm-m4f")
+    ap.add_argument("--branch-penalty", type=int, default=2, help="pipeline refill cycles per taken branch (1..3)")
+    ap.add_argument("--no-pipelining", action="store_true",
+                    help="charge every single load/store 2 cycles (no credit for neighbouring ones)")
+    ap.add_argument("--json", help="also write the figures to this JSON file")
+    args = ap.parse_args()
+    for tool in ("qemu-system-arm", "arm-none-eabi-gcc", "cc"):
+        if shutil.which(tool) is None:
+            sys.exit("bench_target: %s not found (tools/install_deps.sh installs it)" % tool)
+    if not args.no_build:
+        build()
+    BENCH.mkdir(parents=True, exist_ok=True)
+
+    rec = BENCH / "paper.rec"
+    run([SIL, "--quiet", "--no-csv", "--out", BENCH / "paper", "--record", rec])
+    plugin = BENCH / "pil_insn_plugin.so"
+    run(["cc", "-shared", "-fPIC", "-O2", "-Wall", "-Wextra", "-o", plugin, PLUGIN_SRC])
+    entry, ret = step_addresses(REPLAY)
+
+    # SysTick under -icount (and the image's stack and instance figures).
+    out_icount = BENCH / "target-icount.out"
+    cost_path = BENCH / "cost.txt"
+    qemu(REPLAY, [rec, out_icount, cost_path], ["-icount", "shift=0"])
+    cost = cost_path.read_text()
+    systick = {m.group(1): (float(m.group(2)), int(m.group(3)))
+               for m in re.finditer(r"^mode (\S+) steps \d+ .* instructions_mean ([0-9.]+) stack_max_bytes (\d+)",
+                                    cost, re.M)}
+    instance = int(re.search(r"^sizeof_pmstep_t (\d+)", cost, re.M).group(1))
+    config_size = int(re.search(r"^sizeof_pmstep_config_t (\d+)", cost, re.M).group(1))
+
+    # Exact counts per step.
+    out_exact = BENCH / "target.out"
+    steps_path = BENCH / "steps.txt"
+    qemu(REPLAY, [rec, out_exact], ["-plugin", "%s,entry=0x%x,ret=0x%x,out=%s" % (plugin, entry, ret, steps_path)])
+    counts = [int(l) for l in steps_path.read_text().splitlines() if not l.startswith("#")]
+    host = record_outputs(rec)
+    target = target_outputs(out_exact)
+    identical = host == target and host == target_outputs(out_icount)
+    modes = [MODES[o[OUT_MODE]] for o in target]
+    if len(counts) != len(modes):
+        sys.exit("bench_target: %d counted steps for %d periods" % (len(counts), len(modes)))
+    per_mode = collections.defaultdict(list)
+    for m, c in zip(modes, counts):
+        per_mode[m].append(c)
+
+    # Cycle model per mode: one profiled run per contiguous range of steps.
+    insns = disassembly(REPLAY)
+    cycles = {}
+    for m, (first, last) in sorted(mode_ranges(modes).items(), key=lambda kv: kv[1]):
+        prof = BENCH / ("profile-%s.txt" % m)
+        qemu(REPLAY, [rec, BENCH / "target-profile.out"],
+             ["-plugin", "%s,entry=0x%x,ret=0x%x,out=%s,profile=%s,profile_from=%d,profile_to=%d"
+              % (plugin, entry, ret, BENCH / "steps-profile.txt", prof, first, last)])
+        total, taken, mix = model_cycles(prof, insns, args.branch_penalty, not args.no_pipelining)
+        cycles[m] = (total / (last - first), taken / (last - first), mix)
+
+    size = run(["arm-none-eabi-size", "--totals", PIL / "firmware" / "libpmstep_core.a"],
+               stdout=subprocess.PIPE, text=True).stdout
+    flash = int(re.search(r"^\s*(\d+)\s+(\d+)\s+(\d+)\s+\d+\s+[0-9a-f]+\s+\(TOTALS\)", size, re.M).group(1))
+    image_size = run(["arm-none-eabi-size", ROOT / "build" / "stm32g431" / "hal" / "stm32g4" / "pmstep-stm32g431.elf"],
+                     stdout=subprocess.PIPE, text=True, check=False).stdout
+    static_total, static_path, static_unknown = static_stack()
+    gcc = run(["arm-none-eabi-gcc", "-dumpversion"], stdout=subprocess.PIPE, text=True).stdout.strip()
+    qemu_version = run(["qemu-system-arm", "--version"], stdout=subprocess.PIPE, text=True).stdout.splitlines()[0]
+
+    print("Control step on a Cortex-M4F: QEMU mps2-an386 (%s), arm-none-eabi-gcc %s, -Os + LTO" % (qemu_version, gcc))
+    print("paper scenario, %d periods replayed; outputs %s the host's" %
+          (len(counts), "bit-identical to" if identical else "DIFFERENT from"))
+    print()
+    print("%-8s %6s  %5s %7s %5s  %8s  %8s %7s %6s  %8s %7s %6s" % (
+        "mode", "steps", "min", "mean", "max", "SysTick", "cyc 1/i", "us", "CPU%", "cyc M4", "us", "CPU%"))
+    print("%-8s %6s  %19s  %8s  %22s  %22s" % ("", "", "instructions (exact)", "estimate", "@170 MHz, 20 kHz",
+                                              "TRM timings, P=%d%s" % (args.branch_penalty,
+                                                                      "" if args.no_pipelining else ", pipel.")))
+    figures = {}
+    for m in ("S_ALIGN", "C_ALIGN", "RUN"):
+        v = per_mode[m]
+        mean = sum(v) / len(v)
+        c = cycles[m][0]
+        us1, usm = mean / CPU_HZ * 1e6, c / CPU_HZ * 1e6
+        print("%-8s %6d  %5d %7.1f %5d  %8.1f  %8.0f %7.2f %6.1f  %8.0f %7.2f %6.1f" % (
+            m, len(v), min(v), mean, max(v), systick[m][0], mean, us1, us1 * CONTROL_HZ / 1e4,
+            c, usm, usm * CONTROL_HZ / 1e4))
+        figures[m] = {"steps": len(v), "instructions_min": min(v), "instructions_mean": mean,
+                      "instructions_max": max(v), "systick_instructions_mean": systick[m][0],
+                      "cycles_model_mean": c, "taken_branches_mean": cycles[m][1],
+                      "stack_bytes_measured": systick[m][1]}
+    run_max = max(per_mode["RUN"])
+    print()
+    print("worst RUN step: %d instructions = %.2f us at 1 cycle/instruction, %.1f %% of a 50 us period" % (
+        run_max, run_max / CPU_HZ * 1e6, run_max / CPU_HZ * CONTROL_HZ * 100))
+    top = cycles["RUN"][2].most_common(8)
+    print("RUN instruction mix (per step): " + ", ".join("%s %.1f" % (k, n / len(per_mode["RUN"])) for k, n in top))
+    print()
+    print("footprint")
+    print("  core flash (text + rodata, libpmstep_core.a, -Os): %d B" % flash)
+    print("  instance sizeof(pmstep_t): %d B; configuration sizeof(pmstep_config_t): %d B (const, may live in flash)"
+          % (instance, config_size))
+    print("  stack of pmstep_step(), measured in the LTO image: %d B (deepest of all modes)" %
+          max(s for _, s in systick.values()))
+    print("  stack of pmstep_step(), static bound (-fstack-usage, non-LTO library): %d B via %s%s" % (
+        static_total, " -> ".join(static_path),
+        ("; not counted: " + ", ".join(static_unknown) + " (newlib leaf routines)") if static_unknown else ""))
+    if image_size:
+        print("  STM32G431 image (build/stm32g431):")
+        print("    " + "\n    ".join(image_size.strip().splitlines()))
+    if args.json:
+        Path(args.json).write_text(json.dumps({
+            "qemu": qemu_version, "gcc": gcc, "bit_identical": identical, "periods": len(counts),
+            "modes": figures, "core_flash_bytes": flash, "instance_bytes": instance,
+            "config_bytes": config_size, "stack_static_bytes": static_total,
+            "branch_penalty": args.branch_penalty, "load_store_pipelining": not args.no_pipelining},
+            indent=2) + "\n")
+    return 0 if identical else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
