@@ -2,9 +2,9 @@
  * @file pmstep_hal_host.h
  * @brief Host port of the HAL contract: the "hardware" is the plant model of
  *        sil/. Measurements are the plant's currents at the sampling instant and
- *        a fixed bus voltage; the output drives an averaged inverter (phase
- *        voltage held over the period, limited to +/- bus). Bridge off is
- *        modelled as zero phase voltage.
+ *        a fixed bus voltage; the output drives the averaged inverter of
+ *        sil/inverter.h (phase voltage held over the period, limited to +/- bus,
+ *        bridge off = zero phase voltage).
  *
  * Computational delay: with 1 period, the voltage of the step at sample k is
  * applied during [k+1, k+2], as on an MCU that writes duties for the next
@@ -14,6 +14,7 @@
 #define PMSTEP_HAL_HOST_H
 
 #include "pmstep_hal.h"
+#include "sil/inverter.h"
 #include "sil/plant.h"
 
 #ifdef __cplusplus
@@ -22,13 +23,7 @@ extern "C" {
 
 typedef struct {
     plant_t *plant;
-    double bus_voltage_v;
-    unsigned delay_periods;      /**< 0 or 1 */
-    double pending_a_v;          /**< computed, waiting for the next period (delay 1) */
-    double pending_b_v;
-    double applied_a_v;          /**< voltage the plant sees over the coming period */
-    double applied_b_v;
-    unsigned long inverter_limited_periods; /**< periods the inverter had to clip to +/- bus */
+    sil_inverter_t inverter;
 } pmstep_hal_host_t;
 
 /** Binds the port to @p plant; the port state is global, as a real port's registers are. */

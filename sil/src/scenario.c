@@ -365,29 +365,3 @@ void sil_scenario_print(const sil_scenario_t *sc, FILE *file)
         }
     }
 }
-
-void sil_scenario_paper(sil_scenario_t *sc)
-{
-    static const double times[] = {0.0, 0.65, 0.85, 1.2, 1.5, 1.8, 2.0, 2.4};
-    static const double speeds[] = {0.0, 0.0, 10.0, 10.0, -10.0, -10.0, 0.0, 0.0};
-    int k;
-    memset(sc, 0, sizeof *sc);
-    snprintf(sc->name, sizeof sc->name, "paper");
-    sc->motor = plant_paper_params();
-    sc->controller = pmstep_paper_config();
-    sc->load.kind = PLANT_LOAD_STEP;
-    sc->load.torque_nm = 2.0;
-    sc->load.step_time_s = 0.63;
-    sc->duration_s = 2.4;
-    sc->substeps = 10;
-    sc->bus_voltage_v = 48.0;
-    sc->theta0_rad = 30.0 * PI / 180.0;
-    sc->decimation = 10;
-    sc->transient_window_s = 0.2;
-    sc->speed_points = (int)(sizeof times / sizeof times[0]);
-    for (k = 0; k < sc->speed_points; ++k) {
-        sc->speed_time_s[k] = times[k];
-        sc->speed_value_rad_s[k] = speeds[k];
-    }
-    sc->id_target_a = 0.0;
-}

@@ -13,19 +13,6 @@
 
 #include "pil_record.h"
 
-static int read_words(FILE *f, uint32_t *w, size_t n)
-{
-    unsigned char bytes[4u * (PIL_RECORD_HEADER_WORDS > PIL_PERIOD_WORDS ? PIL_RECORD_HEADER_WORDS : PIL_PERIOD_WORDS)];
-    size_t k;
-    if (n > sizeof bytes / 4u || fread(bytes, 4u, n, f) != n) {
-        return -1;
-    }
-    for (k = 0; k < n; ++k) {
-        w[k] = pil_le32(&bytes[4u * k]);
-    }
-    return 0;
-}
-
 /* Distance in units in the last place between two binary32 values (0 for +0/-0). */
 static uint64_t ulp_distance(uint32_t a, uint32_t b)
 {
@@ -38,8 +25,8 @@ int main(int argc, char **argv)
 {
     FILE *rec;
     FILE *tgt;
-    uint32_t head[PIL_RECORD_HEADER_WORDS];
-    uint32_t w[PIL_PERIOD_WORDS];
+    uint32_t head[SIL_RECORD_HEADER_WORDS];
+    uint32_t w[SIL_RECORD_PERIOD_WORDS];
     uint32_t t[SIL_RECORD_OUT_WORDS];
     unsigned long differing[SIL_RECORD_OUT_WORDS] = {0};
     long first[SIL_RECORD_OUT_WORDS];
@@ -58,11 +45,11 @@ int main(int argc, char **argv)
         fprintf(stderr, "pil-compare: cannot open '%s' or '%s'\n", argv[1], argv[2]);
         return 2;
     }
-    if (read_words(rec, head, PIL_RECORD_HEADER_WORDS) != 0 || pil_check_record_header(head) != 0) {
+    if (sil_record_read_words(rec, head, SIL_RECORD_HEADER_WORDS) != 0 || sil_record_check_header(head) != 0) {
         fprintf(stderr, "pil-compare: '%s' is not a version %u SIL record\n", argv[1], SIL_RECORD_VERSION);
         return 2;
     }
-    if (read_words(tgt, t, 3u) != 0 || t[0] != PIL_OUTPUT_MAGIC || t[1] != SIL_RECORD_VERSION
+    if (sil_record_read_words(tgt, t, 3u) != 0 || t[0] != PIL_OUTPUT_MAGIC || t[1] != SIL_RECORD_VERSION
         || t[2] != (uint32_t)SIL_RECORD_OUT_WORDS) {
         fprintf(stderr, "pil-compare: '%s' is not a pil-replay output file\n", argv[2]);
         return 2;
@@ -72,19 +59,19 @@ int main(int argc, char **argv)
     }
     for (;;) {
         uint32_t tag;
-        if (read_words(rec, &tag, 1u) != 0) {
+        if (sil_record_read_words(rec, &tag, 1u) != 0) {
             fprintf(stderr, "pil-compare: record truncated\n");
             return 2;
         }
         if (tag == SIL_RECORD_TAG_SPEED_TARGET) {
-            if (read_words(rec, w, 2u) != 0) {
+            if (sil_record_read_words(rec, w, 2u) != 0) {
                 fprintf(stderr, "pil-compare: record truncated\n");
                 return 2;
             }
         } else if (tag == SIL_RECORD_TAG_PERIOD) {
             const uint32_t *host = &w[SIL_RECORD_IN_WORDS];
             int any = 0;
-            if (read_words(rec, w, PIL_PERIOD_WORDS) != 0 || read_words(tgt, t, SIL_RECORD_OUT_WORDS) != 0) {
+            if (sil_record_read_words(rec, w, SIL_RECORD_PERIOD_WORDS) != 0 || sil_record_read_words(tgt, t, SIL_RECORD_OUT_WORDS) != 0) {
                 fprintf(stderr, "pil-compare: a file ends before period %lu\n", periods);
                 return 1;
             }
@@ -105,7 +92,7 @@ int main(int argc, char **argv)
             periods_differing += (unsigned long)any;
             ++periods;
         } else if (tag == SIL_RECORD_TAG_END) {
-            if (read_words(rec, w, 1u) != 0 || w[0] != periods || read_words(tgt, t, 2u) != 0 || t[0] != PIL_OUTPUT_END
+            if (sil_record_read_words(rec, w, 1u) != 0 || w[0] != periods || sil_record_read_words(tgt, t, 2u) != 0 || t[0] != PIL_OUTPUT_END
                 || t[1] != periods) {
                 fprintf(stderr, "pil-compare: period counts differ (record %lu)\n", periods);
                 return 1;

@@ -20,32 +20,6 @@
 static pmstep_t motor;
 static pmstep_config_t config; /* outlives the instance, as pmstep_init() requires */
 
-static int read_words(FILE *f, uint32_t *w, size_t n)
-{
-    unsigned char bytes[4u * (PIL_RECORD_HEADER_WORDS > PIL_PERIOD_WORDS ? PIL_RECORD_HEADER_WORDS : PIL_PERIOD_WORDS)];
-    size_t k;
-    if (n > sizeof bytes / 4u || fread(bytes, 4u, n, f) != n) {
-        return -1;
-    }
-    for (k = 0; k < n; ++k) {
-        w[k] = pil_le32(&bytes[4u * k]);
-    }
-    return 0;
-}
-
-static int write_words(FILE *f, const uint32_t *w, size_t n)
-{
-    unsigned char bytes[4u * SIL_RECORD_OUT_WORDS];
-    size_t k;
-    if (n > sizeof bytes / 4u) {
-        return -1;
-    }
-    for (k = 0; k < n; ++k) {
-        pil_put_le32(&bytes[4u * k], w[k]);
-    }
-    return fwrite(bytes, 4u, n, f) == n ? 0 : -1;
-}
-
 static const char *const mode_names[MPS2_PIL_MODES] = {"IDLE", "S_ALIGN", "C_ALIGN", "RUN", "FAULT"};
 
 static void write_cost(FILE *f, double insns_per_tick, unsigned long periods)
@@ -73,8 +47,8 @@ int main(int argc, char **argv)
 {
     FILE *in;
     FILE *out;
-    uint32_t head[PIL_RECORD_HEADER_WORDS];
-    uint32_t w[PIL_PERIOD_WORDS];
+    uint32_t head[SIL_RECORD_HEADER_WORDS];
+    uint32_t w[SIL_RECORD_PERIOD_WORDS];
     uint32_t out_words[SIL_RECORD_OUT_WORDS];
     unsigned long periods = 0;
     unsigned long commands = 0;
@@ -95,17 +69,17 @@ int main(int argc, char **argv)
     (void)setvbuf(in, NULL, _IOFBF, IO_BUFFER_BYTES);
     (void)setvbuf(out, NULL, _IOFBF, IO_BUFFER_BYTES);
 
-    if (read_words(in, head, PIL_RECORD_HEADER_WORDS) != 0 || pil_check_record_header(head) != 0) {
+    if (sil_record_read_words(in, head, SIL_RECORD_HEADER_WORDS) != 0 || sil_record_check_header(head) != 0) {
         fprintf(stderr, "pil-replay: '%s' is not a version %u SIL record\n", argv[1], SIL_RECORD_VERSION);
         return 2;
     }
-    pil_config_from_words(&head[5], &config);
+    sil_record_config_from_words(&head[5], &config);
     st = pmstep_init(&motor, &config);
     if (st != PMSTEP_OK) {
         fprintf(stderr, "pil-replay: pmstep_init: %s\n", pmstep_status_str(st));
         return 2;
     }
-    (void)pmstep_set_id_target(&motor, pil_float(head[5u + SIL_RECORD_CONFIG_WORDS]));
+    (void)pmstep_set_id_target(&motor, sil_record_float(head[5u + SIL_RECORD_CONFIG_WORDS]));
     (void)pmstep_start(&motor);
     mps2_pil_init(&motor);
     insns_per_tick = mps2_pil_instructions_per_tick(1000000u);
@@ -113,40 +87,40 @@ int main(int argc, char **argv)
     out_words[0] = PIL_OUTPUT_MAGIC;
     out_words[1] = SIL_RECORD_VERSION;
     out_words[2] = (uint32_t)SIL_RECORD_OUT_WORDS;
-    if (write_words(out, out_words, 3u) != 0) {
+    if (sil_record_write_words(out, out_words, 3u) != 0) {
         fprintf(stderr, "pil-replay: write error\n");
         return 2;
     }
     for (;;) {
         uint32_t tag;
-        if (read_words(in, &tag, 1u) != 0) {
+        if (sil_record_read_words(in, &tag, 1u) != 0) {
             fprintf(stderr, "pil-replay: record truncated after %lu periods\n", periods);
             return 2;
         }
         if (tag == SIL_RECORD_TAG_SPEED_TARGET) {
-            if (read_words(in, w, 2u) != 0) {
+            if (sil_record_read_words(in, w, 2u) != 0) {
                 fprintf(stderr, "pil-replay: record truncated in a command\n");
                 return 2;
             }
-            (void)pmstep_set_speed_target(&motor, pil_float(w[0]), pil_float(w[1]));
+            (void)pmstep_set_speed_target(&motor, sil_record_float(w[0]), sil_record_float(w[1]));
             ++commands;
         } else if (tag == SIL_RECORD_TAG_PERIOD) {
             pmstep_meas_t meas;
             pmstep_output_t o;
-            if (read_words(in, w, PIL_PERIOD_WORDS) != 0) {
+            if (sil_record_read_words(in, w, SIL_RECORD_PERIOD_WORDS) != 0) {
                 fprintf(stderr, "pil-replay: record truncated in period %lu\n", periods);
                 return 2;
             }
-            pil_meas_from_words(w, &meas);
+            sil_record_meas_from_words(w, &meas);
             mps2_pil_control_period(&meas, &o);
-            pil_output_to_words(&o, out_words);
-            if (write_words(out, out_words, SIL_RECORD_OUT_WORDS) != 0) {
+            sil_record_output_to_words(&o, out_words);
+            if (sil_record_write_words(out, out_words, SIL_RECORD_OUT_WORDS) != 0) {
                 fprintf(stderr, "pil-replay: write error in period %lu\n", periods);
                 return 2;
             }
             ++periods;
         } else if (tag == SIL_RECORD_TAG_END) {
-            if (read_words(in, w, 1u) != 0 || w[0] != periods) {
+            if (sil_record_read_words(in, w, 1u) != 0 || w[0] != periods) {
                 fprintf(stderr, "pil-replay: the record's period count does not match (%lu read)\n", periods);
                 return 2;
             }
@@ -158,7 +132,7 @@ int main(int argc, char **argv)
     }
     out_words[0] = PIL_OUTPUT_END;
     out_words[1] = (uint32_t)periods;
-    if (write_words(out, out_words, 2u) != 0 || fclose(out) != 0) {
+    if (sil_record_write_words(out, out_words, 2u) != 0 || fclose(out) != 0) {
         fprintf(stderr, "pil-replay: write error at the end\n");
         return 2;
     }

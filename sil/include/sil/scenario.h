@@ -45,6 +45,15 @@ typedef struct {
 void sil_scenario_paper(sil_scenario_t *sc);
 
 /**
+ * The speed command due at @p t_s under the piecewise-linear profile: at the start of
+ * each segment that changes the speed, ramp to its end value at its slope. Call every
+ * period with the same @p next_segment (start at 0) until it returns 0.
+ * @return 1 with the arguments of pmstep_set_speed_target() in the outputs, or 0.
+ */
+int sil_scenario_speed_command(const sil_scenario_t *sc, double t_s, int *next_segment, float *target_rad_s,
+                               float *ramp_rate_rad_s2);
+
+/**
  * Sets `section.key` from text. @return 0, or -1 with a message in @p err
  * naming the key (unknown key, malformed or out-of-range value).
  */

@@ -1,0 +1,85 @@
+/**
+ * @file metrics.h
+ * @brief What a closed-loop run is judged by: the per-period sample and the
+ *        summary metrics gathered from it. Shared by the SIL runner and the PIL
+ *        closed loop on the target, so both compute the same figures.
+ */
+#ifndef SIL_METRICS_H
+#define SIL_METRICS_H
+
+#include <stdbool.h>
+
+#include "pmstep/pmstep.h"
+#include "sil/scenario.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** One control period, at sample time t_k (plant state before the period). */
+typedef struct {
+    long step;
+    double t_s;
+    double theta_rad, omega_rad_s, i_a_a, i_b_a;
+    double cos_ptheta, sin_ptheta;   /**< true electrical angle */
+    double u_a_v, u_b_v;             /**< voltage the plant sees over [t_k, t_k+1] */
+    double load_nm;                  /**< true T_L */
+    const pmstep_output_t *out;      /**< the step's output (estimates, mode, fault) */
+    pmstep_t *inst;                  /**< the core's instance, for tests that inspect or perturb its state
+                                          (a change takes effect from the next period) */
+} sil_sample_t;
+
+/** Called once per period; return false to stop the run early. */
+typedef bool (*sil_sample_fn)(const sil_sample_t *sample, void *user);
+
+typedef struct {
+    long steps;
+    double sim_time_s;
+    double wall_time_s;
+    double plant_time_s;             /**< wall time inside the plant integration */
+    double firmware_time_s;          /**< wall time inside read + pmstep_step + apply */
+    double real_time_factor;         /**< simulated s per wall s */
+    /* Alignment residuals, from the plant at the sample nearest t_s and t_c. */
+    double cos_ptheta_at_ts, sin_ptheta_at_ts, i_b_residual_at_ts_a;
+    double cos_ptheta_at_tc, sin_ptheta_at_tc, i_a_residual_at_tc_a;
+    /* Speed error |omega - omega*| on the load transient [t_c, t_c + W) and on tracking [t_c + W, end]. */
+    double transient_max_speed_error_rad_s, transient_rms_speed_error_rad_s;
+    double tracking_max_speed_error_rad_s, tracking_rms_speed_error_rad_s;
+    double final_load_hat_nm, final_load_nm, final_load_error_nm;
+    double max_cos_error, max_sin_error;   /**< |c-hat - cos p theta|, |s-hat - sin p theta| in RUN */
+    double max_phase_voltage_v;            /**< max |u_a|, |u_b| applied */
+    double max_phase_current_a;
+    long voltage_limited_periods;          /**< periods the core scaled its voltage to the bus */
+    long inverter_limited_periods;         /**< periods the inverter model clipped */
+    pmstep_mode_t final_mode;
+    pmstep_fault_t fault;
+    long fault_step;
+    double fault_time_s;
+    pmstep_status_t init_status;
+} sil_summary_t;
+
+/** Running sums behind the summary. */
+typedef struct {
+    long ts_step, tc_step, transient_end_step; /**< sample indices of t_s, t_c, t_c + W */
+    double s_align_current_a, c_align_current_a; /**< u_cs/R, u_cc/R with the plant's R */
+    double transient_sq, tracking_sq;
+    long transient_n, tracking_n;
+} sil_metrics_t;
+
+/** Periods nearest to @p duration_s. */
+long sil_periods_in(double duration_s, double period_s);
+
+/** Clears @p summary (fault step and time -1) and prepares @p m for @p sc. */
+void sil_metrics_init(sil_metrics_t *m, const sil_scenario_t *sc, sil_summary_t *summary);
+
+/** Adds one period. */
+void sil_metrics_add(sil_metrics_t *m, const sil_sample_t *x, sil_summary_t *summary);
+
+/** RMS values and the final load error. */
+void sil_metrics_finish(const sil_metrics_t *m, sil_summary_t *summary);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* SIL_METRICS_H */

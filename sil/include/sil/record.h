@@ -1,0 +1,236 @@
+/**
+ * @file record.h
+ * @brief The record of a SIL run and its codec: written by the runner
+ *        (pmstep-sil --record), read by the PIL replay on the target and by the
+ *        host comparison tool. Header-only C99; the one place the word layout lives.
+ */
+#ifndef SIL_RECORD_H
+#define SIL_RECORD_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "pmstep/pmstep.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/*
+ * Record of a run, for replaying the core's inputs on a target (processor in the
+ * loop, tests/pil/). The file is a stream of little-endian 32-bit words; a float
+ * is stored as its IEEE-754 binary32 bit pattern, so a replay sees the very bits
+ * the host core saw.
+ *
+ *   header  SIL_RECORD_MAGIC, SIL_RECORD_VERSION, SIL_RECORD_CONFIG_WORDS,
+ *           SIL_RECORD_IN_WORDS, SIL_RECORD_OUT_WORDS,
+ *           the pmstep_config_t fields in declaration order (SIL_RECORD_CONFIG_WORDS
+ *           words: float bits, int32_t/uint32_t as integers, bool as 0/1),
+ *           i_d* (float, A) given to pmstep_set_id_target()
+ *   entries a tag word, then its payload:
+ *     SIL_RECORD_TAG_SPEED_TARGET  target (float, rad/s), ramp rate (float, rad/s^2):
+ *                                  a pmstep_set_speed_target() call before the next step
+ *     SIL_RECORD_TAG_PERIOD        the step's input, pmstep_meas_t (SIL_RECORD_IN_* order),
+ *                                  then its output, pmstep_output_t (SIL_RECORD_OUT_* order)
+ *     SIL_RECORD_TAG_END           the number of periods
+ *
+ * The run it records: pmstep_init(config), pmstep_set_id_target(i_d*), pmstep_start(),
+ * then the entries in order.
+ */
+#define SIL_RECORD_MAGIC 0x52534D50u /* "PMSR" */
+#define SIL_RECORD_VERSION 1u
+#define SIL_RECORD_CONFIG_WORDS 24u
+#define SIL_RECORD_TAG_SPEED_TARGET 1u
+#define SIL_RECORD_TAG_PERIOD 2u
+#define SIL_RECORD_TAG_END 3u
+
+/** Word order of a period's input (pmstep_meas_t). */
+enum {
+    SIL_RECORD_IN_I_A = 0, SIL_RECORD_IN_I_B, SIL_RECORD_IN_BUS, SIL_RECORD_IN_LOAD,
+    SIL_RECORD_IN_WORDS
+};
+
+/** Word order of a period's output (pmstep_output_t); integers and bools as integers. */
+enum {
+    SIL_RECORD_OUT_U_A = 0, SIL_RECORD_OUT_U_B, SIL_RECORD_OUT_BRIDGE_ENABLE, SIL_RECORD_OUT_VOLTAGE_LIMITED,
+    SIL_RECORD_OUT_MODE, SIL_RECORD_OUT_FAULT, SIL_RECORD_OUT_FAULT_STEP,
+    SIL_RECORD_OUT_COS_HAT, SIL_RECORD_OUT_SIN_HAT, SIL_RECORD_OUT_SPEED_HAT, SIL_RECORD_OUT_LOAD_HAT,
+    SIL_RECORD_OUT_I_A_HAT, SIL_RECORD_OUT_I_B_HAT, SIL_RECORD_OUT_SPEED_REF, SIL_RECORD_OUT_SPEED_REF_DOT,
+    SIL_RECORD_OUT_I_D, SIL_RECORD_OUT_I_Q, SIL_RECORD_OUT_I_D_REF, SIL_RECORD_OUT_I_Q_REF,
+    SIL_RECORD_OUT_WORDS
+};
+
+/** Words of the header (fixed words, configuration, i_d*) and of one period's entry (without its tag). */
+#define SIL_RECORD_HEADER_WORDS (5u + SIL_RECORD_CONFIG_WORDS + 1u)
+#define SIL_RECORD_PERIOD_WORDS ((uint32_t)SIL_RECORD_IN_WORDS + (uint32_t)SIL_RECORD_OUT_WORDS)
+/** Longest run of words read or written at once. */
+#define SIL_RECORD_MAX_WORDS (SIL_RECORD_HEADER_WORDS > 1u + SIL_RECORD_PERIOD_WORDS ? SIL_RECORD_HEADER_WORDS : 1u + SIL_RECORD_PERIOD_WORDS)
+
+static inline uint32_t sil_record_le32(const unsigned char *b)
+{
+    return (uint32_t)b[0] | ((uint32_t)b[1] << 8) | ((uint32_t)b[2] << 16) | ((uint32_t)b[3] << 24);
+}
+
+static inline void sil_record_put_le32(unsigned char *b, uint32_t w)
+{
+    b[0] = (unsigned char)(w & 0xFFu);
+    b[1] = (unsigned char)((w >> 8) & 0xFFu);
+    b[2] = (unsigned char)((w >> 16) & 0xFFu);
+    b[3] = (unsigned char)((w >> 24) & 0xFFu);
+}
+
+static inline float sil_record_float(uint32_t w)
+{
+    float x;
+    memcpy(&x, &w, sizeof x);
+    return x;
+}
+
+static inline uint32_t sil_record_bits(float x)
+{
+    uint32_t w;
+    memcpy(&w, &x, sizeof w);
+    return w;
+}
+
+/** Checks the fixed header words; @return 0 when the record is one this code reads. */
+static inline int sil_record_check_header(const uint32_t *w)
+{
+    return (w[0] == SIL_RECORD_MAGIC && w[1] == SIL_RECORD_VERSION && w[2] == SIL_RECORD_CONFIG_WORDS
+            && w[3] == (uint32_t)SIL_RECORD_IN_WORDS && w[4] == (uint32_t)SIL_RECORD_OUT_WORDS)
+               ? 0
+               : -1;
+}
+
+/** The configuration in the record header (words 5 ..). */
+static inline void sil_record_config_from_words(const uint32_t *w, pmstep_config_t *c)
+{
+    c->resistance_ohm = sil_record_float(w[0]);
+    c->inductance_h = sil_record_float(w[1]);
+    c->inertia_kg_m2 = sil_record_float(w[2]);
+    c->friction_nm_s_per_rad = sil_record_float(w[3]);
+    c->torque_constant_nm_per_a = sil_record_float(w[4]);
+    c->pole_pairs = (int32_t)w[5];
+    c->period_s = sil_record_float(w[6]);
+    c->computational_delay_periods = w[7];
+    c->s_align_time_s = sil_record_float(w[8]);
+    c->c_align_time_s = sil_record_float(w[9]);
+    c->s_align_voltage_v = sil_record_float(w[10]);
+    c->c_align_voltage_v = sil_record_float(w[11]);
+    c->speed_gain_per_s = sil_record_float(w[12]);
+    c->observer_gain_per_s = sil_record_float(w[13]);
+    c->current_gain_per_s = sil_record_float(w[14]);
+    c->adapt_gamma = sil_record_float(w[15]);
+    c->adapt_lambda = sil_record_float(w[16]);
+    c->adapt_r = sil_record_float(w[17]);
+    c->sat_kappa_rad_per_s = sil_record_float(w[18]);
+    c->reference_bandwidth_rad_per_s = sil_record_float(w[19]);
+    c->known_load_mode = w[20] != 0u;
+    c->max_phase_current_a = sil_record_float(w[21]);
+    c->min_bus_voltage_v = sil_record_float(w[22]);
+    c->max_bus_voltage_v = sil_record_float(w[23]);
+}
+
+static inline void sil_record_meas_from_words(const uint32_t *w, pmstep_meas_t *m)
+{
+    m->i_a_a = sil_record_float(w[SIL_RECORD_IN_I_A]);
+    m->i_b_a = sil_record_float(w[SIL_RECORD_IN_I_B]);
+    m->bus_voltage_v = sil_record_float(w[SIL_RECORD_IN_BUS]);
+    m->load_torque_nm = sil_record_float(w[SIL_RECORD_IN_LOAD]);
+}
+
+static inline void sil_record_output_to_words(const pmstep_output_t *o, uint32_t *w)
+{
+    w[SIL_RECORD_OUT_U_A] = sil_record_bits(o->u_a_v);
+    w[SIL_RECORD_OUT_U_B] = sil_record_bits(o->u_b_v);
+    w[SIL_RECORD_OUT_BRIDGE_ENABLE] = o->bridge_enable ? 1u : 0u;
+    w[SIL_RECORD_OUT_VOLTAGE_LIMITED] = o->voltage_limited ? 1u : 0u;
+    w[SIL_RECORD_OUT_MODE] = (uint32_t)o->mode;
+    w[SIL_RECORD_OUT_FAULT] = (uint32_t)o->fault;
+    w[SIL_RECORD_OUT_FAULT_STEP] = o->fault_step;
+    w[SIL_RECORD_OUT_COS_HAT] = sil_record_bits(o->cos_hat);
+    w[SIL_RECORD_OUT_SIN_HAT] = sil_record_bits(o->sin_hat);
+    w[SIL_RECORD_OUT_SPEED_HAT] = sil_record_bits(o->speed_hat_rad_s);
+    w[SIL_RECORD_OUT_LOAD_HAT] = sil_record_bits(o->load_hat_nm);
+    w[SIL_RECORD_OUT_I_A_HAT] = sil_record_bits(o->i_a_hat_a);
+    w[SIL_RECORD_OUT_I_B_HAT] = sil_record_bits(o->i_b_hat_a);
+    w[SIL_RECORD_OUT_SPEED_REF] = sil_record_bits(o->speed_ref_rad_s);
+    w[SIL_RECORD_OUT_SPEED_REF_DOT] = sil_record_bits(o->speed_ref_dot_rad_s2);
+    w[SIL_RECORD_OUT_I_D] = sil_record_bits(o->i_d_a);
+    w[SIL_RECORD_OUT_I_Q] = sil_record_bits(o->i_q_a);
+    w[SIL_RECORD_OUT_I_D_REF] = sil_record_bits(o->i_d_ref_a);
+    w[SIL_RECORD_OUT_I_Q_REF] = sil_record_bits(o->i_q_ref_a);
+}
+
+/** The configuration as the record header's words (pmstep_config_t fields in declaration order). */
+static inline void sil_record_config_to_words(const pmstep_config_t *c, uint32_t *w)
+{
+    w[0] = sil_record_bits(c->resistance_ohm);
+    w[1] = sil_record_bits(c->inductance_h);
+    w[2] = sil_record_bits(c->inertia_kg_m2);
+    w[3] = sil_record_bits(c->friction_nm_s_per_rad);
+    w[4] = sil_record_bits(c->torque_constant_nm_per_a);
+    w[5] = (uint32_t)c->pole_pairs;
+    w[6] = sil_record_bits(c->period_s);
+    w[7] = c->computational_delay_periods;
+    w[8] = sil_record_bits(c->s_align_time_s);
+    w[9] = sil_record_bits(c->c_align_time_s);
+    w[10] = sil_record_bits(c->s_align_voltage_v);
+    w[11] = sil_record_bits(c->c_align_voltage_v);
+    w[12] = sil_record_bits(c->speed_gain_per_s);
+    w[13] = sil_record_bits(c->observer_gain_per_s);
+    w[14] = sil_record_bits(c->current_gain_per_s);
+    w[15] = sil_record_bits(c->adapt_gamma);
+    w[16] = sil_record_bits(c->adapt_lambda);
+    w[17] = sil_record_bits(c->adapt_r);
+    w[18] = sil_record_bits(c->sat_kappa_rad_per_s);
+    w[19] = sil_record_bits(c->reference_bandwidth_rad_per_s);
+    w[20] = c->known_load_mode ? 1u : 0u;
+    w[21] = sil_record_bits(c->max_phase_current_a);
+    w[22] = sil_record_bits(c->min_bus_voltage_v);
+    w[23] = sil_record_bits(c->max_bus_voltage_v);
+}
+
+static inline void sil_record_meas_to_words(const pmstep_meas_t *m, uint32_t *w)
+{
+    w[SIL_RECORD_IN_I_A] = sil_record_bits(m->i_a_a);
+    w[SIL_RECORD_IN_I_B] = sil_record_bits(m->i_b_a);
+    w[SIL_RECORD_IN_BUS] = sil_record_bits(m->bus_voltage_v);
+    w[SIL_RECORD_IN_LOAD] = sil_record_bits(m->load_torque_nm);
+}
+
+/** Reads @p n (<= SIL_RECORD_MAX_WORDS) little-endian words. @return 0, or -1 on a short read. */
+static inline int sil_record_read_words(FILE *f, uint32_t *w, size_t n)
+{
+    unsigned char bytes[4u * SIL_RECORD_MAX_WORDS];
+    size_t k;
+    if (n > SIL_RECORD_MAX_WORDS || fread(bytes, 4u, n, f) != n) {
+        return -1;
+    }
+    for (k = 0; k < n; ++k) {
+        w[k] = sil_record_le32(&bytes[4u * k]);
+    }
+    return 0;
+}
+
+/** Writes @p n (<= SIL_RECORD_MAX_WORDS) words little-endian. @return 0, or -1 on a write error. */
+static inline int sil_record_write_words(FILE *f, const uint32_t *w, size_t n)
+{
+    unsigned char bytes[4u * SIL_RECORD_MAX_WORDS];
+    size_t k;
+    if (n > SIL_RECORD_MAX_WORDS) {
+        return -1;
+    }
+    for (k = 0; k < n; ++k) {
+        sil_record_put_le32(&bytes[4u * k], w[k]);
+    }
+    return fwrite(bytes, 4u, n, f) == n ? 0 : -1;
+}
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* SIL_RECORD_H */

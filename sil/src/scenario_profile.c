@@ -1,0 +1,51 @@
+/* The parts of a scenario a target image can use too (no file parsing): the
+ * paper's scenario and the speed commands of a set-point profile. */
+#include "sil/scenario.h"
+
+#include <math.h>
+#include <string.h>
+
+#define PI 3.14159265358979323846
+
+void sil_scenario_paper(sil_scenario_t *sc)
+{
+    static const double times[] = {0.0, 0.65, 0.85, 1.2, 1.5, 1.8, 2.0, 2.4};
+    static const double speeds[] = {0.0, 0.0, 10.0, 10.0, -10.0, -10.0, 0.0, 0.0};
+    int k;
+    memset(sc, 0, sizeof *sc);
+    snprintf(sc->name, sizeof sc->name, "paper");
+    sc->motor = plant_paper_params();
+    sc->controller = pmstep_paper_config();
+    sc->load.kind = PLANT_LOAD_STEP;
+    sc->load.torque_nm = 2.0;
+    sc->load.step_time_s = 0.63;
+    sc->duration_s = 2.4;
+    sc->substeps = 10;
+    sc->bus_voltage_v = 48.0;
+    sc->theta0_rad = 30.0 * PI / 180.0;
+    sc->decimation = 10;
+    sc->transient_window_s = 0.2;
+    sc->speed_points = (int)(sizeof times / sizeof times[0]);
+    for (k = 0; k < sc->speed_points; ++k) {
+        sc->speed_time_s[k] = times[k];
+        sc->speed_value_rad_s[k] = speeds[k];
+    }
+    sc->id_target_a = 0.0;
+}
+
+int sil_scenario_speed_command(const sil_scenario_t *sc, double t_s, int *next_segment, float *target_rad_s,
+                               float *ramp_rate_rad_s2)
+{
+    while (*next_segment + 1 < sc->speed_points && t_s >= sc->speed_time_s[*next_segment]) {
+        const int k = *next_segment;
+        const double dv = sc->speed_value_rad_s[k + 1] - sc->speed_value_rad_s[k];
+        const double dt = sc->speed_time_s[k + 1] - sc->speed_time_s[k];
+        ++*next_segment;
+        if (dv != 0.0) {
+            *target_rad_s = (float)sc->speed_value_rad_s[k + 1];
+            *ramp_rate_rad_s2 = (float)(fabs(dv) / dt);
+            return 1;
+        }
+    }
+    return 0;
+}
