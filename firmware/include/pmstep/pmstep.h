@@ -81,6 +81,12 @@ pmstep_status_t pmstep_set_id_target(pmstep_t *inst, float target_a);
 /** Runs one control period. Never fails; see pmstep_output_t. */
 void pmstep_step(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out);
 
+/** Calibration and commissioning results so far (telemetry; see pmstep_commissioning_t). */
+void pmstep_get_commissioning(const pmstep_t *inst, pmstep_commissioning_t *out);
+
+/** Short upper-case name of a fault code, e.g. "SPEED_INCONSISTENT" (for logs and reports). */
+const char *pmstep_fault_name(pmstep_fault_t fault);
+
 /** Human-readable text for a status code. */
 const char *pmstep_status_str(pmstep_status_t status);
 

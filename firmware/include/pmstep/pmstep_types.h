@@ -37,7 +37,10 @@ typedef enum {
     PMSTEP_ERR_DELAY = -17,                /**< computational delay not 0 or 1 period */
     PMSTEP_ERR_BAD_MODE = -18,             /**< command not allowed in the present mode */
     PMSTEP_ERR_BAD_COMMAND_VALUE = -19,    /**< non-finite target, or ramp rate <= 0 */
-    PMSTEP_ERR_ALIGNMENT_CURRENT = -20     /**< alignment current u/R at or above max_phase_current_a */
+    PMSTEP_ERR_ALIGNMENT_CURRENT = -20,    /**< alignment current u/R at or above max_phase_current_a */
+    PMSTEP_ERR_CALIBRATION = -21,          /**< calibration/commissioning windows negative or not inside their phase,
+                                                dead-time band not > 0, correction gain < 0 or too high for T_s */
+    PMSTEP_ERR_DETECTION = -22             /**< a detection bound < 0, or detection time shorter than 4 periods */
 } pmstep_status_t;
 
 /** Operating mode of the strategy (Section III.A). */
@@ -46,7 +49,8 @@ typedef enum {
     PMSTEP_MODE_S_ALIGN = 1, /**< u_a = 0, u_b = u_cs   (3), Theorem 1 */
     PMSTEP_MODE_C_ALIGN = 2, /**< u_a = u_cc, u_b = 0   (5), Theorem 2 */
     PMSTEP_MODE_RUN = 3,     /**< adaptive controller (6), or (13) with known load */
-    PMSTEP_MODE_FAULT = 4    /**< latched: bridge off until pmstep_clear_fault() */
+    PMSTEP_MODE_FAULT = 4,   /**< latched: bridge off until pmstep_clear_fault() */
+    PMSTEP_MODE_OFFSET_CAL = 5 /**< Remark 2: bridge off before s-alignment, current-sensor offsets averaged */
 } pmstep_mode_t;
 
 /** Fault causes latched by pmstep_step(). */
@@ -56,7 +60,11 @@ typedef enum {
     PMSTEP_FAULT_OVERCURRENT = 2,           /**< |i_a| or |i_b| above max_phase_current_a */
     PMSTEP_FAULT_BUS_UNDERVOLTAGE = 3,      /**< bus below min_bus_voltage_v */
     PMSTEP_FAULT_BUS_OVERVOLTAGE = 4,       /**< bus above max_bus_voltage_v */
-    PMSTEP_FAULT_STATE_NONFINITE = 5        /**< an internal estimate became NaN/Inf */
+    PMSTEP_FAULT_STATE_NONFINITE = 5,       /**< an internal estimate became NaN/Inf */
+    PMSTEP_FAULT_ANGLE_MAGNITUDE = 6,       /**< |c-hat^2 + s-hat^2 - 1| above angle_magnitude_bound: angle lost */
+    PMSTEP_FAULT_SPEED_INCONSISTENT = 7,    /**< speed from the angle estimate's rotation and w-hat disagree */
+    PMSTEP_FAULT_STALL = 8,                 /**< |w-hat - w*| above stall_speed_error_rad_s: motor not following */
+    PMSTEP_FAULT_COMMISSIONING = 9          /**< measured R, L or k_M outside [1/2, 2] x the configured value */
 } pmstep_fault_t;
 
 /** Constant configuration: motor model (1), strategy timing, gains of (6), limits. */
@@ -96,6 +104,30 @@ typedef struct {
     float max_phase_current_a;     /**< |i_a|, |i_b| above this -> FAULT_OVERCURRENT */
     float min_bus_voltage_v;       /**< bus below -> FAULT_BUS_UNDERVOLTAGE */
     float max_bus_voltage_v;       /**< bus above -> FAULT_BUS_OVERVOLTAGE */
+
+    /* Remark 2 calibration and self-commissioning (all off in the paper's configuration). */
+    float offset_calibration_time_s;   /**< bridge off this long before s-alignment; the current samples are averaged
+                                            as sensor offsets. 0 = none (alignment starts at once) */
+    bool alignment_offset_calibration; /**< also take offsets from the alignment steady states: i_a -> 0 at the end of
+                                            s-alignment, i_b -> 0 at the end of c-alignment */
+    float steady_state_window_s;       /**< averaging window at the end of each alignment (offsets, R); 0 = none */
+    float inductance_window_s;         /**< current-rise window at the start of s-alignment for L; 0 = L not measured */
+    bool use_commissioned_resistance;  /**< RUN uses the measured R in place of resistance_ohm */
+    bool use_commissioned_inductance;  /**< RUN uses the measured L in place of inductance_h */
+    bool use_commissioned_torque_constant; /**< RUN uses k_M measured from the c-alignment swing */
+    float dead_time_s;                 /**< dead time of each half-bridge to compensate (2 per phase); 0 = none */
+    float dead_time_current_band_a;    /**< compensation is linear in i within +/- this band, full outside */
+
+    /* Angle. */
+    float angle_correction_gain_per_s; /**< drift-free option: pulls (c-hat, s-hat) onto the unit circle at this
+                                            rate (flux-magnitude correction); 0 = the paper's open integrals */
+
+    /* Detection (each 0 = off). Persisting detection_time_s -> fault, or re-alignment (max_realignments). */
+    float angle_magnitude_bound;       /**< |c-hat^2 + s-hat^2 - 1| -> FAULT_ANGLE_MAGNITUDE */
+    float speed_consistency_bound_rad_s; /**< |w from the angle's rotation - w-hat|, both low-passed -> FAULT_SPEED_INCONSISTENT */
+    float stall_speed_error_rad_s;     /**< |w-hat - w*| -> FAULT_STALL */
+    float detection_time_s;            /**< persistence before acting; low-pass time constant is a quarter of it */
+    uint32_t max_realignments;         /**< 0: a detection latches its fault; N: re-align (bridge on) up to N times */
 } pmstep_config_t;
 
 /** Samples taken at the start of a period. */
@@ -129,6 +161,19 @@ typedef struct {
     float i_d_ref_a;         /**< i_d* */
     float i_q_ref_a;         /**< i_q* */
 } pmstep_output_t;
+
+/** Remark 2 calibration and self-commissioning results (pmstep_get_commissioning()). */
+typedef struct {
+    float offset_a_a;               /**< current-sensor offset subtracted from every i_a sample (A) */
+    float offset_b_a;               /**< same for i_b */
+    uint32_t offset_samples;        /**< samples behind the offsets (0: none taken, offsets 0) */
+    float resistance_ohm;           /**< R from the alignment steady states, u/i (0: not measured) */
+    float inductance_h;             /**< L from the current rise at the start of s-alignment (0: not measured) */
+    float torque_constant_nm_per_a; /**< k_M from the flux swing of c-alignment (0: not measured) */
+    float dead_time_voltage_v;      /**< full dead-time compensation per phase, 2 V_bus t_d / T_s, last step (V) */
+    uint32_t realignments;          /**< re-alignments after a detection since start */
+    bool measured;                  /**< alignment finished and the values above were taken */
+} pmstep_commissioning_t;
 
 #ifdef __cplusplus
 }
