@@ -1,11 +1,14 @@
 /* Angle reconstruction from current integrals, controller (6) (proof of Theorem 3). */
 #include "pmstep/pmstep_angle.h"
 
-void pmstep_angle_coeffs_init(pmstep_angle_coeffs_t *coeffs, const pmstep_config_t *cfg)
+void pmstep_angle_coeffs_init(pmstep_angle_coeffs_t *coeffs, const pmstep_config_t *cfg,
+                              const pmstep_electrical_t *model)
 {
-    coeffs->voltage_gain = cfg->period_s / cfg->inductance_h;
-    coeffs->current_gain = 0.5f * cfg->resistance_ohm * cfg->period_s / cfg->inductance_h;
-    coeffs->flux_to_angle = cfg->inductance_h * (float)cfg->pole_pairs / cfg->torque_constant_nm_per_a;
+    coeffs->voltage_gain = cfg->period_s / model->inductance_h;
+    coeffs->current_gain = 0.5f * model->resistance_ohm * cfg->period_s / model->inductance_h;
+    coeffs->flux_to_angle = model->inductance_h * (float)cfg->pole_pairs / model->torque_constant_nm_per_a;
+    /* d c-hat / d phi1 = flux_to_angle, so a change g T_s c e of c-hat is g T_s c e / flux_to_angle of phi1. */
+    coeffs->correction_gain = cfg->angle_correction_gain_per_s * cfg->period_s / coeffs->flux_to_angle;
 }
 
 void pmstep_angle_start(pmstep_angle_t *angle, float i_a_a, float i_b_a)
@@ -48,4 +51,11 @@ void pmstep_angle_estimate(const pmstep_angle_t *angle, const pmstep_angle_coeff
     const float flux_b = (i_b_a - angle->i_b_start_a) - (angle->phi_b - angle->phi_b_compensation);
     *cos_hat = 1.0f - coeffs->flux_to_angle * flux_a;
     *sin_hat = -coeffs->flux_to_angle * flux_b;
+}
+
+void pmstep_angle_correct(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs, float cos_hat, float sin_hat)
+{
+    const float radial_step = coeffs->correction_gain * (1.0f - cos_hat * cos_hat - sin_hat * sin_hat);
+    compensated_add(&angle->phi_a, &angle->phi_a_compensation, radial_step * cos_hat);
+    compensated_add(&angle->phi_b, &angle->phi_b_compensation, radial_step * sin_hat);
 }

@@ -3,9 +3,47 @@
 
 #include <math.h> /* isfinite: a classification macro, no libm call */
 #include <stddef.h>
+#include <string.h> /* memcpy of one float: a load */
 
 /* Longest alignment accepted: 2^31 periods keeps step counters far from wrapping. */
 #define PMSTEP_MAX_ALIGN_PERIODS 2147483648.0f
+
+/* Calibration, commissioning, dead time, drift-free gain (times already checked finite). */
+static pmstep_status_t validate_calibration(const pmstep_config_t *cfg)
+{
+    const float s_align_s = cfg->s_align_time_s;
+    const float c_align_s = cfg->c_align_time_s - cfg->s_align_time_s;
+    const bool window = cfg->steady_state_window_s > 0.0f;
+    if (cfg->offset_calibration_time_s < 0.0f || cfg->steady_state_window_s < 0.0f || cfg->inductance_window_s < 0.0f
+        || cfg->steady_state_window_s > 0.5f * s_align_s || cfg->steady_state_window_s > 0.5f * c_align_s
+        || cfg->inductance_window_s > 0.5f * s_align_s
+        || cfg->offset_calibration_time_s / cfg->period_s >= PMSTEP_MAX_ALIGN_PERIODS) {
+        return PMSTEP_ERR_CALIBRATION;
+    }
+    /* What is used must be measured: R and k_M need the windows, L its rise window. */
+    if ((cfg->alignment_offset_calibration && !window) || (cfg->use_commissioned_resistance && !window)
+        || (cfg->use_commissioned_torque_constant && !window)
+        || (cfg->use_commissioned_inductance && !(cfg->inductance_window_s > 0.0f))) {
+        return PMSTEP_ERR_CALIBRATION;
+    }
+    if (cfg->dead_time_s < 0.0f || 2.0f * cfg->dead_time_s >= 0.5f * cfg->period_s
+        || (cfg->dead_time_s > 0.0f && !(cfg->dead_time_current_band_a > 0.0f))) {
+        return PMSTEP_ERR_CALIBRATION;
+    }
+    if (cfg->angle_correction_gain_per_s < 0.0f || cfg->angle_correction_gain_per_s * cfg->period_s >= 0.5f) {
+        return PMSTEP_ERR_CALIBRATION;
+    }
+    return PMSTEP_OK;
+}
+
+pmstep_electrical_t pmstep_configured_electrical(const pmstep_config_t *cfg)
+{
+    pmstep_electrical_t model;
+    model.resistance_ohm = cfg->resistance_ohm;
+    model.inductance_h = cfg->inductance_h;
+    model.torque_constant_nm_per_a = cfg->torque_constant_nm_per_a;
+    return model;
+}
 
 pmstep_status_t pmstep_validate_config(const pmstep_config_t *cfg)
 {
@@ -13,16 +51,29 @@ pmstep_status_t pmstep_validate_config(const pmstep_config_t *cfg)
         return PMSTEP_ERR_NULL_ARGUMENT;
     }
     {
-        const float values[] = {
-            cfg->resistance_ohm, cfg->inductance_h, cfg->inertia_kg_m2, cfg->friction_nm_s_per_rad,
-            cfg->torque_constant_nm_per_a, cfg->period_s, cfg->s_align_time_s, cfg->c_align_time_s,
-            cfg->s_align_voltage_v, cfg->c_align_voltage_v, cfg->speed_gain_per_s, cfg->observer_gain_per_s,
-            cfg->current_gain_per_s, cfg->adapt_gamma, cfg->adapt_lambda, cfg->adapt_r, cfg->sat_kappa_rad_per_s,
-            cfg->reference_bandwidth_rad_per_s, cfg->max_phase_current_a, cfg->min_bus_voltage_v,
-            cfg->max_bus_voltage_v};
+        /* Every float of the configuration, by offset: one small table instead of a copy of each. */
+        static const unsigned char float_fields[] = {
+            offsetof(pmstep_config_t, resistance_ohm), offsetof(pmstep_config_t, inductance_h),
+            offsetof(pmstep_config_t, inertia_kg_m2), offsetof(pmstep_config_t, friction_nm_s_per_rad),
+            offsetof(pmstep_config_t, torque_constant_nm_per_a), offsetof(pmstep_config_t, period_s),
+            offsetof(pmstep_config_t, s_align_time_s), offsetof(pmstep_config_t, c_align_time_s),
+            offsetof(pmstep_config_t, s_align_voltage_v), offsetof(pmstep_config_t, c_align_voltage_v),
+            offsetof(pmstep_config_t, speed_gain_per_s), offsetof(pmstep_config_t, observer_gain_per_s),
+            offsetof(pmstep_config_t, current_gain_per_s), offsetof(pmstep_config_t, adapt_gamma),
+            offsetof(pmstep_config_t, adapt_lambda), offsetof(pmstep_config_t, adapt_r),
+            offsetof(pmstep_config_t, sat_kappa_rad_per_s), offsetof(pmstep_config_t, reference_bandwidth_rad_per_s),
+            offsetof(pmstep_config_t, max_phase_current_a), offsetof(pmstep_config_t, min_bus_voltage_v),
+            offsetof(pmstep_config_t, max_bus_voltage_v), offsetof(pmstep_config_t, offset_calibration_time_s),
+            offsetof(pmstep_config_t, steady_state_window_s), offsetof(pmstep_config_t, inductance_window_s),
+            offsetof(pmstep_config_t, dead_time_s), offsetof(pmstep_config_t, dead_time_current_band_a),
+            offsetof(pmstep_config_t, angle_correction_gain_per_s), offsetof(pmstep_config_t, angle_magnitude_bound),
+            offsetof(pmstep_config_t, speed_consistency_bound_rad_s),
+            offsetof(pmstep_config_t, stall_speed_error_rad_s), offsetof(pmstep_config_t, detection_time_s)};
         size_t n;
-        for (n = 0; n < sizeof values / sizeof values[0]; ++n) {
-            if (!isfinite(values[n])) {
+        for (n = 0; n < sizeof float_fields; ++n) {
+            float value;
+            memcpy(&value, (const unsigned char *)cfg + float_fields[n], sizeof value);
+            if (!isfinite(value)) {
                 return PMSTEP_ERR_NONFINITE_PARAMETER;
             }
         }
@@ -83,6 +134,16 @@ pmstep_status_t pmstep_validate_config(const pmstep_config_t *cfg)
         || cfg->c_align_time_s / cfg->period_s >= PMSTEP_MAX_ALIGN_PERIODS) {
         return PMSTEP_ERR_ALIGNMENT_TIME;
     }
+    if (validate_calibration(cfg) != PMSTEP_OK) {
+        return PMSTEP_ERR_CALIBRATION;
+    }
+    if (cfg->angle_magnitude_bound < 0.0f || cfg->speed_consistency_bound_rad_s < 0.0f
+        || cfg->stall_speed_error_rad_s < 0.0f
+        || ((cfg->angle_magnitude_bound > 0.0f || cfg->speed_consistency_bound_rad_s > 0.0f
+             || cfg->stall_speed_error_rad_s > 0.0f)
+            && !(cfg->detection_time_s >= 4.0f * cfg->period_s))) {
+        return PMSTEP_ERR_DETECTION;
+    }
     {
         /* Condition (4): k_M u_cc/(p L R) - (u_cs^2 + u_cc^2)/(2 R^2) > 0. */
         const float r = cfg->resistance_ohm;
@@ -103,25 +164,27 @@ const char *pmstep_status_str(pmstep_status_t status)
     switch (status) {
     case PMSTEP_OK: return "ok";
     case PMSTEP_ERR_NULL_ARGUMENT: return "null argument";
-    case PMSTEP_ERR_NONFINITE_PARAMETER: return "a configuration value is NaN or infinite";
-    case PMSTEP_ERR_RESISTANCE: return "resistance R must be > 0";
-    case PMSTEP_ERR_INDUCTANCE: return "inductance L must be > 0";
-    case PMSTEP_ERR_INERTIA: return "inertia J must be > 0";
-    case PMSTEP_ERR_TORQUE_CONSTANT: return "torque constant k_M must be > 0";
-    case PMSTEP_ERR_FRICTION: return "friction F must be >= 0";
-    case PMSTEP_ERR_POLE_PAIRS: return "pole pairs p must be >= 1";
-    case PMSTEP_ERR_PERIOD: return "control period must be > 0";
-    case PMSTEP_ERR_GAIN: return "gains k_omega, K_e, K_i, gamma, lambda, r, kappa must be > 0";
-    case PMSTEP_ERR_PERIOD_TOO_LONG: return "period too long for the loop: (R/L + K_e) T_s and (R/L + K_i) T_s must be < 0.5";
-    case PMSTEP_ERR_ALIGNMENT_CONDITION: return "condition (4) violated: k_M u_cc/(p L R) - (u_cs^2 + u_cc^2)/(2 R^2) must be > 0";
-    case PMSTEP_ERR_ALIGNMENT_VOLTAGE: return "alignment voltages must be > 0 and not above the minimum bus voltage";
-    case PMSTEP_ERR_ALIGNMENT_TIME: return "alignment times must satisfy T_s <= t_s and t_s + T_s <= t_c";
-    case PMSTEP_ERR_REFERENCE_BANDWIDTH: return "reference bandwidth varpi_0 must be > 0 with varpi_0 T_s <= 0.5";
-    case PMSTEP_ERR_LIMITS: return "limits must satisfy max current > 0 and 0 < min bus < max bus";
-    case PMSTEP_ERR_DELAY: return "computational delay must be 0 or 1 period";
-    case PMSTEP_ERR_BAD_MODE: return "command not allowed in the present mode";
-    case PMSTEP_ERR_BAD_COMMAND_VALUE: return "command value NaN/infinite or ramp rate not > 0";
-    case PMSTEP_ERR_ALIGNMENT_CURRENT: return "alignment current u/R must be below the overcurrent limit";
+    case PMSTEP_ERR_NONFINITE_PARAMETER: return "a config value is NaN/Inf";
+    case PMSTEP_ERR_RESISTANCE: return "R must be > 0";
+    case PMSTEP_ERR_INDUCTANCE: return "L must be > 0";
+    case PMSTEP_ERR_INERTIA: return "J must be > 0";
+    case PMSTEP_ERR_TORQUE_CONSTANT: return "k_M must be > 0";
+    case PMSTEP_ERR_FRICTION: return "F must be >= 0";
+    case PMSTEP_ERR_POLE_PAIRS: return "p must be >= 1";
+    case PMSTEP_ERR_PERIOD: return "T_s must be > 0";
+    case PMSTEP_ERR_GAIN: return "gains must be > 0";
+    case PMSTEP_ERR_PERIOD_TOO_LONG: return "(R/L + K_e) T_s, (R/L + K_i) T_s must be < 0.5";
+    case PMSTEP_ERR_ALIGNMENT_CONDITION: return "condition (4) violated";
+    case PMSTEP_ERR_ALIGNMENT_VOLTAGE: return "need 0 < u_cs, u_cc <= min bus";
+    case PMSTEP_ERR_ALIGNMENT_TIME: return "need T_s <= t_s <= t_c - T_s";
+    case PMSTEP_ERR_REFERENCE_BANDWIDTH: return "need 0 < varpi_0 T_s <= 0.5";
+    case PMSTEP_ERR_LIMITS: return "need max current > 0, 0 < min bus < max bus";
+    case PMSTEP_ERR_DELAY: return "delay must be 0 or 1 period";
+    case PMSTEP_ERR_BAD_MODE: return "not allowed in this mode";
+    case PMSTEP_ERR_BAD_COMMAND_VALUE: return "command NaN/Inf or ramp rate <= 0";
+    case PMSTEP_ERR_ALIGNMENT_CURRENT: return "alignment current u/R >= overcurrent trip";
+    case PMSTEP_ERR_CALIBRATION: return "calibration settings invalid";
+    case PMSTEP_ERR_DETECTION: return "need detection bounds >= 0, time >= 4 T_s";
     }
     return "unknown status";
 }
@@ -129,14 +192,18 @@ const char *pmstep_status_str(pmstep_status_t status)
 const char *pmstep_fault_str(pmstep_fault_t fault)
 {
     switch (fault) {
-    case PMSTEP_FAULT_NONE: return "none";
-    case PMSTEP_FAULT_MEASUREMENT_NONFINITE: return "measurement NaN or infinite";
-    case PMSTEP_FAULT_OVERCURRENT: return "phase overcurrent";
-    case PMSTEP_FAULT_BUS_UNDERVOLTAGE: return "bus undervoltage";
-    case PMSTEP_FAULT_BUS_OVERVOLTAGE: return "bus overvoltage";
-    case PMSTEP_FAULT_STATE_NONFINITE: return "internal estimate NaN or infinite";
+    case PMSTEP_FAULT_NONE: return "NONE";
+    case PMSTEP_FAULT_MEASUREMENT_NONFINITE: return "MEASUREMENT_NONFINITE";
+    case PMSTEP_FAULT_OVERCURRENT: return "OVERCURRENT";
+    case PMSTEP_FAULT_BUS_UNDERVOLTAGE: return "BUS_UNDERVOLTAGE";
+    case PMSTEP_FAULT_BUS_OVERVOLTAGE: return "BUS_OVERVOLTAGE";
+    case PMSTEP_FAULT_STATE_NONFINITE: return "STATE_NONFINITE";
+    case PMSTEP_FAULT_ANGLE_MAGNITUDE: return "ANGLE_MAGNITUDE";
+    case PMSTEP_FAULT_SPEED_INCONSISTENT: return "SPEED_INCONSISTENT";
+    case PMSTEP_FAULT_STALL: return "STALL";
+    case PMSTEP_FAULT_COMMISSIONING: return "COMMISSIONING";
     }
-    return "unknown fault";
+    return "UNKNOWN";
 }
 
 const char *pmstep_mode_str(pmstep_mode_t mode)
@@ -147,38 +214,44 @@ const char *pmstep_mode_str(pmstep_mode_t mode)
     case PMSTEP_MODE_C_ALIGN: return "C_ALIGN";
     case PMSTEP_MODE_RUN: return "RUN";
     case PMSTEP_MODE_FAULT: return "FAULT";
+    case PMSTEP_MODE_OFFSET_CAL: return "OFFSET_CAL";
     }
     return "unknown mode";
 }
 
 pmstep_config_t pmstep_paper_config(void)
 {
-    pmstep_config_t cfg;
-    /* Motor of Section III.B. */
-    cfg.resistance_ohm = 3.0f;
-    cfg.inductance_h = 0.006f;
-    cfg.inertia_kg_m2 = 0.01f;
-    cfg.friction_nm_s_per_rad = 0.0f;
-    cfg.torque_constant_nm_per_a = 2.0f;
-    cfg.pole_pairs = 6;
-    cfg.period_s = 50e-6f;
-    cfg.computational_delay_periods = 0u;
-    cfg.s_align_time_s = 0.3f;
-    cfg.c_align_time_s = 0.6f;
-    cfg.s_align_voltage_v = 24.0f;
-    cfg.c_align_voltage_v = 24.0f;
-    cfg.speed_gain_per_s = 100.0f;
-    cfg.observer_gain_per_s = 100.0f;
-    cfg.current_gain_per_s = 20.0f;
-    cfg.adapt_gamma = 0.01f / 9.0f;
-    cfg.adapt_lambda = 0.2f;
-    cfg.adapt_r = 1.0f;
-    cfg.sat_kappa_rad_per_s = 9.0f;
-    cfg.reference_bandwidth_rad_per_s = 300.0f;
-    cfg.known_load_mode = false;
-    /* Drive limits (not in the paper): 48 V bus, alignment draws u/R = 8 A. */
-    cfg.max_phase_current_a = 15.0f;
-    cfg.min_bus_voltage_v = 30.0f;
-    cfg.max_bus_voltage_v = 60.0f;
-    return cfg;
+    /* A table in flash, copied out: smaller than one store per field. Fields not named are 0 / false:
+     * calibration, commissioning, dead-time compensation and the drift-free option are off (the paper). */
+    static const pmstep_config_t paper = {
+        /* Motor of Section III.B. */
+        .resistance_ohm = 3.0f,
+        .inductance_h = 0.006f,
+        .inertia_kg_m2 = 0.01f,
+        .torque_constant_nm_per_a = 2.0f,
+        .pole_pairs = 6,
+        .period_s = 50e-6f,
+        .s_align_time_s = 0.3f,
+        .c_align_time_s = 0.6f,
+        .s_align_voltage_v = 24.0f,
+        .c_align_voltage_v = 24.0f,
+        .speed_gain_per_s = 100.0f,
+        .observer_gain_per_s = 100.0f,
+        .current_gain_per_s = 20.0f,
+        .adapt_gamma = 0.01f / 9.0f,
+        .adapt_lambda = 0.2f,
+        .adapt_r = 1.0f,
+        .sat_kappa_rad_per_s = 9.0f,
+        .reference_bandwidth_rad_per_s = 300.0f,
+        /* Drive limits (not in the paper): 48 V bus, alignment draws u/R = 8 A. */
+        .max_phase_current_a = 15.0f,
+        .min_bus_voltage_v = 30.0f,
+        .max_bus_voltage_v = 60.0f,
+        /* Detection (protections, not in the paper): on; far outside what the paper's run reaches. */
+        .angle_magnitude_bound = 0.25f,
+        .speed_consistency_bound_rad_s = 3.0f,
+        .stall_speed_error_rad_s = 3.0f,
+        .detection_time_s = 0.02f
+    };
+    return paper;
 }

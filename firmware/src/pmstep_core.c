@@ -10,6 +10,14 @@ static uint32_t periods_in(float duration_s, float period_s)
     return (uint32_t)(duration_s / period_s + 0.5f);
 }
 
+/* Coefficients of the angle, observer and law for the electrical model in use. */
+static void apply_model(pmstep_t *inst)
+{
+    pmstep_angle_coeffs_init(&inst->angle_coeffs, inst->cfg, &inst->model);
+    pmstep_observer_coeffs_init(&inst->observer_coeffs, inst->cfg, &inst->model);
+    pmstep_law_coeffs_init(&inst->law_coeffs, inst->cfg, &inst->model);
+}
+
 pmstep_status_t pmstep_init(pmstep_t *inst, const pmstep_config_t *cfg)
 {
     pmstep_status_t status;
@@ -21,14 +29,35 @@ pmstep_status_t pmstep_init(pmstep_t *inst, const pmstep_config_t *cfg)
         return status;
     }
     inst->cfg = cfg;
+    inst->model = pmstep_configured_electrical(cfg);
     pmstep_ref_coeffs_init(&inst->ref_coeffs, cfg->reference_bandwidth_rad_per_s, cfg->period_s);
-    pmstep_angle_coeffs_init(&inst->angle_coeffs, cfg);
-    pmstep_observer_coeffs_init(&inst->observer_coeffs, cfg);
-    pmstep_law_coeffs_init(&inst->law_coeffs, cfg);
+    apply_model(inst);
     inst->s_align_steps = periods_in(cfg->s_align_time_s, cfg->period_s);
     inst->c_align_end_step = periods_in(cfg->c_align_time_s, cfg->period_s);
+    inst->commission_plan.s_align_steps = inst->s_align_steps;
+    inst->commission_plan.c_align_end_step = inst->c_align_end_step;
+    inst->commission_plan.window_steps = periods_in(cfg->steady_state_window_s, cfg->period_s);
+    inst->commission_plan.inductance_steps = periods_in(cfg->inductance_window_s, cfg->period_s);
+    inst->commission_plan.offsets_from_alignment = cfg->alignment_offset_calibration;
+    inst->offset_cal_steps = periods_in(cfg->offset_calibration_time_s, cfg->period_s);
+    inst->dead_time_duty = 2.0f * cfg->dead_time_s / cfg->period_s;
+    inst->inv_dead_time_band_per_a = cfg->dead_time_s > 0.0f ? 1.0f / cfg->dead_time_current_band_a : 0.0f;
+    inst->detection_steps = periods_in(cfg->detection_time_s, cfg->period_s);
+    inst->detection_alpha = 4.0f * cfg->period_s / (cfg->detection_time_s > 0.0f ? cfg->detection_time_s : 1.0f);
+    inst->angle_step_per_speed = (float)cfg->pole_pairs * cfg->period_s;
+    inst->consistency_bound_rad = cfg->speed_consistency_bound_rad_s * inst->angle_step_per_speed;
     pmstep_reset(inst);
     return PMSTEP_OK;
+}
+
+/* Forgets what the last alignment measured: offsets 0, the configured model, sums cleared. */
+static void clear_commissioning(pmstep_t *inst)
+{
+    static const pmstep_commissioning_t none = {0};
+    inst->commissioning = none;
+    pmstep_commission_clear(&inst->scratch.sums);
+    inst->model = pmstep_configured_electrical(inst->cfg);
+    apply_model(inst);
 }
 
 /* Clears the dynamic state of the strategy; keeps commands (targets) untouched. */
@@ -54,6 +83,7 @@ void pmstep_reset(pmstep_t *inst)
     pmstep_ref_reset(&inst->i_d_ref, 0.0f);
     pmstep_ref_reset(&inst->known_load_filter, 0.0f);
     clear_dynamic_state(inst);
+    clear_commissioning(inst);
 }
 
 pmstep_status_t pmstep_start(pmstep_t *inst)
@@ -65,7 +95,8 @@ pmstep_status_t pmstep_start(pmstep_t *inst)
         return PMSTEP_ERR_BAD_MODE;
     }
     clear_dynamic_state(inst);
-    inst->mode = PMSTEP_MODE_S_ALIGN;
+    clear_commissioning(inst);
+    inst->mode = inst->offset_cal_steps > 0u ? PMSTEP_MODE_OFFSET_CAL : PMSTEP_MODE_S_ALIGN;
     return PMSTEP_OK;
 }
 
@@ -125,11 +156,18 @@ static float abs_f(float x)
     return x < 0.0f ? -x : x;
 }
 
+/* x - x is 0 for every finite x and NaN for NaN and +/-Inf, so one compare checks a
+ * sum of such differences (cheaper than one isfinite per value on the FPU). */
+static bool all_finite4(float a, float b, float c, float d)
+{
+    return ((a - a) + (b - b)) + ((c - c) + (d - d)) == 0.0f;
+}
+
 /* Protections, checked while the bridge may be on. */
 static pmstep_fault_t check_measurements(const pmstep_config_t *cfg, const pmstep_meas_t *meas)
 {
-    if (!isfinite(meas->i_a_a) || !isfinite(meas->i_b_a) || !isfinite(meas->bus_voltage_v)
-        || (cfg->known_load_mode && !isfinite(meas->load_torque_nm))) {
+    if (!all_finite4(meas->i_a_a, meas->i_b_a, meas->bus_voltage_v,
+                     cfg->known_load_mode ? meas->load_torque_nm : 0.0f)) {
         return PMSTEP_FAULT_MEASUREMENT_NONFINITE;
     }
     if (abs_f(meas->i_a_a) > cfg->max_phase_current_a || abs_f(meas->i_b_a) > cfg->max_phase_current_a) {
@@ -144,12 +182,38 @@ static pmstep_fault_t check_measurements(const pmstep_config_t *cfg, const pmste
     return PMSTEP_FAULT_NONE;
 }
 
-static void latch_fault(pmstep_t *inst, pmstep_fault_t fault)
+
+/* After a detection: align again with the bridge on, keeping what commissioning measured. */
+static void realign(pmstep_t *inst)
 {
     clear_dynamic_state(inst);
-    inst->mode = PMSTEP_MODE_FAULT;
-    inst->fault = fault;
-    inst->fault_step = inst->step_count;
+    inst->commissioning.realignments++;
+    inst->mode = PMSTEP_MODE_S_ALIGN;
+}
+
+/* At t_c, before the first RUN period: Remark 2 offsets and the commissioned model.
+ * @return a fault, or PMSTEP_FAULT_NONE. */
+static pmstep_fault_t finish_commissioning(pmstep_t *inst, const pmstep_meas_t *raw)
+{
+    const pmstep_config_t *cfg = inst->cfg;
+    pmstep_commissioning_t *result = &inst->commissioning;
+    const pmstep_fault_t fault =
+        pmstep_commission_finish(&inst->scratch.sums, &inst->commission_plan, cfg, raw->i_a_a, raw->i_b_a,
+                                 inst->u_applied_a_v, inst->u_applied_b_v, result);
+    if (fault != PMSTEP_FAULT_NONE) {
+        return fault;
+    }
+    if (cfg->use_commissioned_resistance) {
+        inst->model.resistance_ohm = result->resistance_ohm;
+    }
+    if (cfg->use_commissioned_inductance) {
+        inst->model.inductance_h = result->inductance_h;
+    }
+    if (cfg->use_commissioned_torque_constant) {
+        inst->model.torque_constant_nm_per_a = result->torque_constant_nm_per_a;
+    }
+    apply_model(inst);
+    return PMSTEP_FAULT_NONE;
 }
 
 /* Starts controller (6) at t_c: phi = 0, i-hat = i(t_c), w-hat = T_L-hat = 0, references from 0. */
@@ -157,6 +221,7 @@ static void start_run(pmstep_t *inst, const pmstep_meas_t *meas)
 {
     const pmstep_ref_t speed_cmd = inst->speed_ref;
     const pmstep_ref_t i_d_cmd = inst->i_d_ref;
+    static const pmstep_detector_t fresh_detector = {1.0f, 0.0f, 0.0f, 0u, 0u, 0u};
     pmstep_angle_start(&inst->angle, meas->i_a_a, meas->i_b_a);
     pmstep_observer_start(&inst->observer, meas->i_a_a, meas->i_b_a);
     pmstep_ref_reset(&inst->speed_ref, 0.0f);
@@ -164,6 +229,7 @@ static void start_run(pmstep_t *inst, const pmstep_meas_t *meas)
     pmstep_ref_reset(&inst->i_d_ref, 0.0f);
     pmstep_ref_set_target(&inst->i_d_ref, i_d_cmd.target, 0.0f);
     pmstep_ref_reset(&inst->known_load_filter, inst->cfg->known_load_mode ? meas->load_torque_nm : 0.0f);
+    inst->scratch.detector = fresh_detector; /* the sums are spent: (c-hat, s-hat) = (1, 0) at t_c */
     inst->run_started = true;
 }
 
@@ -256,12 +322,84 @@ static void output_off(pmstep_output_t *out, const pmstep_t *inst)
     out->fault_step = inst->fault_step;
 }
 
+/* Latches @p fault: state cleared, bridge off from this period on. */
+static void trip(pmstep_t *inst, pmstep_fault_t fault, pmstep_output_t *out)
+{
+    clear_dynamic_state(inst);
+    inst->mode = PMSTEP_MODE_FAULT;
+    inst->fault = fault;
+    inst->fault_step = inst->step_count;
+    output_off(out, inst);
+}
+
+/* Voltage that makes up for the dead time of a phase's two half-bridges (each loses
+ * sign(i) V_bus t_d / T_s): 2 V_bus t_d / T_s, linear in i within the band. */
+static float dead_time_voltage(const pmstep_t *inst, float current_a, float bus_voltage_v)
+{
+    float share = current_a * inst->inv_dead_time_band_per_a;
+    share = share > 1.0f ? 1.0f : (share < -1.0f ? -1.0f : share);
+    return inst->dead_time_duty * bus_voltage_v * share;
+}
+
+/* Counts the periods @p condition has held; true once it has held @p limit periods. */
+static bool persists(uint32_t *count, bool condition, uint32_t limit)
+{
+    *count = condition ? *count + 1u : 0u;
+    return *count >= limit;
+}
+
+/* Detection in RUN (config "Detection"): a condition persisting detection_steps periods. */
+static pmstep_fault_t detect(pmstep_t *inst, const pmstep_output_t *out)
+{
+    const pmstep_config_t *cfg = inst->cfg;
+    pmstep_detector_t *d = &inst->scratch.detector;
+    const uint32_t limit = inst->detection_steps;
+    pmstep_fault_t found = PMSTEP_FAULT_NONE;
+    if (cfg->angle_magnitude_bound > 0.0f) {
+        const float magnitude_error = out->cos_hat * out->cos_hat + out->sin_hat * out->sin_hat - 1.0f;
+        if (persists(&d->magnitude_count, abs_f(magnitude_error) > cfg->angle_magnitude_bound, limit)) {
+            found = PMSTEP_FAULT_ANGLE_MAGNITUDE;
+        }
+    }
+    if (cfg->speed_consistency_bound_rad_s > 0.0f) {
+        /* sin of the estimate's electrical step over the period, against p T_s w-hat. */
+        const float angle_step = d->prev_cos_hat * out->sin_hat - d->prev_sin_hat * out->cos_hat;
+        const float gap = angle_step - inst->angle_step_per_speed * out->speed_hat_rad_s;
+        d->rotation_gap_rad += inst->detection_alpha * (gap - d->rotation_gap_rad);
+        d->prev_cos_hat = out->cos_hat;
+        d->prev_sin_hat = out->sin_hat;
+        if (persists(&d->consistency_count, abs_f(d->rotation_gap_rad) > inst->consistency_bound_rad, limit)) {
+            found = PMSTEP_FAULT_SPEED_INCONSISTENT;
+        }
+    }
+    if (cfg->stall_speed_error_rad_s > 0.0f
+        && persists(&d->stall_count, abs_f(out->speed_hat_rad_s - out->speed_ref_rad_s) > cfg->stall_speed_error_rad_s,
+                    limit)) {
+        found = PMSTEP_FAULT_STALL;
+    }
+    return found;
+}
+
+/* Bridge off and the mode of this period; the offset calibration's samples. */
+static void offset_calibration_step(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out)
+{
+    pmstep_commission_add_bridge_off(&inst->scratch.sums, meas->i_a_a, meas->i_b_a);
+    out->mode = PMSTEP_MODE_OFFSET_CAL;
+    if (++inst->mode_step >= inst->offset_cal_steps) {
+        inst->mode = PMSTEP_MODE_S_ALIGN;
+        inst->mode_step = 0u;
+    }
+}
+
 void pmstep_step(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out)
 {
     const pmstep_config_t *cfg = inst->cfg;
     pmstep_observer_input_t obs_in;
     pmstep_observer_mech_rates_t mech;
+    pmstep_meas_t sample;
     pmstep_fault_t fault;
+    float dead_time_a_v = 0.0f;
+    float dead_time_b_v = 0.0f;
     float next_a_v;
     float next_b_v;
 
@@ -272,17 +410,36 @@ void pmstep_step(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out
     }
     fault = check_measurements(cfg, meas);
     if (fault != PMSTEP_FAULT_NONE) {
-        latch_fault(inst, fault);
-        output_off(out, inst);
+        trip(inst, fault, out);
         return;
     }
 
     output_off(out, inst);
+    if (inst->mode == PMSTEP_MODE_OFFSET_CAL) {
+        offset_calibration_step(inst, meas, out);
+        return;
+    }
     if (inst->mode_step >= inst->c_align_end_step) {
         inst->mode = PMSTEP_MODE_RUN;
     } else if (inst->mode_step >= inst->s_align_steps) {
         inst->mode = PMSTEP_MODE_C_ALIGN;
     }
+    if (!inst->commissioning.measured) {
+        if (inst->mode != PMSTEP_MODE_RUN) {
+            pmstep_commission_add_alignment(&inst->scratch.sums, &inst->commission_plan, inst->mode_step, meas->i_a_a,
+                                            meas->i_b_a, inst->u_applied_a_v, inst->u_applied_b_v);
+        } else {
+            fault = finish_commissioning(inst, meas);
+            if (fault != PMSTEP_FAULT_NONE) {
+                trip(inst, fault, out);
+                return;
+            }
+        }
+    }
+    /* Remark 2: the sensor offsets (zero until measured) come off every sample. */
+    sample = *meas;
+    sample.i_a_a -= inst->commissioning.offset_a_a;
+    sample.i_b_a -= inst->commissioning.offset_b_a;
     switch (inst->mode) {
     case PMSTEP_MODE_S_ALIGN: /* (3) */
         out->u_a_v = 0.0f;
@@ -293,27 +450,45 @@ void pmstep_step(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out
         out->u_b_v = 0.0f;
         break;
     default: /* RUN: (6) or (13) */
-        run_controller(inst, meas, out, &obs_in, &mech);
+        run_controller(inst, &sample, out, &obs_in, &mech);
+        fault = detect(inst, out);
+        if (fault != PMSTEP_FAULT_NONE) {
+            if (inst->commissioning.realignments < cfg->max_realignments) {
+                realign(inst);
+                output_off(out, inst);
+            } else {
+                trip(inst, fault, out);
+            }
+            return;
+        }
         break;
     }
+    if (inst->dead_time_duty > 0.0f) {
+        /* In alignment the undriven phase carries no current and gets no dead-time term. */
+        dead_time_a_v = inst->mode == PMSTEP_MODE_S_ALIGN ? 0.0f : dead_time_voltage(inst, sample.i_a_a, meas->bus_voltage_v);
+        dead_time_b_v = inst->mode == PMSTEP_MODE_C_ALIGN ? 0.0f : dead_time_voltage(inst, sample.i_b_a, meas->bus_voltage_v);
+    }
+    out->u_a_v += dead_time_a_v;
+    out->u_b_v += dead_time_b_v;
     out->voltage_limited = limit_to_bus(&out->u_a_v, &out->u_b_v, meas->bus_voltage_v);
     out->mode = inst->mode;
     out->bridge_enable = true;
 
-    /* The voltage the bridge applies over the coming period. */
+    /* The voltage the bridge applies over the coming period (its dead-time loss taken off). */
     if (cfg->computational_delay_periods == 0u) {
-        next_a_v = out->u_a_v;
-        next_b_v = out->u_b_v;
+        next_a_v = out->u_a_v - dead_time_a_v;
+        next_b_v = out->u_b_v - dead_time_b_v;
     } else {
         next_a_v = inst->u_pending_a_v;
         next_b_v = inst->u_pending_b_v;
-        inst->u_pending_a_v = out->u_a_v;
-        inst->u_pending_b_v = out->u_b_v;
+        inst->u_pending_a_v = out->u_a_v - dead_time_a_v;
+        inst->u_pending_b_v = out->u_b_v - dead_time_b_v;
     }
     inst->u_applied_a_v = next_a_v;
     inst->u_applied_b_v = next_b_v;
 
     if (inst->mode == PMSTEP_MODE_RUN) {
+        pmstep_angle_correct(&inst->angle, &inst->angle_coeffs, out->cos_hat, out->sin_hat);
         pmstep_observer_advance(&inst->observer, &inst->observer_coeffs, &obs_in, &mech, next_a_v, next_b_v,
                                 cfg->period_s);
         pmstep_ref_advance(&inst->ref_coeffs, &inst->speed_ref, cfg->period_s);
@@ -322,15 +497,19 @@ void pmstep_step(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out
             pmstep_ref_set_target(&inst->known_load_filter, meas->load_torque_nm, 0.0f);
             pmstep_ref_advance(&inst->ref_coeffs, &inst->known_load_filter, cfg->period_s);
         }
-        if (!isfinite(out->u_a_v) || !isfinite(out->u_b_v) || !isfinite(inst->observer.speed_hat_rad_s)
-            || !isfinite(inst->observer.load_hat_nm) || !isfinite(inst->observer.i_a_hat_a)
-            || !isfinite(inst->observer.i_b_hat_a) || !isfinite(inst->angle.phi_a)
-            || !isfinite(inst->angle.phi_b)) {
-            latch_fault(inst, PMSTEP_FAULT_STATE_NONFINITE);
-            output_off(out, inst);
+        if (!all_finite4(out->u_a_v, out->u_b_v, inst->observer.speed_hat_rad_s, inst->observer.load_hat_nm)
+            || !all_finite4(inst->observer.i_a_hat_a, inst->observer.i_b_hat_a, inst->angle.phi_a,
+                            inst->angle.phi_b)) {
+            trip(inst, PMSTEP_FAULT_STATE_NONFINITE, out);
             return;
         }
     } else {
         inst->mode_step++;
     }
+}
+
+void pmstep_get_commissioning(const pmstep_t *inst, pmstep_commissioning_t *out)
+{
+    *out = inst->commissioning;
+    out->dead_time_duty = inst->dead_time_duty;
 }

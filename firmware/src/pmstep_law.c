@@ -3,16 +3,17 @@
 
 #include <math.h> /* sqrtf: one vsqrt.f32 / sqrtss with -fno-math-errno, no libm call */
 
-void pmstep_law_coeffs_init(pmstep_law_coeffs_t *coeffs, const pmstep_config_t *cfg)
+void pmstep_law_coeffs_init(pmstep_law_coeffs_t *coeffs, const pmstep_config_t *cfg,
+                            const pmstep_electrical_t *model)
 {
-    coeffs->j_over_km = cfg->inertia_kg_m2 / cfg->torque_constant_nm_per_a;
+    coeffs->j_over_km = cfg->inertia_kg_m2 / model->torque_constant_nm_per_a;
     coeffs->f_over_j_per_s = cfg->friction_nm_s_per_rad / cfg->inertia_kg_m2;
     coeffs->inv_j = 1.0f / cfg->inertia_kg_m2;
     coeffs->speed_gain_per_s = cfg->speed_gain_per_s;
     coeffs->current_gain_per_s = cfg->current_gain_per_s;
-    coeffs->r_over_l_per_s = cfg->resistance_ohm / cfg->inductance_h;
-    coeffs->km_over_l = cfg->torque_constant_nm_per_a / cfg->inductance_h;
-    coeffs->inductance_h = cfg->inductance_h;
+    coeffs->r_over_l_per_s = model->resistance_ohm / model->inductance_h;
+    coeffs->km_over_l = model->torque_constant_nm_per_a / model->inductance_h;
+    coeffs->inductance_h = model->inductance_h;
     coeffs->pole_pairs = (float)cfg->pole_pairs;
     coeffs->kappa_rad_s = cfg->sat_kappa_rad_per_s;
     coeffs->linear_speed_term = cfg->known_load_mode;

@@ -1,7 +1,8 @@
 /* Current, speed and load observer of controller (6); speed observer (13) of Remark 1. */
 #include "pmstep/pmstep_observer.h"
 
-void pmstep_observer_coeffs_init(pmstep_observer_coeffs_t *coeffs, const pmstep_config_t *cfg)
+void pmstep_observer_coeffs_init(pmstep_observer_coeffs_t *coeffs, const pmstep_config_t *cfg,
+                                 const pmstep_electrical_t *model)
 {
     const float j = cfg->inertia_kg_m2;
     const float f = cfg->friction_nm_s_per_rad;
@@ -10,10 +11,10 @@ void pmstep_observer_coeffs_init(pmstep_observer_coeffs_t *coeffs, const pmstep_
     const float r = cfg->adapt_r;
     const float den = g * g * l + r * f * l * l * j * j;
 
-    coeffs->r_over_l_per_s = cfg->resistance_ohm / cfg->inductance_h;
-    coeffs->inv_l_per_h = 1.0f / cfg->inductance_h;
-    coeffs->km_over_l = cfg->torque_constant_nm_per_a / cfg->inductance_h;
-    coeffs->km_over_j = cfg->torque_constant_nm_per_a / j;
+    coeffs->r_over_l_per_s = model->resistance_ohm / model->inductance_h;
+    coeffs->inv_l_per_h = 1.0f / model->inductance_h;
+    coeffs->km_over_l = model->torque_constant_nm_per_a / model->inductance_h;
+    coeffs->km_over_j = model->torque_constant_nm_per_a / j;
     coeffs->f_over_j_per_s = f / j;
     coeffs->inv_j = 1.0f / j;
     coeffs->observer_gain_per_s = cfg->observer_gain_per_s;

@@ -12,6 +12,7 @@
 static void run_constant_speed(double speed_rad_s, double duration_s, double *max_cos_err, double *max_sin_err)
 {
     const pmstep_config_t cfg = pmstep_paper_config();
+    const pmstep_electrical_t model = pmstep_configured_electrical(&cfg);
     pmstep_angle_coeffs_t coeffs;
     pmstep_angle_t angle;
     /* Start where c-alignment leaves the motor: cos p theta = 1, i_a = u_cc/R. */
@@ -20,7 +21,7 @@ static void run_constant_speed(double speed_rad_s, double duration_s, double *ma
     const long steps = (long)(duration_s / period_s + 0.5);
     long k;
     plant.speed_rad_s = speed_rad_s;
-    pmstep_angle_coeffs_init(&coeffs, &cfg);
+    pmstep_angle_coeffs_init(&coeffs, &cfg, &model);
     pmstep_angle_start(&angle, (float)plant.i_a, (float)plant.i_b);
     *max_cos_err = 0.0;
     *max_sin_err = 0.0;
@@ -65,12 +66,13 @@ static void angle_tracks_reverse_and_fast_rotation(void **state)
 static void angle_starts_at_cos_one(void **state)
 {
     const pmstep_config_t cfg = pmstep_paper_config();
+    const pmstep_electrical_t model = pmstep_configured_electrical(&cfg);
     pmstep_angle_coeffs_t coeffs;
     pmstep_angle_t angle;
     float c;
     float s;
     (void)state;
-    pmstep_angle_coeffs_init(&coeffs, &cfg);
+    pmstep_angle_coeffs_init(&coeffs, &cfg, &model);
     pmstep_angle_start(&angle, 8.0f, -0.25f);
     pmstep_angle_estimate(&angle, &coeffs, 8.0f, -0.25f, &c, &s);
     assert_true(c == 1.0f);

@@ -215,7 +215,7 @@ static void each_fault_latches_with_zero_output(void **state)
         assert_int_equal(out.fault_step, cases[n].at_step);
         assert_false(out.bridge_enable);
         assert_true(out.u_a_v == 0.0f && out.u_b_v == 0.0f);
-        assert_true(strcmp(pmstep_fault_str(out.fault), "unknown fault") != 0);
+        assert_true(strcmp(pmstep_fault_str(out.fault), "UNKNOWN") != 0);
         /* Nothing but an explicit clear leaves FAULT. */
         assert_int_equal(pmstep_start(&inst), PMSTEP_ERR_BAD_MODE);
         assert_int_equal(pmstep_stop(&inst), PMSTEP_ERR_BAD_MODE);

@@ -55,6 +55,7 @@ static void current_loop_gives_error_dynamics_8(void **state)
     /* With the exact angle and w-hat = w, (6) on model (2) must give
      * d(i_q - i_q*)/dt = -(R/L + K_i)(i_q - i_q*) (first lines of (8) with e_w = 0). */
     const pmstep_config_t cfg = pmstep_paper_config();
+    const pmstep_electrical_t model = pmstep_configured_electrical(&cfg);
     pmstep_law_coeffs_t coeffs;
     pmstep_law_refs_t refs = {3.0f, 20.0f, 0.0f, 0.0f, 0.0f};
     const float angle = 0.8f, speed = 3.0f, i_d = 0.3f, i_q = 1.7f, load = 1.0f;
@@ -62,7 +63,7 @@ static void current_loop_gives_error_dynamics_8(void **state)
     float u_a, u_b, u_d, u_q, i_q_ref, i_q_ref_rate;
     double di_q, di_d;
     (void)state;
-    pmstep_law_coeffs_init(&coeffs, &cfg);
+    pmstep_law_coeffs_init(&coeffs, &cfg, &model);
     i_q_ref = pmstep_law_iq_ref(&coeffs, &refs, speed, load);
     i_q_ref_rate = pmstep_law_iq_ref_rate(&coeffs, &refs, speed, 0.0f, 0.0f);
     pmstep_law_voltages(&coeffs, &refs, c, s, i_d, i_q, speed, i_q_ref, i_q_ref_rate, &u_a, &u_b);

@@ -13,6 +13,7 @@
 static void observer_converges_on_exact_samples(void **state)
 {
     const pmstep_config_t cfg = pmstep_paper_config();
+    const pmstep_electrical_t model = pmstep_configured_electrical(&cfg);
     const double period_s = cfg.period_s;
     const double i_q_a = 1.0;   /* q current held by the drive: balances 2 Nm */
     const double speed = 10.0;  /* rad/s */
@@ -27,7 +28,7 @@ static void observer_converges_on_exact_samples(void **state)
     plant.speed_rad_s = speed;
     plant.i_a = 0.0;
     plant.i_b = i_q_a;
-    pmstep_observer_coeffs_init(&coeffs, &cfg);
+    pmstep_observer_coeffs_init(&coeffs, &cfg, &model);
     pmstep_observer_start(&obs, (float)plant.i_a, (float)plant.i_b);
     obs.speed_hat_rad_s = -5.0f; /* wrong start: true speed 10 rad/s, true load 2 Nm */
     obs.load_hat_nm = 0.5f;
@@ -69,9 +70,10 @@ static void observer_converges_on_exact_samples(void **state)
 static void injection_gains_reduce_to_paper_values_without_friction(void **state)
 {
     const pmstep_config_t cfg = pmstep_paper_config();
+    const pmstep_electrical_t model = pmstep_configured_electrical(&cfg);
     pmstep_observer_coeffs_t coeffs;
     (void)state;
-    pmstep_observer_coeffs_init(&coeffs, &cfg);
+    pmstep_observer_coeffs_init(&coeffs, &cfg, &model);
     /* F = 0: g_w = 2/lambda = 10, g_T = J/gamma = 9. */
     assert_true(fabs(coeffs.speed_injection_gain - 10.0) < 1e-5);
     assert_true(fabs(coeffs.load_injection_gain - 9.0) < 1e-4);

@@ -17,14 +17,31 @@
 #include "pmstep/pmstep_angle.h"
 #include "pmstep/pmstep_observer.h"
 #include "pmstep/pmstep_law.h"
+#include "pmstep/pmstep_commission.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
+/** Detection state in RUN (see pmstep_config_t, "Detection"). */
+typedef struct {
+    float prev_cos_hat, prev_sin_hat;  /**< last period's estimate */
+    float rotation_gap_rad;            /**< low-passed (angle step - p T_s w-hat), electrical rad per period */
+    uint32_t magnitude_count, consistency_count, stall_count; /**< periods each condition has persisted */
+} pmstep_detector_t;
+
 /** One controller instance; all state lives here. Treat the fields as private. */
 typedef struct {
     const pmstep_config_t *cfg;
+    pmstep_electrical_t model;    /**< R, L, k_M in use: configured, or commissioned at t_c */
+    pmstep_commission_plan_t commission_plan;
+    uint32_t offset_cal_steps;    /**< periods of bridge-off offset calibration */
+    float dead_time_duty;         /**< 2 t_d / T_s: compensation at full current, fraction of the bus */
+    float inv_dead_time_band_per_a;
+    uint32_t detection_steps;     /**< periods a condition must persist */
+    float detection_alpha;        /**< T_s / tau of the rotation-gap low-pass */
+    float angle_step_per_speed;   /**< p T_s: electrical rad per period per rad/s */
+    float consistency_bound_rad;  /**< speed_consistency_bound_rad_s p T_s */
     pmstep_ref_coeffs_t ref_coeffs;
     pmstep_angle_coeffs_t angle_coeffs;
     pmstep_observer_coeffs_t observer_coeffs;
@@ -49,10 +66,19 @@ typedef struct {
     float u_applied_b_v;
     float u_pending_a_v;          /**< computed, waiting one period (delay = 1) */
     float u_pending_b_v;
+
+    pmstep_commissioning_t commissioning; /**< offsets (subtracted from every sample once measured), R, L, k_M */
+    union {
+        pmstep_commission_sums_t sums;    /**< until t_c */
+        pmstep_detector_t detector;       /**< from t_c */
+    } scratch;
 } pmstep_t;
 
 /** Validates @p cfg and prepares @p inst (mode IDLE). @return PMSTEP_OK or the first violation found. */
 pmstep_status_t pmstep_init(pmstep_t *inst, const pmstep_config_t *cfg);
+
+/** The model of the configuration: R, L, k_M as configured. */
+pmstep_electrical_t pmstep_configured_electrical(const pmstep_config_t *cfg);
 
 /** Validates a configuration without an instance. */
 pmstep_status_t pmstep_validate_config(const pmstep_config_t *cfg);
@@ -60,7 +86,7 @@ pmstep_status_t pmstep_validate_config(const pmstep_config_t *cfg);
 /** Back to IDLE with every state cleared (fault included); keeps the configuration. */
 void pmstep_reset(pmstep_t *inst);
 
-/** IDLE -> S_ALIGN. @return PMSTEP_ERR_BAD_MODE unless IDLE. */
+/** IDLE -> OFFSET_CAL (when configured) or S_ALIGN; commissioning restarts. @return PMSTEP_ERR_BAD_MODE unless IDLE. */
 pmstep_status_t pmstep_start(pmstep_t *inst);
 
 /** Any mode but FAULT -> IDLE (bridge off). @return PMSTEP_ERR_BAD_MODE in FAULT. */
@@ -84,13 +110,10 @@ void pmstep_step(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out
 /** Calibration and commissioning results so far (telemetry; see pmstep_commissioning_t). */
 void pmstep_get_commissioning(const pmstep_t *inst, pmstep_commissioning_t *out);
 
-/** Short upper-case name of a fault code, e.g. "SPEED_INCONSISTENT" (for logs and reports). */
-const char *pmstep_fault_name(pmstep_fault_t fault);
-
 /** Human-readable text for a status code. */
 const char *pmstep_status_str(pmstep_status_t status);
 
-/** Human-readable text for a fault code. */
+/** Name of a fault code, e.g. "SPEED_INCONSISTENT" (the enum's suffix; pmstep_types.h describes each). */
 const char *pmstep_fault_str(pmstep_fault_t fault);
 
 /** Human-readable name of a mode. */

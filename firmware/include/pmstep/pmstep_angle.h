@@ -6,6 +6,13 @@
  * with phi1(t_c) = phi2(t_c) = 0. Each period the applied (zero-order-held)
  * voltage is integrated exactly and the sampled current by the trapezoid rule;
  * the sums are compensated (Kahan) so float32 round-off does not drift.
+ *
+ * Drift-free option (not in the paper): (L/p)(c-hat, s-hat) k_M is the rotor flux
+ * estimated by integrating u - R i, whose true magnitude is k_M/p. Offsets and
+ * parameter errors make the open integral drift off that circle; the correction
+ *   phi1 += g T_s c-hat e / (L p/k_M),  phi2 += g T_s s-hat e / (L p/k_M),  e = 1 - c-hat^2 - s-hat^2
+ * pulls (c-hat, s-hat) back to the unit circle at the rate g (1/s), as the
+ * gradient flux observers of PMSM sensorless control do with the flux magnitude.
  */
 #ifndef PMSTEP_ANGLE_H
 #define PMSTEP_ANGLE_H
@@ -32,9 +39,12 @@ typedef struct {
     float voltage_gain;     /**< T_s / L, A per V */
     float current_gain;     /**< R T_s / (2 L), trapezoid weight */
     float flux_to_angle;    /**< L p / k_M, per A */
+    float correction_gain;  /**< g T_s / flux_to_angle of the drift-free option (0 = paper's method), A */
 } pmstep_angle_coeffs_t;
 
-void pmstep_angle_coeffs_init(pmstep_angle_coeffs_t *coeffs, const pmstep_config_t *cfg);
+/** Coefficients for the period and pole pairs of @p cfg and the electrical model @p model. */
+void pmstep_angle_coeffs_init(pmstep_angle_coeffs_t *coeffs, const pmstep_config_t *cfg,
+                              const pmstep_electrical_t *model);
 
 /** Starts the integrals at t_c: phi = 0, remembers i(t_c). */
 void pmstep_angle_start(pmstep_angle_t *angle, float i_a_a, float i_b_a);
@@ -50,6 +60,13 @@ void pmstep_angle_update(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coe
 /** c-hat and s-hat for the currents sampled now (the same as given to the last update). */
 void pmstep_angle_estimate(const pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs,
                            float i_a_a, float i_b_a, float *cos_hat, float *sin_hat);
+
+/**
+ * Drift-free option: moves phi1, phi2 so the next estimate is pulled onto the unit
+ * circle (see above). No effect with correction_gain = 0.
+ * @param[in] cos_hat, sin_hat  the estimate of this period
+ */
+void pmstep_angle_correct(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs, float cos_hat, float sin_hat);
 
 #ifdef __cplusplus
 }

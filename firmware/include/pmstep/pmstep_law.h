@@ -36,7 +36,9 @@ typedef struct {
     float i_d_ref_a, i_d_ref_rate;                          /**< i_d*, i_d*' */
 } pmstep_law_refs_t;
 
-void pmstep_law_coeffs_init(pmstep_law_coeffs_t *coeffs, const pmstep_config_t *cfg);
+/** Coefficients for the gains and mechanics of @p cfg and the electrical model @p model. */
+void pmstep_law_coeffs_init(pmstep_law_coeffs_t *coeffs, const pmstep_config_t *cfg,
+                            const pmstep_electrical_t *model);
 
 /** Smooth saturation and its derivative. */
 void pmstep_sat(float x, float kappa, float *sat, float *sat_slope);

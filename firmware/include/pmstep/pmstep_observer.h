@@ -55,7 +55,9 @@ typedef struct {
     float load_hat_rate_nm_per_s;
 } pmstep_observer_mech_rates_t;
 
-void pmstep_observer_coeffs_init(pmstep_observer_coeffs_t *coeffs, const pmstep_config_t *cfg);
+/** Coefficients for the gains and mechanics of @p cfg and the electrical model @p model. */
+void pmstep_observer_coeffs_init(pmstep_observer_coeffs_t *coeffs, const pmstep_config_t *cfg,
+                                 const pmstep_electrical_t *model);
 
 /** Starts at t_c: i-hat = i(t_c), w-hat = 0, T_L-hat = 0. */
 void pmstep_observer_start(pmstep_observer_t *obs, float i_a_a, float i_b_a);

@@ -130,6 +130,13 @@ typedef struct {
     uint32_t max_realignments;         /**< 0: a detection latches its fault; N: re-align (bridge on) up to N times */
 } pmstep_config_t;
 
+/** Electrical model the controller works with: the configured values, or commissioned ones. */
+typedef struct {
+    float resistance_ohm;           /**< R */
+    float inductance_h;             /**< L */
+    float torque_constant_nm_per_a; /**< k_M */
+} pmstep_electrical_t;
+
 /** Samples taken at the start of a period. */
 typedef struct {
     float i_a_a;         /**< phase a current */
@@ -170,7 +177,7 @@ typedef struct {
     float resistance_ohm;           /**< R from the alignment steady states, u/i (0: not measured) */
     float inductance_h;             /**< L from the current rise at the start of s-alignment (0: not measured) */
     float torque_constant_nm_per_a; /**< k_M from the flux swing of c-alignment (0: not measured) */
-    float dead_time_voltage_v;      /**< full dead-time compensation per phase, 2 V_bus t_d / T_s, last step (V) */
+    float dead_time_duty;           /**< dead-time compensation at full current, 2 t_d / T_s of the bus per phase */
     uint32_t realignments;          /**< re-alignments after a detection since start */
     bool measured;                  /**< alignment finished and the values above were taken */
 } pmstep_commissioning_t;

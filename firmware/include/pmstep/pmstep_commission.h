@@ -1,0 +1,80 @@
+/**
+ * @file pmstep_commission.h
+ * @brief Remark 2 calibration and self-commissioning from the alignment phases.
+ *
+ * What the alignments make observable (sample m counts periods from the start of
+ * s-alignment; u is the voltage applied over the period that ends at the sample):
+ *  - offsets: a phase whose true current is zero (bridge off before s-alignment;
+ *    i_a at the end of s-alignment (3) and i_b at the end of c-alignment (5),
+ *    where u_a resp. u_b = 0) reads its sensor offset;
+ *  - R: the steady states i_b = u_cs/R (end of s-alignment) and i_a = u_cc/R (end
+ *    of c-alignment), each over a window of W samples;
+ *  - L: the rise of i_b over the first N periods of s-alignment, when the rotor
+ *    has not moved yet: L (i_b(N) - i_b(0)) = integral of (u_b - R i_b);
+ *  - k_M: the flux swing of c-alignment, the rotor turning from sin p theta = 1 to
+ *    cos p theta = 1. With x = L i + (k_M/p)(cos p theta, sin p theta) and x' = u - R i
+ *    (model (1)), over [t_s, t_c]:
+ *      k_M/p =  integral(u_a - R i_a) - L delta i_a      (cos: 0 -> 1)
+ *      k_M/p = -integral(u_b - R i_b) + L delta i_b      (sin: 1 -> 0)
+ *    and the two are averaged. Each phase's R is the one measured on that phase, so
+ *    a constant voltage bias (dead time) or current offset on it cancels.
+ * Currents are integrated by the trapezoid rule, held voltages exactly.
+ */
+#ifndef PMSTEP_COMMISSION_H
+#define PMSTEP_COMMISSION_H
+
+#include "pmstep/pmstep_types.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** When each measurement is taken, in samples from the start of s-alignment. */
+typedef struct {
+    uint32_t s_align_steps;     /**< first sample of c-alignment (t_s) */
+    uint32_t c_align_end_step;  /**< sample at t_c */
+    uint32_t window_steps;      /**< W: steady-state window at the end of each alignment (0 = none) */
+    uint32_t inductance_steps;  /**< N: current-rise window (0 = L not measured) */
+    bool offsets_from_alignment;/**< take offsets from the alignment steady states too */
+} pmstep_commission_plan_t;
+
+/** Running sums (raw samples; offsets are removed at the end). */
+typedef struct {
+    float zero_sum_a_a, zero_sum_b_a;       /**< samples of a phase whose true current is 0 */
+    uint32_t zero_count_a, zero_count_b;
+    float rise_voltage_sum_v, rise_current_sum_a, rise_start_a, rise_end_a; /**< L, phase b */
+    float s_current_sum_a, s_voltage_sum_v; /**< end of s-alignment, phase b */
+    float c_current_sum_a, c_voltage_sum_v; /**< end of c-alignment, phase a */
+    uint32_t s_count, c_count;
+    float swing_voltage_a_v, swing_current_a_a, swing_start_a_a; /**< c-alignment, k_M */
+    float swing_voltage_b_v, swing_current_b_a, swing_start_b_a;
+} pmstep_commission_sums_t;
+
+void pmstep_commission_clear(pmstep_commission_sums_t *sums);
+
+/** A sample with the bridge off (true currents zero). */
+void pmstep_commission_add_bridge_off(pmstep_commission_sums_t *sums, float i_a_a, float i_b_a);
+
+/**
+ * Sample @p sample (< c_align_end_step) of the alignment.
+ * @param[in] u_a_v, u_b_v  voltage applied over the period that ends at this sample
+ */
+void pmstep_commission_add_alignment(pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
+                                     uint32_t sample, float i_a_a, float i_b_a, float u_a_v, float u_b_v);
+
+/**
+ * At t_c: offsets, R, L and k_M from the sums and the samples (i_a, i_b) at t_c;
+ * values not measured are left 0 in @p result. The voltages over the last period
+ * before t_c are @p u_a_v, @p u_b_v.
+ * @return PMSTEP_FAULT_NONE, or PMSTEP_FAULT_COMMISSIONING when a measured value is not
+ *         finite or outside [1/2, 2] x the configured one.
+ */
+pmstep_fault_t pmstep_commission_finish(const pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
+                                        const pmstep_config_t *cfg, float i_a_a, float i_b_a, float u_a_v,
+                                        float u_b_v, pmstep_commissioning_t *result);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PMSTEP_COMMISSION_H */

@@ -1,0 +1,148 @@
+/* Remark 2 calibration and self-commissioning from the alignment phases (see pmstep_commission.h). */
+#include "pmstep/pmstep_commission.h"
+
+#include <math.h> /* isfinite: a classification macro, no libm call */
+
+void pmstep_commission_clear(pmstep_commission_sums_t *sums)
+{
+    static const pmstep_commission_sums_t zero_sums = {0};
+    *sums = zero_sums;
+}
+
+void pmstep_commission_add_bridge_off(pmstep_commission_sums_t *sums, float i_a_a, float i_b_a)
+{
+    sums->zero_sum_a_a += i_a_a;
+    sums->zero_sum_b_a += i_b_a;
+    sums->zero_count_a++;
+    sums->zero_count_b++;
+}
+
+/* Sample in the W samples before @p end? */
+static bool in_window(uint32_t sample, uint32_t end, uint32_t window)
+{
+    return sample < end && sample + window >= end;
+}
+
+void pmstep_commission_add_alignment(pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
+                                     uint32_t sample, float i_a_a, float i_b_a, float u_a_v, float u_b_v)
+{
+    if (sample <= plan->inductance_steps && plan->inductance_steps > 0u) {
+        if (sample == 0u) {
+            sums->rise_start_a = i_b_a;
+        } else {
+            sums->rise_voltage_sum_v += u_b_v;
+        }
+        sums->rise_current_sum_a += i_b_a;
+        sums->rise_end_a = i_b_a;
+    }
+    if (sample < plan->s_align_steps) {
+        if (in_window(sample, plan->s_align_steps, plan->window_steps)) {
+            sums->s_current_sum_a += i_b_a;
+            sums->s_voltage_sum_v += u_b_v;
+            sums->s_count++;
+            if (plan->offsets_from_alignment) {
+                sums->zero_sum_a_a += i_a_a; /* u_a = 0: i_a -> 0 */
+                sums->zero_count_a++;
+            }
+        }
+        return;
+    }
+    if (sample == plan->s_align_steps) {
+        sums->swing_start_a_a = i_a_a;
+        sums->swing_start_b_a = i_b_a;
+    } else {
+        sums->swing_voltage_a_v += u_a_v;
+        sums->swing_voltage_b_v += u_b_v;
+    }
+    sums->swing_current_a_a += i_a_a;
+    sums->swing_current_b_a += i_b_a;
+    if (in_window(sample, plan->c_align_end_step, plan->window_steps)) {
+        sums->c_current_sum_a += i_a_a;
+        sums->c_voltage_sum_v += u_a_v;
+        sums->c_count++;
+        if (plan->offsets_from_alignment) {
+            sums->zero_sum_b_a += i_b_a; /* u_b = 0: i_b -> 0 */
+            sums->zero_count_b++;
+        }
+    }
+}
+
+static float mean_or_zero(float sum, uint32_t count)
+{
+    return count > 0u ? sum / (float)count : 0.0f;
+}
+
+/* Measured value plausible: finite and within [1/2, 2] x the configured one. */
+static bool plausible(float measured, float configured)
+{
+    return isfinite(measured) && measured >= 0.5f * configured && measured <= 2.0f * configured;
+}
+
+/* Trapezoid integral (A s) of the samples 0..n whose sum is @p sum, minus the offset. */
+static float current_integral(float sum, float first, float last, uint32_t periods, float offset, float period_s)
+{
+    return period_s * (sum - 0.5f * (first + last) - (float)periods * offset);
+}
+
+/* R = u/i from a steady-state window's sums. */
+static float window_resistance(float voltage_sum_v, float current_sum_a, uint32_t count, float offset_a)
+{
+    return (voltage_sum_v / (float)count) / (current_sum_a / (float)count - offset_a);
+}
+
+/* integral(u - R i) - L delta i over the c-alignment swing of one phase (V s). */
+static float swing_flux(float voltage_sum_v, float current_sum_a, float start_a, float end_a, uint32_t periods,
+                        float offset_a, float resistance_ohm, float inductance_h, float period_s)
+{
+    const float charge_a_s = current_integral(current_sum_a + end_a, start_a, end_a, periods, offset_a, period_s);
+    return period_s * voltage_sum_v - resistance_ohm * charge_a_s - inductance_h * (end_a - start_a);
+}
+
+pmstep_fault_t pmstep_commission_finish(const pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
+                                        const pmstep_config_t *cfg, float i_a_a, float i_b_a, float u_a_v,
+                                        float u_b_v, pmstep_commissioning_t *result)
+{
+    const float period_s = cfg->period_s;
+    const float offset_a = mean_or_zero(sums->zero_sum_a_a, sums->zero_count_a);
+    const float offset_b = mean_or_zero(sums->zero_sum_b_a, sums->zero_count_b);
+    const bool windows = sums->s_count > 0u && sums->c_count > 0u;
+    float r_a = cfg->resistance_ohm;
+    float r_b = cfg->resistance_ohm;
+    float inductance_h = cfg->inductance_h;
+
+    result->offset_a_a = offset_a;
+    result->offset_b_a = offset_b;
+    result->offset_samples = sums->zero_count_a + sums->zero_count_b;
+    result->resistance_ohm = 0.0f;
+    result->inductance_h = 0.0f;
+    result->torque_constant_nm_per_a = 0.0f;
+    result->measured = true;
+    if (windows) {
+        /* Steady states of (3) and (5): R = u/i on each phase. */
+        r_b = window_resistance(sums->s_voltage_sum_v, sums->s_current_sum_a, sums->s_count, offset_b);
+        r_a = window_resistance(sums->c_voltage_sum_v, sums->c_current_sum_a, sums->c_count, offset_a);
+        result->resistance_ohm = 0.5f * (r_a + r_b);
+    }
+    if (plan->inductance_steps > 0u) {
+        /* L delta i = integral(u - R i) over the rise; the rotor has not moved yet. */
+        const float charge_a_s = current_integral(sums->rise_current_sum_a, sums->rise_start_a, sums->rise_end_a,
+                                                  plan->inductance_steps, offset_b, period_s);
+        inductance_h = (period_s * sums->rise_voltage_sum_v - r_b * charge_a_s) / (sums->rise_end_a - sums->rise_start_a);
+        result->inductance_h = inductance_h;
+    }
+    if (windows) {
+        /* Flux swing of c-alignment (see the header), samples t_s .. t_c; the sign of phase b's is reversed. */
+        const uint32_t periods = plan->c_align_end_step - plan->s_align_steps;
+        const float flux_a = swing_flux(sums->swing_voltage_a_v + u_a_v, sums->swing_current_a_a, sums->swing_start_a_a,
+                                        i_a_a, periods, offset_a, r_a, inductance_h, period_s);
+        const float flux_b = swing_flux(sums->swing_voltage_b_v + u_b_v, sums->swing_current_b_a, sums->swing_start_b_a,
+                                        i_b_a, periods, offset_b, r_b, inductance_h, period_s);
+        result->torque_constant_nm_per_a = 0.5f * (flux_a - flux_b) * (float)cfg->pole_pairs;
+    }
+    if ((windows && !(plausible(result->resistance_ohm, cfg->resistance_ohm)
+                      && plausible(result->torque_constant_nm_per_a, cfg->torque_constant_nm_per_a)))
+        || (plan->inductance_steps > 0u && !plausible(inductance_h, cfg->inductance_h))) {
+        return PMSTEP_FAULT_COMMISSIONING;
+    }
+    return PMSTEP_FAULT_NONE;
+}
