@@ -2,11 +2,11 @@
 #include "pmstep/pmstep_commission.h"
 
 #include <math.h> /* isfinite: a classification macro, no libm call */
+#include <string.h>
 
 void pmstep_commission_clear(pmstep_commission_sums_t *sums)
 {
-    static const pmstep_commission_sums_t zero_sums = {0};
-    *sums = zero_sums;
+    memset(sums, 0, sizeof *sums);
 }
 
 void pmstep_commission_add_bridge_off(pmstep_commission_sums_t *sums, float i_a_a, float i_b_a)
@@ -26,12 +26,12 @@ static bool in_window(uint32_t sample, uint32_t end, uint32_t window)
 void pmstep_commission_add_alignment(pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
                                      uint32_t sample, float i_a_a, float i_b_a, float u_a_v, float u_b_v)
 {
-    if (sample <= plan->inductance_steps && plan->inductance_steps > 0u) {
+    if (sample <= plan->inductance_steps) {
+        /* Samples 0..N of the rise, voltages over periods 1..N (sample 0 has none yet). */
         if (sample == 0u) {
             sums->rise_start_a = i_b_a;
-        } else {
-            sums->rise_voltage_sum_v += u_b_v;
         }
+        sums->rise_voltage_sum_v += sample > 0u ? u_b_v : 0.0f;
         sums->rise_current_sum_a += i_b_a;
         sums->rise_end_a = i_b_a;
     }
@@ -39,7 +39,6 @@ void pmstep_commission_add_alignment(pmstep_commission_sums_t *sums, const pmste
         if (in_window(sample, plan->s_align_steps, plan->window_steps)) {
             sums->s_current_sum_a += i_b_a;
             sums->s_voltage_sum_v += u_b_v;
-            sums->s_count++;
             if (plan->offsets_from_alignment) {
                 sums->zero_sum_a_a += i_a_a; /* u_a = 0: i_a -> 0 */
                 sums->zero_count_a++;
@@ -59,7 +58,6 @@ void pmstep_commission_add_alignment(pmstep_commission_sums_t *sums, const pmste
     if (in_window(sample, plan->c_align_end_step, plan->window_steps)) {
         sums->c_current_sum_a += i_a_a;
         sums->c_voltage_sum_v += u_a_v;
-        sums->c_count++;
         if (plan->offsets_from_alignment) {
             sums->zero_sum_b_a += i_b_a; /* u_b = 0: i_b -> 0 */
             sums->zero_count_b++;
@@ -105,7 +103,7 @@ pmstep_fault_t pmstep_commission_finish(const pmstep_commission_sums_t *sums, co
     const float period_s = cfg->period_s;
     const float offset_a = mean_or_zero(sums->zero_sum_a_a, sums->zero_count_a);
     const float offset_b = mean_or_zero(sums->zero_sum_b_a, sums->zero_count_b);
-    const bool windows = sums->s_count > 0u && sums->c_count > 0u;
+    const bool windows = plan->window_steps > 0u;
     float r_a = cfg->resistance_ohm;
     float r_b = cfg->resistance_ohm;
     float inductance_h = cfg->inductance_h;
@@ -119,8 +117,8 @@ pmstep_fault_t pmstep_commission_finish(const pmstep_commission_sums_t *sums, co
     result->measured = true;
     if (windows) {
         /* Steady states of (3) and (5): R = u/i on each phase. */
-        r_b = window_resistance(sums->s_voltage_sum_v, sums->s_current_sum_a, sums->s_count, offset_b);
-        r_a = window_resistance(sums->c_voltage_sum_v, sums->c_current_sum_a, sums->c_count, offset_a);
+        r_b = window_resistance(sums->s_voltage_sum_v, sums->s_current_sum_a, plan->window_steps, offset_b);
+        r_a = window_resistance(sums->c_voltage_sum_v, sums->c_current_sum_a, plan->window_steps, offset_a);
         result->resistance_ohm = 0.5f * (r_a + r_b);
     }
     if (plan->inductance_steps > 0u) {

@@ -173,18 +173,18 @@ const char *pmstep_status_str(pmstep_status_t status)
     case PMSTEP_ERR_POLE_PAIRS: return "p must be >= 1";
     case PMSTEP_ERR_PERIOD: return "T_s must be > 0";
     case PMSTEP_ERR_GAIN: return "gains must be > 0";
-    case PMSTEP_ERR_PERIOD_TOO_LONG: return "(R/L + K_e) T_s, (R/L + K_i) T_s must be < 0.5";
+    case PMSTEP_ERR_PERIOD_TOO_LONG: return "T_s too long: (R/L + K) T_s >= 0.5";
     case PMSTEP_ERR_ALIGNMENT_CONDITION: return "condition (4) violated";
     case PMSTEP_ERR_ALIGNMENT_VOLTAGE: return "need 0 < u_cs, u_cc <= min bus";
     case PMSTEP_ERR_ALIGNMENT_TIME: return "need T_s <= t_s <= t_c - T_s";
     case PMSTEP_ERR_REFERENCE_BANDWIDTH: return "need 0 < varpi_0 T_s <= 0.5";
-    case PMSTEP_ERR_LIMITS: return "need max current > 0, 0 < min bus < max bus";
+    case PMSTEP_ERR_LIMITS: return "need 0 < min bus < max bus, current > 0";
     case PMSTEP_ERR_DELAY: return "delay must be 0 or 1 period";
     case PMSTEP_ERR_BAD_MODE: return "not allowed in this mode";
-    case PMSTEP_ERR_BAD_COMMAND_VALUE: return "command NaN/Inf or ramp rate <= 0";
-    case PMSTEP_ERR_ALIGNMENT_CURRENT: return "alignment current u/R >= overcurrent trip";
+    case PMSTEP_ERR_BAD_COMMAND_VALUE: return "bad command value";
+    case PMSTEP_ERR_ALIGNMENT_CURRENT: return "alignment u/R >= current limit";
     case PMSTEP_ERR_CALIBRATION: return "calibration settings invalid";
-    case PMSTEP_ERR_DETECTION: return "need detection bounds >= 0, time >= 4 T_s";
+    case PMSTEP_ERR_DETECTION: return "detection settings invalid";
     }
     return "unknown status";
 }

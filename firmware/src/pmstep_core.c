@@ -4,18 +4,19 @@
 
 #include <math.h> /* isfinite: a classification macro, no libm call */
 #include <stddef.h>
+#include <string.h>
 
 static uint32_t periods_in(float duration_s, float period_s)
 {
     return (uint32_t)(duration_s / period_s + 0.5f);
 }
 
-/* Coefficients of the angle, observer and law for the electrical model in use. */
-static void apply_model(pmstep_t *inst)
+/* Coefficients of the angle, observer and law for the electrical model @p model. */
+static void apply_model(pmstep_t *inst, const pmstep_electrical_t *model)
 {
-    pmstep_angle_coeffs_init(&inst->angle_coeffs, inst->cfg, &inst->model);
-    pmstep_observer_coeffs_init(&inst->observer_coeffs, inst->cfg, &inst->model);
-    pmstep_law_coeffs_init(&inst->law_coeffs, inst->cfg, &inst->model);
+    pmstep_angle_coeffs_init(&inst->angle_coeffs, inst->cfg, model);
+    pmstep_observer_coeffs_init(&inst->observer_coeffs, inst->cfg, model);
+    pmstep_law_coeffs_init(&inst->law_coeffs, inst->cfg, model);
 }
 
 pmstep_status_t pmstep_init(pmstep_t *inst, const pmstep_config_t *cfg)
@@ -29,13 +30,9 @@ pmstep_status_t pmstep_init(pmstep_t *inst, const pmstep_config_t *cfg)
         return status;
     }
     inst->cfg = cfg;
-    inst->model = pmstep_configured_electrical(cfg);
     pmstep_ref_coeffs_init(&inst->ref_coeffs, cfg->reference_bandwidth_rad_per_s, cfg->period_s);
-    apply_model(inst);
-    inst->s_align_steps = periods_in(cfg->s_align_time_s, cfg->period_s);
-    inst->c_align_end_step = periods_in(cfg->c_align_time_s, cfg->period_s);
-    inst->commission_plan.s_align_steps = inst->s_align_steps;
-    inst->commission_plan.c_align_end_step = inst->c_align_end_step;
+    inst->commission_plan.s_align_steps = periods_in(cfg->s_align_time_s, cfg->period_s);
+    inst->commission_plan.c_align_end_step = periods_in(cfg->c_align_time_s, cfg->period_s);
     inst->commission_plan.window_steps = periods_in(cfg->steady_state_window_s, cfg->period_s);
     inst->commission_plan.inductance_steps = periods_in(cfg->inductance_window_s, cfg->period_s);
     inst->commission_plan.offsets_from_alignment = cfg->alignment_offset_calibration;
@@ -53,11 +50,10 @@ pmstep_status_t pmstep_init(pmstep_t *inst, const pmstep_config_t *cfg)
 /* Forgets what the last alignment measured: offsets 0, the configured model, sums cleared. */
 static void clear_commissioning(pmstep_t *inst)
 {
-    static const pmstep_commissioning_t none = {0};
-    inst->commissioning = none;
+    const pmstep_electrical_t configured = pmstep_configured_electrical(inst->cfg);
+    memset(&inst->commissioning, 0, sizeof inst->commissioning);
     pmstep_commission_clear(&inst->scratch.sums);
-    inst->model = pmstep_configured_electrical(inst->cfg);
-    apply_model(inst);
+    apply_model(inst, &configured);
 }
 
 /* Clears the dynamic state of the strategy; keeps commands (targets) untouched. */
@@ -127,12 +123,19 @@ pmstep_status_t pmstep_clear_fault(pmstep_t *inst)
     return PMSTEP_OK;
 }
 
+/* x - x is 0 for every finite x and NaN for NaN and +/-Inf, so one compare checks a
+ * sum of such differences (cheaper than one isfinite per value on the FPU). */
+static bool all_finite4(float a, float b, float c, float d)
+{
+    return ((a - a) + (b - b)) + ((c - c) + (d - d)) == 0.0f;
+}
+
 pmstep_status_t pmstep_set_speed_target(pmstep_t *inst, float target_rad_s, float ramp_rate_rad_s2)
 {
     if (inst == NULL) {
         return PMSTEP_ERR_NULL_ARGUMENT;
     }
-    if (!isfinite(target_rad_s) || !isfinite(ramp_rate_rad_s2) || !(ramp_rate_rad_s2 > 0.0f)) {
+    if (!all_finite4(target_rad_s, ramp_rate_rad_s2, 0.0f, 0.0f) || !(ramp_rate_rad_s2 > 0.0f)) {
         return PMSTEP_ERR_BAD_COMMAND_VALUE;
     }
     pmstep_ref_set_target(&inst->speed_ref, target_rad_s, ramp_rate_rad_s2);
@@ -144,7 +147,7 @@ pmstep_status_t pmstep_set_id_target(pmstep_t *inst, float target_a)
     if (inst == NULL) {
         return PMSTEP_ERR_NULL_ARGUMENT;
     }
-    if (!isfinite(target_a)) {
+    if (!all_finite4(target_a, 0.0f, 0.0f, 0.0f)) {
         return PMSTEP_ERR_BAD_COMMAND_VALUE;
     }
     pmstep_ref_set_target(&inst->i_d_ref, target_a, 0.0f);
@@ -154,13 +157,6 @@ pmstep_status_t pmstep_set_id_target(pmstep_t *inst, float target_a)
 static float abs_f(float x)
 {
     return x < 0.0f ? -x : x;
-}
-
-/* x - x is 0 for every finite x and NaN for NaN and +/-Inf, so one compare checks a
- * sum of such differences (cheaper than one isfinite per value on the FPU). */
-static bool all_finite4(float a, float b, float c, float d)
-{
-    return ((a - a) + (b - b)) + ((c - c) + (d - d)) == 0.0f;
 }
 
 /* Protections, checked while the bridge may be on. */
@@ -197,6 +193,7 @@ static pmstep_fault_t finish_commissioning(pmstep_t *inst, const pmstep_meas_t *
 {
     const pmstep_config_t *cfg = inst->cfg;
     pmstep_commissioning_t *result = &inst->commissioning;
+    pmstep_electrical_t model = pmstep_configured_electrical(cfg);
     const pmstep_fault_t fault =
         pmstep_commission_finish(&inst->scratch.sums, &inst->commission_plan, cfg, raw->i_a_a, raw->i_b_a,
                                  inst->u_applied_a_v, inst->u_applied_b_v, result);
@@ -204,15 +201,15 @@ static pmstep_fault_t finish_commissioning(pmstep_t *inst, const pmstep_meas_t *
         return fault;
     }
     if (cfg->use_commissioned_resistance) {
-        inst->model.resistance_ohm = result->resistance_ohm;
+        model.resistance_ohm = result->resistance_ohm;
     }
     if (cfg->use_commissioned_inductance) {
-        inst->model.inductance_h = result->inductance_h;
+        model.inductance_h = result->inductance_h;
     }
     if (cfg->use_commissioned_torque_constant) {
-        inst->model.torque_constant_nm_per_a = result->torque_constant_nm_per_a;
+        model.torque_constant_nm_per_a = result->torque_constant_nm_per_a;
     }
-    apply_model(inst);
+    apply_model(inst, &model);
     return PMSTEP_FAULT_NONE;
 }
 
@@ -419,9 +416,9 @@ void pmstep_step(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out
         offset_calibration_step(inst, meas, out);
         return;
     }
-    if (inst->mode_step >= inst->c_align_end_step) {
+    if (inst->mode_step >= inst->commission_plan.c_align_end_step) {
         inst->mode = PMSTEP_MODE_RUN;
-    } else if (inst->mode_step >= inst->s_align_steps) {
+    } else if (inst->mode_step >= inst->commission_plan.s_align_steps) {
         inst->mode = PMSTEP_MODE_C_ALIGN;
     }
     if (!inst->commissioning.measured) {
@@ -511,5 +508,4 @@ void pmstep_step(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out
 void pmstep_get_commissioning(const pmstep_t *inst, pmstep_commissioning_t *out)
 {
     *out = inst->commissioning;
-    out->dead_time_duty = inst->dead_time_duty;
 }

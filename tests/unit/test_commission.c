@@ -190,7 +190,7 @@ static void hold_to_run(pmstep_t *inst, pmstep_output_t *out)
     const pmstep_meas_t m = {8.0f, 0.0f, 48.0f, 0.0f};
     uint32_t k;
     assert_int_equal(pmstep_start(inst), PMSTEP_OK);
-    for (k = 0; k <= inst->c_align_end_step; ++k) {
+    for (k = 0; k <= inst->commission_plan.c_align_end_step; ++k) {
         pmstep_step(inst, &m, out);
     }
     assert_int_equal(out->mode, PMSTEP_MODE_RUN);

@@ -33,8 +33,7 @@ typedef struct {
 /** One controller instance; all state lives here. Treat the fields as private. */
 typedef struct {
     const pmstep_config_t *cfg;
-    pmstep_electrical_t model;    /**< R, L, k_M in use: configured, or commissioned at t_c */
-    pmstep_commission_plan_t commission_plan;
+    pmstep_commission_plan_t commission_plan; /**< alignment timing (t_s, t_c in periods) and windows */
     uint32_t offset_cal_steps;    /**< periods of bridge-off offset calibration */
     float dead_time_duty;         /**< 2 t_d / T_s: compensation at full current, fraction of the bus */
     float inv_dead_time_band_per_a;
@@ -46,8 +45,6 @@ typedef struct {
     pmstep_angle_coeffs_t angle_coeffs;
     pmstep_observer_coeffs_t observer_coeffs;
     pmstep_law_coeffs_t law_coeffs;
-    uint32_t s_align_steps;       /**< periods of s-alignment */
-    uint32_t c_align_end_step;    /**< periods from start to t_c */
 
     pmstep_mode_t mode;
     pmstep_fault_t fault;

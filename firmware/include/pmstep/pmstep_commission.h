@@ -45,7 +45,6 @@ typedef struct {
     float rise_voltage_sum_v, rise_current_sum_a, rise_start_a, rise_end_a; /**< L, phase b */
     float s_current_sum_a, s_voltage_sum_v; /**< end of s-alignment, phase b */
     float c_current_sum_a, c_voltage_sum_v; /**< end of c-alignment, phase a */
-    uint32_t s_count, c_count;
     float swing_voltage_a_v, swing_current_a_a, swing_start_a_a; /**< c-alignment, k_M */
     float swing_voltage_b_v, swing_current_b_a, swing_start_b_a;
 } pmstep_commission_sums_t;

@@ -177,7 +177,6 @@ typedef struct {
     float resistance_ohm;           /**< R from the alignment steady states, u/i (0: not measured) */
     float inductance_h;             /**< L from the current rise at the start of s-alignment (0: not measured) */
     float torque_constant_nm_per_a; /**< k_M from the flux swing of c-alignment (0: not measured) */
-    float dead_time_duty;           /**< dead-time compensation at full current, 2 t_d / T_s of the bus per phase */
     uint32_t realignments;          /**< re-alignments after a detection since start */
     bool measured;                  /**< alignment finished and the values above were taken */
 } pmstep_commissioning_t;
