@@ -7,6 +7,7 @@ packages=(
   cmake ninja-build gcc g++ pkg-config     # host build
   libcmocka-dev                            # C unit tests
   libinih-dev libcjson-dev                 # SIL scenario files (INI) and JSON summaries
+  libgsl-dev                               # SIL measurement chain: random number generator (MT19937, Gaussian)
   gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi  # Cortex-M4F build
   qemu-system-arm                          # processor-in-the-loop on an emulated Cortex-M4
   python3                                  # benchmark scripts (tools/bench_sil.py, tools/bench_target.py)

@@ -7,6 +7,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "pmstep_hal_host.h"
 #include "sil/runner.h"
 
 static void usage(FILE *f)
@@ -33,14 +34,49 @@ static bool write_row(const sil_sample_t *x, void *user)
 {
     csv_ctx_t *csv = (csv_ctx_t *)user;
     const pmstep_output_t *o = x->out;
+    const pmstep_hal_host_t *port = pmstep_hal_host_state(); /* its last sample is this period's */
     if (x->step % csv->decimation != 0) {
         return true;
     }
-    fprintf(csv->file, "%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d\n", x->t_s,
-            x->theta_rad, x->omega_rad_s, (double)o->speed_ref_rad_s, x->i_a_a, x->i_b_a, x->u_a_v, x->u_b_v,
+    fprintf(csv->file,
+            "%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%.9g,%.9g,%.9g,%.9g\n",
+            x->t_s, x->theta_rad, x->omega_rad_s, (double)o->speed_ref_rad_s, x->i_a_a, x->i_b_a, x->u_a_v, x->u_b_v,
             (double)o->cos_hat, (double)o->sin_hat, x->cos_ptheta, x->sin_ptheta, (double)o->speed_hat_rad_s,
-            (double)o->load_hat_nm, x->load_nm, (int)o->mode, (int)o->fault);
+            (double)o->load_hat_nm, x->load_nm, (int)o->mode, (int)o->fault, (double)port->meas.i_a_a,
+            (double)port->meas.i_b_a, port->bus_v, (double)port->meas.bus_voltage_v);
     return true;
+}
+
+/* The [sensors], [inverter] and [bus] settings and what the ADC clipped. */
+static cJSON *measurement_chain_json(const sil_scenario_t *sc)
+{
+    const pmstep_hal_host_t *port = pmstep_hal_host_state();
+    cJSON *chain = cJSON_CreateObject();
+    cJSON *sensors = cJSON_CreateObject();
+    cJSON *inverter = cJSON_CreateObject();
+    cJSON *bus = cJSON_CreateObject();
+    cJSON_AddNumberToObject(sensors, "adc_bits", sc->sensors.adc_bits);
+    cJSON_AddNumberToObject(sensors, "current_full_scale_a", sc->sensors.current_full_scale_a);
+    cJSON_AddNumberToObject(sensors, "offset_a_a", sc->sensors.offset_a_a);
+    cJSON_AddNumberToObject(sensors, "offset_b_a", sc->sensors.offset_b_a);
+    cJSON_AddNumberToObject(sensors, "gain_error_a", sc->sensors.gain_error_a);
+    cJSON_AddNumberToObject(sensors, "gain_error_b", sc->sensors.gain_error_b);
+    cJSON_AddNumberToObject(sensors, "noise_rms_a", sc->sensors.noise_rms_a);
+    cJSON_AddNumberToObject(sensors, "bus_full_scale_v", sc->sensors.bus_full_scale_v);
+    cJSON_AddNumberToObject(sensors, "bus_noise_rms_v", sc->sensors.bus_noise_rms_v);
+    cJSON_AddItemToObject(chain, "sensors", sensors);
+    cJSON_AddStringToObject(inverter, "model", sc->inverter.model == SIL_INVERTER_SWITCHING ? "switching" : "averaged");
+    cJSON_AddNumberToObject(inverter, "dead_time_s", sc->inverter.dead_time_s);
+    cJSON_AddItemToObject(chain, "inverter", inverter);
+    cJSON_AddNumberToObject(bus, "voltage_v", sc->bus_voltage_v);
+    cJSON_AddNumberToObject(bus, "source_resistance_ohm", sc->bus.source_resistance_ohm);
+    cJSON_AddNumberToObject(bus, "ripple_v", sc->bus.ripple_v);
+    cJSON_AddNumberToObject(bus, "ripple_hz", sc->bus.ripple_hz);
+    cJSON_AddItemToObject(chain, "bus", bus);
+    /* Phase samples (two per period) and bus samples at an end code of the ADC. */
+    cJSON_AddNumberToObject(chain, "adc_clipped_current_samples", (double)port->sensors.clipped_current_samples);
+    cJSON_AddNumberToObject(chain, "adc_clipped_bus_samples", (double)port->sensors.clipped_bus_samples);
+    return chain;
 }
 
 static cJSON *summary_json(const sil_scenario_t *sc, const sil_summary_t *s)
@@ -60,6 +96,8 @@ static cJSON *summary_json(const sil_scenario_t *sc, const sil_summary_t *s)
     cJSON_AddNumberToObject(root, "c_align_time_s", (double)sc->controller.c_align_time_s);
     cJSON_AddNumberToObject(root, "transient_window_s", sc->transient_window_s);
     cJSON_AddNumberToObject(root, "theta0_deg", sc->theta0_rad * 180.0 / 3.14159265358979323846);
+    cJSON_AddNumberToObject(root, "seed", (double)sc->seed);
+    cJSON_AddItemToObject(root, "measurement_chain", measurement_chain_json(sc));
 
     cJSON_AddNumberToObject(align, "cos_ptheta_at_ts", s->cos_ptheta_at_ts);
     cJSON_AddNumberToObject(align, "sin_ptheta_at_ts", s->sin_ptheta_at_ts);
@@ -224,7 +262,8 @@ int main(int argc, char **argv)
         }
         csv.decimation = sc.decimation;
         fprintf(csv.file, "t_s,theta_rad,omega_rad_s,omega_ref_rad_s,i_a_a,i_b_a,u_a_v,u_b_v,cos_hat,sin_hat,"
-                          "cos_ptheta,sin_ptheta,omega_hat_rad_s,load_hat_nm,load_nm,mode,fault\n");
+                          "cos_ptheta,sin_ptheta,omega_hat_rad_s,load_hat_nm,load_nm,mode,fault,"
+                          "i_a_meas_a,i_b_meas_a,bus_voltage_v,bus_voltage_meas_v\n");
     }
     if (record_path != NULL) {
         record = fopen(record_path, "wb");
@@ -237,9 +276,10 @@ int main(int argc, char **argv)
         }
     }
     if (!quiet) {
-        fprintf(stderr, "pmstep-sil: scenario '%s', %.3f s at %.0f Hz, %d RK4 substeps, delay %u\n", sc.name,
-                sc.duration_s, 1.0 / (double)sc.controller.period_s, sc.substeps,
-                (unsigned)sc.controller.computational_delay_periods);
+        fprintf(stderr, "pmstep-sil: scenario '%s', %.3f s at %.0f Hz, %d RK4 substeps, delay %u, %s inverter, seed %lu\n",
+                sc.name, sc.duration_s, 1.0 / (double)sc.controller.period_s, sc.substeps,
+                (unsigned)sc.controller.computational_delay_periods,
+                sc.inverter.model == SIL_INVERTER_SWITCHING ? "switching" : "averaged", (unsigned long)sc.seed);
     }
     run_status = sil_run_record(&sc, write_csv ? write_row : NULL, &csv, !quiet, &summary, record);
     if (record != NULL && fclose(record) != 0 && run_status == 0) {
@@ -247,6 +287,13 @@ int main(int argc, char **argv)
     }
     if (run_status == -2) {
         fprintf(stderr, "pmstep-sil: error writing the record '%s'\n", record_path);
+        if (csv.file != NULL) {
+            fclose(csv.file);
+        }
+        return 2;
+    }
+    if (run_status == -3) {
+        fprintf(stderr, "pmstep-sil: out of memory for the measurement chain's random number generator\n");
         if (csv.file != NULL) {
             fclose(csv.file);
         }

@@ -16,16 +16,47 @@ void sil_metrics_init(sil_metrics_t *m, const sil_scenario_t *sc, sil_summary_t 
     memset(s, 0, sizeof *s);
     s->fault_step = -1;
     s->fault_time_s = -1.0;
-    m->ts_step = sil_periods_in((double)sc->controller.s_align_time_s, period_s);
-    m->tc_step = sil_periods_in((double)sc->controller.c_align_time_s, period_s);
+    /* Alignment starts after the bridge-off offset calibration, when there is one. */
+    const long calibration_steps = sil_periods_in((double)sc->controller.offset_calibration_time_s, period_s);
+    m->ts_step = calibration_steps + sil_periods_in((double)sc->controller.s_align_time_s, period_s);
+    m->tc_step = calibration_steps + sil_periods_in((double)sc->controller.c_align_time_s, period_s);
     m->transient_end_step = m->tc_step + sil_periods_in(sc->transient_window_s, period_s);
+    m->settle_step = m->transient_end_step;
+    m->loss_speed_error_rad_s = sc->loss_speed_error_rad_s;
+    m->loss_angle_error_rad = sc->loss_angle_error_rad;
+    s->run_start_time_s = (double)m->tc_step * period_s;
+    s->settle_time_s = (double)m->settle_step * period_s;
+    s->loss_of_control_time_s = -1.0;
+    s->detection_latency_s = NAN;
     m->s_align_current_a = (double)sc->controller.s_align_voltage_v / sc->motor.resistance_ohm;
     m->c_align_current_a = (double)sc->controller.c_align_voltage_v / sc->motor.resistance_ohm;
+}
+
+/* Electrical angle of (c-hat, s-hat) minus p theta, wrapped to (-pi, pi]. */
+static double angle_error_rad(const pmstep_output_t *out, const sil_sample_t *x)
+{
+    const double c = (double)out->cos_hat;
+    const double s = (double)out->sin_hat;
+    return atan2(s * x->cos_ptheta - c * x->sin_ptheta, c * x->cos_ptheta + s * x->sin_ptheta);
+}
+
+static bool sample_finite(const sil_sample_t *x)
+{
+    const pmstep_output_t *o = x->out;
+    const double sum = x->theta_rad + x->omega_rad_s + x->i_a_a + x->i_b_a + x->u_a_v + x->u_b_v
+                       + (double)o->u_a_v + (double)o->u_b_v + (double)o->cos_hat + (double)o->sin_hat
+                       + (double)o->speed_hat_rad_s + (double)o->load_hat_nm + (double)o->i_a_hat_a
+                       + (double)o->i_b_hat_a;
+    return isfinite(sum) != 0;
 }
 
 void sil_metrics_add(sil_metrics_t *m, const sil_sample_t *x, sil_summary_t *s)
 {
     const pmstep_output_t *out = x->out;
+    if (!sample_finite(x)) {
+        s->nonfinite_seen = true;
+    }
+    pmstep_get_commissioning(x->inst, &s->commissioning);
     if (x->step == m->ts_step) {
         s->cos_ptheta_at_ts = x->cos_ptheta;
         s->sin_ptheta_at_ts = x->sin_ptheta;
@@ -56,6 +87,18 @@ void sil_metrics_add(sil_metrics_t *m, const sil_sample_t *x, sil_summary_t *s)
         }
         s->final_load_hat_nm = (double)out->load_hat_nm;
         s->final_load_nm = x->load_nm;
+        {
+            const double angle_error = fabs(angle_error_rad(out, x));
+            s->final_angle_error_rad = angle_error;
+            if (x->step >= m->settle_step) {
+                s->max_angle_error_rad = fmax(s->max_angle_error_rad, angle_error);
+                s->max_speed_error_after_settle_rad_s = fmax(s->max_speed_error_after_settle_rad_s, speed_error);
+            }
+            if (s->loss_of_control_time_s < 0.0
+                && (speed_error > m->loss_speed_error_rad_s || angle_error > m->loss_angle_error_rad)) {
+                s->loss_of_control_time_s = x->t_s;
+            }
+        }
     }
     if (out->fault != PMSTEP_FAULT_NONE && s->fault == PMSTEP_FAULT_NONE) {
         s->fault = out->fault;
@@ -71,4 +114,7 @@ void sil_metrics_finish(const sil_metrics_t *m, sil_summary_t *s)
     s->transient_rms_speed_error_rad_s = m->transient_n ? sqrt(m->transient_sq / (double)m->transient_n) : 0.0;
     s->tracking_rms_speed_error_rad_s = m->tracking_n ? sqrt(m->tracking_sq / (double)m->tracking_n) : 0.0;
     s->final_load_error_nm = fabs(s->final_load_hat_nm - s->final_load_nm);
+    if (s->loss_of_control_time_s >= 0.0 && s->fault != PMSTEP_FAULT_NONE) {
+        s->detection_latency_s = s->fault_time_s - s->loss_of_control_time_s;
+    }
 }

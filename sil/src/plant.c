@@ -2,6 +2,7 @@
 #include "sil/plant.h"
 
 #include <math.h>
+#include <stddef.h>
 
 plant_params_t plant_paper_params(void)
 {
@@ -99,33 +100,60 @@ static plant_state_t axpy(const plant_state_t *x, double h, const plant_state_t 
     return y;
 }
 
+/* An open phase (bridge off, current extinguished) keeps i = 0: its current does not change. */
+static void hold_open(plant_state_t *dx, bool open_a, bool open_b)
+{
+    if (open_a) {
+        dx->i_a_a = 0.0;
+    }
+    if (open_b) {
+        dx->i_b_a = 0.0;
+    }
+}
+
+void plant_substep(plant_t *plant, double t_s, double h, double u_a_v, double u_b_v, double *charge_a_c,
+                   double *charge_b_c)
+{
+    const plant_state_t x = plant->x;
+    const double p = (double)plant->params.pole_pairs;
+    const double s0 = sin(p * x.theta_rad);
+    const double c0 = cos(p * x.theta_rad);
+    const bool oa = plant->open_a;
+    const bool ob = plant->open_b;
+    plant_state_t k1, k2, k3, k4, y2, y3, y4;
+    double s, c;
+    derivative_at(&plant->params, &plant->load, t_s, &x, s0, c0, u_a_v, u_b_v, &k1);
+    hold_open(&k1, oa, ob);
+    y2 = axpy(&x, 0.5 * h, &k1);
+    rotate(s0, c0, p * (y2.theta_rad - x.theta_rad), &s, &c);
+    derivative_at(&plant->params, &plant->load, t_s + 0.5 * h, &y2, s, c, u_a_v, u_b_v, &k2);
+    hold_open(&k2, oa, ob);
+    y3 = axpy(&x, 0.5 * h, &k2);
+    rotate(s0, c0, p * (y3.theta_rad - x.theta_rad), &s, &c);
+    derivative_at(&plant->params, &plant->load, t_s + 0.5 * h, &y3, s, c, u_a_v, u_b_v, &k3);
+    hold_open(&k3, oa, ob);
+    y4 = axpy(&x, h, &k3);
+    rotate(s0, c0, p * (y4.theta_rad - x.theta_rad), &s, &c);
+    derivative_at(&plant->params, &plant->load, t_s + h, &y4, s, c, u_a_v, u_b_v, &k4);
+    hold_open(&k4, oa, ob);
+    plant->x.theta_rad = x.theta_rad + h / 6.0 * (k1.theta_rad + 2.0 * (k2.theta_rad + k3.theta_rad) + k4.theta_rad);
+    plant->x.omega_rad_s = x.omega_rad_s + h / 6.0 * (k1.omega_rad_s + 2.0 * (k2.omega_rad_s + k3.omega_rad_s) + k4.omega_rad_s);
+    plant->x.i_a_a = x.i_a_a + h / 6.0 * (k1.i_a_a + 2.0 * (k2.i_a_a + k3.i_a_a) + k4.i_a_a);
+    plant->x.i_b_a = x.i_b_a + h / 6.0 * (k1.i_b_a + 2.0 * (k2.i_b_a + k3.i_b_a) + k4.i_b_a);
+    if (charge_a_c != NULL && charge_b_c != NULL) {
+        /* The currents at the four stages, weighted as RK4 weights the derivatives. */
+        *charge_a_c = h / 6.0 * (x.i_a_a + 2.0 * (y2.i_a_a + y3.i_a_a) + y4.i_a_a);
+        *charge_b_c = h / 6.0 * (x.i_b_a + 2.0 * (y2.i_b_a + y3.i_b_a) + y4.i_b_a);
+    }
+}
+
 void plant_advance(plant_t *plant, double u_a_v, double u_b_v, double period_s, int substeps)
 {
     const double h = period_s / (double)substeps;
     const double t0 = plant->time_s;
     int n;
     for (n = 0; n < substeps; ++n) {
-        const double t = t0 + (double)n * h;
-        const plant_state_t x = plant->x;
-        const double p = (double)plant->params.pole_pairs;
-        const double s0 = sin(p * x.theta_rad);
-        const double c0 = cos(p * x.theta_rad);
-        plant_state_t k1, k2, k3, k4, y;
-        double s, c;
-        derivative_at(&plant->params, &plant->load, t, &x, s0, c0, u_a_v, u_b_v, &k1);
-        y = axpy(&x, 0.5 * h, &k1);
-        rotate(s0, c0, p * (y.theta_rad - x.theta_rad), &s, &c);
-        derivative_at(&plant->params, &plant->load, t + 0.5 * h, &y, s, c, u_a_v, u_b_v, &k2);
-        y = axpy(&x, 0.5 * h, &k2);
-        rotate(s0, c0, p * (y.theta_rad - x.theta_rad), &s, &c);
-        derivative_at(&plant->params, &plant->load, t + 0.5 * h, &y, s, c, u_a_v, u_b_v, &k3);
-        y = axpy(&x, h, &k3);
-        rotate(s0, c0, p * (y.theta_rad - x.theta_rad), &s, &c);
-        derivative_at(&plant->params, &plant->load, t + h, &y, s, c, u_a_v, u_b_v, &k4);
-        plant->x.theta_rad = x.theta_rad + h / 6.0 * (k1.theta_rad + 2.0 * (k2.theta_rad + k3.theta_rad) + k4.theta_rad);
-        plant->x.omega_rad_s = x.omega_rad_s + h / 6.0 * (k1.omega_rad_s + 2.0 * (k2.omega_rad_s + k3.omega_rad_s) + k4.omega_rad_s);
-        plant->x.i_a_a = x.i_a_a + h / 6.0 * (k1.i_a_a + 2.0 * (k2.i_a_a + k3.i_a_a) + k4.i_a_a);
-        plant->x.i_b_a = x.i_b_a + h / 6.0 * (k1.i_b_a + 2.0 * (k2.i_b_a + k3.i_b_a) + k4.i_b_a);
+        plant_substep(plant, t0 + (double)n * h, h, u_a_v, u_b_v, NULL, NULL);
     }
     /* Time from the period count, not accumulated substeps. */
     plant->time_s = t0 + period_s;

@@ -81,7 +81,8 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
     const long steps = sil_periods_in(sc->duration_s, period_s);
     const double p = (double)sc->motor.pole_pairs;
     const bool on_terminal = isatty(fileno(stderr)) != 0;
-    const pmstep_hal_host_t *port = pmstep_hal_host_state();
+    pmstep_hal_host_setup_t hardware;
+    sil_inverter_t *inverter = pmstep_hal_host_inverter();
     sil_metrics_t metrics;
     plant_t plant;
     pmstep_output_t out;
@@ -104,7 +105,16 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
     plant.x.omega_rad_s = sc->omega0_rad_s;
     plant.x.i_a_a = sc->i_a0_a;
     plant.x.i_b_a = sc->i_b0_a;
-    pmstep_hal_host_bind(&plant, sc->bus_voltage_v, cfg->computational_delay_periods);
+    hardware.bus_voltage_v = sc->bus_voltage_v;
+    hardware.delay_periods = cfg->computational_delay_periods;
+    hardware.inverter = sc->inverter;
+    hardware.bus = sc->bus;
+    hardware.sensors = sc->sensors;
+    hardware.seed = sc->seed;
+    if (pmstep_hal_host_bind(&plant, &hardware) != 0) {
+        pmstep_hal_host_release();
+        return -3;
+    }
     (void)pmstep_set_id_target(&inst, (float)sc->id_target_a);
     (void)pmstep_start(&inst);
     if (record != NULL) {
@@ -134,7 +144,7 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
         pmstep_step(&inst, &meas, &out);
         pmstep_hal_apply_output(&out);
         t1 = now_s();
-        plant_advance(&plant, port->inverter.applied_a_v, port->inverter.applied_b_v, period_s, sc->substeps);
+        sil_drive_advance(&plant, inverter, period_s, sc->substeps);
         t2 = now_s();
         s->firmware_time_s += t1 - t0;
         s->plant_time_s += t2 - t1;
@@ -146,8 +156,8 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
         sample.t_s = t_s;
         sample.cos_ptheta = cos(p * sample.theta_rad);
         sample.sin_ptheta = sin(p * sample.theta_rad);
-        sample.u_a_v = port->inverter.applied_a_v;
-        sample.u_b_v = port->inverter.applied_b_v;
+        sample.u_a_v = inverter->applied_a_v;
+        sample.u_b_v = inverter->applied_b_v;
         sample.out = &out;
         sample.inst = &inst;
         sil_metrics_add(&metrics, &sample, s);
@@ -168,7 +178,8 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
     s->sim_time_s = (double)s->steps * period_s;
     s->real_time_factor = s->wall_time_s > 0.0 ? s->sim_time_s / s->wall_time_s : 0.0;
     sil_metrics_finish(&metrics, s);
-    s->inverter_limited_periods = (long)port->inverter.limited_periods;
+    s->inverter_limited_periods = (long)inverter->limited_periods;
+    pmstep_hal_host_release();
     if (rec != NULL) {
         const uint32_t end[] = {SIL_RECORD_TAG_END, (uint32_t)s->steps};
         record_words(rec, end, sizeof end / sizeof end[0]);

@@ -12,7 +12,7 @@
 #define PI 3.14159265358979323846
 
 typedef enum { KEY_DOUBLE, KEY_FLOAT, KEY_INT, KEY_UINT, KEY_BOOL, KEY_ANGLE_DEG, KEY_SPEED_POINTS,
-               KEY_LOAD_POINTS, KEY_LOAD_KIND } key_type_t;
+               KEY_LOAD_POINTS, KEY_LOAD_KIND, KEY_INVERTER_MODEL, KEY_ADC_BITS } key_type_t;
 
 /* Range of a numeric key: min/max, each inclusive or exclusive. */
 typedef struct {
@@ -59,6 +59,21 @@ static const key_t_ keys[] = {
     {"controller.max_phase_current_a", KEY_FLOAT, OFF(controller.max_phase_current_a), -BIG, 0, BIG, 0, "overcurrent trip (A)"},
     {"controller.min_bus_voltage_v", KEY_FLOAT, OFF(controller.min_bus_voltage_v), -BIG, 0, BIG, 0, "undervoltage trip (V)"},
     {"controller.max_bus_voltage_v", KEY_FLOAT, OFF(controller.max_bus_voltage_v), -BIG, 0, BIG, 0, "overvoltage trip (V)"},
+    {"controller.offset_calibration_time_s", KEY_FLOAT, OFF(controller.offset_calibration_time_s), -BIG, 0, BIG, 0, "Remark 2: bridge off this long before s-alignment, current offsets averaged (s); 0 = none"},
+    {"controller.alignment_offset_calibration", KEY_BOOL, OFF(controller.alignment_offset_calibration), 0, 0, 1, 0, "offsets also from the alignment steady states (true/false)"},
+    {"controller.steady_state_window_s", KEY_FLOAT, OFF(controller.steady_state_window_s), -BIG, 0, BIG, 0, "averaging window at the end of each alignment (s); 0 = none"},
+    {"controller.inductance_window_s", KEY_FLOAT, OFF(controller.inductance_window_s), -BIG, 0, BIG, 0, "current-rise window at the start of s-alignment for L (s); 0 = L not measured"},
+    {"controller.use_commissioned_resistance", KEY_BOOL, OFF(controller.use_commissioned_resistance), 0, 0, 1, 0, "RUN uses the measured R (true/false)"},
+    {"controller.use_commissioned_inductance", KEY_BOOL, OFF(controller.use_commissioned_inductance), 0, 0, 1, 0, "RUN uses the measured L (true/false)"},
+    {"controller.use_commissioned_torque_constant", KEY_BOOL, OFF(controller.use_commissioned_torque_constant), 0, 0, 1, 0, "RUN uses the measured k_M (true/false)"},
+    {"controller.dead_time_s", KEY_FLOAT, OFF(controller.dead_time_s), -BIG, 0, BIG, 0, "dead time per half-bridge to compensate (s); 0 = none"},
+    {"controller.dead_time_current_band_a", KEY_FLOAT, OFF(controller.dead_time_current_band_a), -BIG, 0, BIG, 0, "dead-time compensation linear within +/- this current (A)"},
+    {"controller.angle_correction_gain_per_s", KEY_FLOAT, OFF(controller.angle_correction_gain_per_s), -BIG, 0, BIG, 0, "pulls (c-hat, s-hat) onto the unit circle at this rate (1/s); 0 = the paper's open integrals"},
+    {"controller.angle_magnitude_bound", KEY_FLOAT, OFF(controller.angle_magnitude_bound), -BIG, 0, BIG, 0, "|c-hat^2 + s-hat^2 - 1| above -> angle lost; 0 = off"},
+    {"controller.speed_consistency_bound_rad_s", KEY_FLOAT, OFF(controller.speed_consistency_bound_rad_s), -BIG, 0, BIG, 0, "|speed from the angle's rotation - omega-hat| above -> inconsistent (rad/s); 0 = off"},
+    {"controller.stall_speed_error_rad_s", KEY_FLOAT, OFF(controller.stall_speed_error_rad_s), -BIG, 0, BIG, 0, "|omega-hat - omega*| above -> stall (rad/s); 0 = off"},
+    {"controller.detection_time_s", KEY_FLOAT, OFF(controller.detection_time_s), -BIG, 0, BIG, 0, "persistence before a detection acts (s)"},
+    {"controller.max_realignments", KEY_UINT, OFF(controller.max_realignments), 0, 0, 4294967295.0, 0, "0: a detection latches its fault; N: re-align up to N times"},
 
     {"run.duration_s", KEY_DOUBLE, OFF(duration_s), 0, 1, 3600, 0, "simulated time (s)"},
     {"run.period_s", KEY_FLOAT, OFF(controller.period_s), 0, 1, 0.01, 0, "control period T_s (s)"},
@@ -71,6 +86,9 @@ static const key_t_ keys[] = {
     {"run.i_b0_a", KEY_DOUBLE, OFF(i_b0_a), -1e4, 0, 1e4, 0, "initial current b (A)"},
     {"run.decimation", KEY_INT, OFF(decimation), 1, 0, 100000000, 0, "a CSV row every N periods"},
     {"run.transient_window_s", KEY_DOUBLE, OFF(transient_window_s), 0, 0, 3600, 0, "load-transient window after t_c (s)"},
+    {"run.seed", KEY_UINT, OFF(seed), 0, 0, 4294967295.0, 0, "seed of every random draw (GSL MT19937; 0 acts as 4357)"},
+    {"run.loss_speed_error_rad_s", KEY_DOUBLE, OFF(loss_speed_error_rad_s), 0, 1, BIG, 0, "|omega - omega*| above this in RUN counts as loss of control (rad/s)"},
+    {"run.loss_angle_error_rad", KEY_DOUBLE, OFF(loss_angle_error_rad), 0, 1, BIG, 0, "angle-estimate error above this in RUN counts as loss of control (rad)"},
 
     {"speed.points", KEY_SPEED_POINTS, 0, 0, 0, 0, 0, "set-point t:omega pairs (s:rad/s), piecewise linear"},
     {"speed.id_target_a", KEY_DOUBLE, OFF(id_target_a), -1e4, 0, 1e4, 0, "i_d* (A)"},
@@ -80,9 +98,27 @@ static const key_t_ keys[] = {
     {"load.step_time_s", KEY_DOUBLE, OFF(load.step_time_s), 0, 0, 3600, 0, "time of the step (s)"},
     {"load.coefficient_nm_s_per_rad", KEY_DOUBLE, OFF(load.coefficient_nm_s_per_rad), -1e6, 0, 1e6, 0, "proportional load T_L = c omega"},
     {"load.points", KEY_LOAD_POINTS, 0, 0, 0, 0, 0, "table t:T_L pairs (s:Nm), piecewise linear"},
+
+    {"sensors.adc_bits", KEY_ADC_BITS, OFF(sensors.adc_bits), 0, 0, 16, 0, "ADC resolution: 0 = ideal (no quantisation), or 8..16 bits"},
+    {"sensors.current_full_scale_a", KEY_DOUBLE, OFF(sensors.current_full_scale_a), 0, 1, 1e6, 0, "current ADC span +/- this, mid-tread, clips beyond (A)"},
+    {"sensors.offset_a_a", KEY_DOUBLE, OFF(sensors.offset_a_a), -1e6, 0, 1e6, 0, "current-sensor offset, phase a (A)"},
+    {"sensors.offset_b_a", KEY_DOUBLE, OFF(sensors.offset_b_a), -1e6, 0, 1e6, 0, "current-sensor offset, phase b (A)"},
+    {"sensors.gain_error_a", KEY_DOUBLE, OFF(sensors.gain_error_a), -0.5, 1, 0.5, 1, "current-sensor gain error, phase a (fraction)"},
+    {"sensors.gain_error_b", KEY_DOUBLE, OFF(sensors.gain_error_b), -0.5, 1, 0.5, 1, "current-sensor gain error, phase b (fraction)"},
+    {"sensors.noise_rms_a", KEY_DOUBLE, OFF(sensors.noise_rms_a), 0, 0, 1e6, 0, "Gaussian current noise per phase per sample (A rms)"},
+    {"sensors.bus_full_scale_v", KEY_DOUBLE, OFF(sensors.bus_full_scale_v), 0, 1, 1e6, 0, "bus ADC span [0, this] (V)"},
+    {"sensors.bus_noise_rms_v", KEY_DOUBLE, OFF(sensors.bus_noise_rms_v), 0, 0, 1e6, 0, "Gaussian bus-voltage noise per sample (V rms)"},
+
+    {"inverter.model", KEY_INVERTER_MODEL, OFF(inverter.model), 0, 0, 0, 0, "averaged | switching"},
+    {"inverter.dead_time_s", KEY_DOUBLE, OFF(inverter.dead_time_s), 0, 0, 0.01, 1, "dead time per half-bridge (s), below run.period_s / 4"},
+
+    {"bus.source_resistance_ohm", KEY_DOUBLE, OFF(bus.source_resistance_ohm), 0, 0, 1e6, 0, "sag V_bus = run.bus_voltage_v - R i_bus (Ohm)"},
+    {"bus.ripple_v", KEY_DOUBLE, OFF(bus.ripple_v), 0, 0, 1e4, 0, "bus ripple amplitude, ripple_v sin(2 pi ripple_hz t) (V)"},
+    {"bus.ripple_hz", KEY_DOUBLE, OFF(bus.ripple_hz), 0, 0, 1e6, 0, "bus ripple frequency (Hz)"},
 };
 
 static const char *const load_kind_names[] = {"none", "constant", "step", "proportional", "table"};
+static const char *const inverter_model_names[] = {"averaged", "switching"};
 
 static int fail(char *err, size_t err_size, const char *fmt, ...)
 {
@@ -191,6 +227,16 @@ int sil_scenario_set(sil_scenario_t *sc, const char *key, const char *value, cha
             }
             return fail(err, err_size, "%s: '%s' is not one of none, constant, step, proportional, table", key, value);
         }
+        case KEY_INVERTER_MODEL: {
+            size_t j;
+            for (j = 0; j < sizeof inverter_model_names / sizeof inverter_model_names[0]; ++j) {
+                if (strcmp(value, inverter_model_names[j]) == 0) {
+                    *(sil_inverter_model_t *)(base + k->offset) = (sil_inverter_model_t)j;
+                    return 0;
+                }
+            }
+            return fail(err, err_size, "%s: '%s' is not one of averaged, switching", key, value);
+        }
         case KEY_BOOL:
             if (strcmp(value, "true") == 0 || strcmp(value, "1") == 0) {
                 *(bool *)(base + k->offset) = true;
@@ -210,14 +256,18 @@ int sil_scenario_set(sil_scenario_t *sc, const char *key, const char *value, cha
             return fail(err, err_size, "%s = %s is out of range: must be %s %g and %s %g (%s)", key, value,
                         k->min_exclusive ? ">" : ">=", k->min, k->max_exclusive ? "<" : "<=", k->max, k->help);
         }
-        if ((k->type == KEY_INT || k->type == KEY_UINT) && v != floor(v)) {
+        if ((k->type == KEY_INT || k->type == KEY_UINT || k->type == KEY_ADC_BITS) && v != floor(v)) {
             return fail(err, err_size, "%s: '%s' is not an integer", key, value);
+        }
+        if (k->type == KEY_ADC_BITS && v > 0.0 && v < 8.0) {
+            return fail(err, err_size, "%s = %s is out of range: must be 0 (ideal) or 8 .. 16 (%s)", key, value, k->help);
         }
         switch (k->type) {
         case KEY_DOUBLE: *(double *)(base + k->offset) = v; break;
         case KEY_FLOAT: *(float *)(base + k->offset) = (float)v; break;
         case KEY_INT: *(int32_t *)(base + k->offset) = (int32_t)v; break;
         case KEY_UINT: *(uint32_t *)(base + k->offset) = (uint32_t)v; break;
+        case KEY_ADC_BITS: *(unsigned *)(base + k->offset) = (unsigned)v; break;
         case KEY_ANGLE_DEG: *(double *)(base + k->offset) = v * PI / 180.0; break;
         default: break;
         }
@@ -301,6 +351,26 @@ int sil_scenario_check(const sil_scenario_t *sc, char *err, size_t err_size)
     if (sc->speed_points == 0) {
         return fail(err, err_size, "speed.points: no set-point profile");
     }
+    if (!(sc->inverter.dead_time_s < 0.25 * (double)sc->controller.period_s)) {
+        return fail(err, err_size, "inverter.dead_time_s = %g is not below run.period_s / 4 = %g", sc->inverter.dead_time_s,
+                    0.25 * (double)sc->controller.period_s);
+    }
+    if (sc->sensors.adc_bits > 0u && sc->sensors.current_full_scale_a < (double)sc->controller.max_phase_current_a) {
+        return fail(err, err_size,
+                    "sensors.current_full_scale_a = %g is below controller.max_phase_current_a = %g: the ADC would clip "
+                    "before the trip",
+                    sc->sensors.current_full_scale_a, (double)sc->controller.max_phase_current_a);
+    }
+    if (sc->sensors.adc_bits > 0u && sc->sensors.bus_full_scale_v < (double)sc->controller.max_bus_voltage_v) {
+        return fail(err, err_size,
+                    "sensors.bus_full_scale_v = %g is below controller.max_bus_voltage_v = %g: the ADC would clip "
+                    "before the overvoltage trip",
+                    sc->sensors.bus_full_scale_v, (double)sc->controller.max_bus_voltage_v);
+    }
+    if (!(sc->bus.ripple_v < sc->bus_voltage_v)) {
+        return fail(err, err_size, "bus.ripple_v = %g is not below run.bus_voltage_v = %g: the bus would reach zero",
+                    sc->bus.ripple_v, sc->bus_voltage_v);
+    }
     return 0;
 }
 
@@ -362,6 +432,8 @@ void sil_scenario_print(const sil_scenario_t *sc, FILE *file)
             }
             break;
         case KEY_LOAD_KIND: fprintf(file, "%s\n", load_kind_names[sc->load.kind]); break;
+        case KEY_INVERTER_MODEL: fprintf(file, "%s\n", inverter_model_names[sc->inverter.model]); break;
+        case KEY_ADC_BITS: fprintf(file, "%u\n", *(const unsigned *)(base + k->offset)); break;
         }
     }
 }

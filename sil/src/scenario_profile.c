@@ -31,6 +31,13 @@ void sil_scenario_paper(sil_scenario_t *sc)
         sc->speed_value_rad_s[k] = speeds[k];
     }
     sc->id_target_a = 0.0;
+    sc->loss_speed_error_rad_s = 2.0;
+    sc->loss_angle_error_rad = 0.5;
+    /* Measurement chain, inverter and bus: all ideal. */
+    sc->seed = 1u;
+    sc->sensors = sil_sensors_ideal();
+    sc->inverter = sil_inverter_ideal_config();
+    sc->bus = sil_bus_ideal_config();
 }
 
 int sil_scenario_speed_command(const sil_scenario_t *sc, double t_s, int *next_segment, float *target_rad_s,

@@ -4,9 +4,10 @@
  * core, which runs from the port's control interrupt. The scenario is the SIL's
  * built-in paper scenario (sil_scenario_paper() in sil/src/scenario.c: 2 Nm load step
  * at 0.63 s, theta0 = 30 deg, 48 V bus, set-point 0 -> 10 -> -10 -> 0 rad/s), shortened
- * by --duration. The scenario, its speed commands, the inverter model and every
- * metric come from sil/ (scenario_profile.c, inverter.c, metrics.c), as in the host
- * runner, so the summary can be compared key by key with
+ * by --duration. The scenario, its speed commands, the inverter and bus model
+ * (sil_drive_advance) and every metric come from sil/ (scenario_profile.c,
+ * inverter.c, metrics.c), as in the host runner, so the summary can be compared key
+ * by key with
  * `pmstep-sil --set run.duration_s=... --set run.substeps=...`.
  *
  * usage (semihosting command line): pil-closed-loop [--duration S] [--substeps N] [--summary FILE]
@@ -111,7 +112,7 @@ int main(int argc, char **argv)
     plant.x.i_a_a = sc.i_a0_a;
     plant.x.i_b_a = sc.i_b0_a;
     p = (double)plant.params.pole_pairs;
-    sil_inverter_init(&inv, sc.bus_voltage_v, config.computational_delay_periods);
+    sil_inverter_init(&inv, &sc.inverter, &sc.bus, sc.bus_voltage_v, config.computational_delay_periods);
 
     (void)pmstep_set_id_target(&motor, (float)sc.id_target_a);
     (void)pmstep_start(&motor);
@@ -135,14 +136,15 @@ int main(int argc, char **argv)
         sample.i_b_a = plant.x.i_b_a;
         sample.load_nm = plant_load_torque(&plant.load, t_s, plant.x.omega_rad_s);
 
-        /* Sample (what the host port reads), control interrupt, inverter, plant. */
+        /* Sample (what the host port reads with the ideal measurement chain: no GSL here),
+         * control interrupt, inverter, plant. */
         meas.i_a_a = (float)sample.i_a_a;
         meas.i_b_a = (float)sample.i_b_a;
-        meas.bus_voltage_v = (float)sc.bus_voltage_v;
+        meas.bus_voltage_v = (float)sil_inverter_bus_voltage(&inv, t_s);
         meas.load_torque_nm = (float)sample.load_nm;
         mps2_pil_control_period(&meas, &out);
-        sil_inverter_apply(&inv, &out);
-        plant_advance(&plant, inv.applied_a_v, inv.applied_b_v, period_s, substeps);
+        sil_inverter_apply(&inv, &out, (double)meas.bus_voltage_v);
+        sil_drive_advance(&plant, &inv, period_s, substeps);
 
         sample.cos_ptheta = cos(p * sample.theta_rad);
         sample.sin_ptheta = sin(p * sample.theta_rad);

@@ -1,35 +1,122 @@
 /**
  * @file inverter.h
- * @brief Averaged inverter model of the SIL: the phase voltage commanded by a
- *        step is held over a period (now, or one period later with a
- *        computational delay), limited to +/- the bus voltage; bridge off is
- *        modelled as zero phase voltage. Shared by the host port and the PIL
+ * @brief Inverter and DC bus of the SIL, and the function that advances the plant
+ *        over one control period through them. Shared by the host port and the PIL
  *        closed loop on the target, so both drive the plant alike.
+ *
+ * MCU side (sil_inverter_apply): the step's voltage is clipped to +/- the bus voltage
+ * the step was given (the duty d = u / V_bus,measured is kept in [-1, 1]; a clip counts
+ * in limited_periods when that command is applied) and applied now, or one period
+ * later with a computational delay of one period.
+ *
+ * Bridge (sil_drive_advance): each phase is an H-bridge of two half-bridges (legs A and
+ * B). Leg A carries +i out to the winding, leg B carries -i. The bridge applies the duty
+ * to the actual bus, d V_bus:
+ *  - averaged model: u = d V_bus - 2 sign(i) V_bus t_d / T (dead time t_d per leg, T the
+ *    control period = PWM period, sign(0) = 0). sign(i) is taken at the start of each RK4
+ *    substep and held over it, so the phase voltage is constant within a substep.
+ *  - switching model: centre-aligned carrier, valley at the period boundary (where the
+ *    ADC samples). Leg A is high for (1+d)/2 T and leg B for (1-d)/2 T, both windows
+ *    centred on mid-period; u = V_bus (s_A - s_B). Dead time delays a leg's turn-on edge
+ *    by t_d when the current flows out of that leg, its turn-off edge when it flows in
+ *    (a leg at d = +/-1 does not switch and has no dead time; a delayed edge is held
+ *    inside the period). Simplification: the current's sign is taken once, at the start
+ *    of the period, for all edges of that period. The plant is integrated segment by
+ *    segment between the sorted edges of both phases, in RK4 substeps of at most
+ *    T / substeps; zero-length segments are skipped.
+ *  - bridge off (either model): every switch off. A phase with current conducts
+ *    through the freewheel diodes, u = -sign(i) V_bus, sign held over each substep; at
+ *    the end of the substep in which the current reaches or crosses zero it is set to
+ *    exactly 0 and the phase is open (the plant holds i = 0, whatever the back EMF) until
+ *    the bridge is enabled again. A back EMF above the bus, which would make the diodes
+ *    conduct again, is not modelled.
+ *
+ * Bus: V_bus(t) = V0 - R_src i_bus + ripple_v sin(2 pi ripple_hz t), clamped at >= 0.
+ * i_bus = (u_a i_a + u_b i_b)/V_bus is taken as the mean over the previous period
+ * (a stiff DC-link capacitor holding the sag of the last period), computed from the
+ * RK4 quadrature of the currents; the ripple is evaluated at each substep's midpoint
+ * and at the sample.
+ *
+ * With the defaults (averaged, t_d = 0, R_src = 0, ripple 0) and a constant bus the
+ * plant receives exactly the commanded voltage, bit for bit, as with plant_advance().
  */
 #ifndef SIL_INVERTER_H
 #define SIL_INVERTER_H
 
+#include <stdbool.h>
+
 #include "pmstep/pmstep_types.h"
+#include "sil/plant.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
+typedef enum {
+    SIL_INVERTER_AVERAGED = 0,   /**< duty times bus, dead time as a mean voltage error */
+    SIL_INVERTER_SWITCHING = 1   /**< switching edges within the period */
+} sil_inverter_model_t;
+
+/** [inverter] of a scenario. */
 typedef struct {
-    double bus_voltage_v;
-    unsigned delay_periods;      /**< 0 or 1 */
-    double pending_a_v;          /**< computed, waiting for the next period (delay 1) */
+    sil_inverter_model_t model;
+    double dead_time_s;           /**< per half-bridge (>= 0, < period/4) */
+} sil_inverter_config_t;
+
+/** [bus] of a scenario (the nominal V0 is run.bus_voltage_v). */
+typedef struct {
+    double source_resistance_ohm; /**< R_src */
+    double ripple_v;              /**< amplitude of the sine ripple (V) */
+    double ripple_hz;
+} sil_bus_config_t;
+
+typedef struct {
+    sil_inverter_config_t cfg;
+    sil_bus_config_t bus;
+    double nominal_bus_voltage_v;  /**< V0 */
+    unsigned delay_periods;        /**< 0 or 1 */
+    /* MCU side: the last step's command, waiting for the next period (delay 1). */
+    double pending_a_v;            /**< clipped to +/- pending_bus_v */
     double pending_b_v;
-    double applied_a_v;          /**< voltage the plant sees over the coming period */
+    double pending_bus_v;          /**< measured bus the step was given */
+    bool pending_clipped;
+    /* The bridge over the coming period. */
+    bool bridge_enable;
+    double command_a_v;            /**< clipped command; the duty is command / command_bus_v */
+    double command_b_v;
+    double command_bus_v;
+    /* What the plant received over the last period (set by sil_drive_advance). */
+    double applied_a_v;            /**< mean phase voltage (before the advance: the command) */
     double applied_b_v;
-    unsigned long limited_periods; /**< periods the inverter had to clip to +/- bus */
+    double mean_current_a[2];      /**< mean current of phase a [0] and b [1] (A) */
+    double min_current_a[2];       /**< extremes of the phase currents at the substep ends, start included (A) */
+    double max_current_a[2];
+    double mean_bus_current_a;     /**< mean i_bus, which sets the sag of the next period */
+    unsigned long limited_periods; /**< periods the MCU had to clip its duty to +/- 1 */
 } sil_inverter_t;
 
-/** Zero voltage, nothing pending. */
-void sil_inverter_init(sil_inverter_t *inv, double bus_voltage_v, unsigned delay_periods);
+/** Averaged model, no dead time. */
+sil_inverter_config_t sil_inverter_ideal_config(void);
 
-/** Takes one step's output; sets applied_a_v, applied_b_v for the coming period. */
-void sil_inverter_apply(sil_inverter_t *inv, const pmstep_output_t *out);
+/** Stiff bus: no source resistance, no ripple (ripple_hz 100). */
+sil_bus_config_t sil_bus_ideal_config(void);
+
+/** Zero voltage, nothing pending, bridge enabled, no bus current. */
+void sil_inverter_init(sil_inverter_t *inv, const sil_inverter_config_t *cfg, const sil_bus_config_t *bus,
+                       double bus_voltage_v, unsigned delay_periods);
+
+/** Takes one step's output and the bus voltage the step was given; sets the command of the coming period. */
+void sil_inverter_apply(sil_inverter_t *inv, const pmstep_output_t *out, double measured_bus_v);
+
+/** The actual bus voltage at time @p t_s of the coming period (sag of the last period, ripple at t). */
+double sil_inverter_bus_voltage(const sil_inverter_t *inv, double t_s);
+
+/**
+ * Advances @p plant by @p period_s from plant->time_s through the inverter and bus
+ * (RK4 substeps of at most period_s / @p substeps), sets plant->time_s to the end of
+ * the period and the inverter's applied voltages, currents and bus current.
+ */
+void sil_drive_advance(plant_t *plant, sil_inverter_t *inv, double period_s, int substeps);
 
 #ifdef __cplusplus
 }

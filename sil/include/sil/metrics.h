@@ -56,12 +56,25 @@ typedef struct {
     long fault_step;
     double fault_time_s;
     pmstep_status_t init_status;
+    /* Robustness: ground truth against what the core reported. */
+    double run_start_time_s;               /**< t_c from the start (offset calibration included) */
+    double settle_time_s;                  /**< run_start_time_s + transient window: "after transients" */
+    double max_angle_error_rad;            /**< max |wrapped angle(c-hat, s-hat) - p theta| in RUN after settle */
+    double final_angle_error_rad;          /**< at the last RUN sample */
+    double max_speed_error_after_settle_rad_s; /**< max |omega - omega*| in RUN after settle */
+    double loss_of_control_time_s;         /**< first RUN sample with |omega - omega*| or the angle error above the
+                                                scenario's loss bounds; -1 if none */
+    double detection_latency_s;            /**< fault time - loss time (negative: fault first); NaN if not both */
+    bool nonfinite_seen;                   /**< a NaN/Inf in the plant state or the core's output */
+    pmstep_commissioning_t commissioning;  /**< what the core measured (pmstep_get_commissioning), last sample */
 } sil_summary_t;
 
 /** Running sums behind the summary. */
 typedef struct {
     long ts_step, tc_step, transient_end_step; /**< sample indices of t_s, t_c, t_c + W */
     double s_align_current_a, c_align_current_a; /**< u_cs/R, u_cc/R with the plant's R */
+    long settle_step;                          /**< first sample counted "after transients" */
+    double loss_speed_error_rad_s, loss_angle_error_rad; /**< the scenario's loss-of-control bounds */
     double transient_sq, tracking_sq;
     long transient_n, tracking_n;
 } sil_metrics_t;

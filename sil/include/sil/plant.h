@@ -1,8 +1,8 @@
 /**
  * @file plant.h
  * @brief Model (1) of the PM step motor in double precision, integrated by RK4
- *        with the phase voltages held over each control period (averaged
- *        inverter). Its parameters may differ from the firmware's.
+ *        with the phase voltages held over each step (sil/inverter.h decides
+ *        them within a control period). Its parameters may differ from the firmware's.
  *
  *   theta' = omega
  *   omega' = -(F/J) omega + (k_M/J)(-i_a sin p theta + i_b cos p theta) - T_L/J
@@ -11,6 +11,8 @@
  */
 #ifndef SIL_PLANT_H
 #define SIL_PLANT_H
+
+#include <stdbool.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -59,6 +61,8 @@ typedef struct {
     plant_load_t load;
     plant_state_t x;
     double time_s;
+    bool open_a;   /**< phase a open (bridge off, current extinguished): i_a' = 0, i_a held at exactly 0 */
+    bool open_b;   /**< same for phase b */
 } plant_t;
 
 /** The motor of the paper's Section III.B. */
@@ -73,6 +77,14 @@ void plant_derivative(const plant_params_t *params, const plant_load_t *load, do
 
 /** Advances by @p period_s with (u_a, u_b) held, in @p substeps RK4 steps. */
 void plant_advance(plant_t *plant, double u_a_v, double u_b_v, double period_s, int substeps);
+
+/**
+ * One RK4 step of @p h_s from time @p t_s with (u_a, u_b) held (an open phase ignores its
+ * voltage). Leaves plant->time_s alone. When @p charge_a_c and @p charge_b_c are not NULL
+ * they receive the integrals of i_a and i_b over the step (C), by the same RK4 quadrature.
+ */
+void plant_substep(plant_t *plant, double t_s, double h_s, double u_a_v, double u_b_v, double *charge_a_c,
+                   double *charge_b_c);
 
 #ifdef __cplusplus
 }

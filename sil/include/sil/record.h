@@ -40,8 +40,8 @@ extern "C" {
  * then the entries in order.
  */
 #define SIL_RECORD_MAGIC 0x52534D50u /* "PMSR" */
-#define SIL_RECORD_VERSION 1u
-#define SIL_RECORD_CONFIG_WORDS 24u
+#define SIL_RECORD_VERSION 2u /* 2: the calibration, commissioning, angle and detection settings */
+#define SIL_RECORD_CONFIG_WORDS 39u
 #define SIL_RECORD_TAG_SPEED_TARGET 1u
 #define SIL_RECORD_TAG_PERIOD 2u
 #define SIL_RECORD_TAG_END 3u
@@ -131,6 +131,21 @@ static inline void sil_record_config_from_words(const uint32_t *w, pmstep_config
     c->max_phase_current_a = sil_record_float(w[21]);
     c->min_bus_voltage_v = sil_record_float(w[22]);
     c->max_bus_voltage_v = sil_record_float(w[23]);
+    c->offset_calibration_time_s = sil_record_float(w[24]);
+    c->alignment_offset_calibration = w[25] != 0u;
+    c->steady_state_window_s = sil_record_float(w[26]);
+    c->inductance_window_s = sil_record_float(w[27]);
+    c->use_commissioned_resistance = w[28] != 0u;
+    c->use_commissioned_inductance = w[29] != 0u;
+    c->use_commissioned_torque_constant = w[30] != 0u;
+    c->dead_time_s = sil_record_float(w[31]);
+    c->dead_time_current_band_a = sil_record_float(w[32]);
+    c->angle_correction_gain_per_s = sil_record_float(w[33]);
+    c->angle_magnitude_bound = sil_record_float(w[34]);
+    c->speed_consistency_bound_rad_s = sil_record_float(w[35]);
+    c->stall_speed_error_rad_s = sil_record_float(w[36]);
+    c->detection_time_s = sil_record_float(w[37]);
+    c->max_realignments = w[38];
 }
 
 static inline void sil_record_meas_from_words(const uint32_t *w, pmstep_meas_t *m)
@@ -191,6 +206,21 @@ static inline void sil_record_config_to_words(const pmstep_config_t *c, uint32_t
     w[21] = sil_record_bits(c->max_phase_current_a);
     w[22] = sil_record_bits(c->min_bus_voltage_v);
     w[23] = sil_record_bits(c->max_bus_voltage_v);
+    w[24] = sil_record_bits(c->offset_calibration_time_s);
+    w[25] = c->alignment_offset_calibration ? 1u : 0u;
+    w[26] = sil_record_bits(c->steady_state_window_s);
+    w[27] = sil_record_bits(c->inductance_window_s);
+    w[28] = c->use_commissioned_resistance ? 1u : 0u;
+    w[29] = c->use_commissioned_inductance ? 1u : 0u;
+    w[30] = c->use_commissioned_torque_constant ? 1u : 0u;
+    w[31] = sil_record_bits(c->dead_time_s);
+    w[32] = sil_record_bits(c->dead_time_current_band_a);
+    w[33] = sil_record_bits(c->angle_correction_gain_per_s);
+    w[34] = sil_record_bits(c->angle_magnitude_bound);
+    w[35] = sil_record_bits(c->speed_consistency_bound_rad_s);
+    w[36] = sil_record_bits(c->stall_speed_error_rad_s);
+    w[37] = sil_record_bits(c->detection_time_s);
+    w[38] = c->max_realignments;
 }
 
 static inline void sil_record_meas_to_words(const pmstep_meas_t *m, uint32_t *w)

@@ -20,15 +20,17 @@ extern "C" {
 
 /**
  * Runs @p sc. @p on_sample may be NULL. @p progress prints a progress line to
- * stderr. @return 0, or -1 when pmstep_init rejected the configuration
- * (summary->init_status says why).
+ * stderr. @return 0, -1 when pmstep_init rejected the configuration
+ * (summary->init_status says why), or -3 when the measurement chain's random
+ * number generator could not be allocated. The host port's state
+ * (pmstep_hal_host_state(): ADC clip counts, last sample) stays readable after the run.
  */
 int sil_run(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user, bool progress, sil_summary_t *summary);
 
 /**
  * sil_run() that also writes the record of sil/record.h to @p record (binary
  * stream; NULL records nothing). @return 0, -1 when pmstep_init rejected the
- * configuration, -2 when writing the record failed.
+ * configuration, -2 when writing the record failed, -3 as sil_run().
  */
 int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user, bool progress,
                    sil_summary_t *summary, FILE *record);

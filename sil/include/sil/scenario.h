@@ -12,7 +12,9 @@
 #include <stdio.h>
 
 #include "pmstep/pmstep.h"
+#include "sil/inverter.h"
 #include "sil/plant.h"
+#include "sil/sensors.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -39,6 +41,12 @@ typedef struct {
     double speed_time_s[SIL_SPEED_POINTS_MAX];
     double speed_value_rad_s[SIL_SPEED_POINTS_MAX];
     double id_target_a;              /**< speed.id_target_a */
+    double loss_speed_error_rad_s;   /**< run.loss_speed_error_rad_s: |omega - omega*| above -> loss of control */
+    double loss_angle_error_rad;     /**< run.loss_angle_error_rad: angle-estimate error above -> loss of control */
+    uint32_t seed;                   /**< run.seed: of every random draw of the run (measurement noise) */
+    sil_sensor_config_t sensors;     /**< [sensors]: measurement chain (ideal by default) */
+    sil_inverter_config_t inverter;  /**< [inverter]: averaged | switching, dead time */
+    sil_bus_config_t bus;            /**< [bus]: source resistance and ripple on run.bus_voltage_v */
 } sil_scenario_t;
 
 /** The paper's Section III: t_s = 0.3 s, t_c = 0.6 s, 2 Nm at 0.63 s, theta0 = 30 deg, 2.4 s, 20 kHz. */
