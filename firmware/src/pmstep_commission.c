@@ -26,12 +26,13 @@ static bool in_window(uint32_t sample, uint32_t end, uint32_t window)
 void pmstep_commission_add_alignment(pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
                                      uint32_t sample, float i_a_a, float i_b_a, float u_a_v, float u_b_v)
 {
-    if (sample <= plan->inductance_steps) {
-        /* Samples 0..N of the rise, voltages over periods 1..N (sample 0 has none yet). */
-        if (sample == 0u) {
+    if (sample >= plan->inductance_start_step && sample - plan->inductance_start_step <= plan->inductance_steps) {
+        /* Samples m0..m0+N of the rise, voltages over the N periods between them. */
+        if (sample == plan->inductance_start_step) {
             sums->rise_start_a = i_b_a;
+        } else {
+            sums->rise_voltage_sum_v += u_b_v;
         }
-        sums->rise_voltage_sum_v += sample > 0u ? u_b_v : 0.0f;
         sums->rise_current_sum_a += i_b_a;
         sums->rise_end_a = i_b_a;
     }

@@ -35,6 +35,7 @@ pmstep_status_t pmstep_init(pmstep_t *inst, const pmstep_config_t *cfg)
     inst->commission_plan.c_align_end_step = periods_in(cfg->c_align_time_s, cfg->period_s);
     inst->commission_plan.window_steps = periods_in(cfg->steady_state_window_s, cfg->period_s);
     inst->commission_plan.inductance_steps = periods_in(cfg->inductance_window_s, cfg->period_s);
+    inst->commission_plan.inductance_start_step = 2u + cfg->computational_delay_periods;
     inst->commission_plan.offsets_from_alignment = cfg->alignment_offset_calibration;
     inst->offset_cal_steps = periods_in(cfg->offset_calibration_time_s, cfg->period_s);
     inst->dead_time_duty = 2.0f * cfg->dead_time_s / cfg->period_s;
@@ -383,6 +384,11 @@ static void offset_calibration_step(pmstep_t *inst, const pmstep_meas_t *meas, p
     pmstep_commission_add_bridge_off(&inst->scratch.sums, meas->i_a_a, meas->i_b_a);
     out->mode = PMSTEP_MODE_OFFSET_CAL;
     if (++inst->mode_step >= inst->offset_cal_steps) {
+        /* Provisional offsets for the alignment (the dead-time compensation needs the sign of
+         * small currents); t_c refines them with the alignment steady states. */
+        const pmstep_commission_sums_t *sums = &inst->scratch.sums;
+        inst->commissioning.offset_a_a = sums->zero_sum_a_a / (float)sums->zero_count_a;
+        inst->commissioning.offset_b_a = sums->zero_sum_b_a / (float)sums->zero_count_b;
         inst->mode = PMSTEP_MODE_S_ALIGN;
         inst->mode_step = 0u;
     }
@@ -411,8 +417,8 @@ void pmstep_step(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out
         return;
     }
 
-    output_off(out, inst);
     if (inst->mode == PMSTEP_MODE_OFFSET_CAL) {
+        output_off(out, inst);
         offset_calibration_step(inst, meas, out);
         return;
     }
@@ -438,15 +444,19 @@ void pmstep_step(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out
     sample.i_a_a -= inst->commissioning.offset_a_a;
     sample.i_b_a -= inst->commissioning.offset_b_a;
     switch (inst->mode) {
-    case PMSTEP_MODE_S_ALIGN: /* (3) */
+    case PMSTEP_MODE_S_ALIGN: /* (3); no telemetry in alignment */
+        output_off(out, inst);
         out->u_a_v = 0.0f;
         out->u_b_v = cfg->s_align_voltage_v;
         break;
     case PMSTEP_MODE_C_ALIGN: /* (5) */
+        output_off(out, inst);
         out->u_a_v = cfg->c_align_voltage_v;
         out->u_b_v = 0.0f;
         break;
-    default: /* RUN: (6) or (13) */
+    default: /* RUN: (6) or (13); run_controller() writes every telemetry field */
+        out->fault = PMSTEP_FAULT_NONE;
+        out->fault_step = inst->fault_step;
         run_controller(inst, &sample, out, &obs_in, &mech);
         fault = detect(inst, out);
         if (fault != PMSTEP_FAULT_NONE) {
@@ -461,9 +471,10 @@ void pmstep_step(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out
         break;
     }
     if (inst->dead_time_duty > 0.0f) {
-        /* In alignment the undriven phase carries no current and gets no dead-time term. */
-        dead_time_a_v = inst->mode == PMSTEP_MODE_S_ALIGN ? 0.0f : dead_time_voltage(inst, sample.i_a_a, meas->bus_voltage_v);
-        dead_time_b_v = inst->mode == PMSTEP_MODE_C_ALIGN ? 0.0f : dead_time_voltage(inst, sample.i_b_a, meas->bus_voltage_v);
+        /* Both phases in every mode: the undriven phase of an alignment still carries its decaying
+         * current. Near zero current the sign comes from offset-corrected samples. */
+        dead_time_a_v = dead_time_voltage(inst, sample.i_a_a, meas->bus_voltage_v);
+        dead_time_b_v = dead_time_voltage(inst, sample.i_b_a, meas->bus_voltage_v);
     }
     out->u_a_v += dead_time_a_v;
     out->u_b_v += dead_time_b_v;
@@ -485,7 +496,9 @@ void pmstep_step(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out
     inst->u_applied_b_v = next_b_v;
 
     if (inst->mode == PMSTEP_MODE_RUN) {
-        pmstep_angle_correct(&inst->angle, &inst->angle_coeffs, out->cos_hat, out->sin_hat);
+        if (inst->angle_coeffs.correction_gain > 0.0f) {
+            pmstep_angle_correct(&inst->angle, &inst->angle_coeffs, out->cos_hat, out->sin_hat);
+        }
         pmstep_observer_advance(&inst->observer, &inst->observer_coeffs, &obs_in, &mech, next_a_v, next_b_v,
                                 cfg->period_s);
         pmstep_ref_advance(&inst->ref_coeffs, &inst->speed_ref, cfg->period_s);

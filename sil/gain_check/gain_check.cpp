@@ -15,6 +15,7 @@
 
 #include "pmstep_hal_host.h"
 #include "sil/runner.h"
+#include "pmstep/pmstep_text.h"
 
 namespace pmstep_gain {
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "gain_check.hpp"
+#include "pmstep/pmstep_text.h"
 
 namespace {
 

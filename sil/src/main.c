@@ -2,6 +2,7 @@
  * writes a CSV time series and a JSON summary, prints the summary. */
 #include <cjson/cJSON.h>
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -9,6 +10,7 @@
 
 #include "pmstep_hal_host.h"
 #include "sil/runner.h"
+#include "pmstep/pmstep_text.h"
 
 static void usage(FILE *f)
 {
@@ -79,6 +81,36 @@ static cJSON *measurement_chain_json(const sil_scenario_t *sc)
     return chain;
 }
 
+/* Ground truth against what the core reported, and what its commissioning measured. */
+static void add_robustness_json(cJSON *root, const sil_summary_t *s)
+{
+    cJSON *robust = cJSON_CreateObject();
+    cJSON *comm = cJSON_CreateObject();
+    const pmstep_commissioning_t *c = &s->commissioning;
+    cJSON_AddNumberToObject(robust, "run_start_time_s", s->run_start_time_s);
+    cJSON_AddNumberToObject(robust, "settle_time_s", s->settle_time_s);
+    cJSON_AddNumberToObject(robust, "max_angle_error_rad", s->max_angle_error_rad);
+    cJSON_AddNumberToObject(robust, "final_angle_error_rad", s->final_angle_error_rad);
+    cJSON_AddNumberToObject(robust, "max_speed_error_rad_s", s->max_speed_error_after_settle_rad_s);
+    cJSON_AddNumberToObject(robust, "loss_of_control_time_s", s->loss_of_control_time_s);
+    if (isnan(s->detection_latency_s)) {
+        cJSON_AddNullToObject(robust, "detection_latency_s");
+    } else {
+        cJSON_AddNumberToObject(robust, "detection_latency_s", s->detection_latency_s);
+    }
+    cJSON_AddBoolToObject(robust, "nonfinite_seen", s->nonfinite_seen);
+    cJSON_AddItemToObject(root, "robustness", robust);
+    cJSON_AddNumberToObject(comm, "offset_a_a", (double)c->offset_a_a);
+    cJSON_AddNumberToObject(comm, "offset_b_a", (double)c->offset_b_a);
+    cJSON_AddNumberToObject(comm, "offset_samples", (double)c->offset_samples);
+    cJSON_AddNumberToObject(comm, "resistance_ohm", (double)c->resistance_ohm);
+    cJSON_AddNumberToObject(comm, "inductance_h", (double)c->inductance_h);
+    cJSON_AddNumberToObject(comm, "torque_constant_nm_per_a", (double)c->torque_constant_nm_per_a);
+    cJSON_AddNumberToObject(comm, "realignments", (double)c->realignments);
+    cJSON_AddBoolToObject(comm, "measured", c->measured);
+    cJSON_AddItemToObject(root, "commissioning", comm);
+}
+
 static cJSON *summary_json(const sil_scenario_t *sc, const sil_summary_t *s)
 {
     cJSON *root = cJSON_CreateObject();
@@ -124,8 +156,10 @@ static cJSON *summary_json(const sil_scenario_t *sc, const sil_summary_t *s)
     cJSON_AddNumberToObject(root, "voltage_limited_periods", (double)s->voltage_limited_periods);
     cJSON_AddNumberToObject(root, "inverter_clipped_periods", (double)s->inverter_limited_periods);
     cJSON_AddStringToObject(root, "final_mode", pmstep_mode_str(s->final_mode));
+    add_robustness_json(root, s);
 
     cJSON_AddNumberToObject(fault, "code", (double)s->fault);
+    cJSON_AddStringToObject(fault, "name", pmstep_fault_str(s->fault));
     cJSON_AddStringToObject(fault, "text", pmstep_fault_str(s->fault));
     cJSON_AddNumberToObject(fault, "step", (double)s->fault_step);
     cJSON_AddNumberToObject(fault, "time_s", s->fault_time_s);

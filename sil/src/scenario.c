@@ -297,7 +297,24 @@ typedef struct {
     sil_scenario_t *sc;
     char message[SIL_ERROR_MAX];
     int failed;
+    char points_key[160];  /**< the points key being read: its value may continue on indented lines */
+    char points_text[4096];
 } load_ctx_t;
+
+/* A points value continued on indented lines (inih hands each line over under the same key)
+ * is joined with a comma, and the whole list is parsed again. */
+static const char *join_points(load_ctx_t *ctx, const char *key, const char *value)
+{
+    const size_t used = strlen(ctx->points_text);
+    if (strcmp(ctx->points_key, key) != 0 || used == 0) {
+        snprintf(ctx->points_key, sizeof ctx->points_key, "%s", key);
+        snprintf(ctx->points_text, sizeof ctx->points_text, "%s", value);
+    } else {
+        const char *separator = ctx->points_text[used - 1] == ',' ? " " : ", ";
+        snprintf(ctx->points_text + used, sizeof ctx->points_text - used, "%s%s", separator, value);
+    }
+    return ctx->points_text;
+}
 
 static int on_ini_entry(void *user, const char *section, const char *name, const char *value)
 {
@@ -312,6 +329,9 @@ static int on_ini_entry(void *user, const char *section, const char *name, const
         return 1;
     }
     snprintf(key, sizeof key, "%s.%s", section, name);
+    if (strcmp(name, "points") == 0) {
+        value = join_points(ctx, key, value);
+    }
     if (sil_scenario_set(ctx->sc, key, value, message, sizeof message) != 0) {
         snprintf(ctx->message, sizeof ctx->message, "%s", message);
         ctx->failed = 1;
@@ -327,6 +347,8 @@ int sil_scenario_load(sil_scenario_t *sc, const char *path, char *err, size_t er
     ctx.sc = sc;
     ctx.message[0] = '\0';
     ctx.failed = 0;
+    ctx.points_key[0] = '\0';
+    ctx.points_text[0] = '\0';
     line = ini_parse(path, on_ini_entry, &ctx);
     if (line == -1) {
         return fail(err, err_size, "%s: cannot open", path);
@@ -378,7 +400,8 @@ static void print_points(FILE *file, const double *t, const double *v, int n)
 {
     int k;
     for (k = 0; k < n; ++k) {
-        fprintf(file, "%s%.9g:%.9g", k ? ", " : "", t[k], v[k]);
+        /* six points a line, continued on indented lines: inih reads lines of up to 200 characters */
+        fprintf(file, "%s%.9g:%.9g", k == 0 ? "" : (k % 6 == 0 ? ",\n    " : ", "), t[k], v[k]);
     }
     fputc('\n', file);
 }

@@ -9,6 +9,7 @@
 #include <math.h>
 
 #include "sil/runner.h"
+#include "pmstep/pmstep_text.h"
 
 #define LATENCY_BOUND_S 0.05
 

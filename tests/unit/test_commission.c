@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "pmstep/pmstep.h"
+#include "pmstep/pmstep_text.h"
 
 /* Short alignments (40 ms each, 22 time constants L/R) so a test runs a few thousand periods. */
 static pmstep_config_t short_config(void)

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "pmstep/pmstep.h"
+#include "pmstep/pmstep_text.h"
 
 static pmstep_meas_t nominal_meas(void)
 {

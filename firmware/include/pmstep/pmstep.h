@@ -107,15 +107,6 @@ void pmstep_step(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out
 /** Calibration and commissioning results so far (telemetry; see pmstep_commissioning_t). */
 void pmstep_get_commissioning(const pmstep_t *inst, pmstep_commissioning_t *out);
 
-/** Human-readable text for a status code. */
-const char *pmstep_status_str(pmstep_status_t status);
-
-/** Name of a fault code, e.g. "SPEED_INCONSISTENT" (the enum's suffix; pmstep_types.h describes each). */
-const char *pmstep_fault_str(pmstep_fault_t fault);
-
-/** Human-readable name of a mode. */
-const char *pmstep_mode_str(pmstep_mode_t mode);
-
 /** Configuration of the paper's Section III (motor, gains, t_s = 0.3 s, t_c = 0.6 s), 20 kHz. */
 pmstep_config_t pmstep_paper_config(void);
 

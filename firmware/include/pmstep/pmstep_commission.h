@@ -9,8 +9,10 @@
  *    where u_a resp. u_b = 0) reads its sensor offset;
  *  - R: the steady states i_b = u_cs/R (end of s-alignment) and i_a = u_cc/R (end
  *    of c-alignment), each over a window of W samples;
- *  - L: the rise of i_b over the first N periods of s-alignment, when the rotor
- *    has not moved yet: L (i_b(N) - i_b(0)) = integral of (u_b - R i_b);
+ *  - L: the rise of i_b over N periods early in s-alignment, when the rotor has
+ *    hardly moved: L (i_b(m0 + N) - i_b(m0)) = integral of (u_b - R i_b). The window
+ *    starts at m0 = 2 + delay, once the current is clear of zero and the dead-time
+ *    compensation acts in full;
  *  - k_M: the flux swing of c-alignment, the rotor turning from sin p theta = 1 to
  *    cos p theta = 1. With x = L i + (k_M/p)(cos p theta, sin p theta) and x' = u - R i
  *    (model (1)), over [t_s, t_c]:
@@ -35,6 +37,7 @@ typedef struct {
     uint32_t c_align_end_step;  /**< sample at t_c */
     uint32_t window_steps;      /**< W: steady-state window at the end of each alignment (0 = none) */
     uint32_t inductance_steps;  /**< N: current-rise window (0 = L not measured) */
+    uint32_t inductance_start_step; /**< m0: first sample of the current-rise window */
     bool offsets_from_alignment;/**< take offsets from the alignment steady states too */
 } pmstep_commission_plan_t;
 

@@ -21,6 +21,7 @@
 #include "sil/inverter.h"
 #include "sil/metrics.h"
 #include "sil/plant.h"
+#include "pmstep/pmstep_text.h"
 
 static pmstep_t motor;
 static pmstep_config_t config; /* outlives the instance, as pmstep_init() requires */

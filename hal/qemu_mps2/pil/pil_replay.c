@@ -14,6 +14,7 @@
 
 #include "pil_record.h"
 #include "pmstep_hal_qemu_mps2.h"
+#include "pmstep/pmstep_text.h"
 
 #define IO_BUFFER_BYTES 65536u
 
