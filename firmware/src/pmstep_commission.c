@@ -23,6 +23,17 @@ static bool in_window(uint32_t sample, uint32_t end, uint32_t window)
     return sample < end && sample + window >= end;
 }
 
+bool pmstep_commission_low_level(const pmstep_commission_plan_t *plan, uint32_t sample, uint32_t end)
+{
+    return plan->bias_estimation && in_window(sample, end, plan->window_steps);
+}
+
+/* End of the full-voltage steady-state window of an alignment ending at @p end. */
+static uint32_t high_window_end(const pmstep_commission_plan_t *plan, uint32_t end)
+{
+    return plan->bias_estimation ? end - plan->window_steps : end;
+}
+
 void pmstep_commission_add_alignment(pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
                                      uint32_t sample, float i_a_a, float i_b_a, float u_a_v, float u_b_v)
 {
@@ -37,7 +48,7 @@ void pmstep_commission_add_alignment(pmstep_commission_sums_t *sums, const pmste
         sums->rise_end_a = i_b_a;
     }
     if (sample < plan->s_align_steps) {
-        if (in_window(sample, plan->s_align_steps, plan->window_steps)) {
+        if (in_window(sample, high_window_end(plan, plan->s_align_steps), plan->window_steps)) {
             sums->s_current_sum_a += i_b_a;
             sums->s_voltage_sum_v += u_b_v;
             if (plan->offsets_from_alignment) {
@@ -45,18 +56,23 @@ void pmstep_commission_add_alignment(pmstep_commission_sums_t *sums, const pmste
                 sums->zero_count_a++;
             }
         }
+        if (plan->bias_estimation && in_window(sample, plan->s_align_steps, plan->window_steps / 2u)) {
+            sums->s_low_current_sum_a += i_b_a;
+            sums->s_low_voltage_sum_v += u_b_v;
+        }
         return;
     }
     if (sample == plan->s_align_steps) {
         sums->swing_start_a_a = i_a_a;
-        sums->swing_start_b_a = i_b_a;
     } else {
         sums->swing_voltage_a_v += u_a_v;
-        sums->swing_voltage_b_v += u_b_v;
     }
     sums->swing_current_a_a += i_a_a;
-    sums->swing_current_b_a += i_b_a;
-    if (in_window(sample, plan->c_align_end_step, plan->window_steps)) {
+    if (plan->bias_estimation && in_window(sample, plan->c_align_end_step, plan->window_steps / 2u)) {
+        sums->c_low_current_sum_a += i_a_a;
+        sums->c_low_voltage_sum_v += u_a_v;
+    }
+    if (in_window(sample, high_window_end(plan, plan->c_align_end_step), plan->window_steps)) {
         sums->c_current_sum_a += i_a_a;
         sums->c_voltage_sum_v += u_a_v;
         if (plan->offsets_from_alignment) {
@@ -89,6 +105,14 @@ static float window_resistance(float voltage_sum_v, float current_sum_a, uint32_
     return (voltage_sum_v / (float)count) / (current_sum_a / (float)count - offset_a);
 }
 
+/* Two steady states (means u_1, i_1 and u_2, i_2) of one phase: R, and the bias u_1 - R i_1. */
+static float two_level_resistance(float u_1, float i_1, float u_2, float i_2, float *bias_v)
+{
+    const float resistance_ohm = (u_1 - u_2) / (i_1 - i_2);
+    *bias_v = u_1 - resistance_ohm * i_1;
+    return resistance_ohm;
+}
+
 /* integral(u - R i) - L delta i over the c-alignment swing of one phase (V s). */
 static float swing_flux(float voltage_sum_v, float current_sum_a, float start_a, float end_a, uint32_t periods,
                         float offset_a, float resistance_ohm, float inductance_h, float period_s)
@@ -98,8 +122,8 @@ static float swing_flux(float voltage_sum_v, float current_sum_a, float start_a,
 }
 
 pmstep_fault_t pmstep_commission_finish(const pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
-                                        const pmstep_config_t *cfg, float i_a_a, float i_b_a, float u_a_v,
-                                        float u_b_v, pmstep_commissioning_t *result)
+                                        const pmstep_config_t *cfg, float i_a_a, float u_a_v,
+                                        pmstep_commissioning_t *result)
 {
     const float period_s = cfg->period_s;
     const float offset_a = mean_or_zero(sums->zero_sum_a_a, sums->zero_count_a);
@@ -113,32 +137,52 @@ pmstep_fault_t pmstep_commission_finish(const pmstep_commission_sums_t *sums, co
     result->offset_b_a = offset_b;
     result->offset_samples = sums->zero_count_a + sums->zero_count_b;
     result->resistance_ohm = 0.0f;
+    result->current_scale_a = 1.0f;
     result->inductance_h = 0.0f;
     result->torque_constant_nm_per_a = 0.0f;
+    result->voltage_bias_a_v = 0.0f;
+    result->voltage_bias_b_v = 0.0f;
     result->measured = true;
-    if (windows) {
+    if (windows && plan->bias_estimation) {
+        /* Two steady states per phase: R and the voltage bias. */
+        const float n_1 = (float)plan->window_steps;
+        const float n_2 = (float)(plan->window_steps / 2u);
+        r_b = two_level_resistance(sums->s_voltage_sum_v / n_1, sums->s_current_sum_a / n_1 - offset_b,
+                                   sums->s_low_voltage_sum_v / n_2, sums->s_low_current_sum_a / n_2 - offset_b,
+                                   &result->voltage_bias_b_v);
+        r_a = two_level_resistance(sums->c_voltage_sum_v / n_1, sums->c_current_sum_a / n_1 - offset_a,
+                                   sums->c_low_voltage_sum_v / n_2, sums->c_low_current_sum_a / n_2 - offset_a,
+                                   &result->voltage_bias_a_v);
+    } else if (windows) {
         /* Steady states of (3) and (5): R = u/i on each phase. */
         r_b = window_resistance(sums->s_voltage_sum_v, sums->s_current_sum_a, plan->window_steps, offset_b);
         r_a = window_resistance(sums->c_voltage_sum_v, sums->c_current_sum_a, plan->window_steps, offset_a);
-        result->resistance_ohm = 0.5f * (r_a + r_b);
+    }
+    if (windows) {
+        /* The phases' apparent R differ by their sensors' gains: phase b is the reference. */
+        result->resistance_ohm = r_b;
+        result->current_scale_a = r_a / r_b;
     }
     if (plan->inductance_steps > 0u) {
         /* L delta i = integral(u - R i) over the rise; the rotor has not moved yet. */
         const float charge_a_s = current_integral(sums->rise_current_sum_a, sums->rise_start_a, sums->rise_end_a,
                                                   plan->inductance_steps, offset_b, period_s);
-        inductance_h = (period_s * sums->rise_voltage_sum_v - r_b * charge_a_s) / (sums->rise_end_a - sums->rise_start_a);
+        const float volt_seconds = period_s * (sums->rise_voltage_sum_v
+                                               - (float)plan->inductance_steps * result->voltage_bias_b_v);
+        inductance_h = (volt_seconds - r_b * charge_a_s) / (sums->rise_end_a - sums->rise_start_a);
         result->inductance_h = inductance_h;
     }
     if (windows) {
-        /* Flux swing of c-alignment (see the header), samples t_s .. t_c; the sign of phase b's is reversed. */
+        /* Flux swing of c-alignment (see the header), samples t_s .. t_c, on the driven phase a:
+         * its current is far from zero throughout, so its voltage is known (bias included). Its
+         * apparent L is phase b's on phase a's sensor scale. */
         const uint32_t periods = plan->c_align_end_step - plan->s_align_steps;
-        const float flux_a = swing_flux(sums->swing_voltage_a_v + u_a_v, sums->swing_current_a_a, sums->swing_start_a_a,
-                                        i_a_a, periods, offset_a, r_a, inductance_h, period_s);
-        const float flux_b = swing_flux(sums->swing_voltage_b_v + u_b_v, sums->swing_current_b_a, sums->swing_start_b_a,
-                                        i_b_a, periods, offset_b, r_b, inductance_h, period_s);
-        result->torque_constant_nm_per_a = 0.5f * (flux_a - flux_b) * (float)cfg->pole_pairs;
+        const float flux_a = swing_flux(sums->swing_voltage_a_v + u_a_v - (float)periods * result->voltage_bias_a_v,
+                                        sums->swing_current_a_a, sums->swing_start_a_a, i_a_a, periods, offset_a, r_a,
+                                        inductance_h * result->current_scale_a, period_s);
+        result->torque_constant_nm_per_a = flux_a * (float)cfg->pole_pairs;
     }
-    if ((windows && !(plausible(result->resistance_ohm, cfg->resistance_ohm)
+    if ((windows && !(plausible(r_a, cfg->resistance_ohm) && plausible(r_b, cfg->resistance_ohm)
                       && plausible(result->torque_constant_nm_per_a, cfg->torque_constant_nm_per_a)))
         || (plan->inductance_steps > 0u && !plausible(inductance_h, cfg->inductance_h))) {
         return PMSTEP_FAULT_COMMISSIONING;

@@ -26,8 +26,18 @@ static pmstep_status_t validate_calibration(const pmstep_config_t *cfg)
         || (cfg->use_commissioned_inductance && !(cfg->inductance_window_s > 0.0f))) {
         return PMSTEP_ERR_CALIBRATION;
     }
+    /* The bias option needs its two windows (2 W) in the second half of each alignment, and
+     * W/2 of settling at the lower level: at least 5 L/R. */
+    if (cfg->voltage_bias_level_fraction < 0.0f || cfg->voltage_bias_level_fraction >= 1.0f
+        || (cfg->voltage_bias_level_fraction > 0.0f
+            && (!window || cfg->steady_state_window_s > 0.25f * s_align_s
+                || cfg->steady_state_window_s > 0.25f * c_align_s
+                || cfg->steady_state_window_s * cfg->resistance_ohm < 10.0f * cfg->inductance_h))) {
+        return PMSTEP_ERR_CALIBRATION;
+    }
     if (cfg->dead_time_s < 0.0f || 2.0f * cfg->dead_time_s >= 0.5f * cfg->period_s
-        || (cfg->dead_time_s > 0.0f && !(cfg->dead_time_current_band_a > 0.0f))) {
+        || ((cfg->dead_time_s > 0.0f || cfg->voltage_bias_level_fraction > 0.0f)
+            && !(cfg->dead_time_current_band_a > 0.0f))) {
         return PMSTEP_ERR_CALIBRATION;
     }
     if (cfg->angle_correction_gain_per_s < 0.0f || cfg->angle_correction_gain_per_s * cfg->period_s >= 0.5f) {
@@ -68,7 +78,8 @@ pmstep_status_t pmstep_validate_config(const pmstep_config_t *cfg)
             offsetof(pmstep_config_t, dead_time_s), offsetof(pmstep_config_t, dead_time_current_band_a),
             offsetof(pmstep_config_t, angle_correction_gain_per_s), offsetof(pmstep_config_t, angle_magnitude_bound),
             offsetof(pmstep_config_t, speed_consistency_bound_rad_s),
-            offsetof(pmstep_config_t, stall_speed_error_rad_s), offsetof(pmstep_config_t, detection_time_s)};
+            offsetof(pmstep_config_t, stall_speed_error_rad_s), offsetof(pmstep_config_t, detection_time_s),
+            offsetof(pmstep_config_t, voltage_bias_level_fraction)};
         size_t n;
         for (n = 0; n < sizeof float_fields; ++n) {
             float value;

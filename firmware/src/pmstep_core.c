@@ -39,7 +39,9 @@ pmstep_status_t pmstep_init(pmstep_t *inst, const pmstep_config_t *cfg)
     inst->commission_plan.offsets_from_alignment = cfg->alignment_offset_calibration;
     inst->offset_cal_steps = periods_in(cfg->offset_calibration_time_s, cfg->period_s);
     inst->dead_time_duty = 2.0f * cfg->dead_time_s / cfg->period_s;
-    inst->inv_dead_time_band_per_a = cfg->dead_time_s > 0.0f ? 1.0f / cfg->dead_time_current_band_a : 0.0f;
+    inst->compensate_voltage = cfg->dead_time_s > 0.0f || cfg->voltage_bias_level_fraction > 0.0f;
+    inst->inv_dead_time_band_per_a = inst->compensate_voltage ? 1.0f / cfg->dead_time_current_band_a : 0.0f;
+    inst->commission_plan.bias_estimation = cfg->voltage_bias_level_fraction > 0.0f;
     inst->detection_steps = periods_in(cfg->detection_time_s, cfg->period_s);
     inst->detection_alpha = 4.0f * cfg->period_s / (cfg->detection_time_s > 0.0f ? cfg->detection_time_s : 1.0f);
     inst->angle_step_per_speed = (float)cfg->pole_pairs * cfg->period_s;
@@ -53,6 +55,7 @@ static void clear_commissioning(pmstep_t *inst)
 {
     const pmstep_electrical_t configured = pmstep_configured_electrical(inst->cfg);
     memset(&inst->commissioning, 0, sizeof inst->commissioning);
+    inst->commissioning.current_scale_a = 1.0f;
     pmstep_commission_clear(&inst->scratch.sums);
     apply_model(inst, &configured);
 }
@@ -78,7 +81,7 @@ void pmstep_reset(pmstep_t *inst)
     inst->step_count = 0u;
     pmstep_ref_reset(&inst->speed_ref, 0.0f);
     pmstep_ref_reset(&inst->i_d_ref, 0.0f);
-    pmstep_ref_reset(&inst->known_load_filter, 0.0f);
+    pmstep_ref_reset(&inst->scratch.run.known_load_filter, 0.0f);
     clear_dynamic_state(inst);
     clear_commissioning(inst);
 }
@@ -196,8 +199,8 @@ static pmstep_fault_t finish_commissioning(pmstep_t *inst, const pmstep_meas_t *
     pmstep_commissioning_t *result = &inst->commissioning;
     pmstep_electrical_t model = pmstep_configured_electrical(cfg);
     const pmstep_fault_t fault =
-        pmstep_commission_finish(&inst->scratch.sums, &inst->commission_plan, cfg, raw->i_a_a, raw->i_b_a,
-                                 inst->u_applied_a_v, inst->u_applied_b_v, result);
+        pmstep_commission_finish(&inst->scratch.sums, &inst->commission_plan, cfg, raw->i_a_a, inst->u_applied_a_v,
+                                 result);
     if (fault != PMSTEP_FAULT_NONE) {
         return fault;
     }
@@ -226,8 +229,8 @@ static void start_run(pmstep_t *inst, const pmstep_meas_t *meas)
     pmstep_ref_set_target(&inst->speed_ref, speed_cmd.target, speed_cmd.ramp_rate_per_s);
     pmstep_ref_reset(&inst->i_d_ref, 0.0f);
     pmstep_ref_set_target(&inst->i_d_ref, i_d_cmd.target, 0.0f);
-    pmstep_ref_reset(&inst->known_load_filter, inst->cfg->known_load_mode ? meas->load_torque_nm : 0.0f);
-    inst->scratch.detector = fresh_detector; /* the sums are spent: (c-hat, s-hat) = (1, 0) at t_c */
+    pmstep_ref_reset(&inst->scratch.run.known_load_filter, inst->cfg->known_load_mode ? meas->load_torque_nm : 0.0f);
+    inst->scratch.run.detector = fresh_detector; /* the sums are spent: (c-hat, s-hat) = (1, 0) at t_c */
     inst->run_started = true;
 }
 
@@ -238,7 +241,7 @@ static void run_controller(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_out
     const bool known_load = inst->cfg->known_load_mode;
     const pmstep_ref_out_t speed_ref = pmstep_ref_output(&inst->ref_coeffs, &inst->speed_ref);
     const pmstep_ref_out_t i_d_ref = pmstep_ref_output(&inst->ref_coeffs, &inst->i_d_ref);
-    const pmstep_ref_out_t load_ref = pmstep_ref_output(&inst->ref_coeffs, &inst->known_load_filter);
+    const pmstep_ref_out_t load_ref = pmstep_ref_output(&inst->ref_coeffs, &inst->scratch.run.known_load_filter);
     pmstep_law_refs_t refs;
     float cos_hat;
     float sin_hat;
@@ -331,12 +334,13 @@ static void trip(pmstep_t *inst, pmstep_fault_t fault, pmstep_output_t *out)
 }
 
 /* Voltage that makes up for the dead time of a phase's two half-bridges (each loses
- * sign(i) V_bus t_d / T_s): 2 V_bus t_d / T_s, linear in i within the band. */
-static float dead_time_voltage(const pmstep_t *inst, float current_a, float bus_voltage_v)
+ * sign(i) V_bus t_d / T_s) and for the measured bias: (2 V_bus t_d / T_s + bias) sign(i),
+ * linear in i within the band. */
+static float dead_time_voltage(const pmstep_t *inst, float current_a, float bus_voltage_v, float bias_v)
 {
     float share = current_a * inst->inv_dead_time_band_per_a;
     share = share > 1.0f ? 1.0f : (share < -1.0f ? -1.0f : share);
-    return inst->dead_time_duty * bus_voltage_v * share;
+    return (inst->dead_time_duty * bus_voltage_v + bias_v) * share;
 }
 
 /* Counts the periods @p condition has held; true once it has held @p limit periods. */
@@ -350,7 +354,7 @@ static bool persists(uint32_t *count, bool condition, uint32_t limit)
 static pmstep_fault_t detect(pmstep_t *inst, const pmstep_output_t *out)
 {
     const pmstep_config_t *cfg = inst->cfg;
-    pmstep_detector_t *d = &inst->scratch.detector;
+    pmstep_detector_t *d = &inst->scratch.run.detector;
     const uint32_t limit = inst->detection_steps;
     pmstep_fault_t found = PMSTEP_FAULT_NONE;
     if (cfg->angle_magnitude_bound > 0.0f) {
@@ -439,20 +443,28 @@ void pmstep_step(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out
             }
         }
     }
-    /* Remark 2: the sensor offsets (zero until measured) come off every sample. */
+    /* Remark 2: the sensor offsets (zero until measured) come off every sample; phase a is put
+     * on phase b's scale (1 until measured). */
     sample = *meas;
-    sample.i_a_a -= inst->commissioning.offset_a_a;
+    sample.i_a_a = (sample.i_a_a - inst->commissioning.offset_a_a) * inst->commissioning.current_scale_a;
     sample.i_b_a -= inst->commissioning.offset_b_a;
     switch (inst->mode) {
     case PMSTEP_MODE_S_ALIGN: /* (3); no telemetry in alignment */
         output_off(out, inst);
         out->u_a_v = 0.0f;
         out->u_b_v = cfg->s_align_voltage_v;
+        if (pmstep_commission_low_level(&inst->commission_plan, inst->mode_step, inst->commission_plan.s_align_steps)) {
+            out->u_b_v *= cfg->voltage_bias_level_fraction; /* second steady state (Remark 2 bias) */
+        }
         break;
     case PMSTEP_MODE_C_ALIGN: /* (5) */
         output_off(out, inst);
         out->u_a_v = cfg->c_align_voltage_v;
         out->u_b_v = 0.0f;
+        if (pmstep_commission_low_level(&inst->commission_plan, inst->mode_step,
+                                        inst->commission_plan.c_align_end_step)) {
+            out->u_a_v *= cfg->voltage_bias_level_fraction;
+        }
         break;
     default: /* RUN: (6) or (13); run_controller() writes every telemetry field */
         out->fault = PMSTEP_FAULT_NONE;
@@ -470,11 +482,23 @@ void pmstep_step(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out
         }
         break;
     }
-    if (inst->dead_time_duty > 0.0f) {
-        /* Both phases in every mode: the undriven phase of an alignment still carries its decaying
-         * current. Near zero current the sign comes from offset-corrected samples. */
-        dead_time_a_v = dead_time_voltage(inst, sample.i_a_a, meas->bus_voltage_v);
-        dead_time_b_v = dead_time_voltage(inst, sample.i_b_a, meas->bus_voltage_v);
+    if (inst->compensate_voltage) {
+        /* Both phases in every mode: the undriven phase of an alignment must really be at 0 V
+         * (a short through the bridge: it damps the rotor's swing); left alone, its dead time
+         * would clamp it open. The sign of the current: in RUN from the current references
+         * (i_d*, i_q*) turned by (c-hat, s-hat), which pass through zero smoothly where a
+         * sampled current would sit in the ADC's zero code and let the phase clamp; in the
+         * alignments from the offset-corrected samples. */
+        float sign_current_a_a = sample.i_a_a;
+        float sign_current_b_a = sample.i_b_a;
+        if (inst->mode == PMSTEP_MODE_RUN) {
+            sign_current_a_a = out->cos_hat * out->i_d_ref_a - out->sin_hat * out->i_q_ref_a;
+            sign_current_b_a = out->sin_hat * out->i_d_ref_a + out->cos_hat * out->i_q_ref_a;
+        }
+        dead_time_a_v = dead_time_voltage(inst, sign_current_a_a, meas->bus_voltage_v,
+                                          inst->commissioning.voltage_bias_a_v);
+        dead_time_b_v = dead_time_voltage(inst, sign_current_b_a, meas->bus_voltage_v,
+                                          inst->commissioning.voltage_bias_b_v);
     }
     out->u_a_v += dead_time_a_v;
     out->u_b_v += dead_time_b_v;
@@ -504,8 +528,8 @@ void pmstep_step(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out
         pmstep_ref_advance(&inst->ref_coeffs, &inst->speed_ref, cfg->period_s);
         pmstep_ref_advance(&inst->ref_coeffs, &inst->i_d_ref, cfg->period_s);
         if (cfg->known_load_mode) {
-            pmstep_ref_set_target(&inst->known_load_filter, meas->load_torque_nm, 0.0f);
-            pmstep_ref_advance(&inst->ref_coeffs, &inst->known_load_filter, cfg->period_s);
+            pmstep_ref_set_target(&inst->scratch.run.known_load_filter, meas->load_torque_nm, 0.0f);
+            pmstep_ref_advance(&inst->ref_coeffs, &inst->scratch.run.known_load_filter, cfg->period_s);
         }
         if (!all_finite4(out->u_a_v, out->u_b_v, inst->observer.speed_hat_rad_s, inst->observer.load_hat_nm)
             || !all_finite4(inst->observer.i_a_hat_a, inst->observer.i_b_hat_a, inst->angle.phi_a,

@@ -106,6 +106,8 @@ static void add_robustness_json(cJSON *root, const sil_summary_t *s)
     cJSON_AddNumberToObject(comm, "resistance_ohm", (double)c->resistance_ohm);
     cJSON_AddNumberToObject(comm, "inductance_h", (double)c->inductance_h);
     cJSON_AddNumberToObject(comm, "torque_constant_nm_per_a", (double)c->torque_constant_nm_per_a);
+    cJSON_AddNumberToObject(comm, "voltage_bias_a_v", (double)c->voltage_bias_a_v);
+    cJSON_AddNumberToObject(comm, "voltage_bias_b_v", (double)c->voltage_bias_b_v);
     cJSON_AddNumberToObject(comm, "realignments", (double)c->realignments);
     cJSON_AddBoolToObject(comm, "measured", c->measured);
     cJSON_AddItemToObject(root, "commissioning", comm);

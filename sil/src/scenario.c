@@ -66,6 +66,7 @@ static const key_t_ keys[] = {
     {"controller.use_commissioned_resistance", KEY_BOOL, OFF(controller.use_commissioned_resistance), 0, 0, 1, 0, "RUN uses the measured R (true/false)"},
     {"controller.use_commissioned_inductance", KEY_BOOL, OFF(controller.use_commissioned_inductance), 0, 0, 1, 0, "RUN uses the measured L (true/false)"},
     {"controller.use_commissioned_torque_constant", KEY_BOOL, OFF(controller.use_commissioned_torque_constant), 0, 0, 1, 0, "RUN uses the measured k_M (true/false)"},
+    {"controller.voltage_bias_level_fraction", KEY_FLOAT, OFF(controller.voltage_bias_level_fraction), -BIG, 0, BIG, 0, "Remark 2 voltage bias: second alignment level as a fraction of the voltage (0 = off)"},
     {"controller.dead_time_s", KEY_FLOAT, OFF(controller.dead_time_s), -BIG, 0, BIG, 0, "dead time per half-bridge to compensate (s); 0 = none"},
     {"controller.dead_time_current_band_a", KEY_FLOAT, OFF(controller.dead_time_current_band_a), -BIG, 0, BIG, 0, "dead-time compensation linear within +/- this current (A)"},
     {"controller.angle_correction_gain_per_s", KEY_FLOAT, OFF(controller.angle_correction_gain_per_s), -BIG, 0, BIG, 0, "pulls (c-hat, s-hat) onto the unit circle at this rate (1/s); 0 = the paper's open integrals"},

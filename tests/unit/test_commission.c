@@ -27,6 +27,7 @@ static pmstep_config_t short_config(void)
  * the sensors add an offset. */
 typedef struct {
     double r_ohm, l_h, i_a_a, i_b_a, offset_a_a, offset_b_a;
+    double bias_v; /* the bridge falls short by this at positive current (a dead time) */
 } rl_plant_t;
 
 static pmstep_meas_t rl_sample(const rl_plant_t *p)
@@ -42,8 +43,8 @@ static pmstep_meas_t rl_sample(const rl_plant_t *p)
 static void rl_advance(rl_plant_t *p, const pmstep_output_t *out, double period_s)
 {
     const double decay = exp(-p->r_ohm * period_s / p->l_h);
-    const double u_a = out->bridge_enable ? (double)out->u_a_v : 0.0;
-    const double u_b = out->bridge_enable ? (double)out->u_b_v : 0.0;
+    const double u_a = out->bridge_enable ? (double)out->u_a_v - (p->i_a_a > 0.0 ? p->bias_v : 0.0) : 0.0;
+    const double u_b = out->bridge_enable ? (double)out->u_b_v - (p->i_b_a > 0.0 ? p->bias_v : 0.0) : 0.0;
     p->i_a_a = p->i_a_a * decay + u_a / p->r_ohm * (1.0 - decay);
     p->i_b_a = p->i_b_a * decay + u_b / p->r_ohm * (1.0 - decay);
 }
@@ -63,6 +64,8 @@ static void run_rl(pmstep_t *inst, rl_plant_t *plant, pmstep_output_t *out, uint
 }
 
 static void no_window(pmstep_config_t *c) { c->steady_state_window_s = 0.0f; c->alignment_offset_calibration = true; }
+static void bias_window_too_short(pmstep_config_t *c) { c->voltage_bias_level_fraction = 0.5f; c->dead_time_current_band_a = 0.05f; c->steady_state_window_s = 0.005f; }
+static void bias_fraction_one(pmstep_config_t *c) { c->voltage_bias_level_fraction = 1.0f; c->dead_time_current_band_a = 0.05f; }
 static void long_window(pmstep_config_t *c) { c->steady_state_window_s = 0.021f; }
 static void long_rise(pmstep_config_t *c) { c->inductance_window_s = 0.021f; }
 static void negative_offset_time(pmstep_config_t *c) { c->offset_calibration_time_s = -1e-3f; }
@@ -90,6 +93,7 @@ static void calibration_settings_are_validated(void **state)
         {dead_time_too_long, PMSTEP_ERR_CALIBRATION},  {correction_too_fast, PMSTEP_ERR_CALIBRATION},
         {correction_negative, PMSTEP_ERR_CALIBRATION}, {negative_bound, PMSTEP_ERR_DETECTION},
         {detection_too_short, PMSTEP_ERR_DETECTION},   {nan_window, PMSTEP_ERR_NONFINITE_PARAMETER},
+        {bias_window_too_short, PMSTEP_ERR_CALIBRATION}, {bias_fraction_one, PMSTEP_ERR_CALIBRATION},
     };
     size_t n;
     pmstep_t inst;
@@ -107,7 +111,7 @@ static void calibration_settings_are_validated(void **state)
 static void bridge_off_calibration_measures_the_offsets(void **state)
 {
     pmstep_config_t cfg = short_config();
-    rl_plant_t plant = {3.0, 0.006, 0.0, 0.0, 0.02, -0.01};
+    rl_plant_t plant = {3.0, 0.006, 0.0, 0.0, 0.02, -0.01, 0.0};
     pmstep_t inst;
     pmstep_output_t out;
     pmstep_commissioning_t result;
@@ -139,7 +143,7 @@ static void locked_rotor_gives_r_and_l_and_fails_the_torque_constant(void **stat
     /* R and L 20 % and 10 % above the configured 3 Ohm, 6 mH; offsets on both sensors.
      * The rotor never swings in c-alignment, so k_M comes out near 0: a commissioning fault. */
     pmstep_config_t cfg = short_config();
-    rl_plant_t plant = {3.6, 0.0066, 0.0, 0.0, 0.02, -0.01};
+    rl_plant_t plant = {3.6, 0.0066, 0.0, 0.0, 0.02, -0.01, 0.0};
     pmstep_t inst;
     pmstep_output_t out;
     pmstep_commissioning_t result;
@@ -160,6 +164,39 @@ static void locked_rotor_gives_r_and_l_and_fails_the_torque_constant(void **stat
     assert_int_equal(out.mode, PMSTEP_MODE_FAULT);
     assert_int_equal(out.fault, PMSTEP_FAULT_COMMISSIONING);
     assert_int_equal(out.fault_step, 1600u + 1u);
+}
+
+static void two_levels_give_r_and_the_voltage_bias(void **state)
+{
+    /* The bridge falls short by 0.3 V at positive current: one level would read R 0.3 V / 6.7 A
+     * (4.5 %) high; the second level at half voltage separates R from the bias. */
+    pmstep_config_t cfg = short_config();
+    rl_plant_t plant = {3.6, 0.0066, 0.0, 0.0, 0.02, -0.01, 0.3};
+    pmstep_t inst;
+    pmstep_output_t out;
+    pmstep_commissioning_t result;
+    uint32_t k;
+    (void)state;
+    cfg.s_align_time_s = 0.16f;
+    cfg.c_align_time_s = 0.32f;
+    cfg.steady_state_window_s = 0.04f; /* the lower level settles for 20 ms, 11 L/R */
+    cfg.voltage_bias_level_fraction = 0.5f;
+    cfg.dead_time_current_band_a = 0.05f;
+    assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
+    assert_int_equal(pmstep_start(&inst), PMSTEP_OK);
+    for (k = 0; k < 3200u; ++k) { /* s-alignment: the last 800 periods at half voltage */
+        const pmstep_meas_t m = rl_sample(&plant);
+        pmstep_step(&inst, &m, &out);
+        assert_true(out.u_b_v == (k < 2400u ? 24.0f : 12.0f));
+        rl_advance(&plant, &out, 50e-6);
+    }
+    run_rl(&inst, &plant, &out, 8000u);
+    pmstep_get_commissioning(&inst, &result);
+    print_message("R %.6f bias %.6f %.6f V\n", (double)result.resistance_ohm, (double)result.voltage_bias_a_v,
+                  (double)result.voltage_bias_b_v);
+    assert_true(fabsf(result.resistance_ohm - 3.6f) < 3.6f * 1e-4f);
+    assert_true(fabsf(result.voltage_bias_a_v - 0.3f) < 1e-3f);
+    assert_true(fabsf(result.voltage_bias_b_v - 0.3f) < 1e-3f);
 }
 
 static void dead_time_is_compensated_on_the_driven_phase(void **state)
@@ -250,6 +287,7 @@ int main(void)
         cmocka_unit_test(calibration_settings_are_validated),
         cmocka_unit_test(bridge_off_calibration_measures_the_offsets),
         cmocka_unit_test(locked_rotor_gives_r_and_l_and_fails_the_torque_constant),
+        cmocka_unit_test(two_levels_give_r_and_the_voltage_bias),
         cmocka_unit_test(dead_time_is_compensated_on_the_driven_phase),
         cmocka_unit_test(lost_angle_faults_or_realigns_after_the_detection_time),
     };

@@ -24,6 +24,7 @@ static void config_round_trips_through_the_words(void **state)
     in.use_commissioned_resistance = true;
     in.use_commissioned_inductance = false;
     in.use_commissioned_torque_constant = true;
+    in.voltage_bias_level_fraction = 0.5f;
     in.dead_time_s = 1e-6f;
     in.dead_time_current_band_a = 0.05f;
     in.angle_correction_gain_per_s = 20.0f;
@@ -42,6 +43,7 @@ static void config_round_trips_through_the_words(void **state)
                 && out.use_commissioned_torque_constant);
     assert_true(out.steady_state_window_s == in.steady_state_window_s && out.inductance_window_s == in.inductance_window_s);
     assert_true(out.dead_time_s == in.dead_time_s && out.dead_time_current_band_a == in.dead_time_current_band_a);
+    assert_true(out.voltage_bias_level_fraction == in.voltage_bias_level_fraction);
     assert_true(out.angle_correction_gain_per_s == in.angle_correction_gain_per_s);
     assert_true(out.angle_magnitude_bound == in.angle_magnitude_bound);
     assert_true(out.speed_consistency_bound_rad_s == in.speed_consistency_bound_rad_s);

@@ -37,6 +37,7 @@ typedef struct {
     uint32_t offset_cal_steps;    /**< periods of bridge-off offset calibration */
     float dead_time_duty;         /**< 2 t_d / T_s: compensation at full current, fraction of the bus */
     float inv_dead_time_band_per_a;
+    bool compensate_voltage;      /**< dead time configured or voltage bias estimated */
     uint32_t detection_steps;     /**< periods a condition must persist */
     float detection_alpha;        /**< T_s / tau of the rotation-gap low-pass */
     float angle_step_per_speed;   /**< p T_s: electrical rad per period per rad/s */
@@ -55,7 +56,6 @@ typedef struct {
 
     pmstep_ref_t speed_ref;
     pmstep_ref_t i_d_ref;
-    pmstep_ref_t known_load_filter; /**< T_L* of Remark 1 */
     pmstep_angle_t angle;
     pmstep_observer_t observer;
 
@@ -67,7 +67,10 @@ typedef struct {
     pmstep_commissioning_t commissioning; /**< offsets (subtracted from every sample once measured), R, L, k_M */
     union {
         pmstep_commission_sums_t sums;    /**< until t_c */
-        pmstep_detector_t detector;       /**< from t_c */
+        struct {
+            pmstep_detector_t detector;
+            pmstep_ref_t known_load_filter; /**< T_L* of Remark 1 */
+        } run;                            /**< from t_c */
     } scratch;
 } pmstep_t;
 

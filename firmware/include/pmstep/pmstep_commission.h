@@ -8,18 +8,23 @@
  *    i_a at the end of s-alignment (3) and i_b at the end of c-alignment (5),
  *    where u_a resp. u_b = 0) reads its sensor offset;
  *  - R: the steady states i_b = u_cs/R (end of s-alignment) and i_a = u_cc/R (end
- *    of c-alignment), each over a window of W samples;
+ *    of c-alignment), each over a window of W samples. With the voltage-bias option
+ *    the window moves W earlier and the last W run at a fraction f of the voltage;
+ *    the last W/2 of those are a second steady state, and per phase
+ *      R = (u_1 - u_2)/(i_1 - i_2),   bias = u_1 - R i_1
+ *    (the voltage the bridge falls short by at positive current: dead time the
+ *    compensation misses, switch drops);
  *  - L: the rise of i_b over N periods early in s-alignment, when the rotor has
  *    hardly moved: L (i_b(m0 + N) - i_b(m0)) = integral of (u_b - R i_b). The window
  *    starts at m0 = 2 + delay, once the current is clear of zero and the dead-time
  *    compensation acts in full;
  *  - k_M: the flux swing of c-alignment, the rotor turning from sin p theta = 1 to
  *    cos p theta = 1. With x = L i + (k_M/p)(cos p theta, sin p theta) and x' = u - R i
- *    (model (1)), over [t_s, t_c]:
- *      k_M/p =  integral(u_a - R i_a) - L delta i_a      (cos: 0 -> 1)
- *      k_M/p = -integral(u_b - R i_b) + L delta i_b      (sin: 1 -> 0)
- *    and the two are averaged. Each phase's R is the one measured on that phase, so
- *    a constant voltage bias (dead time) or current offset on it cancels.
+ *    (model (1)), over [t_s, t_c] on the driven phase a (cos: 0 -> 1):
+ *      k_M/p = integral(u_a - R i_a) - L delta i_a
+ *    with phase a's own R, so a current offset cancels, and its voltage bias taken off.
+ *    (Phase b's swing is not used: its current passes through zero, where the
+ *    dead time makes its voltage unknown.)
  * Currents are integrated by the trapezoid rule, held voltages exactly.
  */
 #ifndef PMSTEP_COMMISSION_H
@@ -39,6 +44,7 @@ typedef struct {
     uint32_t inductance_steps;  /**< N: current-rise window (0 = L not measured) */
     uint32_t inductance_start_step; /**< m0: first sample of the current-rise window */
     bool offsets_from_alignment;/**< take offsets from the alignment steady states too */
+    bool bias_estimation;       /**< second, lower steady state at the end of each alignment */
 } pmstep_commission_plan_t;
 
 /** Running sums (raw samples; offsets are removed at the end). */
@@ -48,11 +54,15 @@ typedef struct {
     float rise_voltage_sum_v, rise_current_sum_a, rise_start_a, rise_end_a; /**< L, phase b */
     float s_current_sum_a, s_voltage_sum_v; /**< end of s-alignment, phase b */
     float c_current_sum_a, c_voltage_sum_v; /**< end of c-alignment, phase a */
+    float s_low_current_sum_a, s_low_voltage_sum_v; /**< lower steady state of s-alignment (bias option) */
+    float c_low_current_sum_a, c_low_voltage_sum_v; /**< lower steady state of c-alignment */
     float swing_voltage_a_v, swing_current_a_a, swing_start_a_a; /**< c-alignment, k_M */
-    float swing_voltage_b_v, swing_current_b_a, swing_start_b_a;
 } pmstep_commission_sums_t;
 
 void pmstep_commission_clear(pmstep_commission_sums_t *sums);
+
+/** True from the sample where an alignment ending at sample @p end runs at its lower level. */
+bool pmstep_commission_low_level(const pmstep_commission_plan_t *plan, uint32_t sample, uint32_t end);
 
 /** A sample with the bridge off (true currents zero). */
 void pmstep_commission_add_bridge_off(pmstep_commission_sums_t *sums, float i_a_a, float i_b_a);
@@ -65,15 +75,15 @@ void pmstep_commission_add_alignment(pmstep_commission_sums_t *sums, const pmste
                                      uint32_t sample, float i_a_a, float i_b_a, float u_a_v, float u_b_v);
 
 /**
- * At t_c: offsets, R, L and k_M from the sums and the samples (i_a, i_b) at t_c;
- * values not measured are left 0 in @p result. The voltages over the last period
- * before t_c are @p u_a_v, @p u_b_v.
+ * At t_c: offsets, R, L and k_M (and the voltage biases) from the sums and the sample
+ * i_a at t_c; values not measured are left 0 in @p result. The voltage of phase a over
+ * the last period before t_c is @p u_a_v.
  * @return PMSTEP_FAULT_NONE, or PMSTEP_FAULT_COMMISSIONING when a measured value is not
  *         finite or outside [1/2, 2] x the configured one.
  */
 pmstep_fault_t pmstep_commission_finish(const pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
-                                        const pmstep_config_t *cfg, float i_a_a, float i_b_a, float u_a_v,
-                                        float u_b_v, pmstep_commissioning_t *result);
+                                        const pmstep_config_t *cfg, float i_a_a, float u_a_v,
+                                        pmstep_commissioning_t *result);
 
 #ifdef __cplusplus
 }

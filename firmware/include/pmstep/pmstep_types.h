@@ -115,6 +115,10 @@ typedef struct {
     bool use_commissioned_resistance;  /**< RUN uses the measured R in place of resistance_ohm */
     bool use_commissioned_inductance;  /**< RUN uses the measured L in place of inductance_h */
     bool use_commissioned_torque_constant; /**< RUN uses k_M measured from the c-alignment swing */
+    float voltage_bias_level_fraction; /**< Remark 2 voltage bias: 0 = off; else the last steady_state_window_s of
+                                            each alignment runs at this fraction of its voltage, and the two steady
+                                            states give R and the bias (the part of the dead time the compensation
+                                            misses), which is then compensated too */
     float dead_time_s;                 /**< dead time of each half-bridge to compensate (2 per phase); 0 = none */
     float dead_time_current_band_a;    /**< compensation is linear in i within +/- this band, full outside */
 
@@ -174,9 +178,13 @@ typedef struct {
     float offset_a_a;               /**< current-sensor offset subtracted from every i_a sample (A) */
     float offset_b_a;               /**< same for i_b */
     uint32_t offset_samples;        /**< samples behind the offsets (0: none taken, offsets 0) */
-    float resistance_ohm;           /**< R from the alignment steady states, u/i (0: not measured) */
+    float resistance_ohm;           /**< R of phase b from its alignment steady state(s) (0: not measured) */
+    float current_scale_a;          /**< R_a / R_b: phase a's samples are multiplied by it, so both phases read on
+                                         phase b's scale (a sensor gain mismatch); 1 until measured */
     float inductance_h;             /**< L from the current rise at the start of s-alignment (0: not measured) */
     float torque_constant_nm_per_a; /**< k_M from the flux swing of c-alignment (0: not measured) */
+    float voltage_bias_a_v;         /**< voltage phase a falls short by at positive current (0: not measured) */
+    float voltage_bias_b_v;         /**< same for phase b */
     uint32_t realignments;          /**< re-alignments after a detection since start */
     bool measured;                  /**< alignment finished and the values above were taken */
 } pmstep_commissioning_t;

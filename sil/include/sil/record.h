@@ -40,8 +40,8 @@ extern "C" {
  * then the entries in order.
  */
 #define SIL_RECORD_MAGIC 0x52534D50u /* "PMSR" */
-#define SIL_RECORD_VERSION 2u /* 2: the calibration, commissioning, angle and detection settings */
-#define SIL_RECORD_CONFIG_WORDS 39u
+#define SIL_RECORD_VERSION 3u /* 2: calibration, commissioning, angle and detection settings; 3: voltage bias */
+#define SIL_RECORD_CONFIG_WORDS 40u
 #define SIL_RECORD_TAG_SPEED_TARGET 1u
 #define SIL_RECORD_TAG_PERIOD 2u
 #define SIL_RECORD_TAG_END 3u
@@ -138,14 +138,15 @@ static inline void sil_record_config_from_words(const uint32_t *w, pmstep_config
     c->use_commissioned_resistance = w[28] != 0u;
     c->use_commissioned_inductance = w[29] != 0u;
     c->use_commissioned_torque_constant = w[30] != 0u;
-    c->dead_time_s = sil_record_float(w[31]);
-    c->dead_time_current_band_a = sil_record_float(w[32]);
-    c->angle_correction_gain_per_s = sil_record_float(w[33]);
-    c->angle_magnitude_bound = sil_record_float(w[34]);
-    c->speed_consistency_bound_rad_s = sil_record_float(w[35]);
-    c->stall_speed_error_rad_s = sil_record_float(w[36]);
-    c->detection_time_s = sil_record_float(w[37]);
-    c->max_realignments = w[38];
+    c->voltage_bias_level_fraction = sil_record_float(w[31]);
+    c->dead_time_s = sil_record_float(w[32]);
+    c->dead_time_current_band_a = sil_record_float(w[33]);
+    c->angle_correction_gain_per_s = sil_record_float(w[34]);
+    c->angle_magnitude_bound = sil_record_float(w[35]);
+    c->speed_consistency_bound_rad_s = sil_record_float(w[36]);
+    c->stall_speed_error_rad_s = sil_record_float(w[37]);
+    c->detection_time_s = sil_record_float(w[38]);
+    c->max_realignments = w[39];
 }
 
 static inline void sil_record_meas_from_words(const uint32_t *w, pmstep_meas_t *m)
@@ -213,14 +214,15 @@ static inline void sil_record_config_to_words(const pmstep_config_t *c, uint32_t
     w[28] = c->use_commissioned_resistance ? 1u : 0u;
     w[29] = c->use_commissioned_inductance ? 1u : 0u;
     w[30] = c->use_commissioned_torque_constant ? 1u : 0u;
-    w[31] = sil_record_bits(c->dead_time_s);
-    w[32] = sil_record_bits(c->dead_time_current_band_a);
-    w[33] = sil_record_bits(c->angle_correction_gain_per_s);
-    w[34] = sil_record_bits(c->angle_magnitude_bound);
-    w[35] = sil_record_bits(c->speed_consistency_bound_rad_s);
-    w[36] = sil_record_bits(c->stall_speed_error_rad_s);
-    w[37] = sil_record_bits(c->detection_time_s);
-    w[38] = c->max_realignments;
+    w[31] = sil_record_bits(c->voltage_bias_level_fraction);
+    w[32] = sil_record_bits(c->dead_time_s);
+    w[33] = sil_record_bits(c->dead_time_current_band_a);
+    w[34] = sil_record_bits(c->angle_correction_gain_per_s);
+    w[35] = sil_record_bits(c->angle_magnitude_bound);
+    w[36] = sil_record_bits(c->speed_consistency_bound_rad_s);
+    w[37] = sil_record_bits(c->stall_speed_error_rad_s);
+    w[38] = sil_record_bits(c->detection_time_s);
+    w[39] = c->max_realignments;
 }
 
 static inline void sil_record_meas_to_words(const pmstep_meas_t *m, uint32_t *w)

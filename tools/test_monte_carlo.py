@@ -1,0 +1,422 @@
+#!/usr/bin/env python3
+"""Self-test of tools/monte_carlo.py: its pure functions, and one small end-to-end run
+against a stand-in for pmstep-sil (a Python script written to a temporary folder, whose
+outcome per case is fixed by the case index), so that no build is needed.
+
+Usage: python3 -m unittest -v test_monte_carlo     (from tools/)
+       python3 tools/test_monte_carlo.py           (from anywhere)
+"""
+import csv
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import textwrap
+import unittest
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import monte_carlo as mc  # noqa: E402  (after the path is set)
+
+SCRIPT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "monte_carlo.py")
+
+
+def summary(fault_code=0, fault_time_s=-1.0, loss_s=-1.0, latency_s=None, speed=0.01, angle=0.001,
+            nonfinite=False, name="overcurrent"):
+    """A summary.json as pmstep-sil writes it, with only what classification reads."""
+    return {
+        "seed": 1,
+        "fault": {"code": fault_code, "name": name if fault_code else "none", "text": "t",
+                  "step": -1, "time_s": fault_time_s},
+        "final_mode": "FAULT" if fault_code else "RUN",
+        "robustness": {"settle_time_s": 0.8, "max_angle_error_rad": angle, "max_speed_error_rad_s": speed,
+                       "loss_of_control_time_s": loss_s, "detection_latency_s": latency_s,
+                       "nonfinite_seen": nonfinite},
+    }
+
+
+class SeedMapping(unittest.TestCase):
+    def test_case_seed(self):
+        self.assertEqual(mc.case_seed(7, 0), 700000)
+        self.assertEqual(mc.case_seed(7, 11), 700011)
+        self.assertEqual(mc.case_seed(0, 99999), 99999)
+        self.assertEqual(mc.case_seed(123, 45), 12300045)
+
+    def test_split_is_the_inverse(self):
+        self.assertEqual(mc.split_case_seed(700011), (7, 11))
+        for base, index in ((0, 0), (1, 99999), (42, 500)):
+            self.assertEqual(mc.split_case_seed(mc.case_seed(base, index)), (base, index))
+
+    def test_out_of_range(self):
+        with self.assertRaises(ValueError):
+            mc.case_seed(7, 100000)
+        with self.assertRaises(ValueError):
+            mc.case_seed(-1, 0)
+
+
+class Sampling(unittest.TestCase):
+    BASE = {"motor.resistance_ohm": 3.0, "motor.inductance_h": 0.006, "motor.torque_constant_nm_per_a": 2.0,
+            "motor.inertia_kg_m2": 0.01, "load.torque_nm": 2.0}
+
+    def test_known_draws(self):
+        # random.Random(700000).random() gives 0.5252184595196231, 0.7456568194701344, ...
+        p = mc.draw_parameters(700000, self.BASE)
+        self.assertAlmostEqual(p["motor.resistance_ohm"], 3.0 * (0.7 + 0.6 * 0.5252184595196231), places=14)
+        self.assertAlmostEqual(p["motor.resistance_ohm"], 3.045393227135322, places=14)
+        self.assertAlmostEqual(p["motor.inductance_h"], 0.006589576366728322, places=16)
+        self.assertAlmostEqual(p["run.theta0_deg"], 338.237522087197, places=10)
+        self.assertAlmostEqual(p["load.torque_nm"], 0.5791380988738883, places=14)
+        self.assertEqual(list(p), [row[0] for row in mc.DISTRIBUTIONS])
+
+    def test_reproducible_and_in_range(self):
+        for seed in range(200):
+            p = mc.draw_parameters(seed, self.BASE)
+            self.assertEqual(p, mc.draw_parameters(seed, self.BASE))
+            for key, kind, a, b in mc.DISTRIBUTIONS:
+                scale = self.BASE[key] if kind == "scale" else 1.0
+                if kind.startswith("times "):
+                    scale = p[kind[len("times "):]]  # relative to a key drawn before it
+                self.assertGreaterEqual(p[key], a * scale, key)
+                self.assertLess(p[key], b * scale, key)
+        self.assertNotEqual(mc.draw_parameters(1, self.BASE), mc.draw_parameters(2, self.BASE))
+
+    def test_format_value_round_trips(self):
+        for v in (3.045393227135322, 1.1266034776300019e-06, 0.0, -0.02):
+            self.assertEqual(float(mc.format_value(v)), v)
+
+
+class ScenarioParsing(unittest.TestCase):
+    TEXT = textwrap.dedent("""\
+        [scenario]
+        name = paper
+
+        [motor]
+        ; plant R (Ohm)
+        resistance_ohm = 3
+        inductance_h = 0.006
+
+        [speed]
+        ; set-point
+        points = 0:0, 0.65:0, 0.85:10
+        """)
+
+    def test_parse(self):
+        s = mc.parse_scenario(self.TEXT)
+        self.assertEqual(s["scenario.name"], "paper")
+        self.assertEqual(s["motor.resistance_ohm"], "3")
+        self.assertEqual(s["speed.points"], "0:0, 0.65:0, 0.85:10")
+        self.assertEqual(len(s), 4)
+
+    def test_missing_keys_in_table_order(self):
+        s = mc.parse_scenario(self.TEXT)
+        table = [("motor.resistance_ohm", "scale", 0.7, 1.3), ("sensors.noise_rms_a", "uniform", 0, 1),
+                 ("motor.inductance_h", "scale", 0.8, 1.2), ("bus.ripple_v", "uniform", 0, 2)]
+        self.assertEqual(mc.missing_keys(s, table), ["sensors.noise_rms_a", "bus.ripple_v", "run.seed"])
+        self.assertEqual(mc.missing_keys(s, table[:1], extra=()), [])
+
+    def test_base_values_need_numbers(self):
+        s = mc.parse_scenario(self.TEXT)
+        self.assertEqual(mc.base_values(s, [("motor.inductance_h", "scale", 0.8, 1.2)]), {"motor.inductance_h": 0.006})
+        with self.assertRaises(mc.ToolError):
+            mc.base_values(s, [("speed.points", "scale", 0.8, 1.2)])
+
+
+class Classification(unittest.TestCase):
+    def cls(self, s, exit_status=None, **bounds):
+        if exit_status is None:
+            exit_status = 3 if s and s["fault"]["code"] else 0
+        return mc.classify(s, exit_status, **bounds)
+
+    def test_success(self):
+        r = self.cls(summary(speed=0.49, angle=0.049))
+        self.assertEqual((r["class"], r["false_trip"], r["latency_s"]), ("success", False, None))
+
+    def test_out_of_spec_on_each_bound(self):
+        self.assertEqual(self.cls(summary(speed=0.5))["class"], "out_of_spec")   # bound is strict
+        self.assertEqual(self.cls(summary(angle=0.05))["class"], "out_of_spec")
+        self.assertEqual(self.cls(summary(speed=None))["class"], "out_of_spec")  # NaN written as null
+        self.assertEqual(self.cls(summary(nonfinite=True))["class"], "out_of_spec")
+        self.assertEqual(self.cls(summary(speed=0.7), speed_bound_rad_s=1.0)["class"], "success")
+
+    def test_detected_loss_with_latency(self):
+        r = self.cls(summary(fault_code=2, fault_time_s=1.23, loss_s=1.2, latency_s=0.03))
+        self.assertEqual(r["class"], "detected")
+        self.assertFalse(r["false_trip"])
+        self.assertAlmostEqual(r["latency_s"], 0.03)
+
+    def test_latency_from_times_when_null(self):
+        r = self.cls(summary(fault_code=2, fault_time_s=1.24, loss_s=1.2, latency_s=None))
+        self.assertEqual(r["class"], "detected")
+        self.assertAlmostEqual(r["latency_s"], 0.04)
+
+    def test_late_fault_is_silent(self):
+        r = self.cls(summary(fault_code=2, fault_time_s=1.3, loss_s=1.2, latency_s=0.1))
+        self.assertEqual(r["class"], "silent")
+        self.assertAlmostEqual(r["latency_s"], 0.1)
+        self.assertEqual(self.cls(summary(fault_code=2, fault_time_s=1.3, loss_s=1.2, latency_s=0.1),
+                                  latency_bound_s=0.2)["class"], "detected")
+
+    def test_fault_before_loss_is_detected(self):
+        r = self.cls(summary(fault_code=2, fault_time_s=1.19, loss_s=1.2, latency_s=-0.01))
+        self.assertEqual(r["class"], "detected")
+        self.assertAlmostEqual(r["latency_s"], -0.01)
+
+    def test_false_trip(self):
+        r = self.cls(summary(fault_code=5, fault_time_s=0.7, name="bus undervoltage"))
+        self.assertEqual((r["class"], r["false_trip"], r["latency_s"]), ("detected", True, None))
+        self.assertIn("bus undervoltage", r["reason"])
+
+    def test_silent_loss(self):
+        r = self.cls(summary(loss_s=1.5))
+        self.assertEqual((r["class"], r["false_trip"]), ("silent", False))
+        self.assertEqual(self.cls(summary(loss_s=0.0))["class"], "silent")  # loss at t = 0 is a loss
+        realigned = summary(loss_s=1.5)
+        realigned["commissioning"] = {"realignments": 2}
+        self.assertIn("no fault latched (2 re-alignment(s))", self.cls(realigned)["reason"])
+
+    def test_crashed(self):
+        ok = summary()
+        self.assertEqual(mc.classify(ok, 2)["class"], "crashed")
+        self.assertEqual(mc.classify(ok, -11)["reason"], "pmstep-sil killed by SIGSEGV")
+        self.assertEqual(mc.classify(ok, None)["class"], "crashed")
+        self.assertEqual(mc.classify(None, 0)["class"], "crashed")
+        self.assertEqual(mc.classify(ok, 0, problem="timed out after 5 s")["reason"], "timed out after 5 s")
+        self.assertEqual(mc.classify(ok, 3)["class"], "crashed")            # exit 3 without a fault
+        self.assertEqual(mc.classify(summary(fault_code=2, fault_time_s=1.0), 0)["class"], "crashed")
+        old = summary()
+        del old["robustness"]["nonfinite_seen"]
+        r = mc.classify(old, 0)
+        self.assertEqual(r["class"], "crashed")
+        self.assertIn("robustness.nonfinite_seen", r["reason"])
+        bad = summary()
+        bad["robustness"]["loss_of_control_time_s"] = "never"
+        self.assertEqual(mc.classify(bad, 0)["class"], "crashed")
+
+
+class Metrics(unittest.TestCase):
+    def test_commissioning_errors_against_the_plant(self):
+        s = summary()
+        s["commissioning"] = {"measured": True, "resistance_ohm": 3.03, "inductance_h": 0.0057,
+                              "torque_constant_nm_per_a": 2.2, "offset_a_a": 0.015, "offset_b_a": -0.01,
+                              "realignments": 0}
+        params = {"motor.resistance_ohm": 3.0, "motor.inductance_h": 0.006, "sensors.offset_a_a": 0.02,
+                  "sensors.offset_b_a": -0.02}
+        m = mc.extract_metrics(s, params, {"motor.torque_constant_nm_per_a": 2.0})
+        self.assertAlmostEqual(m["r_rel_error"], 0.01)
+        self.assertAlmostEqual(m["l_rel_error"], -0.05)
+        self.assertAlmostEqual(m["k_rel_error"], 0.1)      # plant k_M from the scenario when not drawn
+        self.assertAlmostEqual(m["offset_a_error_a"], -0.005)
+        self.assertAlmostEqual(m["offset_b_error_a"], 0.01)
+        self.assertTrue(m["past_settle"])
+        s["commissioning"]["measured"] = False
+        self.assertIsNone(mc.extract_metrics(s, params, {})["r_rel_error"])
+
+    def test_fault_before_settling(self):
+        m = mc.extract_metrics(summary(fault_code=6, fault_time_s=0.7), {}, {})   # settle_time_s = 0.8
+        self.assertFalse(m["past_settle"])
+        self.assertTrue(mc.extract_metrics(summary(fault_code=6, fault_time_s=0.9), {}, {})["past_settle"])
+
+
+class Statistics(unittest.TestCase):
+    def test_wilson(self):
+        low, high = mc.wilson_interval(5, 10)
+        self.assertAlmostEqual(low, 0.236593090512564, places=12)
+        self.assertAlmostEqual(high, 0.7634069094874361, places=12)
+        low, high = mc.wilson_interval(12, 12)
+        self.assertAlmostEqual(low, 12 / (12 + 1.959963984540054 ** 2), places=12)  # = 0.75750599...
+        self.assertEqual(high, 1.0)
+        low, high = mc.wilson_interval(0, 10)
+        self.assertEqual(low, 0.0)
+        self.assertAlmostEqual(high, 0.2775327998628892, places=12)
+        low, high = mc.wilson_interval(99, 100)
+        self.assertAlmostEqual(low, 0.9455138038212946, places=12)
+        self.assertAlmostEqual(high, 0.9982325679358593, places=12)
+        self.assertEqual(mc.wilson_interval(0, 0), (0.0, 1.0))
+        with self.assertRaises(ValueError):
+            mc.wilson_interval(11, 10)
+
+    def test_percentile(self):
+        self.assertEqual(mc.percentile([1, 2, 3, 4], 50), 2.5)
+        self.assertAlmostEqual(mc.percentile([1, 2, 3, 4], 90), 3.7)
+        self.assertEqual(mc.percentile([4, 3, 2, 1], 0), 1)
+        self.assertEqual(mc.percentile([4, 3, 2, 1], 100), 4)
+        self.assertAlmostEqual(mc.percentile([15, 20, 35, 40, 50], 40), 29.0)
+        self.assertEqual(mc.percentile([7.5], 99), 7.5)
+        self.assertIsNone(mc.percentile([], 50))
+        values = list(range(1, 101))
+        self.assertAlmostEqual(mc.percentile(values, 99), 99.01)
+
+    def test_spans_decades(self):
+        self.assertTrue(mc.spans_decades([0.0, 1e-4, 0.02]))
+        self.assertFalse(mc.spans_decades([0.01, 0.5]))
+        self.assertFalse(mc.spans_decades([0.0, 0.3]))
+
+    def test_worst_order(self):
+        def case(seed, cls, speed):
+            return {"seed": seed, "class": cls, "metrics": {"max_speed_error_rad_s": speed}}
+        cases = [case(1, "success", 0.4), case(2, "detected", 0.0), case(3, "success", 0.45),
+                 case(4, "crashed", None), case(5, "out_of_spec", 3.0)]
+        self.assertEqual([c["seed"] for c in mc.worst_order(cases)], [4, 5, 2, 3, 1])
+
+
+FAKE_SIL = textwrap.dedent('''\
+    """Stand-in for pmstep-sil: the case index (run.seed % 100000) chooses the outcome."""
+    import json, os, sys
+    KEYS = """[scenario]
+    name = fake
+    [motor]
+    ; plant R (Ohm)
+    resistance_ohm = 3
+    inductance_h = 0.006
+    inertia_kg_m2 = 0.01
+    friction_nm_s_per_rad = 0
+    torque_constant_nm_per_a = 2
+    [sensors]
+    offset_a_a = 0
+    offset_b_a = 0
+    gain_error_a = 0
+    gain_error_b = 0
+    noise_rms_a = 0
+    [inverter]
+    dead_time_s = 0
+    [bus]
+    ripple_v = 0
+    source_resistance_ohm = 0
+    [controller]
+    dead_time_s = 0
+    [run]
+    seed = 0
+    duration_s = 2.4
+    theta0_deg = 30
+    [load]
+    torque_nm = 2
+    """
+    args = sys.argv[1:]
+    if "--print-scenario" in args:
+        print(KEYS)
+        sys.exit(0)
+    sets = dict(args[i + 1].split("=", 1) for i, a in enumerate(args) if a == "--set")
+    out = args[args.index("--out") + 1]
+    index = int(sets["run.seed"]) % 100000
+    outcome = ["success", "detected", "false_trip", "silent", "out_of_spec", "crash", "late", "success"][index % 8]
+    if outcome == "crash":
+        sys.stderr.write("fake: segmentation fault\\n")
+        sys.exit(139)
+    fault = outcome in ("detected", "false_trip", "late")
+    loss = {"detected": 1.0, "silent": 1.1, "late": 1.2}.get(outcome, -1.0)
+    fault_time = {"detected": 1.02, "false_trip": 0.9, "late": 1.4}.get(outcome, -1.0)
+    r = float(sets["motor.resistance_ohm"])
+    s = {"seed": int(sets["run.seed"]),
+         "fault": {"code": 4 if fault else 0, "name": "overcurrent" if fault else "none", "text": "x",
+                   "step": 1, "time_s": fault_time},
+         "final_mode": "FAULT" if fault else "RUN",
+         "speed": {"tracking_max_abs_error_rad_s": 0.1},
+         "robustness": {"settle_time_s": 0.8, "max_angle_error_rad": 0.001 * (index + 1),
+                        "max_speed_error_rad_s": 2.0 if outcome == "out_of_spec" else 0.01 * (index + 1),
+                        "loss_of_control_time_s": loss,
+                        "detection_latency_s": (fault_time - loss) if fault and loss >= 0 else None,
+                        "nonfinite_seen": False},
+         "commissioning": {"offset_a_a": 0.0, "offset_b_a": 0.0, "resistance_ohm": r * 1.01,
+                           "inductance_h": 0.006, "torque_constant_nm_per_a": 2.0, "realignments": 0,
+                           "measured": True},
+         "timing": {"wall_s": 0.01}}
+    os.makedirs(out, exist_ok=True)
+    with open(os.path.join(out, "summary.json"), "w") as f:
+        json.dump(s, f)
+    sys.exit(3 if fault else 0)
+    ''')
+
+
+class EndToEnd(unittest.TestCase):
+    """The whole tool against the stand-in: 16 cases, two of each outcome."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        cls.sil = os.path.join(cls.tmp.name, "fake-sil")
+        with open(cls.sil, "w") as f:
+            f.write(f"#!{sys.executable}\n" + FAKE_SIL)
+        os.chmod(cls.sil, 0o755)
+        cls.scenario = os.path.join(cls.tmp.name, "fake.ini")
+        with open(cls.scenario, "w") as f:
+            f.write("[scenario]\nname = fake\n")
+        cls.out = os.path.join(cls.tmp.name, "mc")
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def run_tool(self, *extra):
+        cmd = [sys.executable, SCRIPT, "--sil", self.sil, "--scenario", self.scenario, "--out", self.out,
+               "--no-plots", *extra]
+        return subprocess.run(cmd, capture_output=True, text=True, timeout=120)
+
+    def test_run_and_check(self):
+        proc = self.run_tool("--cases", "16", "--seed", "3", "--jobs", "3", "--check")
+        self.assertEqual(proc.returncode, 1, proc.stdout + proc.stderr)
+        lines = proc.stdout.strip().splitlines()
+        self.assertEqual(lines[-1], "4 passed, 12 failed")
+        self.assertIn("silent failure", proc.stdout)
+        self.assertIn("crashed", proc.stdout)
+        # Not a terminal: one progress line per 10 %.
+        progress = [line for line in proc.stderr.splitlines() if "cases (" in line]
+        self.assertEqual(len(progress), 10)
+        self.assertTrue(progress[-1].startswith("monte_carlo: 16/16 cases (100 %)"))
+
+        with open(os.path.join(self.out, "summary.json")) as f:
+            agg = json.load(f)
+        self.assertEqual(agg["counts"], {"success": 4, "detected": 4, "silent": 4, "out_of_spec": 2, "crashed": 2})
+        self.assertEqual(agg["false_trips"], 2)
+        self.assertEqual(agg["detected_losses"], 2)
+        self.assertEqual(agg["faults_by_name"], {"overcurrent": 6})
+        self.assertAlmostEqual(agg["detection_latency_s"]["max"], 0.02)
+        self.assertAlmostEqual(agg["success_rate"], 0.25)
+        self.assertAlmostEqual(agg["distributions"]["commissioning_abs_r_rel_error"]["max"], 0.01)
+        self.assertFalse(agg["check"]["passed"])
+
+        with open(os.path.join(self.out, "cases.csv"), newline="") as f:
+            rows = list(csv.DictReader(f))
+        self.assertEqual([int(r["seed"]) for r in rows], list(range(300000, 300016)))
+        self.assertEqual(rows[5]["class"], "crashed")
+        self.assertIn("exited with status 139", rows[5]["reason"])
+        self.assertEqual(rows[2]["false_trip"], "1")
+        self.assertEqual(float(rows[0]["motor.resistance_ohm"]),
+                         mc.draw_parameters(300000, {"motor.resistance_ohm": 3.0, "motor.inductance_h": 0.006,
+                                                     "motor.torque_constant_nm_per_a": 2.0,
+                                                     "motor.inertia_kg_m2": 0.01,
+                                                     "load.torque_nm": 2.0})["motor.resistance_ohm"])
+
+        with open(os.path.join(self.out, "report.md")) as f:
+            report = f.read()
+        self.assertIn("Success rate: 4/16 = 25.0 %", report)
+        self.assertIn("fake: segmentation fault", report)     # the crashed case's stderr tail
+        self.assertIn("--case 300005", report)
+        for key, _kind, _a, _b in mc.DISTRIBUTIONS:
+            self.assertIn(f"`{key}`", report)
+
+    def test_one_case(self):
+        proc = self.run_tool("--case", "300001")
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        self.assertIn("class: detected", proc.stdout)
+        self.assertIn("--set run.seed=300001", proc.stdout)
+        self.assertEqual(proc.stdout.strip().splitlines()[-1], "0 passed, 1 failed")
+        proc = self.run_tool("--case", "300000", "--check")
+        self.assertEqual(proc.returncode, 0, proc.stdout)
+        self.assertEqual(proc.stdout.strip().splitlines()[-1], "1 passed, 0 failed")
+
+    def test_missing_key_stops(self):
+        paper = os.path.join(self.tmp.name, "old-sil")
+        with open(paper, "w") as f:
+            f.write(f"#!{sys.executable}\nprint('[motor]\\nresistance_ohm = 3\\n')\n")
+        os.chmod(paper, 0o755)
+        proc = subprocess.run([sys.executable, SCRIPT, "--sil", paper, "--scenario", self.scenario, "--out",
+                               self.out, "--cases", "2", "--no-plots"], capture_output=True, text=True, timeout=60)
+        self.assertEqual(proc.returncode, 2)
+        self.assertIn("does not know 16 of the keys", proc.stderr)
+        self.assertIn("sensors.noise_rms_a", proc.stderr)
+        self.assertEqual(proc.stdout.strip().splitlines()[-1], "0 passed, 0 failed")
+
+
+if __name__ == "__main__":
+    unittest.main()
