@@ -93,7 +93,11 @@ def step_addresses(elf):
 def record_outputs(path):
     """Host outputs (tuples of words) from the SIL record."""
     w = struct.unpack("<%dI" % (os.path.getsize(path) // 4), Path(path).read_bytes())
-    i, outs = 5 + 24 + 1, []
+    # header: magic, version, config words, input words, output words, config, i_d* (sil/include/sil/record.h)
+    config_words, in_words, out_words = w[2], w[3], w[4]
+    if (in_words, out_words) != (4, OUT_WORDS):
+        sys.exit("bench_target: record layout %d/%d words, expected 4/%d" % (in_words, out_words, OUT_WORDS))
+    i, outs = 5 + config_words + 1, []
     while True:
         tag = w[i]
         if tag == 1:

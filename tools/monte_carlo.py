@@ -443,6 +443,8 @@ def rerun_command(args, seed):
         value = getattr(args, option)
         if value != default:
             cmd += ["--" + option.replace("_", "-"), format_value(value)]
+    for key in getattr(args, "exclude", []):
+        cmd += ["--exclude", key]
     return cmd + ["--case", str(seed)]
 
 
@@ -894,6 +896,9 @@ def parse_args(argv):
     parser.add_argument("--latency-bound", type=float, default=0.05, metavar="SECONDS",
                         help="a fault later than this after a loss of control is a silent failure (default 0.05 s)")
     parser.add_argument("--min-success", type=float, default=0.99, help="--check: minimum success rate (default 0.99)")
+    parser.add_argument("--exclude", action="append", default=[], metavar="KEY",
+                        help="leave this row of the distribution table out (the scenario's value stays); "
+                             "repeatable, e.g. --exclude controller.dead_time_s for a firmware without compensation")
     parser.add_argument("--case-timeout", type=float, default=600.0, metavar="SECONDS",
                         help="wall time after which one run counts as crashed (default 600 s)")
     args = parser.parse_args(argv[1:])
@@ -938,6 +943,12 @@ def run_one(args, scenario, base):
 
 def main(argv):
     args = parse_args(argv)
+    unknown = [key for key in args.exclude if key not in [row[0] for row in DISTRIBUTIONS]]
+    if unknown:
+        print(f"monte_carlo: --exclude {', '.join(unknown)}: not in the distribution table", file=sys.stderr)
+        return 2
+    # In place, so every function's default table (the same list object) sees it.
+    DISTRIBUTIONS[:] = [row for row in DISTRIBUTIONS if row[0] not in args.exclude]
     started_utc = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC")
     try:
         if not (os.path.isfile(args.sil) and os.access(args.sil, os.X_OK)):
