@@ -79,7 +79,8 @@ pmstep_status_t pmstep_validate_config(const pmstep_config_t *cfg)
             offsetof(pmstep_config_t, angle_correction_gain_per_s), offsetof(pmstep_config_t, angle_magnitude_bound),
             offsetof(pmstep_config_t, speed_consistency_bound_rad_s),
             offsetof(pmstep_config_t, stall_speed_error_rad_s), offsetof(pmstep_config_t, detection_time_s),
-            offsetof(pmstep_config_t, voltage_bias_level_fraction)};
+            offsetof(pmstep_config_t, voltage_bias_level_fraction),
+            offsetof(pmstep_config_t, observer_residual_bound_a)};
         size_t n;
         for (n = 0; n < sizeof float_fields; ++n) {
             float value;
@@ -149,9 +150,9 @@ pmstep_status_t pmstep_validate_config(const pmstep_config_t *cfg)
         return PMSTEP_ERR_CALIBRATION;
     }
     if (cfg->angle_magnitude_bound < 0.0f || cfg->speed_consistency_bound_rad_s < 0.0f
-        || cfg->stall_speed_error_rad_s < 0.0f
+        || cfg->stall_speed_error_rad_s < 0.0f || cfg->observer_residual_bound_a < 0.0f
         || ((cfg->angle_magnitude_bound > 0.0f || cfg->speed_consistency_bound_rad_s > 0.0f
-             || cfg->stall_speed_error_rad_s > 0.0f)
+             || cfg->stall_speed_error_rad_s > 0.0f || cfg->observer_residual_bound_a > 0.0f)
             && !(cfg->detection_time_s >= 4.0f * cfg->period_s))) {
         return PMSTEP_ERR_DETECTION;
     }
@@ -202,6 +203,7 @@ pmstep_config_t pmstep_paper_config(void)
         .angle_magnitude_bound = 0.25f,
         .speed_consistency_bound_rad_s = 3.0f,
         .stall_speed_error_rad_s = 3.0f,
+        .observer_residual_bound_a = 0.3f,
         .detection_time_s = 0.02f
     };
     return paper;

@@ -6,6 +6,9 @@
 #include <stddef.h>
 #include <string.h>
 
+/* Detection runs every this many periods (supervision at a quarter of the control rate). */
+#define DETECTION_DECIMATION 4u
+
 static uint32_t periods_in(float duration_s, float period_s)
 {
     return (uint32_t)(duration_s / period_s + 0.5f);
@@ -42,9 +45,14 @@ pmstep_status_t pmstep_init(pmstep_t *inst, const pmstep_config_t *cfg)
     inst->compensate_voltage = cfg->dead_time_s > 0.0f || cfg->voltage_bias_level_fraction > 0.0f;
     inst->inv_dead_time_band_per_a = inst->compensate_voltage ? 1.0f / cfg->dead_time_current_band_a : 0.0f;
     inst->commission_plan.bias_estimation = cfg->voltage_bias_level_fraction > 0.0f;
-    inst->detection_steps = periods_in(cfg->detection_time_s, cfg->period_s);
-    inst->detection_alpha = 4.0f * cfg->period_s / (cfg->detection_time_s > 0.0f ? cfg->detection_time_s : 1.0f);
-    inst->angle_step_per_speed = (float)cfg->pole_pairs * cfg->period_s;
+    {
+        /* Detection counts checks, one every DETECTION_DECIMATION periods; its low-pass has the
+         * time constant detection_time_s / 4. */
+        const float check_period_s = (float)DETECTION_DECIMATION * cfg->period_s;
+        inst->detection_steps = periods_in(cfg->detection_time_s, check_period_s);
+        inst->detection_alpha = 4.0f * check_period_s / (cfg->detection_time_s > 0.0f ? cfg->detection_time_s : 1.0f);
+        inst->angle_step_per_speed = (float)cfg->pole_pairs * check_period_s;
+    }
     inst->consistency_bound_rad = cfg->speed_consistency_bound_rad_s * inst->angle_step_per_speed;
     pmstep_reset(inst);
     return PMSTEP_OK;
@@ -222,7 +230,7 @@ static void start_run(pmstep_t *inst, const pmstep_meas_t *meas)
 {
     const pmstep_ref_t speed_cmd = inst->speed_ref;
     const pmstep_ref_t i_d_cmd = inst->i_d_ref;
-    static const pmstep_detector_t fresh_detector = {1.0f, 0.0f, 0.0f, 0u, 0u, 0u};
+    static const pmstep_detector_t fresh_detector = {1.0f, 0.0f, 0.0f, 0.0f, 0u, 0u, 0u, 0u};
     pmstep_angle_start(&inst->angle, meas->i_a_a, meas->i_b_a);
     pmstep_observer_start(&inst->observer, meas->i_a_a, meas->i_b_a);
     pmstep_ref_reset(&inst->speed_ref, 0.0f);
@@ -350,8 +358,9 @@ static bool persists(uint32_t *count, bool condition, uint32_t limit)
     return *count >= limit;
 }
 
-/* Detection in RUN (config "Detection"): a condition persisting detection_steps periods. */
-static pmstep_fault_t detect(pmstep_t *inst, const pmstep_output_t *out)
+/* Detection in RUN (config "Detection"): a condition persisting detection_steps periods.
+ * @p sample: the currents this period, as the observer sees them. */
+static pmstep_fault_t detect(pmstep_t *inst, const pmstep_output_t *out, const pmstep_meas_t *sample)
 {
     const pmstep_config_t *cfg = inst->cfg;
     pmstep_detector_t *d = &inst->scratch.run.detector;
@@ -378,6 +387,14 @@ static pmstep_fault_t detect(pmstep_t *inst, const pmstep_output_t *out)
         && persists(&d->stall_count, abs_f(out->speed_hat_rad_s - out->speed_ref_rad_s) > cfg->stall_speed_error_rad_s,
                     limit)) {
         found = PMSTEP_FAULT_STALL;
+    }
+    if (cfg->observer_residual_bound_a > 0.0f) {
+        /* A rotor the estimate believes elsewhere (or still) leaves back-EMF the observer cannot explain. */
+        const float residual = abs_f(sample->i_a_a - out->i_a_hat_a) + abs_f(sample->i_b_a - out->i_b_hat_a);
+        d->residual_a += inst->detection_alpha * (residual - d->residual_a);
+        if (persists(&d->residual_count, d->residual_a > cfg->observer_residual_bound_a, limit)) {
+            found = PMSTEP_FAULT_OBSERVER_RESIDUAL;
+        }
     }
     return found;
 }
@@ -470,7 +487,7 @@ void pmstep_step(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out
         out->fault = PMSTEP_FAULT_NONE;
         out->fault_step = inst->fault_step;
         run_controller(inst, &sample, out, &obs_in, &mech);
-        fault = detect(inst, out);
+        fault = (inst->step_count % DETECTION_DECIMATION) == 0u ? detect(inst, out, &sample) : PMSTEP_FAULT_NONE;
         if (fault != PMSTEP_FAULT_NONE) {
             if (inst->commissioning.realignments < cfg->max_realignments) {
                 realign(inst);

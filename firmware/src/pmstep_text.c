@@ -45,6 +45,7 @@ const char *pmstep_fault_str(pmstep_fault_t fault)
     case PMSTEP_FAULT_SPEED_INCONSISTENT: return "SPEED_INCONSISTENT";
     case PMSTEP_FAULT_STALL: return "STALL";
     case PMSTEP_FAULT_COMMISSIONING: return "COMMISSIONING";
+    case PMSTEP_FAULT_OBSERVER_RESIDUAL: return "OBSERVER_RESIDUAL";
     }
     return "UNKNOWN";
 }

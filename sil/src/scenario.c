@@ -73,6 +73,7 @@ static const key_t_ keys[] = {
     {"controller.angle_magnitude_bound", KEY_FLOAT, OFF(controller.angle_magnitude_bound), -BIG, 0, BIG, 0, "|c-hat^2 + s-hat^2 - 1| above -> angle lost; 0 = off"},
     {"controller.speed_consistency_bound_rad_s", KEY_FLOAT, OFF(controller.speed_consistency_bound_rad_s), -BIG, 0, BIG, 0, "|speed from the angle's rotation - omega-hat| above -> inconsistent (rad/s); 0 = off"},
     {"controller.stall_speed_error_rad_s", KEY_FLOAT, OFF(controller.stall_speed_error_rad_s), -BIG, 0, BIG, 0, "|omega-hat - omega*| above -> stall (rad/s); 0 = off"},
+    {"controller.observer_residual_bound_a", KEY_FLOAT, OFF(controller.observer_residual_bound_a), -BIG, 0, BIG, 0, "detection: low-passed |i - i-hat| sum above -> OBSERVER_RESIDUAL (A, 0 = off)"},
     {"controller.detection_time_s", KEY_FLOAT, OFF(controller.detection_time_s), -BIG, 0, BIG, 0, "persistence before a detection acts (s)"},
     {"controller.max_realignments", KEY_UINT, OFF(controller.max_realignments), 0, 0, 4294967295.0, 0, "0: a detection latches its fault; N: re-align up to N times"},
 

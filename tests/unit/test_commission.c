@@ -261,8 +261,8 @@ static void lost_angle_faults_or_realigns_after_the_detection_time(void **state)
         }
         print_message("max_realignments %u: mode %s after %u periods\n", (unsigned)cfg.max_realignments,
                       pmstep_mode_str(out.mode), (unsigned)k);
-        /* detected on the 400th period (20 ms) of the condition */
-        assert_int_equal(inst.step_count - jump_step, 400u);
+        /* detected after 20 ms of the condition: 100 checks, one every 4th period */
+        assert_true(inst.step_count - jump_step >= 397u && inst.step_count - jump_step <= 400u);
         assert_false(out.bridge_enable);
         if (cfg.max_realignments == 0u) {
             assert_int_equal(out.mode, PMSTEP_MODE_FAULT);

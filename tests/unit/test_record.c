@@ -31,6 +31,7 @@ static void config_round_trips_through_the_words(void **state)
     in.angle_magnitude_bound = 0.3f;
     in.speed_consistency_bound_rad_s = 5.0f;
     in.stall_speed_error_rad_s = 4.0f;
+    in.observer_residual_bound_a = 0.25f;
     in.detection_time_s = 0.02f;
     in.max_realignments = 3u;
     sil_record_config_to_words(&in, w);
@@ -48,6 +49,7 @@ static void config_round_trips_through_the_words(void **state)
     assert_true(out.angle_magnitude_bound == in.angle_magnitude_bound);
     assert_true(out.speed_consistency_bound_rad_s == in.speed_consistency_bound_rad_s);
     assert_true(out.stall_speed_error_rad_s == in.stall_speed_error_rad_s);
+    assert_true(out.observer_residual_bound_a == in.observer_residual_bound_a);
     assert_true(out.detection_time_s == in.detection_time_s && out.max_realignments == 3u);
     /* The last word is the last field. */
     assert_true(w[SIL_RECORD_CONFIG_WORDS - 1u] == 3u);

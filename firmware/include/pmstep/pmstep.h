@@ -25,9 +25,10 @@ extern "C" {
 
 /** Detection state in RUN (see pmstep_config_t, "Detection"). */
 typedef struct {
-    float prev_cos_hat, prev_sin_hat;  /**< last period's estimate */
-    float rotation_gap_rad;            /**< low-passed (angle step - p T_s w-hat), electrical rad per period */
-    uint32_t magnitude_count, consistency_count, stall_count; /**< periods each condition has persisted */
+    float prev_cos_hat, prev_sin_hat;  /**< the estimate at the last check */
+    float rotation_gap_rad;            /**< low-passed (angle step - p w-hat x check period), rad per check */
+    float residual_a;                  /**< low-passed |i_a - i_a-hat| + |i_b - i_b-hat| */
+    uint32_t magnitude_count, consistency_count, stall_count, residual_count; /**< periods each condition has persisted */
 } pmstep_detector_t;
 
 /** One controller instance; all state lives here. Treat the fields as private. */
@@ -38,10 +39,10 @@ typedef struct {
     float dead_time_duty;         /**< 2 t_d / T_s: compensation at full current, fraction of the bus */
     float inv_dead_time_band_per_a;
     bool compensate_voltage;      /**< dead time configured or voltage bias estimated */
-    uint32_t detection_steps;     /**< periods a condition must persist */
-    float detection_alpha;        /**< T_s / tau of the rotation-gap low-pass */
-    float angle_step_per_speed;   /**< p T_s: electrical rad per period per rad/s */
-    float consistency_bound_rad;  /**< speed_consistency_bound_rad_s p T_s */
+    uint32_t detection_steps;     /**< checks (one every 4 periods) a condition must persist */
+    float detection_alpha;        /**< check period / tau of the detection low-passes */
+    float angle_step_per_speed;   /**< p x check period: electrical rad per check per rad/s */
+    float consistency_bound_rad;  /**< speed_consistency_bound_rad_s x angle_step_per_speed */
     pmstep_ref_coeffs_t ref_coeffs;
     pmstep_angle_coeffs_t angle_coeffs;
     pmstep_observer_coeffs_t observer_coeffs;

@@ -64,7 +64,9 @@ typedef enum {
     PMSTEP_FAULT_ANGLE_MAGNITUDE = 6,       /**< |c-hat^2 + s-hat^2 - 1| above angle_magnitude_bound: angle lost */
     PMSTEP_FAULT_SPEED_INCONSISTENT = 7,    /**< speed from the angle estimate's rotation and w-hat disagree */
     PMSTEP_FAULT_STALL = 8,                 /**< |w-hat - w*| above stall_speed_error_rad_s: motor not following */
-    PMSTEP_FAULT_COMMISSIONING = 9          /**< measured R, L or k_M outside [1/2, 2] x the configured value */
+    PMSTEP_FAULT_COMMISSIONING = 9,         /**< measured R, L or k_M outside [1/2, 2] x the configured value */
+    PMSTEP_FAULT_OBSERVER_RESIDUAL = 10     /**< |i_a - i_a-hat| + |i_b - i_b-hat| low-passed above its bound: the
+                                                 observer's model no longer explains the currents */
 } pmstep_fault_t;
 
 /** Constant configuration: motor model (1), strategy timing, gains of (6), limits. */
@@ -126,10 +128,12 @@ typedef struct {
     float angle_correction_gain_per_s; /**< drift-free option: pulls (c-hat, s-hat) onto the unit circle at this
                                             rate (flux-magnitude correction); 0 = the paper's open integrals */
 
-    /* Detection (each 0 = off). Persisting detection_time_s -> fault, or re-alignment (max_realignments). */
+    /* Detection (each 0 = off), checked every 4th period in RUN. Persisting detection_time_s -> fault,
+     * or re-alignment (max_realignments). */
     float angle_magnitude_bound;       /**< |c-hat^2 + s-hat^2 - 1| -> FAULT_ANGLE_MAGNITUDE */
     float speed_consistency_bound_rad_s; /**< |w from the angle's rotation - w-hat|, both low-passed -> FAULT_SPEED_INCONSISTENT */
     float stall_speed_error_rad_s;     /**< |w-hat - w*| -> FAULT_STALL */
+    float observer_residual_bound_a;   /**< |i_a - i_a-hat| + |i_b - i_b-hat|, low-passed -> FAULT_OBSERVER_RESIDUAL */
     float detection_time_s;            /**< persistence before acting; low-pass time constant is a quarter of it */
     uint32_t max_realignments;         /**< 0: a detection latches its fault; N: re-align (bridge on) up to N times */
 } pmstep_config_t;

@@ -40,8 +40,8 @@ extern "C" {
  * then the entries in order.
  */
 #define SIL_RECORD_MAGIC 0x52534D50u /* "PMSR" */
-#define SIL_RECORD_VERSION 3u /* 2: calibration, commissioning, angle and detection settings; 3: voltage bias */
-#define SIL_RECORD_CONFIG_WORDS 40u
+#define SIL_RECORD_VERSION 4u /* 2: calibration, commissioning, angle, detection; 3: voltage bias; 4: residual */
+#define SIL_RECORD_CONFIG_WORDS 41u
 #define SIL_RECORD_TAG_SPEED_TARGET 1u
 #define SIL_RECORD_TAG_PERIOD 2u
 #define SIL_RECORD_TAG_END 3u
@@ -145,8 +145,9 @@ static inline void sil_record_config_from_words(const uint32_t *w, pmstep_config
     c->angle_magnitude_bound = sil_record_float(w[35]);
     c->speed_consistency_bound_rad_s = sil_record_float(w[36]);
     c->stall_speed_error_rad_s = sil_record_float(w[37]);
-    c->detection_time_s = sil_record_float(w[38]);
-    c->max_realignments = w[39];
+    c->observer_residual_bound_a = sil_record_float(w[38]);
+    c->detection_time_s = sil_record_float(w[39]);
+    c->max_realignments = w[40];
 }
 
 static inline void sil_record_meas_from_words(const uint32_t *w, pmstep_meas_t *m)
@@ -221,8 +222,9 @@ static inline void sil_record_config_to_words(const pmstep_config_t *c, uint32_t
     w[35] = sil_record_bits(c->angle_magnitude_bound);
     w[36] = sil_record_bits(c->speed_consistency_bound_rad_s);
     w[37] = sil_record_bits(c->stall_speed_error_rad_s);
-    w[38] = sil_record_bits(c->detection_time_s);
-    w[39] = c->max_realignments;
+    w[38] = sil_record_bits(c->observer_residual_bound_a);
+    w[39] = sil_record_bits(c->detection_time_s);
+    w[40] = c->max_realignments;
 }
 
 static inline void sil_record_meas_to_words(const pmstep_meas_t *m, uint32_t *w)
