@@ -14,25 +14,7 @@ if [ $# -gt 0 ] && [ "${1#-}" = "$1" ]; then
 fi
 mkdir -p "$out"
 
-tools/install_deps.sh
-
-echo "== build (preset host-release)"
-cmake --preset host-release >/dev/null
-cmake --build --preset host-release
-
-echo "== plotting environment (.venv)"
-if [ ! -x .venv/bin/python ]; then
-  if ! python3 -m venv .venv 2>/dev/null; then
-    rm -rf .venv
-    tools/install_deps.sh python3-venv
-    python3 -m venv .venv
-  fi
-fi
-if [ -f tools/requirements.txt ]; then
-  .venv/bin/python -m pip install --quiet --disable-pip-version-check -r tools/requirements.txt
-elif ! .venv/bin/python -c "import matplotlib" 2>/dev/null; then
-  .venv/bin/python -m pip install --quiet --disable-pip-version-check matplotlib
-fi
+tools/setup_host.sh
 
 echo "== theorem check and empirical domain of attraction (about a minute)"
 build/host-release/sil/gain_check/pmstep-gain-check --doa --doa-csv "$out/doa_runs.csv" --out "$out/doa.json" "$@" \
