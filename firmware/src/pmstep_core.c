@@ -89,9 +89,8 @@ void pmstep_reset(pmstep_t *inst)
     inst->step_count = 0u;
     pmstep_ref_reset(&inst->speed_ref, 0.0f);
     pmstep_ref_reset(&inst->i_d_ref, 0.0f);
-    pmstep_ref_reset(&inst->scratch.run.known_load_filter, 0.0f);
     clear_dynamic_state(inst);
-    clear_commissioning(inst);
+    clear_commissioning(inst); /* the scratch union holds the sums until t_c; start_run() sets up the rest */
 }
 
 pmstep_status_t pmstep_start(pmstep_t *inst)
@@ -351,14 +350,15 @@ static float dead_time_voltage(const pmstep_t *inst, float current_a, float bus_
     return (inst->dead_time_duty * bus_voltage_v + bias_v) * share;
 }
 
-/* Counts the periods @p condition has held; true once it has held @p limit periods. */
+/* Counts the checks @p condition has held; true once it has held @p limit checks. */
 static bool persists(uint32_t *count, bool condition, uint32_t limit)
 {
     *count = condition ? *count + 1u : 0u;
     return *count >= limit;
 }
 
-/* Detection in RUN (config "Detection"): a condition persisting detection_steps periods.
+/* Detection in RUN (config "Detection"), every DETECTION_DECIMATION periods: a condition
+ * persisting detection_steps checks.
  * @p sample: the currents this period, as the observer sees them. */
 static pmstep_fault_t detect(pmstep_t *inst, const pmstep_output_t *out, const pmstep_meas_t *sample)
 {
@@ -373,7 +373,7 @@ static pmstep_fault_t detect(pmstep_t *inst, const pmstep_output_t *out, const p
         }
     }
     if (cfg->speed_consistency_bound_rad_s > 0.0f) {
-        /* sin of the estimate's electrical step over the period, against p T_s w-hat. */
+        /* sin of the estimate's electrical step since the last check, against p w-hat x check period. */
         const float angle_step = d->prev_cos_hat * out->sin_hat - d->prev_sin_hat * out->cos_hat;
         const float gap = angle_step - inst->angle_step_per_speed * out->speed_hat_rad_s;
         d->rotation_gap_rad += inst->detection_alpha * (gap - d->rotation_gap_rad);

@@ -28,7 +28,7 @@ typedef struct {
     float prev_cos_hat, prev_sin_hat;  /**< the estimate at the last check */
     float rotation_gap_rad;            /**< low-passed (angle step - p w-hat x check period), rad per check */
     float residual_a;                  /**< low-passed |i_a - i_a-hat| + |i_b - i_b-hat| */
-    uint32_t magnitude_count, consistency_count, stall_count, residual_count; /**< periods each condition has persisted */
+    uint32_t magnitude_count, consistency_count, stall_count, residual_count; /**< checks each condition has persisted */
 } pmstep_detector_t;
 
 /** One controller instance; all state lives here. Treat the fields as private. */
