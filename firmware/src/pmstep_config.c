@@ -1,12 +1,17 @@
-/* Configuration: validation with one status per cause, texts, the paper's configuration. */
+/* Configuration: validation with one status per cause. */
 #include "pmstep/pmstep.h"
+#include "pmstep_internal.h"
 
 #include <math.h> /* isfinite: a classification macro, no libm call */
 #include <stddef.h>
 #include <string.h> /* memcpy of one float: a load */
 
-/* Longest alignment accepted: 2^31 periods keeps step counters far from wrapping. */
-#define PMSTEP_MAX_ALIGN_PERIODS 2147483648.0f
+/* A duration setting: not negative, and at most PMSTEP_MAX_DURATION_PERIODS periods, so its
+ * conversion to a period count (periods_in() in pmstep_core.c) is exact and defined. */
+static bool duration_ok(float duration_s, float period_s)
+{
+    return duration_s >= 0.0f && duration_s / period_s <= PMSTEP_MAX_DURATION_PERIODS;
+}
 
 /* Calibration, commissioning, dead time, drift-free gain (times already checked finite). */
 static pmstep_status_t validate_calibration(const pmstep_config_t *cfg)
@@ -16,8 +21,7 @@ static pmstep_status_t validate_calibration(const pmstep_config_t *cfg)
     const bool window = cfg->steady_state_window_s > 0.0f;
     if (cfg->offset_calibration_time_s < 0.0f || cfg->steady_state_window_s < 0.0f || cfg->inductance_window_s < 0.0f
         || cfg->steady_state_window_s > 0.5f * s_align_s || cfg->steady_state_window_s > 0.5f * c_align_s
-        || cfg->inductance_window_s > 0.5f * s_align_s
-        || cfg->offset_calibration_time_s / cfg->period_s >= PMSTEP_MAX_ALIGN_PERIODS) {
+        || cfg->inductance_window_s > 0.5f * s_align_s || !duration_ok(cfg->offset_calibration_time_s, cfg->period_s)) {
         return PMSTEP_ERR_CALIBRATION;
     }
     /* What is used must be measured: R and k_M need the windows, L its rise window. */
@@ -36,8 +40,10 @@ static pmstep_status_t validate_calibration(const pmstep_config_t *cfg)
         return PMSTEP_ERR_CALIBRATION;
     }
     if (cfg->dead_time_s < 0.0f || 2.0f * cfg->dead_time_s >= 0.5f * cfg->period_s
+        || cfg->dead_time_current_band_a < 0.0f
         || ((cfg->dead_time_s > 0.0f || cfg->voltage_bias_level_fraction > 0.0f)
-            && !(cfg->dead_time_current_band_a > 0.0f))) {
+            && !(cfg->dead_time_current_band_a >= PMSTEP_MIN_CURRENT_BAND_A
+                 && cfg->dead_time_current_band_a <= cfg->max_phase_current_a))) {
         return PMSTEP_ERR_CALIBRATION;
     }
     if (cfg->angle_correction_gain_per_s < 0.0f || cfg->angle_correction_gain_per_s * cfg->period_s >= 0.5f) {
@@ -108,7 +114,7 @@ pmstep_status_t pmstep_validate_config(const pmstep_config_t *cfg)
     if (cfg->pole_pairs < 1) {
         return PMSTEP_ERR_POLE_PAIRS;
     }
-    if (!(cfg->period_s > 0.0f)) {
+    if (!(cfg->period_s >= PMSTEP_MIN_PERIOD_S && cfg->period_s <= PMSTEP_MAX_PERIOD_S)) {
         return PMSTEP_ERR_PERIOD;
     }
     if (!(cfg->speed_gain_per_s > 0.0f) || !(cfg->observer_gain_per_s > 0.0f) || !(cfg->current_gain_per_s > 0.0f)
@@ -143,18 +149,22 @@ pmstep_status_t pmstep_validate_config(const pmstep_config_t *cfg)
         return PMSTEP_ERR_ALIGNMENT_CURRENT;
     }
     if (!(cfg->s_align_time_s >= cfg->period_s) || !(cfg->c_align_time_s - cfg->s_align_time_s >= cfg->period_s)
-        || cfg->c_align_time_s / cfg->period_s >= PMSTEP_MAX_ALIGN_PERIODS) {
+        || !duration_ok(cfg->c_align_time_s, cfg->period_s)) {
         return PMSTEP_ERR_ALIGNMENT_TIME;
     }
     if (validate_calibration(cfg) != PMSTEP_OK) {
         return PMSTEP_ERR_CALIBRATION;
     }
-    if (cfg->angle_magnitude_bound < 0.0f || cfg->speed_consistency_bound_rad_s < 0.0f
-        || cfg->stall_speed_error_rad_s < 0.0f || cfg->observer_residual_bound_a < 0.0f
-        || ((cfg->angle_magnitude_bound > 0.0f || cfg->speed_consistency_bound_rad_s > 0.0f
-             || cfg->stall_speed_error_rad_s > 0.0f || cfg->observer_residual_bound_a > 0.0f)
-            && !(cfg->detection_time_s >= 4.0f * cfg->period_s))) {
-        return PMSTEP_ERR_DETECTION;
+    {
+        /* The persistence is 0 (only with every detector off) or at least 4 periods. */
+        const bool any_detector = cfg->angle_magnitude_bound > 0.0f || cfg->speed_consistency_bound_rad_s > 0.0f
+                                  || cfg->stall_speed_error_rad_s > 0.0f || cfg->observer_residual_bound_a > 0.0f;
+        if (cfg->angle_magnitude_bound < 0.0f || cfg->speed_consistency_bound_rad_s < 0.0f
+            || cfg->stall_speed_error_rad_s < 0.0f || cfg->observer_residual_bound_a < 0.0f
+            || !(cfg->detection_time_s >= 4.0f * cfg->period_s || (cfg->detection_time_s == 0.0f && !any_detector))
+            || !duration_ok(cfg->detection_time_s, cfg->period_s)) {
+            return PMSTEP_ERR_DETECTION;
+        }
     }
     {
         /* Condition (4): k_M u_cc/(p L R) - (u_cs^2 + u_cc^2)/(2 R^2) > 0. */
@@ -168,43 +178,5 @@ pmstep_status_t pmstep_validate_config(const pmstep_config_t *cfg)
             return PMSTEP_ERR_ALIGNMENT_CONDITION;
         }
     }
-    return PMSTEP_OK;
-}
-
-pmstep_config_t pmstep_paper_config(void)
-{
-    /* A table in flash, copied out: smaller than one store per field. Fields not named are 0 / false:
-     * calibration, commissioning, dead-time compensation and the drift-free option are off (the paper). */
-    static const pmstep_config_t paper = {
-        /* Motor of Section III.B. */
-        .resistance_ohm = 3.0f,
-        .inductance_h = 0.006f,
-        .inertia_kg_m2 = 0.01f,
-        .torque_constant_nm_per_a = 2.0f,
-        .pole_pairs = 6,
-        .period_s = 50e-6f,
-        .s_align_time_s = 0.3f,
-        .c_align_time_s = 0.6f,
-        .s_align_voltage_v = 24.0f,
-        .c_align_voltage_v = 24.0f,
-        .speed_gain_per_s = 100.0f,
-        .observer_gain_per_s = 100.0f,
-        .current_gain_per_s = 20.0f,
-        .adapt_gamma = 0.01f / 9.0f,
-        .adapt_lambda = 0.2f,
-        .adapt_r = 1.0f,
-        .sat_kappa_rad_per_s = 9.0f,
-        .reference_bandwidth_rad_per_s = 300.0f,
-        /* Drive limits (not in the paper): 48 V bus, alignment draws u/R = 8 A. */
-        .max_phase_current_a = 15.0f,
-        .min_bus_voltage_v = 30.0f,
-        .max_bus_voltage_v = 60.0f,
-        /* Detection (protections, not in the paper): on; far outside what the paper's run reaches. */
-        .angle_magnitude_bound = 0.25f,
-        .speed_consistency_bound_rad_s = 3.0f,
-        .stall_speed_error_rad_s = 3.0f,
-        .observer_residual_bound_a = 0.3f,
-        .detection_time_s = 0.02f
-    };
-    return paper;
+    return pmstep_derived_coefficients_finite(cfg) ? PMSTEP_OK : PMSTEP_ERR_DERIVED_NONFINITE;
 }

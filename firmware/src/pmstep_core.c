@@ -1,6 +1,7 @@
 /* Mode machine, protections and the control step: strategy of Section III.A,
  * s-alignment (3) -> c-alignment (5) -> controller (6) (or (13), Remark 1). */
 #include "pmstep/pmstep.h"
+#include "pmstep_internal.h"
 
 #include <math.h> /* isfinite: a classification macro, no libm call */
 #include <stddef.h>
@@ -22,18 +23,14 @@ static void apply_model(pmstep_t *inst, const pmstep_electrical_t *model)
     pmstep_law_coeffs_init(&inst->law_coeffs, inst->cfg, model);
 }
 
-pmstep_status_t pmstep_init(pmstep_t *inst, const pmstep_config_t *cfg)
+/* Everything init derives from @p cfg: the coefficients of each block for the configured model,
+ * period counts and the detection constants. */
+static void derive(pmstep_t *inst, const pmstep_config_t *cfg)
 {
-    pmstep_status_t status;
-    if (inst == NULL) {
-        return PMSTEP_ERR_NULL_ARGUMENT;
-    }
-    status = pmstep_validate_config(cfg);
-    if (status != PMSTEP_OK) {
-        return status;
-    }
+    const pmstep_electrical_t configured = pmstep_configured_electrical(cfg);
     inst->cfg = cfg;
     pmstep_ref_coeffs_init(&inst->ref_coeffs, cfg->reference_bandwidth_rad_per_s, cfg->period_s);
+    apply_model(inst, &configured);
     inst->commission_plan.s_align_steps = periods_in(cfg->s_align_time_s, cfg->period_s);
     inst->commission_plan.c_align_end_step = periods_in(cfg->c_align_time_s, cfg->period_s);
     inst->commission_plan.window_steps = periods_in(cfg->steady_state_window_s, cfg->period_s);
@@ -54,6 +51,44 @@ pmstep_status_t pmstep_init(pmstep_t *inst, const pmstep_config_t *cfg)
         inst->angle_step_per_speed = (float)cfg->pole_pairs * check_period_s;
     }
     inst->consistency_bound_rad = cfg->speed_consistency_bound_rad_s * inst->angle_step_per_speed;
+}
+
+/* True if the @p count floats stored from @p first on (a struct of floats only) are all finite. */
+static bool floats_finite(const void *first, size_t count)
+{
+    const unsigned char *bytes = (const unsigned char *)first;
+    float sum = 0.0f;
+    size_t n;
+    for (n = 0; n < count; ++n) {
+        float value;
+        memcpy(&value, bytes + n * sizeof value, sizeof value);
+        sum += value - value; /* 0 for finite values, NaN otherwise */
+    }
+    return sum == 0.0f;
+}
+
+bool pmstep_derived_coefficients_finite(const pmstep_config_t *cfg)
+{
+    /* The derived floats lie together in pmstep_t, from dead_time_duty to the last float of
+     * law_coeffs (pmstep.h); a scratch instance, on the stack of init/validate, holds them. */
+    const size_t first = offsetof(pmstep_t, dead_time_duty);
+    const size_t end = offsetof(pmstep_t, law_coeffs) + offsetof(pmstep_law_coeffs_t, linear_speed_term);
+    pmstep_t scratch;
+    derive(&scratch, cfg);
+    return floats_finite((const unsigned char *)&scratch + first, (end - first) / sizeof(float));
+}
+
+pmstep_status_t pmstep_init(pmstep_t *inst, const pmstep_config_t *cfg)
+{
+    pmstep_status_t status;
+    if (inst == NULL) {
+        return PMSTEP_ERR_NULL_ARGUMENT;
+    }
+    status = pmstep_validate_config(cfg);
+    if (status != PMSTEP_OK) {
+        return status;
+    }
+    derive(inst, cfg);
     pmstep_reset(inst);
     return PMSTEP_OK;
 }
@@ -168,6 +203,12 @@ pmstep_status_t pmstep_set_id_target(pmstep_t *inst, float target_a)
 static float abs_f(float x)
 {
     return x < 0.0f ? -x : x;
+}
+
+/* x within [-limit, limit]. */
+static float clamp_f(float x, float limit)
+{
+    return x > limit ? limit : (x < -limit ? -limit : x);
 }
 
 /* Protections, checked while the bridge may be on. */
@@ -308,14 +349,16 @@ static void run_controller(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_out
     out->i_q_ref_a = i_q_ref;
 }
 
-/* Scales (u_a, u_b) so neither H-bridge exceeds the measured bus; keeps the vector's direction. */
+/* Scales (u_a, u_b) so neither H-bridge exceeds the measured bus; keeps the vector's direction.
+ * The scaled components are clamped to +/- the bus so float rounding of the scale cannot
+ * leave one a unit in the last place above it. */
 static bool limit_to_bus(float *u_a_v, float *u_b_v, float bus_voltage_v)
 {
     const float largest = abs_f(*u_a_v) > abs_f(*u_b_v) ? abs_f(*u_a_v) : abs_f(*u_b_v);
     if (largest > bus_voltage_v) {
         const float scale = bus_voltage_v / largest;
-        *u_a_v *= scale;
-        *u_b_v *= scale;
+        *u_a_v = clamp_f(*u_a_v * scale, bus_voltage_v);
+        *u_b_v = clamp_f(*u_b_v * scale, bus_voltage_v);
         return true;
     }
     return false;
@@ -520,6 +563,11 @@ void pmstep_step(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out
     out->u_a_v += dead_time_a_v;
     out->u_b_v += dead_time_b_v;
     out->voltage_limited = limit_to_bus(&out->u_a_v, &out->u_b_v, meas->bus_voltage_v);
+    if (!all_finite4(out->u_a_v, out->u_b_v, dead_time_a_v, dead_time_b_v)) {
+        /* Every mode: the bridge is never enabled with a voltage that is not a number. */
+        trip(inst, PMSTEP_FAULT_STATE_NONFINITE, out);
+        return;
+    }
     out->mode = inst->mode;
     out->bridge_enable = true;
 
@@ -548,9 +596,9 @@ void pmstep_step(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out
             pmstep_ref_set_target(&inst->scratch.run.known_load_filter, meas->load_torque_nm, 0.0f);
             pmstep_ref_advance(&inst->ref_coeffs, &inst->scratch.run.known_load_filter, cfg->period_s);
         }
-        if (!all_finite4(out->u_a_v, out->u_b_v, inst->observer.speed_hat_rad_s, inst->observer.load_hat_nm)
-            || !all_finite4(inst->observer.i_a_hat_a, inst->observer.i_b_hat_a, inst->angle.phi_a,
-                            inst->angle.phi_b)) {
+        if (!all_finite4(inst->observer.speed_hat_rad_s, inst->observer.load_hat_nm, inst->observer.i_a_hat_a,
+                         inst->observer.i_b_hat_a)
+            || !all_finite4(inst->angle.phi_a, inst->angle.phi_b, 0.0f, 0.0f)) {
             trip(inst, PMSTEP_FAULT_STATE_NONFINITE, out);
             return;
         }

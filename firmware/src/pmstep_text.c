@@ -28,6 +28,7 @@ const char *pmstep_status_str(pmstep_status_t status)
     case PMSTEP_ERR_ALIGNMENT_CURRENT: return "alignment u/R >= current limit";
     case PMSTEP_ERR_CALIBRATION: return "calibration settings invalid";
     case PMSTEP_ERR_DETECTION: return "detection settings invalid";
+    case PMSTEP_ERR_DERIVED_NONFINITE: return "a derived gain is not finite";
     }
     return "unknown status";
 }

@@ -49,6 +49,23 @@ static void bad_bandwidth(pmstep_config_t *c) { c->reference_bandwidth_rad_per_s
 static void bad_limits(pmstep_config_t *c) { c->max_bus_voltage_v = 20.0f; }
 static void bad_delay(pmstep_config_t *c) { c->computational_delay_periods = 2u; }
 static void nan_param(pmstep_config_t *c) { c->inertia_kg_m2 = NAN; }
+/* Found by fuzzing (issue 15): each was accepted and failed only in the step. */
+static void tiny_dead_time_band(pmstep_config_t *c) { c->dead_time_s = 1e-6f; c->dead_time_current_band_a = 1e-40f; }
+static void huge_detection_time(pmstep_config_t *c) { c->detection_time_s = 858993.4592f; }
+static void denormal_period(pmstep_config_t *c) { c->period_s = 1e-40f; }
+static void period_above_range(pmstep_config_t *c) { c->period_s = 0.02f; c->observer_gain_per_s = 1.0f;
+                                                     c->current_gain_per_s = 1.0f; }
+static void gamma_squared_underflows(pmstep_config_t *c) { c->adapt_gamma = 1e-30f; }
+static void inertia_squared_overflows(pmstep_config_t *c) { c->inertia_kg_m2 = 1e28f; }
+static void friction_overflows_load_gain(pmstep_config_t *c) { c->friction_nm_s_per_rad = 3.4e38f; }
+static void detection_time_below_four_periods_with_detectors_off(pmstep_config_t *c)
+{
+    c->angle_magnitude_bound = 0.0f;
+    c->speed_consistency_bound_rad_s = 0.0f;
+    c->stall_speed_error_rad_s = 0.0f;
+    c->observer_residual_bound_a = 0.0f;
+    c->detection_time_s = 1e-40f;
+}
 
 static void every_invalid_configuration_has_its_code(void **state)
 {
@@ -81,6 +98,14 @@ static void every_invalid_configuration_has_its_code(void **state)
         {bad_limits, PMSTEP_ERR_LIMITS},
         {bad_delay, PMSTEP_ERR_DELAY},
         {nan_param, PMSTEP_ERR_NONFINITE_PARAMETER},
+        {tiny_dead_time_band, PMSTEP_ERR_CALIBRATION},
+        {huge_detection_time, PMSTEP_ERR_DETECTION},
+        {denormal_period, PMSTEP_ERR_PERIOD},
+        {period_above_range, PMSTEP_ERR_PERIOD},
+        {gamma_squared_underflows, PMSTEP_ERR_DERIVED_NONFINITE},
+        {inertia_squared_overflows, PMSTEP_ERR_DERIVED_NONFINITE},
+        {friction_overflows_load_gain, PMSTEP_ERR_DERIVED_NONFINITE},
+        {detection_time_below_four_periods_with_detectors_off, PMSTEP_ERR_DETECTION},
     };
     size_t n;
     pmstep_t inst;
@@ -283,6 +308,75 @@ static void voltage_limited_to_bus_keeping_direction(void **state)
     assert_true(fabsf(fmaxf(fabsf(out.u_a_v), fabsf(out.u_b_v)) - 31.0f) < 1e-4f);
 }
 
+static void nonfinite_voltage_never_leaves_with_the_bridge_on(void **state)
+{
+    /* Issue 15, F1: a dead-time band whose inverse is +Inf made 0 x Inf = NaN from the first
+     * S_ALIGN period on, with the bridge enabled. init now refuses such a band; here the
+     * inverse is forced to +Inf behind init's back, and the step itself must still latch
+     * STATE_NONFINITE with the bridge off and zero volts, in an alignment mode. */
+    pmstep_config_t cfg = pmstep_paper_config();
+    pmstep_t inst;
+    pmstep_output_t out;
+    pmstep_meas_t meas = nominal_meas(); /* currents exactly 0 */
+    (void)state;
+    cfg.dead_time_s = 1e-6f;
+    cfg.dead_time_current_band_a = 0.01f;
+    assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
+    inst.inv_dead_time_band_per_a = INFINITY;
+    assert_int_equal(pmstep_start(&inst), PMSTEP_OK);
+    pmstep_step(&inst, &meas, &out);
+    assert_int_equal(out.mode, PMSTEP_MODE_FAULT);
+    assert_int_equal(out.fault, PMSTEP_FAULT_STATE_NONFINITE);
+    assert_false(out.bridge_enable);
+    assert_true(out.u_a_v == 0.0f && out.u_b_v == 0.0f);
+}
+
+static void narrowest_band_gives_finite_alignment_voltages(void **state)
+{
+    /* The narrowest band init accepts, with current samples exactly 0 and at the band. */
+    pmstep_config_t cfg = pmstep_paper_config();
+    pmstep_t inst;
+    pmstep_output_t out;
+    uint32_t k;
+    (void)state;
+    cfg.dead_time_s = 1e-6f;
+    cfg.dead_time_current_band_a = PMSTEP_MIN_CURRENT_BAND_A;
+    assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
+    assert_int_equal(pmstep_start(&inst), PMSTEP_OK);
+    for (k = 0; k < 100u; ++k) {
+        pmstep_meas_t meas = nominal_meas();
+        meas.i_b_a = (k % 2u) == 0u ? 0.0f : PMSTEP_MIN_CURRENT_BAND_A;
+        pmstep_step(&inst, &meas, &out);
+        assert_true(out.bridge_enable);
+        assert_true(isfinite(out.u_a_v) && isfinite(out.u_b_v));
+        assert_true(fabsf(out.u_a_v) <= meas.bus_voltage_v && fabsf(out.u_b_v) <= meas.bus_voltage_v);
+    }
+}
+
+static void limited_voltage_never_exceeds_the_bus_by_rounding(void **state)
+{
+    /* Scaling by bus/largest can round one unit in the last place above the bus; the limit
+     * must hold exactly for every bus the protections let through. */
+    pmstep_config_t cfg = pmstep_paper_config();
+    pmstep_t inst;
+    pmstep_output_t out;
+    unsigned n;
+    (void)state;
+    assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
+    step_to_run(&inst, &out, 48.0f);
+    for (n = 0; n < 2000u; ++n) {
+        pmstep_meas_t meas = nominal_meas();
+        meas.i_a_a = -14.0f + 0.0137f * (float)n;
+        meas.i_b_a = 14.0f - 0.0071f * (float)n;
+        meas.bus_voltage_v = 30.0f + 0.0149f * (float)n;
+        pmstep_step(&inst, &meas, &out);
+        if (!out.bridge_enable) {
+            break; /* a detection may latch on such wild samples: the invariant is about the bridge on */
+        }
+        assert_true(fabsf(out.u_a_v) <= meas.bus_voltage_v && fabsf(out.u_b_v) <= meas.bus_voltage_v);
+    }
+}
+
 static void delay_one_period_integrates_the_applied_voltage(void **state)
 {
     /* With one period of delay, the first RUN period still applies the c-alignment voltage:
@@ -313,6 +407,9 @@ int main(void)
         cmocka_unit_test(nonfinite_known_load_faults_only_in_known_load_mode),
         cmocka_unit_test(voltage_limited_to_bus_keeping_direction),
         cmocka_unit_test(delay_one_period_integrates_the_applied_voltage),
+        cmocka_unit_test(nonfinite_voltage_never_leaves_with_the_bridge_on),
+        cmocka_unit_test(narrowest_band_gives_finite_alignment_voltages),
+        cmocka_unit_test(limited_voltage_never_exceeds_the_bus_by_rounding),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -36,10 +36,11 @@ typedef struct {
     const pmstep_config_t *cfg;
     pmstep_commission_plan_t commission_plan; /**< alignment timing (t_s, t_c in periods) and windows */
     uint32_t offset_cal_steps;    /**< periods of bridge-off offset calibration */
-    float dead_time_duty;         /**< 2 t_d / T_s: compensation at full current, fraction of the bus */
-    float inv_dead_time_band_per_a;
     bool compensate_voltage;      /**< dead time configured or voltage bias estimated */
     uint32_t detection_steps;     /**< checks (one every 4 periods) a condition must persist */
+    /* Floats derived at init, from here to the end of law_coeffs' floats: init checks them all finite. */
+    float dead_time_duty;         /**< 2 t_d / T_s: compensation at full current, fraction of the bus */
+    float inv_dead_time_band_per_a;
     float detection_alpha;        /**< check period / tau of the detection low-passes */
     float angle_step_per_speed;   /**< p x check period: electrical rad per check per rad/s */
     float consistency_bound_rad;  /**< speed_consistency_bound_rad_s x angle_step_per_speed */
@@ -111,7 +112,8 @@ void pmstep_step(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out
 /** Calibration and commissioning results so far (telemetry; see pmstep_commissioning_t). */
 void pmstep_get_commissioning(const pmstep_t *inst, pmstep_commissioning_t *out);
 
-/** Configuration of the paper's Section III (motor, gains, t_s = 0.3 s, t_c = 0.6 s), 20 kHz. */
+/** Configuration of the paper's Section III (motor, gains, t_s = 0.3 s, t_c = 0.6 s), 20 kHz.
+ *  In the library pmstep_presets, apart from the core. */
 pmstep_config_t pmstep_paper_config(void);
 
 #ifdef __cplusplus

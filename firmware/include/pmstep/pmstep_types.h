@@ -40,8 +40,21 @@ typedef enum {
     PMSTEP_ERR_ALIGNMENT_CURRENT = -20,    /**< alignment current u/R at or above max_phase_current_a */
     PMSTEP_ERR_CALIBRATION = -21,          /**< calibration/commissioning windows negative or not inside their phase,
                                                 dead-time band not > 0, correction gain < 0 or too high for T_s */
-    PMSTEP_ERR_DETECTION = -22             /**< a detection bound < 0, or detection time shorter than 4 periods */
+    PMSTEP_ERR_DETECTION = -22,            /**< a detection bound < 0, or detection time shorter than 4 periods or
+                                                longer than PMSTEP_MAX_DURATION_PERIODS periods */
+    PMSTEP_ERR_DERIVED_NONFINITE = -23     /**< a coefficient derived from the settings (an observer injection gain,
+                                                1/J, k_M/L, ...) overflows or is not a number in float32 */
 } pmstep_status_t;
+
+/** Shortest and longest control period accepted (s): 1 MHz down to 100 Hz. */
+#define PMSTEP_MIN_PERIOD_S 1e-6f
+#define PMSTEP_MAX_PERIOD_S 1e-2f
+/** Longest duration accepted for any time setting, in control periods: counts stay exact in
+ *  float32 (2^24) and far from wrapping a uint32_t step counter. */
+#define PMSTEP_MAX_DURATION_PERIODS 16777216.0f
+/** Narrowest dead-time compensation band (A): keeps 1/band finite and its product with a
+ *  current sample far from overflow. */
+#define PMSTEP_MIN_CURRENT_BAND_A 1e-4f
 
 /** Operating mode of the strategy (Section III.A). */
 typedef enum {
