@@ -255,7 +255,12 @@ int main(int argc, char **argv)
                 fprintf(stderr, "pmstep-sil: --out needs a folder\n");
                 return 2;
             }
-            snprintf(out_dir, sizeof out_dir, "%s", argv[++i]);
+            if (strlen(argv[++i]) >= sizeof out_dir) {
+                fprintf(stderr, "pmstep-sil: --out: a folder name of %u characters, longer than %u\n",
+                        (unsigned)strlen(argv[i]), (unsigned)sizeof out_dir - 1u);
+                return 2;
+            }
+            snprintf(out_dir, sizeof out_dir, "%s", argv[i]);
         } else if (strcmp(argv[i], "--no-csv") == 0) {
             write_csv = false;
         } else if (strcmp(argv[i], "--quiet") == 0) {
@@ -281,6 +286,18 @@ int main(int argc, char **argv)
     if (sil_scenario_check(&sc, err, sizeof err) != 0) {
         fprintf(stderr, "pmstep-sil: %s\n", err);
         return 2;
+    }
+    if (write_csv) {
+        /* Refuse a run whose time series would fill the disk, before it starts. */
+        const double rows = sc.duration_s / (double)sc.controller.period_s / (double)sc.decimation;
+        const double csv_mb = rows * SIL_CSV_ROW_MAX_BYTES / 1e6;
+        if (csv_mb > sc.max_csv_mb) {
+            fprintf(stderr,
+                    "pmstep-sil: run.csv would take up to %.0f MB (%.0f rows), more than run.max_csv_mb = %g: raise "
+                    "run.decimation or run.max_csv_mb, or pass --no-csv\n",
+                    csv_mb, rows, sc.max_csv_mb);
+            return 2;
+        }
     }
     if (out_dir[0] == '\0') {
         snprintf(out_dir, sizeof out_dir, "out/%s", sc.name);
@@ -343,7 +360,7 @@ int main(int argc, char **argv)
         }
         return 2;
     }
-    if (csv.file != NULL && fclose(csv.file) != 0) {
+    if (csv.file != NULL && (ferror(csv.file) != 0) + (fclose(csv.file) != 0) != 0) {
         fprintf(stderr, "pmstep-sil: error writing run.csv\n");
         return 2;
     }
@@ -353,10 +370,15 @@ int main(int argc, char **argv)
     f = fopen(path, "w");
     if (f == NULL || text == NULL) {
         fprintf(stderr, "pmstep-sil: cannot write '%s'\n", path);
+        if (f != NULL) {
+            fclose(f);
+        }
         return 2;
     }
-    fprintf(f, "%s\n", text);
-    fclose(f);
+    if ((fprintf(f, "%s\n", text) < 0) + (fclose(f) != 0) != 0) {
+        fprintf(stderr, "pmstep-sil: error writing '%s'\n", path);
+        return 2;
+    }
     if (!quiet) {
         printf("%s\n", text);
         fprintf(stderr, "pmstep-sil: wrote %s%s/summary.json\n", write_csv ? "run.csv and " : "", out_dir);

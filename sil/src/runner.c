@@ -93,11 +93,13 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
     double wall_start;
     long k;
 
-    sil_metrics_init(&metrics, sc, s);
+    memset(s, 0, sizeof *s);
     s->init_status = pmstep_init(&inst, cfg);
     if (s->init_status != PMSTEP_OK) {
         return -1;
     }
+    sil_metrics_init(&metrics, sc, s); /* its period counts need a configuration init accepted; clears s */
+    s->init_status = PMSTEP_OK;
     memset(&plant, 0, sizeof plant);
     plant.params = sc->motor;
     plant.load = sc->load;

@@ -4,10 +4,12 @@
 
 #include <ini.h>
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #define PI 3.14159265358979323846
 
@@ -77,8 +79,9 @@ static const key_t_ keys[] = {
     {"controller.detection_time_s", KEY_FLOAT, OFF(controller.detection_time_s), -BIG, 0, BIG, 0, "persistence before a detection acts (s)"},
     {"controller.max_realignments", KEY_UINT, OFF(controller.max_realignments), 0, 0, 4294967295.0, 0, "0: a detection latches its fault; N: re-align up to N times"},
 
+    /* 3600 s / 1 us = 3.6e9 periods: the core's uint32 step counter does not wrap. */
     {"run.duration_s", KEY_DOUBLE, OFF(duration_s), 0, 1, 3600, 0, "simulated time (s)"},
-    {"run.period_s", KEY_FLOAT, OFF(controller.period_s), 0, 1, 0.01, 0, "control period T_s (s)"},
+    {"run.period_s", KEY_FLOAT, OFF(controller.period_s), 1e-6, 0, 0.01, 0, "control period T_s (s)"},
     {"run.substeps", KEY_INT, OFF(substeps), 1, 0, 10000, 0, "RK4 steps per control period"},
     {"run.delay_periods", KEY_UINT, OFF(controller.computational_delay_periods), 0, 0, 1, 0, "computational delay (0 or 1 period)"},
     {"run.bus_voltage_v", KEY_DOUBLE, OFF(bus_voltage_v), 0, 1, 10000, 0, "DC bus (V)"},
@@ -90,6 +93,7 @@ static const key_t_ keys[] = {
     {"run.transient_window_s", KEY_DOUBLE, OFF(transient_window_s), 0, 0, 3600, 0, "load-transient window after t_c (s)"},
     {"run.seed", KEY_UINT, OFF(seed), 0, 0, 4294967295.0, 0, "seed of every random draw (GSL MT19937; 0 acts as 4357)"},
     {"run.loss_speed_error_rad_s", KEY_DOUBLE, OFF(loss_speed_error_rad_s), 0, 1, BIG, 0, "|omega - omega*| above this in RUN counts as loss of control (rad/s)"},
+    {"run.max_csv_mb", KEY_DOUBLE, OFF(max_csv_mb), 0, 1, 1e6, 0, "refuse to start a run whose run.csv would exceed this (MB)"},
     {"run.loss_angle_error_rad", KEY_DOUBLE, OFF(loss_angle_error_rad), 0, 1, BIG, 0, "angle-estimate error above this in RUN counts as loss of control (rad)"},
 
     {"speed.points", KEY_SPEED_POINTS, 0, 0, 0, 0, 0, "set-point t:omega pairs (s:rad/s), piecewise linear"},
@@ -261,6 +265,10 @@ int sil_scenario_set(sil_scenario_t *sc, const char *key, const char *value, cha
         if ((k->type == KEY_INT || k->type == KEY_UINT || k->type == KEY_ADC_BITS) && v != floor(v)) {
             return fail(err, err_size, "%s: '%s' is not an integer", key, value);
         }
+        if (k->type == KEY_FLOAT && v != 0.0 && !(fabs(v) >= (double)FLT_MIN && fabs(v) <= (double)FLT_MAX)) {
+            return fail(err, err_size, "%s = %s is not representable as a normal float32 (the firmware's type)", key,
+                        value);
+        }
         if (k->type == KEY_ADC_BITS && v > 0.0 && v < 8.0) {
             return fail(err, err_size, "%s = %s is out of range: must be 0 (ideal) or 8 .. 16 (%s)", key, value, k->help);
         }
@@ -304,18 +312,42 @@ typedef struct {
 } load_ctx_t;
 
 /* A points value continued on indented lines (inih hands each line over under the same key)
- * is joined with a comma, and the whole list is parsed again. */
+ * is joined with a comma, and the whole list is parsed again. NULL if the joined list does
+ * not fit. */
 static const char *join_points(load_ctx_t *ctx, const char *key, const char *value)
 {
     const size_t used = strlen(ctx->points_text);
+    int written;
     if (strcmp(ctx->points_key, key) != 0 || used == 0) {
         snprintf(ctx->points_key, sizeof ctx->points_key, "%s", key);
-        snprintf(ctx->points_text, sizeof ctx->points_text, "%s", value);
+        written = snprintf(ctx->points_text, sizeof ctx->points_text, "%s", value);
     } else {
         const char *separator = ctx->points_text[used - 1] == ',' ? " " : ", ";
-        snprintf(ctx->points_text + used, sizeof ctx->points_text - used, "%s%s", separator, value);
+        written = snprintf(ctx->points_text + used, sizeof ctx->points_text - used, "%s%s", separator, value);
+        written += (int)used;
+    }
+    if (written < 0 || (size_t)written >= sizeof ctx->points_text) {
+        ctx->points_text[0] = '\0';
+        return NULL;
     }
     return ctx->points_text;
+}
+
+/* scenario.name names the output folder out/<name>: a plain file name only. */
+static int plain_file_name(const char *name)
+{
+    size_t n;
+    if (name[0] == '\0' || name[0] == '.' || strlen(name) >= sizeof ((sil_scenario_t *)0)->name) {
+        return 0;
+    }
+    for (n = 0; name[n] != '\0'; ++n) {
+        const char c = name[n];
+        if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '.' || c == '_'
+              || c == '-')) {
+            return 0;
+        }
+    }
+    return 1;
 }
 
 static int on_ini_entry(void *user, const char *section, const char *name, const char *value)
@@ -327,12 +359,30 @@ static int on_ini_entry(void *user, const char *section, const char *name, const
         return 0; /* keep the first error */
     }
     if (strcmp(section, "scenario") == 0 && strcmp(name, "name") == 0) {
+        if (!plain_file_name(value)) {
+            snprintf(ctx->message, sizeof ctx->message,
+                     "scenario.name '%.64s' is not a plain file name (1 to %d letters, digits, '.', '_' or '-', not "
+                     "starting with '.'): it names the output folder",
+                     value, (int)sizeof ctx->sc->name - 1);
+            ctx->failed = 1;
+            return 0;
+        }
         snprintf(ctx->sc->name, sizeof ctx->sc->name, "%s", value);
         return 1;
     }
-    snprintf(key, sizeof key, "%s.%s", section, name);
+    if (snprintf(key, sizeof key, "%s.%s", section, name) >= (int)sizeof key) {
+        snprintf(ctx->message, sizeof ctx->message, "key '%.40s...' is too long", section);
+        ctx->failed = 1;
+        return 0;
+    }
     if (strcmp(name, "points") == 0) {
         value = join_points(ctx, key, value);
+        if (value == NULL) {
+            snprintf(ctx->message, sizeof ctx->message, "%s: the joined point list is longer than %d characters", key,
+                     (int)sizeof ctx->points_text - 1);
+            ctx->failed = 1;
+            return 0;
+        }
     }
     if (sil_scenario_set(ctx->sc, key, value, message, sizeof message) != 0) {
         snprintf(ctx->message, sizeof ctx->message, "%s", message);
@@ -342,23 +392,93 @@ static int on_ini_entry(void *user, const char *section, const char *name, const
     return 1;
 }
 
+/* The whole file, checked before inih sees it: a regular file of at most SIL_SCENARIO_MAX_BYTES,
+ * no NUL byte, and no line longer than the INI reader's buffer (which would split it silently).
+ * @return the text (caller frees) or NULL with @p err set. */
+static char *read_scenario_text(const char *path, char *err, size_t err_size)
+{
+    /* inih's buffer holds a line with its "\r\n\0" (ini.h: INI_MAX_LINE must be 3 more than the longest line). */
+    const size_t max_line_chars = (size_t)ini_max_line - 3u;
+    struct stat info;
+    size_t size;
+    size_t n;
+    size_t line_start = 0;
+    int line = 1;
+    char *text;
+    FILE *file = fopen(path, "rb");
+    if (file == NULL) {
+        fail(err, err_size, "%s: cannot open: %s", path, strerror(errno));
+        return NULL;
+    }
+    if (fstat(fileno(file), &info) != 0 || !S_ISREG(info.st_mode)) {
+        fclose(file);
+        fail(err, err_size, "%s: not a regular file", path);
+        return NULL;
+    }
+    if (info.st_size > (off_t)SIL_SCENARIO_MAX_BYTES) {
+        fclose(file);
+        fail(err, err_size, "%s: %lld bytes, more than a scenario file may have (%u)", path, (long long)info.st_size,
+             (unsigned)SIL_SCENARIO_MAX_BYTES);
+        return NULL;
+    }
+    size = (size_t)info.st_size;
+    text = malloc(size + 1u);
+    if (text == NULL) {
+        fclose(file);
+        fail(err, err_size, "%s: out of memory", path);
+        return NULL;
+    }
+    if (fread(text, 1u, size, file) != size) {
+        free(text);
+        fclose(file);
+        fail(err, err_size, "%s: read error", path);
+        return NULL;
+    }
+    fclose(file);
+    text[size] = '\0';
+    for (n = 0; n <= size; ++n) {
+        if (n < size && text[n] == '\0') {
+            free(text);
+            fail(err, err_size, "%s:%d: NUL byte in the file", path, line);
+            return NULL;
+        }
+        if (n == size || text[n] == '\n') {
+            size_t length = n - line_start;
+            if (length > 0u && text[n - 1u] == '\r') {
+                --length;
+            }
+            if (length > max_line_chars) {
+                free(text);
+                fail(err, err_size, "%s:%d: line of %u characters, longer than the %u the INI reader takes (continue a "
+                     "long value on indented lines)", path, line, (unsigned)length, (unsigned)max_line_chars);
+                return NULL;
+            }
+            ++line;
+            line_start = n + 1u;
+        }
+    }
+    return text;
+}
+
 int sil_scenario_load(sil_scenario_t *sc, const char *path, char *err, size_t err_size)
 {
     load_ctx_t ctx;
     int line;
+    char *text = read_scenario_text(path, err, err_size);
+    if (text == NULL) {
+        return -1;
+    }
     ctx.sc = sc;
     ctx.message[0] = '\0';
     ctx.failed = 0;
     ctx.points_key[0] = '\0';
     ctx.points_text[0] = '\0';
-    line = ini_parse(path, on_ini_entry, &ctx);
-    if (line == -1) {
-        return fail(err, err_size, "%s: cannot open", path);
-    }
+    line = ini_parse_string(text, on_ini_entry, &ctx);
+    free(text);
     if (line == -2) {
         return fail(err, err_size, "%s: out of memory", path);
     }
-    if (line > 0) {
+    if (line != 0) {
         if (ctx.failed) {
             return fail(err, err_size, "%s:%d: %s", path, line, ctx.message);
         }
@@ -369,6 +489,7 @@ int sil_scenario_load(sil_scenario_t *sc, const char *path, char *err, size_t er
 
 int sil_scenario_check(const sil_scenario_t *sc, char *err, size_t err_size)
 {
+
     if (sc->load.kind == PLANT_LOAD_TABLE && sc->load.table_points == 0) {
         return fail(err, err_size, "load.type = table needs load.points");
     }

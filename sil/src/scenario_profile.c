@@ -33,6 +33,7 @@ void sil_scenario_paper(sil_scenario_t *sc)
     sc->id_target_a = 0.0;
     sc->loss_speed_error_rad_s = 2.0;
     sc->loss_angle_error_rad = 0.5;
+    sc->max_csv_mb = 1000.0;
     /* Measurement chain, inverter and bus: all ideal. */
     sc->seed = 1u;
     sc->sensors = sil_sensors_ideal();

@@ -22,6 +22,10 @@ extern "C" {
 
 #define SIL_SPEED_POINTS_MAX 64
 #define SIL_ERROR_MAX 256
+/** Largest scenario file read (bytes). */
+#define SIL_SCENARIO_MAX_BYTES (1u << 20)
+/** Bytes of one run.csv row at most (21 columns), for the output-size check. */
+#define SIL_CSV_ROW_MAX_BYTES 330.0
 
 typedef struct {
     char name[64];
@@ -44,6 +48,7 @@ typedef struct {
     double loss_speed_error_rad_s;   /**< run.loss_speed_error_rad_s: |omega - omega*| above -> loss of control */
     double loss_angle_error_rad;     /**< run.loss_angle_error_rad: angle-estimate error above -> loss of control */
     uint32_t seed;                   /**< run.seed: of every random draw of the run (measurement noise) */
+    double max_csv_mb;               /**< run.max_csv_mb: largest run.csv a run may write (MB) */
     sil_sensor_config_t sensors;     /**< [sensors]: measurement chain (ideal by default) */
     sil_inverter_config_t inverter;  /**< [inverter]: averaged | switching, dead time */
     sil_bus_config_t bus;            /**< [bus]: source resistance and ripple on run.bus_voltage_v */
