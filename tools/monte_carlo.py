@@ -65,26 +65,26 @@ import time
 # U[a, b] is a + (b - a) * random(), random() in [0, 1): b itself is never drawn.
 # --------------------------------------------------------------------------------------
 DISTRIBUTIONS = [
-    ("motor.resistance_ohm", "scale", 0.7, 1.3),
-    ("motor.inductance_h", "scale", 0.8, 1.2),
-    ("motor.torque_constant_nm_per_a", "scale", 0.9, 1.1),
-    ("motor.inertia_kg_m2", "scale", 0.5, 1.5),
-    ("motor.friction_nm_s_per_rad", "uniform", 0.0, 0.005),
-    ("sensors.offset_a_a", "uniform", -0.02, 0.02),
-    ("sensors.offset_b_a", "uniform", -0.02, 0.02),
+    ("motor.resistance_Ohm", "scale", 0.7, 1.3),
+    ("motor.inductance_H", "scale", 0.8, 1.2),
+    ("motor.torque_constant_Nm_A", "scale", 0.9, 1.1),
+    ("motor.inertia_kgm2", "scale", 0.5, 1.5),
+    ("motor.friction_Nms_rad", "uniform", 0.0, 0.005),
+    ("sensors.offset_a_A", "uniform", -0.02, 0.02),
+    ("sensors.offset_b_A", "uniform", -0.02, 0.02),
     ("sensors.gain_error_a", "uniform", -0.01, 0.01),
     ("sensors.gain_error_b", "uniform", -0.01, 0.01),
     # Half to one and a half times the acceptance's 5 mA: a real current channel is never quieter
     # than about half an LSB (8 mA at 12 bits over +-16.5 A); README shows what an undithered one does.
-    ("sensors.noise_rms_a", "uniform", 0.0025, 0.0075),
+    ("sensors.noise_rms_A", "uniform", 0.0025, 0.0075),
     ("inverter.dead_time_s", "uniform", 0.0, 1.5e-6),
-    ("bus.ripple_v", "uniform", 0.0, 2.0),
-    ("bus.source_resistance_ohm", "uniform", 0.0, 0.2),
+    ("bus.ripple_V", "uniform", 0.0, 2.0),
+    ("bus.source_resistance_Ohm", "uniform", 0.0, 0.2),
     ("run.theta0_deg", "uniform", 0.0, 360.0),
-    ("load.torque_nm", "scale", 0.0, 1.0),
+    ("load.torque_Nm", "scale", 0.0, 1.0),
     # The firmware compensates the dead time its timer is programmed with; the bridge's own
     # switching delays make the real one differ by up to 10 %.
-    ("controller.dead_time_s", "times inverter.dead_time_s", 0.9, 1.1),
+    ("controller.inverter.dead_time_s", "times inverter.dead_time_s", 0.9, 1.1),
 ]
 
 SEED_STRIDE = 100000          # case seed = base seed * SEED_STRIDE + case index
@@ -116,12 +116,12 @@ REQUIRED_FIELDS = (
 
 # Drawn parameters shown in the worst-case table (key, column title, show as factor).
 KEY_PARAMETERS = (
-    ("motor.resistance_ohm", "R/R0", True),
-    ("motor.inductance_h", "L/L0", True),
-    ("motor.torque_constant_nm_per_a", "k_M/k_M0", True),
-    ("motor.inertia_kg_m2", "J/J0", True),
+    ("motor.resistance_Ohm", "R/R0", True),
+    ("motor.inductance_H", "L/L0", True),
+    ("motor.torque_constant_Nm_A", "k_M/k_M0", True),
+    ("motor.inertia_kgm2", "J/J0", True),
     ("inverter.dead_time_s", "dead time (us)", False),
-    ("load.torque_nm", "load (Nm)", False),
+    ("load.torque_Nm", "load (Nm)", False),
     ("run.theta0_deg", "theta0 (deg)", False),
 )
 
@@ -474,15 +474,15 @@ def extract_metrics(summary, params, base):
     metrics["past_settle"] = not (fault.get("code") and settle_s is not None and fault_s is not None
                                   and 0.0 <= fault_s < settle_s)
     # Commissioned value against the plant's (drawn, else the scenario's) value.
-    for name, key, field in (("r_rel_error", "motor.resistance_ohm", "resistance_ohm"),
-                             ("l_rel_error", "motor.inductance_h", "inductance_h"),
-                             ("k_rel_error", "motor.torque_constant_nm_per_a", "torque_constant_nm_per_a")):
+    for name, key, field in (("r_rel_error", "motor.resistance_Ohm", "resistance_Ohm"),
+                             ("l_rel_error", "motor.inductance_H", "inductance_H"),
+                             ("k_rel_error", "motor.torque_constant_Nm_A", "torque_constant_Nm_A")):
         plant = params.get(key, base.get(key))
         measured = number_or_none(com.get(field))
         ok = metrics["commissioning_measured"] and measured is not None and plant
         metrics[name] = measured / plant - 1.0 if ok else None
-    for name, key, field in (("offset_a_error_a", "sensors.offset_a_a", "offset_a_a"),
-                             ("offset_b_error_a", "sensors.offset_b_a", "offset_b_a")):
+    for name, key, field in (("offset_a_error_A", "sensors.offset_a_A", "offset_a_A"),
+                             ("offset_b_error_A", "sensors.offset_b_A", "offset_b_A")):
         measured = number_or_none(com.get(field))
         ok = metrics["commissioning_measured"] and measured is not None and key in params
         metrics[name] = measured - params[key] if ok else None
@@ -618,8 +618,8 @@ def aggregate(records, args):
         "commissioning_abs_r_rel_error": stats("r_rel_error", abs),
         "commissioning_abs_l_rel_error": stats("l_rel_error", abs),
         "commissioning_abs_k_rel_error": stats("k_rel_error", abs),
-        "commissioning_abs_offset_a_error_a": stats("offset_a_error_a", abs),
-        "commissioning_abs_offset_b_error_a": stats("offset_b_error_a", abs),
+        "commissioning_abs_offset_a_error_A": stats("offset_a_error_A", abs),
+        "commissioning_abs_offset_b_error_A": stats("offset_b_error_A", abs),
     }
     for name in ("r_rel_error", "l_rel_error", "k_rel_error"):
         values = [r["metrics"][name] for r in records if r["metrics"].get(name) is not None]
@@ -783,8 +783,8 @@ def write_report(path, records, agg, args, scenario, version, plots, started_utc
               ("commissioning_abs_r_rel_error", "\\|R commissioned / R plant - 1\\|"),
               ("commissioning_abs_l_rel_error", "\\|L commissioned / L plant - 1\\|"),
               ("commissioning_abs_k_rel_error", "\\|k_M commissioned / k_M plant - 1\\|"),
-              ("commissioning_abs_offset_a_error_a", "\\|offset a commissioned - true\\| (A)"),
-              ("commissioning_abs_offset_b_error_a", "\\|offset b commissioned - true\\| (A)"))
+              ("commissioning_abs_offset_a_error_A", "\\|offset a commissioned - true\\| (A)"),
+              ("commissioning_abs_offset_b_error_A", "\\|offset b commissioned - true\\| (A)"))
     for name, title in titles:
         d = agg["distributions"][name]
         lines.append(f"| {title} | {d['n']} | {fmt(d['p50'])} | {fmt(d['p90'])} | {fmt(d['p99'])} | {fmt(d['max'])} |")
@@ -841,8 +841,8 @@ def write_report(path, records, agg, args, scenario, version, plots, started_utc
 
 CSV_METRICS = ("max_speed_error_rad_s", "max_angle_error_rad", "settle_time_s", "loss_of_control_time_s",
                "detection_latency_s", "fault_time_s", "nonfinite_seen", "tracking_max_abs_error_rad_s",
-               "commissioning_measured", "r_rel_error", "l_rel_error", "k_rel_error", "offset_a_error_a",
-               "offset_b_error_a", "realignments", "final_mode", "past_settle", "wall_s")
+               "commissioning_measured", "r_rel_error", "l_rel_error", "k_rel_error", "offset_a_error_A",
+               "offset_b_error_A", "realignments", "final_mode", "past_settle", "wall_s")
 
 
 def write_cases_csv(path, records):
@@ -898,7 +898,7 @@ def parse_args(argv):
     parser.add_argument("--min-success", type=float, default=0.99, help="--check: minimum success rate (default 0.99)")
     parser.add_argument("--exclude", action="append", default=[], metavar="KEY",
                         help="leave this row of the distribution table out (the scenario's value stays); "
-                             "repeatable, e.g. --exclude controller.dead_time_s for a firmware without compensation")
+                             "repeatable, e.g. --exclude controller.inverter.dead_time_s for a firmware without compensation")
     parser.add_argument("--case-timeout", type=float, default=600.0, metavar="SECONDS",
                         help="wall time after which one run counts as crashed (default 600 s)")
     args = parser.parse_args(argv[1:])

@@ -37,30 +37,30 @@ THRESHOLDS_RAD = (0.05, 0.5)
 
 # The firmware in the paper's mode, detection off (see the module docstring).
 PAPER_FIRMWARE = {
-    "controller.offset_calibration_time_s": "0", "controller.alignment_offset_calibration": "false",
-    "controller.steady_state_window_s": "0", "controller.inductance_window_s": "0",
-    "controller.use_commissioned_resistance": "false", "controller.use_commissioned_inductance": "false",
-    "controller.use_commissioned_torque_constant": "false", "controller.voltage_bias_level_fraction": "0",
-    "controller.dead_time_s": "0", "controller.angle_correction_gain_per_s": "0", "speed.id_target_a": "0",
-    "controller.angle_magnitude_bound": "0", "controller.speed_consistency_bound_rad_s": "0",
-    "controller.stall_speed_error_rad_s": "0", "controller.observer_residual_bound_a": "0",
+    "controller.commissioning.offset_calibration_time_s": "0", "controller.commissioning.alignment_offset_calibration": "false",
+    "controller.commissioning.steady_state_window_s": "0", "controller.commissioning.inductance_window_s": "0",
+    "controller.commissioning.use_measured_resistance": "false", "controller.commissioning.use_measured_inductance": "false",
+    "controller.commissioning.use_measured_torque_constant": "false", "controller.commissioning.voltage_bias_level_fraction": "0",
+    "controller.inverter.dead_time_s": "0", "controller.gains.angle_correction_gain_per_s": "0", "speed.id_target_A": "0",
+    "controller.detection.angle_magnitude_bound": "0", "controller.detection.speed_consistency_bound_rad_s": "0",
+    "controller.detection.stall_speed_error_rad_s": "0", "controller.detection.observer_residual_bound_A": "0",
     "load.step_time_s": "0.63",  # 30 ms after t_c = 0.6 s, as in the paper
 }
 
 # Every non-ideality off; the paper's plant R.
 IDEAL_CHAIN = {
-    "sensors.adc_bits": "0", "sensors.offset_a_a": "0", "sensors.offset_b_a": "0", "sensors.noise_rms_a": "0",
-    "inverter.dead_time_s": "0", "run.delay_periods": "0", "motor.resistance_ohm": "3",
+    "sensors.adc_bits": "0", "sensors.offset_a_A": "0", "sensors.offset_b_A": "0", "sensors.noise_rms_A": "0",
+    "inverter.dead_time_s": "0", "run.delay_periods": "0", "motor.resistance_Ohm": "3",
 }
 
 # (name, keys taken back from the scenario file on top of the ideal chain)
 ALONE = [
     ("12-bit ADC", ["sensors.adc_bits"]),
-    ("+-20 mA offsets", ["sensors.offset_a_a", "sensors.offset_b_a"]),
-    ("5 mA noise", ["sensors.noise_rms_a"]),
+    ("+-20 mA offsets", ["sensors.offset_a_A", "sensors.offset_b_A"]),
+    ("5 mA noise", ["sensors.noise_rms_A"]),
     ("one period delay", ["run.delay_periods"]),
     ("1 us dead time", ["inverter.dead_time_s"]),
-    ("plant R +20 %", ["motor.resistance_ohm"]),
+    ("plant R +20 %", ["motor.resistance_Ohm"]),
 ]
 
 
@@ -69,6 +69,7 @@ def scenario_values(sil, scenario):
     text = subprocess.run([sil, "--scenario", scenario, "--print-scenario"], check=True, capture_output=True,
                           text=True).stdout
     parser = configparser.ConfigParser(comment_prefixes=(";",), interpolation=None)
+    parser.optionxform = str  # keep the keys' case: units are in them (motor.resistance_Ohm)
     parser.read_string(text)
     return {f"{section}.{key}": " ".join(value.split()) for section in parser.sections()
             for key, value in parser[section].items()}
@@ -82,7 +83,7 @@ def cases(values, t_c_s):
     for name, keys in ALONE:
         out.append((name, {**paper, **IDEAL_CHAIN, **{k: values[k] for k in keys}}))
     out.append(("all of the scenario's chain", paper))
-    out.append(("robust mode, all", {"run.duration_s": repr(float(values["controller.offset_calibration_time_s"])
+    out.append(("robust mode, all", {"run.duration_s": repr(float(values["controller.commissioning.offset_calibration_time_s"])
                                                             + t_c_s + HORIZON_S), "run.decimation": "20"}))
     return out
 
@@ -189,7 +190,7 @@ def main(argv):
     ap.add_argument("--check", action="store_true", help="exit 1 unless all ran and the ideal chain < 1e-3 rad")
     args = ap.parse_args(argv)
     values = scenario_values(args.sil, args.scenario)
-    t_c_s = float(values["controller.c_align_time_s"])
+    t_c_s = float(values["controller.alignment.c_align_time_s"])
     todo = cases(values, t_c_s)
     os.makedirs(args.out, exist_ok=True)
     results = [None] * len(todo)

@@ -86,7 +86,7 @@ def main(argv):
         f"Empirical domain of attraction, scenario '{report['scenario']}' — {verdict}\n"
         f"{len(directions)} directions, {int(doa['runs'])} SIL runs; converged = no fault, "
         f"|w - w*|, |w-hat - w| < {opts['speed_tol_rad_s']:g} rad/s on the last {opts['final_window_s']:g} s, "
-        f"|T_L-hat - T_L| < {opts['load_tol_nm']:g} Nm",
+        f"|T_L-hat - T_L| < {opts['load_tol_Nm']:g} Nm",
         fontsize=9)
     fig.tight_layout()
     fig.savefig(out_path, dpi=130)

@@ -22,8 +22,8 @@ import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
 import numpy as np  # noqa: E402
 from matplotlib.ticker import FuncFormatter, MultipleLocator  # noqa: E402
 
-COLUMNS = ("t_s", "theta_rad", "omega_rad_s", "omega_ref_rad_s", "i_a_a", "i_b_a", "u_a_v", "u_b_v",
-           "cos_hat", "sin_hat", "cos_ptheta", "sin_ptheta", "load_hat_nm", "load_nm", "mode")
+COLUMNS = ("t_s", "theta_rad", "omega_rad_s", "omega_ref_rad_s", "i_a_A", "i_b_A", "u_a_V", "u_b_V",
+           "cos_hat", "sin_hat", "cos_ptheta", "sin_ptheta", "load_hat_Nm", "load_Nm", "mode")
 KEYS = ("pole_pairs", "s_align_time_s", "c_align_time_s")
 MODE_RUN, MODE_FAULT = 3, 4
 WIDTH_IN, DPI = 8.0, 120
@@ -110,7 +110,7 @@ def main():
     t_fault = t[faulted[0]] if faulted.size else None
     if t_fault is not None:
         sys.stderr.write(f"plot_run.py: warning: run latched a fault at t = {t_fault:.4f} s\n")
-    stepped = np.flatnonzero(np.abs(d["load_nm"] - d["load_nm"][0]) > 1e-9)
+    stepped = np.flatnonzero(np.abs(d["load_Nm"] - d["load_Nm"][0]) > 1e-9)
     t_load = t[stepped[0]] if stepped.size else None
 
     def finish(axes):
@@ -125,8 +125,8 @@ def main():
     a1.plot(t, d["omega_ref_rad_s"], color="tab:blue")
     a1.set_ylabel("ω* (rad/s)")
     a1.set_title(f"Fig. 1 — Rotor speed reference and applied load torque ({name})", pad=16)
-    a2.plot(t, d["load_nm"], color="tab:red", label="$T_L$ applied")
-    a2.plot(t[run], d["load_hat_nm"][run], color="k", ls="--", lw=1, label="$\\hat{T}_L$ estimate (t ≥ $t_c$)")
+    a2.plot(t, d["load_Nm"], color="tab:red", label="$T_L$ applied")
+    a2.plot(t[run], d["load_hat_Nm"][run], color="k", ls="--", lw=1, label="$\\hat{T}_L$ estimate (t ≥ $t_c$)")
     a2.set_ylabel("load torque (Nm)")
     a2.legend(loc="best", fontsize=9)
     finish((a1, a2))
@@ -159,11 +159,11 @@ def main():
     axes[0].set_ylabel("ω − ω* (rad/s)")
     axes[0].set_title("Fig. 3 — Speed tracking error, (a, b) currents and voltages, angle estimate"
                       " (t ≥ $t_c$)", pad=16)
-    axes[1].plot(ta, d["i_a_a"][after], label="$i_a$")
-    axes[1].plot(ta, d["i_b_a"][after], label="$i_b$")
+    axes[1].plot(ta, d["i_a_A"][after], label="$i_a$")
+    axes[1].plot(ta, d["i_b_A"][after], label="$i_b$")
     axes[1].set_ylabel("current (A)")
-    axes[2].plot(ta, d["u_a_v"][after], label="$u_a$")
-    axes[2].plot(ta, d["u_b_v"][after], label="$u_b$")
+    axes[2].plot(ta, d["u_a_V"][after], label="$u_a$")
+    axes[2].plot(ta, d["u_b_V"][after], label="$u_b$")
     axes[2].set_ylabel("voltage (V)")
     axes[3].plot(t[run], (d["cos_hat"] - d["cos_ptheta"])[run], label="$\\hat{c}$ − cos pθ")
     axes[3].plot(t[run], (d["sin_hat"] - d["sin_ptheta"])[run], label="$\\hat{s}$ − sin pθ")

@@ -56,17 +56,17 @@ class SeedMapping(unittest.TestCase):
 
 
 class Sampling(unittest.TestCase):
-    BASE = {"motor.resistance_ohm": 3.0, "motor.inductance_h": 0.006, "motor.torque_constant_nm_per_a": 2.0,
-            "motor.inertia_kg_m2": 0.01, "load.torque_nm": 2.0}
+    BASE = {"motor.resistance_Ohm": 3.0, "motor.inductance_H": 0.006, "motor.torque_constant_Nm_A": 2.0,
+            "motor.inertia_kgm2": 0.01, "load.torque_Nm": 2.0}
 
     def test_known_draws(self):
         # random.Random(700000).random() gives 0.5252184595196231, 0.7456568194701344, ...
         p = mc.draw_parameters(700000, self.BASE)
-        self.assertAlmostEqual(p["motor.resistance_ohm"], 3.0 * (0.7 + 0.6 * 0.5252184595196231), places=14)
-        self.assertAlmostEqual(p["motor.resistance_ohm"], 3.045393227135322, places=14)
-        self.assertAlmostEqual(p["motor.inductance_h"], 0.006589576366728322, places=16)
+        self.assertAlmostEqual(p["motor.resistance_Ohm"], 3.0 * (0.7 + 0.6 * 0.5252184595196231), places=14)
+        self.assertAlmostEqual(p["motor.resistance_Ohm"], 3.045393227135322, places=14)
+        self.assertAlmostEqual(p["motor.inductance_H"], 0.006589576366728322, places=16)
         self.assertAlmostEqual(p["run.theta0_deg"], 338.237522087197, places=10)
-        self.assertAlmostEqual(p["load.torque_nm"], 0.5791380988738883, places=14)
+        self.assertAlmostEqual(p["load.torque_Nm"], 0.5791380988738883, places=14)
         self.assertEqual(list(p), [row[0] for row in mc.DISTRIBUTIONS])
 
     def test_reproducible_and_in_range(self):
@@ -93,8 +93,8 @@ class ScenarioParsing(unittest.TestCase):
 
         [motor]
         ; plant R (Ohm)
-        resistance_ohm = 3
-        inductance_h = 0.006
+        resistance_Ohm = 3
+        inductance_H = 0.006
 
         [speed]
         ; set-point
@@ -104,20 +104,20 @@ class ScenarioParsing(unittest.TestCase):
     def test_parse(self):
         s = mc.parse_scenario(self.TEXT)
         self.assertEqual(s["scenario.name"], "paper")
-        self.assertEqual(s["motor.resistance_ohm"], "3")
+        self.assertEqual(s["motor.resistance_Ohm"], "3")
         self.assertEqual(s["speed.points"], "0:0, 0.65:0, 0.85:10")
         self.assertEqual(len(s), 4)
 
     def test_missing_keys_in_table_order(self):
         s = mc.parse_scenario(self.TEXT)
-        table = [("motor.resistance_ohm", "scale", 0.7, 1.3), ("sensors.noise_rms_a", "uniform", 0, 1),
-                 ("motor.inductance_h", "scale", 0.8, 1.2), ("bus.ripple_v", "uniform", 0, 2)]
-        self.assertEqual(mc.missing_keys(s, table), ["sensors.noise_rms_a", "bus.ripple_v", "run.seed"])
+        table = [("motor.resistance_Ohm", "scale", 0.7, 1.3), ("sensors.noise_rms_A", "uniform", 0, 1),
+                 ("motor.inductance_H", "scale", 0.8, 1.2), ("bus.ripple_V", "uniform", 0, 2)]
+        self.assertEqual(mc.missing_keys(s, table), ["sensors.noise_rms_A", "bus.ripple_V", "run.seed"])
         self.assertEqual(mc.missing_keys(s, table[:1], extra=()), [])
 
     def test_base_values_need_numbers(self):
         s = mc.parse_scenario(self.TEXT)
-        self.assertEqual(mc.base_values(s, [("motor.inductance_h", "scale", 0.8, 1.2)]), {"motor.inductance_h": 0.006})
+        self.assertEqual(mc.base_values(s, [("motor.inductance_H", "scale", 0.8, 1.2)]), {"motor.inductance_H": 0.006})
         with self.assertRaises(mc.ToolError):
             mc.base_values(s, [("speed.points", "scale", 0.8, 1.2)])
 
@@ -197,17 +197,17 @@ class Classification(unittest.TestCase):
 class Metrics(unittest.TestCase):
     def test_commissioning_errors_against_the_plant(self):
         s = summary()
-        s["commissioning"] = {"measured": True, "resistance_ohm": 3.03, "inductance_h": 0.0057,
-                              "torque_constant_nm_per_a": 2.2, "offset_a_a": 0.015, "offset_b_a": -0.01,
+        s["commissioning"] = {"measured": True, "resistance_Ohm": 3.03, "inductance_H": 0.0057,
+                              "torque_constant_Nm_A": 2.2, "offset_a_A": 0.015, "offset_b_A": -0.01,
                               "realignments": 0}
-        params = {"motor.resistance_ohm": 3.0, "motor.inductance_h": 0.006, "sensors.offset_a_a": 0.02,
-                  "sensors.offset_b_a": -0.02}
-        m = mc.extract_metrics(s, params, {"motor.torque_constant_nm_per_a": 2.0})
+        params = {"motor.resistance_Ohm": 3.0, "motor.inductance_H": 0.006, "sensors.offset_a_A": 0.02,
+                  "sensors.offset_b_A": -0.02}
+        m = mc.extract_metrics(s, params, {"motor.torque_constant_Nm_A": 2.0})
         self.assertAlmostEqual(m["r_rel_error"], 0.01)
         self.assertAlmostEqual(m["l_rel_error"], -0.05)
         self.assertAlmostEqual(m["k_rel_error"], 0.1)      # plant k_M from the scenario when not drawn
-        self.assertAlmostEqual(m["offset_a_error_a"], -0.005)
-        self.assertAlmostEqual(m["offset_b_error_a"], 0.01)
+        self.assertAlmostEqual(m["offset_a_error_A"], -0.005)
+        self.assertAlmostEqual(m["offset_b_error_A"], 0.01)
         self.assertTrue(m["past_settle"])
         s["commissioning"]["measured"] = False
         self.assertIsNone(mc.extract_metrics(s, params, {})["r_rel_error"])
@@ -267,30 +267,30 @@ FAKE_SIL = textwrap.dedent('''\
     name = fake
     [motor]
     ; plant R (Ohm)
-    resistance_ohm = 3
-    inductance_h = 0.006
-    inertia_kg_m2 = 0.01
-    friction_nm_s_per_rad = 0
-    torque_constant_nm_per_a = 2
+    resistance_Ohm = 3
+    inductance_H = 0.006
+    inertia_kgm2 = 0.01
+    friction_Nms_rad = 0
+    torque_constant_Nm_A = 2
     [sensors]
-    offset_a_a = 0
-    offset_b_a = 0
+    offset_a_A = 0
+    offset_b_A = 0
     gain_error_a = 0
     gain_error_b = 0
-    noise_rms_a = 0
+    noise_rms_A = 0
     [inverter]
     dead_time_s = 0
     [bus]
-    ripple_v = 0
-    source_resistance_ohm = 0
-    [controller]
+    ripple_V = 0
+    source_resistance_Ohm = 0
+    [controller.inverter]
     dead_time_s = 0
     [run]
     seed = 0
     duration_s = 2.4
     theta0_deg = 30
     [load]
-    torque_nm = 2
+    torque_Nm = 2
     """
     args = sys.argv[1:]
     if "--print-scenario" in args:
@@ -306,7 +306,7 @@ FAKE_SIL = textwrap.dedent('''\
     fault = outcome in ("detected", "false_trip", "late")
     loss = {"detected": 1.0, "silent": 1.1, "late": 1.2}.get(outcome, -1.0)
     fault_time = {"detected": 1.02, "false_trip": 0.9, "late": 1.4}.get(outcome, -1.0)
-    r = float(sets["motor.resistance_ohm"])
+    r = float(sets["motor.resistance_Ohm"])
     s = {"seed": int(sets["run.seed"]),
          "fault": {"code": 4 if fault else 0, "name": "overcurrent" if fault else "none", "text": "x",
                    "step": 1, "time_s": fault_time},
@@ -317,8 +317,8 @@ FAKE_SIL = textwrap.dedent('''\
                         "loss_of_control_time_s": loss,
                         "detection_latency_s": (fault_time - loss) if fault and loss >= 0 else None,
                         "nonfinite_seen": False},
-         "commissioning": {"offset_a_a": 0.0, "offset_b_a": 0.0, "resistance_ohm": r * 1.01,
-                           "inductance_h": 0.006, "torque_constant_nm_per_a": 2.0, "realignments": 0,
+         "commissioning": {"offset_a_A": 0.0, "offset_b_A": 0.0, "resistance_Ohm": r * 1.01,
+                           "inductance_H": 0.006, "torque_constant_Nm_A": 2.0, "realignments": 0,
                            "measured": True},
          "timing": {"wall_s": 0.01}}
     os.makedirs(out, exist_ok=True)
@@ -381,11 +381,11 @@ class EndToEnd(unittest.TestCase):
         self.assertEqual(rows[5]["class"], "crashed")
         self.assertIn("exited with status 139", rows[5]["reason"])
         self.assertEqual(rows[2]["false_trip"], "1")
-        self.assertEqual(float(rows[0]["motor.resistance_ohm"]),
-                         mc.draw_parameters(300000, {"motor.resistance_ohm": 3.0, "motor.inductance_h": 0.006,
-                                                     "motor.torque_constant_nm_per_a": 2.0,
-                                                     "motor.inertia_kg_m2": 0.01,
-                                                     "load.torque_nm": 2.0})["motor.resistance_ohm"])
+        self.assertEqual(float(rows[0]["motor.resistance_Ohm"]),
+                         mc.draw_parameters(300000, {"motor.resistance_Ohm": 3.0, "motor.inductance_H": 0.006,
+                                                     "motor.torque_constant_Nm_A": 2.0,
+                                                     "motor.inertia_kgm2": 0.01,
+                                                     "load.torque_Nm": 2.0})["motor.resistance_Ohm"])
 
         with open(os.path.join(self.out, "report.md")) as f:
             report = f.read()
@@ -408,13 +408,13 @@ class EndToEnd(unittest.TestCase):
     def test_missing_key_stops(self):
         paper = os.path.join(self.tmp.name, "old-sil")
         with open(paper, "w") as f:
-            f.write(f"#!{sys.executable}\nprint('[motor]\\nresistance_ohm = 3\\n')\n")
+            f.write(f"#!{sys.executable}\nprint('[motor]\\nresistance_Ohm = 3\\n')\n")
         os.chmod(paper, 0o755)
         proc = subprocess.run([sys.executable, SCRIPT, "--sil", paper, "--scenario", self.scenario, "--out",
                                self.out, "--cases", "2", "--no-plots"], capture_output=True, text=True, timeout=60)
         self.assertEqual(proc.returncode, 2)
         self.assertIn("does not know 16 of the keys", proc.stderr)
-        self.assertIn("sensors.noise_rms_a", proc.stderr)
+        self.assertIn("sensors.noise_rms_A", proc.stderr)
         self.assertEqual(proc.stdout.strip().splitlines()[-1], "0 passed, 0 failed")
 
 

@@ -33,18 +33,18 @@ class Series(unittest.TestCase):
 
 
 class Cases(unittest.TestCase):
-    values = {"sensors.adc_bits": "12", "sensors.offset_a_a": "0.02", "sensors.offset_b_a": "-0.02",
-              "sensors.noise_rms_a": "0.005", "run.delay_periods": "1", "inverter.dead_time_s": "1e-06",
-              "motor.resistance_ohm": "3.6", "controller.offset_calibration_time_s": "0.05"}
+    values = {"sensors.adc_bits": "12", "sensors.offset_a_A": "0.02", "sensors.offset_b_A": "-0.02",
+              "sensors.noise_rms_A": "0.005", "run.delay_periods": "1", "inverter.dead_time_s": "1e-06",
+              "motor.resistance_Ohm": "3.6", "controller.commissioning.offset_calibration_time_s": "0.05"}
 
     def test_composition(self):
         runs = dict(drift.cases(self.values, 0.6))
         self.assertEqual(len(runs), 9)
         ideal = runs["ideal chain"]
         self.assertEqual(ideal["sensors.adc_bits"], "0")
-        self.assertEqual(ideal["controller.angle_correction_gain_per_s"], "0")
+        self.assertEqual(ideal["controller.gains.angle_correction_gain_per_s"], "0")
         self.assertEqual(ideal["run.duration_s"], repr(10.6))
-        self.assertEqual(runs["+-20 mA offsets"]["sensors.offset_b_a"], "-0.02")
+        self.assertEqual(runs["+-20 mA offsets"]["sensors.offset_b_A"], "-0.02")
         self.assertEqual(runs["+-20 mA offsets"]["sensors.adc_bits"], "0")
         self.assertNotIn("sensors.adc_bits", runs["all of the scenario's chain"])
         self.assertEqual(runs["robust mode, all"], {"run.duration_s": repr(0.05 + 0.6 + 10.0), "run.decimation": "20"})

@@ -4,23 +4,23 @@
 void pmstep_angle_coeffs_init(pmstep_angle_coeffs_t *coeffs, const pmstep_config_t *cfg,
                               const pmstep_electrical_t *model)
 {
-    coeffs->voltage_gain = cfg->period_s / model->inductance_h;
-    coeffs->current_gain = 0.5f * model->resistance_ohm * cfg->period_s / model->inductance_h;
-    coeffs->flux_to_angle = model->inductance_h * (float)cfg->pole_pairs / model->torque_constant_nm_per_a;
+    coeffs->voltage_gain = cfg->timing.period_s / model->inductance_H;
+    coeffs->current_gain = 0.5f * model->resistance_Ohm * cfg->timing.period_s / model->inductance_H;
+    coeffs->flux_to_angle = model->inductance_H * (float)cfg->motor.pole_pairs / model->torque_constant_Nm_A;
     /* d c-hat / d phi1 = flux_to_angle, so a change g T_s c e of c-hat is g T_s c e / flux_to_angle of phi1. */
-    coeffs->correction_gain = cfg->angle_correction_gain_per_s * cfg->period_s / coeffs->flux_to_angle;
+    coeffs->correction_gain = cfg->gains.angle_correction_gain_per_s * cfg->timing.period_s / coeffs->flux_to_angle;
 }
 
-void pmstep_angle_start(pmstep_angle_t *angle, float i_a_a, float i_b_a)
+void pmstep_angle_start(pmstep_angle_t *angle, float i_a_A, float i_b_A)
 {
     angle->phi_a = 0.0f;
     angle->phi_b = 0.0f;
     angle->phi_a_compensation = 0.0f;
     angle->phi_b_compensation = 0.0f;
-    angle->i_a_start_a = i_a_a;
-    angle->i_b_start_a = i_b_a;
-    angle->i_a_prev_a = i_a_a;
-    angle->i_b_prev_a = i_b_a;
+    angle->i_a_start_A = i_a_A;
+    angle->i_b_start_A = i_b_A;
+    angle->i_a_prev_A = i_a_A;
+    angle->i_b_prev_A = i_b_A;
 }
 
 /* Kahan-compensated sum += increment. */
@@ -33,22 +33,22 @@ static void compensated_add(float *sum, float *compensation, float increment)
 }
 
 void pmstep_angle_update(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs,
-                         float i_a_a, float i_b_a, float u_a_v, float u_b_v)
+                         float i_a_A, float i_b_A, float u_a_V, float u_b_V)
 {
     /* phi' = -(R/L) i + u/L over one period: u held (exact), i by the trapezoid rule. */
-    const float increment_a = coeffs->voltage_gain * u_a_v - coeffs->current_gain * (angle->i_a_prev_a + i_a_a);
-    const float increment_b = coeffs->voltage_gain * u_b_v - coeffs->current_gain * (angle->i_b_prev_a + i_b_a);
+    const float increment_a = coeffs->voltage_gain * u_a_V - coeffs->current_gain * (angle->i_a_prev_A + i_a_A);
+    const float increment_b = coeffs->voltage_gain * u_b_V - coeffs->current_gain * (angle->i_b_prev_A + i_b_A);
     compensated_add(&angle->phi_a, &angle->phi_a_compensation, increment_a);
     compensated_add(&angle->phi_b, &angle->phi_b_compensation, increment_b);
-    angle->i_a_prev_a = i_a_a;
-    angle->i_b_prev_a = i_b_a;
+    angle->i_a_prev_A = i_a_A;
+    angle->i_b_prev_A = i_b_A;
 }
 
 void pmstep_angle_estimate(const pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs,
-                           float i_a_a, float i_b_a, float *cos_hat, float *sin_hat)
+                           float i_a_A, float i_b_A, float *cos_hat, float *sin_hat)
 {
-    const float flux_a = (i_a_a - angle->i_a_start_a) - (angle->phi_a - angle->phi_a_compensation);
-    const float flux_b = (i_b_a - angle->i_b_start_a) - (angle->phi_b - angle->phi_b_compensation);
+    const float flux_a = (i_a_A - angle->i_a_start_A) - (angle->phi_a - angle->phi_a_compensation);
+    const float flux_b = (i_b_A - angle->i_b_start_A) - (angle->phi_b - angle->phi_b_compensation);
     *cos_hat = 1.0f - coeffs->flux_to_angle * flux_a;
     *sin_hat = -coeffs->flux_to_angle * flux_b;
 }

@@ -9,10 +9,10 @@ void pmstep_commission_clear(pmstep_commission_sums_t *sums)
     memset(sums, 0, sizeof *sums);
 }
 
-void pmstep_commission_add_bridge_off(pmstep_commission_sums_t *sums, float i_a_a, float i_b_a)
+void pmstep_commission_add_bridge_off(pmstep_commission_sums_t *sums, float i_a_A, float i_b_A)
 {
-    sums->zero_sum_a_a += i_a_a;
-    sums->zero_sum_b_a += i_b_a;
+    sums->zero_sum_a_A += i_a_A;
+    sums->zero_sum_b_A += i_b_A;
     sums->zero_count_a++;
     sums->zero_count_b++;
 }
@@ -35,48 +35,48 @@ static uint32_t high_window_end(const pmstep_commission_plan_t *plan, uint32_t e
 }
 
 void pmstep_commission_add_alignment(pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
-                                     uint32_t sample, float i_a_a, float i_b_a, float u_a_v, float u_b_v)
+                                     uint32_t sample, float i_a_A, float i_b_A, float u_a_V, float u_b_V)
 {
     if (sample >= plan->inductance_start_step && sample - plan->inductance_start_step <= plan->inductance_steps) {
         /* Samples m0..m0+N of the rise, voltages over the N periods between them. */
         if (sample == plan->inductance_start_step) {
-            sums->rise_start_a = i_b_a;
+            sums->rise_start_A = i_b_A;
         } else {
-            sums->rise_voltage_sum_v += u_b_v;
+            sums->rise_voltage_sum_V += u_b_V;
         }
-        sums->rise_current_sum_a += i_b_a;
-        sums->rise_end_a = i_b_a;
+        sums->rise_current_sum_A += i_b_A;
+        sums->rise_end_A = i_b_A;
     }
     if (sample < plan->s_align_steps) {
         if (in_window(sample, high_window_end(plan, plan->s_align_steps), plan->window_steps)) {
-            sums->s_current_sum_a += i_b_a;
-            sums->s_voltage_sum_v += u_b_v;
+            sums->s_current_sum_A += i_b_A;
+            sums->s_voltage_sum_V += u_b_V;
             if (plan->offsets_from_alignment) {
-                sums->zero_sum_a_a += i_a_a; /* u_a = 0: i_a -> 0 */
+                sums->zero_sum_a_A += i_a_A; /* u_a = 0: i_a -> 0 */
                 sums->zero_count_a++;
             }
         }
         if (plan->bias_estimation && in_window(sample, plan->s_align_steps, plan->window_steps / 2u)) {
-            sums->s_low_current_sum_a += i_b_a;
-            sums->s_low_voltage_sum_v += u_b_v;
+            sums->s_low_current_sum_A += i_b_A;
+            sums->s_low_voltage_sum_V += u_b_V;
         }
         return;
     }
     if (sample == plan->s_align_steps) {
-        sums->swing_start_a_a = i_a_a;
+        sums->swing_start_a_A = i_a_A;
     } else {
-        sums->swing_voltage_a_v += u_a_v;
+        sums->swing_voltage_a_V += u_a_V;
     }
-    sums->swing_current_a_a += i_a_a;
+    sums->swing_current_a_A += i_a_A;
     if (plan->bias_estimation && in_window(sample, plan->c_align_end_step, plan->window_steps / 2u)) {
-        sums->c_low_current_sum_a += i_a_a;
-        sums->c_low_voltage_sum_v += u_a_v;
+        sums->c_low_current_sum_A += i_a_A;
+        sums->c_low_voltage_sum_V += u_a_V;
     }
     if (in_window(sample, high_window_end(plan, plan->c_align_end_step), plan->window_steps)) {
-        sums->c_current_sum_a += i_a_a;
-        sums->c_voltage_sum_v += u_a_v;
+        sums->c_current_sum_A += i_a_A;
+        sums->c_voltage_sum_V += u_a_V;
         if (plan->offsets_from_alignment) {
-            sums->zero_sum_b_a += i_b_a; /* u_b = 0: i_b -> 0 */
+            sums->zero_sum_b_A += i_b_A; /* u_b = 0: i_b -> 0 */
             sums->zero_count_b++;
         }
     }
@@ -100,91 +100,91 @@ static float current_integral(float sum, float first, float last, uint32_t perio
 }
 
 /* R = u/i from a steady-state window's sums. */
-static float window_resistance(float voltage_sum_v, float current_sum_a, uint32_t count, float offset_a)
+static float window_resistance(float voltage_sum_V, float current_sum_A, uint32_t count, float offset_a)
 {
-    return (voltage_sum_v / (float)count) / (current_sum_a / (float)count - offset_a);
+    return (voltage_sum_V / (float)count) / (current_sum_A / (float)count - offset_a);
 }
 
 /* Two steady states (means u_1, i_1 and u_2, i_2) of one phase: R, and the bias u_1 - R i_1. */
-static float two_level_resistance(float u_1, float i_1, float u_2, float i_2, float *bias_v)
+static float two_level_resistance(float u_1, float i_1, float u_2, float i_2, float *bias_V)
 {
-    const float resistance_ohm = (u_1 - u_2) / (i_1 - i_2);
-    *bias_v = u_1 - resistance_ohm * i_1;
-    return resistance_ohm;
+    const float resistance_Ohm = (u_1 - u_2) / (i_1 - i_2);
+    *bias_V = u_1 - resistance_Ohm * i_1;
+    return resistance_Ohm;
 }
 
 /* integral(u - R i) - L delta i over the c-alignment swing of one phase (V s). */
-static float swing_flux(float voltage_sum_v, float current_sum_a, float start_a, float end_a, uint32_t periods,
-                        float offset_a, float resistance_ohm, float inductance_h, float period_s)
+static float swing_flux(float voltage_sum_V, float current_sum_A, float start_a, float end_a, uint32_t periods,
+                        float offset_a, float resistance_Ohm, float inductance_H, float period_s)
 {
-    const float charge_a_s = current_integral(current_sum_a + end_a, start_a, end_a, periods, offset_a, period_s);
-    return period_s * voltage_sum_v - resistance_ohm * charge_a_s - inductance_h * (end_a - start_a);
+    const float charge_a_s = current_integral(current_sum_A + end_a, start_a, end_a, periods, offset_a, period_s);
+    return period_s * voltage_sum_V - resistance_Ohm * charge_a_s - inductance_H * (end_a - start_a);
 }
 
 pmstep_fault_t pmstep_commission_finish(const pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
-                                        const pmstep_config_t *cfg, float i_a_a, float u_a_v,
+                                        const pmstep_config_t *cfg, float i_a_A, float u_a_V,
                                         pmstep_commissioning_t *result)
 {
-    const float period_s = cfg->period_s;
-    const float offset_a = mean_or_zero(sums->zero_sum_a_a, sums->zero_count_a);
-    const float offset_b = mean_or_zero(sums->zero_sum_b_a, sums->zero_count_b);
+    const float period_s = cfg->timing.period_s;
+    const float offset_a = mean_or_zero(sums->zero_sum_a_A, sums->zero_count_a);
+    const float offset_b = mean_or_zero(sums->zero_sum_b_A, sums->zero_count_b);
     const bool windows = plan->window_steps > 0u;
-    float r_a = cfg->resistance_ohm;
-    float r_b = cfg->resistance_ohm;
-    float inductance_h = cfg->inductance_h;
+    float r_a = cfg->motor.resistance_Ohm;
+    float r_b = cfg->motor.resistance_Ohm;
+    float inductance_H = cfg->motor.inductance_H;
 
-    result->offset_a_a = offset_a;
-    result->offset_b_a = offset_b;
+    result->offset_a_A = offset_a;
+    result->offset_b_A = offset_b;
     result->offset_samples = sums->zero_count_a + sums->zero_count_b;
-    result->resistance_ohm = 0.0f;
-    result->current_scale_a = 1.0f;
-    result->inductance_h = 0.0f;
-    result->torque_constant_nm_per_a = 0.0f;
-    result->voltage_bias_a_v = 0.0f;
-    result->voltage_bias_b_v = 0.0f;
+    result->resistance_Ohm = 0.0f;
+    result->phase_a_current_scale = 1.0f;
+    result->inductance_H = 0.0f;
+    result->torque_constant_Nm_A = 0.0f;
+    result->voltage_bias_a_V = 0.0f;
+    result->voltage_bias_b_V = 0.0f;
     result->measured = true;
     if (windows && plan->bias_estimation) {
         /* Two steady states per phase: R and the voltage bias. */
         const float n_1 = (float)plan->window_steps;
         const float n_2 = (float)(plan->window_steps / 2u);
-        r_b = two_level_resistance(sums->s_voltage_sum_v / n_1, sums->s_current_sum_a / n_1 - offset_b,
-                                   sums->s_low_voltage_sum_v / n_2, sums->s_low_current_sum_a / n_2 - offset_b,
-                                   &result->voltage_bias_b_v);
-        r_a = two_level_resistance(sums->c_voltage_sum_v / n_1, sums->c_current_sum_a / n_1 - offset_a,
-                                   sums->c_low_voltage_sum_v / n_2, sums->c_low_current_sum_a / n_2 - offset_a,
-                                   &result->voltage_bias_a_v);
+        r_b = two_level_resistance(sums->s_voltage_sum_V / n_1, sums->s_current_sum_A / n_1 - offset_b,
+                                   sums->s_low_voltage_sum_V / n_2, sums->s_low_current_sum_A / n_2 - offset_b,
+                                   &result->voltage_bias_b_V);
+        r_a = two_level_resistance(sums->c_voltage_sum_V / n_1, sums->c_current_sum_A / n_1 - offset_a,
+                                   sums->c_low_voltage_sum_V / n_2, sums->c_low_current_sum_A / n_2 - offset_a,
+                                   &result->voltage_bias_a_V);
     } else if (windows) {
         /* Steady states of (3) and (5): R = u/i on each phase. */
-        r_b = window_resistance(sums->s_voltage_sum_v, sums->s_current_sum_a, plan->window_steps, offset_b);
-        r_a = window_resistance(sums->c_voltage_sum_v, sums->c_current_sum_a, plan->window_steps, offset_a);
+        r_b = window_resistance(sums->s_voltage_sum_V, sums->s_current_sum_A, plan->window_steps, offset_b);
+        r_a = window_resistance(sums->c_voltage_sum_V, sums->c_current_sum_A, plan->window_steps, offset_a);
     }
     if (windows) {
         /* The phases' apparent R differ by their sensors' gains: phase b is the reference. */
-        result->resistance_ohm = r_b;
-        result->current_scale_a = r_a / r_b;
+        result->resistance_Ohm = r_b;
+        result->phase_a_current_scale = r_a / r_b;
     }
     if (plan->inductance_steps > 0u) {
         /* L delta i = integral(u - R i) over the rise; the rotor has not moved yet. */
-        const float charge_a_s = current_integral(sums->rise_current_sum_a, sums->rise_start_a, sums->rise_end_a,
+        const float charge_a_s = current_integral(sums->rise_current_sum_A, sums->rise_start_A, sums->rise_end_A,
                                                   plan->inductance_steps, offset_b, period_s);
-        const float volt_seconds = period_s * (sums->rise_voltage_sum_v
-                                               - (float)plan->inductance_steps * result->voltage_bias_b_v);
-        inductance_h = (volt_seconds - r_b * charge_a_s) / (sums->rise_end_a - sums->rise_start_a);
-        result->inductance_h = inductance_h;
+        const float volt_seconds = period_s * (sums->rise_voltage_sum_V
+                                               - (float)plan->inductance_steps * result->voltage_bias_b_V);
+        inductance_H = (volt_seconds - r_b * charge_a_s) / (sums->rise_end_A - sums->rise_start_A);
+        result->inductance_H = inductance_H;
     }
     if (windows) {
         /* Flux swing of c-alignment (see the header), samples t_s .. t_c, on the driven phase a:
          * its current is far from zero throughout, so its voltage is known (bias included). Its
          * apparent L is phase b's on phase a's sensor scale. */
         const uint32_t periods = plan->c_align_end_step - plan->s_align_steps;
-        const float flux_a = swing_flux(sums->swing_voltage_a_v + u_a_v - (float)periods * result->voltage_bias_a_v,
-                                        sums->swing_current_a_a, sums->swing_start_a_a, i_a_a, periods, offset_a, r_a,
-                                        inductance_h * result->current_scale_a, period_s);
-        result->torque_constant_nm_per_a = flux_a * (float)cfg->pole_pairs;
+        const float flux_a = swing_flux(sums->swing_voltage_a_V + u_a_V - (float)periods * result->voltage_bias_a_V,
+                                        sums->swing_current_a_A, sums->swing_start_a_A, i_a_A, periods, offset_a, r_a,
+                                        inductance_H * result->phase_a_current_scale, period_s);
+        result->torque_constant_Nm_A = flux_a * (float)cfg->motor.pole_pairs;
     }
-    if ((windows && !(plausible(r_a, cfg->resistance_ohm) && plausible(r_b, cfg->resistance_ohm)
-                      && plausible(result->torque_constant_nm_per_a, cfg->torque_constant_nm_per_a)))
-        || (plan->inductance_steps > 0u && !plausible(inductance_h, cfg->inductance_h))) {
+    if ((windows && !(plausible(r_a, cfg->motor.resistance_Ohm) && plausible(r_b, cfg->motor.resistance_Ohm)
+                      && plausible(result->torque_constant_Nm_A, cfg->motor.torque_constant_Nm_A)))
+        || (plan->inductance_steps > 0u && !plausible(inductance_H, cfg->motor.inductance_H))) {
         return PMSTEP_FAULT_COMMISSIONING;
     }
     return PMSTEP_FAULT_NONE;

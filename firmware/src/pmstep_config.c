@@ -1,4 +1,4 @@
-/* Configuration: validation with one status per cause. */
+/* Configuration validation: one status code per cause, group by group. */
 #include "pmstep/pmstep.h"
 #include "pmstep_internal.h"
 
@@ -7,176 +7,264 @@
 #include <string.h> /* memcpy of one float: a load */
 
 /* A duration setting: not negative, and at most PMSTEP_MAX_DURATION_PERIODS periods, so its
- * conversion to a period count (periods_in() in pmstep_core.c) is exact and defined. */
+ * conversion to a period count (pmstep_periods_in()) is exact and defined. */
 static bool duration_ok(float duration_s, float period_s)
 {
     return duration_s >= 0.0f && duration_s / period_s <= PMSTEP_MAX_DURATION_PERIODS;
 }
 
-/* Calibration, commissioning, dead time, drift-free gain (times already checked finite). */
-static pmstep_status_t validate_calibration(const pmstep_config_t *cfg)
+/* Every float setting, with the sign it must have and the code of each, group by group. One
+ * table instead of a comparison each keeps the core within its flash budget. */
+typedef enum { SIGN_ANY = 0, SIGN_NON_NEGATIVE = 1, SIGN_POSITIVE = 2 } sign_t;
+typedef struct {
+    unsigned char offset; /* offsetof the float in pmstep_config_t */
+    unsigned char sign;   /* sign_t */
+    signed char status;   /* pmstep_status_t when the sign is wrong */
+} sign_rule_t;
+
+#define SIGN_RULE(field, sign, status) {(unsigned char)offsetof(pmstep_config_t, field), sign, (signed char)(status)}
+
+static const sign_rule_t sign_rules[] = {
+    SIGN_RULE(motor.resistance_Ohm, SIGN_POSITIVE, PMSTEP_ERR_RESISTANCE),
+    SIGN_RULE(motor.inductance_H, SIGN_POSITIVE, PMSTEP_ERR_INDUCTANCE),
+    SIGN_RULE(motor.inertia_kgm2, SIGN_POSITIVE, PMSTEP_ERR_INERTIA),
+    SIGN_RULE(motor.torque_constant_Nm_A, SIGN_POSITIVE, PMSTEP_ERR_TORQUE_CONSTANT),
+    SIGN_RULE(motor.friction_Nms_rad, SIGN_NON_NEGATIVE, PMSTEP_ERR_FRICTION),
+    SIGN_RULE(gains.speed_gain_per_s, SIGN_POSITIVE, PMSTEP_ERR_SPEED_GAIN),
+    SIGN_RULE(gains.observer_gain_per_s, SIGN_POSITIVE, PMSTEP_ERR_OBSERVER_GAIN),
+    SIGN_RULE(gains.current_gain_per_s, SIGN_POSITIVE, PMSTEP_ERR_CURRENT_GAIN),
+    SIGN_RULE(gains.adapt_gamma, SIGN_POSITIVE, PMSTEP_ERR_ADAPT_GAMMA),
+    SIGN_RULE(gains.adapt_lambda, SIGN_POSITIVE, PMSTEP_ERR_ADAPT_LAMBDA),
+    SIGN_RULE(gains.adapt_r, SIGN_POSITIVE, PMSTEP_ERR_ADAPT_R),
+    SIGN_RULE(gains.sat_kappa_rad_s, SIGN_POSITIVE, PMSTEP_ERR_SAT_KAPPA),
+    SIGN_RULE(gains.reference_bandwidth_rad_s, SIGN_POSITIVE, PMSTEP_ERR_REFERENCE_BANDWIDTH),
+    SIGN_RULE(gains.angle_correction_gain_per_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_ANGLE_CORRECTION_GAIN),
+    SIGN_RULE(limits.max_phase_current_A, SIGN_POSITIVE, PMSTEP_ERR_MAX_CURRENT),
+    SIGN_RULE(limits.min_bus_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_MIN_BUS),
+    SIGN_RULE(alignment.s_align_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_ALIGNMENT_VOLTAGE),
+    SIGN_RULE(alignment.c_align_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_ALIGNMENT_VOLTAGE),
+    SIGN_RULE(commissioning.offset_calibration_time_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_OFFSET_CALIBRATION_TIME),
+    SIGN_RULE(commissioning.steady_state_window_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_STEADY_STATE_WINDOW),
+    SIGN_RULE(commissioning.inductance_window_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_INDUCTANCE_WINDOW),
+    SIGN_RULE(commissioning.voltage_bias_level_fraction, SIGN_NON_NEGATIVE, PMSTEP_ERR_VOLTAGE_BIAS_FRACTION),
+    SIGN_RULE(inverter.dead_time_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DEAD_TIME),
+    SIGN_RULE(inverter.dead_time_current_band_A, SIGN_NON_NEGATIVE, PMSTEP_ERR_DEAD_TIME_BAND),
+    SIGN_RULE(detection.angle_magnitude_bound, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_BOUND),
+    SIGN_RULE(detection.speed_consistency_bound_rad_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_BOUND),
+    SIGN_RULE(detection.stall_speed_error_rad_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_BOUND),
+    SIGN_RULE(detection.observer_residual_bound_A, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_BOUND),
+    SIGN_RULE(detection.persistence_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_TIME),
+    /* Checked by range below. */
+    SIGN_RULE(timing.period_s, SIGN_ANY, PMSTEP_OK),
+    SIGN_RULE(alignment.s_align_time_s, SIGN_ANY, PMSTEP_OK),
+    SIGN_RULE(alignment.c_align_time_s, SIGN_ANY, PMSTEP_OK),
+    SIGN_RULE(limits.max_bus_voltage_V, SIGN_ANY, PMSTEP_OK),
+};
+
+/* The float at @p rule's offset. */
+static float rule_value(const pmstep_config_t *cfg, const sign_rule_t *rule)
 {
-    const float s_align_s = cfg->s_align_time_s;
-    const float c_align_s = cfg->c_align_time_s - cfg->s_align_time_s;
-    const bool window = cfg->steady_state_window_s > 0.0f;
-    if (cfg->offset_calibration_time_s < 0.0f || cfg->steady_state_window_s < 0.0f || cfg->inductance_window_s < 0.0f
-        || cfg->steady_state_window_s > 0.5f * s_align_s || cfg->steady_state_window_s > 0.5f * c_align_s
-        || cfg->inductance_window_s > 0.5f * s_align_s || !duration_ok(cfg->offset_calibration_time_s, cfg->period_s)) {
-        return PMSTEP_ERR_CALIBRATION;
+    float value;
+    memcpy(&value, (const unsigned char *)cfg + rule->offset, sizeof value);
+    return value;
+}
+
+/* Every float finite first (whatever its place), then the signs in table order. */
+static pmstep_status_t validate_signs(const pmstep_config_t *cfg)
+{
+    size_t n;
+    for (n = 0; n < sizeof sign_rules / sizeof sign_rules[0]; ++n) {
+        if (!isfinite(rule_value(cfg, &sign_rules[n]))) {
+            return PMSTEP_ERR_NONFINITE_PARAMETER;
+        }
     }
-    /* What is used must be measured: R and k_M need the windows, L its rise window. */
-    if ((cfg->alignment_offset_calibration && !window) || (cfg->use_commissioned_resistance && !window)
-        || (cfg->use_commissioned_torque_constant && !window)
-        || (cfg->use_commissioned_inductance && !(cfg->inductance_window_s > 0.0f))) {
-        return PMSTEP_ERR_CALIBRATION;
+    for (n = 0; n < sizeof sign_rules / sizeof sign_rules[0]; ++n) {
+        const float value = rule_value(cfg, &sign_rules[n]);
+        if ((sign_rules[n].sign == (unsigned char)SIGN_POSITIVE && !(value > 0.0f))
+            || (sign_rules[n].sign == (unsigned char)SIGN_NON_NEGATIVE && value < 0.0f)) {
+            return (pmstep_status_t)sign_rules[n].status;
+        }
     }
-    /* The bias option needs its two windows (2 W) in the second half of each alignment, and
-     * W/2 of settling at the lower level: at least 5 L/R. */
-    if (cfg->voltage_bias_level_fraction < 0.0f || cfg->voltage_bias_level_fraction >= 1.0f
-        || (cfg->voltage_bias_level_fraction > 0.0f
-            && (!window || cfg->steady_state_window_s > 0.25f * s_align_s
-                || cfg->steady_state_window_s > 0.25f * c_align_s
-                || cfg->steady_state_window_s * cfg->resistance_ohm < 10.0f * cfg->inductance_h))) {
-        return PMSTEP_ERR_CALIBRATION;
+    return cfg->motor.pole_pairs < 1 ? PMSTEP_ERR_POLE_PAIRS : PMSTEP_OK;
+}
+
+static pmstep_status_t validate_timing(const pmstep_timing_config_t *timing)
+{
+    if (!(timing->period_s >= PMSTEP_MIN_PERIOD_S && timing->period_s <= PMSTEP_MAX_PERIOD_S)) {
+        return PMSTEP_ERR_PERIOD;
     }
-    if (cfg->dead_time_s < 0.0f || 2.0f * cfg->dead_time_s >= 0.5f * cfg->period_s
-        || cfg->dead_time_current_band_a < 0.0f
-        || ((cfg->dead_time_s > 0.0f || cfg->voltage_bias_level_fraction > 0.0f)
-            && !(cfg->dead_time_current_band_a >= PMSTEP_MIN_CURRENT_BAND_A
-                 && cfg->dead_time_current_band_a <= cfg->max_phase_current_a))) {
-        return PMSTEP_ERR_CALIBRATION;
-    }
-    if (cfg->angle_correction_gain_per_s < 0.0f || cfg->angle_correction_gain_per_s * cfg->period_s >= 0.5f) {
-        return PMSTEP_ERR_CALIBRATION;
+    if (timing->computational_delay_periods > 1u) {
+        return PMSTEP_ERR_DELAY;
     }
     return PMSTEP_OK;
 }
 
-pmstep_electrical_t pmstep_configured_electrical(const pmstep_config_t *cfg)
+static pmstep_status_t validate_gains(const pmstep_config_t *cfg)
 {
-    pmstep_electrical_t model;
-    model.resistance_ohm = cfg->resistance_ohm;
-    model.inductance_h = cfg->inductance_h;
-    model.torque_constant_nm_per_a = cfg->torque_constant_nm_per_a;
-    return model;
-}
-
-pmstep_status_t pmstep_validate_config(const pmstep_config_t *cfg)
-{
-    if (cfg == NULL) {
-        return PMSTEP_ERR_NULL_ARGUMENT;
+    const pmstep_gains_config_t *gains = &cfg->gains;
+    const float period_s = cfg->timing.period_s;
+    const float r_over_l = cfg->motor.resistance_Ohm / cfg->motor.inductance_H;
+    /* Forward-Euler observer and current loop: keep their poles well inside the unit circle. */
+    if ((r_over_l + gains->observer_gain_per_s) * period_s >= 0.5f) {
+        return PMSTEP_ERR_OBSERVER_GAIN_FOR_PERIOD;
     }
-    {
-        /* Every float of the configuration, by offset: one small table instead of a copy of each. */
-        static const unsigned char float_fields[] = {
-            offsetof(pmstep_config_t, resistance_ohm), offsetof(pmstep_config_t, inductance_h),
-            offsetof(pmstep_config_t, inertia_kg_m2), offsetof(pmstep_config_t, friction_nm_s_per_rad),
-            offsetof(pmstep_config_t, torque_constant_nm_per_a), offsetof(pmstep_config_t, period_s),
-            offsetof(pmstep_config_t, s_align_time_s), offsetof(pmstep_config_t, c_align_time_s),
-            offsetof(pmstep_config_t, s_align_voltage_v), offsetof(pmstep_config_t, c_align_voltage_v),
-            offsetof(pmstep_config_t, speed_gain_per_s), offsetof(pmstep_config_t, observer_gain_per_s),
-            offsetof(pmstep_config_t, current_gain_per_s), offsetof(pmstep_config_t, adapt_gamma),
-            offsetof(pmstep_config_t, adapt_lambda), offsetof(pmstep_config_t, adapt_r),
-            offsetof(pmstep_config_t, sat_kappa_rad_per_s), offsetof(pmstep_config_t, reference_bandwidth_rad_per_s),
-            offsetof(pmstep_config_t, max_phase_current_a), offsetof(pmstep_config_t, min_bus_voltage_v),
-            offsetof(pmstep_config_t, max_bus_voltage_v), offsetof(pmstep_config_t, offset_calibration_time_s),
-            offsetof(pmstep_config_t, steady_state_window_s), offsetof(pmstep_config_t, inductance_window_s),
-            offsetof(pmstep_config_t, dead_time_s), offsetof(pmstep_config_t, dead_time_current_band_a),
-            offsetof(pmstep_config_t, angle_correction_gain_per_s), offsetof(pmstep_config_t, angle_magnitude_bound),
-            offsetof(pmstep_config_t, speed_consistency_bound_rad_s),
-            offsetof(pmstep_config_t, stall_speed_error_rad_s), offsetof(pmstep_config_t, detection_time_s),
-            offsetof(pmstep_config_t, voltage_bias_level_fraction),
-            offsetof(pmstep_config_t, observer_residual_bound_a)};
-        size_t n;
-        for (n = 0; n < sizeof float_fields; ++n) {
-            float value;
-            memcpy(&value, (const unsigned char *)cfg + float_fields[n], sizeof value);
-            if (!isfinite(value)) {
-                return PMSTEP_ERR_NONFINITE_PARAMETER;
-            }
-        }
+    if ((r_over_l + gains->current_gain_per_s) * period_s >= 0.5f) {
+        return PMSTEP_ERR_CURRENT_GAIN_FOR_PERIOD;
     }
-    if (!(cfg->resistance_ohm > 0.0f)) {
-        return PMSTEP_ERR_RESISTANCE;
-    }
-    if (!(cfg->inductance_h > 0.0f)) {
-        return PMSTEP_ERR_INDUCTANCE;
-    }
-    if (!(cfg->inertia_kg_m2 > 0.0f)) {
-        return PMSTEP_ERR_INERTIA;
-    }
-    if (!(cfg->torque_constant_nm_per_a > 0.0f)) {
-        return PMSTEP_ERR_TORQUE_CONSTANT;
-    }
-    if (cfg->friction_nm_s_per_rad < 0.0f) {
-        return PMSTEP_ERR_FRICTION;
-    }
-    if (cfg->pole_pairs < 1) {
-        return PMSTEP_ERR_POLE_PAIRS;
-    }
-    if (!(cfg->period_s >= PMSTEP_MIN_PERIOD_S && cfg->period_s <= PMSTEP_MAX_PERIOD_S)) {
-        return PMSTEP_ERR_PERIOD;
-    }
-    if (!(cfg->speed_gain_per_s > 0.0f) || !(cfg->observer_gain_per_s > 0.0f) || !(cfg->current_gain_per_s > 0.0f)
-        || !(cfg->adapt_gamma > 0.0f) || !(cfg->adapt_lambda > 0.0f) || !(cfg->adapt_r > 0.0f)
-        || !(cfg->sat_kappa_rad_per_s > 0.0f)) {
-        return PMSTEP_ERR_GAIN;
-    }
-    {
-        /* Forward-Euler observer and current loop: keep their poles well inside the unit circle. */
-        const float r_over_l = cfg->resistance_ohm / cfg->inductance_h;
-        if ((r_over_l + cfg->observer_gain_per_s) * cfg->period_s >= 0.5f
-            || (r_over_l + cfg->current_gain_per_s) * cfg->period_s >= 0.5f) {
-            return PMSTEP_ERR_PERIOD_TOO_LONG;
-        }
-    }
-    if (!(cfg->reference_bandwidth_rad_per_s > 0.0f) || cfg->reference_bandwidth_rad_per_s * cfg->period_s > 0.5f) {
+    if (gains->reference_bandwidth_rad_s * period_s > 0.5f) {
         return PMSTEP_ERR_REFERENCE_BANDWIDTH;
     }
-    if (cfg->computational_delay_periods > 1u) {
-        return PMSTEP_ERR_DELAY;
+    if (gains->angle_correction_gain_per_s * period_s >= 0.5f) {
+        return PMSTEP_ERR_ANGLE_CORRECTION_GAIN;
     }
-    if (!(cfg->max_phase_current_a > 0.0f) || !(cfg->min_bus_voltage_v > 0.0f)
-        || !(cfg->max_bus_voltage_v > cfg->min_bus_voltage_v)) {
-        return PMSTEP_ERR_LIMITS;
+    return PMSTEP_OK;
+}
+
+static pmstep_status_t validate_alignment(const pmstep_config_t *cfg)
+{
+    const pmstep_alignment_config_t *align = &cfg->alignment;
+    const float period_s = cfg->timing.period_s;
+    if (align->s_align_voltage_V > cfg->limits.min_bus_voltage_V
+        || align->c_align_voltage_V > cfg->limits.min_bus_voltage_V) {
+        return PMSTEP_ERR_ALIGNMENT_ABOVE_BUS;
     }
-    if (!(cfg->s_align_voltage_v > 0.0f) || !(cfg->c_align_voltage_v > 0.0f)
-        || cfg->s_align_voltage_v > cfg->min_bus_voltage_v || cfg->c_align_voltage_v > cfg->min_bus_voltage_v) {
-        return PMSTEP_ERR_ALIGNMENT_VOLTAGE;
-    }
-    if (cfg->s_align_voltage_v >= cfg->max_phase_current_a * cfg->resistance_ohm
-        || cfg->c_align_voltage_v >= cfg->max_phase_current_a * cfg->resistance_ohm) {
+    if (align->s_align_voltage_V >= cfg->limits.max_phase_current_A * cfg->motor.resistance_Ohm
+        || align->c_align_voltage_V >= cfg->limits.max_phase_current_A * cfg->motor.resistance_Ohm) {
         return PMSTEP_ERR_ALIGNMENT_CURRENT;
     }
-    if (!(cfg->s_align_time_s >= cfg->period_s) || !(cfg->c_align_time_s - cfg->s_align_time_s >= cfg->period_s)
-        || !duration_ok(cfg->c_align_time_s, cfg->period_s)) {
-        return PMSTEP_ERR_ALIGNMENT_TIME;
+    if (!(align->s_align_time_s >= period_s)) {
+        return PMSTEP_ERR_S_ALIGN_TIME;
     }
-    if (validate_calibration(cfg) != PMSTEP_OK) {
-        return PMSTEP_ERR_CALIBRATION;
+    if (!(align->c_align_time_s - align->s_align_time_s >= period_s)) {
+        return PMSTEP_ERR_C_ALIGN_TIME;
     }
-    {
-        /* The persistence is 0 (only with every detector off) or at least 4 periods. */
-        const bool any_detector = cfg->angle_magnitude_bound > 0.0f || cfg->speed_consistency_bound_rad_s > 0.0f
-                                  || cfg->stall_speed_error_rad_s > 0.0f || cfg->observer_residual_bound_a > 0.0f;
-        if (cfg->angle_magnitude_bound < 0.0f || cfg->speed_consistency_bound_rad_s < 0.0f
-            || cfg->stall_speed_error_rad_s < 0.0f || cfg->observer_residual_bound_a < 0.0f
-            || !(cfg->detection_time_s >= 4.0f * cfg->period_s || (cfg->detection_time_s == 0.0f && !any_detector))
-            || !duration_ok(cfg->detection_time_s, cfg->period_s)) {
-            return PMSTEP_ERR_DETECTION;
-        }
+    if (!duration_ok(align->c_align_time_s, period_s)) {
+        return PMSTEP_ERR_ALIGNMENT_TOO_LONG;
     }
     {
         /* Condition (4): k_M u_cc/(p L R) - (u_cs^2 + u_cc^2)/(2 R^2) > 0. */
-        const float r = cfg->resistance_ohm;
-        const float margin = cfg->torque_constant_nm_per_a * cfg->c_align_voltage_v
-                                 / ((float)cfg->pole_pairs * cfg->inductance_h * r)
-                             - (cfg->s_align_voltage_v * cfg->s_align_voltage_v
-                                + cfg->c_align_voltage_v * cfg->c_align_voltage_v)
+        const float r = cfg->motor.resistance_Ohm;
+        const float margin = cfg->motor.torque_constant_Nm_A * align->c_align_voltage_V
+                                 / ((float)cfg->motor.pole_pairs * cfg->motor.inductance_H * r)
+                             - (align->s_align_voltage_V * align->s_align_voltage_V
+                                + align->c_align_voltage_V * align->c_align_voltage_V)
                                    / (2.0f * r * r);
         if (!(margin > 0.0f)) {
             return PMSTEP_ERR_ALIGNMENT_CONDITION;
         }
     }
-    return pmstep_derived_coefficients_finite(cfg) ? PMSTEP_OK : PMSTEP_ERR_DERIVED_NONFINITE;
+    return PMSTEP_OK;
+}
+
+/* Remark 2 calibration and commissioning (alignment times already checked). */
+static pmstep_status_t validate_commissioning(const pmstep_config_t *cfg)
+{
+    const pmstep_commissioning_config_t *comm = &cfg->commissioning;
+    const float s_align_s = cfg->alignment.s_align_time_s;
+    const float c_align_s = cfg->alignment.c_align_time_s - cfg->alignment.s_align_time_s;
+    const bool window = comm->steady_state_window_s > 0.0f;
+    if (!duration_ok(comm->offset_calibration_time_s, cfg->timing.period_s)) {
+        return PMSTEP_ERR_OFFSET_CALIBRATION_TIME;
+    }
+    if (comm->steady_state_window_s > 0.5f * s_align_s
+        || comm->steady_state_window_s > 0.5f * c_align_s) {
+        return PMSTEP_ERR_STEADY_STATE_WINDOW;
+    }
+    if (comm->inductance_window_s > 0.5f * s_align_s) {
+        return PMSTEP_ERR_INDUCTANCE_WINDOW;
+    }
+    /* What is used must be measured: offsets, R and k_M need the windows, L its rise window. */
+    if (comm->alignment_offset_calibration && !window) {
+        return PMSTEP_ERR_ALIGNMENT_OFFSETS_UNMEASURED;
+    }
+    if (comm->use_measured_resistance && !window) {
+        return PMSTEP_ERR_RESISTANCE_UNMEASURED;
+    }
+    if (comm->use_measured_inductance && !(comm->inductance_window_s > 0.0f)) {
+        return PMSTEP_ERR_INDUCTANCE_UNMEASURED;
+    }
+    if (comm->use_measured_torque_constant && !window) {
+        return PMSTEP_ERR_TORQUE_CONSTANT_UNMEASURED;
+    }
+    if (comm->voltage_bias_level_fraction >= 1.0f) {
+        return PMSTEP_ERR_VOLTAGE_BIAS_FRACTION;
+    }
+    if (comm->voltage_bias_level_fraction > 0.0f) {
+        /* Two windows (2 W) in the second half of each alignment, and W/2 of settling at the
+         * lower level: at least 5 L/R. */
+        if (!window || comm->steady_state_window_s > 0.25f * s_align_s
+            || comm->steady_state_window_s > 0.25f * c_align_s) {
+            return PMSTEP_ERR_VOLTAGE_BIAS_WINDOW;
+        }
+        if (comm->steady_state_window_s * cfg->motor.resistance_Ohm < 10.0f * cfg->motor.inductance_H) {
+            return PMSTEP_ERR_VOLTAGE_BIAS_SETTLING;
+        }
+    }
+    return PMSTEP_OK;
+}
+
+static pmstep_status_t validate_inverter(const pmstep_config_t *cfg)
+{
+    const pmstep_inverter_config_t *inverter = &cfg->inverter;
+    const bool compensating = inverter->dead_time_s > 0.0f || cfg->commissioning.voltage_bias_level_fraction > 0.0f;
+    if (2.0f * inverter->dead_time_s >= 0.5f * cfg->timing.period_s) {
+        return PMSTEP_ERR_DEAD_TIME;
+    }
+    if (compensating
+        && !(inverter->dead_time_current_band_A >= PMSTEP_MIN_CURRENT_BAND_A
+             && inverter->dead_time_current_band_A <= cfg->limits.max_phase_current_A)) {
+        return PMSTEP_ERR_DEAD_TIME_BAND;
+    }
+    return PMSTEP_OK;
+}
+
+static pmstep_status_t validate_detection(const pmstep_config_t *cfg)
+{
+    const pmstep_detection_config_t *det = &cfg->detection;
+    const float period_s = cfg->timing.period_s;
+    const bool any_detector = det->angle_magnitude_bound > 0.0f || det->speed_consistency_bound_rad_s > 0.0f
+                              || det->stall_speed_error_rad_s > 0.0f || det->observer_residual_bound_A > 0.0f;
+    /* The persistence is 0 (only with every detector off) or at least one check. */
+    if (!(det->persistence_s >= (float)PMSTEP_DETECTION_DECIMATION * period_s
+          || (det->persistence_s == 0.0f && !any_detector))
+        || !duration_ok(det->persistence_s, period_s)) {
+        return PMSTEP_ERR_DETECTION_TIME;
+    }
+    return PMSTEP_OK;
+}
+
+pmstep_status_t pmstep_validate_config(const pmstep_config_t *cfg)
+{
+    pmstep_status_t status;
+    if (cfg == NULL) {
+        return PMSTEP_ERR_NULL_ARGUMENT;
+    }
+    /* The signs first (sign_rules), then each group in turn; later groups may rely on the
+     * earlier ones. */
+    status = validate_signs(cfg);
+    if (status == PMSTEP_OK) {
+        status = validate_timing(&cfg->timing);
+    }
+    if (status == PMSTEP_OK) {
+        status = validate_gains(cfg);
+    }
+    if (status == PMSTEP_OK && !(cfg->limits.max_bus_voltage_V > cfg->limits.min_bus_voltage_V)) {
+        status = PMSTEP_ERR_BUS_ORDER;
+    }
+    if (status == PMSTEP_OK) {
+        status = validate_alignment(cfg);
+    }
+    if (status == PMSTEP_OK) {
+        status = validate_commissioning(cfg);
+    }
+    if (status == PMSTEP_OK) {
+        status = validate_inverter(cfg);
+    }
+    if (status == PMSTEP_OK) {
+        status = validate_detection(cfg);
+    }
+    if (status == PMSTEP_OK && !pmstep_derived_coefficients_finite(cfg)) {
+        status = PMSTEP_ERR_DERIVED_NONFINITE;
+    }
+    return status;
 }

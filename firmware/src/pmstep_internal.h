@@ -1,11 +1,51 @@
-/* Private to the core's sources: functions shared between its modules, not part of the API. */
+/* Private to the core's sources: helpers shared between its modules, not part of the API. */
 #ifndef PMSTEP_INTERNAL_H
 #define PMSTEP_INTERNAL_H
 
 #include "pmstep/pmstep.h"
 
+/* |x| without libm. */
+static inline float pmstep_abs(float x)
+{
+    return x < 0.0f ? -x : x;
+}
+
+/* x - x is 0 for every finite x and NaN for NaN and +/-Inf, so one compare checks a sum of
+ * such differences (cheaper than one isfinite per value on the FPU). */
+static inline bool pmstep_all_finite4(float a, float b, float c, float d)
+{
+    return ((a - a) + (b - b)) + ((c - c) + (d - d)) == 0.0f;
+}
+
+/* Whole periods in @p duration_s, rounded; defined for the durations validation accepts
+ * (at most PMSTEP_MAX_DURATION_PERIODS periods). */
+static inline uint32_t pmstep_periods_in(float duration_s, float period_s)
+{
+    return (uint32_t)(duration_s / period_s + 0.5f);
+}
+
 /* True if every coefficient pmstep_init() derives from @p cfg (an already range-checked
  * configuration) is finite in float32. */
 bool pmstep_derived_coefficients_finite(const pmstep_config_t *cfg);
+
+/* ---- Controller (6) / (13) in RUN (pmstep_control.c) ---- */
+
+/* What the control stage hands to the advance stage within one period. */
+typedef struct {
+    pmstep_observer_input_t observer_input;
+    pmstep_observer_mech_rates_t mech_rates;
+} pmstep_control_scratch_t;
+
+/* Control stage: at t_c starts controller (6) (phi = 0, i-hat = i(t_c), w-hat = T_L-hat = 0,
+ * references from 0), else integrates phi over the period that ended; then the law's
+ * voltage (unlimited) and every telemetry field of @p out. @p sample: offset-corrected. */
+void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_output_t *out,
+                            pmstep_control_scratch_t *scratch);
+
+/* Advance stage: the drift-free correction, the observer over the coming period with the
+ * voltage the bridge applies (inst->actuator), the reference filters.
+ * @return false if an internal estimate is no longer finite. */
+bool pmstep_control_advance(pmstep_t *inst, const pmstep_control_scratch_t *scratch, const pmstep_meas_t *meas,
+                            const pmstep_output_t *out);
 
 #endif /* PMSTEP_INTERNAL_H */

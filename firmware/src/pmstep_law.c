@@ -6,16 +6,16 @@
 void pmstep_law_coeffs_init(pmstep_law_coeffs_t *coeffs, const pmstep_config_t *cfg,
                             const pmstep_electrical_t *model)
 {
-    coeffs->j_over_km = cfg->inertia_kg_m2 / model->torque_constant_nm_per_a;
-    coeffs->f_over_j_per_s = cfg->friction_nm_s_per_rad / cfg->inertia_kg_m2;
-    coeffs->inv_j = 1.0f / cfg->inertia_kg_m2;
-    coeffs->speed_gain_per_s = cfg->speed_gain_per_s;
-    coeffs->current_gain_per_s = cfg->current_gain_per_s;
-    coeffs->r_over_l_per_s = model->resistance_ohm / model->inductance_h;
-    coeffs->km_over_l = model->torque_constant_nm_per_a / model->inductance_h;
-    coeffs->inductance_h = model->inductance_h;
-    coeffs->pole_pairs = (float)cfg->pole_pairs;
-    coeffs->kappa_rad_s = cfg->sat_kappa_rad_per_s;
+    coeffs->j_over_km = cfg->motor.inertia_kgm2 / model->torque_constant_Nm_A;
+    coeffs->f_over_j_per_s = cfg->motor.friction_Nms_rad / cfg->motor.inertia_kgm2;
+    coeffs->inv_j = 1.0f / cfg->motor.inertia_kgm2;
+    coeffs->speed_gain_per_s = cfg->gains.speed_gain_per_s;
+    coeffs->current_gain_per_s = cfg->gains.current_gain_per_s;
+    coeffs->r_over_l_per_s = model->resistance_Ohm / model->inductance_H;
+    coeffs->km_over_l = model->torque_constant_Nm_A / model->inductance_H;
+    coeffs->inductance_H = model->inductance_H;
+    coeffs->pole_pairs = (float)cfg->motor.pole_pairs;
+    coeffs->kappa_rad_s = cfg->gains.sat_kappa_rad_s;
     coeffs->linear_speed_term = cfg->known_load_mode;
 }
 
@@ -49,13 +49,13 @@ static void speed_term(const pmstep_law_coeffs_t *coeffs, float error, float *te
 }
 
 float pmstep_law_iq_ref(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs,
-                        float speed_hat_rad_s, float load_nm)
+                        float speed_hat_rad_s, float load_Nm)
 {
     float term;
     float slope;
     speed_term(coeffs, speed_hat_rad_s - refs->speed_ref_rad_s, &term, &slope);
     return coeffs->j_over_km * (coeffs->f_over_j_per_s * refs->speed_ref_rad_s - term
-                                + load_nm * coeffs->inv_j + refs->speed_ref_rate);
+                                + load_Nm * coeffs->inv_j + refs->speed_ref_rate_rad_s2);
 }
 
 float pmstep_law_iq_ref_rate(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs,
@@ -64,23 +64,23 @@ float pmstep_law_iq_ref_rate(const pmstep_law_coeffs_t *coeffs, const pmstep_law
     float term;
     float slope;
     speed_term(coeffs, speed_hat_rad_s - refs->speed_ref_rad_s, &term, &slope);
-    return coeffs->j_over_km * (coeffs->f_over_j_per_s * refs->speed_ref_rate
-                                - slope * (speed_hat_rate - refs->speed_ref_rate)
-                                + load_rate * coeffs->inv_j + refs->speed_ref_accel);
+    return coeffs->j_over_km * (coeffs->f_over_j_per_s * refs->speed_ref_rate_rad_s2
+                                - slope * (speed_hat_rate - refs->speed_ref_rate_rad_s2)
+                                + load_rate * coeffs->inv_j + refs->speed_ref_accel_rad_s3);
 }
 
 void pmstep_law_voltages(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs,
-                         float cos_hat, float sin_hat, float i_d_a, float i_q_a,
-                         float speed_hat_rad_s, float i_q_ref_a, float i_q_ref_rate,
-                         float *u_a_v, float *u_b_v)
+                         float cos_hat, float sin_hat, float i_d_A, float i_q_A,
+                         float speed_hat_rad_s, float i_q_ref_A, float i_q_ref_rate,
+                         float *u_a_V, float *u_b_V)
 {
     const float pw = coeffs->pole_pairs * speed_hat_rad_s;
-    const float phi_d = -coeffs->r_over_l_per_s * refs->i_d_ref_a + pw * i_q_a - refs->i_d_ref_rate;
-    const float phi_q = -coeffs->r_over_l_per_s * i_q_ref_a - pw * i_d_a
+    const float phi_d = -coeffs->r_over_l_per_s * refs->i_d_ref_A + pw * i_q_A - refs->i_d_ref_rate_A_s;
+    const float phi_q = -coeffs->r_over_l_per_s * i_q_ref_A - pw * i_d_A
                         - coeffs->km_over_l * speed_hat_rad_s - i_q_ref_rate;
-    const float u_d = coeffs->inductance_h * (-phi_d - coeffs->current_gain_per_s * (i_d_a - refs->i_d_ref_a));
-    const float u_q = coeffs->inductance_h * (-phi_q - coeffs->current_gain_per_s * (i_q_a - i_q_ref_a));
+    const float u_d = coeffs->inductance_H * (-phi_d - coeffs->current_gain_per_s * (i_d_A - refs->i_d_ref_A));
+    const float u_q = coeffs->inductance_H * (-phi_q - coeffs->current_gain_per_s * (i_q_A - i_q_ref_A));
     /* Inverse Park with the estimated angle. */
-    *u_a_v = cos_hat * u_d - sin_hat * u_q;
-    *u_b_v = sin_hat * u_d + cos_hat * u_q;
+    *u_a_V = cos_hat * u_d - sin_hat * u_q;
+    *u_b_V = sin_hat * u_d + cos_hat * u_q;
 }

@@ -4,9 +4,9 @@
 /* Terms of the series for a = w0 T_s <= 0.5: a^j/j! < 1e-12 beyond j = 16. */
 #define REF_SERIES_TERMS 18
 
-void pmstep_ref_coeffs_init(pmstep_ref_coeffs_t *coeffs, float bandwidth_rad_per_s, float period_s)
+void pmstep_ref_coeffs_init(pmstep_ref_coeffs_t *coeffs, float bandwidth_rad_s, float period_s)
 {
-    const float a = bandwidth_rad_per_s * period_s;
+    const float a = bandwidth_rad_s * period_s;
     /* power[j] = a^j / j!; every sum below has positive terms only (no cancellation). */
     float power[REF_SERIES_TERMS];
     float exp_a = 0.0f;
@@ -56,7 +56,7 @@ void pmstep_ref_coeffs_init(pmstep_ref_coeffs_t *coeffs, float bandwidth_rad_per
         coeffs->gamma1[1] = e * h1;
         coeffs->gamma1[2] = e * h2;
     }
-    coeffs->bandwidth_rad_per_s = bandwidth_rad_per_s;
+    coeffs->bandwidth_rad_s = bandwidth_rad_s;
 }
 
 void pmstep_ref_reset(pmstep_ref_t *ref, float value)
@@ -87,7 +87,7 @@ void pmstep_ref_set_target(pmstep_ref_t *ref, float target, float ramp_rate_per_
 
 pmstep_ref_out_t pmstep_ref_output(const pmstep_ref_coeffs_t *coeffs, const pmstep_ref_t *ref)
 {
-    const float w0 = coeffs->bandwidth_rad_per_s;
+    const float w0 = coeffs->bandwidth_rad_s;
     pmstep_ref_out_t out;
     out.value = ref->value;
     out.rate = w0 * ref->diff23;

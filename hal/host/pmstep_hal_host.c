@@ -7,12 +7,12 @@ int pmstep_hal_host_bind(plant_t *plant, const pmstep_hal_host_setup_t *setup)
 {
     pmstep_hal_host_release();
     port.plant = plant;
-    sil_inverter_init(&port.inverter, &setup->inverter, &setup->bus, setup->bus_voltage_v, setup->delay_periods);
-    port.meas.i_a_a = 0.0f;
-    port.meas.i_b_a = 0.0f;
-    port.meas.bus_voltage_v = (float)setup->bus_voltage_v;
-    port.meas.load_torque_nm = 0.0f;
-    port.bus_v = setup->bus_voltage_v;
+    sil_inverter_init(&port.inverter, &setup->inverter, &setup->bus, setup->bus_voltage_V, setup->delay_periods);
+    port.meas.i_a_A = 0.0f;
+    port.meas.i_b_A = 0.0f;
+    port.meas.bus_voltage_V = (float)setup->bus_voltage_V;
+    port.meas.load_torque_Nm = 0.0f;
+    port.bus_V = setup->bus_voltage_V;
     return sil_sensors_init(&port.sensors, &setup->sensors, setup->seed);
 }
 
@@ -35,18 +35,18 @@ sil_inverter_t *pmstep_hal_host_inverter(void)
 void pmstep_hal_read_measurements(pmstep_meas_t *meas)
 {
     const plant_t *plant = port.plant;
-    double i_a_a, i_b_a;
-    port.bus_v = sil_inverter_bus_voltage(&port.inverter, plant->time_s);
-    sil_sensors_currents(&port.sensors, plant->x.i_a_a, plant->x.i_b_a, &i_a_a, &i_b_a);
-    meas->i_a_a = (float)i_a_a;
-    meas->i_b_a = (float)i_b_a;
-    meas->bus_voltage_v = (float)sil_sensors_bus(&port.sensors, port.bus_v);
-    meas->load_torque_nm = (float)plant_load_torque(&plant->load, plant->time_s, plant->x.omega_rad_s);
+    double i_a_A, i_b_A;
+    port.bus_V = sil_inverter_bus_voltage(&port.inverter, plant->time_s);
+    sil_sensors_currents(&port.sensors, plant->x.i_a_A, plant->x.i_b_A, &i_a_A, &i_b_A);
+    meas->i_a_A = (float)i_a_A;
+    meas->i_b_A = (float)i_b_A;
+    meas->bus_voltage_V = (float)sil_sensors_bus(&port.sensors, port.bus_V);
+    meas->load_torque_Nm = (float)plant_load_torque(&plant->load, plant->time_s, plant->x.omega_rad_s);
     port.meas = *meas;
 }
 
 /* The duty is the command over the bus voltage the core was given in this period. */
 void pmstep_hal_apply_output(const pmstep_output_t *out)
 {
-    sil_inverter_apply(&port.inverter, out, (double)port.meas.bus_voltage_v);
+    sil_inverter_apply(&port.inverter, out, (double)port.meas.bus_voltage_V);
 }

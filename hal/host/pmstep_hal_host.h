@@ -25,7 +25,7 @@ extern "C" {
 
 /** What the port's "hardware" is. */
 typedef struct {
-    double bus_voltage_v;          /**< nominal bus V0 */
+    double bus_voltage_V;          /**< nominal bus V0 */
     unsigned delay_periods;        /**< computational delay of the duty update (0 or 1) */
     sil_inverter_config_t inverter;
     sil_bus_config_t bus;
@@ -39,7 +39,7 @@ typedef struct {
     sil_sensors_t sensors;
     /* The last sample (start of the present period). */
     pmstep_meas_t meas;            /**< what the core was given */
-    double bus_v;                  /**< actual bus voltage at the sample */
+    double bus_V;                  /**< actual bus voltage at the sample */
 } pmstep_hal_host_t;
 
 /**

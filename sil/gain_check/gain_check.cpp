@@ -27,8 +27,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 /** Bracket of the bound on p_e in (7): 12(4 k_M^6/(l^2 L^6) + k_M^2 (R + L K_e)^2/L^4 + k_M^2/L^2) + k_M^2/L^2. */
 double p_e_denominator(const TheoremInputs &in)
 {
-    const double kl = in.torque_constant_nm_per_a / in.inductance_h; // k_M/L
-    const double rl = (in.resistance_ohm + in.inductance_h * in.observer_gain_per_s) / in.inductance_h;
+    const double kl = in.torque_constant_Nm_A / in.inductance_H; // k_M/L
+    const double rl = (in.resistance_Ohm + in.inductance_H * in.observer_gain_per_s) / in.inductance_H;
     const double kl2 = kl * kl;
     return 12.0 * (4.0 * kl2 * kl2 * kl2 / (in.lambda * in.lambda) + kl2 * rl * rl + kl2) + kl2;
 }
@@ -36,7 +36,7 @@ double p_e_denominator(const TheoremInputs &in)
 /** R/L + K_e. */
 double observer_rate(const TheoremInputs &in)
 {
-    return in.resistance_ohm / in.inductance_h + in.observer_gain_per_s;
+    return in.resistance_Ohm / in.inductance_H + in.observer_gain_per_s;
 }
 
 /** e^{4 T}/T^2: the T_p dependence shared by the gamma and r bounds of (7) (minimum at T = 1/2). */
@@ -48,7 +48,7 @@ double t_p_factor(double t_p_s)
 /** Infimum over admissible p_e in (0, p_e bound) of gamma_bound_at(T_p, p_e) = A/p_e + B p_e. */
 double gamma_bound_inf_over_p_e(const TheoremInputs &in, double t_p_s, double p_e_bound)
 {
-    const double L = in.inductance_h, kM = in.torque_constant_nm_per_a;
+    const double L = in.inductance_H, kM = in.torque_constant_Nm_A;
     const double coef_a = in.lambda * in.lambda * std::pow(L / kM, 4) * t_p_factor(t_p_s);
     const double coef_b = 8.0 * std::pow(kM / L, 4);
     const double p_star = std::sqrt(coef_a / coef_b); // minimiser of A/p + B p
@@ -86,38 +86,38 @@ std::string fmt(const char *format, double v)
 TheoremInputs inputs_from_config(const pmstep_config_t &cfg)
 {
     TheoremInputs in;
-    in.resistance_ohm = static_cast<double>(cfg.resistance_ohm);
-    in.inductance_h = static_cast<double>(cfg.inductance_h);
-    in.inertia_kg_m2 = static_cast<double>(cfg.inertia_kg_m2);
-    in.friction_nm_s_per_rad = static_cast<double>(cfg.friction_nm_s_per_rad);
-    in.torque_constant_nm_per_a = static_cast<double>(cfg.torque_constant_nm_per_a);
-    in.pole_pairs = static_cast<int>(cfg.pole_pairs);
-    in.observer_gain_per_s = static_cast<double>(cfg.observer_gain_per_s);
-    in.gamma = static_cast<double>(cfg.adapt_gamma);
-    in.lambda = static_cast<double>(cfg.adapt_lambda);
-    in.r = static_cast<double>(cfg.adapt_r);
-    in.s_align_voltage_v = static_cast<double>(cfg.s_align_voltage_v);
-    in.c_align_voltage_v = static_cast<double>(cfg.c_align_voltage_v);
+    in.resistance_Ohm = static_cast<double>(cfg.motor.resistance_Ohm);
+    in.inductance_H = static_cast<double>(cfg.motor.inductance_H);
+    in.inertia_kgm2 = static_cast<double>(cfg.motor.inertia_kgm2);
+    in.friction_Nms_rad = static_cast<double>(cfg.motor.friction_Nms_rad);
+    in.torque_constant_Nm_A = static_cast<double>(cfg.motor.torque_constant_Nm_A);
+    in.pole_pairs = static_cast<int>(cfg.motor.pole_pairs);
+    in.observer_gain_per_s = static_cast<double>(cfg.gains.observer_gain_per_s);
+    in.gamma = static_cast<double>(cfg.gains.adapt_gamma);
+    in.lambda = static_cast<double>(cfg.gains.adapt_lambda);
+    in.r = static_cast<double>(cfg.gains.adapt_r);
+    in.s_align_voltage_V = static_cast<double>(cfg.alignment.s_align_voltage_V);
+    in.c_align_voltage_V = static_cast<double>(cfg.alignment.c_align_voltage_V);
     return in;
 }
 
 double gamma_bound_at(const TheoremInputs &in, double t_p_s, double p_e)
 {
-    const double L = in.inductance_h, kM = in.torque_constant_nm_per_a;
+    const double L = in.inductance_H, kM = in.torque_constant_Nm_A;
     return in.lambda * in.lambda * std::exp(4.0 * t_p_s) * std::pow(L, 4) / (p_e * std::pow(kM, 4) * t_p_s * t_p_s)
            + 8.0 * p_e * std::pow(kM / L, 4);
 }
 
 double r_bound_at(const TheoremInputs &in, double t_p_s, double p_e)
 {
-    const double L = in.inductance_h, kM = in.torque_constant_nm_per_a, J = in.inertia_kg_m2;
+    const double L = in.inductance_H, kM = in.torque_constant_Nm_A, J = in.inertia_kgm2;
     return 2.0 * in.gamma * in.gamma * std::pow(L, 4)
            / (J * J * J * std::pow(kM, 4) * t_p_s * t_p_s * std::exp(-4.0 * t_p_s) * p_e);
 }
 
 double rho_at(const TheoremInputs &in, double p_e, double s1, double s2)
 {
-    const double L = in.inductance_h, kM = in.torque_constant_nm_per_a, p = in.pole_pairs;
+    const double L = in.inductance_H, kM = in.torque_constant_Nm_A, p = in.pole_pairs;
     const double kl = kM / L;
     const double q = observer_rate(in) - p_e * p_e_denominator(in);
     return L / (2.0 * kM * p)
@@ -128,12 +128,12 @@ TheoremReport check_theorems(const TheoremInputs &in)
 {
     TheoremReport rep;
     rep.in = in;
-    const double R = in.resistance_ohm, L = in.inductance_h, J = in.inertia_kg_m2, F = in.friction_nm_s_per_rad;
-    const double kM = in.torque_constant_nm_per_a, p = in.pole_pairs;
+    const double R = in.resistance_Ohm, L = in.inductance_H, J = in.inertia_kgm2, F = in.friction_Nms_rad;
+    const double kM = in.torque_constant_Nm_A, p = in.pole_pairs;
 
     // (4)
-    rep.condition4_attraction = kM * in.c_align_voltage_v / (p * L * R);
-    rep.condition4_excitation = (in.s_align_voltage_v * in.s_align_voltage_v + in.c_align_voltage_v * in.c_align_voltage_v)
+    rep.condition4_attraction = kM * in.c_align_voltage_V / (p * L * R);
+    rep.condition4_excitation = (in.s_align_voltage_V * in.s_align_voltage_V + in.c_align_voltage_V * in.c_align_voltage_V)
                                 / (2.0 * R * R);
     rep.condition4_margin = rep.condition4_attraction - rep.condition4_excitation;
     rep.condition4_met = rep.condition4_margin > 0.0;
@@ -198,11 +198,11 @@ std::string theorem_text(const TheoremReport &rep, bool plant_differs)
 {
     const TheoremInputs &in = rep.in;
     std::ostringstream o;
-    o << "Controller model: R " << in.resistance_ohm << " Ohm, L " << in.inductance_h << " H, J " << in.inertia_kg_m2
-      << " kg m^2, F " << in.friction_nm_s_per_rad << " Nm s/rad, k_M " << in.torque_constant_nm_per_a << " Nm/A, p "
+    o << "Controller model: R " << in.resistance_Ohm << " Ohm, L " << in.inductance_H << " H, J " << in.inertia_kgm2
+      << " kg m^2, F " << in.friction_Nms_rad << " Nm s/rad, k_M " << in.torque_constant_Nm_A << " Nm/A, p "
       << in.pole_pairs << "\n";
     o << "Gains: K_e " << in.observer_gain_per_s << " 1/s, gamma " << fmt("%.6g", in.gamma) << ", lambda " << in.lambda
-      << ", r " << in.r << "; u_cs " << in.s_align_voltage_v << " V, u_cc " << in.c_align_voltage_v << " V\n";
+      << ", r " << in.r << "; u_cs " << in.s_align_voltage_V << " V, u_cc " << in.c_align_voltage_V << " V\n";
     if (plant_differs) {
         o << "Note: the plant ([motor]) differs from the controller's model; the theorems assume the model is exact.\n";
     }
@@ -248,18 +248,18 @@ cJSON *theorem_json(const TheoremReport &rep, bool plant_differs)
     };
     cJSON *root = cJSON_CreateObject();
     cJSON *inputs = cJSON_AddObjectToObject(root, "controller_model");
-    num(inputs, "resistance_ohm", rep.in.resistance_ohm);
-    num(inputs, "inductance_h", rep.in.inductance_h);
-    num(inputs, "inertia_kg_m2", rep.in.inertia_kg_m2);
-    num(inputs, "friction_nm_s_per_rad", rep.in.friction_nm_s_per_rad);
-    num(inputs, "torque_constant_nm_per_a", rep.in.torque_constant_nm_per_a);
+    num(inputs, "resistance_Ohm", rep.in.resistance_Ohm);
+    num(inputs, "inductance_H", rep.in.inductance_H);
+    num(inputs, "inertia_kgm2", rep.in.inertia_kgm2);
+    num(inputs, "friction_Nms_rad", rep.in.friction_Nms_rad);
+    num(inputs, "torque_constant_Nm_A", rep.in.torque_constant_Nm_A);
     num(inputs, "pole_pairs", rep.in.pole_pairs);
     num(inputs, "observer_gain_per_s", rep.in.observer_gain_per_s);
     num(inputs, "gamma", rep.in.gamma);
     num(inputs, "lambda", rep.in.lambda);
     num(inputs, "r", rep.in.r);
-    num(inputs, "s_align_voltage_v", rep.in.s_align_voltage_v);
-    num(inputs, "c_align_voltage_v", rep.in.c_align_voltage_v);
+    num(inputs, "s_align_voltage_V", rep.in.s_align_voltage_V);
+    num(inputs, "c_align_voltage_V", rep.in.c_align_voltage_V);
     cJSON_AddBoolToObject(root, "plant_differs_from_model", plant_differs);
     cJSON *c4 = cJSON_AddObjectToObject(root, "condition_4");
     num(c4, "attraction", rep.condition4_attraction);
@@ -293,7 +293,7 @@ namespace {
 /** State of one perturbed run, seen by the SIL's sample callback. */
 struct RunProbe {
     std::array<double, 4> error;     // set at t_c + T_s: (i~_a, i~_b, e_w, T~_L)
-    double friction_nm_s_per_rad;    // the controller's F: T~_L = T_L - T_L-hat - F e_w
+    double friction_Nms_rad;    // the controller's F: T~_L = T_L - T_L-hat - F e_w
     double window_start_s;
     long perturbed_step = -1;
     double measured_norm = 0.0;
@@ -319,20 +319,20 @@ bool probe_sample(const sil_sample_t *x, void *user)
         // exactly the requested ones there (the sample callback has no post-period plant state;
         // the host port's plant has it).
         const plant_t *plant = pmstep_hal_host_state()->plant;
-        const double t_next_s = x->t_s + static_cast<double>(x->inst->cfg->period_s);
-        const double load_next_nm = plant_load_torque(&plant->load, t_next_s, plant->x.omega_rad_s);
+        const double t_next_s = x->t_s + static_cast<double>(x->inst->cfg->timing.period_s);
+        const double load_next_Nm = plant_load_torque(&plant->load, t_next_s, plant->x.omega_rad_s);
         pmstep_observer_t &obs = x->inst->observer;
-        obs.i_a_hat_a = static_cast<float>(plant->x.i_a_a - pr->error[0]);
-        obs.i_b_hat_a = static_cast<float>(plant->x.i_b_a - pr->error[1]);
+        obs.i_a_hat_A = static_cast<float>(plant->x.i_a_A - pr->error[0]);
+        obs.i_b_hat_A = static_cast<float>(plant->x.i_b_A - pr->error[1]);
         obs.speed_hat_rad_s = static_cast<float>(plant->x.omega_rad_s + pr->error[2]);
-        obs.load_hat_nm = static_cast<float>(load_next_nm - pr->error[3] - pr->friction_nm_s_per_rad * pr->error[2]);
+        obs.load_hat_Nm = static_cast<float>(load_next_Nm - pr->error[3] - pr->friction_Nms_rad * pr->error[2]);
         pr->perturbed_step = x->step;
         return true;
     }
     const double e_w = static_cast<double>(o->speed_hat_rad_s) - x->omega_rad_s;
     if (x->step == pr->perturbed_step + 1) {
-        const double e[4] = {x->i_a_a - static_cast<double>(o->i_a_hat_a), x->i_b_a - static_cast<double>(o->i_b_hat_a),
-                             e_w, x->load_nm - static_cast<double>(o->load_hat_nm) - pr->friction_nm_s_per_rad * e_w};
+        const double e[4] = {x->i_a_A - static_cast<double>(o->i_a_hat_A), x->i_b_A - static_cast<double>(o->i_b_hat_A),
+                             e_w, x->load_Nm - static_cast<double>(o->load_hat_Nm) - pr->friction_Nms_rad * e_w};
         pr->measured_norm = std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2] + e[3] * e[3]);
     }
     if (!std::isfinite(x->omega_rad_s) || !std::isfinite(e_w)) {
@@ -344,7 +344,7 @@ bool probe_sample(const sil_sample_t *x, void *user)
                                           std::fabs(x->omega_rad_s - static_cast<double>(o->speed_ref_rad_s)));
         pr->window_speed_hat_error = std::max(pr->window_speed_hat_error, std::fabs(e_w));
     }
-    pr->last_load_error = std::fabs(static_cast<double>(o->load_hat_nm) - x->load_nm);
+    pr->last_load_error = std::fabs(static_cast<double>(o->load_hat_Nm) - x->load_Nm);
     return true;
 }
 
@@ -360,7 +360,7 @@ DoaRun doa_single_run(const sil_scenario_t &sc, const std::array<double, 4> &err
 {
     RunProbe probe;
     probe.error = error;
-    probe.friction_nm_s_per_rad = static_cast<double>(sc.controller.friction_nm_s_per_rad);
+    probe.friction_Nms_rad = static_cast<double>(sc.controller.motor.friction_Nms_rad);
     probe.window_start_s = sc.duration_s - opt.final_window_s;
     sil_summary_t summary;
     DoaRun run;
@@ -368,7 +368,7 @@ DoaRun doa_single_run(const sil_scenario_t &sc, const std::array<double, 4> &err
     run.radius = std::sqrt(error[0] * error[0] + error[1] * error[1] + error[2] * error[2] + error[3] * error[3]);
     run.converged = false;
     run.final_speed_error_rad_s = kNaN;
-    run.final_load_error_nm = kNaN;
+    run.final_load_error_Nm = kNaN;
     run.measured_norm = kNaN;
     if (sil_run(&sc, probe_sample, &probe, false, &summary) != 0) {
         run.reason = std::string("configuration rejected: ") + pmstep_status_str(summary.init_status);
@@ -376,7 +376,7 @@ DoaRun doa_single_run(const sil_scenario_t &sc, const std::array<double, 4> &err
     }
     run.measured_norm = probe.perturbed_step >= 0 ? probe.measured_norm : kNaN;
     run.final_speed_error_rad_s = std::max(probe.window_speed_error, probe.window_speed_hat_error);
-    run.final_load_error_nm = probe.last_load_error;
+    run.final_load_error_Nm = probe.last_load_error;
     char buf[160];
     if (summary.fault != PMSTEP_FAULT_NONE) {
         std::snprintf(buf, sizeof buf, "fault at %.4f s: %s", summary.fault_time_s, pmstep_fault_str(summary.fault));
@@ -391,7 +391,7 @@ DoaRun doa_single_run(const sil_scenario_t &sc, const std::array<double, 4> &err
     } else if (probe.window_speed_hat_error >= opt.speed_tol_rad_s) {
         std::snprintf(buf, sizeof buf, "max |w-hat - w| = %.3g rad/s on the final window", probe.window_speed_hat_error);
         run.reason = buf;
-    } else if (probe.last_load_error >= opt.load_tol_nm) {
+    } else if (probe.last_load_error >= opt.load_tol_Nm) {
         std::snprintf(buf, sizeof buf, "|T_L-hat - T_L| = %.3g Nm at the end", probe.last_load_error);
         run.reason = buf;
     } else {
@@ -496,7 +496,7 @@ std::string doa_text(const DoaResult &res, const TheoremReport &rep)
       << ", " << opt.bisection_steps << " bisections\n";
     o << "  converged = no fault, max |w - w*| and |w-hat - w| < " << fmt("%.3g", opt.speed_tol_rad_s)
       << " rad/s on the last " << fmt("%.3g", opt.final_window_s) << " s, |T_L-hat - T_L| < "
-      << fmt("%.3g", opt.load_tol_nm) << " Nm at the end\n";
+      << fmt("%.3g", opt.load_tol_Nm) << " Nm at the end\n";
     o << "  without added errors: " << res.baseline_reason << "\n";
     for (const DoaDirection &d : res.directions) {
         if (d.label[0] == '+' || d.label[0] == '-') {
@@ -544,7 +544,7 @@ cJSON *doa_json(const DoaResult &res)
     num(o, "bisection_steps", opt.bisection_steps);
     num(o, "final_window_s", opt.final_window_s);
     num(o, "speed_tol_rad_s", opt.speed_tol_rad_s);
-    num(o, "load_tol_nm", opt.load_tol_nm);
+    num(o, "load_tol_Nm", opt.load_tol_Nm);
     cJSON_AddBoolToObject(root, "baseline_converged", res.baseline_converged);
     cJSON_AddStringToObject(root, "baseline_reason", res.baseline_reason.c_str());
     num(root, "radius_all_converged", res.radius_all_converged);
@@ -572,13 +572,13 @@ bool doa_write_csv(const DoaResult &res, const std::string &path)
     if (f == nullptr) {
         return false;
     }
-    std::fprintf(f, "direction,label,radius,measured_norm,converged,final_speed_error_rad_s,final_load_error_nm,reason\n");
+    std::fprintf(f, "direction,label,radius,measured_norm,converged,final_speed_error_rad_s,final_load_error_Nm,reason\n");
     for (const DoaRun &r : res.runs) {
         std::string reason = r.reason;
         std::replace(reason.begin(), reason.end(), ',', ';');
         std::fprintf(f, "%d,%s,%.9g,%.9g,%d,%.6g,%.6g,%s\n", r.direction,
                      res.directions[static_cast<std::size_t>(r.direction)].label.c_str(), r.radius, r.measured_norm,
-                     r.converged ? 1 : 0, r.final_speed_error_rad_s, r.final_load_error_nm, reason.c_str());
+                     r.converged ? 1 : 0, r.final_speed_error_rad_s, r.final_load_error_Nm, reason.c_str());
     }
     return std::fclose(f) == 0;
 }

@@ -28,18 +28,18 @@ namespace pmstep_gain {
 
 /** What the theorems are about: the motor model and gains the controller uses (SI units). */
 struct TheoremInputs {
-    double resistance_ohm;           ///< R
-    double inductance_h;             ///< L
-    double inertia_kg_m2;            ///< J
-    double friction_nm_s_per_rad;    ///< F
-    double torque_constant_nm_per_a; ///< k_M
+    double resistance_Ohm;           ///< R
+    double inductance_H;             ///< L
+    double inertia_kgm2;            ///< J
+    double friction_Nms_rad;    ///< F
+    double torque_constant_Nm_A; ///< k_M
     int pole_pairs;                  ///< p
     double observer_gain_per_s;      ///< K_e
     double gamma;                    ///< gamma
     double lambda;                   ///< lambda
     double r;                        ///< r
-    double s_align_voltage_v;        ///< u_cs
-    double c_align_voltage_v;        ///< u_cc
+    double s_align_voltage_V;        ///< u_cs
+    double c_align_voltage_V;        ///< u_cc
 };
 
 /** The controller's side of a scenario (the [controller] section). */
@@ -98,7 +98,7 @@ struct DoaOptions {
     int bisection_steps = 4;         ///< refinements between the last success and the first failure
     double final_window_s = 0.2;     ///< convergence is judged on [end - window, end]
     double speed_tol_rad_s = 0.05;   ///< max |w - w*| and |w-hat - w| on the window
-    double load_tol_nm = 0.05;       ///< |T_L-hat - T_L| at the end
+    double load_tol_Nm = 0.05;       ///< |T_L-hat - T_L| at the end
 };
 
 /** One SIL run with estimation errors set at the start of (6). */
@@ -109,7 +109,7 @@ struct DoaRun {
     bool converged;
     std::string reason;              ///< "converged", "fault: ...", "speed error ...", ...
     double final_speed_error_rad_s;  ///< max |w - w*| on the final window
-    double final_load_error_nm;
+    double final_load_error_Nm;
 };
 
 struct DoaDirection {

@@ -47,13 +47,13 @@ bool close(double a, double b)
 /** The theorems assume the controller's model is the plant. */
 bool plant_differs(const sil_scenario_t &sc)
 {
-    const pmstep_config_t &c = sc.controller;
+    const pmstep_motor_config_t &c = sc.controller.motor;
     const plant_params_t &m = sc.motor;
-    return !close(m.resistance_ohm, static_cast<double>(c.resistance_ohm))
-           || !close(m.inductance_h, static_cast<double>(c.inductance_h))
-           || !close(m.inertia_kg_m2, static_cast<double>(c.inertia_kg_m2))
-           || !close(m.friction_nm_s_per_rad, static_cast<double>(c.friction_nm_s_per_rad))
-           || !close(m.torque_constant_nm_per_a, static_cast<double>(c.torque_constant_nm_per_a))
+    return !close(m.resistance_Ohm, static_cast<double>(c.resistance_Ohm))
+           || !close(m.inductance_H, static_cast<double>(c.inductance_H))
+           || !close(m.inertia_kgm2, static_cast<double>(c.inertia_kgm2))
+           || !close(m.friction_Nms_rad, static_cast<double>(c.friction_Nms_rad))
+           || !close(m.torque_constant_Nm_A, static_cast<double>(c.torque_constant_Nm_A))
            || m.pole_pairs != c.pole_pairs;
 }
 
@@ -162,7 +162,7 @@ int main(int argc, char **argv)
     if (doa && !(opt.radius_factor > 1.0 && opt.radius_max >= opt.radius_min)) {
         return fail("--doa needs --doa-factor > 1 and --doa-radius-max >= --doa-radius-min");
     }
-    if (doa && !(sc.duration_s - opt.final_window_s > static_cast<double>(sc.controller.c_align_time_s))) {
+    if (doa && !(sc.duration_s - opt.final_window_s > static_cast<double>(sc.controller.alignment.c_align_time_s))) {
         return fail("--doa needs run.duration_s > t_c + 0.2 s (the final window)");
     }
 

@@ -42,10 +42,10 @@ static bool write_row(const sil_sample_t *x, void *user)
     }
     fprintf(csv->file,
             "%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%.9g,%.9g,%.9g,%.9g\n",
-            x->t_s, x->theta_rad, x->omega_rad_s, (double)o->speed_ref_rad_s, x->i_a_a, x->i_b_a, x->u_a_v, x->u_b_v,
+            x->t_s, x->theta_rad, x->omega_rad_s, (double)o->speed_ref_rad_s, x->i_a_A, x->i_b_A, x->u_a_V, x->u_b_V,
             (double)o->cos_hat, (double)o->sin_hat, x->cos_ptheta, x->sin_ptheta, (double)o->speed_hat_rad_s,
-            (double)o->load_hat_nm, x->load_nm, (int)o->mode, (int)o->fault, (double)port->meas.i_a_a,
-            (double)port->meas.i_b_a, port->bus_v, (double)port->meas.bus_voltage_v);
+            (double)o->load_hat_Nm, x->load_Nm, (int)o->mode, (int)o->fault, (double)port->meas.i_a_A,
+            (double)port->meas.i_b_A, port->bus_V, (double)port->meas.bus_voltage_V);
     return true;
 }
 
@@ -58,22 +58,22 @@ static cJSON *measurement_chain_json(const sil_scenario_t *sc)
     cJSON *inverter = cJSON_CreateObject();
     cJSON *bus = cJSON_CreateObject();
     cJSON_AddNumberToObject(sensors, "adc_bits", sc->sensors.adc_bits);
-    cJSON_AddNumberToObject(sensors, "current_full_scale_a", sc->sensors.current_full_scale_a);
-    cJSON_AddNumberToObject(sensors, "offset_a_a", sc->sensors.offset_a_a);
-    cJSON_AddNumberToObject(sensors, "offset_b_a", sc->sensors.offset_b_a);
+    cJSON_AddNumberToObject(sensors, "current_full_scale_A", sc->sensors.current_full_scale_A);
+    cJSON_AddNumberToObject(sensors, "offset_a_A", sc->sensors.offset_a_A);
+    cJSON_AddNumberToObject(sensors, "offset_b_A", sc->sensors.offset_b_A);
     cJSON_AddNumberToObject(sensors, "gain_error_a", sc->sensors.gain_error_a);
     cJSON_AddNumberToObject(sensors, "gain_error_b", sc->sensors.gain_error_b);
-    cJSON_AddNumberToObject(sensors, "noise_rms_a", sc->sensors.noise_rms_a);
-    cJSON_AddNumberToObject(sensors, "bus_full_scale_v", sc->sensors.bus_full_scale_v);
-    cJSON_AddNumberToObject(sensors, "bus_noise_rms_v", sc->sensors.bus_noise_rms_v);
+    cJSON_AddNumberToObject(sensors, "noise_rms_A", sc->sensors.noise_rms_A);
+    cJSON_AddNumberToObject(sensors, "bus_full_scale_V", sc->sensors.bus_full_scale_V);
+    cJSON_AddNumberToObject(sensors, "bus_noise_rms_V", sc->sensors.bus_noise_rms_V);
     cJSON_AddItemToObject(chain, "sensors", sensors);
     cJSON_AddStringToObject(inverter, "model", sc->inverter.model == SIL_INVERTER_SWITCHING ? "switching" : "averaged");
     cJSON_AddNumberToObject(inverter, "dead_time_s", sc->inverter.dead_time_s);
     cJSON_AddItemToObject(chain, "inverter", inverter);
-    cJSON_AddNumberToObject(bus, "voltage_v", sc->bus_voltage_v);
-    cJSON_AddNumberToObject(bus, "source_resistance_ohm", sc->bus.source_resistance_ohm);
-    cJSON_AddNumberToObject(bus, "ripple_v", sc->bus.ripple_v);
-    cJSON_AddNumberToObject(bus, "ripple_hz", sc->bus.ripple_hz);
+    cJSON_AddNumberToObject(bus, "voltage_V", sc->bus_voltage_V);
+    cJSON_AddNumberToObject(bus, "source_resistance_Ohm", sc->bus.source_resistance_Ohm);
+    cJSON_AddNumberToObject(bus, "ripple_V", sc->bus.ripple_V);
+    cJSON_AddNumberToObject(bus, "ripple_Hz", sc->bus.ripple_Hz);
     cJSON_AddItemToObject(chain, "bus", bus);
     /* Phase samples (two per period) and bus samples at an end code of the ADC. */
     cJSON_AddNumberToObject(chain, "adc_clipped_current_samples", (double)port->sensors.clipped_current_samples);
@@ -100,14 +100,14 @@ static void add_robustness_json(cJSON *root, const sil_summary_t *s)
     }
     cJSON_AddBoolToObject(robust, "nonfinite_seen", s->nonfinite_seen);
     cJSON_AddItemToObject(root, "robustness", robust);
-    cJSON_AddNumberToObject(comm, "offset_a_a", (double)c->offset_a_a);
-    cJSON_AddNumberToObject(comm, "offset_b_a", (double)c->offset_b_a);
+    cJSON_AddNumberToObject(comm, "offset_a_A", (double)c->offset_a_A);
+    cJSON_AddNumberToObject(comm, "offset_b_A", (double)c->offset_b_A);
     cJSON_AddNumberToObject(comm, "offset_samples", (double)c->offset_samples);
-    cJSON_AddNumberToObject(comm, "resistance_ohm", (double)c->resistance_ohm);
-    cJSON_AddNumberToObject(comm, "inductance_h", (double)c->inductance_h);
-    cJSON_AddNumberToObject(comm, "torque_constant_nm_per_a", (double)c->torque_constant_nm_per_a);
-    cJSON_AddNumberToObject(comm, "voltage_bias_a_v", (double)c->voltage_bias_a_v);
-    cJSON_AddNumberToObject(comm, "voltage_bias_b_v", (double)c->voltage_bias_b_v);
+    cJSON_AddNumberToObject(comm, "resistance_Ohm", (double)c->resistance_Ohm);
+    cJSON_AddNumberToObject(comm, "inductance_H", (double)c->inductance_H);
+    cJSON_AddNumberToObject(comm, "torque_constant_Nm_A", (double)c->torque_constant_Nm_A);
+    cJSON_AddNumberToObject(comm, "voltage_bias_a_V", (double)c->voltage_bias_a_V);
+    cJSON_AddNumberToObject(comm, "voltage_bias_b_V", (double)c->voltage_bias_b_V);
     cJSON_AddNumberToObject(comm, "realignments", (double)c->realignments);
     cJSON_AddBoolToObject(comm, "measured", c->measured);
     cJSON_AddItemToObject(root, "commissioning", comm);
@@ -123,11 +123,11 @@ static cJSON *summary_json(const sil_scenario_t *sc, const sil_summary_t *s)
     cJSON *fault = cJSON_CreateObject();
     cJSON_AddStringToObject(root, "scenario", sc->name);
     cJSON_AddNumberToObject(root, "pole_pairs", sc->motor.pole_pairs);
-    cJSON_AddNumberToObject(root, "control_period_s", (double)sc->controller.period_s);
+    cJSON_AddNumberToObject(root, "control_period_s", (double)sc->controller.timing.period_s);
     cJSON_AddNumberToObject(root, "substeps", sc->substeps);
-    cJSON_AddNumberToObject(root, "delay_periods", sc->controller.computational_delay_periods);
-    cJSON_AddNumberToObject(root, "s_align_time_s", (double)sc->controller.s_align_time_s);
-    cJSON_AddNumberToObject(root, "c_align_time_s", (double)sc->controller.c_align_time_s);
+    cJSON_AddNumberToObject(root, "delay_periods", sc->controller.timing.computational_delay_periods);
+    cJSON_AddNumberToObject(root, "s_align_time_s", (double)sc->controller.alignment.s_align_time_s);
+    cJSON_AddNumberToObject(root, "c_align_time_s", (double)sc->controller.alignment.c_align_time_s);
     cJSON_AddNumberToObject(root, "transient_window_s", sc->transient_window_s);
     cJSON_AddNumberToObject(root, "theta0_deg", sc->theta0_rad * 180.0 / 3.14159265358979323846);
     cJSON_AddNumberToObject(root, "seed", (double)sc->seed);
@@ -135,10 +135,10 @@ static cJSON *summary_json(const sil_scenario_t *sc, const sil_summary_t *s)
 
     cJSON_AddNumberToObject(align, "cos_ptheta_at_ts", s->cos_ptheta_at_ts);
     cJSON_AddNumberToObject(align, "sin_ptheta_at_ts", s->sin_ptheta_at_ts);
-    cJSON_AddNumberToObject(align, "i_b_minus_ucs_over_r_at_ts_a", s->i_b_residual_at_ts_a);
+    cJSON_AddNumberToObject(align, "i_b_minus_ucs_over_r_at_ts_A", s->i_b_residual_at_ts_A);
     cJSON_AddNumberToObject(align, "cos_ptheta_at_tc", s->cos_ptheta_at_tc);
     cJSON_AddNumberToObject(align, "sin_ptheta_at_tc", s->sin_ptheta_at_tc);
-    cJSON_AddNumberToObject(align, "i_a_minus_ucc_over_r_at_tc_a", s->i_a_residual_at_tc_a);
+    cJSON_AddNumberToObject(align, "i_a_minus_ucc_over_r_at_tc_A", s->i_a_residual_at_tc_A);
     cJSON_AddItemToObject(root, "alignment", align);
 
     cJSON_AddNumberToObject(speed, "transient_max_abs_error_rad_s", s->transient_max_speed_error_rad_s);
@@ -147,14 +147,14 @@ static cJSON *summary_json(const sil_scenario_t *sc, const sil_summary_t *s)
     cJSON_AddNumberToObject(speed, "tracking_rms_error_rad_s", s->tracking_rms_speed_error_rad_s);
     cJSON_AddItemToObject(root, "speed", speed);
 
-    cJSON_AddNumberToObject(root, "final_load_hat_nm", s->final_load_hat_nm);
-    cJSON_AddNumberToObject(root, "final_load_nm", s->final_load_nm);
-    cJSON_AddNumberToObject(root, "final_load_abs_error_nm", s->final_load_error_nm);
+    cJSON_AddNumberToObject(root, "final_load_hat_Nm", s->final_load_hat_Nm);
+    cJSON_AddNumberToObject(root, "final_load_Nm", s->final_load_Nm);
+    cJSON_AddNumberToObject(root, "final_load_abs_error_Nm", s->final_load_error_Nm);
     cJSON_AddNumberToObject(angle, "max_abs_cos_error", s->max_cos_error);
     cJSON_AddNumberToObject(angle, "max_abs_sin_error", s->max_sin_error);
     cJSON_AddItemToObject(root, "angle_estimate", angle);
-    cJSON_AddNumberToObject(root, "max_abs_phase_voltage_v", s->max_phase_voltage_v);
-    cJSON_AddNumberToObject(root, "max_abs_phase_current_a", s->max_phase_current_a);
+    cJSON_AddNumberToObject(root, "max_abs_phase_voltage_V", s->max_phase_voltage_V);
+    cJSON_AddNumberToObject(root, "max_abs_phase_current_a", s->max_phase_current_A);
     cJSON_AddNumberToObject(root, "voltage_limited_periods", (double)s->voltage_limited_periods);
     cJSON_AddNumberToObject(root, "inverter_clipped_periods", (double)s->inverter_limited_periods);
     cJSON_AddStringToObject(root, "final_mode", pmstep_mode_str(s->final_mode));
@@ -289,13 +289,13 @@ int main(int argc, char **argv)
     }
     if (write_csv) {
         /* Refuse a run whose time series would fill the disk, before it starts. */
-        const double rows = sc.duration_s / (double)sc.controller.period_s / (double)sc.decimation;
-        const double csv_mb = rows * SIL_CSV_ROW_MAX_BYTES / 1e6;
-        if (csv_mb > sc.max_csv_mb) {
+        const double rows = sc.duration_s / (double)sc.controller.timing.period_s / (double)sc.decimation;
+        const double csv_MB = rows * SIL_CSV_ROW_MAX_BYTES / 1e6;
+        if (csv_MB > sc.max_csv_MB) {
             fprintf(stderr,
-                    "pmstep-sil: run.csv would take up to %.0f MB (%.0f rows), more than run.max_csv_mb = %g: raise "
-                    "run.decimation or run.max_csv_mb, or pass --no-csv\n",
-                    csv_mb, rows, sc.max_csv_mb);
+                    "pmstep-sil: run.csv would take up to %.0f MB (%.0f rows), more than run.max_csv_MB = %g: raise "
+                    "run.decimation or run.max_csv_MB, or pass --no-csv\n",
+                    csv_MB, rows, sc.max_csv_MB);
             return 2;
         }
     }
@@ -314,9 +314,9 @@ int main(int argc, char **argv)
             return 2;
         }
         csv.decimation = sc.decimation;
-        fprintf(csv.file, "t_s,theta_rad,omega_rad_s,omega_ref_rad_s,i_a_a,i_b_a,u_a_v,u_b_v,cos_hat,sin_hat,"
-                          "cos_ptheta,sin_ptheta,omega_hat_rad_s,load_hat_nm,load_nm,mode,fault,"
-                          "i_a_meas_a,i_b_meas_a,bus_voltage_v,bus_voltage_meas_v\n");
+        fprintf(csv.file, "t_s,theta_rad,omega_rad_s,omega_ref_rad_s,i_a_A,i_b_A,u_a_V,u_b_V,cos_hat,sin_hat,"
+                          "cos_ptheta,sin_ptheta,omega_hat_rad_s,load_hat_Nm,load_Nm,mode,fault,"
+                          "i_a_meas_A,i_b_meas_A,bus_voltage_V,bus_voltage_meas_V\n");
     }
     if (record_path != NULL) {
         record = fopen(record_path, "wb");
@@ -330,8 +330,8 @@ int main(int argc, char **argv)
     }
     if (!quiet) {
         fprintf(stderr, "pmstep-sil: scenario '%s', %.3f s at %.0f Hz, %d RK4 substeps, delay %u, %s inverter, seed %lu\n",
-                sc.name, sc.duration_s, 1.0 / (double)sc.controller.period_s, sc.substeps,
-                (unsigned)sc.controller.computational_delay_periods,
+                sc.name, sc.duration_s, 1.0 / (double)sc.controller.timing.period_s, sc.substeps,
+                (unsigned)sc.controller.timing.computational_delay_periods,
                 sc.inverter.model == SIL_INVERTER_SWITCHING ? "switching" : "averaged", (unsigned long)sc.seed);
     }
     run_status = sil_run_record(&sc, write_csv ? write_row : NULL, &csv, !quiet, &summary, record);

@@ -11,15 +11,15 @@ long sil_periods_in(double duration_s, double period_s)
 
 void sil_metrics_init(sil_metrics_t *m, const sil_scenario_t *sc, sil_summary_t *s)
 {
-    const double period_s = (double)sc->controller.period_s;
+    const double period_s = (double)sc->controller.timing.period_s;
     memset(m, 0, sizeof *m);
     memset(s, 0, sizeof *s);
     s->fault_step = -1;
     s->fault_time_s = -1.0;
     /* Alignment starts after the bridge-off offset calibration, when there is one. */
-    const long calibration_steps = sil_periods_in((double)sc->controller.offset_calibration_time_s, period_s);
-    m->ts_step = calibration_steps + sil_periods_in((double)sc->controller.s_align_time_s, period_s);
-    m->tc_step = calibration_steps + sil_periods_in((double)sc->controller.c_align_time_s, period_s);
+    const long calibration_steps = sil_periods_in((double)sc->controller.commissioning.offset_calibration_time_s, period_s);
+    m->ts_step = calibration_steps + sil_periods_in((double)sc->controller.alignment.s_align_time_s, period_s);
+    m->tc_step = calibration_steps + sil_periods_in((double)sc->controller.alignment.c_align_time_s, period_s);
     m->transient_end_step = m->tc_step + sil_periods_in(sc->transient_window_s, period_s);
     m->settle_step = m->transient_end_step;
     m->loss_speed_error_rad_s = sc->loss_speed_error_rad_s;
@@ -28,8 +28,8 @@ void sil_metrics_init(sil_metrics_t *m, const sil_scenario_t *sc, sil_summary_t 
     s->settle_time_s = (double)m->settle_step * period_s;
     s->loss_of_control_time_s = -1.0;
     s->detection_latency_s = NAN;
-    m->s_align_current_a = (double)sc->controller.s_align_voltage_v / sc->motor.resistance_ohm;
-    m->c_align_current_a = (double)sc->controller.c_align_voltage_v / sc->motor.resistance_ohm;
+    m->s_align_current_A = (double)sc->controller.alignment.s_align_voltage_V / sc->motor.resistance_Ohm;
+    m->c_align_current_A = (double)sc->controller.alignment.c_align_voltage_V / sc->motor.resistance_Ohm;
 }
 
 /* Electrical angle of (c-hat, s-hat) minus p theta, wrapped to (-pi, pi]. */
@@ -43,10 +43,10 @@ static double angle_error_rad(const pmstep_output_t *out, const sil_sample_t *x)
 static bool sample_finite(const sil_sample_t *x)
 {
     const pmstep_output_t *o = x->out;
-    const double sum = x->theta_rad + x->omega_rad_s + x->i_a_a + x->i_b_a + x->u_a_v + x->u_b_v
-                       + (double)o->u_a_v + (double)o->u_b_v + (double)o->cos_hat + (double)o->sin_hat
-                       + (double)o->speed_hat_rad_s + (double)o->load_hat_nm + (double)o->i_a_hat_a
-                       + (double)o->i_b_hat_a;
+    const double sum = x->theta_rad + x->omega_rad_s + x->i_a_A + x->i_b_A + x->u_a_V + x->u_b_V
+                       + (double)o->u_a_V + (double)o->u_b_V + (double)o->cos_hat + (double)o->sin_hat
+                       + (double)o->speed_hat_rad_s + (double)o->load_hat_Nm + (double)o->i_a_hat_A
+                       + (double)o->i_b_hat_A;
     return isfinite(sum) != 0;
 }
 
@@ -60,15 +60,15 @@ void sil_metrics_add(sil_metrics_t *m, const sil_sample_t *x, sil_summary_t *s)
     if (x->step == m->ts_step) {
         s->cos_ptheta_at_ts = x->cos_ptheta;
         s->sin_ptheta_at_ts = x->sin_ptheta;
-        s->i_b_residual_at_ts_a = x->i_b_a - m->s_align_current_a;
+        s->i_b_residual_at_ts_A = x->i_b_A - m->s_align_current_A;
     }
     if (x->step == m->tc_step) {
         s->cos_ptheta_at_tc = x->cos_ptheta;
         s->sin_ptheta_at_tc = x->sin_ptheta;
-        s->i_a_residual_at_tc_a = x->i_a_a - m->c_align_current_a;
+        s->i_a_residual_at_tc_A = x->i_a_A - m->c_align_current_A;
     }
-    s->max_phase_voltage_v = fmax(s->max_phase_voltage_v, fmax(fabs(x->u_a_v), fabs(x->u_b_v)));
-    s->max_phase_current_a = fmax(s->max_phase_current_a, fmax(fabs(x->i_a_a), fabs(x->i_b_a)));
+    s->max_phase_voltage_V = fmax(s->max_phase_voltage_V, fmax(fabs(x->u_a_V), fabs(x->u_b_V)));
+    s->max_phase_current_A = fmax(s->max_phase_current_A, fmax(fabs(x->i_a_A), fabs(x->i_b_A)));
     if (out->voltage_limited) {
         s->voltage_limited_periods++;
     }
@@ -85,8 +85,8 @@ void sil_metrics_add(sil_metrics_t *m, const sil_sample_t *x, sil_summary_t *s)
             m->tracking_sq += speed_error * speed_error;
             ++m->tracking_n;
         }
-        s->final_load_hat_nm = (double)out->load_hat_nm;
-        s->final_load_nm = x->load_nm;
+        s->final_load_hat_Nm = (double)out->load_hat_Nm;
+        s->final_load_Nm = x->load_Nm;
         {
             const double angle_error = fabs(angle_error_rad(out, x));
             s->final_angle_error_rad = angle_error;
@@ -113,7 +113,7 @@ void sil_metrics_finish(const sil_metrics_t *m, sil_summary_t *s)
 {
     s->transient_rms_speed_error_rad_s = m->transient_n ? sqrt(m->transient_sq / (double)m->transient_n) : 0.0;
     s->tracking_rms_speed_error_rad_s = m->tracking_n ? sqrt(m->tracking_sq / (double)m->tracking_n) : 0.0;
-    s->final_load_error_nm = fabs(s->final_load_hat_nm - s->final_load_nm);
+    s->final_load_error_Nm = fabs(s->final_load_hat_Nm - s->final_load_Nm);
     if (s->loss_of_control_time_s >= 0.0 && s->fault != PMSTEP_FAULT_NONE) {
         s->detection_latency_s = s->fault_time_s - s->loss_of_control_time_s;
     }

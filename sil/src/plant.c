@@ -7,11 +7,11 @@
 plant_params_t plant_paper_params(void)
 {
     plant_params_t p;
-    p.resistance_ohm = 3.0;
-    p.inductance_h = 0.006;
-    p.inertia_kg_m2 = 0.01;
-    p.friction_nm_s_per_rad = 0.0;
-    p.torque_constant_nm_per_a = 2.0;
+    p.resistance_Ohm = 3.0;
+    p.inductance_H = 0.006;
+    p.inertia_kgm2 = 0.01;
+    p.friction_Nms_rad = 0.0;
+    p.torque_constant_Nm_A = 2.0;
     p.pole_pairs = 6;
     return p;
 }
@@ -22,11 +22,11 @@ double plant_load_torque(const plant_load_t *load, double t_s, double omega_rad_
     case PLANT_LOAD_NONE:
         return 0.0;
     case PLANT_LOAD_CONSTANT:
-        return load->torque_nm;
+        return load->torque_Nm;
     case PLANT_LOAD_STEP:
-        return t_s >= load->step_time_s ? load->torque_nm : 0.0;
+        return t_s >= load->step_time_s ? load->torque_Nm : 0.0;
     case PLANT_LOAD_PROPORTIONAL:
-        return load->coefficient_nm_s_per_rad * omega_rad_s;
+        return load->coefficient_Nms_rad * omega_rad_s;
     case PLANT_LOAD_TABLE: {
         int k;
         const int n = load->table_points;
@@ -34,16 +34,16 @@ double plant_load_torque(const plant_load_t *load, double t_s, double omega_rad_
             return 0.0;
         }
         if (t_s <= load->table_time_s[0]) {
-            return load->table_torque_nm[0];
+            return load->table_torque_Nm[0];
         }
         for (k = 1; k < n; ++k) {
             if (t_s < load->table_time_s[k]) {
                 const double t0 = load->table_time_s[k - 1];
                 const double w = (t_s - t0) / (load->table_time_s[k] - t0);
-                return load->table_torque_nm[k - 1] + w * (load->table_torque_nm[k] - load->table_torque_nm[k - 1]);
+                return load->table_torque_Nm[k - 1] + w * (load->table_torque_Nm[k] - load->table_torque_Nm[k - 1]);
             }
         }
-        return load->table_torque_nm[n - 1];
+        return load->table_torque_Nm[n - 1];
     }
     }
     return 0.0;
@@ -51,25 +51,25 @@ double plant_load_torque(const plant_load_t *load, double t_s, double omega_rad_
 
 /* (1) with sin p theta and cos p theta given. */
 static void derivative_at(const plant_params_t *params, const plant_load_t *load, double t_s, const plant_state_t *x,
-                          double s, double c, double u_a_v, double u_b_v, plant_state_t *dx)
+                          double s, double c, double u_a_V, double u_b_V, plant_state_t *dx)
 {
-    const double inv_l = 1.0 / params->inductance_h;
-    const double inv_j = 1.0 / params->inertia_kg_m2;
-    const double k_m = params->torque_constant_nm_per_a;
-    const double load_nm = plant_load_torque(load, t_s, x->omega_rad_s);
+    const double inv_l = 1.0 / params->inductance_H;
+    const double inv_j = 1.0 / params->inertia_kgm2;
+    const double k_m = params->torque_constant_Nm_A;
+    const double load_Nm = plant_load_torque(load, t_s, x->omega_rad_s);
 
     dx->theta_rad = x->omega_rad_s;
-    dx->omega_rad_s = inv_j * (-params->friction_nm_s_per_rad * x->omega_rad_s
-                               + k_m * (-x->i_a_a * s + x->i_b_a * c) - load_nm);
-    dx->i_a_a = inv_l * (-params->resistance_ohm * x->i_a_a + k_m * x->omega_rad_s * s + u_a_v);
-    dx->i_b_a = inv_l * (-params->resistance_ohm * x->i_b_a - k_m * x->omega_rad_s * c + u_b_v);
+    dx->omega_rad_s = inv_j * (-params->friction_Nms_rad * x->omega_rad_s
+                               + k_m * (-x->i_a_A * s + x->i_b_A * c) - load_Nm);
+    dx->i_a_A = inv_l * (-params->resistance_Ohm * x->i_a_A + k_m * x->omega_rad_s * s + u_a_V);
+    dx->i_b_A = inv_l * (-params->resistance_Ohm * x->i_b_A - k_m * x->omega_rad_s * c + u_b_V);
 }
 
 void plant_derivative(const plant_params_t *params, const plant_load_t *load, double t_s,
-                      const plant_state_t *x, double u_a_v, double u_b_v, plant_state_t *dx)
+                      const plant_state_t *x, double u_a_V, double u_b_V, plant_state_t *dx)
 {
     const double angle = (double)params->pole_pairs * x->theta_rad;
-    derivative_at(params, load, t_s, x, sin(angle), cos(angle), u_a_v, u_b_v, dx);
+    derivative_at(params, load, t_s, x, sin(angle), cos(angle), u_a_V, u_b_V, dx);
 }
 
 /* sin and cos of (angle + delta) from those of angle. Within a substep delta = p (theta_stage -
@@ -95,8 +95,8 @@ static plant_state_t axpy(const plant_state_t *x, double h, const plant_state_t 
     plant_state_t y;
     y.theta_rad = x->theta_rad + h * dx->theta_rad;
     y.omega_rad_s = x->omega_rad_s + h * dx->omega_rad_s;
-    y.i_a_a = x->i_a_a + h * dx->i_a_a;
-    y.i_b_a = x->i_b_a + h * dx->i_b_a;
+    y.i_a_A = x->i_a_A + h * dx->i_a_A;
+    y.i_b_A = x->i_b_A + h * dx->i_b_A;
     return y;
 }
 
@@ -104,14 +104,14 @@ static plant_state_t axpy(const plant_state_t *x, double h, const plant_state_t 
 static void hold_open(plant_state_t *dx, bool open_a, bool open_b)
 {
     if (open_a) {
-        dx->i_a_a = 0.0;
+        dx->i_a_A = 0.0;
     }
     if (open_b) {
-        dx->i_b_a = 0.0;
+        dx->i_b_A = 0.0;
     }
 }
 
-void plant_substep(plant_t *plant, double t_s, double h, double u_a_v, double u_b_v, double *charge_a_c,
+void plant_substep(plant_t *plant, double t_s, double h, double u_a_V, double u_b_V, double *charge_a_c,
                    double *charge_b_c)
 {
     const plant_state_t x = plant->x;
@@ -122,38 +122,38 @@ void plant_substep(plant_t *plant, double t_s, double h, double u_a_v, double u_
     const bool ob = plant->open_b;
     plant_state_t k1, k2, k3, k4, y2, y3, y4;
     double s, c;
-    derivative_at(&plant->params, &plant->load, t_s, &x, s0, c0, u_a_v, u_b_v, &k1);
+    derivative_at(&plant->params, &plant->load, t_s, &x, s0, c0, u_a_V, u_b_V, &k1);
     hold_open(&k1, oa, ob);
     y2 = axpy(&x, 0.5 * h, &k1);
     rotate(s0, c0, p * (y2.theta_rad - x.theta_rad), &s, &c);
-    derivative_at(&plant->params, &plant->load, t_s + 0.5 * h, &y2, s, c, u_a_v, u_b_v, &k2);
+    derivative_at(&plant->params, &plant->load, t_s + 0.5 * h, &y2, s, c, u_a_V, u_b_V, &k2);
     hold_open(&k2, oa, ob);
     y3 = axpy(&x, 0.5 * h, &k2);
     rotate(s0, c0, p * (y3.theta_rad - x.theta_rad), &s, &c);
-    derivative_at(&plant->params, &plant->load, t_s + 0.5 * h, &y3, s, c, u_a_v, u_b_v, &k3);
+    derivative_at(&plant->params, &plant->load, t_s + 0.5 * h, &y3, s, c, u_a_V, u_b_V, &k3);
     hold_open(&k3, oa, ob);
     y4 = axpy(&x, h, &k3);
     rotate(s0, c0, p * (y4.theta_rad - x.theta_rad), &s, &c);
-    derivative_at(&plant->params, &plant->load, t_s + h, &y4, s, c, u_a_v, u_b_v, &k4);
+    derivative_at(&plant->params, &plant->load, t_s + h, &y4, s, c, u_a_V, u_b_V, &k4);
     hold_open(&k4, oa, ob);
     plant->x.theta_rad = x.theta_rad + h / 6.0 * (k1.theta_rad + 2.0 * (k2.theta_rad + k3.theta_rad) + k4.theta_rad);
     plant->x.omega_rad_s = x.omega_rad_s + h / 6.0 * (k1.omega_rad_s + 2.0 * (k2.omega_rad_s + k3.omega_rad_s) + k4.omega_rad_s);
-    plant->x.i_a_a = x.i_a_a + h / 6.0 * (k1.i_a_a + 2.0 * (k2.i_a_a + k3.i_a_a) + k4.i_a_a);
-    plant->x.i_b_a = x.i_b_a + h / 6.0 * (k1.i_b_a + 2.0 * (k2.i_b_a + k3.i_b_a) + k4.i_b_a);
+    plant->x.i_a_A = x.i_a_A + h / 6.0 * (k1.i_a_A + 2.0 * (k2.i_a_A + k3.i_a_A) + k4.i_a_A);
+    plant->x.i_b_A = x.i_b_A + h / 6.0 * (k1.i_b_A + 2.0 * (k2.i_b_A + k3.i_b_A) + k4.i_b_A);
     if (charge_a_c != NULL && charge_b_c != NULL) {
         /* The currents at the four stages, weighted as RK4 weights the derivatives. */
-        *charge_a_c = h / 6.0 * (x.i_a_a + 2.0 * (y2.i_a_a + y3.i_a_a) + y4.i_a_a);
-        *charge_b_c = h / 6.0 * (x.i_b_a + 2.0 * (y2.i_b_a + y3.i_b_a) + y4.i_b_a);
+        *charge_a_c = h / 6.0 * (x.i_a_A + 2.0 * (y2.i_a_A + y3.i_a_A) + y4.i_a_A);
+        *charge_b_c = h / 6.0 * (x.i_b_A + 2.0 * (y2.i_b_A + y3.i_b_A) + y4.i_b_A);
     }
 }
 
-void plant_advance(plant_t *plant, double u_a_v, double u_b_v, double period_s, int substeps)
+void plant_advance(plant_t *plant, double u_a_V, double u_b_V, double period_s, int substeps)
 {
     const double h = period_s / (double)substeps;
     const double t0 = plant->time_s;
     int n;
     for (n = 0; n < substeps; ++n) {
-        plant_substep(plant, t0 + (double)n * h, h, u_a_v, u_b_v, NULL, NULL);
+        plant_substep(plant, t0 + (double)n * h, h, u_a_V, u_b_V, NULL, NULL);
     }
     /* Time from the period count, not accumulated substeps. */
     plant->time_s = t0 + period_s;

@@ -31,12 +31,12 @@ static void record_words(record_t *rec, const uint32_t *words, size_t n)
     }
 }
 
-static void record_header(record_t *rec, const pmstep_config_t *c, float id_target_a)
+static void record_header(record_t *rec, const pmstep_config_t *c, float id_target_A)
 {
     uint32_t head[SIL_RECORD_HEADER_WORDS] = {SIL_RECORD_MAGIC, SIL_RECORD_VERSION, SIL_RECORD_CONFIG_WORDS,
                                               (uint32_t)SIL_RECORD_IN_WORDS, (uint32_t)SIL_RECORD_OUT_WORDS};
     sil_record_config_to_words(c, &head[5]);
-    head[5u + SIL_RECORD_CONFIG_WORDS] = sil_record_bits(id_target_a);
+    head[5u + SIL_RECORD_CONFIG_WORDS] = sil_record_bits(id_target_A);
     record_words(rec, head, SIL_RECORD_HEADER_WORDS);
 }
 
@@ -77,7 +77,7 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
 {
     static pmstep_t inst; /* as on the MCU: one static instance */
     const pmstep_config_t *cfg = &sc->controller;
-    const double period_s = (double)cfg->period_s;
+    const double period_s = (double)cfg->timing.period_s;
     const long steps = sil_periods_in(sc->duration_s, period_s);
     const double p = (double)sc->motor.pole_pairs;
     const bool on_terminal = isatty(fileno(stderr)) != 0;
@@ -105,10 +105,10 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
     plant.load = sc->load;
     plant.x.theta_rad = sc->theta0_rad;
     plant.x.omega_rad_s = sc->omega0_rad_s;
-    plant.x.i_a_a = sc->i_a0_a;
-    plant.x.i_b_a = sc->i_b0_a;
-    hardware.bus_voltage_v = sc->bus_voltage_v;
-    hardware.delay_periods = cfg->computational_delay_periods;
+    plant.x.i_a_A = sc->i_a0_A;
+    plant.x.i_b_A = sc->i_b0_A;
+    hardware.bus_voltage_V = sc->bus_voltage_V;
+    hardware.delay_periods = cfg->timing.computational_delay_periods;
     hardware.inverter = sc->inverter;
     hardware.bus = sc->bus;
     hardware.sensors = sc->sensors;
@@ -117,12 +117,12 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
         pmstep_hal_host_release();
         return -3;
     }
-    (void)pmstep_set_id_target(&inst, (float)sc->id_target_a);
+    (void)pmstep_set_id_target(&inst, (float)sc->id_target_A);
     (void)pmstep_start(&inst);
     if (record != NULL) {
         rec_state.file = record;
         rec = &rec_state;
-        record_header(rec, cfg, (float)sc->id_target_a);
+        record_header(rec, cfg, (float)sc->id_target_A);
     }
 
     wall_start = now_s();
@@ -136,9 +136,9 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
         command_speed(&inst, sc, t_s, &next_segment, rec);
         sample.theta_rad = plant.x.theta_rad;
         sample.omega_rad_s = plant.x.omega_rad_s;
-        sample.i_a_a = plant.x.i_a_a;
-        sample.i_b_a = plant.x.i_b_a;
-        sample.load_nm = plant_load_torque(&plant.load, t_s, plant.x.omega_rad_s);
+        sample.i_a_A = plant.x.i_a_A;
+        sample.i_b_A = plant.x.i_b_A;
+        sample.load_Nm = plant_load_torque(&plant.load, t_s, plant.x.omega_rad_s);
 
         /* pmstep_hal_control_period(), spelled out to keep the measurement for the record. */
         t0 = now_s();
@@ -158,8 +158,8 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
         sample.t_s = t_s;
         sample.cos_ptheta = cos(p * sample.theta_rad);
         sample.sin_ptheta = sin(p * sample.theta_rad);
-        sample.u_a_v = inverter->applied_a_v;
-        sample.u_b_v = inverter->applied_b_v;
+        sample.u_a_V = inverter->applied_a_V;
+        sample.u_b_V = inverter->applied_b_V;
         sample.out = &out;
         sample.inst = &inst;
         sil_metrics_add(&metrics, &sample, s);

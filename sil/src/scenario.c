@@ -32,95 +32,95 @@ typedef struct {
 #define BIG 1e12
 
 static const key_t_ keys[] = {
-    {"motor.resistance_ohm", KEY_DOUBLE, OFF(motor.resistance_ohm), 0, 1, BIG, 0, "plant R (Ohm)"},
-    {"motor.inductance_h", KEY_DOUBLE, OFF(motor.inductance_h), 0, 1, BIG, 0, "plant L (H)"},
-    {"motor.inertia_kg_m2", KEY_DOUBLE, OFF(motor.inertia_kg_m2), 0, 1, BIG, 0, "plant J (kg m^2)"},
-    {"motor.friction_nm_s_per_rad", KEY_DOUBLE, OFF(motor.friction_nm_s_per_rad), 0, 0, BIG, 0, "plant F (Nm s/rad)"},
-    {"motor.torque_constant_nm_per_a", KEY_DOUBLE, OFF(motor.torque_constant_nm_per_a), 0, 1, BIG, 0, "plant k_M (Nm/A)"},
+    {"motor.resistance_Ohm", KEY_DOUBLE, OFF(motor.resistance_Ohm), 0, 1, BIG, 0, "plant R (Ohm)"},
+    {"motor.inductance_H", KEY_DOUBLE, OFF(motor.inductance_H), 0, 1, BIG, 0, "plant L (H)"},
+    {"motor.inertia_kgm2", KEY_DOUBLE, OFF(motor.inertia_kgm2), 0, 1, BIG, 0, "plant J (kg m^2)"},
+    {"motor.friction_Nms_rad", KEY_DOUBLE, OFF(motor.friction_Nms_rad), 0, 0, BIG, 0, "plant F (Nm s/rad)"},
+    {"motor.torque_constant_Nm_A", KEY_DOUBLE, OFF(motor.torque_constant_Nm_A), 0, 1, BIG, 0, "plant k_M (Nm/A)"},
     {"motor.pole_pairs", KEY_INT, OFF(motor.pole_pairs), 1, 0, 1000, 0, "plant p"},
 
-    {"controller.resistance_ohm", KEY_FLOAT, OFF(controller.resistance_ohm), -BIG, 0, BIG, 0, "R the firmware assumes (Ohm)"},
-    {"controller.inductance_h", KEY_FLOAT, OFF(controller.inductance_h), -BIG, 0, BIG, 0, "L (H)"},
-    {"controller.inertia_kg_m2", KEY_FLOAT, OFF(controller.inertia_kg_m2), -BIG, 0, BIG, 0, "J (kg m^2)"},
-    {"controller.friction_nm_s_per_rad", KEY_FLOAT, OFF(controller.friction_nm_s_per_rad), -BIG, 0, BIG, 0, "F (Nm s/rad)"},
-    {"controller.torque_constant_nm_per_a", KEY_FLOAT, OFF(controller.torque_constant_nm_per_a), -BIG, 0, BIG, 0, "k_M (Nm/A)"},
-    {"controller.pole_pairs", KEY_INT, OFF(controller.pole_pairs), -1000, 0, 1000, 0, "p"},
-    {"controller.s_align_time_s", KEY_FLOAT, OFF(controller.s_align_time_s), -BIG, 0, BIG, 0, "t_s (s)"},
-    {"controller.c_align_time_s", KEY_FLOAT, OFF(controller.c_align_time_s), -BIG, 0, BIG, 0, "t_c (s)"},
-    {"controller.s_align_voltage_v", KEY_FLOAT, OFF(controller.s_align_voltage_v), -BIG, 0, BIG, 0, "u_cs (V)"},
-    {"controller.c_align_voltage_v", KEY_FLOAT, OFF(controller.c_align_voltage_v), -BIG, 0, BIG, 0, "u_cc (V)"},
-    {"controller.speed_gain_per_s", KEY_FLOAT, OFF(controller.speed_gain_per_s), -BIG, 0, BIG, 0, "k_omega (1/s)"},
-    {"controller.observer_gain_per_s", KEY_FLOAT, OFF(controller.observer_gain_per_s), -BIG, 0, BIG, 0, "K_e (1/s)"},
-    {"controller.current_gain_per_s", KEY_FLOAT, OFF(controller.current_gain_per_s), -BIG, 0, BIG, 0, "K_i (1/s)"},
-    {"controller.adapt_gamma", KEY_FLOAT, OFF(controller.adapt_gamma), -BIG, 0, BIG, 0, "gamma"},
-    {"controller.adapt_lambda", KEY_FLOAT, OFF(controller.adapt_lambda), -BIG, 0, BIG, 0, "lambda"},
-    {"controller.adapt_r", KEY_FLOAT, OFF(controller.adapt_r), -BIG, 0, BIG, 0, "r"},
-    {"controller.sat_kappa_rad_per_s", KEY_FLOAT, OFF(controller.sat_kappa_rad_per_s), -BIG, 0, BIG, 0, "kappa (rad/s)"},
-    {"controller.reference_bandwidth_rad_per_s", KEY_FLOAT, OFF(controller.reference_bandwidth_rad_per_s), -BIG, 0, BIG, 0, "varpi_0 (rad/s)"},
+    {"controller.motor.resistance_Ohm", KEY_FLOAT, OFF(controller.motor.resistance_Ohm), -BIG, 0, BIG, 0, "R the firmware assumes (Ohm)"},
+    {"controller.motor.inductance_H", KEY_FLOAT, OFF(controller.motor.inductance_H), -BIG, 0, BIG, 0, "L (H)"},
+    {"controller.motor.inertia_kgm2", KEY_FLOAT, OFF(controller.motor.inertia_kgm2), -BIG, 0, BIG, 0, "J (kg m^2)"},
+    {"controller.motor.friction_Nms_rad", KEY_FLOAT, OFF(controller.motor.friction_Nms_rad), -BIG, 0, BIG, 0, "F (Nm s/rad)"},
+    {"controller.motor.torque_constant_Nm_A", KEY_FLOAT, OFF(controller.motor.torque_constant_Nm_A), -BIG, 0, BIG, 0, "k_M (Nm/A)"},
+    {"controller.motor.pole_pairs", KEY_INT, OFF(controller.motor.pole_pairs), -1000, 0, 1000, 0, "p"},
+    {"controller.alignment.s_align_time_s", KEY_FLOAT, OFF(controller.alignment.s_align_time_s), -BIG, 0, BIG, 0, "t_s (s)"},
+    {"controller.alignment.c_align_time_s", KEY_FLOAT, OFF(controller.alignment.c_align_time_s), -BIG, 0, BIG, 0, "t_c (s)"},
+    {"controller.alignment.s_align_voltage_V", KEY_FLOAT, OFF(controller.alignment.s_align_voltage_V), -BIG, 0, BIG, 0, "u_cs (V)"},
+    {"controller.alignment.c_align_voltage_V", KEY_FLOAT, OFF(controller.alignment.c_align_voltage_V), -BIG, 0, BIG, 0, "u_cc (V)"},
+    {"controller.gains.speed_gain_per_s", KEY_FLOAT, OFF(controller.gains.speed_gain_per_s), -BIG, 0, BIG, 0, "k_omega (1/s)"},
+    {"controller.gains.observer_gain_per_s", KEY_FLOAT, OFF(controller.gains.observer_gain_per_s), -BIG, 0, BIG, 0, "K_e (1/s)"},
+    {"controller.gains.current_gain_per_s", KEY_FLOAT, OFF(controller.gains.current_gain_per_s), -BIG, 0, BIG, 0, "K_i (1/s)"},
+    {"controller.gains.adapt_gamma", KEY_FLOAT, OFF(controller.gains.adapt_gamma), -BIG, 0, BIG, 0, "gamma"},
+    {"controller.gains.adapt_lambda", KEY_FLOAT, OFF(controller.gains.adapt_lambda), -BIG, 0, BIG, 0, "lambda"},
+    {"controller.gains.adapt_r", KEY_FLOAT, OFF(controller.gains.adapt_r), -BIG, 0, BIG, 0, "r"},
+    {"controller.gains.sat_kappa_rad_s", KEY_FLOAT, OFF(controller.gains.sat_kappa_rad_s), -BIG, 0, BIG, 0, "kappa (rad/s)"},
+    {"controller.gains.reference_bandwidth_rad_s", KEY_FLOAT, OFF(controller.gains.reference_bandwidth_rad_s), -BIG, 0, BIG, 0, "varpi_0 (rad/s)"},
+    {"controller.gains.angle_correction_gain_per_s", KEY_FLOAT, OFF(controller.gains.angle_correction_gain_per_s), -BIG, 0, BIG, 0, "pulls (c-hat, s-hat) onto the unit circle at this rate (1/s); 0 = the paper's open integrals"},
+    {"controller.limits.max_phase_current_A", KEY_FLOAT, OFF(controller.limits.max_phase_current_A), -BIG, 0, BIG, 0, "overcurrent trip (A)"},
+    {"controller.limits.min_bus_voltage_V", KEY_FLOAT, OFF(controller.limits.min_bus_voltage_V), -BIG, 0, BIG, 0, "undervoltage trip (V)"},
+    {"controller.limits.max_bus_voltage_V", KEY_FLOAT, OFF(controller.limits.max_bus_voltage_V), -BIG, 0, BIG, 0, "overvoltage trip (V)"},
+    {"controller.commissioning.offset_calibration_time_s", KEY_FLOAT, OFF(controller.commissioning.offset_calibration_time_s), -BIG, 0, BIG, 0, "Remark 2: bridge off this long before s-alignment, current offsets averaged (s); 0 = none"},
+    {"controller.commissioning.alignment_offset_calibration", KEY_BOOL, OFF(controller.commissioning.alignment_offset_calibration), 0, 0, 1, 0, "offsets also from the alignment steady states (true/false)"},
+    {"controller.commissioning.steady_state_window_s", KEY_FLOAT, OFF(controller.commissioning.steady_state_window_s), -BIG, 0, BIG, 0, "averaging window at the end of each alignment (s); 0 = none"},
+    {"controller.commissioning.inductance_window_s", KEY_FLOAT, OFF(controller.commissioning.inductance_window_s), -BIG, 0, BIG, 0, "current-rise window at the start of s-alignment for L (s); 0 = L not measured"},
+    {"controller.commissioning.use_measured_resistance", KEY_BOOL, OFF(controller.commissioning.use_measured_resistance), 0, 0, 1, 0, "RUN uses the measured R (true/false)"},
+    {"controller.commissioning.use_measured_inductance", KEY_BOOL, OFF(controller.commissioning.use_measured_inductance), 0, 0, 1, 0, "RUN uses the measured L (true/false)"},
+    {"controller.commissioning.use_measured_torque_constant", KEY_BOOL, OFF(controller.commissioning.use_measured_torque_constant), 0, 0, 1, 0, "RUN uses the measured k_M (true/false)"},
+    {"controller.commissioning.voltage_bias_level_fraction", KEY_FLOAT, OFF(controller.commissioning.voltage_bias_level_fraction), -BIG, 0, BIG, 0, "Remark 2 voltage bias: second alignment level as a fraction of the voltage (0 = off)"},
+    {"controller.inverter.dead_time_s", KEY_FLOAT, OFF(controller.inverter.dead_time_s), -BIG, 0, BIG, 0, "dead time per half-bridge to compensate (s); 0 = none"},
+    {"controller.inverter.dead_time_current_band_A", KEY_FLOAT, OFF(controller.inverter.dead_time_current_band_A), -BIG, 0, BIG, 0, "dead-time compensation linear within +/- this current (A)"},
+    {"controller.detection.angle_magnitude_bound", KEY_FLOAT, OFF(controller.detection.angle_magnitude_bound), -BIG, 0, BIG, 0, "|c-hat^2 + s-hat^2 - 1| above -> angle lost; 0 = off"},
+    {"controller.detection.speed_consistency_bound_rad_s", KEY_FLOAT, OFF(controller.detection.speed_consistency_bound_rad_s), -BIG, 0, BIG, 0, "|speed from the angle's rotation - omega-hat| above -> inconsistent (rad/s); 0 = off"},
+    {"controller.detection.stall_speed_error_rad_s", KEY_FLOAT, OFF(controller.detection.stall_speed_error_rad_s), -BIG, 0, BIG, 0, "|omega-hat - omega*| above -> stall (rad/s); 0 = off"},
+    {"controller.detection.observer_residual_bound_A", KEY_FLOAT, OFF(controller.detection.observer_residual_bound_A), -BIG, 0, BIG, 0, "detection: low-passed |i - i-hat| sum above -> OBSERVER_RESIDUAL (A, 0 = off)"},
+    {"controller.detection.persistence_s", KEY_FLOAT, OFF(controller.detection.persistence_s), -BIG, 0, BIG, 0, "persistence before a detection acts (s)"},
+    {"controller.detection.max_realignments", KEY_UINT, OFF(controller.detection.max_realignments), 0, 0, 4294967295.0, 0, "0: a detection latches its fault; N: re-align up to N times"},
     {"controller.known_load_mode", KEY_BOOL, OFF(controller.known_load_mode), 0, 0, 1, 0, "Remark 1: load torque measured (true/false)"},
-    {"controller.max_phase_current_a", KEY_FLOAT, OFF(controller.max_phase_current_a), -BIG, 0, BIG, 0, "overcurrent trip (A)"},
-    {"controller.min_bus_voltage_v", KEY_FLOAT, OFF(controller.min_bus_voltage_v), -BIG, 0, BIG, 0, "undervoltage trip (V)"},
-    {"controller.max_bus_voltage_v", KEY_FLOAT, OFF(controller.max_bus_voltage_v), -BIG, 0, BIG, 0, "overvoltage trip (V)"},
-    {"controller.offset_calibration_time_s", KEY_FLOAT, OFF(controller.offset_calibration_time_s), -BIG, 0, BIG, 0, "Remark 2: bridge off this long before s-alignment, current offsets averaged (s); 0 = none"},
-    {"controller.alignment_offset_calibration", KEY_BOOL, OFF(controller.alignment_offset_calibration), 0, 0, 1, 0, "offsets also from the alignment steady states (true/false)"},
-    {"controller.steady_state_window_s", KEY_FLOAT, OFF(controller.steady_state_window_s), -BIG, 0, BIG, 0, "averaging window at the end of each alignment (s); 0 = none"},
-    {"controller.inductance_window_s", KEY_FLOAT, OFF(controller.inductance_window_s), -BIG, 0, BIG, 0, "current-rise window at the start of s-alignment for L (s); 0 = L not measured"},
-    {"controller.use_commissioned_resistance", KEY_BOOL, OFF(controller.use_commissioned_resistance), 0, 0, 1, 0, "RUN uses the measured R (true/false)"},
-    {"controller.use_commissioned_inductance", KEY_BOOL, OFF(controller.use_commissioned_inductance), 0, 0, 1, 0, "RUN uses the measured L (true/false)"},
-    {"controller.use_commissioned_torque_constant", KEY_BOOL, OFF(controller.use_commissioned_torque_constant), 0, 0, 1, 0, "RUN uses the measured k_M (true/false)"},
-    {"controller.voltage_bias_level_fraction", KEY_FLOAT, OFF(controller.voltage_bias_level_fraction), -BIG, 0, BIG, 0, "Remark 2 voltage bias: second alignment level as a fraction of the voltage (0 = off)"},
-    {"controller.dead_time_s", KEY_FLOAT, OFF(controller.dead_time_s), -BIG, 0, BIG, 0, "dead time per half-bridge to compensate (s); 0 = none"},
-    {"controller.dead_time_current_band_a", KEY_FLOAT, OFF(controller.dead_time_current_band_a), -BIG, 0, BIG, 0, "dead-time compensation linear within +/- this current (A)"},
-    {"controller.angle_correction_gain_per_s", KEY_FLOAT, OFF(controller.angle_correction_gain_per_s), -BIG, 0, BIG, 0, "pulls (c-hat, s-hat) onto the unit circle at this rate (1/s); 0 = the paper's open integrals"},
-    {"controller.angle_magnitude_bound", KEY_FLOAT, OFF(controller.angle_magnitude_bound), -BIG, 0, BIG, 0, "|c-hat^2 + s-hat^2 - 1| above -> angle lost; 0 = off"},
-    {"controller.speed_consistency_bound_rad_s", KEY_FLOAT, OFF(controller.speed_consistency_bound_rad_s), -BIG, 0, BIG, 0, "|speed from the angle's rotation - omega-hat| above -> inconsistent (rad/s); 0 = off"},
-    {"controller.stall_speed_error_rad_s", KEY_FLOAT, OFF(controller.stall_speed_error_rad_s), -BIG, 0, BIG, 0, "|omega-hat - omega*| above -> stall (rad/s); 0 = off"},
-    {"controller.observer_residual_bound_a", KEY_FLOAT, OFF(controller.observer_residual_bound_a), -BIG, 0, BIG, 0, "detection: low-passed |i - i-hat| sum above -> OBSERVER_RESIDUAL (A, 0 = off)"},
-    {"controller.detection_time_s", KEY_FLOAT, OFF(controller.detection_time_s), -BIG, 0, BIG, 0, "persistence before a detection acts (s)"},
-    {"controller.max_realignments", KEY_UINT, OFF(controller.max_realignments), 0, 0, 4294967295.0, 0, "0: a detection latches its fault; N: re-align up to N times"},
 
     /* 3600 s / 1 us = 3.6e9 periods: the core's uint32 step counter does not wrap. */
     {"run.duration_s", KEY_DOUBLE, OFF(duration_s), 0, 1, 3600, 0, "simulated time (s)"},
-    {"run.period_s", KEY_FLOAT, OFF(controller.period_s), 1e-6, 0, 0.01, 0, "control period T_s (s)"},
+    {"run.period_s", KEY_FLOAT, OFF(controller.timing.period_s), 1e-6, 0, 0.01, 0, "control period T_s (s)"},
     {"run.substeps", KEY_INT, OFF(substeps), 1, 0, 10000, 0, "RK4 steps per control period"},
-    {"run.delay_periods", KEY_UINT, OFF(controller.computational_delay_periods), 0, 0, 1, 0, "computational delay (0 or 1 period)"},
-    {"run.bus_voltage_v", KEY_DOUBLE, OFF(bus_voltage_v), 0, 1, 10000, 0, "DC bus (V)"},
+    {"run.delay_periods", KEY_UINT, OFF(controller.timing.computational_delay_periods), 0, 0, 1, 0, "computational delay (0 or 1 period)"},
+    {"run.bus_voltage_V", KEY_DOUBLE, OFF(bus_voltage_V), 0, 1, 10000, 0, "DC bus (V)"},
     {"run.theta0_deg", KEY_ANGLE_DEG, OFF(theta0_rad), -1e6, 0, 1e6, 0, "initial rotor angle (mechanical deg)"},
     {"run.omega0_rad_s", KEY_DOUBLE, OFF(omega0_rad_s), -1e4, 0, 1e4, 0, "initial speed (rad/s)"},
-    {"run.i_a0_a", KEY_DOUBLE, OFF(i_a0_a), -1e4, 0, 1e4, 0, "initial current a (A)"},
-    {"run.i_b0_a", KEY_DOUBLE, OFF(i_b0_a), -1e4, 0, 1e4, 0, "initial current b (A)"},
+    {"run.i_a0_A", KEY_DOUBLE, OFF(i_a0_A), -1e4, 0, 1e4, 0, "initial current a (A)"},
+    {"run.i_b0_A", KEY_DOUBLE, OFF(i_b0_A), -1e4, 0, 1e4, 0, "initial current b (A)"},
     {"run.decimation", KEY_INT, OFF(decimation), 1, 0, 100000000, 0, "a CSV row every N periods"},
     {"run.transient_window_s", KEY_DOUBLE, OFF(transient_window_s), 0, 0, 3600, 0, "load-transient window after t_c (s)"},
     {"run.seed", KEY_UINT, OFF(seed), 0, 0, 4294967295.0, 0, "seed of every random draw (GSL MT19937; 0 acts as 4357)"},
     {"run.loss_speed_error_rad_s", KEY_DOUBLE, OFF(loss_speed_error_rad_s), 0, 1, BIG, 0, "|omega - omega*| above this in RUN counts as loss of control (rad/s)"},
-    {"run.max_csv_mb", KEY_DOUBLE, OFF(max_csv_mb), 0, 1, 1e6, 0, "refuse to start a run whose run.csv would exceed this (MB)"},
+    {"run.max_csv_MB", KEY_DOUBLE, OFF(max_csv_MB), 0, 1, 1e6, 0, "refuse to start a run whose run.csv would exceed this (MB)"},
     {"run.loss_angle_error_rad", KEY_DOUBLE, OFF(loss_angle_error_rad), 0, 1, BIG, 0, "angle-estimate error above this in RUN counts as loss of control (rad)"},
 
     {"speed.points", KEY_SPEED_POINTS, 0, 0, 0, 0, 0, "set-point t:omega pairs (s:rad/s), piecewise linear"},
-    {"speed.id_target_a", KEY_DOUBLE, OFF(id_target_a), -1e4, 0, 1e4, 0, "i_d* (A)"},
+    {"speed.id_target_A", KEY_DOUBLE, OFF(id_target_A), -1e4, 0, 1e4, 0, "i_d* (A)"},
 
     {"load.type", KEY_LOAD_KIND, 0, 0, 0, 0, 0, "none | constant | step | proportional | table"},
-    {"load.torque_nm", KEY_DOUBLE, OFF(load.torque_nm), -1e6, 0, 1e6, 0, "constant / step load (Nm)"},
+    {"load.torque_Nm", KEY_DOUBLE, OFF(load.torque_Nm), -1e6, 0, 1e6, 0, "constant / step load (Nm)"},
     {"load.step_time_s", KEY_DOUBLE, OFF(load.step_time_s), 0, 0, 3600, 0, "time of the step (s)"},
-    {"load.coefficient_nm_s_per_rad", KEY_DOUBLE, OFF(load.coefficient_nm_s_per_rad), -1e6, 0, 1e6, 0, "proportional load T_L = c omega"},
+    {"load.coefficient_Nms_rad", KEY_DOUBLE, OFF(load.coefficient_Nms_rad), -1e6, 0, 1e6, 0, "proportional load T_L = c omega"},
     {"load.points", KEY_LOAD_POINTS, 0, 0, 0, 0, 0, "table t:T_L pairs (s:Nm), piecewise linear"},
 
     {"sensors.adc_bits", KEY_ADC_BITS, OFF(sensors.adc_bits), 0, 0, 16, 0, "ADC resolution: 0 = ideal (no quantisation), or 8..16 bits"},
-    {"sensors.current_full_scale_a", KEY_DOUBLE, OFF(sensors.current_full_scale_a), 0, 1, 1e6, 0, "current ADC span +/- this, mid-tread, clips beyond (A)"},
-    {"sensors.offset_a_a", KEY_DOUBLE, OFF(sensors.offset_a_a), -1e6, 0, 1e6, 0, "current-sensor offset, phase a (A)"},
-    {"sensors.offset_b_a", KEY_DOUBLE, OFF(sensors.offset_b_a), -1e6, 0, 1e6, 0, "current-sensor offset, phase b (A)"},
+    {"sensors.current_full_scale_A", KEY_DOUBLE, OFF(sensors.current_full_scale_A), 0, 1, 1e6, 0, "current ADC span +/- this, mid-tread, clips beyond (A)"},
+    {"sensors.offset_a_A", KEY_DOUBLE, OFF(sensors.offset_a_A), -1e6, 0, 1e6, 0, "current-sensor offset, phase a (A)"},
+    {"sensors.offset_b_A", KEY_DOUBLE, OFF(sensors.offset_b_A), -1e6, 0, 1e6, 0, "current-sensor offset, phase b (A)"},
     {"sensors.gain_error_a", KEY_DOUBLE, OFF(sensors.gain_error_a), -0.5, 1, 0.5, 1, "current-sensor gain error, phase a (fraction)"},
     {"sensors.gain_error_b", KEY_DOUBLE, OFF(sensors.gain_error_b), -0.5, 1, 0.5, 1, "current-sensor gain error, phase b (fraction)"},
-    {"sensors.noise_rms_a", KEY_DOUBLE, OFF(sensors.noise_rms_a), 0, 0, 1e6, 0, "Gaussian current noise per phase per sample (A rms)"},
-    {"sensors.bus_full_scale_v", KEY_DOUBLE, OFF(sensors.bus_full_scale_v), 0, 1, 1e6, 0, "bus ADC span [0, this] (V)"},
-    {"sensors.bus_noise_rms_v", KEY_DOUBLE, OFF(sensors.bus_noise_rms_v), 0, 0, 1e6, 0, "Gaussian bus-voltage noise per sample (V rms)"},
+    {"sensors.noise_rms_A", KEY_DOUBLE, OFF(sensors.noise_rms_A), 0, 0, 1e6, 0, "Gaussian current noise per phase per sample (A rms)"},
+    {"sensors.bus_full_scale_V", KEY_DOUBLE, OFF(sensors.bus_full_scale_V), 0, 1, 1e6, 0, "bus ADC span [0, this] (V)"},
+    {"sensors.bus_noise_rms_V", KEY_DOUBLE, OFF(sensors.bus_noise_rms_V), 0, 0, 1e6, 0, "Gaussian bus-voltage noise per sample (V rms)"},
 
     {"inverter.model", KEY_INVERTER_MODEL, OFF(inverter.model), 0, 0, 0, 0, "averaged | switching"},
     {"inverter.dead_time_s", KEY_DOUBLE, OFF(inverter.dead_time_s), 0, 0, 0.01, 1, "dead time per half-bridge (s), below run.period_s / 4"},
 
-    {"bus.source_resistance_ohm", KEY_DOUBLE, OFF(bus.source_resistance_ohm), 0, 0, 1e6, 0, "sag V_bus = run.bus_voltage_v - R i_bus (Ohm)"},
-    {"bus.ripple_v", KEY_DOUBLE, OFF(bus.ripple_v), 0, 0, 1e4, 0, "bus ripple amplitude, ripple_v sin(2 pi ripple_hz t) (V)"},
-    {"bus.ripple_hz", KEY_DOUBLE, OFF(bus.ripple_hz), 0, 0, 1e6, 0, "bus ripple frequency (Hz)"},
+    {"bus.source_resistance_Ohm", KEY_DOUBLE, OFF(bus.source_resistance_Ohm), 0, 0, 1e6, 0, "sag V_bus = run.bus_voltage_V - R i_bus (Ohm)"},
+    {"bus.ripple_V", KEY_DOUBLE, OFF(bus.ripple_V), 0, 0, 1e4, 0, "bus ripple amplitude, ripple_V sin(2 pi ripple_Hz t) (V)"},
+    {"bus.ripple_Hz", KEY_DOUBLE, OFF(bus.ripple_Hz), 0, 0, 1e6, 0, "bus ripple frequency (Hz)"},
 };
 
 static const char *const load_kind_names[] = {"none", "constant", "step", "proportional", "table"};
@@ -221,7 +221,7 @@ int sil_scenario_set(sil_scenario_t *sc, const char *key, const char *value, cha
             return parse_points(key, value, sc->speed_time_s, sc->speed_value_rad_s, SIL_SPEED_POINTS_MAX,
                                 &sc->speed_points, err, err_size);
         case KEY_LOAD_POINTS:
-            return parse_points(key, value, sc->load.table_time_s, sc->load.table_torque_nm, PLANT_LOAD_TABLE_MAX,
+            return parse_points(key, value, sc->load.table_time_s, sc->load.table_torque_Nm, PLANT_LOAD_TABLE_MAX,
                                 &sc->load.table_points, err, err_size);
         case KEY_LOAD_KIND: {
             size_t j;
@@ -496,25 +496,25 @@ int sil_scenario_check(const sil_scenario_t *sc, char *err, size_t err_size)
     if (sc->speed_points == 0) {
         return fail(err, err_size, "speed.points: no set-point profile");
     }
-    if (!(sc->inverter.dead_time_s < 0.25 * (double)sc->controller.period_s)) {
+    if (!(sc->inverter.dead_time_s < 0.25 * (double)sc->controller.timing.period_s)) {
         return fail(err, err_size, "inverter.dead_time_s = %g is not below run.period_s / 4 = %g", sc->inverter.dead_time_s,
-                    0.25 * (double)sc->controller.period_s);
+                    0.25 * (double)sc->controller.timing.period_s);
     }
-    if (sc->sensors.adc_bits > 0u && sc->sensors.current_full_scale_a < (double)sc->controller.max_phase_current_a) {
+    if (sc->sensors.adc_bits > 0u && sc->sensors.current_full_scale_A < (double)sc->controller.limits.max_phase_current_A) {
         return fail(err, err_size,
-                    "sensors.current_full_scale_a = %g is below controller.max_phase_current_a = %g: the ADC would clip "
+                    "sensors.current_full_scale_A = %g is below controller.limits.max_phase_current_A = %g: the ADC would clip "
                     "before the trip",
-                    sc->sensors.current_full_scale_a, (double)sc->controller.max_phase_current_a);
+                    sc->sensors.current_full_scale_A, (double)sc->controller.limits.max_phase_current_A);
     }
-    if (sc->sensors.adc_bits > 0u && sc->sensors.bus_full_scale_v < (double)sc->controller.max_bus_voltage_v) {
+    if (sc->sensors.adc_bits > 0u && sc->sensors.bus_full_scale_V < (double)sc->controller.limits.max_bus_voltage_V) {
         return fail(err, err_size,
-                    "sensors.bus_full_scale_v = %g is below controller.max_bus_voltage_v = %g: the ADC would clip "
+                    "sensors.bus_full_scale_V = %g is below controller.limits.max_bus_voltage_V = %g: the ADC would clip "
                     "before the overvoltage trip",
-                    sc->sensors.bus_full_scale_v, (double)sc->controller.max_bus_voltage_v);
+                    sc->sensors.bus_full_scale_V, (double)sc->controller.limits.max_bus_voltage_V);
     }
-    if (!(sc->bus.ripple_v < sc->bus_voltage_v)) {
-        return fail(err, err_size, "bus.ripple_v = %g is not below run.bus_voltage_v = %g: the bus would reach zero",
-                    sc->bus.ripple_v, sc->bus_voltage_v);
+    if (!(sc->bus.ripple_V < sc->bus_voltage_V)) {
+        return fail(err, err_size, "bus.ripple_V = %g is not below run.bus_voltage_V = %g: the bus would reach zero",
+                    sc->bus.ripple_V, sc->bus_voltage_V);
     }
     return 0;
 }
@@ -552,7 +552,7 @@ void sil_scenario_print(const sil_scenario_t *sc, FILE *file)
     fprintf(file, "[scenario]\nname = %s\n", sc->name);
     for (n = 0; n < sizeof keys / sizeof keys[0]; ++n) {
         const key_t_ *k = &keys[n];
-        const char *dot = strchr(k->name, '.');
+        const char *dot = strrchr(k->name, '.'); /* [controller.gains] speed_gain_per_s = ... */
         const size_t section_len = (size_t)(dot - k->name);
         if (strncmp(section, k->name, section_len) != 0 || section[section_len] != '\0') {
             static char current[32];
@@ -572,7 +572,7 @@ void sil_scenario_print(const sil_scenario_t *sc, FILE *file)
         case KEY_SPEED_POINTS: print_points(file, sc->speed_time_s, sc->speed_value_rad_s, sc->speed_points); break;
         case KEY_LOAD_POINTS:
             if (sc->load.table_points > 0) {
-                print_points(file, sc->load.table_time_s, sc->load.table_torque_nm, sc->load.table_points);
+                print_points(file, sc->load.table_time_s, sc->load.table_torque_Nm, sc->load.table_points);
             } else {
                 fprintf(file, "0:0\n");
             }

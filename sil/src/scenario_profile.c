@@ -17,11 +17,11 @@ void sil_scenario_paper(sil_scenario_t *sc)
     sc->motor = plant_paper_params();
     sc->controller = pmstep_paper_config();
     sc->load.kind = PLANT_LOAD_STEP;
-    sc->load.torque_nm = 2.0;
+    sc->load.torque_Nm = 2.0;
     sc->load.step_time_s = 0.63;
     sc->duration_s = 2.4;
     sc->substeps = 10;
-    sc->bus_voltage_v = 48.0;
+    sc->bus_voltage_V = 48.0;
     sc->theta0_rad = 30.0 * PI / 180.0;
     sc->decimation = 10;
     sc->transient_window_s = 0.2;
@@ -30,10 +30,10 @@ void sil_scenario_paper(sil_scenario_t *sc)
         sc->speed_time_s[k] = times[k];
         sc->speed_value_rad_s[k] = speeds[k];
     }
-    sc->id_target_a = 0.0;
+    sc->id_target_A = 0.0;
     sc->loss_speed_error_rad_s = 2.0;
     sc->loss_angle_error_rad = 0.5;
-    sc->max_csv_mb = 1000.0;
+    sc->max_csv_MB = 1000.0;
     /* Measurement chain, inverter and bus: all ideal. */
     sc->seed = 1u;
     sc->sensors = sil_sensors_ideal();

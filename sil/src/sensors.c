@@ -56,33 +56,33 @@ static double current_sample(sil_sensors_t *s, double i_a, double gain_error, do
     if (offset_a != 0.0) {
         x += offset_a;
     }
-    if (c->noise_rms_a > 0.0) {
-        x += gsl_ran_gaussian_ziggurat((gsl_rng *)s->rng, c->noise_rms_a);
+    if (c->noise_rms_A > 0.0) {
+        x += gsl_ran_gaussian_ziggurat((gsl_rng *)s->rng, c->noise_rms_A);
     }
     if (c->adc_bits > 0u) {
         int clipped;
-        x = sil_adc_quantise(x, -c->current_full_scale_a, c->current_full_scale_a, c->adc_bits, &clipped);
+        x = sil_adc_quantise(x, -c->current_full_scale_A, c->current_full_scale_A, c->adc_bits, &clipped);
         s->clipped_current_samples += (unsigned long)clipped;
     }
     return x;
 }
 
-void sil_sensors_currents(sil_sensors_t *s, double i_a_a, double i_b_a, double *i_a_meas_a, double *i_b_meas_a)
+void sil_sensors_currents(sil_sensors_t *s, double i_a_A, double i_b_A, double *i_a_meas_A, double *i_b_meas_A)
 {
-    *i_a_meas_a = current_sample(s, i_a_a, s->cfg.gain_error_a, s->cfg.offset_a_a);
-    *i_b_meas_a = current_sample(s, i_b_a, s->cfg.gain_error_b, s->cfg.offset_b_a);
+    *i_a_meas_A = current_sample(s, i_a_A, s->cfg.gain_error_a, s->cfg.offset_a_A);
+    *i_b_meas_A = current_sample(s, i_b_A, s->cfg.gain_error_b, s->cfg.offset_b_A);
 }
 
-double sil_sensors_bus(sil_sensors_t *s, double bus_v)
+double sil_sensors_bus(sil_sensors_t *s, double bus_V)
 {
     const sil_sensor_config_t *c = &s->cfg;
-    double x = bus_v;
-    if (c->bus_noise_rms_v > 0.0) {
-        x += gsl_ran_gaussian_ziggurat((gsl_rng *)s->rng, c->bus_noise_rms_v);
+    double x = bus_V;
+    if (c->bus_noise_rms_V > 0.0) {
+        x += gsl_ran_gaussian_ziggurat((gsl_rng *)s->rng, c->bus_noise_rms_V);
     }
     if (c->adc_bits > 0u) {
         int clipped;
-        x = sil_adc_quantise(x, 0.0, c->bus_full_scale_v, c->adc_bits, &clipped);
+        x = sil_adc_quantise(x, 0.0, c->bus_full_scale_V, c->adc_bits, &clipped);
         s->clipped_bus_samples += (unsigned long)clipped;
     }
     return x;

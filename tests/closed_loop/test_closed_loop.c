@@ -36,22 +36,22 @@ static bool collect(const sil_sample_t *x, void *user)
         }
         m->max_cos_err = fmax(m->max_cos_err, fabs((double)o->cos_hat - x->cos_ptheta));
         m->max_sin_err = fmax(m->max_sin_err, fabs((double)o->sin_hat - x->sin_ptheta));
-        m->load_hat_end = (double)o->load_hat_nm;
-        m->load_end = x->load_nm;
+        m->load_hat_end = (double)o->load_hat_Nm;
+        m->load_end = x->load_Nm;
     }
     return true;
 }
 
 static void run(const sil_scenario_t *sc, metrics_t *m, sil_summary_t *s)
 {
-    m->t_c = (double)sc->controller.c_align_time_s;
+    m->t_c = (double)sc->controller.alignment.c_align_time_s;
     m->peak_transient = m->max_tracking = m->max_cos_err = m->max_sin_err = 0.0;
     m->load_hat_end = m->load_end = 0.0;
     m->saw_run = 0;
     assert_int_equal(sil_run(sc, collect, m, false, s), 0);
     print_message("  %5.0f Hz delay %u theta0 %6.2f deg: cos(t_s) %.2e, cos(t_c) %.9f, peak %.4f, track %.5f rad/s, "
                   "T_L-hat %.5f Nm, angle err %.2e/%.2e\n",
-                  1.0 / (double)sc->controller.period_s, (unsigned)sc->controller.computational_delay_periods,
+                  1.0 / (double)sc->controller.timing.period_s, (unsigned)sc->controller.timing.computational_delay_periods,
                   sc->theta0_rad * 180.0 / PI, s->cos_ptheta_at_ts, s->cos_ptheta_at_tc, m->peak_transient,
                   m->max_tracking, m->load_hat_end, m->max_cos_err, m->max_sin_err);
     assert_int_equal(s->fault, PMSTEP_FAULT_NONE);
@@ -89,8 +89,8 @@ static void other_rates_and_delay_converge_and_track(void **state)
         metrics_t m;
         sil_summary_t s;
         sil_scenario_paper(&sc);
-        sc.controller.period_s = cases[n].period_s;
-        sc.controller.computational_delay_periods = cases[n].delay;
+        sc.controller.timing.period_s = cases[n].period_s;
+        sc.controller.timing.computational_delay_periods = cases[n].delay;
         run(&sc, &m, &s);
         assert_true(fabs(s.cos_ptheta_at_ts) < 1e-3);
         assert_true(s.cos_ptheta_at_tc > 0.9999);

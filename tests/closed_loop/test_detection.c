@@ -35,19 +35,19 @@ static void resistance_error_in_paper_mode_is_caught(void **state)
     static sil_scenario_t sc;
     (void)state;
     sil_scenario_paper(&sc);
-    sc.motor.resistance_ohm *= 1.2;
+    sc.motor.resistance_Ohm *= 1.2;
     (void)run_and_check("plant R +20 %, paper mode", &sc, NULL, NULL);
 }
 
 /* Remark 2 calibration and self-commissioning on (what robust.ini uses). */
 static void commissioning_on(sil_scenario_t *sc)
 {
-    sc->controller.steady_state_window_s = 0.05f;
-    sc->controller.inductance_window_s = 0.0005f;
-    sc->controller.alignment_offset_calibration = true;
-    sc->controller.use_commissioned_resistance = true;
-    sc->controller.use_commissioned_inductance = true;
-    sc->controller.use_commissioned_torque_constant = true;
+    sc->controller.commissioning.steady_state_window_s = 0.05f;
+    sc->controller.commissioning.inductance_window_s = 0.0005f;
+    sc->controller.commissioning.alignment_offset_calibration = true;
+    sc->controller.commissioning.use_measured_resistance = true;
+    sc->controller.commissioning.use_measured_inductance = true;
+    sc->controller.commissioning.use_measured_torque_constant = true;
 }
 
 static void rotor_that_does_not_align_fails_commissioning(void **state)
@@ -58,7 +58,7 @@ static void rotor_that_does_not_align_fails_commissioning(void **state)
     (void)state;
     sil_scenario_paper(&sc);
     commissioning_on(&sc);
-    sc.motor.inertia_kg_m2 *= 1e4;
+    sc.motor.inertia_kgm2 *= 1e4;
     sc.load.kind = PLANT_LOAD_NONE;
     assert_int_equal(run_and_check("rotor locked (J x 1e4), commissioning", &sc, NULL, NULL),
                      PMSTEP_FAULT_COMMISSIONING);
@@ -72,7 +72,7 @@ static void rotor_that_does_not_align_stalls_in_paper_mode(void **state)
     sil_summary_t s;
     (void)state;
     sil_scenario_paper(&sc);
-    sc.motor.inertia_kg_m2 *= 1e4;
+    sc.motor.inertia_kgm2 *= 1e4;
     sc.load.kind = PLANT_LOAD_NONE;
     assert_int_equal(sil_run(&sc, NULL, NULL, false, &s), 0);
     print_message("  %-40s fault %-18s at %.4f s (w* leaves 0 at 0.65 s)\n", "rotor locked (J x 1e4), paper mode",
@@ -89,7 +89,7 @@ static void jammed_load_is_caught(void **state)
     sil_scenario_paper(&sc);
     commissioning_on(&sc);
     sc.load.kind = PLANT_LOAD_STEP;
-    sc.load.torque_nm = 40.0;
+    sc.load.torque_Nm = 40.0;
     sc.load.step_time_s = 1.0;
     (void)run_and_check("load jams to 40 Nm at 1.0 s", &sc, NULL, NULL);
 }

@@ -35,9 +35,9 @@ static void acceptance(sil_inverter_model_t model)
                   model == SIL_INVERTER_SWITCHING ? "switching" : "averaged", (unsigned)sc.seed,
                   pmstep_mode_str(s.final_mode), pmstep_fault_str(s.fault), s.settle_time_s, s.max_angle_error_rad,
                   s.max_speed_error_after_settle_rad_s, s.tracking_rms_speed_error_rad_s,
-                  (double)s.commissioning.resistance_ohm, 1e3 * (double)s.commissioning.inductance_h,
-                  (double)s.commissioning.torque_constant_nm_per_a, 1e3 * (double)s.commissioning.offset_a_a,
-                  1e3 * (double)s.commissioning.offset_b_a, pmstep_hal_host_state()->sensors.clipped_current_samples);
+                  (double)s.commissioning.resistance_Ohm, 1e3 * (double)s.commissioning.inductance_H,
+                  (double)s.commissioning.torque_constant_Nm_A, 1e3 * (double)s.commissioning.offset_a_A,
+                  1e3 * (double)s.commissioning.offset_b_A, pmstep_hal_host_state()->sensors.clipped_current_samples);
     assert_true(sc.duration_s - s.settle_time_s >= 30.0);
     assert_int_equal(s.fault, PMSTEP_FAULT_NONE);
     assert_int_equal(s.final_mode, PMSTEP_MODE_RUN);

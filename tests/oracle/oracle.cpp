@@ -23,12 +23,12 @@ Scenario paper_scenario()
     sc.gains = Gains{100.0, 100.0, 20.0, 0.01 / 9.0, 0.2, 1.0, 9.0, 300.0};
     sc.s_align_time_s = 0.3;
     sc.c_align_time_s = 0.6;
-    sc.s_align_voltage_v = 24.0;
-    sc.c_align_voltage_v = 24.0;
+    sc.s_align_voltage_V = 24.0;
+    sc.c_align_voltage_V = 24.0;
     sc.theta0_rad = 30.0 * M_PI / 180.0;
     sc.omega0_rad_s = 0.0;
-    sc.i_a0_a = 0.0;
-    sc.i_b0_a = 0.0;
+    sc.i_a0_A = 0.0;
+    sc.i_b0_A = 0.0;
     // Ramps: 0 -> 10 rad/s over [0.65, 0.85], -> -10 over [1.2, 1.5], -> 0 over [1.8, 2.0].
     sc.speed_commands = {{0.65, 10.0, 50.0}, {1.2, -10.0, 20.0 / 0.3}, {1.8, 0.0, 50.0}};
     sc.load_steps = {{0.63, 2.0}}; // 2 Nm (rated) at 0.63 s
@@ -37,34 +37,34 @@ Scenario paper_scenario()
     return sc;
 }
 
-double lyapunov_s(const Motor &m, double u_cs_v, double theta_rad, double omega_rad_s, double i_a_a, double i_b_a)
+double lyapunov_s(const Motor &m, double u_cs_V, double theta_rad, double omega_rad_s, double i_a_A, double i_b_A)
 {
-    const double i_b_err = i_b_a - u_cs_v / m.resistance_ohm;
+    const double i_b_err = i_b_A - u_cs_V / m.resistance_Ohm;
     const double p = m.pole_pairs;
-    return 0.5 * (m.inertia_kg_m2 / m.inductance_h * omega_rad_s * omega_rad_s + i_a_a * i_a_a + i_b_err * i_b_err)
-           - m.torque_constant_nm_per_a * u_cs_v / (p * m.inductance_h * m.resistance_ohm)
+    return 0.5 * (m.inertia_kgm2 / m.inductance_H * omega_rad_s * omega_rad_s + i_a_A * i_a_A + i_b_err * i_b_err)
+           - m.torque_constant_Nm_A * u_cs_V / (p * m.inductance_H * m.resistance_Ohm)
                  * (std::sin(p * theta_rad) - 2.0);
 }
 
-double lyapunov_c(const Motor &m, double u_cc_v, double theta_rad, double omega_rad_s, double i_a_a, double i_b_a)
+double lyapunov_c(const Motor &m, double u_cc_V, double theta_rad, double omega_rad_s, double i_a_A, double i_b_A)
 {
-    const double i_a_err = i_a_a - u_cc_v / m.resistance_ohm;
+    const double i_a_err = i_a_A - u_cc_V / m.resistance_Ohm;
     const double p = m.pole_pairs;
-    return 0.5 * (m.inertia_kg_m2 / m.inductance_h * omega_rad_s * omega_rad_s + i_a_err * i_a_err + i_b_a * i_b_a)
-           - m.torque_constant_nm_per_a * u_cc_v / (p * m.inductance_h * m.resistance_ohm)
+    return 0.5 * (m.inertia_kgm2 / m.inductance_H * omega_rad_s * omega_rad_s + i_a_err * i_a_err + i_b_A * i_b_A)
+           - m.torque_constant_Nm_A * u_cc_V / (p * m.inductance_H * m.resistance_Ohm)
                  * (std::cos(p * theta_rad) - 2.0);
 }
 
 double speed_injection_gain(const Motor &m, const Gains &g)
 {
-    const double J = m.inertia_kg_m2, F = m.friction_nm_s_per_rad;
+    const double J = m.inertia_kgm2, F = m.friction_Nms_rad;
     const double den = g.gamma * g.gamma * g.lambda + g.r * F * g.lambda * g.lambda * J * J;
     return (2.0 * g.gamma * g.gamma + g.r * F * g.lambda * J * J) / den;
 }
 
 double load_injection_gain(const Motor &m, const Gains &g)
 {
-    const double J = m.inertia_kg_m2, F = m.friction_nm_s_per_rad;
+    const double J = m.inertia_kgm2, F = m.friction_Nms_rad;
     const double den = g.gamma * g.gamma * g.lambda + g.r * F * g.lambda * g.lambda * J * J;
     return (2.0 * g.gamma * g.gamma * F + g.lambda * J * g.gamma + g.lambda * J * J * g.r * F * F) / den;
 }
@@ -142,7 +142,7 @@ double load_at(const Scenario &sc, double t_s)
     double torque = 0.0;
     for (const LoadStep &s : sc.load_steps) {
         if (s.time_s <= t_s) {
-            torque = s.torque_nm;
+            torque = s.torque_Nm;
         }
     }
     return torque;
@@ -161,24 +161,24 @@ void smooth_sat(double x, double kappa, double &sat, double &slope)
 struct ClosedLoop {
     const Scenario &sc;
     Phase phase;
-    double load_nm;          ///< T_L on the segment
+    double load_Nm;          ///< T_L on the segment
     SetpointPiece setpoint;
-    double i_a_tc_a, i_b_tc_a; ///< i_a(t_c), i_b(t_c) of the angle formula of (6)
+    double i_a_tc_A, i_b_tc_A; ///< i_a(t_c), i_b(t_c) of the angle formula of (6)
 
     /** Evaluates the law and, when @p dx is given, the time derivative of the state. */
     void eval(const State &x, double t, Signals &sig, State *dx) const
     {
         const Motor &m = sc.motor;
         const Gains &g = sc.gains;
-        const double R = m.resistance_ohm, L = m.inductance_h, J = m.inertia_kg_m2;
-        const double F = m.friction_nm_s_per_rad, kM = m.torque_constant_nm_per_a;
+        const double R = m.resistance_Ohm, L = m.inductance_H, J = m.inertia_kgm2;
+        const double F = m.friction_Nms_rad, kM = m.torque_constant_Nm_A;
         const double p = m.pole_pairs;
         const double w0 = g.reference_bandwidth_rad_s;
         const double theta = x[idx::theta], omega = x[idx::omega], i_a = x[idx::i_a], i_b = x[idx::i_b];
         const double sin_pt = std::sin(p * theta), cos_pt = std::cos(p * theta);
 
         sig = Signals();
-        sig.load_nm = load_nm;
+        sig.load_Nm = load_Nm;
         double u_a = 0.0, u_b = 0.0;
         double d_phi1 = 0.0, d_phi2 = 0.0, d_ia_hat = 0.0, d_ib_hat = 0.0, d_omega_hat = 0.0, d_load_hat = 0.0;
         double d_ref1 = 0.0, d_ref2 = 0.0, d_ref3 = 0.0, d_lref1 = 0.0, d_lref2 = 0.0, d_lref3 = 0.0;
@@ -186,13 +186,13 @@ struct ClosedLoop {
 
         if (phase == Phase::s_align) {
             // (3): u_a = 0, u_b = u_cs. Theorem 1: U_s' = -(F/L) w^2 - (R/L)(i_a^2 + (i_b - u_cs/R)^2).
-            u_b = sc.s_align_voltage_v;
-            const double i_b_err = i_b - sc.s_align_voltage_v / R;
+            u_b = sc.s_align_voltage_V;
+            const double i_b_err = i_b - sc.s_align_voltage_V / R;
             d_dissipation = -(F / L) * omega * omega - (R / L) * (i_a * i_a + i_b_err * i_b_err);
         } else if (phase == Phase::c_align) {
             // (5): u_a = u_cc, u_b = 0. Theorem 2: U_c' = -(F/L) w^2 - (R/L)((i_a - u_cc/R)^2 + i_b^2).
-            u_a = sc.c_align_voltage_v;
-            const double i_a_err = i_a - sc.c_align_voltage_v / R;
+            u_a = sc.c_align_voltage_V;
+            const double i_a_err = i_a - sc.c_align_voltage_V / R;
             d_dissipation = -(F / L) * omega * omega - (R / L) * (i_a_err * i_a_err + i_b * i_b);
         } else {
             // Controller (6) (design notes, section 3).
@@ -200,8 +200,8 @@ struct ClosedLoop {
             const double i_a_hat = x[idx::i_a_hat], i_b_hat = x[idx::i_b_hat];
             const double omega_hat = x[idx::omega_hat], load_hat = x[idx::load_hat];
             // Angle from the current integrals: c-hat, s-hat.
-            const double c_hat = -(L * p / kM) * (i_a - i_a_tc_a - phi1) + 1.0;
-            const double s_hat = -(L * p / kM) * (i_b - i_b_tc_a - phi2);
+            const double c_hat = -(L * p / kM) * (i_a - i_a_tc_A - phi1) + 1.0;
+            const double s_hat = -(L * p / kM) * (i_b - i_b_tc_A - phi2);
             // Park with the estimate.
             const double i_d = c_hat * i_a + s_hat * i_b;
             const double i_q = -s_hat * i_a + c_hat * i_b;
@@ -213,12 +213,12 @@ struct ClosedLoop {
             d_ref3 = w0 * (x2 - x3);
             const double w_ref = x3, w_ref_rate = d_ref3, w_ref_accel = w0 * (d_ref2 - d_ref3);
             // T_L* of Remark 1: the same H(s) applied to the known load.
-            d_lref1 = w0 * (load_nm - x[idx::lref1]);
+            d_lref1 = w0 * (load_Nm - x[idx::lref1]);
             d_lref2 = w0 * (x[idx::lref1] - x[idx::lref2]);
             d_lref3 = w0 * (x[idx::lref2] - x[idx::lref3]);
             const double load_star = x[idx::lref3], load_star_rate = d_lref3;
             // i_d* = 0 (Section III.B).
-            const double i_d_ref = 0.0, i_d_ref_rate = 0.0;
+            const double i_d_ref = 0.0, i_d_ref_rate_A_s = 0.0;
             // Injection term eps = (k_M/L)(s-hat i~_a - c-hat i~_b).
             const double i_a_err = i_a - i_a_hat, i_b_err = i_b - i_b_hat;
             const double eps = (kM / L) * (s_hat * i_a_err - c_hat * i_b_err);
@@ -255,7 +255,7 @@ struct ClosedLoop {
             // i_q*' with the observer's own right-hand sides (design notes, errata).
             const double i_q_ref_rate = (J / kM) * ((F / J) * w_ref_rate - speed_slope * (d_omega_hat - w_ref_rate)
                                                     + law_load_rate / J + w_ref_accel);
-            const double phi_d = -(R / L) * i_d_ref + p * omega_hat * i_q - i_d_ref_rate;
+            const double phi_d = -(R / L) * i_d_ref + p * omega_hat * i_q - i_d_ref_rate_A_s;
             const double phi_q = -(R / L) * i_q_ref - p * omega_hat * i_d - (kM / L) * omega_hat - i_q_ref_rate;
             const double u_d = L * (-phi_d - g.current_gain_per_s * (i_d - i_d_ref));
             const double u_q = L * (-phi_q - g.current_gain_per_s * (i_q - i_q_ref));
@@ -276,20 +276,20 @@ struct ClosedLoop {
             sig.omega_ref_accel_rad_s3 = w_ref_accel;
             sig.cos_hat = c_hat;
             sig.sin_hat = s_hat;
-            sig.i_d_a = i_d;
-            sig.i_q_a = i_q;
-            sig.i_q_ref_a = i_q_ref;
-            sig.law_load_nm = law_load;
+            sig.i_d_A = i_d;
+            sig.i_q_A = i_q;
+            sig.i_q_ref_A = i_q_ref;
+            sig.law_load_Nm = law_load;
         }
-        sig.u_a_v = u_a;
-        sig.u_b_v = u_b;
+        sig.u_a_V = u_a;
+        sig.u_b_V = u_b;
 
         if (dx != nullptr) {
             State &d = *dx;
             d.resize(idx::size);
             // Plant (1).
             d[idx::theta] = omega;
-            d[idx::omega] = -(F / J) * omega + (kM / J) * (-i_a * sin_pt + i_b * cos_pt) - load_nm / J;
+            d[idx::omega] = -(F / J) * omega + (kM / J) * (-i_a * sin_pt + i_b * cos_pt) - load_Nm / J;
             d[idx::i_a] = -(R / L) * i_a + (kM / L) * omega * sin_pt + u_a / L;
             d[idx::i_b] = -(R / L) * i_b - (kM / L) * omega * cos_pt + u_b / L;
             d[idx::phi1] = d_phi1;
@@ -339,8 +339,8 @@ std::vector<Sample> simulate(const Scenario &sc, const std::vector<double> &samp
     State x = State::Zero(idx::size);
     x[idx::theta] = sc.theta0_rad;
     x[idx::omega] = sc.omega0_rad_s;
-    x[idx::i_a] = sc.i_a0_a;
-    x[idx::i_b] = sc.i_b0_a;
+    x[idx::i_a] = sc.i_a0_A;
+    x[idx::i_b] = sc.i_b0_A;
 
     std::vector<Sample> out;
     out.reserve(sample_times_s.size());
@@ -364,10 +364,10 @@ std::vector<Sample> simulate(const Scenario &sc, const std::vector<double> &samp
             i_b_tc = x[idx::i_b];
             x[idx::phi1] = 0.0;
             x[idx::phi2] = 0.0;
-            x[idx::i_a_hat] = x[idx::i_a] - err.i_a_err_a;
-            x[idx::i_b_hat] = x[idx::i_b] - err.i_b_err_a;
+            x[idx::i_a_hat] = x[idx::i_a] - err.i_a_err_A;
+            x[idx::i_b_hat] = x[idx::i_b] - err.i_b_err_A;
             x[idx::omega_hat] = err.speed_err_rad_s;
-            x[idx::load_hat] = -err.load_err_nm - sc.motor.friction_nm_s_per_rad * err.speed_err_rad_s;
+            x[idx::load_hat] = -err.load_err_Nm - sc.motor.friction_Nms_rad * err.speed_err_rad_s;
             if (sc.known_load) {
                 x[idx::load_hat] = 0.0;
             }

@@ -25,11 +25,11 @@ namespace pmstep_oracle {
 
 /** Motor of model (1). */
 struct Motor {
-    double resistance_ohm;          ///< R
-    double inductance_h;            ///< L
-    double inertia_kg_m2;           ///< J
-    double friction_nm_s_per_rad;   ///< F >= 0
-    double torque_constant_nm_per_a;///< k_M
+    double resistance_Ohm;          ///< R
+    double inductance_H;            ///< L
+    double inertia_kgm2;           ///< J
+    double friction_Nms_rad;   ///< F >= 0
+    double torque_constant_Nm_A;///< k_M
     int pole_pairs;                 ///< p
 };
 
@@ -56,17 +56,17 @@ struct RampCommand {
 /** Load steps: T_L(t) = torque of the last step with time_s <= t, 0 before the first. */
 struct LoadStep {
     double time_s;
-    double torque_nm;
+    double torque_Nm;
 };
 
 /** Offsets of controller (6)'s initial estimates at t_c (zero in the paper): the estimates start at
  *  i-hat = i(t_c) - i~, w-hat = 0 + e_w, T_L-hat = 0 - T~_L - F e_w, so the estimation errors
  *  (i~_a, i~_b, e_w, T~_L) of Theorem 3 grow by these amounts. */
 struct InitialErrors {
-    double i_a_err_a = 0.0;   ///< i~_a(t_c) = i_a - i_a-hat
-    double i_b_err_a = 0.0;   ///< i~_b(t_c)
+    double i_a_err_A = 0.0;   ///< i~_a(t_c) = i_a - i_a-hat
+    double i_b_err_A = 0.0;   ///< i~_b(t_c)
     double speed_err_rad_s = 0.0; ///< e_w(t_c) = w-hat - w
-    double load_err_nm = 0.0; ///< T~_L(t_c) = T_L - T_L-hat - F e_w
+    double load_err_Nm = 0.0; ///< T~_L(t_c) = T_L - T_L-hat - F e_w
 };
 
 struct Scenario {
@@ -74,12 +74,12 @@ struct Scenario {
     Gains gains;
     double s_align_time_s;   ///< t_s
     double c_align_time_s;   ///< t_c
-    double s_align_voltage_v;///< u_cs of (3)
-    double c_align_voltage_v;///< u_cc of (5)
+    double s_align_voltage_V;///< u_cs of (3)
+    double c_align_voltage_V;///< u_cc of (5)
     double theta0_rad;
     double omega0_rad_s;
-    double i_a0_a;
-    double i_b0_a;
+    double i_a0_A;
+    double i_b0_A;
     std::vector<RampCommand> speed_commands; ///< in time order
     std::vector<LoadStep> load_steps;        ///< in time order
     bool known_load;          ///< Remark 1: law (13) with T_L* = H(s) T_L
@@ -113,10 +113,10 @@ constexpr int size = 17;
 struct Signals {
     double omega_ref_rad_s = 0, omega_ref_rate_rad_s2 = 0, omega_ref_accel_rad_s3 = 0;
     double cos_hat = 0, sin_hat = 0;     ///< estimates of cos p theta, sin p theta
-    double i_d_a = 0, i_q_a = 0, i_q_ref_a = 0;
-    double u_a_v = 0, u_b_v = 0;
-    double load_nm = 0;                  ///< true T_L
-    double law_load_nm = 0;              ///< T_L-hat, or T_L* in Remark 1
+    double i_d_A = 0, i_q_A = 0, i_q_ref_A = 0;
+    double u_a_V = 0, u_b_V = 0;
+    double load_Nm = 0;                  ///< true T_L
+    double law_load_Nm = 0;              ///< T_L-hat, or T_L* in Remark 1
 };
 
 struct Sample {
@@ -139,10 +139,10 @@ std::vector<Sample> simulate(const Scenario &sc, const std::vector<double> &samp
                              const Options &opt = Options(), Stats *stats = nullptr);
 
 /** U_s of Theorem 1's proof: (1/2)(J/L w^2 + i_a^2 + (i_b - u_cs/R)^2) - k_M u_cs/(p L R) (sin p theta - 2). */
-double lyapunov_s(const Motor &m, double u_cs_v, double theta_rad, double omega_rad_s, double i_a_a, double i_b_a);
+double lyapunov_s(const Motor &m, double u_cs_V, double theta_rad, double omega_rad_s, double i_a_A, double i_b_A);
 
 /** U_c of Theorem 2's proof: (1/2)(J/L w^2 + (i_a - u_cc/R)^2 + i_b^2) - k_M u_cc/(p L R) (cos p theta - 2). */
-double lyapunov_c(const Motor &m, double u_cc_v, double theta_rad, double omega_rad_s, double i_a_a, double i_b_a);
+double lyapunov_c(const Motor &m, double u_cc_V, double theta_rad, double omega_rad_s, double i_a_A, double i_b_A);
 
 /** Injection gains of (6): g_w = (2g^2 + rF l J^2)/(g^2 l + rF l^2 J^2), g_T = (2g^2 F + l J g + l J^2 r F^2)/(same). */
 double speed_injection_gain(const Motor &m, const Gains &g);

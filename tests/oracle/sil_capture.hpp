@@ -16,10 +16,10 @@ namespace pmstep_oracle {
 /** One control period of the SIL at its sample time t_k (plant state before the period). */
 struct SilSample {
     double t_s;
-    double theta_rad, omega_rad_s, i_a_a, i_b_a;
-    double u_a_v, u_b_v, load_nm;
+    double theta_rad, omega_rad_s, i_a_A, i_b_A;
+    double u_a_V, u_b_V, load_Nm;
     pmstep_mode_t mode;
-    double omega_ref_rad_s, speed_hat_rad_s, load_hat_nm, i_a_hat_a, i_b_hat_a;
+    double omega_ref_rad_s, speed_hat_rad_s, load_hat_Nm, i_a_hat_A, i_b_hat_A;
     double cos_hat, sin_hat;
 };
 

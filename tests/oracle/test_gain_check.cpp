@@ -118,7 +118,7 @@ static void gains_above_the_bounds_meet_condition_7(void **state)
     assert_true(near(gamma_bound_at(in, rep.t_p_s, rep.p_e_low), in.gamma, 1e-9));
 
     TheoremInputs with_friction = in;
-    with_friction.friction_nm_s_per_rad = 1e-3;
+    with_friction.friction_Nms_rad = 1e-3;
     with_friction.r = 1.0;
     const TheoremReport small_r = check_theorems(with_friction);
     with_friction.r = 10.0 * r_bound_at(with_friction, small_r.t_p_s, small_r.p_e_bound);
@@ -136,7 +136,7 @@ static void condition_4_margin_sign(void **state)
 {
     (void)state;
     TheoremInputs in = paper_inputs();
-    in.c_align_voltage_v = 1.0; // 2/(0.108) - (576 + 1)/18 = 18.52 - 32.06 < 0
+    in.c_align_voltage_V = 1.0; // 2/(0.108) - (576 + 1)/18 = 18.52 - 32.06 < 0
     const TheoremReport rep = check_theorems(in);
     print_message("  u_cc = 1 V: margin %.4f\n", rep.condition4_margin);
     assert_true(near(rep.condition4_margin, 2.0 / 0.108 - 577.0 / 18.0, 1e-9));
@@ -156,7 +156,7 @@ static void sil_converges_with_the_paper_gains(void **state)
     const DoaOptions opt;
     const DoaRun base = doa_single_run(sc, {0.0, 0.0, 0.0, 0.0}, opt);
     print_message("  paper scenario: %s (max |w - w*| %.2e rad/s on the last %.1f s, |T_L-hat - T_L| %.2e Nm)\n",
-                  base.reason.c_str(), base.final_speed_error_rad_s, opt.final_window_s, base.final_load_error_nm);
+                  base.reason.c_str(), base.final_speed_error_rad_s, opt.final_window_s, base.final_load_error_Nm);
     assert_true(base.converged);
     const double radius = 10.0 * rep.rho_ceiling;
     for (int axis = 0; axis < 4; ++axis) {

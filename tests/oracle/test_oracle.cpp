@@ -46,10 +46,10 @@ double first_sample_at_or_after(double t_s, double period_s)
 Scenario oracle_on_sil_grid(const sil_scenario_t &sil)
 {
     Scenario sc = paper_scenario();
-    const double period_s = static_cast<double>(sil.controller.period_s);
-    sc.s_align_time_s = static_cast<double>(sil_period_index(sil, static_cast<double>(sil.controller.s_align_time_s)))
+    const double period_s = static_cast<double>(sil.controller.timing.period_s);
+    sc.s_align_time_s = static_cast<double>(sil_period_index(sil, static_cast<double>(sil.controller.alignment.s_align_time_s)))
                         * period_s;
-    sc.c_align_time_s = static_cast<double>(sil_period_index(sil, static_cast<double>(sil.controller.c_align_time_s)))
+    sc.c_align_time_s = static_cast<double>(sil_period_index(sil, static_cast<double>(sil.controller.alignment.c_align_time_s)))
                         * period_s;
     for (RampCommand &cmd : sc.speed_commands) {
         cmd.time_s = first_sample_at_or_after(cmd.time_s, period_s);
@@ -65,7 +65,7 @@ struct Comparison {
     double max_speed_ref_diff_rad_s;  ///< max |w*_SIL - w*_oracle| on [t_c, end]
     double elec_angle_diff_ts_rad;    ///< |p theta_SIL - p theta_oracle| at t_s
     double elec_angle_diff_tc_rad;    ///< the same at t_c
-    double final_load_hat_sil_nm, final_load_hat_oracle_nm;
+    double final_load_hat_sil_Nm, final_load_hat_oracle_Nm;
     long voltage_limited_periods;
 };
 
@@ -73,7 +73,7 @@ Comparison compare_with_oracle(double period_s)
 {
     sil_scenario_t sil;
     sil_scenario_paper(&sil);
-    sil.controller.period_s = static_cast<float>(period_s);
+    sil.controller.timing.period_s = static_cast<float>(period_s);
     const SilRun run = capture_sil(sil);
     assert_int_equal(run.status, 0);
     assert_int_equal(run.summary.fault, PMSTEP_FAULT_NONE);
@@ -84,8 +84,8 @@ Comparison compare_with_oracle(double period_s)
     assert_int_equal(oracle.size(), run.samples.size());
 
     const double p = sc.motor.pole_pairs;
-    const auto k_s = static_cast<std::size_t>(sil_period_index(sil, static_cast<double>(sil.controller.s_align_time_s)));
-    const auto k_c = static_cast<std::size_t>(sil_period_index(sil, static_cast<double>(sil.controller.c_align_time_s)));
+    const auto k_s = static_cast<std::size_t>(sil_period_index(sil, static_cast<double>(sil.controller.alignment.s_align_time_s)));
+    const auto k_c = static_cast<std::size_t>(sil_period_index(sil, static_cast<double>(sil.controller.alignment.c_align_time_s)));
     Comparison c{};
     for (std::size_t k = k_c; k < times.size(); ++k) {
         const SilSample &s = run.samples[k];
@@ -102,14 +102,14 @@ Comparison compare_with_oracle(double period_s)
     }
     c.elec_angle_diff_ts_rad = std::fabs(p * (run.samples[k_s].theta_rad - oracle[k_s].x[idx::theta]));
     c.elec_angle_diff_tc_rad = std::fabs(p * (run.samples[k_c].theta_rad - oracle[k_c].x[idx::theta]));
-    c.final_load_hat_sil_nm = run.samples.back().load_hat_nm;
-    c.final_load_hat_oracle_nm = oracle.back().x[idx::load_hat];
+    c.final_load_hat_sil_Nm = run.samples.back().load_hat_Nm;
+    c.final_load_hat_oracle_Nm = oracle.back().x[idx::load_hat];
     c.voltage_limited_periods = run.summary.voltage_limited_periods + run.summary.inverter_limited_periods;
     print_message("  %5.0f Hz: max|w_SIL - w_oracle| = %.6f rad/s at %.5f s (w-hat %.6f, w* %.2e), "
                   "|p theta diff| at t_s %.2e, at t_c %.2e rad, T_L-hat %.6f vs %.6f Nm\n",
                   1.0 / period_s, c.max_speed_diff_rad_s, c.max_speed_diff_time_s, c.max_speed_hat_diff_rad_s,
                   c.max_speed_ref_diff_rad_s, c.elec_angle_diff_ts_rad, c.elec_angle_diff_tc_rad,
-                  c.final_load_hat_sil_nm, c.final_load_hat_oracle_nm);
+                  c.final_load_hat_sil_Nm, c.final_load_hat_oracle_Nm);
     return c;
 }
 
@@ -211,7 +211,7 @@ static void oracle_is_converged_at_its_tolerance(void **state)
             const double p = sc.motor.pole_pairs;
             peak_after_load_step = std::max(peak_after_load_step, smp.t_s < 0.8 ? e : 0.0);
             max_tracking = std::max(max_tracking, smp.t_s >= 0.8 ? e : 0.0);
-            max_voltage = std::max({max_voltage, std::fabs(smp.sig.u_a_v), std::fabs(smp.sig.u_b_v)});
+            max_voltage = std::max({max_voltage, std::fabs(smp.sig.u_a_V), std::fabs(smp.sig.u_b_V)});
             max_angle_error = std::max({max_angle_error, std::fabs(smp.sig.cos_hat - std::cos(p * smp.x[idx::theta])),
                                         std::fabs(smp.sig.sin_hat - std::sin(p * smp.x[idx::theta]))});
         }
@@ -235,7 +235,7 @@ static void sil_matches_oracle_at_20khz(void **state)
     assert_true(c.max_speed_diff_rad_s < 0.05);
     assert_true(c.elec_angle_diff_ts_rad < 1e-4);
     assert_true(c.elec_angle_diff_tc_rad < 1e-4);
-    assert_true(std::fabs(c.final_load_hat_sil_nm - c.final_load_hat_oracle_nm) < 0.01);
+    assert_true(std::fabs(c.final_load_hat_sil_Nm - c.final_load_hat_oracle_Nm) < 0.01);
 }
 
 /* 10 -> 20 -> 40 kHz: the speed (and speed estimate) difference to the oracle shrinks each time,
@@ -284,7 +284,7 @@ static void theorem1_s_alignment(void **state)
     sil_scenario_paper(&sil);
     const Scenario sc = oracle_on_sil_grid(sil);
     const Motor &m = sc.motor;
-    const double u_cs = sc.s_align_voltage_v, p = m.pole_pairs;
+    const double u_cs = sc.s_align_voltage_V, p = m.pole_pairs;
     const std::vector<double> times = sil_sample_times(sil);
     const auto k_s = static_cast<std::size_t>(sil_period_index(sil, sc.s_align_time_s));
     const std::vector<Sample> oracle = simulate(sc, std::vector<double>(times.begin(), times.begin() + k_s + 1));
@@ -296,7 +296,7 @@ static void theorem1_s_alignment(void **state)
         const Eigen::VectorXd &x = oracle[k].x;
         const double u_o = lyapunov_s(m, u_cs, x[idx::theta], x[idx::omega], x[idx::i_a], x[idx::i_b]);
         const SilSample &y = run.samples[k];
-        const double u_s = lyapunov_s(m, u_cs, y.theta_rad, y.omega_rad_s, y.i_a_a, y.i_b_a);
+        const double u_s = lyapunov_s(m, u_cs, y.theta_rad, y.omega_rad_s, y.i_a_A, y.i_b_A);
         if (k == 0) {
             o.first = u_o;
             s.first = u_s;
@@ -312,7 +312,7 @@ static void theorem1_s_alignment(void **state)
         o.last = u_o;
         s.last = u_s;
     }
-    const double u_min = m.torque_constant_nm_per_a * u_cs / (p * m.inductance_h * m.resistance_ohm); // at sin = 1
+    const double u_min = m.torque_constant_Nm_A * u_cs / (p * m.inductance_H * m.resistance_Ohm); // at sin = 1
     print_message("  U_s: oracle %.6f -> %.9f (min %.9f), max step increase %.2e; SIL %.6f -> %.9f, max increase "
                   "%.2e; |U_s - U_s(0) - int U_s'| <= %.2e\n",
                   o.first, o.last, u_min, o.max_increase, s.first, s.last, s.max_increase, balance_error);
@@ -326,9 +326,9 @@ static void theorem1_s_alignment(void **state)
     const SilSample &ys = run.samples[k_s];
     const double residuals[2][5] = {
         {std::cos(p * xs[idx::theta]), std::sin(p * xs[idx::theta]) - 1.0, xs[idx::omega], xs[idx::i_a],
-         xs[idx::i_b] - u_cs / m.resistance_ohm},
-        {std::cos(p * ys.theta_rad), std::sin(p * ys.theta_rad) - 1.0, ys.omega_rad_s, ys.i_a_a,
-         ys.i_b_a - u_cs / m.resistance_ohm}};
+         xs[idx::i_b] - u_cs / m.resistance_Ohm},
+        {std::cos(p * ys.theta_rad), std::sin(p * ys.theta_rad) - 1.0, ys.omega_rad_s, ys.i_a_A,
+         ys.i_b_A - u_cs / m.resistance_Ohm}};
     for (int which = 0; which < 2; ++which) {
         print_message("  %s at t_s: cos p theta %.2e, sin p theta - 1 %.2e, w %.2e rad/s, i_a %.2e A, i_b - u_cs/R %.2e A\n",
                       which == 0 ? "oracle" : "SIL   ", residuals[which][0], residuals[which][1], residuals[which][2],
@@ -349,9 +349,9 @@ static void theorem2_c_alignment(void **state)
     sil_scenario_paper(&sil);
     const Scenario sc = oracle_on_sil_grid(sil);
     const Motor &m = sc.motor;
-    const double u_cs = sc.s_align_voltage_v, u_cc = sc.c_align_voltage_v, p = m.pole_pairs, R = m.resistance_ohm;
+    const double u_cs = sc.s_align_voltage_V, u_cc = sc.c_align_voltage_V, p = m.pole_pairs, R = m.resistance_Ohm;
     // Condition (4): k_M u_cc/(p L R) - (u_cs^2 + u_cc^2)/(2 R^2) > 0 (444.4 - 64 for the paper).
-    const double margin4 = m.torque_constant_nm_per_a * u_cc / (p * m.inductance_h * R) - (u_cs * u_cs + u_cc * u_cc) / (2 * R * R);
+    const double margin4 = m.torque_constant_Nm_A * u_cc / (p * m.inductance_H * R) - (u_cs * u_cs + u_cc * u_cc) / (2 * R * R);
     assert_true(margin4 > 0.0);
 
     const std::vector<double> times = sil_sample_times(sil);
@@ -366,7 +366,7 @@ static void theorem2_c_alignment(void **state)
         const Eigen::VectorXd &x = oracle[k].x;
         const double u_o = lyapunov_c(m, u_cc, x[idx::theta], x[idx::omega], x[idx::i_a], x[idx::i_b]);
         const SilSample &y = run.samples[k];
-        const double u_s = lyapunov_c(m, u_cc, y.theta_rad, y.omega_rad_s, y.i_a_a, y.i_b_a);
+        const double u_s = lyapunov_c(m, u_cc, y.theta_rad, y.omega_rad_s, y.i_a_A, y.i_b_A);
         if (k == k_s) {
             o.first = u_o;
             s.first = u_s;
@@ -381,7 +381,7 @@ static void theorem2_c_alignment(void **state)
         o.last = u_o;
         s.last = u_s;
     }
-    const double u_min = m.torque_constant_nm_per_a * u_cc / (p * m.inductance_h * R); // at cos = 1
+    const double u_min = m.torque_constant_Nm_A * u_cc / (p * m.inductance_H * R); // at cos = 1
     print_message("  condition (4) margin %.3f; U_c: oracle %.6f -> %.9f (min %.9f), max step increase %.2e; "
                   "SIL %.6f -> %.9f, max increase %.2e; |U_c - U_c(t_s) - int U_c'| <= %.2e\n",
                   margin4, o.first, o.last, u_min, o.max_increase, s.first, s.last, s.max_increase, balance_error);
@@ -398,7 +398,7 @@ static void theorem2_c_alignment(void **state)
     const double residuals[2][5] = {
         {std::cos(p * xc[idx::theta]) - 1.0, std::sin(p * xc[idx::theta]), xc[idx::omega], xc[idx::i_a] - u_cc / R,
          xc[idx::i_b]},
-        {std::cos(p * yc.theta_rad) - 1.0, std::sin(p * yc.theta_rad), yc.omega_rad_s, yc.i_a_a - u_cc / R, yc.i_b_a}};
+        {std::cos(p * yc.theta_rad) - 1.0, std::sin(p * yc.theta_rad), yc.omega_rad_s, yc.i_a_A - u_cc / R, yc.i_b_A}};
     for (int which = 0; which < 2; ++which) {
         print_message("  %s at t_c: cos p theta - 1 %.2e, sin p theta %.2e, w %.2e rad/s, i_a - u_cc/R %.2e A, i_b %.2e A\n",
                       which == 0 ? "oracle" : "SIL   ", residuals[which][0], residuals[which][1], residuals[which][2],
@@ -452,7 +452,7 @@ static void remark1_speed_error_decays_exponentially(void **state)
     const double end_sil = decay_end(t, err_sil, begin_s, 1.0, window_s);
     const DecayFit fo = fit_decay(t, err_oracle, begin_s, end_oracle, window_s);
     const DecayFit fs = fit_decay(t, err_sil, begin_s, end_sil, window_s);
-    const double expected = -(sc.motor.friction_nm_s_per_rad / sc.motor.inertia_kg_m2 + sc.gains.speed_gain_per_s);
+    const double expected = -(sc.motor.friction_Nms_rad / sc.motor.inertia_kgm2 + sc.gains.speed_gain_per_s);
     print_message("  decay rate of |w - w*|: oracle %.2f 1/s (R^2 %.5f, %d windows to %.3f s), SIL %.2f 1/s "
                   "(R^2 %.5f, %d windows to %.3f s); (14) predicts %.1f\n",
                   fo.rate_per_s, fo.r_squared, fo.windows, end_oracle, fs.rate_per_s, fs.r_squared, fs.windows, end_sil,

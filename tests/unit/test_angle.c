@@ -17,7 +17,7 @@ static void run_constant_speed(double speed_rad_s, double duration_s, double *ma
     pmstep_angle_t angle;
     /* Start where c-alignment leaves the motor: cos p theta = 1, i_a = u_cc/R. */
     exact_plant_t plant = {3.0, 0.006, 2.0, 6.0, 0.0, 0.0, 8.0, 0.0};
-    const double period_s = cfg.period_s;
+    const double period_s = cfg.timing.period_s;
     const long steps = (long)(duration_s / period_s + 0.5);
     long k;
     plant.speed_rad_s = speed_rad_s;

@@ -9,44 +9,45 @@
 #include <string.h>
 
 #include "pmstep/pmstep.h"
+#include "pmstep/pmstep_instance.h" /* the tests look inside the instance */
 #include "pmstep/pmstep_text.h"
 
 /* Short alignments (40 ms each, 22 time constants L/R) so a test runs a few thousand periods. */
 static pmstep_config_t short_config(void)
 {
     pmstep_config_t cfg = pmstep_paper_config();
-    cfg.s_align_time_s = 0.04f;
-    cfg.c_align_time_s = 0.08f;
-    cfg.steady_state_window_s = 0.005f; /* 100 periods; L/R = 2 ms, so 7.5 time constants in */
-    cfg.inductance_window_s = 0.0005f;  /* 10 periods of current rise */
-    cfg.alignment_offset_calibration = true;
+    cfg.alignment.s_align_time_s = 0.04f;
+    cfg.alignment.c_align_time_s = 0.08f;
+    cfg.commissioning.steady_state_window_s = 0.005f; /* 100 periods; L/R = 2 ms, so 7.5 time constants in */
+    cfg.commissioning.inductance_window_s = 0.0005f;  /* 10 periods of current rise */
+    cfg.commissioning.alignment_offset_calibration = true;
     return cfg;
 }
 
 /* Both phases as R, L with the rotor locked (no back-EMF), exact for held voltages;
  * the sensors add an offset. */
 typedef struct {
-    double r_ohm, l_h, i_a_a, i_b_a, offset_a_a, offset_b_a;
-    double bias_v; /* the bridge falls short by this at positive current (a dead time) */
+    double r_Ohm, l_H, i_a_A, i_b_A, offset_a_A, offset_b_A;
+    double bias_V; /* the bridge falls short by this at positive current (a dead time) */
 } rl_plant_t;
 
 static pmstep_meas_t rl_sample(const rl_plant_t *p)
 {
     pmstep_meas_t m;
-    m.i_a_a = (float)(p->i_a_a + p->offset_a_a);
-    m.i_b_a = (float)(p->i_b_a + p->offset_b_a);
-    m.bus_voltage_v = 48.0f;
-    m.load_torque_nm = 0.0f;
+    m.i_a_A = (float)(p->i_a_A + p->offset_a_A);
+    m.i_b_A = (float)(p->i_b_A + p->offset_b_A);
+    m.bus_voltage_V = 48.0f;
+    m.load_torque_Nm = 0.0f;
     return m;
 }
 
 static void rl_advance(rl_plant_t *p, const pmstep_output_t *out, double period_s)
 {
-    const double decay = exp(-p->r_ohm * period_s / p->l_h);
-    const double u_a = out->bridge_enable ? (double)out->u_a_v - (p->i_a_a > 0.0 ? p->bias_v : 0.0) : 0.0;
-    const double u_b = out->bridge_enable ? (double)out->u_b_v - (p->i_b_a > 0.0 ? p->bias_v : 0.0) : 0.0;
-    p->i_a_a = p->i_a_a * decay + u_a / p->r_ohm * (1.0 - decay);
-    p->i_b_a = p->i_b_a * decay + u_b / p->r_ohm * (1.0 - decay);
+    const double decay = exp(-p->r_Ohm * period_s / p->l_H);
+    const double u_a = out->bridge_enable ? (double)out->u_a_V - (p->i_a_A > 0.0 ? p->bias_V : 0.0) : 0.0;
+    const double u_b = out->bridge_enable ? (double)out->u_b_V - (p->i_b_A > 0.0 ? p->bias_V : 0.0) : 0.0;
+    p->i_a_A = p->i_a_A * decay + u_a / p->r_Ohm * (1.0 - decay);
+    p->i_b_A = p->i_b_A * decay + u_b / p->r_Ohm * (1.0 - decay);
 }
 
 /* Runs until the core leaves the alignment (RUN or FAULT) or @p max_steps. */
@@ -59,26 +60,27 @@ static void run_rl(pmstep_t *inst, rl_plant_t *plant, pmstep_output_t *out, uint
         if (out->mode == PMSTEP_MODE_RUN || out->mode == PMSTEP_MODE_FAULT) {
             return;
         }
-        rl_advance(plant, out, (double)inst->cfg->period_s);
+        rl_advance(plant, out, (double)inst->cfg->timing.period_s);
     }
 }
 
-static void no_window(pmstep_config_t *c) { c->steady_state_window_s = 0.0f; c->alignment_offset_calibration = true; }
-static void bias_window_too_short(pmstep_config_t *c) { c->voltage_bias_level_fraction = 0.5f; c->dead_time_current_band_a = 0.05f; c->steady_state_window_s = 0.005f; }
-static void bias_fraction_one(pmstep_config_t *c) { c->voltage_bias_level_fraction = 1.0f; c->dead_time_current_band_a = 0.05f; }
-static void long_window(pmstep_config_t *c) { c->steady_state_window_s = 0.021f; }
-static void long_rise(pmstep_config_t *c) { c->inductance_window_s = 0.021f; }
-static void negative_offset_time(pmstep_config_t *c) { c->offset_calibration_time_s = -1e-3f; }
-static void use_unmeasured_l(pmstep_config_t *c) { c->inductance_window_s = 0.0f; c->use_commissioned_inductance = true; }
-static void use_unmeasured_r(pmstep_config_t *c) { no_window(c); c->alignment_offset_calibration = false; c->use_commissioned_resistance = true; }
-static void use_unmeasured_km(pmstep_config_t *c) { no_window(c); c->alignment_offset_calibration = false; c->use_commissioned_torque_constant = true; }
-static void dead_time_without_band(pmstep_config_t *c) { c->dead_time_s = 1e-6f; }
-static void dead_time_too_long(pmstep_config_t *c) { c->dead_time_s = 13e-6f; c->dead_time_current_band_a = 0.1f; }
-static void correction_too_fast(pmstep_config_t *c) { c->angle_correction_gain_per_s = 10000.0f; }
-static void correction_negative(pmstep_config_t *c) { c->angle_correction_gain_per_s = -1.0f; }
-static void negative_bound(pmstep_config_t *c) { c->stall_speed_error_rad_s = -1.0f; }
-static void detection_too_short(pmstep_config_t *c) { c->detection_time_s = 3.0f * c->period_s; }
-static void nan_window(pmstep_config_t *c) { c->steady_state_window_s = NAN; }
+static void no_window(pmstep_config_t *c) { c->commissioning.steady_state_window_s = 0.0f; c->commissioning.alignment_offset_calibration = true; }
+static void bias_window_too_short(pmstep_config_t *c) { c->commissioning.voltage_bias_level_fraction = 0.5f; c->inverter.dead_time_current_band_A = 0.05f; c->commissioning.steady_state_window_s = 0.005f; }
+static void bias_window_too_long(pmstep_config_t *c) { c->commissioning.voltage_bias_level_fraction = 0.5f; c->inverter.dead_time_current_band_A = 0.05f; c->commissioning.steady_state_window_s = 0.015f; }
+static void bias_fraction_one(pmstep_config_t *c) { c->commissioning.voltage_bias_level_fraction = 1.0f; c->inverter.dead_time_current_band_A = 0.05f; }
+static void long_window(pmstep_config_t *c) { c->commissioning.steady_state_window_s = 0.021f; }
+static void long_rise(pmstep_config_t *c) { c->commissioning.inductance_window_s = 0.021f; }
+static void negative_offset_time(pmstep_config_t *c) { c->commissioning.offset_calibration_time_s = -1e-3f; }
+static void use_unmeasured_l(pmstep_config_t *c) { c->commissioning.inductance_window_s = 0.0f; c->commissioning.use_measured_inductance = true; }
+static void use_unmeasured_r(pmstep_config_t *c) { no_window(c); c->commissioning.alignment_offset_calibration = false; c->commissioning.use_measured_resistance = true; }
+static void use_unmeasured_km(pmstep_config_t *c) { no_window(c); c->commissioning.alignment_offset_calibration = false; c->commissioning.use_measured_torque_constant = true; }
+static void dead_time_without_band(pmstep_config_t *c) { c->inverter.dead_time_s = 1e-6f; }
+static void dead_time_too_long(pmstep_config_t *c) { c->inverter.dead_time_s = 13e-6f; c->inverter.dead_time_current_band_A = 0.1f; }
+static void correction_too_fast(pmstep_config_t *c) { c->gains.angle_correction_gain_per_s = 10000.0f; }
+static void correction_negative(pmstep_config_t *c) { c->gains.angle_correction_gain_per_s = -1.0f; }
+static void negative_bound(pmstep_config_t *c) { c->detection.stall_speed_error_rad_s = -1.0f; }
+static void detection_too_short(pmstep_config_t *c) { c->detection.persistence_s = 3.0f * c->timing.period_s; }
+static void nan_window(pmstep_config_t *c) { c->commissioning.steady_state_window_s = NAN; }
 
 static void calibration_settings_are_validated(void **state)
 {
@@ -86,14 +88,23 @@ static void calibration_settings_are_validated(void **state)
         void (*edit)(pmstep_config_t *);
         pmstep_status_t expected;
     } cases[] = {
-        {no_window, PMSTEP_ERR_CALIBRATION},           {long_window, PMSTEP_ERR_CALIBRATION},
-        {long_rise, PMSTEP_ERR_CALIBRATION},           {negative_offset_time, PMSTEP_ERR_CALIBRATION},
-        {use_unmeasured_l, PMSTEP_ERR_CALIBRATION},    {use_unmeasured_r, PMSTEP_ERR_CALIBRATION},
-        {use_unmeasured_km, PMSTEP_ERR_CALIBRATION},   {dead_time_without_band, PMSTEP_ERR_CALIBRATION},
-        {dead_time_too_long, PMSTEP_ERR_CALIBRATION},  {correction_too_fast, PMSTEP_ERR_CALIBRATION},
-        {correction_negative, PMSTEP_ERR_CALIBRATION}, {negative_bound, PMSTEP_ERR_DETECTION},
-        {detection_too_short, PMSTEP_ERR_DETECTION},   {nan_window, PMSTEP_ERR_NONFINITE_PARAMETER},
-        {bias_window_too_short, PMSTEP_ERR_CALIBRATION}, {bias_fraction_one, PMSTEP_ERR_CALIBRATION},
+        {no_window, PMSTEP_ERR_ALIGNMENT_OFFSETS_UNMEASURED},
+        {long_window, PMSTEP_ERR_STEADY_STATE_WINDOW},
+        {long_rise, PMSTEP_ERR_INDUCTANCE_WINDOW},
+        {negative_offset_time, PMSTEP_ERR_OFFSET_CALIBRATION_TIME},
+        {use_unmeasured_l, PMSTEP_ERR_INDUCTANCE_UNMEASURED},
+        {use_unmeasured_r, PMSTEP_ERR_RESISTANCE_UNMEASURED},
+        {use_unmeasured_km, PMSTEP_ERR_TORQUE_CONSTANT_UNMEASURED},
+        {dead_time_without_band, PMSTEP_ERR_DEAD_TIME_BAND},
+        {dead_time_too_long, PMSTEP_ERR_DEAD_TIME},
+        {correction_too_fast, PMSTEP_ERR_ANGLE_CORRECTION_GAIN},
+        {correction_negative, PMSTEP_ERR_ANGLE_CORRECTION_GAIN},
+        {negative_bound, PMSTEP_ERR_DETECTION_BOUND},
+        {detection_too_short, PMSTEP_ERR_DETECTION_TIME},
+        {nan_window, PMSTEP_ERR_NONFINITE_PARAMETER},
+        {bias_window_too_short, PMSTEP_ERR_VOLTAGE_BIAS_SETTLING},
+        {bias_window_too_long, PMSTEP_ERR_VOLTAGE_BIAS_WINDOW},
+        {bias_fraction_one, PMSTEP_ERR_VOLTAGE_BIAS_FRACTION},
     };
     size_t n;
     pmstep_t inst;
@@ -117,8 +128,8 @@ static void bridge_off_calibration_measures_the_offsets(void **state)
     pmstep_commissioning_t result;
     uint32_t k;
     (void)state;
-    cfg.offset_calibration_time_s = 0.001f; /* 20 periods */
-    cfg.alignment_offset_calibration = false;
+    cfg.commissioning.offset_calibration_time_s = 0.001f; /* 20 periods */
+    cfg.commissioning.alignment_offset_calibration = false;
     assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
     assert_int_equal(pmstep_start(&inst), PMSTEP_OK);
     for (k = 0; k < 20u; ++k) {
@@ -130,12 +141,12 @@ static void bridge_off_calibration_measures_the_offsets(void **state)
     }
     run_rl(&inst, &plant, &out, 4000u);
     pmstep_get_commissioning(&inst, &result);
-    print_message("offsets %.6f %.6f from %u samples\n", (double)result.offset_a_a, (double)result.offset_b_a,
+    print_message("offsets %.6f %.6f from %u samples\n", (double)result.offset_a_A, (double)result.offset_b_A,
                   (unsigned)result.offset_samples);
     assert_true(result.measured);
     assert_int_equal(result.offset_samples, 40u);
-    assert_true(fabsf(result.offset_a_a - 0.02f) < 1e-7f);
-    assert_true(fabsf(result.offset_b_a + 0.01f) < 1e-7f);
+    assert_true(fabsf(result.offset_a_A - 0.02f) < 1e-7f);
+    assert_true(fabsf(result.offset_b_A + 0.01f) < 1e-7f);
 }
 
 static void locked_rotor_gives_r_and_l_and_fails_the_torque_constant(void **state)
@@ -152,15 +163,15 @@ static void locked_rotor_gives_r_and_l_and_fails_the_torque_constant(void **stat
     assert_int_equal(pmstep_start(&inst), PMSTEP_OK);
     run_rl(&inst, &plant, &out, 4000u);
     pmstep_get_commissioning(&inst, &result);
-    print_message("R %.6f L %.7f k_M %.5f offsets %.6f %.6f\n", (double)result.resistance_ohm,
-                  (double)result.inductance_h, (double)result.torque_constant_nm_per_a, (double)result.offset_a_a,
-                  (double)result.offset_b_a);
-    assert_true(fabsf(result.offset_a_a - 0.02f) < 1e-5f);
-    assert_true(fabsf(result.offset_b_a + 0.01f) < 1e-5f);
-    assert_true(fabsf(result.resistance_ohm - 3.6f) < 3.6f * 1e-4f);
+    print_message("R %.6f L %.7f k_M %.5f offsets %.6f %.6f\n", (double)result.resistance_Ohm,
+                  (double)result.inductance_H, (double)result.torque_constant_Nm_A, (double)result.offset_a_A,
+                  (double)result.offset_b_A);
+    assert_true(fabsf(result.offset_a_A - 0.02f) < 1e-5f);
+    assert_true(fabsf(result.offset_b_A + 0.01f) < 1e-5f);
+    assert_true(fabsf(result.resistance_Ohm - 3.6f) < 3.6f * 1e-4f);
     /* The trapezoid rule over 10 periods of an exponential with tau = 1.83 ms: error ~ (T/tau)^2/12. */
-    assert_true(fabsf(result.inductance_h - 0.0066f) < 0.0066f * 1e-3f);
-    assert_true(fabsf(result.torque_constant_nm_per_a) < 0.05f);
+    assert_true(fabsf(result.inductance_H - 0.0066f) < 0.0066f * 1e-3f);
+    assert_true(fabsf(result.torque_constant_Nm_A) < 0.05f);
     assert_int_equal(out.mode, PMSTEP_MODE_FAULT);
     assert_int_equal(out.fault, PMSTEP_FAULT_COMMISSIONING);
     assert_int_equal(out.fault_step, 1600u + 1u);
@@ -177,26 +188,26 @@ static void two_levels_give_r_and_the_voltage_bias(void **state)
     pmstep_commissioning_t result;
     uint32_t k;
     (void)state;
-    cfg.s_align_time_s = 0.16f;
-    cfg.c_align_time_s = 0.32f;
-    cfg.steady_state_window_s = 0.04f; /* the lower level settles for 20 ms, 11 L/R */
-    cfg.voltage_bias_level_fraction = 0.5f;
-    cfg.dead_time_current_band_a = 0.05f;
+    cfg.alignment.s_align_time_s = 0.16f;
+    cfg.alignment.c_align_time_s = 0.32f;
+    cfg.commissioning.steady_state_window_s = 0.04f; /* the lower level settles for 20 ms, 11 L/R */
+    cfg.commissioning.voltage_bias_level_fraction = 0.5f;
+    cfg.inverter.dead_time_current_band_A = 0.05f;
     assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
     assert_int_equal(pmstep_start(&inst), PMSTEP_OK);
     for (k = 0; k < 3200u; ++k) { /* s-alignment: the last 800 periods at half voltage */
         const pmstep_meas_t m = rl_sample(&plant);
         pmstep_step(&inst, &m, &out);
-        assert_true(out.u_b_v == (k < 2400u ? 24.0f : 12.0f));
+        assert_true(out.u_b_V == (k < 2400u ? 24.0f : 12.0f));
         rl_advance(&plant, &out, 50e-6);
     }
     run_rl(&inst, &plant, &out, 8000u);
     pmstep_get_commissioning(&inst, &result);
-    print_message("R %.6f bias %.6f %.6f V\n", (double)result.resistance_ohm, (double)result.voltage_bias_a_v,
-                  (double)result.voltage_bias_b_v);
-    assert_true(fabsf(result.resistance_ohm - 3.6f) < 3.6f * 1e-4f);
-    assert_true(fabsf(result.voltage_bias_a_v - 0.3f) < 1e-3f);
-    assert_true(fabsf(result.voltage_bias_b_v - 0.3f) < 1e-3f);
+    print_message("R %.6f bias %.6f %.6f V\n", (double)result.resistance_Ohm, (double)result.voltage_bias_a_V,
+                  (double)result.voltage_bias_b_V);
+    assert_true(fabsf(result.resistance_Ohm - 3.6f) < 3.6f * 1e-4f);
+    assert_true(fabsf(result.voltage_bias_a_V - 0.3f) < 1e-3f);
+    assert_true(fabsf(result.voltage_bias_b_V - 0.3f) < 1e-3f);
 }
 
 static void dead_time_is_compensated_on_the_driven_phase(void **state)
@@ -206,20 +217,20 @@ static void dead_time_is_compensated_on_the_driven_phase(void **state)
     pmstep_output_t out;
     pmstep_meas_t m = {0.0f, 8.0f, 48.0f, 0.0f};
     (void)state;
-    cfg.dead_time_s = 1e-6f;
-    cfg.dead_time_current_band_a = 0.1f;
+    cfg.inverter.dead_time_s = 1e-6f;
+    cfg.inverter.dead_time_current_band_A = 0.1f;
     assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
     assert_int_equal(pmstep_start(&inst), PMSTEP_OK);
     pmstep_step(&inst, &m, &out);
     /* Two half-bridges per phase, each losing V_bus t_d / T_s = 0.96 V. */
     assert_int_equal(out.mode, PMSTEP_MODE_S_ALIGN);
-    assert_true(fabsf(out.u_b_v - (24.0f + 1.92f)) < 1e-4f);
-    assert_true(out.u_a_v == 0.0f);
-    m.i_b_a = 0.05f; /* inside the band: half */
+    assert_true(fabsf(out.u_b_V - (24.0f + 1.92f)) < 1e-4f);
+    assert_true(out.u_a_V == 0.0f);
+    m.i_b_A = 0.05f; /* inside the band: half */
     pmstep_step(&inst, &m, &out);
-    assert_true(fabsf(out.u_b_v - (24.0f + 0.96f)) < 1e-4f);
+    assert_true(fabsf(out.u_b_V - (24.0f + 0.96f)) < 1e-4f);
     /* The integrators get the voltage the bridge delivers, without the compensation. */
-    assert_true(fabsf(inst.u_applied_b_v - 24.0f) < 1e-5f);
+    assert_true(fabsf(inst.actuator.u_applied_b_V - 24.0f) < 1e-5f);
 }
 
 /* Holds the c-aligned state (i_a = 8 A, rotor still) into RUN. */
@@ -243,11 +254,11 @@ static void lost_angle_faults_or_realigns_after_the_detection_time(void **state)
     uint32_t k;
     uint32_t jump_step;
     (void)state;
-    cfg.s_align_time_s = 0.02f;
-    cfg.c_align_time_s = 0.04f;
-    cfg.speed_consistency_bound_rad_s = 0.0f; /* only the magnitude check in this test */
-    cfg.stall_speed_error_rad_s = 0.0f;
-    for (cfg.max_realignments = 0u; cfg.max_realignments <= 1u; ++cfg.max_realignments) {
+    cfg.alignment.s_align_time_s = 0.02f;
+    cfg.alignment.c_align_time_s = 0.04f;
+    cfg.detection.speed_consistency_bound_rad_s = 0.0f; /* only the magnitude check in this test */
+    cfg.detection.stall_speed_error_rad_s = 0.0f;
+    for (cfg.detection.max_realignments = 0u; cfg.detection.max_realignments <= 1u; ++cfg.detection.max_realignments) {
         assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
         hold_to_run(&inst, &out);
         /* Hold c-hat at 1.5 (|c^2 + s^2 - 1| = 1.25): with i_a = i_a(t_c), c-hat = 1 + (L p/k_M) phi1. */
@@ -259,12 +270,12 @@ static void lost_angle_faults_or_realigns_after_the_detection_time(void **state)
             inst.angle.phi_b_compensation = 0.0f;
             pmstep_step(&inst, &m, &out);
         }
-        print_message("max_realignments %u: mode %s after %u periods\n", (unsigned)cfg.max_realignments,
+        print_message("max_realignments %u: mode %s after %u periods\n", (unsigned)cfg.detection.max_realignments,
                       pmstep_mode_str(out.mode), (unsigned)k);
-        /* detected after 20 ms of the condition: 100 checks, one every 4th period */
+        /* detected after 20 ms of the condition: 100 checks, one every PMSTEP_DETECTION_DECIMATION periods */
         assert_true(inst.step_count - jump_step >= 397u && inst.step_count - jump_step <= 400u);
         assert_false(out.bridge_enable);
-        if (cfg.max_realignments == 0u) {
+        if (cfg.detection.max_realignments == 0u) {
             assert_int_equal(out.mode, PMSTEP_MODE_FAULT);
             assert_int_equal(out.fault, PMSTEP_FAULT_ANGLE_MAGNITUDE);
             assert_string_equal(pmstep_fault_str(out.fault), "ANGLE_MAGNITUDE");
@@ -276,7 +287,7 @@ static void lost_angle_faults_or_realigns_after_the_detection_time(void **state)
             assert_int_equal(result.realignments, 1u);
             pmstep_step(&inst, &m, &out); /* the alignment drives again */
             assert_true(out.bridge_enable);
-            assert_true(out.u_b_v == cfg.s_align_voltage_v);
+            assert_true(out.u_b_V == cfg.alignment.s_align_voltage_V);
         }
     }
 }

@@ -9,104 +9,137 @@
 #include <string.h>
 
 #include "pmstep/pmstep.h"
+#include "pmstep/pmstep_instance.h" /* the tests look inside the instance */
 #include "pmstep/pmstep_text.h"
 
 static pmstep_meas_t nominal_meas(void)
 {
     pmstep_meas_t m;
-    m.i_a_a = 0.0f;
-    m.i_b_a = 0.0f;
-    m.bus_voltage_v = 48.0f;
-    m.load_torque_nm = 0.0f;
+    m.i_a_A = 0.0f;
+    m.i_b_A = 0.0f;
+    m.bus_voltage_V = 48.0f;
+    m.load_torque_Nm = 0.0f;
     return m;
 }
+
+/* Every status code, so the tests below can tell each has its text and its test. */
+static const pmstep_status_t all_status_codes[] = {
+    PMSTEP_OK, PMSTEP_ERR_NULL_ARGUMENT, PMSTEP_ERR_BAD_MODE, PMSTEP_ERR_BAD_COMMAND_VALUE,
+    PMSTEP_ERR_NONFINITE_PARAMETER, PMSTEP_ERR_DERIVED_NONFINITE, PMSTEP_ERR_RESISTANCE, PMSTEP_ERR_INDUCTANCE,
+    PMSTEP_ERR_INERTIA, PMSTEP_ERR_TORQUE_CONSTANT, PMSTEP_ERR_FRICTION, PMSTEP_ERR_POLE_PAIRS, PMSTEP_ERR_PERIOD,
+    PMSTEP_ERR_DELAY, PMSTEP_ERR_SPEED_GAIN, PMSTEP_ERR_OBSERVER_GAIN, PMSTEP_ERR_CURRENT_GAIN,
+    PMSTEP_ERR_ADAPT_GAMMA, PMSTEP_ERR_ADAPT_LAMBDA, PMSTEP_ERR_ADAPT_R, PMSTEP_ERR_SAT_KAPPA,
+    PMSTEP_ERR_OBSERVER_GAIN_FOR_PERIOD, PMSTEP_ERR_CURRENT_GAIN_FOR_PERIOD, PMSTEP_ERR_REFERENCE_BANDWIDTH,
+    PMSTEP_ERR_ANGLE_CORRECTION_GAIN, PMSTEP_ERR_MAX_CURRENT, PMSTEP_ERR_MIN_BUS, PMSTEP_ERR_BUS_ORDER,
+    PMSTEP_ERR_ALIGNMENT_VOLTAGE, PMSTEP_ERR_ALIGNMENT_ABOVE_BUS, PMSTEP_ERR_ALIGNMENT_CURRENT,
+    PMSTEP_ERR_S_ALIGN_TIME, PMSTEP_ERR_C_ALIGN_TIME, PMSTEP_ERR_ALIGNMENT_TOO_LONG, PMSTEP_ERR_ALIGNMENT_CONDITION,
+    PMSTEP_ERR_OFFSET_CALIBRATION_TIME, PMSTEP_ERR_STEADY_STATE_WINDOW, PMSTEP_ERR_INDUCTANCE_WINDOW,
+    PMSTEP_ERR_ALIGNMENT_OFFSETS_UNMEASURED, PMSTEP_ERR_RESISTANCE_UNMEASURED, PMSTEP_ERR_INDUCTANCE_UNMEASURED,
+    PMSTEP_ERR_TORQUE_CONSTANT_UNMEASURED, PMSTEP_ERR_VOLTAGE_BIAS_FRACTION, PMSTEP_ERR_VOLTAGE_BIAS_WINDOW,
+    PMSTEP_ERR_VOLTAGE_BIAS_SETTLING, PMSTEP_ERR_DEAD_TIME, PMSTEP_ERR_DEAD_TIME_BAND, PMSTEP_ERR_DETECTION_BOUND,
+    PMSTEP_ERR_DETECTION_TIME};
 
 /* ---- validation: each cause has its own code and text ---- */
 
 typedef void (*config_edit_t)(pmstep_config_t *cfg);
-static void bad_r(pmstep_config_t *c) { c->resistance_ohm = 0.0f; }
-static void bad_l(pmstep_config_t *c) { c->inductance_h = -1e-3f; }
-static void bad_j(pmstep_config_t *c) { c->inertia_kg_m2 = 0.0f; }
-static void bad_km(pmstep_config_t *c) { c->torque_constant_nm_per_a = 0.0f; }
-static void bad_f(pmstep_config_t *c) { c->friction_nm_s_per_rad = -0.1f; }
-static void bad_p(pmstep_config_t *c) { c->pole_pairs = 0; }
-static void bad_period(pmstep_config_t *c) { c->period_s = 0.0f; }
-static void bad_k_omega(pmstep_config_t *c) { c->speed_gain_per_s = 0.0f; }
-static void bad_k_e(pmstep_config_t *c) { c->observer_gain_per_s = -1.0f; }
-static void bad_k_i(pmstep_config_t *c) { c->current_gain_per_s = 0.0f; }
-static void bad_gamma(pmstep_config_t *c) { c->adapt_gamma = 0.0f; }
-static void bad_lambda(pmstep_config_t *c) { c->adapt_lambda = 0.0f; }
-static void bad_r_gain(pmstep_config_t *c) { c->adapt_r = 0.0f; }
-static void bad_kappa(pmstep_config_t *c) { c->sat_kappa_rad_per_s = 0.0f; }
-static void long_period(pmstep_config_t *c) { c->period_s = 1e-3f; } /* (500 + 100) * 1e-3 >= 0.5 */
-static void bad_condition4(pmstep_config_t *c) { c->c_align_voltage_v = 1.0f; } /* margin 18.5 - 32.1 < 0 */
-static void bad_condition4_slow_motor(pmstep_config_t *c) { c->torque_constant_nm_per_a = 0.2f; } /* 44.4 - 64 < 0 */
-static void bad_align_voltage(pmstep_config_t *c) { c->s_align_voltage_v = 40.0f; } /* above min bus 30 V */
-static void zero_align_voltage(pmstep_config_t *c) { c->c_align_voltage_v = 0.0f; }
-static void bad_align_current(pmstep_config_t *c) { c->max_phase_current_a = 7.0f; } /* 24 V / 3 Ohm = 8 A */
-static void bad_align_time(pmstep_config_t *c) { c->c_align_time_s = c->s_align_time_s; }
-static void bad_bandwidth(pmstep_config_t *c) { c->reference_bandwidth_rad_per_s = 20000.0f; }
-static void bad_limits(pmstep_config_t *c) { c->max_bus_voltage_v = 20.0f; }
-static void bad_delay(pmstep_config_t *c) { c->computational_delay_periods = 2u; }
-static void nan_param(pmstep_config_t *c) { c->inertia_kg_m2 = NAN; }
+static void bad_r(pmstep_config_t *c) { c->motor.resistance_Ohm = 0.0f; }
+static void bad_l(pmstep_config_t *c) { c->motor.inductance_H = -1e-3f; }
+static void bad_j(pmstep_config_t *c) { c->motor.inertia_kgm2 = 0.0f; }
+static void bad_km(pmstep_config_t *c) { c->motor.torque_constant_Nm_A = 0.0f; }
+static void bad_f(pmstep_config_t *c) { c->motor.friction_Nms_rad = -0.1f; }
+static void bad_p(pmstep_config_t *c) { c->motor.pole_pairs = 0; }
+static void bad_period(pmstep_config_t *c) { c->timing.period_s = 0.0f; }
+static void bad_k_omega(pmstep_config_t *c) { c->gains.speed_gain_per_s = 0.0f; }
+static void bad_k_e(pmstep_config_t *c) { c->gains.observer_gain_per_s = -1.0f; }
+static void bad_k_i(pmstep_config_t *c) { c->gains.current_gain_per_s = 0.0f; }
+static void bad_gamma(pmstep_config_t *c) { c->gains.adapt_gamma = 0.0f; }
+static void bad_lambda(pmstep_config_t *c) { c->gains.adapt_lambda = 0.0f; }
+static void bad_r_gain(pmstep_config_t *c) { c->gains.adapt_r = 0.0f; }
+static void bad_kappa(pmstep_config_t *c) { c->gains.sat_kappa_rad_s = 0.0f; }
+static void observer_too_fast(pmstep_config_t *c) { c->timing.period_s = 9.9e-4f; } /* (500 + 100) * 9.9e-4 >= 0.5 */
+static void current_loop_too_fast(pmstep_config_t *c) /* (500 + 1) 9.9e-4 < 0.5 <= (500 + 20) 9.9e-4 */
+{
+    c->timing.period_s = 9.9e-4f;
+    c->gains.observer_gain_per_s = 1.0f;
+}
+static void zero_max_current(pmstep_config_t *c) { c->limits.max_phase_current_A = 0.0f; }
+static void zero_min_bus(pmstep_config_t *c) { c->limits.min_bus_voltage_V = 0.0f; }
+static void s_align_too_short(pmstep_config_t *c) { c->alignment.s_align_time_s = 10e-6f; }
+static void alignment_too_long(pmstep_config_t *c) { c->alignment.c_align_time_s = 1000.0f; } /* 2e7 periods > 2^24 */
+static void bad_condition4(pmstep_config_t *c) { c->alignment.c_align_voltage_V = 1.0f; } /* margin 18.5 - 32.1 < 0 */
+static void bad_condition4_slow_motor(pmstep_config_t *c) { c->motor.torque_constant_Nm_A = 0.2f; } /* 44.4 - 64 < 0 */
+static void align_voltage_above_bus(pmstep_config_t *c) { c->alignment.s_align_voltage_V = 40.0f; } /* above min bus 30 V */
+static void zero_align_voltage(pmstep_config_t *c) { c->alignment.c_align_voltage_V = 0.0f; }
+static void bad_align_current(pmstep_config_t *c) { c->limits.max_phase_current_A = 7.0f; } /* 24 V / 3 Ohm = 8 A */
+static void bad_align_time(pmstep_config_t *c) { c->alignment.c_align_time_s = c->alignment.s_align_time_s; }
+static void bad_bandwidth(pmstep_config_t *c) { c->gains.reference_bandwidth_rad_s = 20000.0f; }
+static void bad_limits(pmstep_config_t *c) { c->limits.max_bus_voltage_V = 20.0f; }
+static void bad_delay(pmstep_config_t *c) { c->timing.computational_delay_periods = 2u; }
+static void nan_param(pmstep_config_t *c) { c->motor.inertia_kgm2 = NAN; }
 /* Found by fuzzing (issue 15): each was accepted and failed only in the step. */
-static void tiny_dead_time_band(pmstep_config_t *c) { c->dead_time_s = 1e-6f; c->dead_time_current_band_a = 1e-40f; }
-static void huge_detection_time(pmstep_config_t *c) { c->detection_time_s = 858993.4592f; }
-static void denormal_period(pmstep_config_t *c) { c->period_s = 1e-40f; }
-static void period_above_range(pmstep_config_t *c) { c->period_s = 0.02f; c->observer_gain_per_s = 1.0f;
-                                                     c->current_gain_per_s = 1.0f; }
-static void gamma_squared_underflows(pmstep_config_t *c) { c->adapt_gamma = 1e-30f; }
-static void inertia_squared_overflows(pmstep_config_t *c) { c->inertia_kg_m2 = 1e28f; }
-static void friction_overflows_load_gain(pmstep_config_t *c) { c->friction_nm_s_per_rad = 3.4e38f; }
+static void tiny_dead_time_band(pmstep_config_t *c) { c->inverter.dead_time_s = 1e-6f; c->inverter.dead_time_current_band_A = 1e-40f; }
+static void huge_detection_time(pmstep_config_t *c) { c->detection.persistence_s = 858993.4592f; }
+static void denormal_period(pmstep_config_t *c) { c->timing.period_s = 1e-40f; }
+static void period_above_range(pmstep_config_t *c) { c->timing.period_s = 0.02f; c->gains.observer_gain_per_s = 1.0f;
+                                                     c->gains.current_gain_per_s = 1.0f; }
+static void gamma_squared_underflows(pmstep_config_t *c) { c->gains.adapt_gamma = 1e-30f; }
+static void inertia_squared_overflows(pmstep_config_t *c) { c->motor.inertia_kgm2 = 1e28f; }
+static void friction_overflows_load_gain(pmstep_config_t *c) { c->motor.friction_Nms_rad = 3.4e38f; }
 static void detection_time_below_four_periods_with_detectors_off(pmstep_config_t *c)
 {
-    c->angle_magnitude_bound = 0.0f;
-    c->speed_consistency_bound_rad_s = 0.0f;
-    c->stall_speed_error_rad_s = 0.0f;
-    c->observer_residual_bound_a = 0.0f;
-    c->detection_time_s = 1e-40f;
+    c->detection.angle_magnitude_bound = 0.0f;
+    c->detection.speed_consistency_bound_rad_s = 0.0f;
+    c->detection.stall_speed_error_rad_s = 0.0f;
+    c->detection.observer_residual_bound_A = 0.0f;
+    c->detection.persistence_s = 1e-40f;
 }
+
+static const struct {
+    config_edit_t edit;
+    pmstep_status_t expected;
+} validation_cases[] = {
+    {bad_r, PMSTEP_ERR_RESISTANCE},
+    {bad_l, PMSTEP_ERR_INDUCTANCE},
+    {bad_j, PMSTEP_ERR_INERTIA},
+    {bad_km, PMSTEP_ERR_TORQUE_CONSTANT},
+    {bad_f, PMSTEP_ERR_FRICTION},
+    {bad_p, PMSTEP_ERR_POLE_PAIRS},
+    {bad_period, PMSTEP_ERR_PERIOD},
+    {bad_k_omega, PMSTEP_ERR_SPEED_GAIN},
+    {bad_k_e, PMSTEP_ERR_OBSERVER_GAIN},
+    {bad_k_i, PMSTEP_ERR_CURRENT_GAIN},
+    {bad_gamma, PMSTEP_ERR_ADAPT_GAMMA},
+    {bad_lambda, PMSTEP_ERR_ADAPT_LAMBDA},
+    {bad_r_gain, PMSTEP_ERR_ADAPT_R},
+    {bad_kappa, PMSTEP_ERR_SAT_KAPPA},
+    {observer_too_fast, PMSTEP_ERR_OBSERVER_GAIN_FOR_PERIOD},
+    {current_loop_too_fast, PMSTEP_ERR_CURRENT_GAIN_FOR_PERIOD},
+    {zero_max_current, PMSTEP_ERR_MAX_CURRENT},
+    {zero_min_bus, PMSTEP_ERR_MIN_BUS},
+    {s_align_too_short, PMSTEP_ERR_S_ALIGN_TIME},
+    {alignment_too_long, PMSTEP_ERR_ALIGNMENT_TOO_LONG},
+    {bad_condition4, PMSTEP_ERR_ALIGNMENT_CONDITION},
+    {bad_condition4_slow_motor, PMSTEP_ERR_ALIGNMENT_CONDITION},
+    {align_voltage_above_bus, PMSTEP_ERR_ALIGNMENT_ABOVE_BUS},
+    {zero_align_voltage, PMSTEP_ERR_ALIGNMENT_VOLTAGE},
+    {bad_align_current, PMSTEP_ERR_ALIGNMENT_CURRENT},
+    {bad_align_time, PMSTEP_ERR_C_ALIGN_TIME},
+    {bad_bandwidth, PMSTEP_ERR_REFERENCE_BANDWIDTH},
+    {bad_limits, PMSTEP_ERR_BUS_ORDER},
+    {bad_delay, PMSTEP_ERR_DELAY},
+    {nan_param, PMSTEP_ERR_NONFINITE_PARAMETER},
+    {tiny_dead_time_band, PMSTEP_ERR_DEAD_TIME_BAND},
+    {huge_detection_time, PMSTEP_ERR_DETECTION_TIME},
+    {denormal_period, PMSTEP_ERR_PERIOD},
+    {period_above_range, PMSTEP_ERR_PERIOD},
+    {gamma_squared_underflows, PMSTEP_ERR_DERIVED_NONFINITE},
+    {inertia_squared_overflows, PMSTEP_ERR_DERIVED_NONFINITE},
+    {friction_overflows_load_gain, PMSTEP_ERR_DERIVED_NONFINITE},
+    {detection_time_below_four_periods_with_detectors_off, PMSTEP_ERR_DETECTION_TIME},
+};
 
 static void every_invalid_configuration_has_its_code(void **state)
 {
-    static const struct {
-        config_edit_t edit;
-        pmstep_status_t expected;
-    } cases[] = {
-        {bad_r, PMSTEP_ERR_RESISTANCE},
-        {bad_l, PMSTEP_ERR_INDUCTANCE},
-        {bad_j, PMSTEP_ERR_INERTIA},
-        {bad_km, PMSTEP_ERR_TORQUE_CONSTANT},
-        {bad_f, PMSTEP_ERR_FRICTION},
-        {bad_p, PMSTEP_ERR_POLE_PAIRS},
-        {bad_period, PMSTEP_ERR_PERIOD},
-        {bad_k_omega, PMSTEP_ERR_GAIN},
-        {bad_k_e, PMSTEP_ERR_GAIN},
-        {bad_k_i, PMSTEP_ERR_GAIN},
-        {bad_gamma, PMSTEP_ERR_GAIN},
-        {bad_lambda, PMSTEP_ERR_GAIN},
-        {bad_r_gain, PMSTEP_ERR_GAIN},
-        {bad_kappa, PMSTEP_ERR_GAIN},
-        {long_period, PMSTEP_ERR_PERIOD_TOO_LONG},
-        {bad_condition4, PMSTEP_ERR_ALIGNMENT_CONDITION},
-        {bad_condition4_slow_motor, PMSTEP_ERR_ALIGNMENT_CONDITION},
-        {bad_align_voltage, PMSTEP_ERR_ALIGNMENT_VOLTAGE},
-        {zero_align_voltage, PMSTEP_ERR_ALIGNMENT_VOLTAGE},
-        {bad_align_current, PMSTEP_ERR_ALIGNMENT_CURRENT},
-        {bad_align_time, PMSTEP_ERR_ALIGNMENT_TIME},
-        {bad_bandwidth, PMSTEP_ERR_REFERENCE_BANDWIDTH},
-        {bad_limits, PMSTEP_ERR_LIMITS},
-        {bad_delay, PMSTEP_ERR_DELAY},
-        {nan_param, PMSTEP_ERR_NONFINITE_PARAMETER},
-        {tiny_dead_time_band, PMSTEP_ERR_CALIBRATION},
-        {huge_detection_time, PMSTEP_ERR_DETECTION},
-        {denormal_period, PMSTEP_ERR_PERIOD},
-        {period_above_range, PMSTEP_ERR_PERIOD},
-        {gamma_squared_underflows, PMSTEP_ERR_DERIVED_NONFINITE},
-        {inertia_squared_overflows, PMSTEP_ERR_DERIVED_NONFINITE},
-        {friction_overflows_load_gain, PMSTEP_ERR_DERIVED_NONFINITE},
-        {detection_time_below_four_periods_with_detectors_off, PMSTEP_ERR_DETECTION},
-    };
     size_t n;
     pmstep_t inst;
     pmstep_config_t good = pmstep_paper_config();
@@ -114,14 +147,61 @@ static void every_invalid_configuration_has_its_code(void **state)
     assert_int_equal(pmstep_init(&inst, &good), PMSTEP_OK);
     assert_int_equal(pmstep_init(NULL, &good), PMSTEP_ERR_NULL_ARGUMENT);
     assert_int_equal(pmstep_init(&inst, NULL), PMSTEP_ERR_NULL_ARGUMENT);
-    for (n = 0; n < sizeof cases / sizeof cases[0]; ++n) {
+    for (n = 0; n < sizeof validation_cases / sizeof validation_cases[0]; ++n) {
         pmstep_config_t cfg = pmstep_paper_config();
         pmstep_status_t status;
-        cases[n].edit(&cfg);
+        validation_cases[n].edit(&cfg);
         status = pmstep_init(&inst, &cfg);
         print_message("case %u: %d (%s)\n", (unsigned)n, (int)status, pmstep_status_str(status));
-        assert_int_equal(status, cases[n].expected);
+        assert_int_equal(status, validation_cases[n].expected);
         assert_true(strcmp(pmstep_status_str(status), "unknown status") != 0);
+    }
+}
+
+/* The validation causes this file does not provoke, and the file that does: test_commission.c
+ * (commissioning, inverter, detection and angle-correction settings). */
+static const pmstep_status_t codes_tested_in_test_commission[] = {
+    PMSTEP_ERR_ANGLE_CORRECTION_GAIN, PMSTEP_ERR_OFFSET_CALIBRATION_TIME, PMSTEP_ERR_STEADY_STATE_WINDOW,
+    PMSTEP_ERR_INDUCTANCE_WINDOW, PMSTEP_ERR_ALIGNMENT_OFFSETS_UNMEASURED, PMSTEP_ERR_RESISTANCE_UNMEASURED,
+    PMSTEP_ERR_INDUCTANCE_UNMEASURED, PMSTEP_ERR_TORQUE_CONSTANT_UNMEASURED, PMSTEP_ERR_VOLTAGE_BIAS_FRACTION,
+    PMSTEP_ERR_VOLTAGE_BIAS_WINDOW, PMSTEP_ERR_VOLTAGE_BIAS_SETTLING, PMSTEP_ERR_DEAD_TIME, PMSTEP_ERR_DETECTION_BOUND};
+
+static void every_validation_code_is_provoked(void **state)
+{
+    /* Each configuration code (-10 and below) is the expected result of some case above or
+     * of test_commission.c's table: one cause, one code, one test. */
+    size_t n;
+    (void)state;
+    for (n = 0; n < sizeof all_status_codes / sizeof all_status_codes[0]; ++n) {
+        const pmstep_status_t code = all_status_codes[n];
+        bool found = false;
+        size_t k;
+        if (code > PMSTEP_ERR_NONFINITE_PARAMETER) {
+            continue; /* ok and the command codes: commands_validate_their_values */
+        }
+        for (k = 0; k < sizeof validation_cases / sizeof validation_cases[0]; ++k) {
+            found = found || validation_cases[k].expected == code;
+        }
+        for (k = 0; k < sizeof codes_tested_in_test_commission / sizeof codes_tested_in_test_commission[0]; ++k) {
+            found = found || codes_tested_in_test_commission[k] == code;
+        }
+        print_message("%d %s: %s\n", (int)code, pmstep_status_str(code), found ? "tested" : "NOT TESTED");
+        assert_true(found);
+    }
+}
+
+static void every_code_has_its_own_text(void **state)
+{
+    size_t n;
+    size_t m;
+    (void)state;
+    for (n = 0; n < sizeof all_status_codes / sizeof all_status_codes[0]; ++n) {
+        const char *text = pmstep_status_str(all_status_codes[n]);
+        assert_true(strcmp(text, "unknown status") != 0);
+        for (m = 0; m < n; ++m) {
+            assert_true(all_status_codes[m] != all_status_codes[n]);
+            assert_true(strcmp(pmstep_status_str(all_status_codes[m]), text) != 0);
+        }
     }
 }
 
@@ -158,7 +238,7 @@ static void alignment_timing_and_voltages(void **state)
     pmstep_step(&inst, &meas, &out); /* IDLE: bridge off */
     assert_int_equal(out.mode, PMSTEP_MODE_IDLE);
     assert_false(out.bridge_enable);
-    assert_true(out.u_a_v == 0.0f && out.u_b_v == 0.0f);
+    assert_true(out.u_a_V == 0.0f && out.u_b_V == 0.0f);
 
     assert_int_equal(pmstep_start(&inst), PMSTEP_OK);
     assert_int_equal(pmstep_start(&inst), PMSTEP_ERR_BAD_MODE);
@@ -167,10 +247,10 @@ static void alignment_timing_and_voltages(void **state)
         assert_true(out.bridge_enable);
         if (k < s_steps) { /* (3) */
             assert_int_equal(out.mode, PMSTEP_MODE_S_ALIGN);
-            assert_true(out.u_a_v == 0.0f && out.u_b_v == 24.0f);
+            assert_true(out.u_a_V == 0.0f && out.u_b_V == 24.0f);
         } else if (k < c_steps) { /* (5) */
             assert_int_equal(out.mode, PMSTEP_MODE_C_ALIGN);
-            assert_true(out.u_a_v == 24.0f && out.u_b_v == 0.0f);
+            assert_true(out.u_a_V == 24.0f && out.u_b_V == 0.0f);
         } else {
             assert_int_equal(out.mode, PMSTEP_MODE_RUN);
             assert_true(out.cos_hat == 1.0f || k > c_steps);
@@ -201,11 +281,11 @@ static void commands_validate_their_values(void **state)
 /* ---- faults: zero output, bridge off, code and step latched, only clear leaves ---- */
 
 typedef void (*meas_edit_t)(pmstep_meas_t *m);
-static void nan_current(pmstep_meas_t *m) { m->i_b_a = NAN; }
-static void inf_bus(pmstep_meas_t *m) { m->bus_voltage_v = INFINITY; }
-static void over_current(pmstep_meas_t *m) { m->i_a_a = -15.5f; }
-static void under_voltage(pmstep_meas_t *m) { m->bus_voltage_v = 25.0f; }
-static void over_voltage(pmstep_meas_t *m) { m->bus_voltage_v = 65.0f; }
+static void nan_current(pmstep_meas_t *m) { m->i_b_A = NAN; }
+static void inf_bus(pmstep_meas_t *m) { m->bus_voltage_V = INFINITY; }
+static void over_current(pmstep_meas_t *m) { m->i_a_A = -15.5f; }
+static void under_voltage(pmstep_meas_t *m) { m->bus_voltage_V = 25.0f; }
+static void over_voltage(pmstep_meas_t *m) { m->bus_voltage_V = 65.0f; }
 
 static void each_fault_latches_with_zero_output(void **state)
 {
@@ -240,7 +320,7 @@ static void each_fault_latches_with_zero_output(void **state)
         assert_int_equal(out.fault, cases[n].expected);
         assert_int_equal(out.fault_step, cases[n].at_step);
         assert_false(out.bridge_enable);
-        assert_true(out.u_a_v == 0.0f && out.u_b_v == 0.0f);
+        assert_true(out.u_a_V == 0.0f && out.u_b_V == 0.0f);
         assert_true(strcmp(pmstep_fault_str(out.fault), "UNKNOWN") != 0);
         /* Nothing but an explicit clear leaves FAULT. */
         assert_int_equal(pmstep_start(&inst), PMSTEP_ERR_BAD_MODE);
@@ -262,7 +342,7 @@ static void nonfinite_known_load_faults_only_in_known_load_mode(void **state)
     pmstep_output_t out;
     pmstep_meas_t meas = nominal_meas();
     (void)state;
-    meas.load_torque_nm = NAN;
+    meas.load_torque_Nm = NAN;
     assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
     assert_int_equal(pmstep_start(&inst), PMSTEP_OK);
     pmstep_step(&inst, &meas, &out);
@@ -275,12 +355,12 @@ static void nonfinite_known_load_faults_only_in_known_load_mode(void **state)
 }
 
 /* Steps to RUN with the rotor "held" at cos p theta = 1 (currents of the c-aligned state). */
-static void step_to_run(pmstep_t *inst, pmstep_output_t *out, float bus_v)
+static void step_to_run(pmstep_t *inst, pmstep_output_t *out, float bus_V)
 {
     uint32_t k;
     pmstep_meas_t meas = nominal_meas();
-    meas.bus_voltage_v = bus_v;
-    meas.i_a_a = 8.0f;
+    meas.bus_voltage_V = bus_V;
+    meas.i_a_A = 8.0f;
     assert_int_equal(pmstep_start(inst), PMSTEP_OK);
     for (k = 0; k <= 12000u; ++k) {
         pmstep_step(inst, &meas, out);
@@ -298,14 +378,14 @@ static void voltage_limited_to_bus_keeping_direction(void **state)
     assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
     step_to_run(&inst, &out, 48.0f);
     /* A wild current sample makes the law ask for far more than the bus. */
-    meas.i_a_a = -14.0f;
-    meas.i_b_a = 14.0f;
-    meas.bus_voltage_v = 31.0f;
+    meas.i_a_A = -14.0f;
+    meas.i_b_A = 14.0f;
+    meas.bus_voltage_V = 31.0f;
     pmstep_step(&inst, &meas, &out);
     assert_int_equal(out.fault, PMSTEP_FAULT_NONE);
     assert_true(out.voltage_limited);
-    assert_true(fabsf(out.u_a_v) <= 31.0f && fabsf(out.u_b_v) <= 31.0f);
-    assert_true(fabsf(fmaxf(fabsf(out.u_a_v), fabsf(out.u_b_v)) - 31.0f) < 1e-4f);
+    assert_true(fabsf(out.u_a_V) <= 31.0f && fabsf(out.u_b_V) <= 31.0f);
+    assert_true(fabsf(fmaxf(fabsf(out.u_a_V), fabsf(out.u_b_V)) - 31.0f) < 1e-4f);
 }
 
 static void nonfinite_voltage_never_leaves_with_the_bridge_on(void **state)
@@ -319,16 +399,16 @@ static void nonfinite_voltage_never_leaves_with_the_bridge_on(void **state)
     pmstep_output_t out;
     pmstep_meas_t meas = nominal_meas(); /* currents exactly 0 */
     (void)state;
-    cfg.dead_time_s = 1e-6f;
-    cfg.dead_time_current_band_a = 0.01f;
+    cfg.inverter.dead_time_s = 1e-6f;
+    cfg.inverter.dead_time_current_band_A = 0.01f;
     assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
-    inst.inv_dead_time_band_per_a = INFINITY;
+    inst.actuate_coeffs.inv_band_per_A = INFINITY;
     assert_int_equal(pmstep_start(&inst), PMSTEP_OK);
     pmstep_step(&inst, &meas, &out);
     assert_int_equal(out.mode, PMSTEP_MODE_FAULT);
     assert_int_equal(out.fault, PMSTEP_FAULT_STATE_NONFINITE);
     assert_false(out.bridge_enable);
-    assert_true(out.u_a_v == 0.0f && out.u_b_v == 0.0f);
+    assert_true(out.u_a_V == 0.0f && out.u_b_V == 0.0f);
 }
 
 static void narrowest_band_gives_finite_alignment_voltages(void **state)
@@ -339,17 +419,17 @@ static void narrowest_band_gives_finite_alignment_voltages(void **state)
     pmstep_output_t out;
     uint32_t k;
     (void)state;
-    cfg.dead_time_s = 1e-6f;
-    cfg.dead_time_current_band_a = PMSTEP_MIN_CURRENT_BAND_A;
+    cfg.inverter.dead_time_s = 1e-6f;
+    cfg.inverter.dead_time_current_band_A = PMSTEP_MIN_CURRENT_BAND_A;
     assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
     assert_int_equal(pmstep_start(&inst), PMSTEP_OK);
     for (k = 0; k < 100u; ++k) {
         pmstep_meas_t meas = nominal_meas();
-        meas.i_b_a = (k % 2u) == 0u ? 0.0f : PMSTEP_MIN_CURRENT_BAND_A;
+        meas.i_b_A = (k % 2u) == 0u ? 0.0f : PMSTEP_MIN_CURRENT_BAND_A;
         pmstep_step(&inst, &meas, &out);
         assert_true(out.bridge_enable);
-        assert_true(isfinite(out.u_a_v) && isfinite(out.u_b_v));
-        assert_true(fabsf(out.u_a_v) <= meas.bus_voltage_v && fabsf(out.u_b_v) <= meas.bus_voltage_v);
+        assert_true(isfinite(out.u_a_V) && isfinite(out.u_b_V));
+        assert_true(fabsf(out.u_a_V) <= meas.bus_voltage_V && fabsf(out.u_b_V) <= meas.bus_voltage_V);
     }
 }
 
@@ -366,14 +446,14 @@ static void limited_voltage_never_exceeds_the_bus_by_rounding(void **state)
     step_to_run(&inst, &out, 48.0f);
     for (n = 0; n < 2000u; ++n) {
         pmstep_meas_t meas = nominal_meas();
-        meas.i_a_a = -14.0f + 0.0137f * (float)n;
-        meas.i_b_a = 14.0f - 0.0071f * (float)n;
-        meas.bus_voltage_v = 30.0f + 0.0149f * (float)n;
+        meas.i_a_A = -14.0f + 0.0137f * (float)n;
+        meas.i_b_A = 14.0f - 0.0071f * (float)n;
+        meas.bus_voltage_V = 30.0f + 0.0149f * (float)n;
         pmstep_step(&inst, &meas, &out);
         if (!out.bridge_enable) {
             break; /* a detection may latch on such wild samples: the invariant is about the bridge on */
         }
-        assert_true(fabsf(out.u_a_v) <= meas.bus_voltage_v && fabsf(out.u_b_v) <= meas.bus_voltage_v);
+        assert_true(fabsf(out.u_a_V) <= meas.bus_voltage_V && fabsf(out.u_b_V) <= meas.bus_voltage_V);
     }
 }
 
@@ -386,10 +466,10 @@ static void delay_one_period_integrates_the_applied_voltage(void **state)
     pmstep_output_t out;
     pmstep_meas_t meas = nominal_meas();
     (void)state;
-    cfg.computational_delay_periods = 1u;
+    cfg.timing.computational_delay_periods = 1u;
     assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
     step_to_run(&inst, &out, 48.0f);
-    meas.i_a_a = 8.0f;
+    meas.i_a_A = 8.0f;
     pmstep_step(&inst, &meas, &out);
     /* phi1 = T/L (24 - R (8 + 8)/2) = 0 exactly for the held c-aligned state. */
     assert_true(fabsf(inst.angle.phi_a) < 1e-6f);
@@ -400,6 +480,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(every_invalid_configuration_has_its_code),
+        cmocka_unit_test(every_code_has_its_own_text),
+        cmocka_unit_test(every_validation_code_is_provoked),
         cmocka_unit_test(condition4_cases_are_on_the_right_side),
         cmocka_unit_test(alignment_timing_and_voltages),
         cmocka_unit_test(commands_validate_their_values),

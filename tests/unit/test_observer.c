@@ -14,8 +14,8 @@ static void observer_converges_on_exact_samples(void **state)
 {
     const pmstep_config_t cfg = pmstep_paper_config();
     const pmstep_electrical_t model = pmstep_configured_electrical(&cfg);
-    const double period_s = cfg.period_s;
-    const double i_q_a = 1.0;   /* q current held by the drive: balances 2 Nm */
+    const double period_s = cfg.timing.period_s;
+    const double i_q_A = 1.0;   /* q current held by the drive: balances 2 Nm */
     const double speed = 10.0;  /* rad/s */
     exact_plant_t plant = {3.0, 0.006, 2.0, 6.0, 0.0, 0.0, 0.0, 0.0};
     pmstep_observer_coeffs_t coeffs;
@@ -27,11 +27,11 @@ static void observer_converges_on_exact_samples(void **state)
     (void)state;
     plant.speed_rad_s = speed;
     plant.i_a = 0.0;
-    plant.i_b = i_q_a;
+    plant.i_b = i_q_A;
     pmstep_observer_coeffs_init(&coeffs, &cfg, &model);
     pmstep_observer_start(&obs, (float)plant.i_a, (float)plant.i_b);
     obs.speed_hat_rad_s = -5.0f; /* wrong start: true speed 10 rad/s, true load 2 Nm */
-    obs.load_hat_nm = 0.5f;
+    obs.load_hat_Nm = 0.5f;
     for (k = 0; k < 60000; ++k) { /* 3 s */
         const double c = cos(6.0 * plant.theta_rad);
         const double s = sin(6.0 * plant.theta_rad);
@@ -39,30 +39,30 @@ static void observer_converges_on_exact_samples(void **state)
         pmstep_observer_mech_rates_t mech;
         /* Voltage (2) that holds i_d = 0, i_q = 1 A at this speed, at the mid-period angle. */
         const double mid = 6.0 * (plant.theta_rad + 0.5 * speed * period_s);
-        const double u_d = -0.006 * 6.0 * speed * i_q_a;
-        const double u_q = 3.0 * i_q_a + 2.0 * speed;
+        const double u_d = -0.006 * 6.0 * speed * i_q_A;
+        const double u_q = 3.0 * i_q_A + 2.0 * speed;
         const float u_a = (float)(cos(mid) * u_d - sin(mid) * u_q);
         const float u_b = (float)(sin(mid) * u_d + cos(mid) * u_q);
-        in.i_a_a = (float)plant.i_a;
-        in.i_b_a = (float)plant.i_b;
+        in.i_a_A = (float)plant.i_a;
+        in.i_b_A = (float)plant.i_b;
         in.cos_hat = (float)c;
         in.sin_hat = (float)s;
-        pmstep_park(in.cos_hat, in.sin_hat, in.i_a_a, in.i_b_a, &in.i_d_a, &in.i_q_a);
-        in.i_d_err_a = 0.0f;
-        in.i_q_err_a = 0.0f;
-        in.known_load_nm = 0.0f;
+        pmstep_park(in.cos_hat, in.sin_hat, in.i_a_A, in.i_b_A, &in.i_d_A, &in.i_q_A);
+        in.i_d_err_A = 0.0f;
+        in.i_q_err_A = 0.0f;
+        in.known_load_Nm = 0.0f;
         mech = pmstep_observer_mech_rates(&obs, &coeffs, &in, false);
         pmstep_observer_advance(&obs, &coeffs, &in, &mech, u_a, u_b, (float)period_s);
         exact_plant_advance(&plant, u_a, u_b, period_s);
         if (k >= 40000) {
             /* Balanced load k_M i_q over the last second. */
-            load_sum += obs.load_hat_nm - 2.0 * (-s * plant.i_a + c * plant.i_b);
+            load_sum += obs.load_hat_Nm - 2.0 * (-s * plant.i_a + c * plant.i_b);
             speed_err_end = fmax(speed_err_end, fabs(obs.speed_hat_rad_s - speed));
             ++n_avg;
         }
     }
     print_message("after 2-3 s: max |w-hat - w| = %.3g rad/s, mean (T_L-hat - k_M i_q) = %.3g Nm, T_L-hat = %.5f\n",
-                  speed_err_end, load_sum / (double)n_avg, obs.load_hat_nm);
+                  speed_err_end, load_sum / (double)n_avg, obs.load_hat_Nm);
     assert_true(speed_err_end < 1e-2);
     assert_true(fabs(load_sum / (double)n_avg) < 1e-2);
 }

@@ -28,10 +28,10 @@ typedef struct {
     float phi_b;            /**< phi2, A */
     float phi_a_compensation; /**< Kahan running compensation of phi1 */
     float phi_b_compensation; /**< Kahan running compensation of phi2 */
-    float i_a_start_a;      /**< i_a(t_c) */
-    float i_b_start_a;      /**< i_b(t_c) */
-    float i_a_prev_a;       /**< i_a at the previous sample */
-    float i_b_prev_a;       /**< i_b at the previous sample */
+    float i_a_start_A;      /**< i_a(t_c) */
+    float i_b_start_A;      /**< i_b(t_c) */
+    float i_a_prev_A;       /**< i_a at the previous sample */
+    float i_b_prev_A;       /**< i_b at the previous sample */
 } pmstep_angle_t;
 
 /** Constants derived once from the configuration. */
@@ -47,19 +47,19 @@ void pmstep_angle_coeffs_init(pmstep_angle_coeffs_t *coeffs, const pmstep_config
                               const pmstep_electrical_t *model);
 
 /** Starts the integrals at t_c: phi = 0, remembers i(t_c). */
-void pmstep_angle_start(pmstep_angle_t *angle, float i_a_a, float i_b_a);
+void pmstep_angle_start(pmstep_angle_t *angle, float i_a_A, float i_b_A);
 
 /**
  * Integrates phi1, phi2 over the period that just ended.
- * @param[in] i_a_a, i_b_a   currents sampled at the end of the period
- * @param[in] u_a_v, u_b_v   voltages applied during the period
+ * @param[in] i_a_A, i_b_A   currents sampled at the end of the period
+ * @param[in] u_a_V, u_b_V   voltages applied during the period
  */
 void pmstep_angle_update(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs,
-                         float i_a_a, float i_b_a, float u_a_v, float u_b_v);
+                         float i_a_A, float i_b_A, float u_a_V, float u_b_V);
 
 /** c-hat and s-hat for the currents sampled now (the same as given to the last update). */
 void pmstep_angle_estimate(const pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs,
-                           float i_a_a, float i_b_a, float *cos_hat, float *sin_hat);
+                           float i_a_A, float i_b_A, float *cos_hat, float *sin_hat);
 
 /**
  * Drift-free option: moves phi1, phi2 so the next estimate is pulled onto the unit

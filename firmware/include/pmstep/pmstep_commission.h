@@ -49,14 +49,14 @@ typedef struct {
 
 /** Running sums (raw samples; offsets are removed at the end). */
 typedef struct {
-    float zero_sum_a_a, zero_sum_b_a;       /**< samples of a phase whose true current is 0 */
+    float zero_sum_a_A, zero_sum_b_A;       /**< samples of a phase whose true current is 0 */
     uint32_t zero_count_a, zero_count_b;
-    float rise_voltage_sum_v, rise_current_sum_a, rise_start_a, rise_end_a; /**< L, phase b */
-    float s_current_sum_a, s_voltage_sum_v; /**< end of s-alignment, phase b */
-    float c_current_sum_a, c_voltage_sum_v; /**< end of c-alignment, phase a */
-    float s_low_current_sum_a, s_low_voltage_sum_v; /**< lower steady state of s-alignment (bias option) */
-    float c_low_current_sum_a, c_low_voltage_sum_v; /**< lower steady state of c-alignment */
-    float swing_voltage_a_v, swing_current_a_a, swing_start_a_a; /**< c-alignment, k_M */
+    float rise_voltage_sum_V, rise_current_sum_A, rise_start_A, rise_end_A; /**< L, phase b */
+    float s_current_sum_A, s_voltage_sum_V; /**< end of s-alignment, phase b */
+    float c_current_sum_A, c_voltage_sum_V; /**< end of c-alignment, phase a */
+    float s_low_current_sum_A, s_low_voltage_sum_V; /**< lower steady state of s-alignment (bias option) */
+    float c_low_current_sum_A, c_low_voltage_sum_V; /**< lower steady state of c-alignment */
+    float swing_voltage_a_V, swing_current_a_A, swing_start_a_A; /**< c-alignment, k_M */
 } pmstep_commission_sums_t;
 
 void pmstep_commission_clear(pmstep_commission_sums_t *sums);
@@ -65,24 +65,24 @@ void pmstep_commission_clear(pmstep_commission_sums_t *sums);
 bool pmstep_commission_low_level(const pmstep_commission_plan_t *plan, uint32_t sample, uint32_t end);
 
 /** A sample with the bridge off (true currents zero). */
-void pmstep_commission_add_bridge_off(pmstep_commission_sums_t *sums, float i_a_a, float i_b_a);
+void pmstep_commission_add_bridge_off(pmstep_commission_sums_t *sums, float i_a_A, float i_b_A);
 
 /**
  * Sample @p sample (< c_align_end_step) of the alignment.
- * @param[in] u_a_v, u_b_v  voltage applied over the period that ends at this sample
+ * @param[in] u_a_V, u_b_V  voltage applied over the period that ends at this sample
  */
 void pmstep_commission_add_alignment(pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
-                                     uint32_t sample, float i_a_a, float i_b_a, float u_a_v, float u_b_v);
+                                     uint32_t sample, float i_a_A, float i_b_A, float u_a_V, float u_b_V);
 
 /**
  * At t_c: offsets, R, L and k_M (and the voltage biases) from the sums and the sample
  * i_a at t_c; values not measured are left 0 in @p result. The voltage of phase a over
- * the last period before t_c is @p u_a_v.
+ * the last period before t_c is @p u_a_V.
  * @return PMSTEP_FAULT_NONE, or PMSTEP_FAULT_COMMISSIONING when a measured value is not
  *         finite or outside [1/2, 2] x the configured one.
  */
 pmstep_fault_t pmstep_commission_finish(const pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
-                                        const pmstep_config_t *cfg, float i_a_a, float u_a_v,
+                                        const pmstep_config_t *cfg, float i_a_A, float u_a_V,
                                         pmstep_commissioning_t *result);
 
 #ifdef __cplusplus

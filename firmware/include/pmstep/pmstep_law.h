@@ -23,8 +23,8 @@ typedef struct {
     float speed_gain_per_s;   /**< k_w */
     float current_gain_per_s; /**< K_i */
     float r_over_l_per_s;     /**< R/L */
-    float km_over_l;          /**< k_M/L */
-    float inductance_h;       /**< L */
+    float km_over_l;          /**< k_M/L, A/rad */
+    float inductance_H;       /**< L */
     float pole_pairs;         /**< p */
     float kappa_rad_s;        /**< kappa */
     bool linear_speed_term;   /**< Remark 1 (13): k_w (w-hat - w*) without saturation */
@@ -32,8 +32,8 @@ typedef struct {
 
 /** References at one sample. */
 typedef struct {
-    float speed_ref_rad_s, speed_ref_rate, speed_ref_accel; /**< w*, w*', w*'' */
-    float i_d_ref_a, i_d_ref_rate;                          /**< i_d*, i_d*' */
+    float speed_ref_rad_s, speed_ref_rate_rad_s2, speed_ref_accel_rad_s3; /**< w*, w*', w*'' */
+    float i_d_ref_A, i_d_ref_rate_A_s;                          /**< i_d*, i_d*' */
 } pmstep_law_refs_t;
 
 /** Coefficients for the gains and mechanics of @p cfg and the electrical model @p model. */
@@ -48,7 +48,7 @@ void pmstep_park(float cos_hat, float sin_hat, float a, float b, float *d, float
 
 /** i_q* = (J/k_M)[(F/J) w* - k_w sat(w-hat - w*) + T/J + w*'], T = T_L-hat or T_L*. */
 float pmstep_law_iq_ref(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs,
-                        float speed_hat_rad_s, float load_nm);
+                        float speed_hat_rad_s, float load_Nm);
 
 /** i_q*' = (J/k_M)[(F/J) w*' - k_w sat'(e)(w-hat' - w*') + T'/J + w*'']. */
 float pmstep_law_iq_ref_rate(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs,
@@ -60,9 +60,9 @@ float pmstep_law_iq_ref_rate(const pmstep_law_coeffs_t *coeffs, const pmstep_law
  * u_a = c u_d - s u_q, u_b = s u_d + c u_q.
  */
 void pmstep_law_voltages(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs,
-                         float cos_hat, float sin_hat, float i_d_a, float i_q_a,
-                         float speed_hat_rad_s, float i_q_ref_a, float i_q_ref_rate,
-                         float *u_a_v, float *u_b_v);
+                         float cos_hat, float sin_hat, float i_d_A, float i_q_A,
+                         float speed_hat_rad_s, float i_q_ref_A, float i_q_ref_rate,
+                         float *u_a_V, float *u_b_V);
 
 #ifdef __cplusplus
 }

@@ -20,16 +20,16 @@ extern "C" {
 #endif
 
 typedef struct {
-    float i_a_hat_a;
-    float i_b_hat_a;
+    float i_a_hat_A;
+    float i_b_hat_A;
     float speed_hat_rad_s;
-    float load_hat_nm;
+    float load_hat_Nm;
 } pmstep_observer_t;
 
 typedef struct {
     float r_over_l_per_s;     /**< R/L */
-    float inv_l_per_h;        /**< 1/L */
-    float km_over_l;          /**< k_M/L, A/(rad) per s... (V s/rad)/H */
+    float inv_l_per_H;        /**< 1/L */
+    float km_over_l;          /**< k_M/L: (V s/rad)/(V s/A) = A/rad */
     float km_over_j;          /**< k_M/J */
     float f_over_j_per_s;     /**< F/J */
     float inv_j;              /**< 1/J */
@@ -42,17 +42,17 @@ typedef struct {
 
 /** Signals the mechanical part of the observer needs at one sample. */
 typedef struct {
-    float i_a_a, i_b_a;       /**< measured currents */
+    float i_a_A, i_b_A;       /**< measured currents */
     float cos_hat, sin_hat;   /**< angle estimate */
-    float i_d_a, i_q_a;       /**< Park of the currents with (c-hat, s-hat) */
-    float i_d_err_a, i_q_err_a; /**< i_d - i_d*, i_q - i_q* (Remark 1 only) */
-    float known_load_nm;      /**< T_L* (Remark 1 only) */
+    float i_d_A, i_q_A;       /**< Park of the currents with (c-hat, s-hat) */
+    float i_d_err_A, i_q_err_A; /**< i_d - i_d*, i_q - i_q* (Remark 1 only) */
+    float known_load_Nm;      /**< T_L* (Remark 1 only) */
 } pmstep_observer_input_t;
 
 /** Time derivatives of the speed and load estimates. */
 typedef struct {
     float speed_hat_rate_rad_s2;
-    float load_hat_rate_nm_per_s;
+    float load_hat_rate_Nm_s;
 } pmstep_observer_mech_rates_t;
 
 /** Coefficients for the gains and mechanics of @p cfg and the electrical model @p model. */
@@ -60,7 +60,7 @@ void pmstep_observer_coeffs_init(pmstep_observer_coeffs_t *coeffs, const pmstep_
                                  const pmstep_electrical_t *model);
 
 /** Starts at t_c: i-hat = i(t_c), w-hat = 0, T_L-hat = 0. */
-void pmstep_observer_start(pmstep_observer_t *obs, float i_a_a, float i_b_a);
+void pmstep_observer_start(pmstep_observer_t *obs, float i_a_A, float i_b_A);
 
 /** w-hat' and T_L-hat' of (6) (adaptive: known_load = false) or (13) (known_load = true). */
 pmstep_observer_mech_rates_t pmstep_observer_mech_rates(const pmstep_observer_t *obs,
@@ -72,7 +72,7 @@ pmstep_observer_mech_rates_t pmstep_observer_mech_rates(const pmstep_observer_t 
 void pmstep_observer_advance(pmstep_observer_t *obs, const pmstep_observer_coeffs_t *coeffs,
                              const pmstep_observer_input_t *in,
                              const pmstep_observer_mech_rates_t *mech,
-                             float u_a_v, float u_b_v, float period_s);
+                             float u_a_V, float u_b_V, float period_s);
 
 #ifdef __cplusplus
 }

@@ -24,7 +24,7 @@ typedef struct {
     float phi[3][2];     /**< e^{A T_s} in the (d1, d2, y) coordinates, columns of d1 and d2 */
     float gamma0[3];     /**< response to the held set-point error r - y at the period start */
     float gamma1[3];     /**< response to the set-point change over the period (linear in time) */
-    float bandwidth_rad_per_s; /**< w0 */
+    float bandwidth_rad_s; /**< w0 */
 } pmstep_ref_coeffs_t;
 
 /** One filtered set-point channel. */
@@ -48,7 +48,7 @@ typedef struct {
 } pmstep_ref_out_t;
 
 /** Exact discretisation; valid for 0 < w0 T_s <= 0.5 (pmstep_validate_config checks). */
-void pmstep_ref_coeffs_init(pmstep_ref_coeffs_t *coeffs, float bandwidth_rad_per_s, float period_s);
+void pmstep_ref_coeffs_init(pmstep_ref_coeffs_t *coeffs, float bandwidth_rad_s, float period_s);
 
 /** Puts the filter at rest at @p value (set-point, target and output equal). */
 void pmstep_ref_reset(pmstep_ref_t *ref, float value);

@@ -15,35 +15,71 @@
 extern "C" {
 #endif
 
-/** Status of a fallible call: 0 = ok, negative = one named cause. */
+/** Status of a fallible call: 0 = ok, negative = one named cause (pmstep_status_str() gives its text). */
 typedef enum {
     PMSTEP_OK = 0,
-    PMSTEP_ERR_NULL_ARGUMENT = -1,
-    PMSTEP_ERR_NONFINITE_PARAMETER = -2,
-    PMSTEP_ERR_RESISTANCE = -3,            /**< R <= 0 */
-    PMSTEP_ERR_INDUCTANCE = -4,            /**< L <= 0 */
-    PMSTEP_ERR_INERTIA = -5,               /**< J <= 0 */
-    PMSTEP_ERR_TORQUE_CONSTANT = -6,       /**< k_M <= 0 */
-    PMSTEP_ERR_FRICTION = -7,              /**< F < 0 */
-    PMSTEP_ERR_POLE_PAIRS = -8,            /**< p < 1 */
-    PMSTEP_ERR_PERIOD = -9,                /**< T_s <= 0 */
-    PMSTEP_ERR_GAIN = -10,                 /**< a gain (k_w, K_e, K_i, gamma, lambda, r, kappa) <= 0 */
-    PMSTEP_ERR_PERIOD_TOO_LONG = -11,      /**< (R/L + K_e) T_s >= 0.5 or (R/L + K_i) T_s >= 0.5 */
-    PMSTEP_ERR_ALIGNMENT_CONDITION = -12,  /**< condition (4) violated */
-    PMSTEP_ERR_ALIGNMENT_VOLTAGE = -13,    /**< u_cs or u_cc <= 0, or above the minimum bus voltage */
-    PMSTEP_ERR_ALIGNMENT_TIME = -14,       /**< t_s <= 0 or t_c <= t_s, or not at least one period each */
-    PMSTEP_ERR_REFERENCE_BANDWIDTH = -15,  /**< varpi_0 <= 0 or varpi_0 T_s > 0.5 */
-    PMSTEP_ERR_LIMITS = -16,               /**< current or bus limits not positive / not ordered */
-    PMSTEP_ERR_DELAY = -17,                /**< computational delay not 0 or 1 period */
-    PMSTEP_ERR_BAD_MODE = -18,             /**< command not allowed in the present mode */
-    PMSTEP_ERR_BAD_COMMAND_VALUE = -19,    /**< non-finite target, or ramp rate <= 0 */
-    PMSTEP_ERR_ALIGNMENT_CURRENT = -20,    /**< alignment current u/R at or above max_phase_current_a */
-    PMSTEP_ERR_CALIBRATION = -21,          /**< calibration/commissioning windows negative or not inside their phase,
-                                                dead-time band not > 0, correction gain < 0 or too high for T_s */
-    PMSTEP_ERR_DETECTION = -22,            /**< a detection bound < 0, or detection time shorter than 4 periods or
-                                                longer than PMSTEP_MAX_DURATION_PERIODS periods */
-    PMSTEP_ERR_DERIVED_NONFINITE = -23     /**< a coefficient derived from the settings (an observer injection gain,
-                                                1/J, k_M/L, ...) overflows or is not a number in float32 */
+    /* Arguments and commands. */
+    PMSTEP_ERR_NULL_ARGUMENT = -1,          /**< a pointer argument is NULL */
+    PMSTEP_ERR_BAD_MODE = -2,               /**< command not allowed in the present mode */
+    PMSTEP_ERR_BAD_COMMAND_VALUE = -3,      /**< non-finite target, or ramp rate <= 0 */
+    /* Configuration: any group. */
+    PMSTEP_ERR_NONFINITE_PARAMETER = -10,   /**< a setting is NaN or Inf */
+    PMSTEP_ERR_DERIVED_NONFINITE = -11,     /**< a coefficient derived from the settings (an injection gain of the
+                                                 observer, 1/J, k_M/L, ...) overflows or is not a number in float32 */
+    /* motor */
+    PMSTEP_ERR_RESISTANCE = -20,            /**< R <= 0 */
+    PMSTEP_ERR_INDUCTANCE = -21,            /**< L <= 0 */
+    PMSTEP_ERR_INERTIA = -22,               /**< J <= 0 */
+    PMSTEP_ERR_TORQUE_CONSTANT = -23,       /**< k_M <= 0 */
+    PMSTEP_ERR_FRICTION = -24,              /**< F < 0 */
+    PMSTEP_ERR_POLE_PAIRS = -25,            /**< p < 1 */
+    /* timing */
+    PMSTEP_ERR_PERIOD = -30,                /**< T_s outside [PMSTEP_MIN_PERIOD_S, PMSTEP_MAX_PERIOD_S] */
+    PMSTEP_ERR_DELAY = -31,                 /**< computational delay not 0 or 1 period */
+    /* gains */
+    PMSTEP_ERR_SPEED_GAIN = -40,            /**< k_w <= 0 */
+    PMSTEP_ERR_OBSERVER_GAIN = -41,         /**< K_e <= 0 */
+    PMSTEP_ERR_CURRENT_GAIN = -42,          /**< K_i <= 0 */
+    PMSTEP_ERR_ADAPT_GAMMA = -43,           /**< gamma <= 0 */
+    PMSTEP_ERR_ADAPT_LAMBDA = -44,          /**< lambda <= 0 */
+    PMSTEP_ERR_ADAPT_R = -45,               /**< r <= 0 */
+    PMSTEP_ERR_SAT_KAPPA = -46,             /**< kappa <= 0 */
+    PMSTEP_ERR_OBSERVER_GAIN_FOR_PERIOD = -47, /**< (R/L + K_e) T_s >= 0.5: forward-Euler observer too close to unstable */
+    PMSTEP_ERR_CURRENT_GAIN_FOR_PERIOD = -48,  /**< (R/L + K_i) T_s >= 0.5: current loop too fast for the period */
+    PMSTEP_ERR_REFERENCE_BANDWIDTH = -49,   /**< varpi_0 <= 0 or varpi_0 T_s > 0.5 */
+    PMSTEP_ERR_ANGLE_CORRECTION_GAIN = -50, /**< drift-free gain g < 0 or g T_s >= 0.5 */
+    /* limits */
+    PMSTEP_ERR_MAX_CURRENT = -60,           /**< max_phase_current_A <= 0 */
+    PMSTEP_ERR_MIN_BUS = -61,               /**< min_bus_voltage_V <= 0 */
+    PMSTEP_ERR_BUS_ORDER = -62,             /**< max_bus_voltage_V <= min_bus_voltage_V */
+    /* alignment */
+    PMSTEP_ERR_ALIGNMENT_VOLTAGE = -70,     /**< u_cs or u_cc <= 0 */
+    PMSTEP_ERR_ALIGNMENT_ABOVE_BUS = -71,   /**< u_cs or u_cc above the minimum bus voltage */
+    PMSTEP_ERR_ALIGNMENT_CURRENT = -72,     /**< u_cs/R or u_cc/R at or above max_phase_current_A */
+    PMSTEP_ERR_S_ALIGN_TIME = -73,          /**< t_s shorter than one period */
+    PMSTEP_ERR_C_ALIGN_TIME = -74,          /**< t_c - t_s shorter than one period */
+    PMSTEP_ERR_ALIGNMENT_TOO_LONG = -75,    /**< t_c longer than PMSTEP_MAX_DURATION_PERIODS periods */
+    PMSTEP_ERR_ALIGNMENT_CONDITION = -76,   /**< condition (4) violated */
+    /* commissioning */
+    PMSTEP_ERR_OFFSET_CALIBRATION_TIME = -80, /**< offset calibration time < 0 or longer than PMSTEP_MAX_DURATION_PERIODS */
+    PMSTEP_ERR_STEADY_STATE_WINDOW = -81,   /**< steady-state window < 0 or longer than half an alignment */
+    PMSTEP_ERR_INDUCTANCE_WINDOW = -82,     /**< current-rise window < 0 or longer than half of s-alignment */
+    PMSTEP_ERR_ALIGNMENT_OFFSETS_UNMEASURED = -83, /**< offsets from the alignments without a steady-state window */
+    PMSTEP_ERR_RESISTANCE_UNMEASURED = -84, /**< measured R used without a steady-state window */
+    PMSTEP_ERR_INDUCTANCE_UNMEASURED = -85, /**< measured L used without a current-rise window */
+    PMSTEP_ERR_TORQUE_CONSTANT_UNMEASURED = -86, /**< measured k_M used without a steady-state window */
+    PMSTEP_ERR_VOLTAGE_BIAS_FRACTION = -87, /**< voltage-bias level fraction outside [0, 1) */
+    PMSTEP_ERR_VOLTAGE_BIAS_WINDOW = -88,   /**< voltage bias without a window, or a window over a quarter alignment */
+    PMSTEP_ERR_VOLTAGE_BIAS_SETTLING = -89, /**< voltage bias: half a window is shorter than 5 L/R of settling */
+    /* inverter */
+    PMSTEP_ERR_DEAD_TIME = -90,             /**< dead time < 0 or 4 t_d >= T_s */
+    PMSTEP_ERR_DEAD_TIME_BAND = -91,        /**< compensation band < 0, or in use and outside
+                                                 [PMSTEP_MIN_CURRENT_BAND_A, max_phase_current_A] */
+    /* detection */
+    PMSTEP_ERR_DETECTION_BOUND = -100,      /**< a detection bound < 0 */
+    PMSTEP_ERR_DETECTION_TIME = -101        /**< persistence not 0 (only with every detector off) or within
+                                                 [PMSTEP_DETECTION_DECIMATION periods (one check),
+                                                 PMSTEP_MAX_DURATION_PERIODS periods] */
 } pmstep_status_t;
 
 /** Shortest and longest control period accepted (s): 1 MHz down to 100 Hz. */
@@ -55,6 +91,8 @@ typedef enum {
 /** Narrowest dead-time compensation band (A): keeps 1/band finite and its product with a
  *  current sample far from overflow. */
 #define PMSTEP_MIN_CURRENT_BAND_A 1e-4f
+/** Detection runs in RUN every this many periods (supervision at a fraction of the control rate). */
+#define PMSTEP_DETECTION_DECIMATION 4u
 
 /** Operating mode of the strategy (Section III.A). */
 typedef enum {
@@ -70,9 +108,9 @@ typedef enum {
 typedef enum {
     PMSTEP_FAULT_NONE = 0,
     PMSTEP_FAULT_MEASUREMENT_NONFINITE = 1, /**< NaN or Inf in a current, bus or load input */
-    PMSTEP_FAULT_OVERCURRENT = 2,           /**< |i_a| or |i_b| above max_phase_current_a */
-    PMSTEP_FAULT_BUS_UNDERVOLTAGE = 3,      /**< bus below min_bus_voltage_v */
-    PMSTEP_FAULT_BUS_OVERVOLTAGE = 4,       /**< bus above max_bus_voltage_v */
+    PMSTEP_FAULT_OVERCURRENT = 2,           /**< |i_a| or |i_b| above max_phase_current_A */
+    PMSTEP_FAULT_BUS_UNDERVOLTAGE = 3,      /**< bus below min_bus_voltage_V */
+    PMSTEP_FAULT_BUS_OVERVOLTAGE = 4,       /**< bus above max_bus_voltage_V */
     PMSTEP_FAULT_STATE_NONFINITE = 5,       /**< an internal estimate became NaN/Inf */
     PMSTEP_FAULT_ANGLE_MAGNITUDE = 6,       /**< |c-hat^2 + s-hat^2 - 1| above angle_magnitude_bound: angle lost */
     PMSTEP_FAULT_SPEED_INCONSISTENT = 7,    /**< speed from the angle estimate's rotation and w-hat disagree */
@@ -82,94 +120,128 @@ typedef enum {
                                                  observer's model no longer explains the currents */
 } pmstep_fault_t;
 
-/** Constant configuration: motor model (1), strategy timing, gains of (6), limits. */
+/** Motor model (1), as known to the controller. */
 typedef struct {
-    /* Motor model (1), as known to the controller. */
-    float resistance_ohm;          /**< R */
-    float inductance_h;            /**< L */
-    float inertia_kg_m2;           /**< J */
-    float friction_nm_s_per_rad;   /**< F >= 0 */
-    float torque_constant_nm_per_a;/**< k_M */
-    int32_t pole_pairs;            /**< p >= 1 */
+    float resistance_Ohm;       /**< R */
+    float inductance_H;         /**< L */
+    float inertia_kgm2;         /**< J */
+    float friction_Nms_rad;     /**< F >= 0 */
+    float torque_constant_Nm_A; /**< k_M */
+    int32_t pole_pairs;         /**< p >= 1 */
+} pmstep_motor_config_t;
 
-    /* Timing. */
-    float period_s;                /**< control period T_s */
+/** Control period and delay of the drive. */
+typedef struct {
+    float period_s;                       /**< control period T_s */
     uint32_t computational_delay_periods; /**< 0: voltage computed at k applied in [k, k+1]; 1: in [k+1, k+2] */
+} pmstep_timing_config_t;
 
-    /* Alignment (3), (5). */
-    float s_align_time_s;          /**< t_s, measured from start */
-    float c_align_time_s;          /**< t_c, measured from start (t_c > t_s) */
-    float s_align_voltage_v;       /**< u_cs */
-    float c_align_voltage_v;       /**< u_cc */
+/** Alignment (3), (5). */
+typedef struct {
+    float s_align_time_s;    /**< t_s, measured from the start of s-alignment */
+    float c_align_time_s;    /**< t_c, measured from the same start (t_c > t_s) */
+    float s_align_voltage_V; /**< u_cs */
+    float c_align_voltage_V; /**< u_cc */
+} pmstep_alignment_config_t;
 
-    /* Controller (6) gains. */
-    float speed_gain_per_s;        /**< k_omega */
-    float observer_gain_per_s;     /**< K_e */
-    float current_gain_per_s;      /**< K_i */
-    float adapt_gamma;             /**< gamma */
-    float adapt_lambda;            /**< lambda */
-    float adapt_r;                 /**< r (only matters when F > 0) */
-    float sat_kappa_rad_per_s;     /**< kappa of the smooth saturation sat_kappa */
-    float reference_bandwidth_rad_per_s; /**< varpi_0 of H(s) = varpi_0^3/(s+varpi_0)^3 */
+/** Gains of controller (6), the reference filter and the drift-free angle option. */
+typedef struct {
+    float speed_gain_per_s;          /**< k_w */
+    float observer_gain_per_s;       /**< K_e */
+    float current_gain_per_s;        /**< K_i */
+    float adapt_gamma;               /**< gamma (kg m^2 s: g_T = J/gamma with F = 0) */
+    float adapt_lambda;              /**< lambda (s: g_w = 2/lambda with F = 0) */
+    float adapt_r;                   /**< r (only matters when F > 0) */
+    float sat_kappa_rad_s;           /**< kappa of the smooth saturation sat_kappa */
+    float reference_bandwidth_rad_s; /**< varpi_0 of H(s) = varpi_0^3/(s+varpi_0)^3 */
+    float angle_correction_gain_per_s; /**< drift-free option: pulls (c-hat, s-hat) onto the unit circle at this
+                                            rate (flux-magnitude correction); 0 = the paper's open integrals */
+} pmstep_gains_config_t;
 
-    /* Remark 1: load torque known and given each period in pmstep_meas_t. */
-    bool known_load_mode;
+/** Protections. */
+typedef struct {
+    float max_phase_current_A; /**< |i_a|, |i_b| above this -> FAULT_OVERCURRENT */
+    float min_bus_voltage_V;   /**< bus below -> FAULT_BUS_UNDERVOLTAGE */
+    float max_bus_voltage_V;   /**< bus above -> FAULT_BUS_OVERVOLTAGE */
+} pmstep_limits_config_t;
 
-    /* Protections. */
-    float max_phase_current_a;     /**< |i_a|, |i_b| above this -> FAULT_OVERCURRENT */
-    float min_bus_voltage_v;       /**< bus below -> FAULT_BUS_UNDERVOLTAGE */
-    float max_bus_voltage_v;       /**< bus above -> FAULT_BUS_OVERVOLTAGE */
-
-    /* Remark 2 calibration and self-commissioning (all off in the paper's configuration). */
+/** Remark 2 calibration and self-commissioning (all off in the paper's configuration). */
+typedef struct {
     float offset_calibration_time_s;   /**< bridge off this long before s-alignment; the current samples are averaged
                                             as sensor offsets. 0 = none (alignment starts at once) */
     bool alignment_offset_calibration; /**< also take offsets from the alignment steady states: i_a -> 0 at the end of
                                             s-alignment, i_b -> 0 at the end of c-alignment */
     float steady_state_window_s;       /**< averaging window at the end of each alignment (offsets, R); 0 = none */
     float inductance_window_s;         /**< current-rise window at the start of s-alignment for L; 0 = L not measured */
-    bool use_commissioned_resistance;  /**< RUN uses the measured R in place of resistance_ohm */
-    bool use_commissioned_inductance;  /**< RUN uses the measured L in place of inductance_h */
-    bool use_commissioned_torque_constant; /**< RUN uses k_M measured from the c-alignment swing */
+    bool use_measured_resistance;      /**< RUN uses the measured R in place of motor.resistance_Ohm */
+    bool use_measured_inductance;      /**< RUN uses the measured L in place of motor.inductance_H */
+    bool use_measured_torque_constant; /**< RUN uses k_M measured from the c-alignment swing */
     float voltage_bias_level_fraction; /**< Remark 2 voltage bias: 0 = off; else the last steady_state_window_s of
                                             each alignment runs at this fraction of its voltage, and the two steady
                                             states give R and the bias (the part of the dead time the compensation
                                             misses), which is then compensated too */
-    float dead_time_s;                 /**< dead time of each half-bridge to compensate (2 per phase); 0 = none */
-    float dead_time_current_band_a;    /**< compensation is linear in i within +/- this band, full outside */
+} pmstep_commissioning_config_t;
 
-    /* Angle. */
-    float angle_correction_gain_per_s; /**< drift-free option: pulls (c-hat, s-hat) onto the unit circle at this
-                                            rate (flux-magnitude correction); 0 = the paper's open integrals */
+/** What the controller knows of its inverter: dead-time compensation. */
+typedef struct {
+    float dead_time_s;              /**< dead time of each half-bridge to compensate (2 per phase); 0 = none */
+    float dead_time_current_band_A; /**< compensation is linear in i within +/- this band, full outside */
+} pmstep_inverter_config_t;
 
-    /* Detection (each 0 = off), checked every 4th period in RUN. Persisting detection_time_s -> fault,
-     * or re-alignment (max_realignments). */
-    float angle_magnitude_bound;       /**< |c-hat^2 + s-hat^2 - 1| -> FAULT_ANGLE_MAGNITUDE */
-    float speed_consistency_bound_rad_s; /**< |w from the angle's rotation - w-hat|, both low-passed -> FAULT_SPEED_INCONSISTENT */
-    float stall_speed_error_rad_s;     /**< |w-hat - w*| -> FAULT_STALL */
-    float observer_residual_bound_a;   /**< |i_a - i_a-hat| + |i_b - i_b-hat|, low-passed -> FAULT_OBSERVER_RESIDUAL */
-    float detection_time_s;            /**< persistence before acting; low-pass time constant is a quarter of it */
-    uint32_t max_realignments;         /**< 0: a detection latches its fault; N: re-align (bridge on) up to N times */
+/** Detection in RUN, every PMSTEP_DETECTION_DECIMATION periods; a bound of 0 switches its detector off.
+ *  A condition persisting persistence_s latches its fault, or re-aligns (max_realignments). */
+typedef struct {
+    float angle_magnitude_bound;         /**< |c-hat^2 + s-hat^2 - 1| -> FAULT_ANGLE_MAGNITUDE */
+    float speed_consistency_bound_rad_s; /**< |w from the angle's rotation - w-hat|, both low-passed
+                                              -> FAULT_SPEED_INCONSISTENT */
+    float stall_speed_error_rad_s;       /**< |w-hat - w*| -> FAULT_STALL */
+    float observer_residual_bound_A;     /**< |i_a - i_a-hat| + |i_b - i_b-hat|, low-passed -> FAULT_OBSERVER_RESIDUAL */
+    float persistence_s;                 /**< persistence before acting; low-pass time constant is a quarter of it */
+    uint32_t max_realignments;           /**< 0: a detection latches its fault; N: re-align (bridge on) up to N times */
+} pmstep_detection_config_t;
+
+/** Constant configuration (may live in flash; must outlive the instance). */
+typedef struct {
+    pmstep_motor_config_t motor;
+    pmstep_timing_config_t timing;
+    pmstep_alignment_config_t alignment;
+    pmstep_gains_config_t gains;
+    pmstep_limits_config_t limits;
+    pmstep_commissioning_config_t commissioning;
+    pmstep_inverter_config_t inverter;
+    pmstep_detection_config_t detection;
+    bool known_load_mode; /**< Remark 1: load torque known, given each period in pmstep_meas_t */
 } pmstep_config_t;
 
 /** Electrical model the controller works with: the configured values, or commissioned ones. */
 typedef struct {
-    float resistance_ohm;           /**< R */
-    float inductance_h;             /**< L */
-    float torque_constant_nm_per_a; /**< k_M */
+    float resistance_Ohm;           /**< R */
+    float inductance_H;             /**< L */
+    float torque_constant_Nm_A; /**< k_M */
 } pmstep_electrical_t;
+
+/** The model of the configuration: R, L, k_M as configured. */
+static inline pmstep_electrical_t pmstep_configured_electrical(const pmstep_config_t *cfg)
+{
+    pmstep_electrical_t model;
+    model.resistance_Ohm = cfg->motor.resistance_Ohm;
+    model.inductance_H = cfg->motor.inductance_H;
+    model.torque_constant_Nm_A = cfg->motor.torque_constant_Nm_A;
+    return model;
+}
 
 /** Samples taken at the start of a period. */
 typedef struct {
-    float i_a_a;         /**< phase a current */
-    float i_b_a;         /**< phase b current */
-    float bus_voltage_v; /**< DC bus voltage */
-    float load_torque_nm;/**< known load T_L (used only in known_load_mode) */
+    float i_a_A;         /**< phase a current */
+    float i_b_A;         /**< phase b current */
+    float bus_voltage_V; /**< DC bus voltage */
+    float load_torque_Nm;/**< known load T_L (used only in known_load_mode) */
 } pmstep_meas_t;
 
 /** What one step commands, and what it estimated. */
 typedef struct {
-    float u_a_v;             /**< phase a voltage to apply (per the configured delay) */
-    float u_b_v;             /**< phase b voltage */
+    float u_a_V;             /**< phase a voltage to apply (per the configured delay) */
+    float u_b_V;             /**< phase b voltage */
     bool bridge_enable;      /**< false: switch the bridge off */
     bool voltage_limited;    /**< the computed voltage exceeded the bus and was scaled down */
     pmstep_mode_t mode;
@@ -179,29 +251,29 @@ typedef struct {
     float cos_hat;           /**< c-hat, estimate of cos(p theta) */
     float sin_hat;           /**< s-hat, estimate of sin(p theta) */
     float speed_hat_rad_s;   /**< omega-hat */
-    float load_hat_nm;       /**< T_L-hat (or the filtered known load T_L* in known_load_mode) */
-    float i_a_hat_a;         /**< observer current a */
-    float i_b_hat_a;         /**< observer current b */
+    float load_hat_Nm;       /**< T_L-hat (or the filtered known load T_L* in known_load_mode) */
+    float i_a_hat_A;         /**< observer current a */
+    float i_b_hat_A;         /**< observer current b */
     float speed_ref_rad_s;   /**< omega* */
-    float speed_ref_dot_rad_s2; /**< omega*' */
-    float i_d_a;             /**< i_d from (c-hat, s-hat) */
-    float i_q_a;             /**< i_q from (c-hat, s-hat) */
-    float i_d_ref_a;         /**< i_d* */
-    float i_q_ref_a;         /**< i_q* */
+    float speed_ref_rate_rad_s2; /**< omega*' */
+    float i_d_A;             /**< i_d from (c-hat, s-hat) */
+    float i_q_A;             /**< i_q from (c-hat, s-hat) */
+    float i_d_ref_A;         /**< i_d* */
+    float i_q_ref_A;         /**< i_q* */
 } pmstep_output_t;
 
 /** Remark 2 calibration and self-commissioning results (pmstep_get_commissioning()). */
 typedef struct {
-    float offset_a_a;               /**< current-sensor offset subtracted from every i_a sample (A) */
-    float offset_b_a;               /**< same for i_b */
+    float offset_a_A;               /**< current-sensor offset subtracted from every i_a sample (A) */
+    float offset_b_A;               /**< same for i_b */
     uint32_t offset_samples;        /**< samples behind the offsets (0: none taken, offsets 0) */
-    float resistance_ohm;           /**< R of phase b from its alignment steady state(s) (0: not measured) */
-    float current_scale_a;          /**< R_a / R_b: phase a's samples are multiplied by it, so both phases read on
+    float resistance_Ohm;           /**< R of phase b from its alignment steady state(s) (0: not measured) */
+    float phase_a_current_scale;          /**< R_a / R_b: phase a's samples are multiplied by it, so both phases read on
                                          phase b's scale (a sensor gain mismatch); 1 until measured */
-    float inductance_h;             /**< L from the current rise at the start of s-alignment (0: not measured) */
-    float torque_constant_nm_per_a; /**< k_M from the flux swing of c-alignment (0: not measured) */
-    float voltage_bias_a_v;         /**< voltage phase a falls short by at positive current (0: not measured) */
-    float voltage_bias_b_v;         /**< same for phase b */
+    float inductance_H;             /**< L from the current rise at the start of s-alignment (0: not measured) */
+    float torque_constant_Nm_A; /**< k_M from the flux swing of c-alignment (0: not measured) */
+    float voltage_bias_a_V;         /**< voltage phase a falls short by at positive current (0: not measured) */
+    float voltage_bias_b_V;         /**< same for phase b */
     uint32_t realignments;          /**< re-alignments after a detection since start */
     bool measured;                  /**< alignment finished and the values above were taken */
 } pmstep_commissioning_t;

@@ -34,22 +34,22 @@ static void write_summary(FILE *f, const sil_summary_t *s, double duration_s, in
     fprintf(f, "  \"alignment\": {\n");
     fprintf(f, "    \"cos_ptheta_at_ts\": %.17g,\n    \"sin_ptheta_at_ts\": %.17g,\n", s->cos_ptheta_at_ts,
             s->sin_ptheta_at_ts);
-    fprintf(f, "    \"i_b_minus_ucs_over_r_at_ts_a\": %.17g,\n", s->i_b_residual_at_ts_a);
+    fprintf(f, "    \"i_b_minus_ucs_over_r_at_ts_A\": %.17g,\n", s->i_b_residual_at_ts_A);
     fprintf(f, "    \"cos_ptheta_at_tc\": %.17g,\n    \"sin_ptheta_at_tc\": %.17g,\n", s->cos_ptheta_at_tc,
             s->sin_ptheta_at_tc);
-    fprintf(f, "    \"i_a_minus_ucc_over_r_at_tc_a\": %.17g\n  },\n", s->i_a_residual_at_tc_a);
+    fprintf(f, "    \"i_a_minus_ucc_over_r_at_tc_A\": %.17g\n  },\n", s->i_a_residual_at_tc_A);
     fprintf(f, "  \"speed\": {\n");
     fprintf(f, "    \"transient_max_abs_error_rad_s\": %.17g,\n    \"transient_rms_error_rad_s\": %.17g,\n",
             s->transient_max_speed_error_rad_s, s->transient_rms_speed_error_rad_s);
     fprintf(f, "    \"tracking_max_abs_error_rad_s\": %.17g,\n    \"tracking_rms_error_rad_s\": %.17g\n  },\n",
             s->tracking_max_speed_error_rad_s, s->tracking_rms_speed_error_rad_s);
-    fprintf(f, "  \"final_load_hat_nm\": %.17g,\n  \"final_load_nm\": %.17g,\n", s->final_load_hat_nm,
-            s->final_load_nm);
-    fprintf(f, "  \"final_load_abs_error_nm\": %.17g,\n", s->final_load_error_nm);
+    fprintf(f, "  \"final_load_hat_Nm\": %.17g,\n  \"final_load_Nm\": %.17g,\n", s->final_load_hat_Nm,
+            s->final_load_Nm);
+    fprintf(f, "  \"final_load_abs_error_Nm\": %.17g,\n", s->final_load_error_Nm);
     fprintf(f, "  \"angle_estimate\": {\n    \"max_abs_cos_error\": %.17g,\n    \"max_abs_sin_error\": %.17g\n  },\n",
             s->max_cos_error, s->max_sin_error);
-    fprintf(f, "  \"max_abs_phase_voltage_v\": %.17g,\n  \"max_abs_phase_current_a\": %.17g,\n",
-            s->max_phase_voltage_v, s->max_phase_current_a);
+    fprintf(f, "  \"max_abs_phase_voltage_V\": %.17g,\n  \"max_abs_phase_current_a\": %.17g,\n",
+            s->max_phase_voltage_V, s->max_phase_current_A);
     fprintf(f, "  \"voltage_limited_periods\": %ld,\n  \"inverter_clipped_periods\": %ld,\n",
             s->voltage_limited_periods, s->inverter_limited_periods);
     fprintf(f, "  \"final_mode\": \"%s\",\n", pmstep_mode_str(s->final_mode));
@@ -101,7 +101,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "pil-closed-loop: pmstep_init: %s\n", pmstep_status_str(st));
         return 2;
     }
-    period_s = (double)config.period_s;
+    period_s = (double)config.timing.period_s;
     steps = sil_periods_in(sc.duration_s, period_s);
     sil_metrics_init(&metrics, &sc, &s);
 
@@ -110,12 +110,12 @@ int main(int argc, char **argv)
     plant.load = sc.load;
     plant.x.theta_rad = sc.theta0_rad;
     plant.x.omega_rad_s = sc.omega0_rad_s;
-    plant.x.i_a_a = sc.i_a0_a;
-    plant.x.i_b_a = sc.i_b0_a;
+    plant.x.i_a_A = sc.i_a0_A;
+    plant.x.i_b_A = sc.i_b0_A;
     p = (double)plant.params.pole_pairs;
-    sil_inverter_init(&inv, &sc.inverter, &sc.bus, sc.bus_voltage_v, config.computational_delay_periods);
+    sil_inverter_init(&inv, &sc.inverter, &sc.bus, sc.bus_voltage_V, config.timing.computational_delay_periods);
 
-    (void)pmstep_set_id_target(&motor, (float)sc.id_target_a);
+    (void)pmstep_set_id_target(&motor, (float)sc.id_target_A);
     (void)pmstep_start(&motor);
     mps2_pil_init(&motor);
 
@@ -133,24 +133,24 @@ int main(int argc, char **argv)
         sample.t_s = t_s;
         sample.theta_rad = plant.x.theta_rad;
         sample.omega_rad_s = plant.x.omega_rad_s;
-        sample.i_a_a = plant.x.i_a_a;
-        sample.i_b_a = plant.x.i_b_a;
-        sample.load_nm = plant_load_torque(&plant.load, t_s, plant.x.omega_rad_s);
+        sample.i_a_A = plant.x.i_a_A;
+        sample.i_b_A = plant.x.i_b_A;
+        sample.load_Nm = plant_load_torque(&plant.load, t_s, plant.x.omega_rad_s);
 
         /* Sample (what the host port reads with the ideal measurement chain: no GSL here),
          * control interrupt, inverter, plant. */
-        meas.i_a_a = (float)sample.i_a_a;
-        meas.i_b_a = (float)sample.i_b_a;
-        meas.bus_voltage_v = (float)sil_inverter_bus_voltage(&inv, t_s);
-        meas.load_torque_nm = (float)sample.load_nm;
+        meas.i_a_A = (float)sample.i_a_A;
+        meas.i_b_A = (float)sample.i_b_A;
+        meas.bus_voltage_V = (float)sil_inverter_bus_voltage(&inv, t_s);
+        meas.load_torque_Nm = (float)sample.load_Nm;
         mps2_pil_control_period(&meas, &out);
-        sil_inverter_apply(&inv, &out, (double)meas.bus_voltage_v);
+        sil_inverter_apply(&inv, &out, (double)meas.bus_voltage_V);
         sil_drive_advance(&plant, &inv, period_s, substeps);
 
         sample.cos_ptheta = cos(p * sample.theta_rad);
         sample.sin_ptheta = sin(p * sample.theta_rad);
-        sample.u_a_v = inv.applied_a_v;
-        sample.u_b_v = inv.applied_b_v;
+        sample.u_a_V = inv.applied_a_V;
+        sample.u_b_V = inv.applied_b_V;
         sample.out = &out;
         sample.inst = &motor;
         sil_metrics_add(&metrics, &sample, &s);

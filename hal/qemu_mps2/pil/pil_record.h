@@ -27,9 +27,9 @@ extern "C" {
 static inline const char *pil_output_word_name(unsigned k)
 {
     static const char *const names[SIL_RECORD_OUT_WORDS] = {
-        "u_a_v", "u_b_v", "bridge_enable", "voltage_limited", "mode", "fault", "fault_step",
-        "cos_hat", "sin_hat", "speed_hat_rad_s", "load_hat_nm", "i_a_hat_a", "i_b_hat_a",
-        "speed_ref_rad_s", "speed_ref_dot_rad_s2", "i_d_a", "i_q_a", "i_d_ref_a", "i_q_ref_a"};
+        "u_a_V", "u_b_V", "bridge_enable", "voltage_limited", "mode", "fault", "fault_step",
+        "cos_hat", "sin_hat", "speed_hat_rad_s", "load_hat_Nm", "i_a_hat_A", "i_b_hat_A",
+        "speed_ref_rad_s", "speed_ref_rate_rad_s2", "i_d_A", "i_q_A", "i_d_ref_A", "i_q_ref_A"};
     return k < (unsigned)SIL_RECORD_OUT_WORDS ? names[k] : "?";
 }
 

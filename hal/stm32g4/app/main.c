@@ -32,8 +32,8 @@ int main(void)
         halt((int32_t)port_st);
     }
     motor_config = pmstep_paper_config();
-    motor_config.period_s = pmstep_stm32g4_period_s(&board); /* 50 us at 20 kHz */
-    motor_config.computational_delay_periods = 1u;          /* duties load at the next carrier peak */
+    motor_config.timing.period_s = pmstep_stm32g4_period_s(&board); /* 50 us at 20 kHz */
+    motor_config.timing.computational_delay_periods = 1u;          /* duties load at the next carrier peak */
     st = pmstep_init(&motor, &motor_config);
     if (st != PMSTEP_OK) {
         halt(-100 + (int32_t)st);

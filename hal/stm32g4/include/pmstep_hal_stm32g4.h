@@ -71,7 +71,7 @@ typedef struct {
     pmstep_stm32g4_clock_t clock;
 
     /* PWM */
-    uint32_t pwm_frequency_hz;        /**< carrier (= control) frequency, e.g. 20000 */
+    uint32_t pwm_frequency_Hz;        /**< carrier (= control) frequency, e.g. 20000 */
     uint32_t dead_time_ns;            /**< inserted between complementary outputs */
     float duty_min;                   /**< per half-bridge, e.g. 0 (bootstrap drivers may need > 0) */
     float duty_max;                   /**< per half-bridge, e.g. 1 (bootstrap drivers may need < 1) */
@@ -115,35 +115,35 @@ pmstep_stm32g4_config_t pmstep_stm32g4_default_config(void);
 float pmstep_stm32g4_counts_to_si(uint32_t counts, float offset_counts, float gain_per_count);
 
 /**
- * Duties of the two half-bridges of one H-bridge for the voltage @p u_v across it,
+ * Duties of the two half-bridges of one H-bridge for the voltage @p u_V across it,
  * against the measured bus: d+ = 1/2 + u/(2 V_bus), d- = 1/2 - u/(2 V_bus), each
  * clamped to [duty_min, duty_max]. A bus that is not positive (or NaN) or a NaN
  * voltage gives 1/2 and 1/2 (zero volts).
  */
-void pmstep_stm32g4_duties(float u_v, float bus_v, float duty_min, float duty_max, float *d_plus, float *d_minus);
+void pmstep_stm32g4_duties(float u_V, float bus_V, float duty_min, float duty_max, float *d_plus, float *d_minus);
 
 /** Compare value for a duty: round(duty * arr), within 0..arr. */
 uint32_t pmstep_stm32g4_duty_to_ccr(float duty, uint32_t arr);
 
 /**
- * TIM1 BDTR.DTG for at least @p dead_time_ns with the timer clock @p tim_clock_hz
+ * TIM1 BDTR.DTG for at least @p dead_time_ns with the timer clock @p tim_clock_Hz
  * (t_DTS = 1/f_TIM, CKD = 0), by the four ranges of RM0440 §28.6.20:
  * DTG[7]=0: n t; 10x: (64+x) 2t; 110x: (32+x) 8t; 111x: (32+x) 16t.
  * @return PMSTEP_STM32G4_OK or PMSTEP_STM32G4_ERR_DEAD_TIME.
  */
-pmstep_stm32g4_status_t pmstep_stm32g4_dead_time_dtg(uint32_t dead_time_ns, uint32_t tim_clock_hz, uint8_t *dtg);
+pmstep_stm32g4_status_t pmstep_stm32g4_dead_time_dtg(uint32_t dead_time_ns, uint32_t tim_clock_Hz, uint8_t *dtg);
 
-/** Dead time (ns, rounded down) that a DTG code gives at @p tim_clock_hz. */
-uint32_t pmstep_stm32g4_dtg_to_ns(uint8_t dtg, uint32_t tim_clock_hz);
+/** Dead time (ns, rounded down) that a DTG code gives at @p tim_clock_Hz. */
+uint32_t pmstep_stm32g4_dtg_to_ns(uint8_t dtg, uint32_t tim_clock_Hz);
 
 /** SYSCLK (Hz) of a clock configuration, or 0 when it is out of range. */
-uint32_t pmstep_stm32g4_sysclk_hz(const pmstep_stm32g4_clock_t *clock);
+uint32_t pmstep_stm32g4_sysclk_Hz(const pmstep_stm32g4_clock_t *clock);
 
-/** Flash wait states for @p hclk_hz in range 1 boost mode (RM0440 §3.3.3, Table 9). */
-uint32_t pmstep_stm32g4_flash_latency(uint32_t hclk_hz);
+/** Flash wait states for @p hclk_Hz in range 1 boost mode (RM0440 §3.3.3, Table 9). */
+uint32_t pmstep_stm32g4_flash_latency(uint32_t hclk_Hz);
 
 /** TIM1 ARR for a centre-aligned carrier: round(f_TIM / (2 f_pwm)); 0 when outside 2..65535. */
-uint32_t pmstep_stm32g4_pwm_arr(uint32_t tim_clock_hz, uint32_t pwm_frequency_hz);
+uint32_t pmstep_stm32g4_pwm_arr(uint32_t tim_clock_Hz, uint32_t pwm_frequency_Hz);
 
 /** Text for a status code. */
 const char *pmstep_stm32g4_status_str(pmstep_stm32g4_status_t status);
@@ -157,7 +157,7 @@ pmstep_stm32g4_status_t pmstep_stm32g4_clock_init(const pmstep_stm32g4_clock_t *
 pmstep_stm32g4_status_t pmstep_stm32g4_gpio_init(const pmstep_stm32g4_config_t *cfg);
 
 /** TIM1: centre-aligned PWM, dead time, break, ADC trigger; outputs off (MOE = 0), counter stopped. */
-pmstep_stm32g4_status_t pmstep_stm32g4_pwm_init(const pmstep_stm32g4_config_t *cfg, uint32_t tim_clock_hz);
+pmstep_stm32g4_status_t pmstep_stm32g4_pwm_init(const pmstep_stm32g4_config_t *cfg, uint32_t tim_clock_Hz);
 
 /** ADC1/ADC2: power-up, calibration, injected sequences on TIM1_TRGO2, JEOS interrupt of ADC1. */
 pmstep_stm32g4_status_t pmstep_stm32g4_adc_init(const pmstep_stm32g4_config_t *cfg);

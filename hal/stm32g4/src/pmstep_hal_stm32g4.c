@@ -15,7 +15,7 @@ static struct {
     const pmstep_stm32g4_config_t *cfg;
     pmstep_t *inst;
     uint32_t arr;
-    float bus_voltage_v;  /* this period's sample, for the duties */
+    float bus_voltage_V;  /* this period's sample, for the duties */
     pmstep_output_t out;
     volatile pmstep_stm32g4_fault_t fault;
     volatile bool bridge_on;
@@ -67,12 +67,12 @@ static void latch_fault(pmstep_stm32g4_fault_t fault)
 void pmstep_hal_read_measurements(pmstep_meas_t *meas)
 {
     const pmstep_stm32g4_config_t *cfg = port.cfg;
-    meas->i_a_a = pmstep_stm32g4_counts_to_si(STM32G4_ADC1->JDR[0], cfg->i_a_offset_counts, cfg->i_a_gain_a_per_count);
-    meas->bus_voltage_v = pmstep_stm32g4_counts_to_si(STM32G4_ADC1->JDR[1], cfg->bus_offset_counts,
+    meas->i_a_A = pmstep_stm32g4_counts_to_si(STM32G4_ADC1->JDR[0], cfg->i_a_offset_counts, cfg->i_a_gain_a_per_count);
+    meas->bus_voltage_V = pmstep_stm32g4_counts_to_si(STM32G4_ADC1->JDR[1], cfg->bus_offset_counts,
                                                       cfg->bus_gain_v_per_count);
-    meas->i_b_a = pmstep_stm32g4_counts_to_si(STM32G4_ADC2->JDR[0], cfg->i_b_offset_counts, cfg->i_b_gain_a_per_count);
-    meas->load_torque_nm = 0.0f; /* no torque sensor on this board (known_load_mode unsupported) */
-    port.bus_voltage_v = meas->bus_voltage_v;
+    meas->i_b_A = pmstep_stm32g4_counts_to_si(STM32G4_ADC2->JDR[0], cfg->i_b_offset_counts, cfg->i_b_gain_a_per_count);
+    meas->load_torque_Nm = 0.0f; /* no torque sensor on this board (known_load_mode unsupported) */
+    port.bus_voltage_V = meas->bus_voltage_V;
     if (fault_input_asserted()) {
         latch_fault(PMSTEP_STM32G4_FAULT_INPUT);
     }
@@ -89,10 +89,10 @@ void pmstep_hal_apply_output(const pmstep_output_t *out)
         return;
     }
     /* Preloaded: these take effect at the next update event (the next carrier peak). */
-    pmstep_stm32g4_duties(out->u_a_v, port.bus_voltage_v, cfg->duty_min, cfg->duty_max, &d_plus, &d_minus);
+    pmstep_stm32g4_duties(out->u_a_V, port.bus_voltage_V, cfg->duty_min, cfg->duty_max, &d_plus, &d_minus);
     tim->CCR1 = pmstep_stm32g4_duty_to_ccr(d_plus, port.arr);
     tim->CCR2 = pmstep_stm32g4_duty_to_ccr(d_minus, port.arr);
-    pmstep_stm32g4_duties(out->u_b_v, port.bus_voltage_v, cfg->duty_min, cfg->duty_max, &d_plus, &d_minus);
+    pmstep_stm32g4_duties(out->u_b_V, port.bus_voltage_V, cfg->duty_min, cfg->duty_max, &d_plus, &d_minus);
     tim->CCR3 = pmstep_stm32g4_duty_to_ccr(d_plus, port.arr);
     tim->CCR4 = pmstep_stm32g4_duty_to_ccr(d_minus, port.arr);
     if (!port.bridge_on) {
@@ -171,14 +171,14 @@ uint32_t pmstep_stm32g4_isr_cycles_max(void)
 
 float pmstep_stm32g4_period_s(const pmstep_stm32g4_config_t *cfg)
 {
-    uint32_t sysclk_hz;
+    uint32_t sysclk_Hz;
     uint32_t arr;
     if (cfg == NULL) {
         return 0.0f;
     }
-    sysclk_hz = pmstep_stm32g4_sysclk_hz(&cfg->clock);
-    arr = pmstep_stm32g4_pwm_arr(sysclk_hz, cfg->pwm_frequency_hz);
-    return arr == 0u ? 0.0f : (float)(2u * arr) / (float)sysclk_hz;
+    sysclk_Hz = pmstep_stm32g4_sysclk_Hz(&cfg->clock);
+    arr = pmstep_stm32g4_pwm_arr(sysclk_Hz, cfg->pwm_frequency_Hz);
+    return arr == 0u ? 0.0f : (float)(2u * arr) / (float)sysclk_Hz;
 }
 
 static void nvic_enable(uint32_t irq, uint8_t priority)
@@ -192,13 +192,13 @@ static void nvic_enable(uint32_t irq, uint8_t priority)
 
 pmstep_stm32g4_status_t pmstep_stm32g4_init(const pmstep_stm32g4_config_t *cfg, pmstep_t *inst)
 {
-    uint32_t sysclk_hz;
+    uint32_t sysclk_Hz;
     pmstep_stm32g4_status_t st;
     if (cfg == NULL || inst == NULL) {
         return PMSTEP_STM32G4_ERR_NULL_ARGUMENT;
     }
-    sysclk_hz = pmstep_stm32g4_sysclk_hz(&cfg->clock);
-    if (sysclk_hz == 0u) {
+    sysclk_Hz = pmstep_stm32g4_sysclk_Hz(&cfg->clock);
+    if (sysclk_Hz == 0u) {
         return PMSTEP_STM32G4_ERR_CLOCK_CONFIG;
     }
     port.cfg = cfg;
@@ -206,11 +206,11 @@ pmstep_stm32g4_status_t pmstep_stm32g4_init(const pmstep_stm32g4_config_t *cfg, 
     port.fault = PMSTEP_STM32G4_FAULT_NONE;
     port.bridge_on = false;
     port.isr_cycles_max = 0u;
-    port.arr = pmstep_stm32g4_pwm_arr(sysclk_hz, cfg->pwm_frequency_hz);
+    port.arr = pmstep_stm32g4_pwm_arr(sysclk_Hz, cfg->pwm_frequency_Hz);
 
     st = pmstep_stm32g4_gpio_init(cfg);
     if (st == PMSTEP_STM32G4_OK) {
-        st = pmstep_stm32g4_pwm_init(cfg, sysclk_hz); /* TIM1 runs at PCLK2 = SYSCLK */
+        st = pmstep_stm32g4_pwm_init(cfg, sysclk_Hz); /* TIM1 runs at PCLK2 = SYSCLK */
     }
     if (st == PMSTEP_STM32G4_OK) {
         st = pmstep_stm32g4_adc_init(cfg);

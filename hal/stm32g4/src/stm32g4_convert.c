@@ -17,15 +17,15 @@ static float clamp(float x, float lo, float hi)
     return x < lo ? lo : (x > hi ? hi : x);
 }
 
-void pmstep_stm32g4_duties(float u_v, float bus_v, float duty_min, float duty_max, float *d_plus, float *d_minus)
+void pmstep_stm32g4_duties(float u_V, float bus_V, float duty_min, float duty_max, float *d_plus, float *d_minus)
 {
     float half_ratio;
-    if (!(bus_v > 0.0f) || u_v != u_v) { /* no bus, NaN bus or NaN voltage: zero volts */
+    if (!(bus_V > 0.0f) || u_V != u_V) { /* no bus, NaN bus or NaN voltage: zero volts */
         *d_plus = clamp(0.5f, duty_min, duty_max);
         *d_minus = *d_plus;
         return;
     }
-    half_ratio = 0.5f * (u_v / bus_v);
+    half_ratio = 0.5f * (u_V / bus_V);
     *d_plus = clamp(0.5f + half_ratio, duty_min, duty_max);
     *d_minus = clamp(0.5f - half_ratio, duty_min, duty_max);
 }
@@ -42,11 +42,11 @@ uint32_t pmstep_stm32g4_duty_to_ccr(float duty, uint32_t arr)
     return (uint32_t)counts;
 }
 
-pmstep_stm32g4_status_t pmstep_stm32g4_dead_time_dtg(uint32_t dead_time_ns, uint32_t tim_clock_hz, uint8_t *dtg)
+pmstep_stm32g4_status_t pmstep_stm32g4_dead_time_dtg(uint32_t dead_time_ns, uint32_t tim_clock_Hz, uint8_t *dtg)
 {
     /* Timer clock periods needed, rounded up so the dead time is at least the one asked for. */
-    const uint64_t ticks = ((uint64_t)dead_time_ns * tim_clock_hz + 999999999u) / 1000000000u;
-    if (dtg == NULL || tim_clock_hz == 0u) {
+    const uint64_t ticks = ((uint64_t)dead_time_ns * tim_clock_Hz + 999999999u) / 1000000000u;
+    if (dtg == NULL || tim_clock_Hz == 0u) {
         return PMSTEP_STM32G4_ERR_NULL_ARGUMENT;
     }
     if (ticks <= 127u) {
@@ -63,7 +63,7 @@ pmstep_stm32g4_status_t pmstep_stm32g4_dead_time_dtg(uint32_t dead_time_ns, uint
     return PMSTEP_STM32G4_OK;
 }
 
-uint32_t pmstep_stm32g4_dtg_to_ns(uint8_t dtg, uint32_t tim_clock_hz)
+uint32_t pmstep_stm32g4_dtg_to_ns(uint8_t dtg, uint32_t tim_clock_Hz)
 {
     uint64_t ticks;
     if ((dtg & 0x80u) == 0u) {
@@ -75,40 +75,40 @@ uint32_t pmstep_stm32g4_dtg_to_ns(uint8_t dtg, uint32_t tim_clock_hz)
     } else {
         ticks = 16u * (32u + (dtg & 0x1Fu));
     }
-    return tim_clock_hz == 0u ? 0u : (uint32_t)(ticks * 1000000000u / tim_clock_hz);
+    return tim_clock_Hz == 0u ? 0u : (uint32_t)(ticks * 1000000000u / tim_clock_Hz);
 }
 
-uint32_t pmstep_stm32g4_sysclk_hz(const pmstep_stm32g4_clock_t *clock)
+uint32_t pmstep_stm32g4_sysclk_Hz(const pmstep_stm32g4_clock_t *clock)
 {
-    uint32_t vco_in_hz;
-    uint32_t vco_out_hz;
-    uint32_t sysclk_hz;
+    uint32_t vco_in_Hz;
+    uint32_t vco_out_Hz;
+    uint32_t sysclk_Hz;
     if (clock == NULL || clock->pll_m < 1u || clock->pll_m > 16u || clock->pll_n < 8u || clock->pll_n > 127u
         || (clock->pll_r != 2u && clock->pll_r != 4u && clock->pll_r != 6u && clock->pll_r != 8u)) {
         return 0u;
     }
     /* PLL input 2.66..16 MHz, VCO 96..344 MHz (datasheet DS12589, PLL characteristics). */
-    vco_in_hz = HSI16_HZ / clock->pll_m;
-    vco_out_hz = vco_in_hz * clock->pll_n;
-    sysclk_hz = vco_out_hz / clock->pll_r;
-    if (vco_in_hz < 2660000u || vco_out_hz < 96000000u || vco_out_hz > 344000000u || sysclk_hz > SYSCLK_MAX_HZ) {
+    vco_in_Hz = HSI16_HZ / clock->pll_m;
+    vco_out_Hz = vco_in_Hz * clock->pll_n;
+    sysclk_Hz = vco_out_Hz / clock->pll_r;
+    if (vco_in_Hz < 2660000u || vco_out_Hz < 96000000u || vco_out_Hz > 344000000u || sysclk_Hz > SYSCLK_MAX_HZ) {
         return 0u;
     }
-    return sysclk_hz;
+    return sysclk_Hz;
 }
 
-uint32_t pmstep_stm32g4_flash_latency(uint32_t hclk_hz)
+uint32_t pmstep_stm32g4_flash_latency(uint32_t hclk_Hz)
 {
-    return hclk_hz == 0u ? 0u : (hclk_hz - 1u) / 34000000u;
+    return hclk_Hz == 0u ? 0u : (hclk_Hz - 1u) / 34000000u;
 }
 
-uint32_t pmstep_stm32g4_pwm_arr(uint32_t tim_clock_hz, uint32_t pwm_frequency_hz)
+uint32_t pmstep_stm32g4_pwm_arr(uint32_t tim_clock_Hz, uint32_t pwm_frequency_Hz)
 {
     uint64_t arr;
-    if (pwm_frequency_hz == 0u) {
+    if (pwm_frequency_Hz == 0u) {
         return 0u;
     }
-    arr = ((uint64_t)tim_clock_hz + pwm_frequency_hz) / (2u * (uint64_t)pwm_frequency_hz);
+    arr = ((uint64_t)tim_clock_Hz + pwm_frequency_Hz) / (2u * (uint64_t)pwm_frequency_Hz);
     return (arr < 2u || arr > 65535u) ? 0u : (uint32_t)arr;
 }
 
@@ -147,7 +147,7 @@ pmstep_stm32g4_config_t pmstep_stm32g4_default_config(void)
     c.clock.pll_m = 4u;  /* 16 MHz / 4 = 4 MHz */
     c.clock.pll_n = 85u; /* x 85 = 340 MHz VCO */
     c.clock.pll_r = 2u;  /* / 2 = 170 MHz */
-    c.pwm_frequency_hz = 20000u;
+    c.pwm_frequency_Hz = 20000u;
     c.dead_time_ns = 500u;
     c.duty_min = 0.0f;
     c.duty_max = 1.0f;

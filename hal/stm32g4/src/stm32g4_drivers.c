@@ -37,17 +37,17 @@ pmstep_stm32g4_status_t pmstep_stm32g4_clock_init(const pmstep_stm32g4_clock_t *
     stm32g4_rcc_t *const rcc = STM32G4_RCC;
     stm32g4_pwr_t *const pwr = STM32G4_PWR;
     stm32g4_flash_t *const flash = STM32G4_FLASH;
-    const uint32_t sysclk_hz = pmstep_stm32g4_sysclk_hz(clock);
+    const uint32_t sysclk_Hz = pmstep_stm32g4_sysclk_Hz(clock);
     uint32_t latency;
     uint32_t reg;
 
     if (clock == NULL) {
         return PMSTEP_STM32G4_ERR_NULL_ARGUMENT;
     }
-    if (sysclk_hz == 0u) {
+    if (sysclk_Hz == 0u) {
         return PMSTEP_STM32G4_ERR_CLOCK_CONFIG;
     }
-    latency = pmstep_stm32g4_flash_latency(sysclk_hz);
+    latency = pmstep_stm32g4_flash_latency(sysclk_Hz);
 
     /* Voltage range 1; boost mode (R1MODE = 0) above 150 MHz, with HCLK = SYSCLK / 2 while
      * switching (the sequence of RM0440 §6.1.5). */
@@ -58,7 +58,7 @@ pmstep_stm32g4_status_t pmstep_stm32g4_clock_init(const pmstep_stm32g4_clock_t *
         return PMSTEP_STM32G4_ERR_CLOCK_TIMEOUT;
     }
     rcc->CFGR = (rcc->CFGR & ~RCC_CFGR_HPRE_MASK) | (RCC_CFGR_HPRE_DIV2 << RCC_CFGR_HPRE_POS);
-    if (sysclk_hz > 150000000u) {
+    if (sysclk_Hz > 150000000u) {
         pwr->CR5 &= ~PWR_CR5_R1MODE;
     } else {
         pwr->CR5 |= PWR_CR5_R1MODE;
@@ -165,7 +165,7 @@ pmstep_stm32g4_status_t pmstep_stm32g4_gpio_init(const pmstep_stm32g4_config_t *
 }
 
 /* ---- TIM1: RM0440 §28.3 (functional description), §28.6 (registers) ---- */
-pmstep_stm32g4_status_t pmstep_stm32g4_pwm_init(const pmstep_stm32g4_config_t *cfg, uint32_t tim_clock_hz)
+pmstep_stm32g4_status_t pmstep_stm32g4_pwm_init(const pmstep_stm32g4_config_t *cfg, uint32_t tim_clock_Hz)
 {
     stm32g4_tim_t *const tim = STM32G4_TIM1;
     const uint32_t pwm_channel = (TIM_OCM_PWM1 << TIM_CCMR_OCM_POS) | TIM_CCMR_OCPE;
@@ -180,11 +180,11 @@ pmstep_stm32g4_status_t pmstep_stm32g4_pwm_init(const pmstep_stm32g4_config_t *c
     if (!(cfg->duty_min >= 0.0f && cfg->duty_max <= 1.0f && cfg->duty_min < cfg->duty_max)) {
         return PMSTEP_STM32G4_ERR_DUTY_RANGE;
     }
-    arr = pmstep_stm32g4_pwm_arr(tim_clock_hz, cfg->pwm_frequency_hz);
+    arr = pmstep_stm32g4_pwm_arr(tim_clock_Hz, cfg->pwm_frequency_Hz);
     if (arr == 0u) {
         return PMSTEP_STM32G4_ERR_PWM_FREQUENCY;
     }
-    st = pmstep_stm32g4_dead_time_dtg(cfg->dead_time_ns, tim_clock_hz, &dtg);
+    st = pmstep_stm32g4_dead_time_dtg(cfg->dead_time_ns, tim_clock_Hz, &dtg);
     if (st != PMSTEP_STM32G4_OK) {
         return st;
     }

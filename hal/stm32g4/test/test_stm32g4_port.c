@@ -86,8 +86,8 @@ static int setup(void **state)
     adc2_enabled_seen = false;
     board = pmstep_stm32g4_default_config();
     motor_config = pmstep_paper_config();
-    motor_config.period_s = pmstep_stm32g4_period_s(&board);
-    motor_config.computational_delay_periods = 1u;
+    motor_config.timing.period_s = pmstep_stm32g4_period_s(&board);
+    motor_config.timing.computational_delay_periods = 1u;
     assert_int_equal(pmstep_init(&motor, &motor_config), PMSTEP_OK);
     return 0;
 }
@@ -111,10 +111,10 @@ static void adc_samples(uint32_t i_a_counts, uint32_t bus_counts, uint32_t i_b_c
     stm32g4_fake.adc1.ISR |= ADC_ISR_JEOC | ADC_ISR_JEOS;
 }
 
-/* Counts of the default board for a bus of @p bus_v volts. */
-static uint32_t bus_counts(float bus_v)
+/* Counts of the default board for a bus of @p bus_V volts. */
+static uint32_t bus_counts(float bus_V)
 {
-    return (uint32_t)lroundf(bus_v / board.bus_gain_v_per_count);
+    return (uint32_t)lroundf(bus_V / board.bus_gain_v_per_count);
 }
 
 static bool enable_pin_set_last(void)
@@ -232,10 +232,10 @@ static void test_clock_arithmetic(void **state)
     const pmstep_stm32g4_clock_t bad_r = {4u, 85u, 3u};
     const pmstep_stm32g4_clock_t vco_low = {4u, 20u, 2u};   /* VCO 80 MHz */
     (void)state;
-    assert_int_equal(pmstep_stm32g4_sysclk_hz(&c170), 170000000u);
-    assert_int_equal(pmstep_stm32g4_sysclk_hz(&too_fast), 0u);
-    assert_int_equal(pmstep_stm32g4_sysclk_hz(&bad_r), 0u);
-    assert_int_equal(pmstep_stm32g4_sysclk_hz(&vco_low), 0u);
+    assert_int_equal(pmstep_stm32g4_sysclk_Hz(&c170), 170000000u);
+    assert_int_equal(pmstep_stm32g4_sysclk_Hz(&too_fast), 0u);
+    assert_int_equal(pmstep_stm32g4_sysclk_Hz(&bad_r), 0u);
+    assert_int_equal(pmstep_stm32g4_sysclk_Hz(&vco_low), 0u);
     assert_int_equal(pmstep_stm32g4_flash_latency(170000000u), 4u);
     assert_int_equal(pmstep_stm32g4_flash_latency(136000000u), 3u);
     assert_int_equal(pmstep_stm32g4_flash_latency(34000000u), 0u);
@@ -316,12 +316,12 @@ static void test_pwm_init(void **state)
     assert_true(tim->DIER & TIM_DIER_BIE);
     assert_true(tim->EGR & TIM_EGR_UG);
 
-    board.pwm_frequency_hz = 10000u;
+    board.pwm_frequency_Hz = 10000u;
     assert_int_equal(pmstep_stm32g4_pwm_init(&board, 170000000u), PMSTEP_STM32G4_OK);
     assert_int_equal(tim->ARR, 8500u);
-    board.pwm_frequency_hz = 1000u;
+    board.pwm_frequency_Hz = 1000u;
     assert_int_equal(pmstep_stm32g4_pwm_init(&board, 170000000u), PMSTEP_STM32G4_ERR_PWM_FREQUENCY);
-    board.pwm_frequency_hz = 20000u;
+    board.pwm_frequency_Hz = 20000u;
     board.dead_time_ns = 10000u;
     assert_int_equal(pmstep_stm32g4_pwm_init(&board, 170000000u), PMSTEP_STM32G4_ERR_DEAD_TIME);
     board.dead_time_ns = 500u;
@@ -518,10 +518,10 @@ static void test_measurements_in_si(void **state)
     port_up();
     adc_samples(2048u + 248u, bus_counts(24.0f), 2048u - 124u);
     pmstep_hal_read_measurements(&m);
-    assert_float_equal(m.i_a_a, 248.0f * board.i_a_gain_a_per_count, 1e-6f); /* 1.998 A */
-    assert_float_equal(m.i_b_a, -124.0f * board.i_b_gain_a_per_count, 1e-6f);
-    assert_float_equal(m.bus_voltage_v, 24.0f, 0.5f * board.bus_gain_v_per_count);
-    assert_float_equal(m.load_torque_nm, 0.0f, 0.0f);
+    assert_float_equal(m.i_a_A, 248.0f * board.i_a_gain_a_per_count, 1e-6f); /* 1.998 A */
+    assert_float_equal(m.i_b_A, -124.0f * board.i_b_gain_a_per_count, 1e-6f);
+    assert_float_equal(m.bus_voltage_V, 24.0f, 0.5f * board.bus_gain_v_per_count);
+    assert_float_equal(m.load_torque_Nm, 0.0f, 0.0f);
 }
 
 int main(void)

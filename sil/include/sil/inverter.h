@@ -31,7 +31,7 @@
  *    the bridge is enabled again. A back EMF above the bus, which would make the diodes
  *    conduct again, is not modelled.
  *
- * Bus: V_bus(t) = V0 - R_src i_bus + ripple_v sin(2 pi ripple_hz t), clamped at >= 0.
+ * Bus: V_bus(t) = V0 - R_src i_bus + ripple_V sin(2 pi ripple_Hz t), clamped at >= 0.
  * i_bus = (u_a i_a + u_b i_b)/V_bus is taken as the mean over the previous period
  * (a stiff DC-link capacitor holding the sag of the last period), computed from the
  * RK4 quadrature of the currents; the ripple is evaluated at each substep's midpoint
@@ -63,50 +63,50 @@ typedef struct {
     double dead_time_s;           /**< per half-bridge (>= 0, < period/4) */
 } sil_inverter_config_t;
 
-/** [bus] of a scenario (the nominal V0 is run.bus_voltage_v). */
+/** [bus] of a scenario (the nominal V0 is run.bus_voltage_V). */
 typedef struct {
-    double source_resistance_ohm; /**< R_src */
-    double ripple_v;              /**< amplitude of the sine ripple (V) */
-    double ripple_hz;
+    double source_resistance_Ohm; /**< R_src */
+    double ripple_V;              /**< amplitude of the sine ripple (V) */
+    double ripple_Hz;
 } sil_bus_config_t;
 
 typedef struct {
     sil_inverter_config_t cfg;
     sil_bus_config_t bus;
-    double nominal_bus_voltage_v;  /**< V0 */
+    double nominal_bus_voltage_V;  /**< V0 */
     unsigned delay_periods;        /**< 0 or 1 */
     /* MCU side: the last step's command, waiting for the next period (delay 1). */
-    double pending_a_v;            /**< clipped to +/- pending_bus_v */
-    double pending_b_v;
-    double pending_bus_v;          /**< measured bus the step was given */
+    double pending_a_V;            /**< clipped to +/- pending_bus_V */
+    double pending_b_V;
+    double pending_bus_V;          /**< measured bus the step was given */
     bool pending_clipped;
     /* The bridge over the coming period. */
     bool bridge_enable;
-    double command_a_v;            /**< clipped command; the duty is command / command_bus_v */
-    double command_b_v;
-    double command_bus_v;
+    double command_a_V;            /**< clipped command; the duty is command / command_bus_V */
+    double command_b_V;
+    double command_bus_V;
     /* What the plant received over the last period (set by sil_drive_advance). */
-    double applied_a_v;            /**< mean phase voltage (before the advance: the command) */
-    double applied_b_v;
-    double mean_current_a[2];      /**< mean current of phase a [0] and b [1] (A) */
-    double min_current_a[2];       /**< extremes of the phase currents at the substep ends, start included (A) */
-    double max_current_a[2];
-    double mean_bus_current_a;     /**< mean i_bus, which sets the sag of the next period */
+    double applied_a_V;            /**< mean phase voltage (before the advance: the command) */
+    double applied_b_V;
+    double mean_current_A[2];      /**< mean current of phase a [0] and b [1] (A) */
+    double min_current_A[2];       /**< extremes of the phase currents at the substep ends, start included (A) */
+    double max_current_A[2];
+    double mean_bus_current_A;     /**< mean i_bus, which sets the sag of the next period */
     unsigned long limited_periods; /**< periods the MCU had to clip its duty to +/- 1 */
 } sil_inverter_t;
 
 /** Averaged model, no dead time. */
 sil_inverter_config_t sil_inverter_ideal_config(void);
 
-/** Stiff bus: no source resistance, no ripple (ripple_hz 100). */
+/** Stiff bus: no source resistance, no ripple (ripple_Hz 100). */
 sil_bus_config_t sil_bus_ideal_config(void);
 
 /** Zero voltage, nothing pending, bridge enabled, no bus current. */
 void sil_inverter_init(sil_inverter_t *inv, const sil_inverter_config_t *cfg, const sil_bus_config_t *bus,
-                       double bus_voltage_v, unsigned delay_periods);
+                       double bus_voltage_V, unsigned delay_periods);
 
 /** Takes one step's output and the bus voltage the step was given; sets the command of the coming period. */
-void sil_inverter_apply(sil_inverter_t *inv, const pmstep_output_t *out, double measured_bus_v);
+void sil_inverter_apply(sil_inverter_t *inv, const pmstep_output_t *out, double measured_bus_V);
 
 /** The actual bus voltage at time @p t_s of the coming period (sag of the last period, ripple at t). */
 double sil_inverter_bus_voltage(const sil_inverter_t *inv, double t_s);

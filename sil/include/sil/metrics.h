@@ -20,10 +20,10 @@ extern "C" {
 typedef struct {
     long step;
     double t_s;
-    double theta_rad, omega_rad_s, i_a_a, i_b_a;
+    double theta_rad, omega_rad_s, i_a_A, i_b_A;
     double cos_ptheta, sin_ptheta;   /**< true electrical angle */
-    double u_a_v, u_b_v;             /**< voltage the plant sees over [t_k, t_k+1] */
-    double load_nm;                  /**< true T_L */
+    double u_a_V, u_b_V;             /**< voltage the plant sees over [t_k, t_k+1] */
+    double load_Nm;                  /**< true T_L */
     const pmstep_output_t *out;      /**< the step's output (estimates, mode, fault) */
     pmstep_t *inst;                  /**< the core's instance, for tests that inspect or perturb its state
                                           (a change takes effect from the next period) */
@@ -40,15 +40,15 @@ typedef struct {
     double firmware_time_s;          /**< wall time inside read + pmstep_step + apply */
     double real_time_factor;         /**< simulated s per wall s */
     /* Alignment residuals, from the plant at the sample nearest t_s and t_c. */
-    double cos_ptheta_at_ts, sin_ptheta_at_ts, i_b_residual_at_ts_a;
-    double cos_ptheta_at_tc, sin_ptheta_at_tc, i_a_residual_at_tc_a;
+    double cos_ptheta_at_ts, sin_ptheta_at_ts, i_b_residual_at_ts_A;
+    double cos_ptheta_at_tc, sin_ptheta_at_tc, i_a_residual_at_tc_A;
     /* Speed error |omega - omega*| on the load transient [t_c, t_c + W) and on tracking [t_c + W, end]. */
     double transient_max_speed_error_rad_s, transient_rms_speed_error_rad_s;
     double tracking_max_speed_error_rad_s, tracking_rms_speed_error_rad_s;
-    double final_load_hat_nm, final_load_nm, final_load_error_nm;
+    double final_load_hat_Nm, final_load_Nm, final_load_error_Nm;
     double max_cos_error, max_sin_error;   /**< |c-hat - cos p theta|, |s-hat - sin p theta| in RUN */
-    double max_phase_voltage_v;            /**< max |u_a|, |u_b| applied */
-    double max_phase_current_a;
+    double max_phase_voltage_V;            /**< max |u_a|, |u_b| applied */
+    double max_phase_current_A;
     long voltage_limited_periods;          /**< periods the core scaled its voltage to the bus */
     long inverter_limited_periods;         /**< periods the inverter model clipped */
     pmstep_mode_t final_mode;
@@ -72,7 +72,7 @@ typedef struct {
 /** Running sums behind the summary. */
 typedef struct {
     long ts_step, tc_step, transient_end_step; /**< sample indices of t_s, t_c, t_c + W */
-    double s_align_current_a, c_align_current_a; /**< u_cs/R, u_cc/R with the plant's R */
+    double s_align_current_A, c_align_current_A; /**< u_cs/R, u_cc/R with the plant's R */
     long settle_step;                          /**< first sample counted "after transients" */
     double loss_speed_error_rad_s, loss_angle_error_rad; /**< the scenario's loss-of-control bounds */
     double transient_sq, tracking_sq;

@@ -20,19 +20,19 @@ extern "C" {
 
 /** Physical motor parameters (SI). */
 typedef struct {
-    double resistance_ohm;          /**< R */
-    double inductance_h;            /**< L */
-    double inertia_kg_m2;           /**< J */
-    double friction_nm_s_per_rad;   /**< F */
-    double torque_constant_nm_per_a;/**< k_M */
+    double resistance_Ohm;          /**< R */
+    double inductance_H;            /**< L */
+    double inertia_kgm2;           /**< J */
+    double friction_Nms_rad;   /**< F */
+    double torque_constant_Nm_A;/**< k_M */
     int pole_pairs;                 /**< p */
 } plant_params_t;
 
 /** Load torque T_L(t, omega). */
 typedef enum {
     PLANT_LOAD_NONE = 0,        /**< T_L = 0 */
-    PLANT_LOAD_CONSTANT = 1,    /**< T_L = torque_nm */
-    PLANT_LOAD_STEP = 2,        /**< T_L = torque_nm for t >= step_time_s, else 0 */
+    PLANT_LOAD_CONSTANT = 1,    /**< T_L = torque_Nm */
+    PLANT_LOAD_STEP = 2,        /**< T_L = torque_Nm for t >= step_time_s, else 0 */
     PLANT_LOAD_PROPORTIONAL = 3,/**< T_L = coefficient * omega (viscous load) */
     PLANT_LOAD_TABLE = 4        /**< piecewise linear in t through the points, held outside */
 } plant_load_kind_t;
@@ -41,19 +41,19 @@ typedef enum {
 
 typedef struct {
     plant_load_kind_t kind;
-    double torque_nm;
+    double torque_Nm;
     double step_time_s;
-    double coefficient_nm_s_per_rad;
+    double coefficient_Nms_rad;
     int table_points;
     double table_time_s[PLANT_LOAD_TABLE_MAX];   /**< strictly increasing */
-    double table_torque_nm[PLANT_LOAD_TABLE_MAX];
+    double table_torque_Nm[PLANT_LOAD_TABLE_MAX];
 } plant_load_t;
 
 typedef struct {
     double theta_rad;
     double omega_rad_s;
-    double i_a_a;
-    double i_b_a;
+    double i_a_A;
+    double i_b_A;
 } plant_state_t;
 
 typedef struct {
@@ -73,17 +73,17 @@ double plant_load_torque(const plant_load_t *load, double t_s, double omega_rad_
 
 /** Right-hand side of (1). */
 void plant_derivative(const plant_params_t *params, const plant_load_t *load, double t_s,
-                      const plant_state_t *x, double u_a_v, double u_b_v, plant_state_t *dx);
+                      const plant_state_t *x, double u_a_V, double u_b_V, plant_state_t *dx);
 
 /** Advances by @p period_s with (u_a, u_b) held, in @p substeps RK4 steps. */
-void plant_advance(plant_t *plant, double u_a_v, double u_b_v, double period_s, int substeps);
+void plant_advance(plant_t *plant, double u_a_V, double u_b_V, double period_s, int substeps);
 
 /**
  * One RK4 step of @p h_s from time @p t_s with (u_a, u_b) held (an open phase ignores its
  * voltage). Leaves plant->time_s alone. When @p charge_a_c and @p charge_b_c are not NULL
  * they receive the integrals of i_a and i_b over the step (C), by the same RK4 quadrature.
  */
-void plant_substep(plant_t *plant, double t_s, double h_s, double u_a_v, double u_b_v, double *charge_a_c,
+void plant_substep(plant_t *plant, double t_s, double h_s, double u_a_V, double u_b_V, double *charge_a_c,
                    double *charge_b_c);
 
 #ifdef __cplusplus

@@ -107,61 +107,61 @@ static inline int sil_record_check_header(const uint32_t *w)
 /** The configuration in the record header (words 5 ..). */
 static inline void sil_record_config_from_words(const uint32_t *w, pmstep_config_t *c)
 {
-    c->resistance_ohm = sil_record_float(w[0]);
-    c->inductance_h = sil_record_float(w[1]);
-    c->inertia_kg_m2 = sil_record_float(w[2]);
-    c->friction_nm_s_per_rad = sil_record_float(w[3]);
-    c->torque_constant_nm_per_a = sil_record_float(w[4]);
-    c->pole_pairs = (int32_t)w[5];
-    c->period_s = sil_record_float(w[6]);
-    c->computational_delay_periods = w[7];
-    c->s_align_time_s = sil_record_float(w[8]);
-    c->c_align_time_s = sil_record_float(w[9]);
-    c->s_align_voltage_v = sil_record_float(w[10]);
-    c->c_align_voltage_v = sil_record_float(w[11]);
-    c->speed_gain_per_s = sil_record_float(w[12]);
-    c->observer_gain_per_s = sil_record_float(w[13]);
-    c->current_gain_per_s = sil_record_float(w[14]);
-    c->adapt_gamma = sil_record_float(w[15]);
-    c->adapt_lambda = sil_record_float(w[16]);
-    c->adapt_r = sil_record_float(w[17]);
-    c->sat_kappa_rad_per_s = sil_record_float(w[18]);
-    c->reference_bandwidth_rad_per_s = sil_record_float(w[19]);
+    c->motor.resistance_Ohm = sil_record_float(w[0]);
+    c->motor.inductance_H = sil_record_float(w[1]);
+    c->motor.inertia_kgm2 = sil_record_float(w[2]);
+    c->motor.friction_Nms_rad = sil_record_float(w[3]);
+    c->motor.torque_constant_Nm_A = sil_record_float(w[4]);
+    c->motor.pole_pairs = (int32_t)w[5];
+    c->timing.period_s = sil_record_float(w[6]);
+    c->timing.computational_delay_periods = w[7];
+    c->alignment.s_align_time_s = sil_record_float(w[8]);
+    c->alignment.c_align_time_s = sil_record_float(w[9]);
+    c->alignment.s_align_voltage_V = sil_record_float(w[10]);
+    c->alignment.c_align_voltage_V = sil_record_float(w[11]);
+    c->gains.speed_gain_per_s = sil_record_float(w[12]);
+    c->gains.observer_gain_per_s = sil_record_float(w[13]);
+    c->gains.current_gain_per_s = sil_record_float(w[14]);
+    c->gains.adapt_gamma = sil_record_float(w[15]);
+    c->gains.adapt_lambda = sil_record_float(w[16]);
+    c->gains.adapt_r = sil_record_float(w[17]);
+    c->gains.sat_kappa_rad_s = sil_record_float(w[18]);
+    c->gains.reference_bandwidth_rad_s = sil_record_float(w[19]);
     c->known_load_mode = w[20] != 0u;
-    c->max_phase_current_a = sil_record_float(w[21]);
-    c->min_bus_voltage_v = sil_record_float(w[22]);
-    c->max_bus_voltage_v = sil_record_float(w[23]);
-    c->offset_calibration_time_s = sil_record_float(w[24]);
-    c->alignment_offset_calibration = w[25] != 0u;
-    c->steady_state_window_s = sil_record_float(w[26]);
-    c->inductance_window_s = sil_record_float(w[27]);
-    c->use_commissioned_resistance = w[28] != 0u;
-    c->use_commissioned_inductance = w[29] != 0u;
-    c->use_commissioned_torque_constant = w[30] != 0u;
-    c->voltage_bias_level_fraction = sil_record_float(w[31]);
-    c->dead_time_s = sil_record_float(w[32]);
-    c->dead_time_current_band_a = sil_record_float(w[33]);
-    c->angle_correction_gain_per_s = sil_record_float(w[34]);
-    c->angle_magnitude_bound = sil_record_float(w[35]);
-    c->speed_consistency_bound_rad_s = sil_record_float(w[36]);
-    c->stall_speed_error_rad_s = sil_record_float(w[37]);
-    c->observer_residual_bound_a = sil_record_float(w[38]);
-    c->detection_time_s = sil_record_float(w[39]);
-    c->max_realignments = w[40];
+    c->limits.max_phase_current_A = sil_record_float(w[21]);
+    c->limits.min_bus_voltage_V = sil_record_float(w[22]);
+    c->limits.max_bus_voltage_V = sil_record_float(w[23]);
+    c->commissioning.offset_calibration_time_s = sil_record_float(w[24]);
+    c->commissioning.alignment_offset_calibration = w[25] != 0u;
+    c->commissioning.steady_state_window_s = sil_record_float(w[26]);
+    c->commissioning.inductance_window_s = sil_record_float(w[27]);
+    c->commissioning.use_measured_resistance = w[28] != 0u;
+    c->commissioning.use_measured_inductance = w[29] != 0u;
+    c->commissioning.use_measured_torque_constant = w[30] != 0u;
+    c->commissioning.voltage_bias_level_fraction = sil_record_float(w[31]);
+    c->inverter.dead_time_s = sil_record_float(w[32]);
+    c->inverter.dead_time_current_band_A = sil_record_float(w[33]);
+    c->gains.angle_correction_gain_per_s = sil_record_float(w[34]);
+    c->detection.angle_magnitude_bound = sil_record_float(w[35]);
+    c->detection.speed_consistency_bound_rad_s = sil_record_float(w[36]);
+    c->detection.stall_speed_error_rad_s = sil_record_float(w[37]);
+    c->detection.observer_residual_bound_A = sil_record_float(w[38]);
+    c->detection.persistence_s = sil_record_float(w[39]);
+    c->detection.max_realignments = w[40];
 }
 
 static inline void sil_record_meas_from_words(const uint32_t *w, pmstep_meas_t *m)
 {
-    m->i_a_a = sil_record_float(w[SIL_RECORD_IN_I_A]);
-    m->i_b_a = sil_record_float(w[SIL_RECORD_IN_I_B]);
-    m->bus_voltage_v = sil_record_float(w[SIL_RECORD_IN_BUS]);
-    m->load_torque_nm = sil_record_float(w[SIL_RECORD_IN_LOAD]);
+    m->i_a_A = sil_record_float(w[SIL_RECORD_IN_I_A]);
+    m->i_b_A = sil_record_float(w[SIL_RECORD_IN_I_B]);
+    m->bus_voltage_V = sil_record_float(w[SIL_RECORD_IN_BUS]);
+    m->load_torque_Nm = sil_record_float(w[SIL_RECORD_IN_LOAD]);
 }
 
 static inline void sil_record_output_to_words(const pmstep_output_t *o, uint32_t *w)
 {
-    w[SIL_RECORD_OUT_U_A] = sil_record_bits(o->u_a_v);
-    w[SIL_RECORD_OUT_U_B] = sil_record_bits(o->u_b_v);
+    w[SIL_RECORD_OUT_U_A] = sil_record_bits(o->u_a_V);
+    w[SIL_RECORD_OUT_U_B] = sil_record_bits(o->u_b_V);
     w[SIL_RECORD_OUT_BRIDGE_ENABLE] = o->bridge_enable ? 1u : 0u;
     w[SIL_RECORD_OUT_VOLTAGE_LIMITED] = o->voltage_limited ? 1u : 0u;
     w[SIL_RECORD_OUT_MODE] = (uint32_t)o->mode;
@@ -170,69 +170,69 @@ static inline void sil_record_output_to_words(const pmstep_output_t *o, uint32_t
     w[SIL_RECORD_OUT_COS_HAT] = sil_record_bits(o->cos_hat);
     w[SIL_RECORD_OUT_SIN_HAT] = sil_record_bits(o->sin_hat);
     w[SIL_RECORD_OUT_SPEED_HAT] = sil_record_bits(o->speed_hat_rad_s);
-    w[SIL_RECORD_OUT_LOAD_HAT] = sil_record_bits(o->load_hat_nm);
-    w[SIL_RECORD_OUT_I_A_HAT] = sil_record_bits(o->i_a_hat_a);
-    w[SIL_RECORD_OUT_I_B_HAT] = sil_record_bits(o->i_b_hat_a);
+    w[SIL_RECORD_OUT_LOAD_HAT] = sil_record_bits(o->load_hat_Nm);
+    w[SIL_RECORD_OUT_I_A_HAT] = sil_record_bits(o->i_a_hat_A);
+    w[SIL_RECORD_OUT_I_B_HAT] = sil_record_bits(o->i_b_hat_A);
     w[SIL_RECORD_OUT_SPEED_REF] = sil_record_bits(o->speed_ref_rad_s);
-    w[SIL_RECORD_OUT_SPEED_REF_DOT] = sil_record_bits(o->speed_ref_dot_rad_s2);
-    w[SIL_RECORD_OUT_I_D] = sil_record_bits(o->i_d_a);
-    w[SIL_RECORD_OUT_I_Q] = sil_record_bits(o->i_q_a);
-    w[SIL_RECORD_OUT_I_D_REF] = sil_record_bits(o->i_d_ref_a);
-    w[SIL_RECORD_OUT_I_Q_REF] = sil_record_bits(o->i_q_ref_a);
+    w[SIL_RECORD_OUT_SPEED_REF_DOT] = sil_record_bits(o->speed_ref_rate_rad_s2);
+    w[SIL_RECORD_OUT_I_D] = sil_record_bits(o->i_d_A);
+    w[SIL_RECORD_OUT_I_Q] = sil_record_bits(o->i_q_A);
+    w[SIL_RECORD_OUT_I_D_REF] = sil_record_bits(o->i_d_ref_A);
+    w[SIL_RECORD_OUT_I_Q_REF] = sil_record_bits(o->i_q_ref_A);
 }
 
 /** The configuration as the record header's words (pmstep_config_t fields in declaration order). */
 static inline void sil_record_config_to_words(const pmstep_config_t *c, uint32_t *w)
 {
-    w[0] = sil_record_bits(c->resistance_ohm);
-    w[1] = sil_record_bits(c->inductance_h);
-    w[2] = sil_record_bits(c->inertia_kg_m2);
-    w[3] = sil_record_bits(c->friction_nm_s_per_rad);
-    w[4] = sil_record_bits(c->torque_constant_nm_per_a);
-    w[5] = (uint32_t)c->pole_pairs;
-    w[6] = sil_record_bits(c->period_s);
-    w[7] = c->computational_delay_periods;
-    w[8] = sil_record_bits(c->s_align_time_s);
-    w[9] = sil_record_bits(c->c_align_time_s);
-    w[10] = sil_record_bits(c->s_align_voltage_v);
-    w[11] = sil_record_bits(c->c_align_voltage_v);
-    w[12] = sil_record_bits(c->speed_gain_per_s);
-    w[13] = sil_record_bits(c->observer_gain_per_s);
-    w[14] = sil_record_bits(c->current_gain_per_s);
-    w[15] = sil_record_bits(c->adapt_gamma);
-    w[16] = sil_record_bits(c->adapt_lambda);
-    w[17] = sil_record_bits(c->adapt_r);
-    w[18] = sil_record_bits(c->sat_kappa_rad_per_s);
-    w[19] = sil_record_bits(c->reference_bandwidth_rad_per_s);
+    w[0] = sil_record_bits(c->motor.resistance_Ohm);
+    w[1] = sil_record_bits(c->motor.inductance_H);
+    w[2] = sil_record_bits(c->motor.inertia_kgm2);
+    w[3] = sil_record_bits(c->motor.friction_Nms_rad);
+    w[4] = sil_record_bits(c->motor.torque_constant_Nm_A);
+    w[5] = (uint32_t)c->motor.pole_pairs;
+    w[6] = sil_record_bits(c->timing.period_s);
+    w[7] = c->timing.computational_delay_periods;
+    w[8] = sil_record_bits(c->alignment.s_align_time_s);
+    w[9] = sil_record_bits(c->alignment.c_align_time_s);
+    w[10] = sil_record_bits(c->alignment.s_align_voltage_V);
+    w[11] = sil_record_bits(c->alignment.c_align_voltage_V);
+    w[12] = sil_record_bits(c->gains.speed_gain_per_s);
+    w[13] = sil_record_bits(c->gains.observer_gain_per_s);
+    w[14] = sil_record_bits(c->gains.current_gain_per_s);
+    w[15] = sil_record_bits(c->gains.adapt_gamma);
+    w[16] = sil_record_bits(c->gains.adapt_lambda);
+    w[17] = sil_record_bits(c->gains.adapt_r);
+    w[18] = sil_record_bits(c->gains.sat_kappa_rad_s);
+    w[19] = sil_record_bits(c->gains.reference_bandwidth_rad_s);
     w[20] = c->known_load_mode ? 1u : 0u;
-    w[21] = sil_record_bits(c->max_phase_current_a);
-    w[22] = sil_record_bits(c->min_bus_voltage_v);
-    w[23] = sil_record_bits(c->max_bus_voltage_v);
-    w[24] = sil_record_bits(c->offset_calibration_time_s);
-    w[25] = c->alignment_offset_calibration ? 1u : 0u;
-    w[26] = sil_record_bits(c->steady_state_window_s);
-    w[27] = sil_record_bits(c->inductance_window_s);
-    w[28] = c->use_commissioned_resistance ? 1u : 0u;
-    w[29] = c->use_commissioned_inductance ? 1u : 0u;
-    w[30] = c->use_commissioned_torque_constant ? 1u : 0u;
-    w[31] = sil_record_bits(c->voltage_bias_level_fraction);
-    w[32] = sil_record_bits(c->dead_time_s);
-    w[33] = sil_record_bits(c->dead_time_current_band_a);
-    w[34] = sil_record_bits(c->angle_correction_gain_per_s);
-    w[35] = sil_record_bits(c->angle_magnitude_bound);
-    w[36] = sil_record_bits(c->speed_consistency_bound_rad_s);
-    w[37] = sil_record_bits(c->stall_speed_error_rad_s);
-    w[38] = sil_record_bits(c->observer_residual_bound_a);
-    w[39] = sil_record_bits(c->detection_time_s);
-    w[40] = c->max_realignments;
+    w[21] = sil_record_bits(c->limits.max_phase_current_A);
+    w[22] = sil_record_bits(c->limits.min_bus_voltage_V);
+    w[23] = sil_record_bits(c->limits.max_bus_voltage_V);
+    w[24] = sil_record_bits(c->commissioning.offset_calibration_time_s);
+    w[25] = c->commissioning.alignment_offset_calibration ? 1u : 0u;
+    w[26] = sil_record_bits(c->commissioning.steady_state_window_s);
+    w[27] = sil_record_bits(c->commissioning.inductance_window_s);
+    w[28] = c->commissioning.use_measured_resistance ? 1u : 0u;
+    w[29] = c->commissioning.use_measured_inductance ? 1u : 0u;
+    w[30] = c->commissioning.use_measured_torque_constant ? 1u : 0u;
+    w[31] = sil_record_bits(c->commissioning.voltage_bias_level_fraction);
+    w[32] = sil_record_bits(c->inverter.dead_time_s);
+    w[33] = sil_record_bits(c->inverter.dead_time_current_band_A);
+    w[34] = sil_record_bits(c->gains.angle_correction_gain_per_s);
+    w[35] = sil_record_bits(c->detection.angle_magnitude_bound);
+    w[36] = sil_record_bits(c->detection.speed_consistency_bound_rad_s);
+    w[37] = sil_record_bits(c->detection.stall_speed_error_rad_s);
+    w[38] = sil_record_bits(c->detection.observer_residual_bound_A);
+    w[39] = sil_record_bits(c->detection.persistence_s);
+    w[40] = c->detection.max_realignments;
 }
 
 static inline void sil_record_meas_to_words(const pmstep_meas_t *m, uint32_t *w)
 {
-    w[SIL_RECORD_IN_I_A] = sil_record_bits(m->i_a_a);
-    w[SIL_RECORD_IN_I_B] = sil_record_bits(m->i_b_a);
-    w[SIL_RECORD_IN_BUS] = sil_record_bits(m->bus_voltage_v);
-    w[SIL_RECORD_IN_LOAD] = sil_record_bits(m->load_torque_nm);
+    w[SIL_RECORD_IN_I_A] = sil_record_bits(m->i_a_A);
+    w[SIL_RECORD_IN_I_B] = sil_record_bits(m->i_b_A);
+    w[SIL_RECORD_IN_BUS] = sil_record_bits(m->bus_voltage_V);
+    w[SIL_RECORD_IN_LOAD] = sil_record_bits(m->load_torque_Nm);
 }
 
 /** Reads @p n (<= SIL_RECORD_MAX_WORDS) little-endian words. @return 0, or -1 on a short read. */

@@ -34,24 +34,24 @@ typedef struct {
     pmstep_config_t controller;      /**< [controller]: what the firmware is told */
     double duration_s;               /**< run.duration_s */
     int substeps;                    /**< run.substeps: RK4 steps per control period */
-    double bus_voltage_v;            /**< run.bus_voltage_v */
+    double bus_voltage_V;            /**< run.bus_voltage_V */
     double theta0_rad;               /**< run.theta0_deg (stored in rad) */
     double omega0_rad_s;             /**< run.omega0_rad_s */
-    double i_a0_a;                   /**< run.i_a0_a */
-    double i_b0_a;                   /**< run.i_b0_a */
+    double i_a0_A;                   /**< run.i_a0_A */
+    double i_b0_A;                   /**< run.i_b0_A */
     int decimation;                  /**< run.decimation: a CSV row every N periods */
     double transient_window_s;       /**< run.transient_window_s: [t_c, t_c + W) is the load transient */
     int speed_points;                /**< [speed] points = t:v, ... (rad/s, piecewise linear) */
     double speed_time_s[SIL_SPEED_POINTS_MAX];
     double speed_value_rad_s[SIL_SPEED_POINTS_MAX];
-    double id_target_a;              /**< speed.id_target_a */
+    double id_target_A;              /**< speed.id_target_A */
     double loss_speed_error_rad_s;   /**< run.loss_speed_error_rad_s: |omega - omega*| above -> loss of control */
     double loss_angle_error_rad;     /**< run.loss_angle_error_rad: angle-estimate error above -> loss of control */
     uint32_t seed;                   /**< run.seed: of every random draw of the run (measurement noise) */
-    double max_csv_mb;               /**< run.max_csv_mb: largest run.csv a run may write (MB) */
+    double max_csv_MB;               /**< run.max_csv_MB: largest run.csv a run may write (MB) */
     sil_sensor_config_t sensors;     /**< [sensors]: measurement chain (ideal by default) */
     sil_inverter_config_t inverter;  /**< [inverter]: averaged | switching, dead time */
-    sil_bus_config_t bus;            /**< [bus]: source resistance and ripple on run.bus_voltage_v */
+    sil_bus_config_t bus;            /**< [bus]: source resistance and ripple on run.bus_voltage_V */
 } sil_scenario_t;
 
 /** The paper's Section III: t_s = 0.3 s, t_c = 0.6 s, 2 Nm at 0.63 s, theta0 = 30 deg, 2.4 s, 20 kHz. */

@@ -4,9 +4,9 @@
  *        currents and the bus voltage, sampled at the carrier centre (the period
  *        boundary, where the PWM applies zero volts to every phase).
  *
- *   current:  x = (1 + gain_error) i + offset + n,   n ~ N(0, noise_rms_a^2) per phase per sample
+ *   current:  x = (1 + gain_error) i + offset + n,   n ~ N(0, noise_rms_A^2) per phase per sample
  *             then an N-bit bipolar mid-tread ADC over [-full scale, +full scale]
- *   bus:      x = V_bus + n,  n ~ N(0, bus_noise_rms_v^2), then an N-bit ADC over [0, bus full scale]
+ *   bus:      x = V_bus + n,  n ~ N(0, bus_noise_rms_V^2), then an N-bit ADC over [0, bus full scale]
  *
  * Every term is skipped when its setting is zero (no RNG call without noise, no
  * quantisation with adc_bits = 0), so the ideal chain returns its input bit for bit.
@@ -24,14 +24,14 @@ extern "C" {
 /** [sensors] of a scenario. */
 typedef struct {
     unsigned adc_bits;             /**< 0 = ideal (no quantisation, no clipping), else 8..16 */
-    double current_full_scale_a;   /**< bipolar span +/- this (A) */
-    double offset_a_a;             /**< current-sensor offset, phase a (A) */
-    double offset_b_a;
+    double current_full_scale_A;   /**< bipolar span +/- this (A) */
+    double offset_a_A;             /**< current-sensor offset, phase a (A) */
+    double offset_b_A;
     double gain_error_a;           /**< relative gain error, phase a (0.01 = reads 1 % high) */
     double gain_error_b;
-    double noise_rms_a;            /**< Gaussian noise per phase per sample (A rms) */
-    double bus_full_scale_v;       /**< unipolar span [0, this] (V) */
-    double bus_noise_rms_v;        /**< Gaussian noise on the bus sample (V rms) */
+    double noise_rms_A;            /**< Gaussian noise per phase per sample (A rms) */
+    double bus_full_scale_V;       /**< unipolar span [0, this] (V) */
+    double bus_noise_rms_V;        /**< Gaussian noise on the bus sample (V rms) */
 } sil_sensor_config_t;
 
 typedef struct {
@@ -48,14 +48,14 @@ static inline sil_sensor_config_t sil_sensors_ideal(void)
 {
     sil_sensor_config_t c;
     c.adc_bits = 0u;
-    c.current_full_scale_a = 16.5;
-    c.offset_a_a = 0.0;
-    c.offset_b_a = 0.0;
+    c.current_full_scale_A = 16.5;
+    c.offset_a_A = 0.0;
+    c.offset_b_A = 0.0;
     c.gain_error_a = 0.0;
     c.gain_error_b = 0.0;
-    c.noise_rms_a = 0.0;
-    c.bus_full_scale_v = 80.0;
-    c.bus_noise_rms_v = 0.0;
+    c.noise_rms_A = 0.0;
+    c.bus_full_scale_V = 80.0;
+    c.bus_noise_rms_V = 0.0;
     return c;
 }
 
@@ -65,11 +65,11 @@ int sil_sensors_init(sil_sensors_t *s, const sil_sensor_config_t *cfg, unsigned 
 /** Frees the RNG (the counters stay readable). */
 void sil_sensors_release(sil_sensors_t *s);
 
-/** Samples both phase currents (A): what the ADC reports for the plant's @p i_a_a, @p i_b_a. */
-void sil_sensors_currents(sil_sensors_t *s, double i_a_a, double i_b_a, double *i_a_meas_a, double *i_b_meas_a);
+/** Samples both phase currents (A): what the ADC reports for the plant's @p i_a_A, @p i_b_A. */
+void sil_sensors_currents(sil_sensors_t *s, double i_a_A, double i_b_A, double *i_a_meas_A, double *i_b_meas_A);
 
-/** Samples the bus (V): what the ADC reports for the actual @p bus_v. */
-double sil_sensors_bus(sil_sensors_t *s, double bus_v);
+/** Samples the bus (V): what the ADC reports for the actual @p bus_V. */
+double sil_sensors_bus(sil_sensors_t *s, double bus_V);
 
 /**
  * Mid-tread ADC over [@p low, @p high] with 2^@p bits codes of width q = (high - low)/2^bits;

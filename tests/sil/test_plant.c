@@ -29,12 +29,12 @@ static void locked_rotor_rl_step_response(void **state)
     (void)state;
     for (k = 1; k <= 400; ++k) { /* 20 ms = 10 L/R */
         plant_advance(&plant, u, 0.0, period, 10);
-        max_err = fmax(max_err, fabs(plant.x.i_a_a - u / 3.0 * (1.0 - exp(-500.0 * k * period))));
+        max_err = fmax(max_err, fabs(plant.x.i_a_A - u / 3.0 * (1.0 - exp(-500.0 * k * period))));
     }
     print_message("locked rotor: max |i_a - analytic| = %.3g A; theta = %g, i_b = %g\n", max_err,
-                  plant.x.theta_rad, plant.x.i_b_a);
+                  plant.x.theta_rad, plant.x.i_b_A);
     assert_true(max_err < 1e-9);
-    assert_true(plant.x.theta_rad == 0.0 && plant.x.omega_rad_s == 0.0 && plant.x.i_b_a == 0.0);
+    assert_true(plant.x.theta_rad == 0.0 && plant.x.omega_rad_s == 0.0 && plant.x.i_b_A == 0.0);
 }
 
 static void free_rotor_with_zero_current(void **state)
@@ -46,10 +46,10 @@ static void free_rotor_with_zero_current(void **state)
     double max_w_err = 0.0, max_theta_err = 0.0;
     int k;
     (void)state;
-    plant.params.torque_constant_nm_per_a = 0.0;
-    plant.params.friction_nm_s_per_rad = f;
+    plant.params.torque_constant_Nm_A = 0.0;
+    plant.params.friction_Nms_rad = f;
     plant.load.kind = PLANT_LOAD_CONSTANT;
-    plant.load.torque_nm = t_load;
+    plant.load.torque_Nm = t_load;
     plant.x.omega_rad_s = w0;
     for (k = 1; k <= 2000; ++k) { /* 0.1 s */
         const double t = k * period;
@@ -59,7 +59,7 @@ static void free_rotor_with_zero_current(void **state)
         plant_advance(&plant, 0.0, 0.0, period, 10);
         max_w_err = fmax(max_w_err, fabs(plant.x.omega_rad_s - w));
         max_theta_err = fmax(max_theta_err, fabs(plant.x.theta_rad - theta));
-        assert_true(plant.x.i_a_a == 0.0 && plant.x.i_b_a == 0.0);
+        assert_true(plant.x.i_a_A == 0.0 && plant.x.i_b_A == 0.0);
     }
     print_message("free rotor: max |omega err| = %.3g rad/s, max |theta err| = %.3g rad\n", max_w_err, max_theta_err);
     assert_true(max_w_err < 1e-10);
@@ -74,7 +74,7 @@ static plant_state_t coupled_run(int substeps)
     int k;
     plant.x.theta_rad = 0.3;
     plant.load.kind = PLANT_LOAD_PROPORTIONAL;
-    plant.load.coefficient_nm_s_per_rad = 0.05;
+    plant.load.coefficient_Nms_rad = 0.05;
     for (k = 0; k < 100; ++k) {
         const double t = k * period;
         const double angle = 6.0 * 30.0 * t * t;
@@ -87,7 +87,7 @@ static plant_state_t coupled_run(int substeps)
 static double distance(const plant_state_t *a, const plant_state_t *b)
 {
     return fabs(a->theta_rad - b->theta_rad) + fabs(a->omega_rad_s - b->omega_rad_s)
-           + fabs(a->i_a_a - b->i_a_a) + fabs(a->i_b_a - b->i_b_a);
+           + fabs(a->i_a_A - b->i_a_A) + fabs(a->i_b_A - b->i_b_A);
 }
 
 static void halving_the_substep_cuts_the_error_16_times(void **state)
@@ -111,18 +111,18 @@ static void load_profiles(void **state)
     (void)state;
     memset(&load, 0, sizeof load);
     load.kind = PLANT_LOAD_STEP;
-    load.torque_nm = 2.0;
+    load.torque_Nm = 2.0;
     load.step_time_s = 0.63;
     assert_true(plant_load_torque(&load, 0.6299, 5.0) == 0.0);
     assert_true(plant_load_torque(&load, 0.63, 5.0) == 2.0);
     load.kind = PLANT_LOAD_PROPORTIONAL;
-    load.coefficient_nm_s_per_rad = 0.1;
+    load.coefficient_Nms_rad = 0.1;
     assert_true(fabs(plant_load_torque(&load, 1.0, -5.0) + 0.5) < 1e-15);
     load.kind = PLANT_LOAD_TABLE;
     load.table_points = 3;
-    load.table_time_s[0] = 1.0; load.table_torque_nm[0] = 0.0;
-    load.table_time_s[1] = 2.0; load.table_torque_nm[1] = 1.0;
-    load.table_time_s[2] = 3.0; load.table_torque_nm[2] = -1.0;
+    load.table_time_s[0] = 1.0; load.table_torque_Nm[0] = 0.0;
+    load.table_time_s[1] = 2.0; load.table_torque_Nm[1] = 1.0;
+    load.table_time_s[2] = 3.0; load.table_torque_Nm[2] = -1.0;
     assert_true(plant_load_torque(&load, 0.0, 0.0) == 0.0);
     assert_true(fabs(plant_load_torque(&load, 1.5, 0.0) - 0.5) < 1e-15);
     assert_true(fabs(plant_load_torque(&load, 2.75, 0.0) + 0.5) < 1e-15);

@@ -22,41 +22,41 @@ static plant_t rl_plant(void)
     plant_t plant;
     memset(&plant, 0, sizeof plant);
     plant.params = plant_paper_params();
-    plant.params.torque_constant_nm_per_a = 0.0;
+    plant.params.torque_constant_Nm_A = 0.0;
     plant.load.kind = PLANT_LOAD_NONE;
     return plant;
 }
 
-static sil_inverter_t make_inverter(sil_inverter_model_t model, double dead_time_s, double source_resistance_ohm)
+static sil_inverter_t make_inverter(sil_inverter_model_t model, double dead_time_s, double source_resistance_Ohm)
 {
     sil_inverter_t inv;
     sil_inverter_config_t cfg = sil_inverter_ideal_config();
     sil_bus_config_t bus = sil_bus_ideal_config();
     cfg.model = model;
     cfg.dead_time_s = dead_time_s;
-    bus.source_resistance_ohm = source_resistance_ohm;
+    bus.source_resistance_Ohm = source_resistance_Ohm;
     sil_inverter_init(&inv, &cfg, &bus, BUS_V, 0u);
     return inv;
 }
 
 /* One control period: the MCU takes (u_a, u_b) against the bus it measured, the plant advances. */
-static void period(plant_t *plant, sil_inverter_t *inv, double u_a_v, double u_b_v, bool enable, double measured_bus_v)
+static void period(plant_t *plant, sil_inverter_t *inv, double u_a_V, double u_b_V, bool enable, double measured_bus_V)
 {
     pmstep_output_t out;
     memset(&out, 0, sizeof out);
-    out.u_a_v = (float)u_a_v;
-    out.u_b_v = (float)u_b_v;
+    out.u_a_V = (float)u_a_V;
+    out.u_b_V = (float)u_b_V;
     out.bridge_enable = enable;
-    sil_inverter_apply(inv, &out, measured_bus_v);
+    sil_inverter_apply(inv, &out, measured_bus_V);
     sil_drive_advance(plant, inv, PERIOD_S, 10);
 }
 
-static void run(plant_t *plant, sil_inverter_t *inv, double u_a_v, double u_b_v, long periods)
+static void run(plant_t *plant, sil_inverter_t *inv, double u_a_V, double u_b_V, long periods)
 {
     long k;
     for (k = 0; k < periods; ++k) {
         plant->time_s = (double)k * PERIOD_S;
-        period(plant, inv, u_a_v, u_b_v, true, BUS_V);
+        period(plant, inv, u_a_V, u_b_V, true, BUS_V);
     }
 }
 
@@ -73,13 +73,13 @@ static void ideal_averaged_is_plant_advance_bit_for_bit(void **state)
     a.x.theta_rad = 0.3;
     b = a;
     for (k = 0; k < 2000; ++k) {
-        const float u_a_v = (float)(20.0 * cos(3e-3 * (double)k)), u_b_v = (float)(60.0 * sin(2e-3 * (double)k));
-        const double clipped_b_v = fmax(-BUS_V, fmin(BUS_V, (double)u_b_v));
+        const float u_a_V = (float)(20.0 * cos(3e-3 * (double)k)), u_b_V = (float)(60.0 * sin(2e-3 * (double)k));
+        const double clipped_b_V = fmax(-BUS_V, fmin(BUS_V, (double)u_b_V));
         a.time_s = b.time_s = (double)k * PERIOD_S;
-        period(&a, &inv, (double)u_a_v, (double)u_b_v, true, BUS_V);
-        plant_advance(&b, (double)u_a_v, clipped_b_v, PERIOD_S, 10);
+        period(&a, &inv, (double)u_a_V, (double)u_b_V, true, BUS_V);
+        plant_advance(&b, (double)u_a_V, clipped_b_V, PERIOD_S, 10);
         assert_true(memcmp(&a.x, &b.x, sizeof a.x) == 0);
-        assert_true(inv.applied_a_v == (double)u_a_v && inv.applied_b_v == clipped_b_v);
+        assert_true(inv.applied_a_V == (double)u_a_V && inv.applied_b_V == clipped_b_V);
     }
     print_message("ideal averaged drive = plant_advance bit for bit over 2000 periods; %lu periods clipped\n",
                   inv.limited_periods);
@@ -89,32 +89,32 @@ static void ideal_averaged_is_plant_advance_bit_for_bit(void **state)
 static void averaged_dead_time_shifts_the_steady_current(void **state)
 {
     /* 2 legs per phase, each -sign(i) V t_d / T: the steady current moves by -2 sign(i) V t_d / (T R). */
-    const double dead_time_s = 1e-6, u_v = 12.0;
+    const double dead_time_s = 1e-6, u_V = 12.0;
     const double error_v = 2.0 * BUS_V * dead_time_s / PERIOD_S; /* 1.92 V */
     plant_t plant = rl_plant();
     sil_inverter_t inv = make_inverter(SIL_INVERTER_AVERAGED, dead_time_s, 0.0);
     (void)state;
-    run(&plant, &inv, u_v, -u_v, 2000); /* 0.1 s = 50 L/R */
+    run(&plant, &inv, u_V, -u_V, 2000); /* 0.1 s = 50 L/R */
     print_message("averaged, t_d = 1 us: i_a = %.12f A (expected %.12f), i_b = %.12f A; mean u_a = %.12f V\n",
-                  plant.x.i_a_a, (u_v - error_v) / R_OHM, plant.x.i_b_a, inv.applied_a_v);
-    assert_true(fabs(plant.x.i_a_a - (u_v - error_v) / R_OHM) < 1e-9);
-    assert_true(fabs(plant.x.i_b_a - (-u_v + error_v) / R_OHM) < 1e-9);
-    assert_true(fabs(inv.applied_a_v - (u_v - error_v)) < 1e-9);
+                  plant.x.i_a_A, (u_V - error_v) / R_OHM, plant.x.i_b_A, inv.applied_a_V);
+    assert_true(fabs(plant.x.i_a_A - (u_V - error_v) / R_OHM) < 1e-9);
+    assert_true(fabs(plant.x.i_b_A - (-u_V + error_v) / R_OHM) < 1e-9);
+    assert_true(fabs(inv.applied_a_V - (u_V - error_v)) < 1e-9);
 }
 
 static void switching_dead_time_shifts_the_mean_current_alike(void **state)
 {
     /* The switching model's edge shifts give the same mean voltage error, so the same mean current. */
-    const double dead_time_s = 1e-6, u_v = 12.0;
-    const double expected_a = (u_v - 2.0 * BUS_V * dead_time_s / PERIOD_S) / R_OHM;
+    const double dead_time_s = 1e-6, u_V = 12.0;
+    const double expected_a = (u_V - 2.0 * BUS_V * dead_time_s / PERIOD_S) / R_OHM;
     plant_t plant = rl_plant();
     sil_inverter_t inv = make_inverter(SIL_INVERTER_SWITCHING, dead_time_s, 0.0);
     (void)state;
-    run(&plant, &inv, u_v, -u_v, 2000);
+    run(&plant, &inv, u_V, -u_V, 2000);
     print_message("switching, t_d = 1 us: mean i_a = %.12f A, mean i_b = %.12f A (expected +/-%.12f)\n",
-                  inv.mean_current_a[0], inv.mean_current_a[1], expected_a);
-    assert_true(fabs(inv.mean_current_a[0] - expected_a) < 1e-9);
-    assert_true(fabs(inv.mean_current_a[1] + expected_a) < 1e-9);
+                  inv.mean_current_A[0], inv.mean_current_A[1], expected_a);
+    assert_true(fabs(inv.mean_current_A[0] - expected_a) < 1e-9);
+    assert_true(fabs(inv.mean_current_A[1] + expected_a) < 1e-9);
 }
 
 static void switching_matches_averaged_and_the_rl_ripple(void **state)
@@ -125,12 +125,12 @@ static void switching_matches_averaged_and_the_rl_ripple(void **state)
      * Against the averaged model (whose current is the response to the mean voltage) the switching
      * model's period mean differs by the zero-mean ripple's transient, at most |i_v - d V/R| (the
      * ripple's value at the valley, decaying with L/R), and its valley sample by the same. */
-    const double d = 0.25, u_v = d * BUS_V;
+    const double d = 0.25, u_V = d * BUS_V;
     const double a_s = d * PERIOD_S / 2.0, b_s = PERIOD_S / 2.0 - a_s;
     const double i_max = BUS_V / R_OHM * (1.0 - exp(-a_s / TAU_S)) / (1.0 - exp(-PERIOD_S / (2.0 * TAU_S)));
     const double i_min = i_max * exp(-b_s / TAU_S);
     const double i_valley = i_max * exp(-b_s / (2.0 * TAU_S));
-    const double mean_a = u_v / R_OHM;
+    const double mean_a = u_V / R_OHM;
     const double bound_a = fabs(i_valley - mean_a) + 1e-9;
     plant_t sw = rl_plant(), av = rl_plant();
     sil_inverter_t inv_sw = make_inverter(SIL_INVERTER_SWITCHING, 0.0, 0.0);
@@ -140,28 +140,28 @@ static void switching_matches_averaged_and_the_rl_ripple(void **state)
     (void)state;
     for (k = 0; k < 2000; ++k) {
         sw.time_s = av.time_s = (double)k * PERIOD_S;
-        period(&sw, &inv_sw, u_v, 0.0, true, BUS_V);
-        period(&av, &inv_av, u_v, 0.0, true, BUS_V);
-        max_mean_diff = fmax(max_mean_diff, fabs(inv_sw.mean_current_a[0] - inv_av.mean_current_a[0]));
-        max_valley_diff = fmax(max_valley_diff, fabs(sw.x.i_a_a - av.x.i_a_a));
+        period(&sw, &inv_sw, u_V, 0.0, true, BUS_V);
+        period(&av, &inv_av, u_V, 0.0, true, BUS_V);
+        max_mean_diff = fmax(max_mean_diff, fabs(inv_sw.mean_current_A[0] - inv_av.mean_current_A[0]));
+        max_valley_diff = fmax(max_valley_diff, fabs(sw.x.i_a_A - av.x.i_a_A));
     }
     print_message("switching vs averaged (d = 0.25, 2000 periods): max |period-mean difference| = %.3g A, "
                   "max |valley difference| = %.3g A, bound |i_v - dV/R| = %.3g A\n",
                   max_mean_diff, max_valley_diff, bound_a - 1e-9);
     print_message("steady state: mean %.12f A (dV/R %.12f), valley %.12f A (analytic %.12f), peak-to-peak %.9f A "
                   "(analytic %.9f, linear V d(1-d)T/(2L) = %.9f)\n",
-                  inv_sw.mean_current_a[0], mean_a, sw.x.i_a_a, i_valley,
-                  inv_sw.max_current_a[0] - inv_sw.min_current_a[0], i_max - i_min,
+                  inv_sw.mean_current_A[0], mean_a, sw.x.i_a_A, i_valley,
+                  inv_sw.max_current_A[0] - inv_sw.min_current_A[0], i_max - i_min,
                   BUS_V * d * (1.0 - d) * PERIOD_S / (2.0 * L_H));
     assert_true(max_mean_diff <= bound_a);
     assert_true(max_valley_diff <= bound_a);
-    assert_true(fabs(inv_sw.mean_current_a[0] - mean_a) < 1e-9);
-    assert_true(fabs(sw.x.i_a_a - i_valley) < 1e-9);
-    assert_true(fabs(inv_sw.max_current_a[0] - i_max) < 1e-9);
-    assert_true(fabs(inv_sw.min_current_a[0] - i_min) < 1e-9);
-    assert_true(fabs((inv_sw.max_current_a[0] - inv_sw.min_current_a[0]) - (i_max - i_min)) < 1e-9);
+    assert_true(fabs(inv_sw.mean_current_A[0] - mean_a) < 1e-9);
+    assert_true(fabs(sw.x.i_a_A - i_valley) < 1e-9);
+    assert_true(fabs(inv_sw.max_current_A[0] - i_max) < 1e-9);
+    assert_true(fabs(inv_sw.min_current_A[0] - i_min) < 1e-9);
+    assert_true(fabs((inv_sw.max_current_A[0] - inv_sw.min_current_A[0]) - (i_max - i_min)) < 1e-9);
     /* Phase b at d = 0: both legs switch together, no voltage, no current. */
-    assert_true(sw.x.i_b_a == 0.0 && inv_sw.applied_b_v == 0.0);
+    assert_true(sw.x.i_b_A == 0.0 && inv_sw.applied_b_V == 0.0);
 }
 
 static void bridge_off_freewheels_to_exactly_zero_and_holds(void **state)
@@ -177,38 +177,38 @@ static void bridge_off_freewheels_to_exactly_zero_and_holds(void **state)
         sil_inverter_t inv = make_inverter(models[m], 1e-6, 0.0);
         double zero_a_s = -1.0, zero_b_s = -1.0;
         long k;
-        plant.x.i_a_a = i_a0;
-        plant.x.i_b_a = i_b0;
+        plant.x.i_a_A = i_a0;
+        plant.x.i_b_A = i_b0;
         for (k = 0; k < 400; ++k) {
             plant.time_s = (double)k * PERIOD_S;
             period(&plant, &inv, 10.0, 10.0, false, BUS_V);
-            if (zero_a_s < 0.0 && plant.x.i_a_a == 0.0) {
+            if (zero_a_s < 0.0 && plant.x.i_a_A == 0.0) {
                 zero_a_s = plant.time_s;
             }
-            if (zero_b_s < 0.0 && plant.x.i_b_a == 0.0) {
+            if (zero_b_s < 0.0 && plant.x.i_b_A == 0.0) {
                 zero_b_s = plant.time_s;
             }
             if (zero_a_s >= 0.0) {
-                assert_true(plant.x.i_a_a == 0.0 && plant.open_a);
+                assert_true(plant.x.i_a_A == 0.0 && plant.open_a);
             } else {
-                assert_true(plant.x.i_a_a > 0.0);
+                assert_true(plant.x.i_a_A > 0.0);
             }
             if (zero_b_s >= 0.0) {
-                assert_true(plant.x.i_b_a == 0.0 && plant.open_b);
+                assert_true(plant.x.i_b_A == 0.0 && plant.open_b);
             } else {
-                assert_true(plant.x.i_b_a < 0.0);
+                assert_true(plant.x.i_b_A < 0.0);
             }
         }
         print_message("%s, bridge off: i_a 5 A -> 0 by %.6f ms (analytic %.6f), i_b -3 A -> 0 by %.6f ms "
                       "(analytic %.6f); held at exactly 0 to 20 ms; bus current %.3g A\n",
                       m == 0 ? "averaged" : "switching", zero_a_s * 1e3, t_a_s * 1e3, zero_b_s * 1e3, t_b_s * 1e3,
-                      inv.mean_bus_current_a);
+                      inv.mean_bus_current_A);
         /* Zero is detected at the end of the period holding the crossing. */
         assert_true(zero_a_s >= t_a_s && zero_a_s < t_a_s + PERIOD_S + h_s);
         assert_true(zero_b_s >= t_b_s && zero_b_s < t_b_s + PERIOD_S + h_s);
         /* Enabling the bridge closes the phases again. */
         period(&plant, &inv, 12.0, 0.0, true, BUS_V);
-        assert_true(!plant.open_a && !plant.open_b && plant.x.i_a_a > 0.0);
+        assert_true(!plant.open_a && !plant.open_b && plant.x.i_a_A > 0.0);
     }
 }
 
@@ -227,7 +227,7 @@ static void open_phase_holds_zero_against_back_emf(void **state)
     for (k = 0; k < 1000; ++k) {
         plant.time_s = (double)k * PERIOD_S;
         period(&plant, &inv, 0.0, 0.0, false, BUS_V);
-        assert_true(plant.x.i_a_a == 0.0 && plant.x.i_b_a == 0.0);
+        assert_true(plant.x.i_a_A == 0.0 && plant.x.i_b_A == 0.0);
     }
     assert_true(plant.x.omega_rad_s == 5.0);
     assert_true(fabs(plant.x.theta_rad - 5.0 * 1000.0 * PERIOD_S) < 1e-12);
@@ -246,9 +246,9 @@ static void bus_sags_with_the_source_resistance(void **state)
     run(&plant, &inv, d * BUS_V, 0.0, 4000);
     v = sil_inverter_bus_voltage(&inv, plant.time_s);
     print_message("bus sag, R_src = 1 Ohm, d = 0.25: V = %.12f V (expected %.12f), i_bus = %.12f A, i_a = %.12f A\n", v,
-                  v_expected, inv.mean_bus_current_a, plant.x.i_a_a);
+                  v_expected, inv.mean_bus_current_A, plant.x.i_a_A);
     assert_true(fabs(v - v_expected) < 1e-9);
-    assert_true(fabs(plant.x.i_a_a - d * v_expected / R_OHM) < 1e-9);
+    assert_true(fabs(plant.x.i_a_A - d * v_expected / R_OHM) < 1e-9);
 }
 
 static void bus_ripple_and_duty_clip(void **state)
@@ -258,8 +258,8 @@ static void bus_ripple_and_duty_clip(void **state)
     sil_inverter_config_t cfg = sil_inverter_ideal_config();
     sil_bus_config_t bus = sil_bus_ideal_config();
     (void)state;
-    bus.ripple_v = 2.0;
-    bus.ripple_hz = 100.0;
+    bus.ripple_V = 2.0;
+    bus.ripple_Hz = 100.0;
     sil_inverter_init(&inv, &cfg, &bus, BUS_V, 0u);
     assert_true(fabs(sil_inverter_bus_voltage(&inv, 2.5e-3) - (BUS_V + 2.0)) < 1e-12);
     assert_true(fabs(sil_inverter_bus_voltage(&inv, 7.5e-3) - (BUS_V - 2.0)) < 1e-12);
@@ -267,10 +267,10 @@ static void bus_ripple_and_duty_clip(void **state)
     plant.time_s = 2.5e-3 - 0.5 * PERIOD_S;
     period(&plant, &inv, 60.0, -20.0, true, 40.0);
     print_message("command 60 V / -20 V against a 40 V reading, bus ~50 V: mean u = %.6f V, %.6f V; %lu clipped\n",
-                  inv.applied_a_v, inv.applied_b_v, inv.limited_periods);
+                  inv.applied_a_V, inv.applied_b_V, inv.limited_periods);
     assert_true(inv.limited_periods == 1u);
-    assert_true(fabs(inv.applied_a_v - (BUS_V + 2.0)) < 1e-3);          /* d = 1 */
-    assert_true(fabs(inv.applied_b_v + 0.5 * (BUS_V + 2.0)) < 1e-3);    /* d = -0.5 */
+    assert_true(fabs(inv.applied_a_V - (BUS_V + 2.0)) < 1e-3);          /* d = 1 */
+    assert_true(fabs(inv.applied_b_V + 0.5 * (BUS_V + 2.0)) < 1e-3);    /* d = -0.5 */
 }
 
 int main(void)

@@ -66,8 +66,8 @@ static void offset_and_gain_are_applied(void **state)
     sil_sensor_config_t cfg = sil_sensors_ideal();
     double a, b;
     (void)state;
-    cfg.offset_a_a = 0.02;
-    cfg.offset_b_a = -0.03;
+    cfg.offset_a_A = 0.02;
+    cfg.offset_b_A = -0.03;
     cfg.gain_error_a = 0.01;
     cfg.gain_error_b = -0.02;
     assert_int_equal(sil_sensors_init(&s, &cfg, 1u), 0);
@@ -96,8 +96,8 @@ static void ideal_chain_is_the_identity_and_draws_nothing(void **state)
         assert_true(b == -values[n] && signbit(b) == signbit(-values[n]));
         assert_true(sil_sensors_bus(&ideal, 48.0 + values[n]) == 48.0 + values[n]);
     }
-    ideal.cfg.noise_rms_a = 1.0;
-    cfg.noise_rms_a = 1.0;
+    ideal.cfg.noise_rms_A = 1.0;
+    cfg.noise_rms_A = 1.0;
     assert_int_equal(sil_sensors_init(&fresh, &cfg, 7u), 0);
     sil_sensors_currents(&ideal, 0.0, 0.0, &a, &b);
     sil_sensors_currents(&fresh, 0.0, 0.0, &a_fresh, &b_fresh);
@@ -119,8 +119,8 @@ static void noise_mean_and_std(void **state)
     double mean_a, mean_b, std_a, std_b, corr, mean_v, std_v;
     long k;
     (void)state;
-    cfg.noise_rms_a = sigma;
-    cfg.bus_noise_rms_v = sigma_v;
+    cfg.noise_rms_A = sigma;
+    cfg.bus_noise_rms_V = sigma_v;
     assert_int_equal(sil_sensors_init(&s, &cfg, 12345u), 0);
     for (k = 0; k < N; ++k) {
         double a, b, v;
@@ -164,8 +164,8 @@ static void seed_fixes_the_sequence(void **state)
     sil_sensor_config_t cfg = sil_sensors_ideal();
     int k, same_as_other_seed = 0;
     (void)state;
-    cfg.noise_rms_a = 0.005;
-    cfg.bus_noise_rms_v = 0.1;
+    cfg.noise_rms_A = 0.005;
+    cfg.bus_noise_rms_V = 0.1;
     cfg.adc_bits = 16;
     assert_int_equal(sil_sensors_init(&s1, &cfg, 42u), 0);
     assert_int_equal(sil_sensors_init(&s2, &cfg, 42u), 0);

@@ -1,0 +1,70 @@
+/**
+ * @file pmstep_actuate.h
+ * @brief Actuation stage: dead-time compensation, the bus limit, the output check and the
+ *        bookkeeping of the computational delay.
+ *
+ *  - Each half-bridge loses sign(i) V_bus t_d / T_s to its dead time, so a phase (two
+ *    half-bridges) is given (2 V_bus t_d / T_s + bias) sign(i) more, linear in i within
+ *    +/- the current band (bias: what commissioning measured, Remark 2).
+ *  - The command (u_a, u_b) is scaled, keeping its direction, so neither H-bridge exceeds the
+ *    bus measured this period; the scaled components are clamped to +/- the bus so rounding
+ *    cannot leave one a unit in the last place above it.
+ *  - A command that is not finite is refused: the caller latches STATE_NONFINITE, so the
+ *    bridge is never enabled with such a voltage.
+ *  - The voltage the bridge applies over the coming period, its dead-time loss taken off,
+ *    is what phi1, phi2 and the observer integrate: this period's command (no delay), or
+ *    the previous period's (one period of delay).
+ */
+#ifndef PMSTEP_ACTUATE_H
+#define PMSTEP_ACTUATE_H
+
+#include "pmstep/pmstep_types.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Voltages of the delay line. */
+typedef struct {
+    float u_applied_a_V; /**< voltage applied over the period that ends at the next sample */
+    float u_applied_b_V;
+    float u_pending_a_V; /**< computed, waiting one period (delay = 1) */
+    float u_pending_b_V;
+} pmstep_actuator_t;
+
+/** Constants derived from the configuration. */
+typedef struct {
+    float dead_time_duty;       /**< 2 t_d / T_s: compensation at full current, fraction of the bus */
+    float inv_band_per_A;       /**< 1 / dead_time_current_band_A (0 without compensation) */
+    bool compensate;            /**< dead time configured or voltage bias estimated */
+    bool delayed;               /**< one period of computational delay */
+} pmstep_actuate_coeffs_t;
+
+/** Coefficients for @p cfg (already validated). */
+void pmstep_actuate_coeffs_init(pmstep_actuate_coeffs_t *coeffs, const pmstep_config_t *cfg);
+
+/** Zero volts applied and pending. */
+void pmstep_actuate_reset(pmstep_actuator_t *actuator);
+
+/** Signs of the phase currents and the voltage biases the compensation works from. */
+typedef struct {
+    float sign_current_a_A, sign_current_b_A; /**< current whose sign (and size within the band) is used */
+    float bias_a_V, bias_b_V;                 /**< measured voltage biases (Remark 2), 0 if none */
+} pmstep_compensation_input_t;
+
+/**
+ * Compensates, limits and checks the command in @p out (u_a_V, u_b_V on entry), sets
+ * voltage_limited, and advances the delay line.
+ * @param[in] compensation   read only when coeffs->compensate
+ * @param[in] bus_voltage_V  the bus measured this period (finite, > 0)
+ * @retval true   @p out holds the finite command to apply, |u| <= bus on each phase
+ * @retval false  the command is not finite; nothing was advanced (latch a fault)
+ */
+bool pmstep_actuate(pmstep_actuator_t *actuator, const pmstep_actuate_coeffs_t *coeffs,
+                    const pmstep_compensation_input_t *compensation, float bus_voltage_V, pmstep_output_t *out);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PMSTEP_ACTUATE_H */

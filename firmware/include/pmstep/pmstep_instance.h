@@ -1,0 +1,69 @@
+/**
+ * @file pmstep_instance.h
+ * @brief Layout of the controller instance. Not API: pmstep.h includes it only so that an
+ *        application can allocate pmstep_t statically (no heap). Use the functions of
+ *        pmstep.h; tests that look inside include this header by name.
+ */
+#ifndef PMSTEP_INSTANCE_H
+#define PMSTEP_INSTANCE_H
+
+#include "pmstep/pmstep_types.h"
+#include "pmstep/pmstep_ref.h"
+#include "pmstep/pmstep_angle.h"
+#include "pmstep/pmstep_observer.h"
+#include "pmstep/pmstep_law.h"
+#include "pmstep/pmstep_commission.h"
+#include "pmstep/pmstep_detect.h"
+#include "pmstep/pmstep_actuate.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** One controller instance; all state lives here. */
+typedef struct {
+    const pmstep_config_t *cfg;
+
+    /* Derived from the configuration at init (the angle, observer and law coefficients again
+     * at t_c, for the commissioned model). Their floats lie in two runs that init checks
+     * finite: detect_coeffs.alpha .. actuate_coeffs.inv_band_per_A, and ref_coeffs .. the last
+     * float of law_coeffs (pmstep_core.c). */
+    pmstep_commission_plan_t commission_plan; /**< alignment timing (t_s, t_c in periods) and windows */
+    uint32_t offset_cal_steps;                /**< periods of bridge-off offset calibration */
+    pmstep_detect_coeffs_t detect_coeffs;
+    pmstep_actuate_coeffs_t actuate_coeffs;
+    pmstep_ref_coeffs_t ref_coeffs;
+    pmstep_angle_coeffs_t angle_coeffs;
+    pmstep_observer_coeffs_t observer_coeffs;
+    pmstep_law_coeffs_t law_coeffs;
+
+    /* Mode machine. */
+    pmstep_mode_t mode;
+    pmstep_fault_t fault;
+    uint32_t fault_step;  /**< step_count at which the fault latched */
+    uint32_t step_count;  /**< periods run since init/reset */
+    uint32_t mode_step;   /**< periods since the alignment started */
+    bool run_started;     /**< RUN initialised at t_c */
+
+    /* Controller (6) state and commands. */
+    pmstep_ref_t speed_ref;
+    pmstep_ref_t i_d_ref;
+    pmstep_angle_t angle;
+    pmstep_observer_t observer;
+    pmstep_actuator_t actuator;
+
+    pmstep_commissioning_t commissioning; /**< offsets (subtracted from every sample once measured), R, L, k_M */
+    union {
+        pmstep_commission_sums_t sums;    /**< until t_c */
+        struct {
+            pmstep_detector_t detector;
+            pmstep_ref_t known_load_filter; /**< T_L* of Remark 1 */
+        } run;                            /**< from t_c */
+    } scratch;
+} pmstep_t;
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PMSTEP_INSTANCE_H */

@@ -1,0 +1,81 @@
+/* Actuation: dead-time compensation, bus limit, output check, computational delay (pmstep_actuate.h). */
+#include "pmstep/pmstep_actuate.h"
+
+#include "pmstep_internal.h"
+
+void pmstep_actuate_coeffs_init(pmstep_actuate_coeffs_t *coeffs, const pmstep_config_t *cfg)
+{
+    coeffs->compensate = cfg->inverter.dead_time_s > 0.0f || cfg->commissioning.voltage_bias_level_fraction > 0.0f;
+    coeffs->delayed = cfg->timing.computational_delay_periods != 0u;
+    coeffs->dead_time_duty = 2.0f * cfg->inverter.dead_time_s / cfg->timing.period_s;
+    coeffs->inv_band_per_A = coeffs->compensate ? 1.0f / cfg->inverter.dead_time_current_band_A : 0.0f;
+}
+
+void pmstep_actuate_reset(pmstep_actuator_t *actuator)
+{
+    actuator->u_applied_a_V = 0.0f;
+    actuator->u_applied_b_V = 0.0f;
+    actuator->u_pending_a_V = 0.0f;
+    actuator->u_pending_b_V = 0.0f;
+}
+
+/* x within [-limit, limit]. */
+static float clamp_f(float x, float limit)
+{
+    return x > limit ? limit : (x < -limit ? -limit : x);
+}
+
+/* (2 V_bus t_d / T_s + bias) sign(i), linear in i within the band. */
+static float dead_time_voltage(const pmstep_actuate_coeffs_t *coeffs, float current_A, float bus_voltage_V,
+                               float bias_V)
+{
+    const float share = clamp_f(current_A * coeffs->inv_band_per_A, 1.0f);
+    return (coeffs->dead_time_duty * bus_voltage_V + bias_V) * share;
+}
+
+/* Scales (u_a, u_b) so neither H-bridge exceeds the bus; keeps the vector's direction. */
+static bool limit_to_bus(float *u_a_V, float *u_b_V, float bus_voltage_V)
+{
+    const float largest = pmstep_abs(*u_a_V) > pmstep_abs(*u_b_V) ? pmstep_abs(*u_a_V) : pmstep_abs(*u_b_V);
+    if (largest > bus_voltage_V) {
+        const float scale = bus_voltage_V / largest;
+        *u_a_V = clamp_f(*u_a_V * scale, bus_voltage_V);
+        *u_b_V = clamp_f(*u_b_V * scale, bus_voltage_V);
+        return true;
+    }
+    return false;
+}
+
+bool pmstep_actuate(pmstep_actuator_t *actuator, const pmstep_actuate_coeffs_t *coeffs,
+                    const pmstep_compensation_input_t *compensation, float bus_voltage_V, pmstep_output_t *out)
+{
+    float dead_time_a_V = 0.0f;
+    float dead_time_b_V = 0.0f;
+    float next_a_V;
+    float next_b_V;
+    if (coeffs->compensate) {
+        dead_time_a_V = dead_time_voltage(coeffs, compensation->sign_current_a_A, bus_voltage_V,
+                                          compensation->bias_a_V);
+        dead_time_b_V = dead_time_voltage(coeffs, compensation->sign_current_b_A, bus_voltage_V,
+                                          compensation->bias_b_V);
+    }
+    out->u_a_V += dead_time_a_V;
+    out->u_b_V += dead_time_b_V;
+    out->voltage_limited = limit_to_bus(&out->u_a_V, &out->u_b_V, bus_voltage_V);
+    if (!pmstep_all_finite4(out->u_a_V, out->u_b_V, dead_time_a_V, dead_time_b_V)) {
+        return false;
+    }
+    /* The voltage the bridge applies over the coming period (its dead-time loss taken off). */
+    if (coeffs->delayed) {
+        next_a_V = actuator->u_pending_a_V;
+        next_b_V = actuator->u_pending_b_V;
+        actuator->u_pending_a_V = out->u_a_V - dead_time_a_V;
+        actuator->u_pending_b_V = out->u_b_V - dead_time_b_V;
+    } else {
+        next_a_V = out->u_a_V - dead_time_a_V;
+        next_b_V = out->u_b_V - dead_time_b_V;
+    }
+    actuator->u_applied_a_V = next_a_V;
+    actuator->u_applied_b_V = next_b_V;
+    return true;
+}

@@ -1,0 +1,107 @@
+/* Controller (6), or (13) with a known load (Remark 1), in RUN: the control stage (angle,
+ * Park, observer rates, law) and the advance stage (observer, references). */
+#include "pmstep_internal.h"
+
+/* Starts controller (6) at t_c: phi = 0, i-hat = i(t_c), w-hat = T_L-hat = 0, references from 0. */
+static void start_run(pmstep_t *inst, const pmstep_meas_t *sample)
+{
+    const pmstep_ref_t speed_cmd = inst->speed_ref;
+    const pmstep_ref_t i_d_cmd = inst->i_d_ref;
+    pmstep_angle_start(&inst->angle, sample->i_a_A, sample->i_b_A);
+    pmstep_observer_start(&inst->observer, sample->i_a_A, sample->i_b_A);
+    pmstep_ref_reset(&inst->speed_ref, 0.0f);
+    pmstep_ref_set_target(&inst->speed_ref, speed_cmd.target, speed_cmd.ramp_rate_per_s);
+    pmstep_ref_reset(&inst->i_d_ref, 0.0f);
+    pmstep_ref_set_target(&inst->i_d_ref, i_d_cmd.target, 0.0f);
+    pmstep_ref_reset(&inst->scratch.run.known_load_filter, inst->cfg->known_load_mode ? sample->load_torque_Nm : 0.0f);
+    pmstep_detect_start(&inst->scratch.run.detector); /* the sums are spent */
+    inst->run_started = true;
+}
+
+void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_output_t *out,
+                            pmstep_control_scratch_t *scratch)
+{
+    const bool known_load = inst->cfg->known_load_mode;
+    const pmstep_ref_out_t speed_ref = pmstep_ref_output(&inst->ref_coeffs, &inst->speed_ref);
+    const pmstep_ref_out_t i_d_ref = pmstep_ref_output(&inst->ref_coeffs, &inst->i_d_ref);
+    const pmstep_ref_out_t load_ref = pmstep_ref_output(&inst->ref_coeffs, &inst->scratch.run.known_load_filter);
+    pmstep_observer_input_t *obs_in = &scratch->observer_input;
+    pmstep_law_refs_t refs;
+    float cos_hat;
+    float sin_hat;
+    float i_d;
+    float i_q;
+    float load_Nm;
+    float load_rate;
+    float i_q_ref;
+    float i_q_ref_rate;
+
+    if (!inst->run_started) {
+        start_run(inst, sample);
+    } else {
+        pmstep_angle_update(&inst->angle, &inst->angle_coeffs, sample->i_a_A, sample->i_b_A,
+                            inst->actuator.u_applied_a_V, inst->actuator.u_applied_b_V);
+    }
+    pmstep_angle_estimate(&inst->angle, &inst->angle_coeffs, sample->i_a_A, sample->i_b_A, &cos_hat, &sin_hat);
+    pmstep_park(cos_hat, sin_hat, sample->i_a_A, sample->i_b_A, &i_d, &i_q);
+
+    refs.speed_ref_rad_s = speed_ref.value;
+    refs.speed_ref_rate_rad_s2 = speed_ref.rate;
+    refs.speed_ref_accel_rad_s3 = speed_ref.accel;
+    refs.i_d_ref_A = i_d_ref.value;
+    refs.i_d_ref_rate_A_s = i_d_ref.rate;
+
+    load_Nm = known_load ? load_ref.value : inst->observer.load_hat_Nm;
+    i_q_ref = pmstep_law_iq_ref(&inst->law_coeffs, &refs, inst->observer.speed_hat_rad_s, load_Nm);
+
+    obs_in->i_a_A = sample->i_a_A;
+    obs_in->i_b_A = sample->i_b_A;
+    obs_in->cos_hat = cos_hat;
+    obs_in->sin_hat = sin_hat;
+    obs_in->i_d_A = i_d;
+    obs_in->i_q_A = i_q;
+    obs_in->i_d_err_A = i_d - refs.i_d_ref_A;
+    obs_in->i_q_err_A = i_q - i_q_ref;
+    obs_in->known_load_Nm = load_ref.value;
+    scratch->mech_rates = pmstep_observer_mech_rates(&inst->observer, &inst->observer_coeffs, obs_in, known_load);
+
+    load_rate = known_load ? load_ref.rate : scratch->mech_rates.load_hat_rate_Nm_s;
+    i_q_ref_rate = pmstep_law_iq_ref_rate(&inst->law_coeffs, &refs, inst->observer.speed_hat_rad_s,
+                                          scratch->mech_rates.speed_hat_rate_rad_s2, load_rate);
+    pmstep_law_voltages(&inst->law_coeffs, &refs, cos_hat, sin_hat, i_d, i_q, inst->observer.speed_hat_rad_s,
+                        i_q_ref, i_q_ref_rate, &out->u_a_V, &out->u_b_V);
+
+    out->cos_hat = cos_hat;
+    out->sin_hat = sin_hat;
+    out->speed_hat_rad_s = inst->observer.speed_hat_rad_s;
+    out->load_hat_Nm = load_Nm;
+    out->i_a_hat_A = inst->observer.i_a_hat_A;
+    out->i_b_hat_A = inst->observer.i_b_hat_A;
+    out->speed_ref_rad_s = speed_ref.value;
+    out->speed_ref_rate_rad_s2 = speed_ref.rate;
+    out->i_d_A = i_d;
+    out->i_q_A = i_q;
+    out->i_d_ref_A = refs.i_d_ref_A;
+    out->i_q_ref_A = i_q_ref;
+}
+
+bool pmstep_control_advance(pmstep_t *inst, const pmstep_control_scratch_t *scratch, const pmstep_meas_t *meas,
+                            const pmstep_output_t *out)
+{
+    const pmstep_config_t *cfg = inst->cfg;
+    const float period_s = cfg->timing.period_s;
+    if (inst->angle_coeffs.correction_gain > 0.0f) {
+        pmstep_angle_correct(&inst->angle, &inst->angle_coeffs, out->cos_hat, out->sin_hat);
+    }
+    pmstep_observer_advance(&inst->observer, &inst->observer_coeffs, &scratch->observer_input, &scratch->mech_rates,
+                            inst->actuator.u_applied_a_V, inst->actuator.u_applied_b_V, period_s);
+    pmstep_ref_advance(&inst->ref_coeffs, &inst->speed_ref, period_s);
+    pmstep_ref_advance(&inst->ref_coeffs, &inst->i_d_ref, period_s);
+    if (cfg->known_load_mode) {
+        pmstep_ref_set_target(&inst->scratch.run.known_load_filter, meas->load_torque_Nm, 0.0f);
+        pmstep_ref_advance(&inst->ref_coeffs, &inst->scratch.run.known_load_filter, period_s);
+    }
+    return pmstep_all_finite4(inst->observer.speed_hat_rad_s, inst->observer.load_hat_Nm, inst->observer.i_a_hat_A,
+                              inst->observer.i_b_hat_A)
+           && pmstep_all_finite4(inst->angle.phi_a, inst->angle.phi_b, 0.0f, 0.0f);
+}
