@@ -22,11 +22,9 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
                             pmstep_control_scratch_t *scratch)
 {
     const bool known_load = inst->cfg->known_load_mode;
-    const pmstep_ref_out_t speed_ref = pmstep_ref_output(&inst->ref_coeffs, &inst->speed_ref);
-    const pmstep_ref_out_t i_d_ref = pmstep_ref_output(&inst->ref_coeffs, &inst->i_d_ref);
-    const pmstep_ref_out_t load_ref = pmstep_ref_output(&inst->ref_coeffs, &inst->scratch.run.known_load_filter);
     pmstep_observer_input_t *obs_in = &scratch->observer_input;
     pmstep_law_refs_t refs;
+    pmstep_ref_out_t ref; /* each filter's output in turn */
     float cos_hat;
     float sin_hat;
     float i_d;
@@ -45,13 +43,16 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
     pmstep_angle_estimate(&inst->angle, &inst->angle_coeffs, sample->i_a_A, sample->i_b_A, &cos_hat, &sin_hat);
     pmstep_park(cos_hat, sin_hat, sample->i_a_A, sample->i_b_A, &i_d, &i_q);
 
-    refs.speed_ref_rad_s = speed_ref.value;
-    refs.speed_ref_rate_rad_s2 = speed_ref.rate;
-    refs.speed_ref_accel_rad_s3 = speed_ref.accel;
-    refs.i_d_ref_A = i_d_ref.value;
-    refs.i_d_ref_rate_A_s = i_d_ref.rate;
+    ref = pmstep_ref_output(&inst->ref_coeffs, &inst->speed_ref);
+    refs.speed_ref_rad_s = ref.value;
+    refs.speed_ref_rate_rad_s2 = ref.rate;
+    refs.speed_ref_accel_rad_s3 = ref.accel;
+    ref = pmstep_ref_output(&inst->ref_coeffs, &inst->i_d_ref);
+    refs.i_d_ref_A = ref.value;
+    refs.i_d_ref_rate_A_s = ref.rate;
+    ref = pmstep_ref_output(&inst->ref_coeffs, &inst->scratch.run.known_load_filter); /* T_L*, Remark 1 */
 
-    load_Nm = known_load ? load_ref.value : inst->observer.load_hat_Nm;
+    load_Nm = known_load ? ref.value : inst->observer.load_hat_Nm;
     i_q_ref = pmstep_law_iq_ref(&inst->law_coeffs, &refs, inst->observer.speed_hat_rad_s, load_Nm);
 
     obs_in->i_a_A = sample->i_a_A;
@@ -62,10 +63,10 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
     obs_in->i_q_A = i_q;
     obs_in->i_d_err_A = i_d - refs.i_d_ref_A;
     obs_in->i_q_err_A = i_q - i_q_ref;
-    obs_in->known_load_Nm = load_ref.value;
+    obs_in->known_load_Nm = ref.value;
     scratch->mech_rates = pmstep_observer_mech_rates(&inst->observer, &inst->observer_coeffs, obs_in, known_load);
 
-    load_rate = known_load ? load_ref.rate : scratch->mech_rates.load_hat_rate_Nm_s;
+    load_rate = known_load ? ref.rate : scratch->mech_rates.load_hat_rate_Nm_s;
     i_q_ref_rate = pmstep_law_iq_ref_rate(&inst->law_coeffs, &refs, inst->observer.speed_hat_rad_s,
                                           scratch->mech_rates.speed_hat_rate_rad_s2, load_rate);
     pmstep_law_voltages(&inst->law_coeffs, &refs, cos_hat, sin_hat, i_d, i_q, inst->observer.speed_hat_rad_s,
@@ -77,8 +78,8 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
     out->load_hat_Nm = load_Nm;
     out->i_a_hat_A = inst->observer.i_a_hat_A;
     out->i_b_hat_A = inst->observer.i_b_hat_A;
-    out->speed_ref_rad_s = speed_ref.value;
-    out->speed_ref_rate_rad_s2 = speed_ref.rate;
+    out->speed_ref_rad_s = refs.speed_ref_rad_s;
+    out->speed_ref_rate_rad_s2 = refs.speed_ref_rate_rad_s2;
     out->i_d_A = i_d;
     out->i_q_A = i_q;
     out->i_d_ref_A = refs.i_d_ref_A;
