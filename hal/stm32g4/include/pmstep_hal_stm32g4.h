@@ -13,7 +13,8 @@
  * with the duty d of a half-bridge the fraction of the period its high side is on.
  *
  * Timing: TIM1 counts up and down (centre-aligned mode 1), so the carrier period is
- * 2 ARR / f_TIM1. Channel 5 (internal) makes TRGO2 rise at the counter peak, the
+ * 2 ARR / f_TIM1. Channel 5 (internal) makes TRGO2 rise at the counter peak (one timer
+ * tick before it, at CNT = ARR - 1), the
  * centre of the interval where every low side conducts; ADC1 (i_a, then the bus)
  * and ADC2 (i_b) convert on that edge; ADC1's end of injected sequence interrupts.
  * The interrupt writes the duties into preloaded compare registers that take
@@ -139,7 +140,12 @@ uint32_t pmstep_stm32g4_dtg_to_ns(uint8_t dtg, uint32_t tim_clock_hz);
 /** SYSCLK (Hz) of a clock configuration, or 0 when it is out of range. */
 uint32_t pmstep_stm32g4_sysclk_hz(const pmstep_stm32g4_clock_t *clock);
 
-/** Flash wait states for @p hclk_hz in range 1 boost mode (RM0440 §3.3.3, Table 9). */
+/** Flash wait states for @p hclk_hz in range 1 boost mode (@p boost) or normal mode
+ *  (RM0440 §3.3.3, Table 9: 34 MHz resp. 30 MHz per wait state). */
+uint32_t pmstep_stm32g4_flash_latency_mode(uint32_t hclk_hz, bool boost);
+
+/** Flash wait states for @p hclk_hz in the regulator mode the port uses at that clock: boost
+ *  above 150 MHz, normal mode at or below. */
 uint32_t pmstep_stm32g4_flash_latency(uint32_t hclk_hz);
 
 /** TIM1 ARR for a centre-aligned carrier: round(f_TIM / (2 f_pwm)); 0 when outside 2..65535. */

@@ -97,9 +97,17 @@ uint32_t pmstep_stm32g4_sysclk_hz(const pmstep_stm32g4_clock_t *clock)
     return sysclk_hz;
 }
 
+uint32_t pmstep_stm32g4_flash_latency_mode(uint32_t hclk_hz, bool boost)
+{
+    /* RM0440 §3.3.3, Table 9: one wait state per 34 MHz in range 1 boost mode, per 30 MHz in
+     * range 1 normal mode (the thresholds of ST's LL utilities, UTILS_SCALE1_LATENCYn_FREQ). */
+    const uint32_t per_wait_state_hz = boost ? 34000000u : 30000000u;
+    return hclk_hz == 0u ? 0u : (hclk_hz - 1u) / per_wait_state_hz;
+}
+
 uint32_t pmstep_stm32g4_flash_latency(uint32_t hclk_hz)
 {
-    return hclk_hz == 0u ? 0u : (hclk_hz - 1u) / 34000000u;
+    return pmstep_stm32g4_flash_latency_mode(hclk_hz, hclk_hz > 150000000u);
 }
 
 uint32_t pmstep_stm32g4_pwm_arr(uint32_t tim_clock_hz, uint32_t pwm_frequency_hz)
@@ -164,11 +172,11 @@ pmstep_stm32g4_config_t pmstep_stm32g4_default_config(void)
     c.break_active_high = false;
     c.break_filter = 4u;
     c.adc1_channel_i_a = 1u; /* PA0 ADC12_IN1 */
-    c.adc1_channel_bus = 3u; /* PA2 ADC1_IN3 */
+    c.adc1_channel_bus = 6u; /* PC0 ADC1_IN6 (PA2/PA3 are the NUCLEO's virtual COM port) */
     c.adc2_channel_i_b = 2u; /* PA1 ADC12_IN2 */
     c.adc_sample_time = 2u;  /* 12.5 ADC clock cycles */
     c.adc_pins[0] = (pmstep_stm32g4_pin_t){0u, 0u, 0u};
-    c.adc_pins[1] = (pmstep_stm32g4_pin_t){0u, 2u, 0u};
+    c.adc_pins[1] = (pmstep_stm32g4_pin_t){2u, 0u, 0u};
     c.adc_pins[2] = (pmstep_stm32g4_pin_t){0u, 1u, 0u};
     /* Current sensors: 0.1 V/A around 1.65 V. Bus: 1:20 divider. */
     c.i_a_offset_counts = 2048.0f;

@@ -39,14 +39,24 @@ void stm32g4_fake_wait_hook(void)
                             | ((stm32g4_fake.rcc.CFGR & RCC_CFGR_SW_MASK) << RCC_CFGR_SWS_POS);
     stm32g4_fake.adc1.CR &= ~ADC_CR_ADCAL;
     stm32g4_fake.adc2.CR &= ~ADC_CR_ADCAL;
+    /* ADRDY only once enabled (a plain-RAM write of ADRDY to clear it would set it here). */
     if (stm32g4_fake.adc1.CR & ADC_CR_ADEN) {
         stm32g4_fake.adc1.ISR |= ADC_ISR_ADRDY;
         adc1_enabled_seen = true;
+    } else if (!adc1_enabled_seen) {
+        stm32g4_fake.adc1.ISR &= ~ADC_ISR_ADRDY;
     }
     if (stm32g4_fake.adc2.CR & ADC_CR_ADEN) {
         stm32g4_fake.adc2.ISR |= ADC_ISR_ADRDY;
         adc2_enabled_seen = true;
+    } else if (!adc2_enabled_seen) {
+        stm32g4_fake.adc2.ISR &= ~ADC_ISR_ADRDY;
     }
+}
+
+stm32g4_gpio_t *stm32g4_fake_gpio(uint32_t port)
+{
+    return &stm32g4_fake.gpio[port];
 }
 
 static pmstep_stm32g4_config_t board;
@@ -237,9 +247,16 @@ static void test_clock_arithmetic(void **state)
     assert_int_equal(pmstep_stm32g4_sysclk_hz(&bad_r), 0u);
     assert_int_equal(pmstep_stm32g4_sysclk_hz(&vco_low), 0u);
     assert_int_equal(pmstep_stm32g4_flash_latency(170000000u), 4u);
-    assert_int_equal(pmstep_stm32g4_flash_latency(136000000u), 3u);
-    assert_int_equal(pmstep_stm32g4_flash_latency(34000000u), 0u);
-    assert_int_equal(pmstep_stm32g4_flash_latency(34000001u), 1u);
+    assert_int_equal(pmstep_stm32g4_flash_latency(151000000u), 4u);
+    assert_int_equal(pmstep_stm32g4_flash_latency_mode(34000000u, true), 0u);
+    assert_int_equal(pmstep_stm32g4_flash_latency_mode(34000001u, true), 1u);
+    /* At or below 150 MHz the port runs range 1 normal mode: 30 MHz per wait state. */
+    assert_int_equal(pmstep_stm32g4_flash_latency(150000000u), 4u);
+    assert_int_equal(pmstep_stm32g4_flash_latency(64000000u), 2u);
+    assert_int_equal(pmstep_stm32g4_flash_latency(30000000u), 0u);
+    assert_int_equal(pmstep_stm32g4_flash_latency(30000001u), 1u);
+    assert_int_equal(pmstep_stm32g4_flash_latency_mode(64000000u, true), 1u);
+    assert_int_equal(pmstep_stm32g4_flash_latency_mode(150000000u, true), 4u);
     assert_int_equal(pmstep_stm32g4_pwm_arr(170000000u, 20000u), ARR_20KHZ);
     assert_int_equal(pmstep_stm32g4_pwm_arr(170000000u, 10000u), 8500u);
     assert_int_equal(pmstep_stm32g4_pwm_arr(170000000u, 40000u), 2125u);
@@ -298,7 +315,7 @@ static void test_pwm_init(void **state)
     assert_int_equal(tim->CCMR1, pwm1 | (pwm1 << 8));               /* CH1, CH2 PWM mode 1, preload */
     assert_int_equal(tim->CCMR2, pwm1 | (pwm1 << 8));               /* CH3, CH4 */
     assert_int_equal(tim->CCMR3, (7u << 4) | (1u << 3));            /* CH5 PWM mode 2: trigger at peak */
-    assert_int_equal(tim->CCR5, ARR_20KHZ);
+    assert_int_equal(tim->CCR5, ARR_20KHZ - 1u);                    /* reached on the up slope */
     assert_int_equal(tim->CCR1, ARR_20KHZ / 2u);                    /* 0 V until the first step */
     assert_int_equal(tim->CCR4, ARR_20KHZ / 2u);
     assert_int_equal(tim->CCER, 0x5555u | TIM_CCER_CC5E);           /* CHx and CHxN of 1..4, active high */
@@ -346,10 +363,10 @@ static void test_adc_init(void **state)
     assert_int_equal(adc1->CR & ADC_CR_ADCALDIF, 0u); /* single-ended calibration */
     assert_true(adc1->CR & ADC_CR_JADSTART);
     assert_true(adc2->CR & ADC_CR_JADSTART);
-    /* ADC1: 2 conversions, i_a (ch 1) then bus (ch 3); ADC2: i_b (ch 2) */
-    assert_int_equal(adc1->JSQR, 1u | trigger | (1u << 9) | (3u << 15));
+    /* ADC1: 2 conversions, i_a (ch 1) then bus (ch 6); ADC2: i_b (ch 2) */
+    assert_int_equal(adc1->JSQR, 1u | trigger | (1u << 9) | (6u << 15));
     assert_int_equal(adc2->JSQR, 0u | trigger | (2u << 9));
-    assert_int_equal(adc1->SMPR1, (2u << 3) | (2u << 9));
+    assert_int_equal(adc1->SMPR1, (2u << 3) | (2u << 18));
     assert_int_equal(adc2->SMPR1, 2u << 6);
     assert_int_equal(adc1->IER, ADC_IER_JEOSIE);
     assert_int_equal(adc2->IER, 0u);
