@@ -212,6 +212,7 @@ static void adc_poll(unsigned a)
  * effect; §28.6.6 TIMx_EGR UG; §28.3.17/§28.6.20: MOE cannot be set while a break is active).
  * ------------------------------------------------------------------------- */
 static void update_event(bool by_ug);
+static void break_update(void);
 
 static void tim_sync(void)
 {
@@ -222,10 +223,7 @@ static void tim_sync(void)
         TIM->EGR = 0u;
         update_event(true);
     }
-    if (M.break_active) {
-        TIM->BDTR &= ~TIM_BDTR_MOE;
-        M.sr |= TIM_SR_BIF;
-    }
+    break_update();
     TIM->SR = M.sr;
 }
 
@@ -448,9 +446,6 @@ static void outputs_update(void)
                     M.dt_out[ch][k] = true;
                 } else {
                     M.dt_wait[ch][k]--;
-                    if (M.dt_wait[ch][k] == 0u) {
-                        M.dt_out[ch][k] = true;
-                    }
                 }
             }
         }
