@@ -208,7 +208,10 @@ pmstep_stm32g4_status_t pmstep_stm32g4_init(const pmstep_stm32g4_config_t *cfg, 
     port.isr_cycles_max = 0u;
     port.arr = pmstep_stm32g4_pwm_arr(sysclk_hz, cfg->pwm_frequency_hz);
 
-    st = pmstep_stm32g4_gpio_init(cfg);
+    st = pmstep_stm32g4_check_pins(cfg); /* one function per pin, the board's own pins kept */
+    if (st == PMSTEP_STM32G4_OK) {
+        st = pmstep_stm32g4_gpio_init(cfg);
+    }
     if (st == PMSTEP_STM32G4_OK) {
         st = pmstep_stm32g4_pwm_init(cfg, sysclk_hz); /* TIM1 runs at PCLK2 = SYSCLK */
     }

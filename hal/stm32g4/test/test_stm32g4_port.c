@@ -9,6 +9,7 @@
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
+#include <stdio.h>
 #include <string.h>
 
 #include <cmocka.h>
@@ -541,6 +542,109 @@ static void test_measurements_in_si(void **state)
     assert_float_equal(m.load_torque_nm, 0.0f, 0.0f);
 }
 
+/* ---- pin maps ---- */
+
+/* Signals of the STM32G431RB (LQFP64) pins a drive may use here, from ST's pin data
+ * (STM32_open_pin_data, STM32G431R(6-8-B)Tx.xml): the check that each pin of the map can
+ * carry the signal the map gives it. */
+typedef struct {
+    uint8_t port;
+    uint8_t pin;
+    const char *signals;
+} pin_signals_t;
+
+static const pin_signals_t g431rb_signals[] = {
+    {0u, 0u, " ADC1_IN1 ADC2_IN1 "},  {0u, 1u, " ADC1_IN2 ADC2_IN2 "},   {0u, 2u, " ADC1_IN3 LPUART1_TX "},
+    {0u, 3u, " ADC1_IN4 LPUART1_RX "}, {0u, 6u, " ADC2_IN3 TIM1_BKIN "},  {0u, 7u, " ADC2_IN4 TIM1_CH1N "},
+    {0u, 8u, " TIM1_CH1 "},            {0u, 9u, " TIM1_CH2 "},            {0u, 10u, " TIM1_CH3 "},
+    {0u, 11u, " TIM1_CH1N TIM1_CH4 "}, {1u, 0u, " ADC1_IN15 TIM1_CH2N "}, {1u, 1u, " ADC1_IN12 TIM1_CH3N "},
+    {2u, 0u, " ADC1_IN6 ADC2_IN6 TIM1_CH1 LPUART1_RX "},                  {2u, 5u, " ADC2_IN11 TIM1_CH4N "},
+    {1u, 5u, " "},                     {2u, 6u, " "},
+};
+
+static bool pin_can_carry(const pmstep_stm32g4_pin_use_t *u)
+{
+    char want[24];
+    unsigned k;
+    if (u->signal[0] == 'G') { /* plain GPIO: any I/O pin */
+        return true;
+    }
+    if (u->channel != 0u) {
+        snprintf(want, sizeof want, " %s%u ", u->signal, (unsigned)u->channel);
+    } else {
+        snprintf(want, sizeof want, " %s ", u->signal);
+    }
+    for (k = 0; k < sizeof g431rb_signals / sizeof g431rb_signals[0]; ++k) {
+        if (g431rb_signals[k].port == u->pin.port && g431rb_signals[k].pin == u->pin.pin) {
+            return strstr(g431rb_signals[k].signals, want) != NULL;
+        }
+    }
+    return false;
+}
+
+static void test_pin_map_default_board(void **state)
+{
+    pmstep_stm32g4_pin_use_t map[18];
+    uint32_t n;
+    uint32_t i;
+    uint32_t j;
+    (void)state;
+    assert_int_equal(pmstep_stm32g4_check_pins(&board), PMSTEP_STM32G4_OK);
+    n = pmstep_stm32g4_pin_map(&board, map, 18u);
+    assert_int_equal(n, 16u);
+    for (i = 0; i < n; ++i) {
+        if (!pin_can_carry(&map[i])) {
+            print_error("P%c%u cannot carry %s%u (%s)\n", 'A' + map[i].pin.port, map[i].pin.pin, map[i].signal,
+                        map[i].channel, map[i].function);
+            fail();
+        }
+        for (j = i + 1u; j < n; ++j) { /* one pin, one function */
+            assert_false(map[i].pin.port == map[j].pin.port && map[i].pin.pin == map[j].pin.pin);
+        }
+        /* The virtual COM port pins carry the console and nothing else. */
+        if (map[i].pin.port == 0u && (map[i].pin.pin == 2u || map[i].pin.pin == 3u)) {
+            assert_true(strncmp(map[i].signal, "LPUART1_", 8u) == 0);
+        }
+    }
+    /* The map's ADC channels are the ones the ADC is set up with. */
+    assert_int_equal(map[9].channel, board.adc1_channel_i_a);
+    assert_int_equal(map[10].channel, board.adc1_channel_bus);
+    assert_int_equal(map[11].channel, board.adc2_channel_i_b);
+}
+
+static void test_pin_map_conflicts_refused(void **state)
+{
+    pmstep_stm32g4_config_t c;
+    (void)state;
+    c = board;
+    c.adc_pins[1] = (pmstep_stm32g4_pin_t){0u, 2u, 0u}; /* the old bus input: the VCP's TX */
+    c.console_tx = (pmstep_stm32g4_pin_t){2u, 4u, 7u};  /* console moved away, PA2 still the board's */
+    assert_int_equal(pmstep_stm32g4_check_pins(&c), PMSTEP_STM32G4_ERR_PIN_RESERVED);
+    c = board;
+    c.adc_pins[1] = (pmstep_stm32g4_pin_t){0u, 2u, 0u}; /* bus on the console's pin */
+    assert_int_equal(pmstep_stm32g4_check_pins(&c), PMSTEP_STM32G4_ERR_PIN_CONFLICT);
+    c = board;
+    c.enable_pin = c.pwm_high[0]; /* two functions on PA8 */
+    assert_int_equal(pmstep_stm32g4_check_pins(&c), PMSTEP_STM32G4_ERR_PIN_CONFLICT);
+    c = board;
+    c.fault_pin = (pmstep_stm32g4_pin_t){0u, 13u, 0u}; /* SWDIO */
+    assert_int_equal(pmstep_stm32g4_check_pins(&c), PMSTEP_STM32G4_ERR_PIN_RESERVED);
+    c = board;
+    c.enable_pin = (pmstep_stm32g4_pin_t){0u, 5u, 0u}; /* LD2 */
+    assert_int_equal(pmstep_stm32g4_check_pins(&c), PMSTEP_STM32G4_ERR_PIN_RESERVED);
+    c.board = NULL; /* another controller board: only conflicts are checked */
+    assert_int_equal(pmstep_stm32g4_check_pins(&c), PMSTEP_STM32G4_OK);
+    c.pwm_low[3].pin = 16u;
+    assert_int_equal(pmstep_stm32g4_check_pins(&c), PMSTEP_STM32G4_ERR_PIN);
+    assert_int_equal(pmstep_stm32g4_check_pins(NULL), PMSTEP_STM32G4_ERR_NULL_ARGUMENT);
+    /* The port refuses to start on a conflicting map, before touching a pin. */
+    c = board;
+    c.enable_pin = c.pwm_low[0];
+    fault_input(false);
+    assert_int_equal(pmstep_stm32g4_init(&c, &motor), PMSTEP_STM32G4_ERR_PIN_CONFLICT);
+    assert_int_equal(stm32g4_fake.rcc.AHB2ENR, 0u);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -560,6 +664,8 @@ int main(void)
         cmocka_unit_test_setup(test_core_fault_turns_bridge_off, setup),
         cmocka_unit_test_setup(test_break_interrupt, setup),
         cmocka_unit_test_setup(test_measurements_in_si, setup),
+        cmocka_unit_test_setup(test_pin_map_default_board, setup),
+        cmocka_unit_test_setup(test_pin_map_conflicts_refused, setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
