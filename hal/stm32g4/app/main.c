@@ -1,17 +1,30 @@
 /*
  * STM32G431 firmware image: the paper's controller on the board described by
- * pmstep_stm32g4_default_config(). After reset it sets the clock to 170 MHz, brings
- * up TIM1, the ADCs and the gate driver pins with the bridge off, starts the
- * strategy (s-alignment, c-alignment, then the adaptive controller with a 10 rad/s
- * set-point) and sleeps; everything else happens in the ADC interrupt, every
- * 50 us. A real application replaces the fixed start and set-point by its commands.
+ * pmstep_stm32g4_default_config() (a NUCLEO-G431RB with a dual full-bridge stage), driven
+ * from the console on LPUART1 (the ST-LINK virtual COM port, 115200 8N1; protocol in
+ * console/include/pmstep_console.h, host tool tools/pmstep_console.py).
+ *
+ * After reset: clock to 170 MHz, TIM1, the ADCs and the gate-driver pins with the bridge
+ * off, the console's UART; the motor waits in IDLE for a start command. The control step
+ * runs in the ADC interrupt every 50 us; this main loop receives and parses commands,
+ * applies each one at a period boundary (the control interrupt held off for the few
+ * microseconds it takes, never inside a step), and sends replies and telemetry. The
+ * control interrupt's code does not change with the console.
  */
+#include "pmstep_console.h"
 #include "pmstep_hal_stm32g4.h"
+#include "stm32g4_regs.h"
+
+#ifndef PMSTEP_VERSION_TEXT
+#define PMSTEP_VERSION_TEXT "0.0.0"
+#endif
 
 static pmstep_t motor;
 static pmstep_config_t motor_config;       /* must outlive the instance */
 static pmstep_stm32g4_config_t board;      /* must outlive the port */
+static pmstep_console_t console;
 volatile int32_t app_status;               /* for a debugger: 0, or the failing step's status */
+volatile uint32_t app_uart_errors;         /* receive errors (overrun, framing, noise) */
 
 static void halt(int32_t status)
 {
@@ -21,19 +34,40 @@ static void halt(int32_t status)
     }
 }
 
+/* A 64-bit cycle count from the DWT counter the port runs (polled far more often than it wraps). */
+static uint64_t cycles(void)
+{
+    static uint32_t last;
+    static uint64_t total;
+    const uint32_t now = STM32G4_DWT->CYCCNT;
+    total += (uint32_t)(now - last);
+    last = now;
+    return total;
+}
+
+static void snapshot(pmstep_console_snapshot_t *snap, uint64_t cycles_per_period)
+{
+    snap->period = (uint32_t)(cycles() / cycles_per_period) - 1u; /* the period that just ended */
+    pmstep_stm32g4_last_period(&snap->out, &snap->meas, &snap->port_fault);
+}
+
 int main(void)
 {
     pmstep_status_t st;
     pmstep_stm32g4_status_t port_st;
+    uint32_t sysclk_hz;
+    uint64_t cycles_per_period;
+    uint64_t cycles_per_ms;
+    uint8_t tx[64];
+    uint32_t tx_len = 0u;
+    uint32_t tx_pos = 0u;
 
     board = pmstep_stm32g4_default_config();
     port_st = pmstep_stm32g4_clock_init(&board.clock);
     if (port_st != PMSTEP_STM32G4_OK) {
         halt((int32_t)port_st);
     }
-    motor_config = pmstep_paper_config();
-    motor_config.period_s = pmstep_stm32g4_period_s(&board); /* 50 us at 20 kHz */
-    motor_config.computational_delay_periods = 1u;          /* duties load at the next carrier peak */
+    motor_config = pmstep_console_app_config(pmstep_stm32g4_period_s(&board), 1u); /* duties load one period later */
     st = pmstep_init(&motor, &motor_config);
     if (st != PMSTEP_OK) {
         halt(-100 + (int32_t)st);
@@ -42,10 +76,38 @@ int main(void)
     if (port_st != PMSTEP_STM32G4_OK) {
         halt((int32_t)port_st);
     }
-    (void)pmstep_set_speed_target(&motor, 10.0f, 50.0f);
-    (void)pmstep_start(&motor);
+    sysclk_hz = pmstep_stm32g4_sysclk_hz(&board.clock);
+    port_st = pmstep_stm32g4_lpuart_init(&board, sysclk_hz); /* PCLK1 = SYSCLK */
+    if (port_st != PMSTEP_STM32G4_OK) {
+        halt((int32_t)port_st);
+    }
+    pmstep_console_init(&console, "pmstep " PMSTEP_VERSION_TEXT " stm32g431", false);
+    cycles_per_period = (uint64_t)((float)sysclk_hz * motor_config.period_s + 0.5f);
+    cycles_per_ms = sysclk_hz / 1000u;
     pmstep_stm32g4_start();
+
     for (;;) {
-        __asm volatile("wfi");
+        uint8_t rx[32];
+        const uint32_t n = pmstep_stm32g4_lpuart_read(rx, sizeof rx, (uint32_t *)&app_uart_errors);
+        const uint32_t now_ms = (uint32_t)(cycles() / cycles_per_ms);
+        pmstep_console_snapshot_t snap;
+        const uint32_t period_now = (uint32_t)(cycles() / cycles_per_period);
+        pmstep_console_receive(&console, rx, n, now_ms);
+        if (pmstep_console_pending(&console)
+            || (console.decimation != 0u && (int32_t)(period_now - 1u - console.next_telemetry) >= 0)) {
+            pmstep_stm32g4_hold_control();
+            snapshot(&snap, cycles_per_period);
+            if (pmstep_console_pending_command(&console) == PMSTEP_CONSOLE_CLEAR_FAULT) {
+                (void)pmstep_stm32g4_clear_fault(); /* the port's latch too (break, driver fault input) */
+            }
+            pmstep_console_boundary(&console, &motor, &motor_config, &snap);
+            pmstep_stm32g4_release_control();
+            pmstep_console_telemetry(&console, &snap);
+        }
+        if (tx_pos == tx_len) {
+            tx_len = pmstep_console_transmit(&console, tx, sizeof tx);
+            tx_pos = 0u;
+        }
+        tx_pos += pmstep_stm32g4_lpuart_write(&tx[tx_pos], tx_len - tx_pos);
     }
 }

@@ -241,6 +241,31 @@ bool pmstep_stm32g4_bridge_on(void);
 /** Longest control interrupt so far, in CPU cycles (DWT cycle counter). */
 uint32_t pmstep_stm32g4_isr_cycles_max(void);
 
+/** LPUART BRR for @p baud from the kernel clock @p clock_hz (RM0440 §38.4), 0 if out of range. */
+uint32_t pmstep_stm32g4_lpuart_brr(uint32_t clock_hz, uint32_t baud);
+
+/** LPUART1 at cfg->console_baud 8N1 from PCLK1 = @p pclk1_hz, on the console pins. */
+pmstep_stm32g4_status_t pmstep_stm32g4_lpuart_init(const pmstep_stm32g4_config_t *cfg, uint32_t pclk1_hz);
+
+/** Takes up to @p max received bytes, never waits; a receive error adds one to @p errors. */
+uint32_t pmstep_stm32g4_lpuart_read(uint8_t *data, uint32_t max, uint32_t *errors);
+
+/** Sends as many of @p n bytes as the transmitter takes now, never waits. @return that count. */
+uint32_t pmstep_stm32g4_lpuart_write(const uint8_t *data, uint32_t n);
+
+/** Holds the control interrupt off (main loop, for a period boundary: never for long). */
+void pmstep_stm32g4_hold_control(void);
+
+/** Lets the control interrupt run again (a period that ended meanwhile runs now). */
+void pmstep_stm32g4_release_control(void);
+
+/**
+ * The last period as the control interrupt left it, read between periods (call between
+ * pmstep_stm32g4_hold_control() and _release_control()): the step's output, the samples
+ * converted again from the ADC data registers, the port's fault.
+ */
+void pmstep_stm32g4_last_period(pmstep_output_t *out, pmstep_meas_t *meas, uint8_t *port_fault);
+
 /** ADC1 and ADC2 interrupt: the control period. */
 void ADC1_2_IRQHandler(void);
 

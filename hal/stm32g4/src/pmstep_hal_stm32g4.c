@@ -237,3 +237,34 @@ void pmstep_stm32g4_start(void)
 {
     STM32G4_TIM1->CR1 |= TIM_CR1_CEN;
 }
+
+void pmstep_stm32g4_hold_control(void)
+{
+    STM32G4_NVIC->ICER[STM32G4_IRQ_ADC1_2 / 32u] = STM32G4_BIT(STM32G4_IRQ_ADC1_2 % 32u);
+#if !defined(STM32G4_FAKE_REGISTERS)
+    __asm volatile("dsb\n\tisb" ::: "memory"); /* no control interrupt after this point */
+#endif
+}
+
+void pmstep_stm32g4_release_control(void)
+{
+    STM32G4_NVIC->ISER[STM32G4_IRQ_ADC1_2 / 32u] = STM32G4_BIT(STM32G4_IRQ_ADC1_2 % 32u);
+}
+
+void pmstep_stm32g4_last_period(pmstep_output_t *out, pmstep_meas_t *meas, uint8_t *port_fault)
+{
+    const pmstep_stm32g4_config_t *cfg = port.cfg;
+    *out = port.out;
+    *port_fault = (uint8_t)port.fault;
+    if (cfg == NULL) {
+        const pmstep_meas_t zero = {0.0f, 0.0f, 0.0f, 0.0f};
+        *meas = zero;
+        return;
+    }
+    /* The injected data registers hold the last period's samples until the next trigger. */
+    meas->i_a_a = pmstep_stm32g4_counts_to_si(STM32G4_ADC1->JDR[0], cfg->i_a_offset_counts, cfg->i_a_gain_a_per_count);
+    meas->bus_voltage_v = pmstep_stm32g4_counts_to_si(STM32G4_ADC1->JDR[1], cfg->bus_offset_counts,
+                                                      cfg->bus_gain_v_per_count);
+    meas->i_b_a = pmstep_stm32g4_counts_to_si(STM32G4_ADC2->JDR[0], cfg->i_b_offset_counts, cfg->i_b_gain_a_per_count);
+    meas->load_torque_nm = 0.0f;
+}

@@ -337,3 +337,69 @@ pmstep_stm32g4_status_t pmstep_stm32g4_adc_init(const pmstep_stm32g4_config_t *c
     adc_cr_set(adc2, ADC_CR_JADSTART);
     return PMSTEP_STM32G4_OK;
 }
+
+/* ---- LPUART1, the console: RM0440 §38.4 (baud rate 256 f_ck / BRR, f_ck within 3..4096 x the
+ * baud rate), §38.7 (registers). 8 data bits, no parity, 1 stop bit (the reset values of CR1
+ * and CR2), no FIFO, polled from the main loop. ---- */
+uint32_t pmstep_stm32g4_lpuart_brr(uint32_t clock_hz, uint32_t baud)
+{
+    uint64_t brr;
+    if (baud == 0u || (uint64_t)clock_hz < 3u * (uint64_t)baud || (uint64_t)clock_hz > 4096u * (uint64_t)baud) {
+        return 0u;
+    }
+    brr = (256u * (uint64_t)clock_hz + baud / 2u) / baud;
+    return (brr < LPUART_BRR_MIN || brr > LPUART_BRR_MAX) ? 0u : (uint32_t)brr;
+}
+
+pmstep_stm32g4_status_t pmstep_stm32g4_lpuart_init(const pmstep_stm32g4_config_t *cfg, uint32_t pclk1_hz)
+{
+    stm32g4_lpuart_t *const u = STM32G4_LPUART1;
+    uint32_t brr;
+    if (cfg == NULL) {
+        return PMSTEP_STM32G4_ERR_NULL_ARGUMENT;
+    }
+    brr = pmstep_stm32g4_lpuart_brr(pclk1_hz, cfg->console_baud);
+    if (brr == 0u) {
+        return PMSTEP_STM32G4_ERR_UART_CONFIG;
+    }
+    if (!pin_valid(&cfg->console_tx) || !pin_valid(&cfg->console_rx)) {
+        return PMSTEP_STM32G4_ERR_PIN;
+    }
+    STM32G4_RCC->CCIPR &= ~RCC_CCIPR_LPUART1SEL_MASK; /* kernel clock PCLK1 */
+    STM32G4_RCC->APB1ENR2 |= RCC_APB1ENR2_LPUART1EN;
+    (void)STM32G4_RCC->APB1ENR2;
+    u->CR1 = 0u; /* UE = 0 while BRR is written */
+    u->PRESC = 0u;
+    u->BRR = brr;
+    u->CR1 = LPUART_CR1_UE | LPUART_CR1_RE | LPUART_CR1_TE;
+    pin_configure(&cfg->console_tx, GPIO_MODE_AF, 0u);
+    pin_configure(&cfg->console_rx, GPIO_MODE_AF, GPIO_PULL_UP); /* idle high when unconnected */
+    return PMSTEP_STM32G4_OK;
+}
+
+uint32_t pmstep_stm32g4_lpuart_read(uint8_t *data, uint32_t max, uint32_t *errors)
+{
+    stm32g4_lpuart_t *const u = STM32G4_LPUART1;
+    uint32_t n = 0u;
+    const uint32_t isr = u->ISR;
+    if ((isr & LPUART_ISR_ERRORS) != 0u) { /* overrun, framing, noise, parity: counted, cleared */
+        u->ICR = isr & LPUART_ISR_ERRORS;
+        if (errors != NULL) {
+            ++*errors;
+        }
+    }
+    while (n < max && (u->ISR & LPUART_ISR_RXNE) != 0u) {
+        data[n++] = (uint8_t)(u->RDR & 0xFFu);
+    }
+    return n;
+}
+
+uint32_t pmstep_stm32g4_lpuart_write(const uint8_t *data, uint32_t n)
+{
+    stm32g4_lpuart_t *const u = STM32G4_LPUART1;
+    uint32_t k = 0u;
+    while (k < n && (u->ISR & LPUART_ISR_TXE) != 0u) {
+        u->TDR = data[k++];
+    }
+    return k;
+}

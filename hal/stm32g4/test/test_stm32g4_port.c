@@ -645,6 +645,65 @@ static void test_pin_map_conflicts_refused(void **state)
     assert_int_equal(stm32g4_fake.rcc.AHB2ENR, 0u);
 }
 
+/* ---- console UART (LPUART1) and the main loop's access to the last period ---- */
+
+static void test_lpuart(void **state)
+{
+    stm32g4_lpuart_t *u = &stm32g4_fake.lpuart1;
+    uint8_t buf[8];
+    uint32_t errors = 0u;
+    (void)state;
+    /* 256 x 170 MHz / 115200 = 377777.8 -> 377778; limits 3x..4096x the baud rate (RM0440 §38.4). */
+    assert_int_equal(pmstep_stm32g4_lpuart_brr(170000000u, 115200u), 377778u);
+    assert_int_equal(pmstep_stm32g4_lpuart_brr(170000000u, 921600u), 47222u);
+    assert_int_equal(pmstep_stm32g4_lpuart_brr(170000000u, 9600u), 0u);    /* f_ck > 4096 x baud */
+    assert_int_equal(pmstep_stm32g4_lpuart_brr(170000000u, 60000000u), 0u); /* f_ck < 3 x baud */
+    assert_int_equal(pmstep_stm32g4_lpuart_brr(170000000u, 0u), 0u);
+    assert_int_equal(pmstep_stm32g4_lpuart_init(&board, 170000000u), PMSTEP_STM32G4_OK);
+    assert_int_equal(u->BRR, 377778u);
+    assert_int_equal(u->CR1, LPUART_CR1_UE | LPUART_CR1_RE | LPUART_CR1_TE);
+    assert_true(stm32g4_fake.rcc.APB1ENR2 & RCC_APB1ENR2_LPUART1EN);
+    assert_int_equal(stm32g4_fake.rcc.CCIPR & RCC_CCIPR_LPUART1SEL_MASK, 0u);
+    assert_int_equal((stm32g4_fake.gpio[0].MODER >> 4) & 3u, GPIO_MODE_AF); /* PA2 */
+    assert_int_equal((stm32g4_fake.gpio[0].AFR[0] >> 8) & 0xFu, 12u);       /* AF12 */
+    assert_int_equal((stm32g4_fake.gpio[0].AFR[0] >> 12) & 0xFu, 12u);      /* PA3 AF12 */
+    board.console_baud = 9600u;
+    assert_int_equal(pmstep_stm32g4_lpuart_init(&board, 170000000u), PMSTEP_STM32G4_ERR_UART_CONFIG);
+    /* Never waits: nothing received, nothing taken; transmitter busy, nothing sent. */
+    u->ISR = 0u;
+    assert_int_equal(pmstep_stm32g4_lpuart_read(buf, sizeof buf, &errors), 0u);
+    assert_int_equal(pmstep_stm32g4_lpuart_write(buf, 4u), 0u);
+    u->ISR = LPUART_ISR_TXE;
+    assert_int_equal(pmstep_stm32g4_lpuart_write((const uint8_t *)"abcd", 4u), 4u);
+    assert_int_equal(u->TDR, 'd');
+    u->ISR = 1u << 3; /* overrun */
+    (void)pmstep_stm32g4_lpuart_read(buf, sizeof buf, &errors);
+    assert_int_equal(errors, 1u);
+    assert_int_equal(u->ICR, 1u << 3);
+}
+
+static void test_hold_and_last_period(void **state)
+{
+    pmstep_output_t out;
+    pmstep_meas_t meas;
+    uint8_t port_fault = 9u;
+    (void)state;
+    port_up();
+    pmstep_stm32g4_hold_control();
+    assert_int_equal(stm32g4_fake.nvic.ICER[0], 1u << 18);
+    pmstep_stm32g4_release_control();
+    assert_true(stm32g4_fake.nvic.ISER[0] & (1u << 18));
+    assert_int_equal(pmstep_start(&motor), PMSTEP_OK);
+    adc_samples(2048u + 124u, bus_counts(48.0f), 2048u);
+    ADC1_2_IRQHandler();
+    pmstep_stm32g4_last_period(&out, &meas, &port_fault);
+    assert_int_equal(out.mode, PMSTEP_MODE_S_ALIGN);
+    assert_float_equal(out.u_b_v, 24.0f, 1e-3f);
+    assert_float_equal(meas.i_a_a, 124.0f * board.i_a_gain_a_per_count, 1e-6f);
+    assert_float_equal(meas.bus_voltage_v, 48.0f, board.bus_gain_v_per_count);
+    assert_int_equal(port_fault, PMSTEP_STM32G4_FAULT_NONE);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -666,6 +725,8 @@ int main(void)
         cmocka_unit_test_setup(test_measurements_in_si, setup),
         cmocka_unit_test_setup(test_pin_map_default_board, setup),
         cmocka_unit_test_setup(test_pin_map_conflicts_refused, setup),
+        cmocka_unit_test_setup(test_lpuart, setup),
+        cmocka_unit_test_setup(test_hold_and_last_period, setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
