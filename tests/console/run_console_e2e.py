@@ -16,11 +16,12 @@ Checks: the target's summary matches the host SIL's (pil-summary-compare, the PI
 tolerances); the fuzz run's summary is byte-identical to the clean run's; every telemetry
 frame matches the SIL's CSV row of the same period within the PIL tolerances; the final
 status is RUN without fault; the fuzz run counted its bad input and applied exactly the
-clean run's commands; the control step's instruction count per mode (SysTick, -icount
-shift=0) is the same in both runs. Writes OUT/report.txt.
+clean run's commands; the control step's instruction count is the same in both runs: with
+--plugin (hal/qemu_mps2/tools/pil_insn_plugin.c) exactly, step by step, otherwise as the SysTick
+mean per mode (-icount shift=0). Writes OUT/report.txt.
 
 usage: run_console_e2e.py --qemu Q --image ELF --sil PMSTEP_SIL --compare PIL_SUMMARY_COMPARE --out DIR
-       [--duration 0.9] [--substeps 10] [--decimation 200]
+       [--duration 0.9] [--substeps 10] [--decimation 200] [--plugin pil_insn_plugin.so]
 """
 import argparse
 import csv
@@ -28,6 +29,8 @@ import json
 import math
 import os
 import random
+import re
+import shutil
 import socket
 import struct
 import subprocess
@@ -105,6 +108,20 @@ class Fuzzer(threading.Thread):
         time.sleep(3.0)
 
 
+def step_addresses(elf):
+    """Entry of pmstep_step and the instruction after its call in the control interrupt (as
+    tools/bench_target.py)."""
+    nm = subprocess.run(["arm-none-eabi-nm", elf], stdout=subprocess.PIPE, text=True, check=True).stdout
+    entry = next(int(l.split()[0], 16) for l in nm.splitlines() if l.split()[-1] == "pmstep_step")
+    dis = subprocess.run(["arm-none-eabi-objdump", "-d", "--no-show-raw-insn", elf], stdout=subprocess.PIPE,
+                         text=True, check=True).stdout
+    lines = [l for l in dis.split("<Irq10_Handler>:", 1)[1].splitlines() if re.match(r"^\s+[0-9a-f]+:", l)]
+    for i, l in enumerate(lines):
+        if re.search(r"\bbl\s+[0-9a-f]+ <pmstep_step>", l):
+            return entry, int(lines[i + 1].split(":")[0], 16)
+    raise RuntimeError("no call of pmstep_step in the control interrupt")
+
+
 def run_target(a, out, mode, period_s, k_speed, steps):
     port = free_port()
     summary = out / f"{mode}_summary.json"
@@ -118,6 +135,10 @@ def run_target(a, out, mode, period_s, k_speed, steps):
     cmdline = [a.qemu, "-M", "mps2-an386", "-cpu", "cortex-m4", "-nographic", "-monitor", "none", "-icount",
                "shift=0", "-serial", f"tcp:127.0.0.1:{port},server=on,wait=on", "-semihosting-config", semi,
                "-kernel", a.image]
+    steps_file = out / f"{mode}_steps.txt"
+    if a.plugin:
+        entry, ret = step_addresses(a.image)
+        cmdline[1:1] = ["-plugin", f"{a.plugin},entry=0x{entry:x},ret=0x{ret:x},out={steps_file}"]
     qemu = subprocess.Popen(cmdline, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     link = None
     for _ in range(200):
@@ -177,6 +198,8 @@ def run_target(a, out, mode, period_s, k_speed, steps):
     pc.write_csv(out / f"{mode}_telemetry.csv", log["telemetry"])
     log["summary"] = summary
     log["cost"] = parse_cost(cost)
+    if a.plugin:
+        log["insns"] = [int(l) for l in steps_file.read_text().splitlines() if not l.startswith("#")]
     return log
 
 
@@ -200,6 +223,7 @@ def main():
     ap.add_argument("--duration", type=float, default=0.9)
     ap.add_argument("--substeps", type=int, default=10)
     ap.add_argument("--decimation", type=int, default=200)
+    ap.add_argument("--plugin", help="QEMU TCG plugin counting each pmstep_step()'s instructions")
     a = ap.parse_args()
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -282,6 +306,18 @@ def main():
         # SysTick counts every 40 instructions; the mean of thousands of steps carries well under one.
         if fv is None or fv["steps"] != v["steps"] or abs(fv["instructions_mean"] - v["instructions_mean"]) > 1.0:
             failures.append(f"control step cost of {m}: clean {v} vs fuzz {fv}")
+    if a.plugin:
+        ca, fa = clean["insns"], fuzz["insns"]
+        if len(ca) != steps or ca != fa:
+            failures.append(f"exact instruction counts of the control step differ (clean {len(ca)} steps, fuzz {len(fa)})")
+        else:
+            report.append(f"control step, exact instructions (plugin), identical step by step in both runs ({steps} steps):")
+            t_s, t_c = 0.3, 0.6  # the paper scenario's alignment times
+            for name, lo, hi in (("S_ALIGN", 0, int(round(t_s / period_s))),
+                                 ("C_ALIGN", int(round(t_s / period_s)), int(round(t_c / period_s))),
+                                 ("RUN", int(round(t_c / period_s)), steps)):
+                seg = ca[lo:hi]
+                report.append(f"  periods {lo}..{hi - 1} ({name}): min {min(seg)} mean {sum(seg) / len(seg):.1f} max {max(seg)}")
     ta = [(t["period"], t["speed_hat_rad_s"], t["load_hat_nm"]) for t in clean["telemetry"]]
     tb = [(t["period"], t["speed_hat_rad_s"], t["load_hat_nm"]) for t in fuzz["telemetry"]]
     if ta != tb:

@@ -34,20 +34,34 @@ static void halt(int32_t status)
     }
 }
 
-/* A 64-bit cycle count from the DWT counter the port runs (polled far more often than it wraps). */
-static uint64_t cycles(void)
+/* Milliseconds and control periods since start, from the DWT cycle counter the port runs (the
+ * main loop polls it far more often than it wraps, every 25 s at 170 MHz). 32-bit arithmetic. */
+static struct {
+    uint32_t last;
+    uint32_t cycles_per_ms;
+    uint32_t cycles_per_period;
+    uint32_t rem_ms;
+    uint32_t rem_period;
+    uint32_t ms;
+    uint32_t periods;
+} clk;
+
+static void clock_update(void)
 {
-    static uint32_t last;
-    static uint64_t total;
     const uint32_t now = STM32G4_DWT->CYCCNT;
-    total += (uint32_t)(now - last);
-    last = now;
-    return total;
+    const uint32_t d = now - clk.last;
+    clk.last = now;
+    clk.rem_ms += d;
+    clk.ms += clk.rem_ms / clk.cycles_per_ms;
+    clk.rem_ms %= clk.cycles_per_ms;
+    clk.rem_period += d;
+    clk.periods += clk.rem_period / clk.cycles_per_period;
+    clk.rem_period %= clk.cycles_per_period;
 }
 
-static void snapshot(pmstep_console_snapshot_t *snap, uint64_t cycles_per_period)
+static void snapshot(pmstep_console_snapshot_t *snap)
 {
-    snap->period = (uint32_t)(cycles() / cycles_per_period) - 1u; /* the period that just ended */
+    snap->period = clk.periods - 1u; /* the period that just ended (counted from the timer's start) */
     pmstep_stm32g4_last_period(&snap->out, &snap->meas, &snap->port_fault);
 }
 
@@ -56,8 +70,6 @@ int main(void)
     pmstep_status_t st;
     pmstep_stm32g4_status_t port_st;
     uint32_t sysclk_hz;
-    uint64_t cycles_per_period;
-    uint64_t cycles_per_ms;
     uint8_t tx[64];
     uint32_t tx_len = 0u;
     uint32_t tx_pos = 0u;
@@ -82,21 +94,21 @@ int main(void)
         halt((int32_t)port_st);
     }
     pmstep_console_init(&console, "pmstep " PMSTEP_VERSION_TEXT " stm32g431", false);
-    cycles_per_period = (uint64_t)((float)sysclk_hz * motor_config.period_s + 0.5f);
-    cycles_per_ms = sysclk_hz / 1000u;
+    clk.cycles_per_period = (uint32_t)((float)sysclk_hz * motor_config.period_s + 0.5f); /* 2 ARR */
+    clk.cycles_per_ms = sysclk_hz / 1000u;
+    clk.last = STM32G4_DWT->CYCCNT;
     pmstep_stm32g4_start();
 
     for (;;) {
         uint8_t rx[32];
         const uint32_t n = pmstep_stm32g4_lpuart_read(rx, sizeof rx, (uint32_t *)&app_uart_errors);
-        const uint32_t now_ms = (uint32_t)(cycles() / cycles_per_ms);
         pmstep_console_snapshot_t snap;
-        const uint32_t period_now = (uint32_t)(cycles() / cycles_per_period);
-        pmstep_console_receive(&console, rx, n, now_ms);
+        clock_update();
+        pmstep_console_receive(&console, rx, n, clk.ms);
         if (pmstep_console_pending(&console)
-            || (console.decimation != 0u && (int32_t)(period_now - 1u - console.next_telemetry) >= 0)) {
+            || (console.decimation != 0u && (int32_t)(clk.periods - 1u - console.next_telemetry) >= 0)) {
             pmstep_stm32g4_hold_control();
-            snapshot(&snap, cycles_per_period);
+            snapshot(&snap);
             if (pmstep_console_pending_command(&console) == PMSTEP_CONSOLE_CLEAR_FAULT) {
                 (void)pmstep_stm32g4_clear_fault(); /* the port's latch too (break, driver fault input) */
             }
