@@ -26,7 +26,7 @@ uint16_t pmstep_console_crc16(uint16_t crc, const uint8_t *data, uint32_t n)
     return (uint16_t)r;
 }
 
-static bool finite(float x)
+static bool is_finite(float x)
 {
     return (x - x) == 0.0f; /* NaN and +-Inf give NaN */
 }
@@ -271,7 +271,7 @@ static void handle_frame(pmstep_console_t *c)
         }
         c->a = get_f32(d);
         c->b = get_f32(d + 4);
-        if (!finite(c->a) || !finite(c->b)) {
+        if (!is_finite(c->a) || !is_finite(c->b)) {
             send_error(c, type, seq, PMSTEP_CONSOLE_ERR_BAD_VALUE);
             return;
         }
@@ -282,7 +282,7 @@ static void handle_frame(pmstep_console_t *c)
             return;
         }
         c->a = get_f32(d);
-        if (!finite(c->a)) {
+        if (!is_finite(c->a)) {
             send_error(c, type, seq, PMSTEP_CONSOLE_ERR_BAD_VALUE);
             return;
         }
@@ -315,7 +315,7 @@ static void handle_frame(pmstep_console_t *c)
                 send_error(c, type, seq, PMSTEP_CONSOLE_ERR_READ_ONLY);
                 return;
             }
-            if (!finite(c->a)) {
+            if (!is_finite(c->a)) {
                 send_error(c, type, seq, PMSTEP_CONSOLE_ERR_BAD_VALUE);
                 return;
             }

@@ -67,7 +67,7 @@ class AgainstTheFirmwareConsole(unittest.TestCase):
             self.drive.kill()
         os.close(self.master)
 
-    def test_session(self):
+    def test_full_dialogue(self):
         c = self.con
         hello = c.hello()
         self.assertEqual(hello["protocol"], 1)
