@@ -126,6 +126,21 @@ class AgainstTheFirmwareConsole(unittest.TestCase):
             self.assertEqual(pc.main(["plot", path, png]), 0)
             self.assertGreater(os.path.getsize(png), 1000)
 
+    def test_interactive(self):
+        out = io.StringIO()
+        shell = pc.Shell(self.con)
+        with contextlib.redirect_stdout(out):
+            shell.onecmd("hello")
+            shell.onecmd("speed nan")         # refused by the drive: an error line, the shell goes on
+            shell.onecmd("id 0.5")
+            shell.onecmd("no_such_command")
+            self.assertTrue(shell.onecmd("quit"))
+        text = out.getvalue()
+        self.assertIn("pmstep host-drive", text)
+        self.assertIn("error: request 0x05: bad value", text)
+        self.assertIn("i_d target 0.5 A: from period 0", text)
+        self.assertIn("unknown command: no_such_command", text)
+
     def test_command_line(self):
         out = io.StringIO()
         self.link.close()
