@@ -9,22 +9,11 @@
  * runs in the ADC interrupt every 50 us; this main loop receives and parses commands,
  * applies each one at a period boundary (the control interrupt held off for the few
  * microseconds it takes, never inside a step), and sends replies and telemetry. The
- * control interrupt's code does not change with the console.
+ * control interrupt has no console code in it. The application itself is app.c.
  */
-#include "pmstep_console.h"
-#include "pmstep_hal_stm32g4.h"
-#include "stm32g4_regs.h"
+#include "app.h"
 
-#ifndef PMSTEP_VERSION_TEXT
-#define PMSTEP_VERSION_TEXT "0.0.0"
-#endif
-
-static pmstep_t motor;
-static pmstep_config_t motor_config;       /* must outlive the instance */
-static pmstep_stm32g4_config_t board;      /* must outlive the port */
-static pmstep_console_t console;
-volatile int32_t app_status;               /* for a debugger: 0, or the failing step's status */
-volatile uint32_t app_uart_errors;         /* receive errors (overrun, framing, noise) */
+volatile int32_t app_status; /* for a debugger: 0, or the failing step's status */
 
 static void halt(int32_t status)
 {
@@ -34,92 +23,13 @@ static void halt(int32_t status)
     }
 }
 
-/* Milliseconds and control periods since start, from the DWT cycle counter the port runs (the
- * main loop polls it far more often than it wraps, every 25 s at 170 MHz). 32-bit arithmetic. */
-static struct {
-    uint32_t last;
-    uint32_t cycles_per_ms;
-    uint32_t cycles_per_period;
-    uint32_t rem_ms;
-    uint32_t rem_period;
-    uint32_t ms;
-    uint32_t periods;
-} clk;
-
-static void clock_update(void)
-{
-    const uint32_t now = STM32G4_DWT->CYCCNT;
-    const uint32_t d = now - clk.last;
-    clk.last = now;
-    clk.rem_ms += d;
-    clk.ms += clk.rem_ms / clk.cycles_per_ms;
-    clk.rem_ms %= clk.cycles_per_ms;
-    clk.rem_period += d;
-    clk.periods += clk.rem_period / clk.cycles_per_period;
-    clk.rem_period %= clk.cycles_per_period;
-}
-
-static void snapshot(pmstep_console_snapshot_t *snap)
-{
-    snap->period = clk.periods - 1u; /* the period that just ended (counted from the timer's start) */
-    pmstep_stm32g4_last_period(&snap->out, &snap->meas, &snap->port_fault);
-}
-
 int main(void)
 {
-    pmstep_status_t st;
-    pmstep_stm32g4_status_t port_st;
-    uint32_t sysclk_hz;
-    uint8_t tx[64];
-    uint32_t tx_len = 0u;
-    uint32_t tx_pos = 0u;
-
-    board = pmstep_stm32g4_default_config();
-    port_st = pmstep_stm32g4_clock_init(&board.clock);
-    if (port_st != PMSTEP_STM32G4_OK) {
-        halt((int32_t)port_st);
+    const int32_t st = pmstep_app_init();
+    if (st != 0) {
+        halt(st);
     }
-    motor_config = pmstep_console_app_config(pmstep_stm32g4_period_s(&board), 1u); /* duties load one period later */
-    st = pmstep_init(&motor, &motor_config);
-    if (st != PMSTEP_OK) {
-        halt(-100 + (int32_t)st);
-    }
-    port_st = pmstep_stm32g4_init(&board, &motor);
-    if (port_st != PMSTEP_STM32G4_OK) {
-        halt((int32_t)port_st);
-    }
-    sysclk_hz = pmstep_stm32g4_sysclk_hz(&board.clock);
-    port_st = pmstep_stm32g4_lpuart_init(&board, sysclk_hz); /* PCLK1 = SYSCLK */
-    if (port_st != PMSTEP_STM32G4_OK) {
-        halt((int32_t)port_st);
-    }
-    pmstep_console_init(&console, "pmstep " PMSTEP_VERSION_TEXT " stm32g431", false);
-    clk.cycles_per_period = (uint32_t)((float)sysclk_hz * motor_config.period_s + 0.5f); /* 2 ARR */
-    clk.cycles_per_ms = sysclk_hz / 1000u;
-    clk.last = STM32G4_DWT->CYCCNT;
-    pmstep_stm32g4_start();
-
     for (;;) {
-        uint8_t rx[32];
-        const uint32_t n = pmstep_stm32g4_lpuart_read(rx, sizeof rx, (uint32_t *)&app_uart_errors);
-        pmstep_console_snapshot_t snap;
-        clock_update();
-        pmstep_console_receive(&console, rx, n, clk.ms);
-        if (pmstep_console_pending(&console)
-            || (console.decimation != 0u && (int32_t)(clk.periods - 1u - console.next_telemetry) >= 0)) {
-            pmstep_stm32g4_hold_control();
-            snapshot(&snap);
-            if (pmstep_console_pending_command(&console) == PMSTEP_CONSOLE_CLEAR_FAULT) {
-                (void)pmstep_stm32g4_clear_fault(); /* the port's latch too (break, driver fault input) */
-            }
-            pmstep_console_boundary(&console, &motor, &motor_config, &snap);
-            pmstep_stm32g4_release_control();
-            pmstep_console_telemetry(&console, &snap);
-        }
-        if (tx_pos == tx_len) {
-            tx_len = pmstep_console_transmit(&console, tx, sizeof tx);
-            tx_pos = 0u;
-        }
-        tx_pos += pmstep_stm32g4_lpuart_write(&tx[tx_pos], tx_len - tx_pos);
+        pmstep_app_poll();
     }
 }

@@ -486,6 +486,12 @@ stm32g4_gpio_t *stm32g4_fake_gpio(uint32_t port);
 #define STM32G4_DEMCR (stm32g4_fake.demcr)
 #define STM32G4_DWT (&stm32g4_fake.dwt)
 #define STM32G4_WAIT_HOOK() stm32g4_fake_wait_hook()
+/** LPUART data registers: a read of RDR takes the byte (and clears RXNE), a write of TDR sends
+ *  one; plain RAM cannot show either, so the fake goes through these. */
+uint32_t stm32g4_fake_lpuart_rdr(void);
+void stm32g4_fake_lpuart_tdr(uint32_t byte);
+#define STM32G4_LPUART_READ_RDR(u) ((void)(u), stm32g4_fake_lpuart_rdr())
+#define STM32G4_LPUART_WRITE_TDR(u, b) ((void)(u), stm32g4_fake_lpuart_tdr(b))
 #else
 #define STM32G4_RCC ((stm32g4_rcc_t *)STM32G4_RCC_BASE)
 #define STM32G4_PWR ((stm32g4_pwr_t *)STM32G4_PWR_BASE)
@@ -501,6 +507,8 @@ stm32g4_gpio_t *stm32g4_fake_gpio(uint32_t port);
 #define STM32G4_DEMCR (*(volatile uint32_t *)STM32G4_DEMCR_ADDR)
 #define STM32G4_DWT ((stm32g4_dwt_t *)STM32G4_DWT_BASE)
 #define STM32G4_WAIT_HOOK() ((void)0)
+#define STM32G4_LPUART_READ_RDR(u) ((u)->RDR)
+#define STM32G4_LPUART_WRITE_TDR(u, b) ((u)->TDR = (b))
 #endif
 
 #ifdef __cplusplus

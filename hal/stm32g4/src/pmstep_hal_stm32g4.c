@@ -248,7 +248,9 @@ void pmstep_stm32g4_hold_control(void)
 
 void pmstep_stm32g4_release_control(void)
 {
-    STM32G4_NVIC->ISER[STM32G4_IRQ_ADC1_2 / 32u] = STM32G4_BIT(STM32G4_IRQ_ADC1_2 % 32u);
+    /* Write-one-to-set; the read-modify-write keeps a fake register block (plain RAM) showing
+     * every enabled line, as nvic_enable() does, and changes nothing on the hardware. */
+    STM32G4_NVIC->ISER[STM32G4_IRQ_ADC1_2 / 32u] |= STM32G4_BIT(STM32G4_IRQ_ADC1_2 % 32u);
 }
 
 void pmstep_stm32g4_last_period(pmstep_output_t *out, pmstep_meas_t *meas, uint8_t *port_fault)

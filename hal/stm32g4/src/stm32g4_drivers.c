@@ -389,7 +389,7 @@ uint32_t pmstep_stm32g4_lpuart_read(uint8_t *data, uint32_t max, uint32_t *error
         }
     }
     while (n < max && (u->ISR & LPUART_ISR_RXNE) != 0u) {
-        data[n++] = (uint8_t)(u->RDR & 0xFFu);
+        data[n++] = (uint8_t)(STM32G4_LPUART_READ_RDR(u) & 0xFFu);
     }
     return n;
 }
@@ -399,7 +399,8 @@ uint32_t pmstep_stm32g4_lpuart_write(const uint8_t *data, uint32_t n)
     stm32g4_lpuart_t *const u = STM32G4_LPUART1;
     uint32_t k = 0u;
     while (k < n && (u->ISR & LPUART_ISR_TXE) != 0u) {
-        u->TDR = data[k++];
+        STM32G4_LPUART_WRITE_TDR(u, data[k]);
+        ++k;
     }
     return k;
 }

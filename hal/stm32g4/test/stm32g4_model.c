@@ -227,8 +227,66 @@ static void tim_sync(void)
     TIM->SR = M.sr;
 }
 
+/* ---------------------------------------------------------------------------
+ * LPUART1 (§38.7.8, §38.7.10, §38.7.11): RXNE while received data waits in RDR, cleared by
+ * reading RDR; TXE when TDR can take a byte. The NVIC's ICER (ARMv7-M B3.4.4) clears enables.
+ * The DWT cycle counter counts CPU cycles (ARMv7-M C1.8.8): one per TIM1 tick here.
+ * ------------------------------------------------------------------------- */
+static void uart_status(void)
+{
+    stm32g4_fake.lpuart1.ISR = (stm32g4_fake.lpuart1.ISR & ~LPUART_ISR_RXNE) | LPUART_ISR_TXE
+                               | (M.uart_rx_head < M.uart_rx_len ? LPUART_ISR_RXNE : 0u);
+    if (M.uart_rx_head < M.uart_rx_len) {
+        stm32g4_fake.lpuart1.RDR = M.uart_rx[M.uart_rx_head];
+    }
+}
+
+void stm32g4_model_uart_send(const uint8_t *data, uint32_t n)
+{
+    uint32_t k;
+    if (M.uart_rx_head == M.uart_rx_len) {
+        M.uart_rx_head = 0u;
+        M.uart_rx_len = 0u;
+    }
+    for (k = 0; k < n && M.uart_rx_len < sizeof M.uart_rx; ++k) {
+        M.uart_rx[M.uart_rx_len++] = data[k];
+    }
+    uart_status();
+}
+
+uint32_t stm32g4_fake_lpuart_rdr(void)
+{
+    uint32_t b = stm32g4_fake.lpuart1.RDR;
+    if (M.uart_rx_head < M.uart_rx_len) {
+        b = M.uart_rx[M.uart_rx_head++];
+    }
+    uart_status();
+    return b;
+}
+
+void stm32g4_fake_lpuart_tdr(uint32_t byte)
+{
+    if ((stm32g4_fake.lpuart1.CR1 & (LPUART_CR1_UE | LPUART_CR1_TE)) == (LPUART_CR1_UE | LPUART_CR1_TE)
+        && (stm32g4_fake.rcc.APB1ENR2 & RCC_APB1ENR2_LPUART1EN) != 0u && M.uart_tx_len < sizeof M.uart_tx) {
+        M.uart_tx[M.uart_tx_len++] = (uint8_t)byte;
+    }
+}
+
+/* The model takes interrupts only between the application's turns (never inside one), so a
+ * line held off with ICER and enabled again with ISER within a turn needs no modelling; ICER
+ * writes are consumed (the tests check the enables the turn leaves behind). */
+static void nvic_sync(void)
+{
+    unsigned i;
+    for (i = 0; i < 8u; ++i) {
+        stm32g4_fake.nvic.ICER[i] = 0u;
+    }
+}
+
 void stm32g4_model_sync(void)
 {
+    nvic_sync();
+    uart_status();
     gpio_sync();
     adc_sync(0u);
     adc_sync(1u);
@@ -581,6 +639,9 @@ void stm32g4_model_run(uint64_t ticks)
         stm32g4_model_sync();
         M.update_pulse = false;
         M.tick++;
+        if ((stm32g4_fake.dwt.CTRL & DWT_CTRL_CYCCNTENA) != 0u) {
+            stm32g4_fake.dwt.CYCCNT++;
+        }
         break_update();
         if ((TIM->CR1 & TIM_CR1_CEN) != 0u) {
             counter_tick();

@@ -86,6 +86,13 @@ typedef struct {
     stm32g4_gpio_t gpio_seen[STM32G4_GPIO_PORTS]; /**< register values the model last accepted */
     unsigned unclocked_writes;  /**< writes to a GPIO port whose clock was off (lost) */
 
+    /* ---- LPUART1 (the console): bytes from the host, bytes sent ---- */
+    uint8_t uart_rx[4096];
+    uint32_t uart_rx_head;
+    uint32_t uart_rx_len;
+    uint8_t uart_tx[16384];
+    uint32_t uart_tx_len;
+
     /* ---- interrupts taken ---- */
     unsigned adc_irqs;
     unsigned brk_irqs;
@@ -110,6 +117,10 @@ bool stm32g4_model_flash_ok(uint32_t hclk_hz);
 
 /** Dead time in TIM1 clock ticks of a DTG code (RM0440 §28.6.20, CKD = 0). */
 uint32_t stm32g4_model_dead_time_ticks(uint32_t dtg);
+
+/** Queues @p n bytes for LPUART1's receiver (RXNE while any is left); the transmitter takes every
+ *  byte at once (TXE always set) into uart_tx. Line timing is not modelled. */
+void stm32g4_model_uart_send(const uint8_t *data, uint32_t n);
 
 /** Drives an input pin's level (IDR), port 0 = A; accepted whatever the port's clock. */
 void stm32g4_model_pin_in(unsigned port, unsigned pin, bool high);

@@ -60,6 +60,17 @@ stm32g4_gpio_t *stm32g4_fake_gpio(uint32_t port)
     return &stm32g4_fake.gpio[port];
 }
 
+/* LPUART data registers as plain RAM: RDR as it is, TDR keeps the last byte. */
+uint32_t stm32g4_fake_lpuart_rdr(void)
+{
+    return stm32g4_fake.lpuart1.RDR;
+}
+
+void stm32g4_fake_lpuart_tdr(uint32_t byte)
+{
+    stm32g4_fake.lpuart1.TDR = byte;
+}
+
 static pmstep_stm32g4_config_t board;
 static pmstep_config_t motor_config;
 static pmstep_t motor;
