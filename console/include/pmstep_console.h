@@ -151,6 +151,12 @@ int pmstep_console_config_set(pmstep_config_t *cfg, uint32_t id, float value);
 /** The application's configuration: the paper's, with the port's period and delay. */
 pmstep_config_t pmstep_console_app_config(float period_s, uint32_t computational_delay_periods);
 
+/** The control period (s) of @p cfg. */
+float pmstep_console_config_period_s(const pmstep_config_t *cfg);
+
+/** The computational delay (periods) of @p cfg. */
+uint32_t pmstep_console_config_delay_periods(const pmstep_config_t *cfg);
+
 typedef struct {
     /* receiver */
     uint8_t state;

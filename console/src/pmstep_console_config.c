@@ -1,8 +1,8 @@
 /*
- * The configuration values the console reads and writes by name or id, and the
- * application's configuration. The only file of the console and the applications that
- * names fields of pmstep_config_t: a change of the core's configuration layout is an edit
- * of this file alone.
+ * The configuration values the console reads and writes by name or id, the application's
+ * configuration, and the two values the images read (period, delay). The only file of the
+ * console, the applications and their tests that names fields of pmstep_config_t: a change of
+ * the core's configuration layout is an edit of this file alone.
  */
 #include <stddef.h>
 
@@ -136,4 +136,14 @@ pmstep_config_t pmstep_console_app_config(float period_s, uint32_t computational
     cfg.period_s = period_s;
     cfg.computational_delay_periods = computational_delay_periods;
     return cfg;
+}
+
+float pmstep_console_config_period_s(const pmstep_config_t *cfg)
+{
+    return cfg->period_s;
+}
+
+uint32_t pmstep_console_config_delay_periods(const pmstep_config_t *cfg)
+{
+    return cfg->computational_delay_periods;
 }

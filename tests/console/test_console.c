@@ -283,7 +283,9 @@ static void test_config_by_name_and_id(void **state)
         step();
         assert_int_equal(replies(r, 2), 1u);
         assert_int_equal(ack_status(&r[0]), PMSTEP_ERR_RESISTANCE);
-        assert_float_equal(cfg.resistance_ohm, 3.0f, 0.0f);
+        float ohm = 0.0f;
+        assert_true(pmstep_console_config_get(&cfg, 0u, &ohm)); /* resistance_ohm */
+        assert_float_equal(ohm, 3.0f, 0.0f);
     }
     /* Read-only (the port's period), unknown name, non-integer integer. */
     {
@@ -314,7 +316,9 @@ static void test_config_by_name_and_id(void **state)
         assert_int_equal(replies(r, 2), 1u);
         assert_int_equal(r[0].type, 0xFFu);
         assert_int_equal(r[0].data[1], PMSTEP_CONSOLE_ERR_NOT_STOPPED);
-        assert_float_equal(cfg.speed_gain_per_s, 120.0f, 0.0f);
+        float g = 0.0f;
+        assert_true(pmstep_console_config_get(&cfg, 12u, &g)); /* speed_gain_per_s */
+        assert_float_equal(g, 120.0f, 0.0f);
     }
 }
 

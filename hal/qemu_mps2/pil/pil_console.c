@@ -240,7 +240,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "pil-console: pmstep_init: %s\n", pmstep_status_str(st));
         return 2;
     }
-    L.period_s = (double)config.period_s;
+    L.period_s = (double)pmstep_console_config_period_s(&config);
     steps = sil_periods_in(L.sc.duration_s, L.period_s);
     sil_metrics_init(&L.metrics, &L.sc, &L.s);
     memset(&L.plant, 0, sizeof L.plant);
@@ -251,7 +251,8 @@ int main(int argc, char **argv)
     L.plant.x.i_a_a = L.sc.i_a0_a;
     L.plant.x.i_b_a = L.sc.i_b0_a;
     L.p = (double)L.plant.params.pole_pairs;
-    sil_inverter_init(&L.inv, &L.sc.inverter, &L.sc.bus, L.sc.bus_voltage_v, config.computational_delay_periods);
+    sil_inverter_init(&L.inv, &L.sc.inverter, &L.sc.bus, L.sc.bus_voltage_v,
+                      pmstep_console_config_delay_periods(&config));
 
     mps2_pil_init(&motor);
     insns_per_tick = mps2_pil_instructions_per_tick(100000u);

@@ -81,7 +81,7 @@ int32_t pmstep_app_init(void)
     uart_errors = 0u;
     tx_len = 0u;
     tx_pos = 0u;
-    clk.cycles_per_period = (uint32_t)((float)sysclk_hz * motor_config.period_s + 0.5f); /* 2 ARR */
+    clk.cycles_per_period = (uint32_t)((float)sysclk_hz * pmstep_stm32g4_period_s(&board) + 0.5f); /* 2 ARR */
     clk.cycles_per_ms = sysclk_hz / 1000u;
     clk.last = STM32G4_DWT->CYCCNT;
     clk.rem_ms = 0u;

@@ -29,9 +29,7 @@ static int setup(void **state)
     (void)state;
     stm32g4_model_reset();
     board = pmstep_stm32g4_default_config();
-    motor_config = pmstep_paper_config();
-    motor_config.period_s = pmstep_stm32g4_period_s(&board);
-    motor_config.computational_delay_periods = 1u;
+    motor_config = pmstep_console_app_config(pmstep_stm32g4_period_s(&board), 1u);
     assert_int_equal(pmstep_init(&motor, &motor_config), PMSTEP_OK);
     return 0;
 }
