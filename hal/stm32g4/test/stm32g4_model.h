@@ -13,7 +13,9 @@
  * handlers at the tick they become pending (the CPU time of a handler is not modelled).
  *
  * Each rule in stm32g4_model.c cites the section of the reference manual (ST RM0440,
- * "STM32G4 Series advanced Arm-based 32-bit MCUs") it models. Not modelled: prescaler
+ * "STM32G4 Series advanced Arm-based 32-bit MCUs") it models, numbered as in the revision the
+ * port's register header follows (Rev 8), with the section's title where other revisions number
+ * it differently. Not modelled: prescaler
  * other than 0, input capture, break filter and break 2, OCxREF clear, combined/asymmetric
  * PWM modes, the injected queue (JQDIS = 1 is assumed), regular conversions.
  */
