@@ -5,12 +5,13 @@
 function(pmstep_label_tests_here)
   get_directory_property(tests TESTS)
   foreach(test IN LISTS tests)
-    if(test MATCHES "^pil\\.")
+    if(test MATCHES "^pil\\." OR test MATCHES "^console\\.qemu_e2e$")
       set(speed pil slow)
     elseif(test MATCHES "^(closed_loop|robustness|oracle)\\."
            OR test MATCHES "^gain_check\\.(theory_and_sil|cli_doa_smoke)$"
            OR test MATCHES "^sil_cli\\.scenario_"
-           OR test MATCHES "^hal\\.stm32g4_image")
+           OR test MATCHES "^hal\\.stm32g4_image"
+           OR test MATCHES "^console\\.host_tool$")
       set(speed slow)
     else()
       set(speed fast)

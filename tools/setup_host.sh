@@ -12,12 +12,5 @@ echo "== build (preset host-release)"
 cmake --preset host-release >/dev/null
 cmake --build --preset host-release
 
-echo "== plotting environment (.venv, tools/requirements.txt)"
-if [ ! -x .venv/bin/python ]; then
-  if ! python3 -m venv .venv 2>/dev/null; then
-    rm -rf .venv
-    tools/install_deps.sh python3-venv
-    python3 -m venv .venv
-  fi
-fi
-.venv/bin/python -m pip install --quiet --disable-pip-version-check -r tools/requirements.txt
+echo "== Python environment (.venv, tools/requirements.txt)"
+tools/setup_venv.sh

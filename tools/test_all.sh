@@ -7,6 +7,9 @@ cd "$(dirname "$0")/.."
 
 tools/install_deps.sh
 
+echo "== Python environment (.venv, tools/requirements.txt: the console's pyserial, plots)"
+tools/setup_venv.sh
+
 echo "== host build (preset host: ASan + UBSan)"
 cmake --preset host >/dev/null
 cmake --build --preset host

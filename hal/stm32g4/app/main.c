@@ -1,17 +1,19 @@
 /*
  * STM32G431 firmware image: the paper's controller on the board described by
- * pmstep_stm32g4_default_config(). After reset it sets the clock to 170 MHz, brings
- * up TIM1, the ADCs and the gate driver pins with the bridge off, starts the
- * strategy (s-alignment, c-alignment, then the adaptive controller with a 10 rad/s
- * set-point) and sleeps; everything else happens in the ADC interrupt, every
- * 50 us. A real application replaces the fixed start and set-point by its commands.
+ * pmstep_stm32g4_default_config() (a NUCLEO-G431RB with a dual full-bridge stage), driven
+ * from the console on LPUART1 (the ST-LINK virtual COM port, 115200 8N1; protocol in
+ * firmware/console/include/pmstep_console.h, host tool tools/pmstep_console.py).
+ *
+ * After reset: clock to 170 MHz, TIM1, the ADCs and the gate-driver pins with the bridge
+ * off, the console's UART; the motor waits in IDLE for a start command. The control step
+ * runs in the ADC interrupt every 50 us; this main loop receives and parses commands,
+ * applies each one at a period boundary (the control interrupt held off for the few
+ * microseconds it takes, never inside a step), and sends replies and telemetry. The
+ * control interrupt has no console code in it. The application itself is app.c.
  */
-#include "pmstep_hal_stm32g4.h"
+#include "app.h"
 
-static pmstep_t motor;
-static pmstep_config_t motor_config;       /* must outlive the instance */
-static pmstep_stm32g4_config_t board;      /* must outlive the port */
-volatile int32_t app_status;               /* for a debugger: 0, or the failing step's status */
+volatile int32_t app_status; /* for a debugger: 0, or the failing step's status */
 
 static void halt(int32_t status)
 {
@@ -23,29 +25,11 @@ static void halt(int32_t status)
 
 int main(void)
 {
-    pmstep_status_t st;
-    pmstep_stm32g4_status_t port_st;
-
-    board = pmstep_stm32g4_default_config();
-    port_st = pmstep_stm32g4_clock_init(&board.clock);
-    if (port_st != PMSTEP_STM32G4_OK) {
-        halt((int32_t)port_st);
+    const int32_t st = pmstep_app_init();
+    if (st != 0) {
+        halt(st);
     }
-    motor_config = pmstep_paper_config();
-    motor_config.timing.period_s = pmstep_stm32g4_period_s(&board); /* 50 us at 20 kHz */
-    motor_config.timing.computational_delay_periods = 1u;          /* duties load at the next carrier peak */
-    st = pmstep_init(&motor, &motor_config);
-    if (st != PMSTEP_OK) {
-        halt(-100 + (int32_t)st);
-    }
-    port_st = pmstep_stm32g4_init(&board, &motor);
-    if (port_st != PMSTEP_STM32G4_OK) {
-        halt((int32_t)port_st);
-    }
-    (void)pmstep_set_speed_target(&motor, 10.0f, 50.0f);
-    (void)pmstep_start(&motor);
-    pmstep_stm32g4_start();
     for (;;) {
-        __asm volatile("wfi");
+        pmstep_app_poll();
     }
 }

@@ -13,7 +13,8 @@
  * with the duty d of a half-bridge the fraction of the period its high side is on.
  *
  * Timing: TIM1 counts up and down (centre-aligned mode 1), so the carrier period is
- * 2 ARR / f_TIM1. Channel 5 (internal) makes TRGO2 rise at the counter peak, the
+ * 2 ARR / f_TIM1. Channel 5 (internal) makes TRGO2 rise at the counter peak (one timer
+ * tick before it, at CNT = ARR - 1), the
  * centre of the interval where every low side conducts; ADC1 (i_a, then the bus)
  * and ADC2 (i_b) convert on that edge; ADC1's end of injected sequence interrupts.
  * The interrupt writes the duties into preloaded compare registers that take
@@ -43,7 +44,10 @@ typedef enum {
     PMSTEP_STM32G4_ERR_DUTY_RANGE = -6,     /**< duty_min/duty_max not 0 <= min < max <= 1 */
     PMSTEP_STM32G4_ERR_ADC_CONFIG = -7,     /**< channel or sample-time code out of range */
     PMSTEP_STM32G4_ERR_ADC_TIMEOUT = -8,    /**< ADC calibration or enable did not complete */
-    PMSTEP_STM32G4_ERR_PIN = -9             /**< a pin's port, number or alternate function out of range */
+    PMSTEP_STM32G4_ERR_PIN = -9,            /**< a pin's port, number or alternate function out of range */
+    PMSTEP_STM32G4_ERR_PIN_CONFLICT = -10,  /**< two functions on one pin */
+    PMSTEP_STM32G4_ERR_PIN_RESERVED = -11,  /**< a pin the board itself uses (VCP, SWD, crystal..) given another function */
+    PMSTEP_STM32G4_ERR_UART_CONFIG = -12    /**< console baud rate outside what LPUART1 can make from its clock */
 } pmstep_stm32g4_status_t;
 
 /** Why the port holds the bridge off, independently of the core. */
@@ -59,6 +63,28 @@ typedef struct {
     uint8_t pin;
     uint8_t af;
 } pmstep_stm32g4_pin_t;
+
+/** One use of a pin: what it does on the drive, the MCU signal (with an ADC channel number
+ *  appended when @p channel is not 0), and the pin. */
+typedef struct {
+    const char *function;   /**< e.g. "phase a+ high side" */
+    const char *signal;     /**< e.g. "TIM1_CH1", "ADC1_IN" (then channel), "GPIO output" */
+    uint8_t channel;        /**< ADC channel of an analog input, 0 otherwise */
+    pmstep_stm32g4_pin_t pin;
+} pmstep_stm32g4_pin_use_t;
+
+/** A controller board: the pins it uses itself (and what for), which a drive may use only for
+ *  the same signal (the console on the virtual COM port) or not at all. */
+typedef struct {
+    const char *name;
+    const pmstep_stm32g4_pin_use_t *reserved;
+    uint32_t reserved_count;
+} pmstep_stm32g4_board_t;
+
+/** NUCLEO-G431RB (MB1367, user manual UM2505): ST-LINK virtual COM port on LPUART1 PA2/PA3,
+ *  SWD PA13/PA14, SWO PB3, LD2 on PA5, B1 on PC13, HSE crystal PF0/PF1, LSE crystal PC14/PC15,
+ *  BOOT0 on PB8, NRST on PG10. */
+extern const pmstep_stm32g4_board_t pmstep_stm32g4_board_nucleo_g431rb;
 
 /** Clock tree: HSI16 -> PLL; SYSCLK = 16 MHz / pll_m * pll_n / pll_r (HCLK = PCLK1 = PCLK2 = SYSCLK). */
 typedef struct {
@@ -99,13 +125,36 @@ typedef struct {
     bool enable_active_high;
     pmstep_stm32g4_pin_t fault_pin;   /**< gate driver fault (input with pull-up when active low) */
     bool fault_active_high;
+
+    /* Console: LPUART1, 8N1 */
+    pmstep_stm32g4_pin_t console_tx;  /**< LPUART1_TX */
+    pmstep_stm32g4_pin_t console_rx;  /**< LPUART1_RX */
+    uint32_t console_baud;            /**< e.g. 115200 */
+
+    /** The controller board whose own pins the drive must keep off (NULL: none checked). */
+    const pmstep_stm32g4_board_t *board;
 } pmstep_stm32g4_config_t;
 
+/** Every pin @p cfg uses, with its function, into @p out (up to @p max). @return the count
+ *  (18 for a complete configuration), or 0 if @p cfg is NULL. */
+uint32_t pmstep_stm32g4_pin_map(const pmstep_stm32g4_config_t *cfg, pmstep_stm32g4_pin_use_t *out, uint32_t max);
+
 /**
- * A board: Nucleo-G431RB-like pins (to check against your schematic and the
- * datasheet's alternate-function table, DS12589), 20 kHz, 500 ns dead time,
- * 12-bit ADC with a 3.3 V reference, current sensors of 0.1 V/A centred at
- * 1.65 V, bus divider 1:20.
+ * Checks the pin map of @p cfg: every pin in range, one function per pin, and the board's
+ * own pins (cfg->board) used only for the signal the board gives them.
+ * @retval PMSTEP_STM32G4_OK
+ * @retval PMSTEP_STM32G4_ERR_NULL_ARGUMENT
+ * @retval PMSTEP_STM32G4_ERR_PIN           a port, pin or alternate function out of range
+ * @retval PMSTEP_STM32G4_ERR_PIN_CONFLICT  two functions on one pin
+ * @retval PMSTEP_STM32G4_ERR_PIN_RESERVED  a board pin given another function
+ */
+pmstep_stm32g4_status_t pmstep_stm32g4_check_pins(const pmstep_stm32g4_config_t *cfg);
+
+/**
+ * The default drive: a NUCLEO-G431RB with a dual full-bridge power stage (pin map in
+ * stm32g4_board.c; check it against your stage's schematic), 20 kHz, 500 ns dead time,
+ * 12-bit ADC with a 3.3 V reference, current sensors of 0.1 V/A centred at 1.65 V, bus
+ * divider 1:20, console on LPUART1 (the ST-LINK virtual COM port) at 115200 8N1.
  */
 pmstep_stm32g4_config_t pmstep_stm32g4_default_config(void);
 
@@ -139,7 +188,12 @@ uint32_t pmstep_stm32g4_dtg_to_ns(uint8_t dtg, uint32_t tim_clock_Hz);
 /** SYSCLK (Hz) of a clock configuration, or 0 when it is out of range. */
 uint32_t pmstep_stm32g4_sysclk_Hz(const pmstep_stm32g4_clock_t *clock);
 
-/** Flash wait states for @p hclk_Hz in range 1 boost mode (RM0440 §3.3.3, Table 9). */
+/** Flash wait states for @p hclk_Hz in range 1 boost mode (@p boost) or normal mode
+ *  (RM0440 §3.3.3, Table 9: 34 MHz resp. 30 MHz per wait state). */
+uint32_t pmstep_stm32g4_flash_latency_mode(uint32_t hclk_Hz, bool boost);
+
+/** Flash wait states for @p hclk_Hz in the regulator mode the port uses at that clock: boost
+ *  above 150 MHz, normal mode at or below. */
 uint32_t pmstep_stm32g4_flash_latency(uint32_t hclk_Hz);
 
 /** TIM1 ARR for a centre-aligned carrier: round(f_TIM / (2 f_pwm)); 0 when outside 2..65535. */
@@ -186,6 +240,31 @@ bool pmstep_stm32g4_bridge_on(void);
 
 /** Longest control interrupt so far, in CPU cycles (DWT cycle counter). */
 uint32_t pmstep_stm32g4_isr_cycles_max(void);
+
+/** LPUART BRR for @p baud from the kernel clock @p clock_hz (RM0440 §38.4), 0 if out of range. */
+uint32_t pmstep_stm32g4_lpuart_brr(uint32_t clock_hz, uint32_t baud);
+
+/** LPUART1 at cfg->console_baud 8N1 from PCLK1 = @p pclk1_hz, on the console pins. */
+pmstep_stm32g4_status_t pmstep_stm32g4_lpuart_init(const pmstep_stm32g4_config_t *cfg, uint32_t pclk1_hz);
+
+/** Takes up to @p max received bytes, never waits; a receive error adds one to @p errors. */
+uint32_t pmstep_stm32g4_lpuart_read(uint8_t *data, uint32_t max, uint32_t *errors);
+
+/** Sends as many of @p n bytes as the transmitter takes now, never waits. @return that count. */
+uint32_t pmstep_stm32g4_lpuart_write(const uint8_t *data, uint32_t n);
+
+/** Holds the control interrupt off (main loop, for a period boundary: never for long). */
+void pmstep_stm32g4_hold_control(void);
+
+/** Lets the control interrupt run again (a period that ended meanwhile runs now). */
+void pmstep_stm32g4_release_control(void);
+
+/**
+ * The last period as the control interrupt left it, read between periods (call between
+ * pmstep_stm32g4_hold_control() and _release_control()): the step's output, the samples
+ * converted again from the ADC data registers, the port's fault.
+ */
+void pmstep_stm32g4_last_period(pmstep_output_t *out, pmstep_meas_t *meas, uint8_t *port_fault);
 
 /** ADC1 and ADC2 interrupt: the control period. */
 void ADC1_2_IRQHandler(void);

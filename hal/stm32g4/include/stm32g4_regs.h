@@ -147,9 +147,9 @@ STM32G4_STATIC_ASSERT(offsetof(stm32g4_pwr_t, CR5) == 0x80, pwr_cr5);
 typedef struct {
     volatile uint32_t ACR; /* 0x00 access control */
 } stm32g4_flash_t;
-/* FLASH_ACR (§3.7.1): LATENCY[3:0], PRFTEN 8, ICEN 9, DCEN 10. Wait states in range 1 boost
- * mode: one per 34 MHz of HCLK, 4 WS up to 170 MHz (§3.3.3, Table 9 "Number of wait states
- * according to CPU clock (HCLK) frequency"). */
+/* FLASH_ACR (§3.7.1): LATENCY[3:0], PRFTEN 8, ICEN 9, DCEN 10. Wait states (§3.3.3, Table 9
+ * "Number of wait states according to CPU clock (HCLK) frequency"): range 1 boost mode one per
+ * 34 MHz of HCLK (4 WS up to 170 MHz), range 1 normal mode one per 30 MHz (up to 150 MHz). */
 #define FLASH_ACR_LATENCY_MASK 0xFu
 #define FLASH_ACR_PRFTEN STM32G4_BIT(8)
 #define FLASH_ACR_ICEN STM32G4_BIT(9)
@@ -360,6 +360,38 @@ STM32G4_STATIC_ASSERT(offsetof(stm32g4_adc_common_t, CCR) == 0x08, adc_ccr);
 #define ADC_CHANNEL_MAX 18u
 
 /* ---------------------------------------------------------------------------
+ * LPUART1: RM0440 §38.7 "LPUART registers", base 0x4000 8000 (the NUCLEO's virtual COM port)
+ * ------------------------------------------------------------------------- */
+typedef struct {
+    volatile uint32_t CR1;   /* 0x00 */
+    volatile uint32_t CR2;   /* 0x04 */
+    volatile uint32_t CR3;   /* 0x08 */
+    volatile uint32_t BRR;   /* 0x0C 256 f_ck / baud, 0x300..0xFFFFF */
+    uint32_t reserved0[2];   /* 0x10, 0x14 */
+    volatile uint32_t RQR;   /* 0x18 */
+    volatile uint32_t ISR;   /* 0x1C */
+    volatile uint32_t ICR;   /* 0x20 flags cleared by writing 1 */
+    volatile uint32_t RDR;   /* 0x24 */
+    volatile uint32_t TDR;   /* 0x28 */
+    volatile uint32_t PRESC; /* 0x2C */
+} stm32g4_lpuart_t;
+STM32G4_STATIC_ASSERT(offsetof(stm32g4_lpuart_t, ISR) == 0x1C, lpuart_isr);
+STM32G4_STATIC_ASSERT(offsetof(stm32g4_lpuart_t, PRESC) == 0x2C, lpuart_presc);
+/* LPUART_CR1 (§38.7.1): UE 0, RE 2, TE 3. LPUART_ISR (§38.7.8): PE 0, FE 1, NE 2, ORE 3, RXNE 5,
+ * TXE 7. LPUART_ICR (§38.7.9): PECF 0, FECF 1, NECF 2, ORECF 3. RCC_APB1ENR2 (§7.4.18): LPUART1EN 0.
+ * RCC_CCIPR (§7.4.26): LPUART1SEL[11:10], 00 = PCLK1. */
+#define LPUART_CR1_UE STM32G4_BIT(0)
+#define LPUART_CR1_RE STM32G4_BIT(2)
+#define LPUART_CR1_TE STM32G4_BIT(3)
+#define LPUART_ISR_ERRORS (STM32G4_BIT(0) | STM32G4_BIT(1) | STM32G4_BIT(2) | STM32G4_BIT(3))
+#define LPUART_ISR_RXNE STM32G4_BIT(5)
+#define LPUART_ISR_TXE STM32G4_BIT(7)
+#define LPUART_BRR_MIN 0x300u
+#define LPUART_BRR_MAX 0xFFFFFu
+#define RCC_APB1ENR2_LPUART1EN STM32G4_BIT(0)
+#define RCC_CCIPR_LPUART1SEL_MASK (3u << 10)
+
+/* ---------------------------------------------------------------------------
  * Cortex-M4 core peripherals (ARMv7-M ARM, ARM DDI 0403E)
  * ------------------------------------------------------------------------- */
 /* NVIC (B3.4.3): ISER 0xE000E100, ICER 0xE000E180, ISPR 0xE000E200, ICPR 0xE000E280,
@@ -403,6 +435,7 @@ typedef struct {
 
 /* Base addresses (RM0440 Table 4) */
 #define STM32G4_PWR_BASE 0x40007000u
+#define STM32G4_LPUART1_BASE 0x40008000u
 #define STM32G4_TIM1_BASE 0x40012C00u
 #define STM32G4_RCC_BASE 0x40021000u
 #define STM32G4_FLASH_R_BASE 0x40022000u
@@ -427,6 +460,7 @@ typedef struct {
     stm32g4_adc_t adc1;
     stm32g4_adc_t adc2;
     stm32g4_adc_common_t adc12;
+    stm32g4_lpuart_t lpuart1;
     stm32g4_nvic_t nvic;
     stm32g4_scb_t scb;
     volatile uint32_t demcr;
@@ -435,19 +469,29 @@ typedef struct {
 extern stm32g4_fake_t stm32g4_fake;
 /** Called in every iteration of a bounded wait loop: the test plays the hardware here. */
 void stm32g4_fake_wait_hook(void);
+/** A GPIO port's block: every driver access to a port goes through it, so a test can play the
+ *  clock gating of the port (writes to a port whose clock is off are lost on the hardware). */
+stm32g4_gpio_t *stm32g4_fake_gpio(uint32_t port);
 #define STM32G4_RCC (&stm32g4_fake.rcc)
 #define STM32G4_PWR (&stm32g4_fake.pwr)
 #define STM32G4_FLASH (&stm32g4_fake.flash)
-#define STM32G4_GPIO(port) (&stm32g4_fake.gpio[(port)])
+#define STM32G4_GPIO(port) stm32g4_fake_gpio((uint32_t)(port))
 #define STM32G4_TIM1 (&stm32g4_fake.tim1)
 #define STM32G4_ADC1 (&stm32g4_fake.adc1)
 #define STM32G4_ADC2 (&stm32g4_fake.adc2)
 #define STM32G4_ADC12 (&stm32g4_fake.adc12)
+#define STM32G4_LPUART1 (&stm32g4_fake.lpuart1)
 #define STM32G4_NVIC (&stm32g4_fake.nvic)
 #define STM32G4_SCB (&stm32g4_fake.scb)
 #define STM32G4_DEMCR (stm32g4_fake.demcr)
 #define STM32G4_DWT (&stm32g4_fake.dwt)
 #define STM32G4_WAIT_HOOK() stm32g4_fake_wait_hook()
+/** LPUART data registers: a read of RDR takes the byte (and clears RXNE), a write of TDR sends
+ *  one; plain RAM cannot show either, so the fake goes through these. */
+uint32_t stm32g4_fake_lpuart_rdr(void);
+void stm32g4_fake_lpuart_tdr(uint32_t byte);
+#define STM32G4_LPUART_READ_RDR(u) ((void)(u), stm32g4_fake_lpuart_rdr())
+#define STM32G4_LPUART_WRITE_TDR(u, b) ((void)(u), stm32g4_fake_lpuart_tdr(b))
 #else
 #define STM32G4_RCC ((stm32g4_rcc_t *)STM32G4_RCC_BASE)
 #define STM32G4_PWR ((stm32g4_pwr_t *)STM32G4_PWR_BASE)
@@ -457,11 +501,14 @@ void stm32g4_fake_wait_hook(void);
 #define STM32G4_ADC1 ((stm32g4_adc_t *)STM32G4_ADC1_BASE)
 #define STM32G4_ADC2 ((stm32g4_adc_t *)STM32G4_ADC2_BASE)
 #define STM32G4_ADC12 ((stm32g4_adc_common_t *)STM32G4_ADC12_COMMON_BASE)
+#define STM32G4_LPUART1 ((stm32g4_lpuart_t *)STM32G4_LPUART1_BASE)
 #define STM32G4_NVIC ((stm32g4_nvic_t *)STM32G4_NVIC_BASE)
 #define STM32G4_SCB ((stm32g4_scb_t *)STM32G4_SCB_VTOR_ADDR)
 #define STM32G4_DEMCR (*(volatile uint32_t *)STM32G4_DEMCR_ADDR)
 #define STM32G4_DWT ((stm32g4_dwt_t *)STM32G4_DWT_BASE)
 #define STM32G4_WAIT_HOOK() ((void)0)
+#define STM32G4_LPUART_READ_RDR(u) ((u)->RDR)
+#define STM32G4_LPUART_WRITE_TDR(u, b) ((u)->TDR = (b))
 #endif
 
 #ifdef __cplusplus

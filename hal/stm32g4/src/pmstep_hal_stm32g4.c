@@ -208,7 +208,10 @@ pmstep_stm32g4_status_t pmstep_stm32g4_init(const pmstep_stm32g4_config_t *cfg, 
     port.isr_cycles_max = 0u;
     port.arr = pmstep_stm32g4_pwm_arr(sysclk_Hz, cfg->pwm_frequency_Hz);
 
-    st = pmstep_stm32g4_gpio_init(cfg);
+    st = pmstep_stm32g4_check_pins(cfg); /* one function per pin, the board's own pins kept */
+    if (st == PMSTEP_STM32G4_OK) {
+        st = pmstep_stm32g4_gpio_init(cfg);
+    }
     if (st == PMSTEP_STM32G4_OK) {
         st = pmstep_stm32g4_pwm_init(cfg, sysclk_Hz); /* TIM1 runs at PCLK2 = SYSCLK */
     }
@@ -233,4 +236,37 @@ pmstep_stm32g4_status_t pmstep_stm32g4_init(const pmstep_stm32g4_config_t *cfg, 
 void pmstep_stm32g4_start(void)
 {
     STM32G4_TIM1->CR1 |= TIM_CR1_CEN;
+}
+
+void pmstep_stm32g4_hold_control(void)
+{
+    STM32G4_NVIC->ICER[STM32G4_IRQ_ADC1_2 / 32u] = STM32G4_BIT(STM32G4_IRQ_ADC1_2 % 32u);
+#if !defined(STM32G4_FAKE_REGISTERS)
+    __asm volatile("dsb\n\tisb" ::: "memory"); /* no control interrupt after this point */
+#endif
+}
+
+void pmstep_stm32g4_release_control(void)
+{
+    /* Write-one-to-set; the read-modify-write keeps a fake register block (plain RAM) showing
+     * every enabled line, as nvic_enable() does, and changes nothing on the hardware. */
+    STM32G4_NVIC->ISER[STM32G4_IRQ_ADC1_2 / 32u] |= STM32G4_BIT(STM32G4_IRQ_ADC1_2 % 32u);
+}
+
+void pmstep_stm32g4_last_period(pmstep_output_t *out, pmstep_meas_t *meas, uint8_t *port_fault)
+{
+    const pmstep_stm32g4_config_t *cfg = port.cfg;
+    *out = port.out;
+    *port_fault = (uint8_t)port.fault;
+    if (cfg == NULL) {
+        const pmstep_meas_t zero = {0.0f, 0.0f, 0.0f, 0.0f};
+        *meas = zero;
+        return;
+    }
+    /* The injected data registers hold the last period's samples until the next trigger. */
+    meas->i_a_A = pmstep_stm32g4_counts_to_si(STM32G4_ADC1->JDR[0], cfg->i_a_offset_counts, cfg->i_a_gain_a_per_count);
+    meas->bus_voltage_V = pmstep_stm32g4_counts_to_si(STM32G4_ADC1->JDR[1], cfg->bus_offset_counts,
+                                                      cfg->bus_gain_v_per_count);
+    meas->i_b_A = pmstep_stm32g4_counts_to_si(STM32G4_ADC2->JDR[0], cfg->i_b_offset_counts, cfg->i_b_gain_a_per_count);
+    meas->load_torque_Nm = 0.0f;
 }

@@ -97,9 +97,17 @@ uint32_t pmstep_stm32g4_sysclk_Hz(const pmstep_stm32g4_clock_t *clock)
     return sysclk_Hz;
 }
 
+uint32_t pmstep_stm32g4_flash_latency_mode(uint32_t hclk_Hz, bool boost)
+{
+    /* RM0440 §3.3.3, Table 9: one wait state per 34 MHz in range 1 boost mode, per 30 MHz in
+     * range 1 normal mode (the thresholds of ST's LL utilities, UTILS_SCALE1_LATENCYn_FREQ). */
+    const uint32_t per_wait_state_hz = boost ? 34000000u : 30000000u;
+    return hclk_Hz == 0u ? 0u : (hclk_Hz - 1u) / per_wait_state_hz;
+}
+
 uint32_t pmstep_stm32g4_flash_latency(uint32_t hclk_Hz)
 {
-    return hclk_Hz == 0u ? 0u : (hclk_Hz - 1u) / 34000000u;
+    return pmstep_stm32g4_flash_latency_mode(hclk_Hz, hclk_Hz > 150000000u);
 }
 
 uint32_t pmstep_stm32g4_pwm_arr(uint32_t tim_clock_Hz, uint32_t pwm_frequency_Hz)
@@ -135,51 +143,12 @@ const char *pmstep_stm32g4_status_str(pmstep_stm32g4_status_t status)
         return "ADC calibration or enable timed out";
     case PMSTEP_STM32G4_ERR_PIN:
         return "pin port, number or alternate function out of range";
+    case PMSTEP_STM32G4_ERR_PIN_CONFLICT:
+        return "two functions on one pin";
+    case PMSTEP_STM32G4_ERR_PIN_RESERVED:
+        return "a pin the board itself uses is given another function";
+    case PMSTEP_STM32G4_ERR_UART_CONFIG:
+        return "console baud rate out of LPUART1's range";
     }
     return "unknown status";
-}
-
-pmstep_stm32g4_config_t pmstep_stm32g4_default_config(void)
-{
-    /* 12-bit ADC, 3.3 V reference: 3.3/4096 V per count. */
-    const float volts_per_count = 3.3f / 4096.0f;
-    pmstep_stm32g4_config_t c;
-    c.clock.pll_m = 4u;  /* 16 MHz / 4 = 4 MHz */
-    c.clock.pll_n = 85u; /* x 85 = 340 MHz VCO */
-    c.clock.pll_r = 2u;  /* / 2 = 170 MHz */
-    c.pwm_frequency_Hz = 20000u;
-    c.dead_time_ns = 500u;
-    c.duty_min = 0.0f;
-    c.duty_max = 1.0f;
-    /* TIM1 pins (DS12589 alternate functions; check against your board). */
-    c.pwm_high[0] = (pmstep_stm32g4_pin_t){0u, 8u, 6u};   /* PA8  TIM1_CH1  AF6: a+ */
-    c.pwm_high[1] = (pmstep_stm32g4_pin_t){0u, 9u, 6u};   /* PA9  TIM1_CH2  AF6: a- */
-    c.pwm_high[2] = (pmstep_stm32g4_pin_t){0u, 10u, 6u};  /* PA10 TIM1_CH3  AF6: b+ */
-    c.pwm_high[3] = (pmstep_stm32g4_pin_t){0u, 11u, 11u}; /* PA11 TIM1_CH4  AF11: b- */
-    c.pwm_low[0] = (pmstep_stm32g4_pin_t){0u, 7u, 6u};    /* PA7  TIM1_CH1N AF6 */
-    c.pwm_low[1] = (pmstep_stm32g4_pin_t){1u, 0u, 6u};    /* PB0  TIM1_CH2N AF6 */
-    c.pwm_low[2] = (pmstep_stm32g4_pin_t){1u, 1u, 6u};    /* PB1  TIM1_CH3N AF6 */
-    c.pwm_low[3] = (pmstep_stm32g4_pin_t){2u, 5u, 6u};    /* PC5  TIM1_CH4N AF6 */
-    c.break_input = (pmstep_stm32g4_pin_t){0u, 6u, 6u};   /* PA6  TIM1_BKIN AF6 */
-    c.break_active_high = false;
-    c.break_filter = 4u;
-    c.adc1_channel_i_a = 1u; /* PA0 ADC12_IN1 */
-    c.adc1_channel_bus = 3u; /* PA2 ADC1_IN3 */
-    c.adc2_channel_i_b = 2u; /* PA1 ADC12_IN2 */
-    c.adc_sample_time = 2u;  /* 12.5 ADC clock cycles */
-    c.adc_pins[0] = (pmstep_stm32g4_pin_t){0u, 0u, 0u};
-    c.adc_pins[1] = (pmstep_stm32g4_pin_t){0u, 2u, 0u};
-    c.adc_pins[2] = (pmstep_stm32g4_pin_t){0u, 1u, 0u};
-    /* Current sensors: 0.1 V/A around 1.65 V. Bus: 1:20 divider. */
-    c.i_a_offset_counts = 2048.0f;
-    c.i_a_gain_a_per_count = volts_per_count / 0.1f;
-    c.i_b_offset_counts = 2048.0f;
-    c.i_b_gain_a_per_count = volts_per_count / 0.1f;
-    c.bus_offset_counts = 0.0f;
-    c.bus_gain_v_per_count = volts_per_count * 20.0f;
-    c.enable_pin = (pmstep_stm32g4_pin_t){1u, 5u, 0u}; /* PB5 */
-    c.enable_active_high = true;
-    c.fault_pin = (pmstep_stm32g4_pin_t){2u, 6u, 0u};  /* PC6, open-drain nFAULT */
-    c.fault_active_high = false;
-    return c;
 }

@@ -47,7 +47,8 @@ pmstep_stm32g4_status_t pmstep_stm32g4_clock_init(const pmstep_stm32g4_clock_t *
     if (sysclk_Hz == 0u) {
         return PMSTEP_STM32G4_ERR_CLOCK_CONFIG;
     }
-    latency = pmstep_stm32g4_flash_latency(sysclk_Hz);
+    /* Boost mode only above 150 MHz; the wait states follow the mode (RM0440 §3.3.3, Table 9). */
+    latency = pmstep_stm32g4_flash_latency_mode(sysclk_Hz, sysclk_Hz > 150000000u);
 
     /* Voltage range 1; boost mode (R1MODE = 0) above 150 MHz, with HCLK = SYSCLK / 2 while
      * switching (the sequence of RM0440 §6.1.5). */
@@ -107,12 +108,19 @@ static bool pin_valid(const pmstep_stm32g4_pin_t *p)
     return p->port < STM32G4_GPIO_PORTS && p->pin < 16u && p->af < 16u;
 }
 
+/* A GPIO port's clock on: its registers take no write before (RM0440 §7.4.15). */
+static void port_clock_on(uint8_t port)
+{
+    STM32G4_RCC->AHB2ENR |= STM32G4_BIT(RCC_AHB2ENR_GPIOAEN_POS + port);
+    (void)STM32G4_RCC->AHB2ENR; /* the enable takes effect before the port is written */
+}
+
 static void pin_configure(const pmstep_stm32g4_pin_t *p, uint32_t mode, uint32_t pull)
 {
-    stm32g4_gpio_t *const gpio = STM32G4_GPIO(p->port);
+    stm32g4_gpio_t *gpio;
     const uint32_t shift2 = 2u * p->pin;
-    STM32G4_RCC->AHB2ENR |= STM32G4_BIT(RCC_AHB2ENR_GPIOAEN_POS + p->port);
-    (void)STM32G4_RCC->AHB2ENR;
+    port_clock_on(p->port);
+    gpio = STM32G4_GPIO(p->port);
     if (mode == GPIO_MODE_AF) {
         const uint32_t shift4 = 4u * (p->pin % 8u);
         gpio->AFR[p->pin / 8u] = (gpio->AFR[p->pin / 8u] & ~(0xFu << shift4)) | ((uint32_t)p->af << shift4);
@@ -149,7 +157,9 @@ pmstep_stm32g4_status_t pmstep_stm32g4_gpio_init(const pmstep_stm32g4_config_t *
     if (!pin_valid(&cfg->break_input) || !pin_valid(&cfg->enable_pin) || !pin_valid(&cfg->fault_pin)) {
         return PMSTEP_STM32G4_ERR_PIN;
     }
-    /* Enable output first, at its off level, so the driver never sees a floating enable. */
+    /* Enable output first, at its off level, so the driver never sees a floating enable: the
+     * port's clock on, the off level in ODR, then the pin made an output. */
+    port_clock_on(cfg->enable_pin.port);
     enable_pin_off(cfg);
     pin_configure(&cfg->enable_pin, GPIO_MODE_OUTPUT, 0u);
     pin_configure(&cfg->fault_pin, GPIO_MODE_INPUT, cfg->fault_active_high ? GPIO_PULL_DOWN : GPIO_PULL_UP);
@@ -205,8 +215,11 @@ pmstep_stm32g4_status_t pmstep_stm32g4_pwm_init(const pmstep_stm32g4_config_t *c
      * (and the compare-preload transfer) happens at the overflow, the counter peak
      * (RM0440 §28.3.3 "Repetition counter"). */
     tim->RCR = 1u;
-    /* CH1..CH4: PWM mode 1 (high side on while CNT < CCR), compare preload. CH5: PWM mode 2 with
-     * CCR5 = ARR, so OC5REF rises when the counter reaches its peak. */
+    /* CH1..CH4: PWM mode 1 (high side on while CNT < CCR), compare preload. CH5: PWM mode 2
+     * (inactive while CNT < CCR5 counting up, active while CNT > CCR5 counting down) with
+     * CCR5 = ARR - 1: in centre-aligned mode the counter runs 0..ARR-1 up and ARR..1 down, so
+     * OC5REF is high for CNT = ARR-1 (up) and CNT = ARR (down) and rises one timer tick before
+     * the peak. (CCR5 = ARR would never be reached counting up nor exceeded counting down.) */
     tim->CCMR1 = (pwm_channel << TIM_CCMR_OC_LOW_POS) | (pwm_channel << TIM_CCMR_OC_HIGH_POS);
     tim->CCMR2 = (pwm_channel << TIM_CCMR_OC_LOW_POS) | (pwm_channel << TIM_CCMR_OC_HIGH_POS);
     tim->CCMR3 = ((TIM_OCM_PWM2 << TIM_CCMR_OCM_POS) | TIM_CCMR_OCPE) << TIM_CCMR_OC_LOW_POS;
@@ -214,7 +227,7 @@ pmstep_stm32g4_status_t pmstep_stm32g4_pwm_init(const pmstep_stm32g4_config_t *c
     tim->CCR2 = arr / 2u;
     tim->CCR3 = arr / 2u;
     tim->CCR4 = arr / 2u;
-    tim->CCR5 = arr;
+    tim->CCR5 = arr - 1u;
     {
         uint32_t ccer = TIM_CCER_CC5E;
         for (k = 1u; k <= 4u; ++k) {
@@ -261,12 +274,22 @@ static bool adc_calibrate_and_enable(stm32g4_adc_t *adc)
         return false;
     }
     adc->ISR = ADC_ISR_ADRDY;
-    adc_cr_set(adc, ADC_CR_ADEN);
-    if (!wait_set(&adc->ISR, ADC_ISR_ADRDY, ADC_ISR_ADRDY)) {
-        return false;
+    /* ADEN set less than 4 ADC clock cycles after ADCAL clears is reset by the calibration
+     * logic: set it again until ADRDY (ST's HAL does the same, stm32g4xx_hal_adc.c). */
+    {
+        uint32_t n;
+        for (n = 0; n < WAIT_LIMIT; ++n) {
+            if ((adc->CR & ADC_CR_ADEN) == 0u) {
+                adc_cr_set(adc, ADC_CR_ADEN);
+            }
+            STM32G4_WAIT_HOOK();
+            if ((adc->ISR & ADC_ISR_ADRDY) != 0u) {
+                adc->ISR = ADC_ISR_ADRDY;
+                return true;
+            }
+        }
     }
-    adc->ISR = ADC_ISR_ADRDY;
-    return true;
+    return false;
 }
 
 pmstep_stm32g4_status_t pmstep_stm32g4_adc_init(const pmstep_stm32g4_config_t *cfg)
@@ -313,4 +336,71 @@ pmstep_stm32g4_status_t pmstep_stm32g4_adc_init(const pmstep_stm32g4_config_t *c
     adc_cr_set(adc1, ADC_CR_JADSTART);
     adc_cr_set(adc2, ADC_CR_JADSTART);
     return PMSTEP_STM32G4_OK;
+}
+
+/* ---- LPUART1, the console: RM0440 §38.4 (baud rate 256 f_ck / BRR, f_ck within 3..4096 x the
+ * baud rate), §38.7 (registers). 8 data bits, no parity, 1 stop bit (the reset values of CR1
+ * and CR2), no FIFO, polled from the main loop. ---- */
+uint32_t pmstep_stm32g4_lpuart_brr(uint32_t clock_hz, uint32_t baud)
+{
+    uint64_t brr;
+    if (baud == 0u || (uint64_t)clock_hz < 3u * (uint64_t)baud || (uint64_t)clock_hz > 4096u * (uint64_t)baud) {
+        return 0u;
+    }
+    brr = (256u * (uint64_t)clock_hz + baud / 2u) / baud;
+    return (brr < LPUART_BRR_MIN || brr > LPUART_BRR_MAX) ? 0u : (uint32_t)brr;
+}
+
+pmstep_stm32g4_status_t pmstep_stm32g4_lpuart_init(const pmstep_stm32g4_config_t *cfg, uint32_t pclk1_hz)
+{
+    stm32g4_lpuart_t *const u = STM32G4_LPUART1;
+    uint32_t brr;
+    if (cfg == NULL) {
+        return PMSTEP_STM32G4_ERR_NULL_ARGUMENT;
+    }
+    brr = pmstep_stm32g4_lpuart_brr(pclk1_hz, cfg->console_baud);
+    if (brr == 0u) {
+        return PMSTEP_STM32G4_ERR_UART_CONFIG;
+    }
+    if (!pin_valid(&cfg->console_tx) || !pin_valid(&cfg->console_rx)) {
+        return PMSTEP_STM32G4_ERR_PIN;
+    }
+    STM32G4_RCC->CCIPR &= ~RCC_CCIPR_LPUART1SEL_MASK; /* kernel clock PCLK1 */
+    STM32G4_RCC->APB1ENR2 |= RCC_APB1ENR2_LPUART1EN;
+    (void)STM32G4_RCC->APB1ENR2;
+    u->CR1 = 0u; /* UE = 0 while BRR is written */
+    u->PRESC = 0u;
+    u->BRR = brr;
+    u->CR1 = LPUART_CR1_UE | LPUART_CR1_RE | LPUART_CR1_TE;
+    pin_configure(&cfg->console_tx, GPIO_MODE_AF, 0u);
+    pin_configure(&cfg->console_rx, GPIO_MODE_AF, GPIO_PULL_UP); /* idle high when unconnected */
+    return PMSTEP_STM32G4_OK;
+}
+
+uint32_t pmstep_stm32g4_lpuart_read(uint8_t *data, uint32_t max, uint32_t *errors)
+{
+    stm32g4_lpuart_t *const u = STM32G4_LPUART1;
+    uint32_t n = 0u;
+    const uint32_t isr = u->ISR;
+    if ((isr & LPUART_ISR_ERRORS) != 0u) { /* overrun, framing, noise, parity: counted, cleared */
+        u->ICR = isr & LPUART_ISR_ERRORS;
+        if (errors != NULL) {
+            ++*errors;
+        }
+    }
+    while (n < max && (u->ISR & LPUART_ISR_RXNE) != 0u) {
+        data[n++] = (uint8_t)(STM32G4_LPUART_READ_RDR(u) & 0xFFu);
+    }
+    return n;
+}
+
+uint32_t pmstep_stm32g4_lpuart_write(const uint8_t *data, uint32_t n)
+{
+    stm32g4_lpuart_t *const u = STM32G4_LPUART1;
+    uint32_t k = 0u;
+    while (k < n && (u->ISR & LPUART_ISR_TXE) != 0u) {
+        STM32G4_LPUART_WRITE_TDR(u, data[k]);
+        ++k;
+    }
+    return k;
 }

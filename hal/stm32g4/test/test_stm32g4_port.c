@@ -9,6 +9,7 @@
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
+#include <stdio.h>
 #include <string.h>
 
 #include <cmocka.h>
@@ -39,14 +40,35 @@ void stm32g4_fake_wait_hook(void)
                             | ((stm32g4_fake.rcc.CFGR & RCC_CFGR_SW_MASK) << RCC_CFGR_SWS_POS);
     stm32g4_fake.adc1.CR &= ~ADC_CR_ADCAL;
     stm32g4_fake.adc2.CR &= ~ADC_CR_ADCAL;
+    /* ADRDY only once enabled (a plain-RAM write of ADRDY to clear it would set it here). */
     if (stm32g4_fake.adc1.CR & ADC_CR_ADEN) {
         stm32g4_fake.adc1.ISR |= ADC_ISR_ADRDY;
         adc1_enabled_seen = true;
+    } else if (!adc1_enabled_seen) {
+        stm32g4_fake.adc1.ISR &= ~ADC_ISR_ADRDY;
     }
     if (stm32g4_fake.adc2.CR & ADC_CR_ADEN) {
         stm32g4_fake.adc2.ISR |= ADC_ISR_ADRDY;
         adc2_enabled_seen = true;
+    } else if (!adc2_enabled_seen) {
+        stm32g4_fake.adc2.ISR &= ~ADC_ISR_ADRDY;
     }
+}
+
+stm32g4_gpio_t *stm32g4_fake_gpio(uint32_t port)
+{
+    return &stm32g4_fake.gpio[port];
+}
+
+/* LPUART data registers as plain RAM: RDR as it is, TDR keeps the last byte. */
+uint32_t stm32g4_fake_lpuart_rdr(void)
+{
+    return stm32g4_fake.lpuart1.RDR;
+}
+
+void stm32g4_fake_lpuart_tdr(uint32_t byte)
+{
+    stm32g4_fake.lpuart1.TDR = byte;
 }
 
 static pmstep_stm32g4_config_t board;
@@ -237,9 +259,16 @@ static void test_clock_arithmetic(void **state)
     assert_int_equal(pmstep_stm32g4_sysclk_Hz(&bad_r), 0u);
     assert_int_equal(pmstep_stm32g4_sysclk_Hz(&vco_low), 0u);
     assert_int_equal(pmstep_stm32g4_flash_latency(170000000u), 4u);
-    assert_int_equal(pmstep_stm32g4_flash_latency(136000000u), 3u);
-    assert_int_equal(pmstep_stm32g4_flash_latency(34000000u), 0u);
-    assert_int_equal(pmstep_stm32g4_flash_latency(34000001u), 1u);
+    assert_int_equal(pmstep_stm32g4_flash_latency(151000000u), 4u);
+    assert_int_equal(pmstep_stm32g4_flash_latency_mode(34000000u, true), 0u);
+    assert_int_equal(pmstep_stm32g4_flash_latency_mode(34000001u, true), 1u);
+    /* At or below 150 MHz the port runs range 1 normal mode: 30 MHz per wait state. */
+    assert_int_equal(pmstep_stm32g4_flash_latency(150000000u), 4u);
+    assert_int_equal(pmstep_stm32g4_flash_latency(64000000u), 2u);
+    assert_int_equal(pmstep_stm32g4_flash_latency(30000000u), 0u);
+    assert_int_equal(pmstep_stm32g4_flash_latency(30000001u), 1u);
+    assert_int_equal(pmstep_stm32g4_flash_latency_mode(64000000u, true), 1u);
+    assert_int_equal(pmstep_stm32g4_flash_latency_mode(150000000u, true), 4u);
     assert_int_equal(pmstep_stm32g4_pwm_arr(170000000u, 20000u), ARR_20KHZ);
     assert_int_equal(pmstep_stm32g4_pwm_arr(170000000u, 10000u), 8500u);
     assert_int_equal(pmstep_stm32g4_pwm_arr(170000000u, 40000u), 2125u);
@@ -298,7 +327,7 @@ static void test_pwm_init(void **state)
     assert_int_equal(tim->CCMR1, pwm1 | (pwm1 << 8));               /* CH1, CH2 PWM mode 1, preload */
     assert_int_equal(tim->CCMR2, pwm1 | (pwm1 << 8));               /* CH3, CH4 */
     assert_int_equal(tim->CCMR3, (7u << 4) | (1u << 3));            /* CH5 PWM mode 2: trigger at peak */
-    assert_int_equal(tim->CCR5, ARR_20KHZ);
+    assert_int_equal(tim->CCR5, ARR_20KHZ - 1u);                    /* reached on the up slope */
     assert_int_equal(tim->CCR1, ARR_20KHZ / 2u);                    /* 0 V until the first step */
     assert_int_equal(tim->CCR4, ARR_20KHZ / 2u);
     assert_int_equal(tim->CCER, 0x5555u | TIM_CCER_CC5E);           /* CHx and CHxN of 1..4, active high */
@@ -346,10 +375,10 @@ static void test_adc_init(void **state)
     assert_int_equal(adc1->CR & ADC_CR_ADCALDIF, 0u); /* single-ended calibration */
     assert_true(adc1->CR & ADC_CR_JADSTART);
     assert_true(adc2->CR & ADC_CR_JADSTART);
-    /* ADC1: 2 conversions, i_a (ch 1) then bus (ch 3); ADC2: i_b (ch 2) */
-    assert_int_equal(adc1->JSQR, 1u | trigger | (1u << 9) | (3u << 15));
+    /* ADC1: 2 conversions, i_a (ch 1) then bus (ch 6); ADC2: i_b (ch 2) */
+    assert_int_equal(adc1->JSQR, 1u | trigger | (1u << 9) | (6u << 15));
     assert_int_equal(adc2->JSQR, 0u | trigger | (2u << 9));
-    assert_int_equal(adc1->SMPR1, (2u << 3) | (2u << 9));
+    assert_int_equal(adc1->SMPR1, (2u << 3) | (2u << 18));
     assert_int_equal(adc2->SMPR1, 2u << 6);
     assert_int_equal(adc1->IER, ADC_IER_JEOSIE);
     assert_int_equal(adc2->IER, 0u);
@@ -524,6 +553,168 @@ static void test_measurements_in_si(void **state)
     assert_float_equal(m.load_torque_Nm, 0.0f, 0.0f);
 }
 
+/* ---- pin maps ---- */
+
+/* Signals of the STM32G431RB (LQFP64) pins a drive may use here, from ST's pin data
+ * (STM32_open_pin_data, STM32G431R(6-8-B)Tx.xml): the check that each pin of the map can
+ * carry the signal the map gives it. */
+typedef struct {
+    uint8_t port;
+    uint8_t pin;
+    const char *signals;
+} pin_signals_t;
+
+static const pin_signals_t g431rb_signals[] = {
+    {0u, 0u, " ADC1_IN1 ADC2_IN1 "},  {0u, 1u, " ADC1_IN2 ADC2_IN2 "},   {0u, 2u, " ADC1_IN3 LPUART1_TX "},
+    {0u, 3u, " ADC1_IN4 LPUART1_RX "}, {0u, 6u, " ADC2_IN3 TIM1_BKIN "},  {0u, 7u, " ADC2_IN4 TIM1_CH1N "},
+    {0u, 8u, " TIM1_CH1 "},            {0u, 9u, " TIM1_CH2 "},            {0u, 10u, " TIM1_CH3 "},
+    {0u, 11u, " TIM1_CH1N TIM1_CH4 "}, {1u, 0u, " ADC1_IN15 TIM1_CH2N "}, {1u, 1u, " ADC1_IN12 TIM1_CH3N "},
+    {2u, 0u, " ADC1_IN6 ADC2_IN6 TIM1_CH1 LPUART1_RX "},                  {2u, 5u, " ADC2_IN11 TIM1_CH4N "},
+    {1u, 5u, " "},                     {2u, 6u, " "},
+};
+
+static bool pin_can_carry(const pmstep_stm32g4_pin_use_t *u)
+{
+    char want[24];
+    unsigned k;
+    if (u->signal[0] == 'G') { /* plain GPIO: any I/O pin */
+        return true;
+    }
+    if (u->channel != 0u) {
+        snprintf(want, sizeof want, " %s%u ", u->signal, (unsigned)u->channel);
+    } else {
+        snprintf(want, sizeof want, " %s ", u->signal);
+    }
+    for (k = 0; k < sizeof g431rb_signals / sizeof g431rb_signals[0]; ++k) {
+        if (g431rb_signals[k].port == u->pin.port && g431rb_signals[k].pin == u->pin.pin) {
+            return strstr(g431rb_signals[k].signals, want) != NULL;
+        }
+    }
+    return false;
+}
+
+static void test_pin_map_default_board(void **state)
+{
+    pmstep_stm32g4_pin_use_t map[18];
+    uint32_t n;
+    uint32_t i;
+    uint32_t j;
+    (void)state;
+    assert_int_equal(pmstep_stm32g4_check_pins(&board), PMSTEP_STM32G4_OK);
+    n = pmstep_stm32g4_pin_map(&board, map, 18u);
+    assert_int_equal(n, 16u);
+    for (i = 0; i < n; ++i) {
+        if (!pin_can_carry(&map[i])) {
+            print_error("P%c%u cannot carry %s%u (%s)\n", 'A' + map[i].pin.port, map[i].pin.pin, map[i].signal,
+                        map[i].channel, map[i].function);
+            fail();
+        }
+        for (j = i + 1u; j < n; ++j) { /* one pin, one function */
+            assert_false(map[i].pin.port == map[j].pin.port && map[i].pin.pin == map[j].pin.pin);
+        }
+        /* The virtual COM port pins carry the console and nothing else. */
+        if (map[i].pin.port == 0u && (map[i].pin.pin == 2u || map[i].pin.pin == 3u)) {
+            assert_true(strncmp(map[i].signal, "LPUART1_", 8u) == 0);
+        }
+    }
+    /* The map's ADC channels are the ones the ADC is set up with. */
+    assert_int_equal(map[9].channel, board.adc1_channel_i_a);
+    assert_int_equal(map[10].channel, board.adc1_channel_bus);
+    assert_int_equal(map[11].channel, board.adc2_channel_i_b);
+}
+
+static void test_pin_map_conflicts_refused(void **state)
+{
+    pmstep_stm32g4_config_t c;
+    (void)state;
+    c = board;
+    c.adc_pins[1] = (pmstep_stm32g4_pin_t){0u, 2u, 0u}; /* the old bus input: the VCP's TX */
+    c.console_tx = (pmstep_stm32g4_pin_t){2u, 4u, 7u};  /* console moved away, PA2 still the board's */
+    assert_int_equal(pmstep_stm32g4_check_pins(&c), PMSTEP_STM32G4_ERR_PIN_RESERVED);
+    c = board;
+    c.adc_pins[1] = (pmstep_stm32g4_pin_t){0u, 2u, 0u}; /* bus on the console's pin */
+    assert_int_equal(pmstep_stm32g4_check_pins(&c), PMSTEP_STM32G4_ERR_PIN_CONFLICT);
+    c = board;
+    c.enable_pin = c.pwm_high[0]; /* two functions on PA8 */
+    assert_int_equal(pmstep_stm32g4_check_pins(&c), PMSTEP_STM32G4_ERR_PIN_CONFLICT);
+    c = board;
+    c.fault_pin = (pmstep_stm32g4_pin_t){0u, 13u, 0u}; /* SWDIO */
+    assert_int_equal(pmstep_stm32g4_check_pins(&c), PMSTEP_STM32G4_ERR_PIN_RESERVED);
+    c = board;
+    c.enable_pin = (pmstep_stm32g4_pin_t){0u, 5u, 0u}; /* LD2 */
+    assert_int_equal(pmstep_stm32g4_check_pins(&c), PMSTEP_STM32G4_ERR_PIN_RESERVED);
+    c.board = NULL; /* another controller board: only conflicts are checked */
+    assert_int_equal(pmstep_stm32g4_check_pins(&c), PMSTEP_STM32G4_OK);
+    c.pwm_low[3].pin = 16u;
+    assert_int_equal(pmstep_stm32g4_check_pins(&c), PMSTEP_STM32G4_ERR_PIN);
+    assert_int_equal(pmstep_stm32g4_check_pins(NULL), PMSTEP_STM32G4_ERR_NULL_ARGUMENT);
+    /* The port refuses to start on a conflicting map, before touching a pin. */
+    c = board;
+    c.enable_pin = c.pwm_low[0];
+    fault_input(false);
+    assert_int_equal(pmstep_stm32g4_init(&c, &motor), PMSTEP_STM32G4_ERR_PIN_CONFLICT);
+    assert_int_equal(stm32g4_fake.rcc.AHB2ENR, 0u);
+}
+
+/* ---- console UART (LPUART1) and the main loop's access to the last period ---- */
+
+static void test_lpuart(void **state)
+{
+    stm32g4_lpuart_t *u = &stm32g4_fake.lpuart1;
+    uint8_t buf[8];
+    uint32_t errors = 0u;
+    (void)state;
+    /* 256 x 170 MHz / 115200 = 377777.8 -> 377778; limits 3x..4096x the baud rate (RM0440 §38.4). */
+    assert_int_equal(pmstep_stm32g4_lpuart_brr(170000000u, 115200u), 377778u);
+    assert_int_equal(pmstep_stm32g4_lpuart_brr(170000000u, 921600u), 47222u);
+    assert_int_equal(pmstep_stm32g4_lpuart_brr(170000000u, 9600u), 0u);    /* f_ck > 4096 x baud */
+    assert_int_equal(pmstep_stm32g4_lpuart_brr(170000000u, 60000000u), 0u); /* f_ck < 3 x baud */
+    assert_int_equal(pmstep_stm32g4_lpuart_brr(170000000u, 0u), 0u);
+    assert_int_equal(pmstep_stm32g4_lpuart_init(&board, 170000000u), PMSTEP_STM32G4_OK);
+    assert_int_equal(u->BRR, 377778u);
+    assert_int_equal(u->CR1, LPUART_CR1_UE | LPUART_CR1_RE | LPUART_CR1_TE);
+    assert_true(stm32g4_fake.rcc.APB1ENR2 & RCC_APB1ENR2_LPUART1EN);
+    assert_int_equal(stm32g4_fake.rcc.CCIPR & RCC_CCIPR_LPUART1SEL_MASK, 0u);
+    assert_int_equal((stm32g4_fake.gpio[0].MODER >> 4) & 3u, GPIO_MODE_AF); /* PA2 */
+    assert_int_equal((stm32g4_fake.gpio[0].AFR[0] >> 8) & 0xFu, 12u);       /* AF12 */
+    assert_int_equal((stm32g4_fake.gpio[0].AFR[0] >> 12) & 0xFu, 12u);      /* PA3 AF12 */
+    board.console_baud = 9600u;
+    assert_int_equal(pmstep_stm32g4_lpuart_init(&board, 170000000u), PMSTEP_STM32G4_ERR_UART_CONFIG);
+    /* Never waits: nothing received, nothing taken; transmitter busy, nothing sent. */
+    u->ISR = 0u;
+    assert_int_equal(pmstep_stm32g4_lpuart_read(buf, sizeof buf, &errors), 0u);
+    assert_int_equal(pmstep_stm32g4_lpuart_write(buf, 4u), 0u);
+    u->ISR = LPUART_ISR_TXE;
+    assert_int_equal(pmstep_stm32g4_lpuart_write((const uint8_t *)"abcd", 4u), 4u);
+    assert_int_equal(u->TDR, 'd');
+    u->ISR = 1u << 3; /* overrun */
+    (void)pmstep_stm32g4_lpuart_read(buf, sizeof buf, &errors);
+    assert_int_equal(errors, 1u);
+    assert_int_equal(u->ICR, 1u << 3);
+}
+
+static void test_hold_and_last_period(void **state)
+{
+    pmstep_output_t out;
+    pmstep_meas_t meas;
+    uint8_t port_fault = 9u;
+    (void)state;
+    port_up();
+    pmstep_stm32g4_hold_control();
+    assert_int_equal(stm32g4_fake.nvic.ICER[0], 1u << 18);
+    pmstep_stm32g4_release_control();
+    assert_true(stm32g4_fake.nvic.ISER[0] & (1u << 18));
+    assert_int_equal(pmstep_start(&motor), PMSTEP_OK);
+    adc_samples(2048u + 124u, bus_counts(48.0f), 2048u);
+    ADC1_2_IRQHandler();
+    pmstep_stm32g4_last_period(&out, &meas, &port_fault);
+    assert_int_equal(out.mode, PMSTEP_MODE_S_ALIGN);
+    assert_float_equal(out.u_b_V, 24.0f, 1e-3f);
+    assert_float_equal(meas.i_a_A, 124.0f * board.i_a_gain_a_per_count, 1e-6f);
+    assert_float_equal(meas.bus_voltage_V, 48.0f, board.bus_gain_v_per_count);
+    assert_int_equal(port_fault, PMSTEP_STM32G4_FAULT_NONE);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -543,6 +734,10 @@ int main(void)
         cmocka_unit_test_setup(test_core_fault_turns_bridge_off, setup),
         cmocka_unit_test_setup(test_break_interrupt, setup),
         cmocka_unit_test_setup(test_measurements_in_si, setup),
+        cmocka_unit_test_setup(test_pin_map_default_board, setup),
+        cmocka_unit_test_setup(test_pin_map_conflicts_refused, setup),
+        cmocka_unit_test_setup(test_lpuart, setup),
+        cmocka_unit_test_setup(test_hold_and_last_period, setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

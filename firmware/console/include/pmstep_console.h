@@ -1,0 +1,237 @@
+/**
+ * @file pmstep_console.h
+ * @brief Command and telemetry interface of a pmstep drive over a byte stream (a UART):
+ *        framing, parser, commands, replies and a telemetry stream. C99, no heap, no stdio,
+ *        bounded work per byte; portable (the ports give it bytes and take its bytes).
+ *
+ * Frame (both directions):
+ *
+ *     0xA5 | LEN | TYPE SEQ DATA... (LEN bytes, 2..PMSTEP_CONSOLE_MAX_PAYLOAD) | CRC16 (LE)
+ *
+ * CRC-16/CCITT-FALSE (polynomial 0x1021, initial 0xFFFF, no reflection, no final XOR) over
+ * LEN and the payload. Numbers are little-endian; floats IEEE-754 binary32, in SI units
+ * (rad/s, rad/s^2, A, V, Nm, s). A reply has TYPE = request | 0x80 and the request's SEQ;
+ * an error reply has TYPE 0xFF and DATA = request TYPE, error code (pmstep_console_error_t).
+ * Telemetry frames (TYPE 0x90, SEQ 0) come unasked at the chosen decimation.
+ *
+ * Requests (DATA):
+ *   0x01 HELLO              -                        -> protocol version u8, max payload u8, text
+ *                                                       "pmstep <version> <port>"
+ *   0x02 START, 0x03 STOP, 0x04 CLEAR_FAULT  -       -> ACK: status i16, period u32
+ *   0x05 SPEED_TARGET       target f32, ramp f32     -> ACK (pmstep_set_speed_target)
+ *   0x06 ID_TARGET          target f32               -> ACK (pmstep_set_id_target)
+ *   0x07 GET_STATUS         -                        -> STATUS (pmstep_console_encode_status)
+ *   0x08 GET_CONFIG         id u8 | 0xFF name        -> id u8, type u8, flags u8, value f32, name
+ *   0x09 SET_CONFIG         id u8 | 0xFF, value f32 [, name]  -> ACK (IDLE or FAULT only)
+ *   0x0A GET_COMMISSIONING  -                        -> measured u8, offset_samples u32,
+ *                              realignments u32, 8 f32 (offsets a/b, R, current scale, L, k_M,
+ *                              voltage biases a/b)
+ *   0x0B TELEMETRY          decimation u32 (0: off)  -> ACK; then TELEMETRY frames
+ *   0x0C GET_COUNTERS       -                        -> the counters, u32 each
+ *   0x40 SIM_ADVANCE        periods u32              -> (simulation images only) reply when run:
+ *                                                       status i16 (0), period u32
+ *   0x41 SIM_FINISH         -                        -> (simulation images only) ACK, then the
+ *                                                       image writes its results and exits
+ *
+ * ACK status: 0 done, a negative pmstep_status_t when the core refused (e.g. -2
+ * PMSTEP_ERR_BAD_MODE), and the period from which the command takes effect (the first
+ * step that sees it). STATUS and TELEMETRY carry the index of the period whose step they
+ * report; telemetry comes for the periods that are multiples of the decimation.
+ *
+ * Timing: pmstep_console_receive() runs in the main loop, never in the control interrupt.
+ * Commands that touch the core wait in a one-slot mailbox and are applied by
+ * pmstep_console_boundary(), which the application calls at a period boundary (between two
+ * control interrupts, with that interrupt held off): a command never lands inside a step.
+ * Bad input - bytes outside a frame, a length out of range, a frame cut short (no byte for
+ * PMSTEP_CONSOLE_TRUNCATION_MS), a wrong CRC - is dropped and counted; a well-framed
+ * request that is unknown, of the wrong length, with a non-finite value, or sent while one
+ * is still waiting, gets an error reply and is counted. Nothing blocks: a full transmit
+ * buffer drops the frame and counts it.
+ */
+#ifndef PMSTEP_CONSOLE_H
+#define PMSTEP_CONSOLE_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "pmstep/pmstep.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define PMSTEP_CONSOLE_PROTOCOL_VERSION 1u
+#define PMSTEP_CONSOLE_SYNC 0xA5u
+#define PMSTEP_CONSOLE_MAX_PAYLOAD 64u    /**< TYPE + SEQ + DATA */
+#define PMSTEP_CONSOLE_TX_BYTES 1024u     /**< transmit ring */
+#define PMSTEP_CONSOLE_TRUNCATION_MS 20u  /**< a frame silent this long is dropped */
+
+/** Request types. */
+typedef enum {
+    PMSTEP_CONSOLE_HELLO = 0x01,
+    PMSTEP_CONSOLE_START = 0x02,
+    PMSTEP_CONSOLE_STOP = 0x03,
+    PMSTEP_CONSOLE_CLEAR_FAULT = 0x04,
+    PMSTEP_CONSOLE_SPEED_TARGET = 0x05,
+    PMSTEP_CONSOLE_ID_TARGET = 0x06,
+    PMSTEP_CONSOLE_GET_STATUS = 0x07,
+    PMSTEP_CONSOLE_GET_CONFIG = 0x08,
+    PMSTEP_CONSOLE_SET_CONFIG = 0x09,
+    PMSTEP_CONSOLE_GET_COMMISSIONING = 0x0A,
+    PMSTEP_CONSOLE_TELEMETRY = 0x0B,
+    PMSTEP_CONSOLE_GET_COUNTERS = 0x0C,
+    PMSTEP_CONSOLE_SIM_ADVANCE = 0x40,
+    PMSTEP_CONSOLE_SIM_FINISH = 0x41,
+    PMSTEP_CONSOLE_TELEMETRY_FRAME = 0x90,
+    PMSTEP_CONSOLE_ERROR_FRAME = 0xFF
+} pmstep_console_type_t;
+
+/** Error reply codes: one per cause. */
+typedef enum {
+    PMSTEP_CONSOLE_ERR_UNKNOWN_COMMAND = 1,
+    PMSTEP_CONSOLE_ERR_BAD_LENGTH = 2,     /**< DATA length wrong for the request */
+    PMSTEP_CONSOLE_ERR_BAD_VALUE = 3,      /**< a value NaN/Inf, or out of the field's range */
+    PMSTEP_CONSOLE_ERR_UNKNOWN_CONFIG = 4, /**< no configuration value of that id or name */
+    PMSTEP_CONSOLE_ERR_READ_ONLY = 5,      /**< the value is fixed by the port (period, delay) */
+    PMSTEP_CONSOLE_ERR_NOT_STOPPED = 6,    /**< a configuration change while the motor runs */
+    PMSTEP_CONSOLE_ERR_BUSY = 7,           /**< the previous command has not reached the core yet */
+    PMSTEP_CONSOLE_ERR_NOT_SUPPORTED = 8   /**< e.g. SIM_ADVANCE on hardware */
+} pmstep_console_error_t;
+
+/** What the console counted, since init. */
+typedef struct {
+    uint32_t rx_bytes;
+    uint32_t rx_frames;         /**< frames with a good CRC */
+    uint32_t rx_garbage_bytes;  /**< bytes outside any frame (before a sync) */
+    uint32_t rx_bad_length;     /**< LEN out of 2..PMSTEP_CONSOLE_MAX_PAYLOAD (frame dropped) */
+    uint32_t rx_crc_errors;     /**< frames dropped for their CRC */
+    uint32_t rx_truncated;      /**< frames dropped because they stopped mid-way */
+    uint32_t rx_error_replies;  /**< well-framed requests answered with an error */
+    uint32_t commands_applied;  /**< commands that reached the core at a period boundary */
+    uint32_t tx_frames;
+    uint32_t tx_dropped;        /**< frames not sent: transmit buffer full */
+    uint32_t telemetry_frames;
+} pmstep_console_counters_t;
+
+/** The drive's state as the application saw it at the last period boundary. */
+typedef struct {
+    uint32_t period;            /**< index of the period whose step @p out is (periods since start-up
+                                     minus one; UINT32_MAX before the first step) */
+    pmstep_output_t out;        /**< the last step's output */
+    pmstep_meas_t meas;         /**< the last step's samples */
+    uint8_t port_fault;         /**< the port's own fault (break, driver fault input), 0 = none */
+} pmstep_console_snapshot_t;
+
+/** A configuration value exposed by name and id (pmstep_console_config.c). */
+typedef struct {
+    const char *name;
+    uint8_t type;    /**< PMSTEP_CONSOLE_CFG_F32, _U32, _I32, _BOOL */
+    uint8_t flags;   /**< PMSTEP_CONSOLE_CFG_READ_ONLY */
+    uint16_t offset; /**< in pmstep_config_t */
+} pmstep_console_config_entry_t;
+
+#define PMSTEP_CONSOLE_CFG_F32 0u
+#define PMSTEP_CONSOLE_CFG_U32 1u
+#define PMSTEP_CONSOLE_CFG_I32 2u
+#define PMSTEP_CONSOLE_CFG_BOOL 3u
+#define PMSTEP_CONSOLE_CFG_READ_ONLY 1u
+
+/** The table of configuration values: @p count gets its length. */
+const pmstep_console_config_entry_t *pmstep_console_config_table(uint32_t *count);
+
+/** Reads entry @p id of @p cfg as a float. @return false if @p id is out of the table. */
+bool pmstep_console_config_get(const pmstep_config_t *cfg, uint32_t id, float *value);
+
+/**
+ * Writes entry @p id of @p cfg (integers and booleans must be given exactly, e.g. 1.0).
+ * @return 0, or PMSTEP_CONSOLE_ERR_UNKNOWN_CONFIG / _READ_ONLY / _BAD_VALUE.
+ */
+int pmstep_console_config_set(pmstep_config_t *cfg, uint32_t id, float value);
+
+/** The application's configuration: the paper's, with the port's period and delay. */
+pmstep_config_t pmstep_console_app_config(float period_s, uint32_t computational_delay_periods);
+
+/** The control period (s) of @p cfg. */
+float pmstep_console_config_period_s(const pmstep_config_t *cfg);
+
+/** The computational delay (periods) of @p cfg. */
+uint32_t pmstep_console_config_delay_periods(const pmstep_config_t *cfg);
+
+typedef struct {
+    /* receiver */
+    uint8_t state;
+    uint8_t len;
+    uint8_t pos;
+    uint8_t buf[PMSTEP_CONSOLE_MAX_PAYLOAD + 2u];
+    uint32_t last_byte_ms;
+    /* mailbox: one command waiting for a period boundary */
+    bool pending;
+    uint8_t cmd;
+    uint8_t seq;
+    uint8_t cfg_id;
+    float a;
+    float b;
+    uint32_t u;
+    /* simulation images: periods to run (SIM_ADVANCE) */
+    bool simulation;
+    uint32_t advance_periods;
+    uint8_t advance_seq;
+    bool advancing;
+    bool finish_requested;
+    /* telemetry */
+    uint32_t decimation;
+    uint32_t next_telemetry;
+    /* transmitter */
+    uint8_t tx[PMSTEP_CONSOLE_TX_BYTES];
+    uint32_t tx_head;
+    uint32_t tx_tail;
+    const char *identity; /**< "pmstep <version> <port>" */
+    pmstep_console_counters_t count;
+} pmstep_console_t;
+
+/** A console in its initial state; @p identity is the hello text (must outlive it). */
+void pmstep_console_init(pmstep_console_t *c, const char *identity, bool simulation);
+
+/** Feeds received bytes (main loop). @p now_ms: a millisecond clock, for the truncation timeout. */
+void pmstep_console_receive(pmstep_console_t *c, const uint8_t *data, uint32_t n, uint32_t now_ms);
+
+/** Drops a frame that has been silent for PMSTEP_CONSOLE_TRUNCATION_MS (main loop). */
+void pmstep_console_poll(pmstep_console_t *c, uint32_t now_ms);
+
+/** Whether a command waits for the next period boundary. */
+bool pmstep_console_pending(const pmstep_console_t *c);
+
+/**
+ * At a period boundary (no control step running, none can start): applies the waiting
+ * command to @p inst (configuration changes to @p cfg, then pmstep_init()) and queues its
+ * reply, built from @p snap.
+ */
+void pmstep_console_boundary(pmstep_console_t *c, pmstep_t *inst, pmstep_config_t *cfg,
+                             const pmstep_console_snapshot_t *snap);
+
+/** Queues a telemetry frame if @p snap->period is due (main loop, after a period). */
+void pmstep_console_telemetry(pmstep_console_t *c, const pmstep_console_snapshot_t *snap);
+
+/** Periods a SIM_ADVANCE asks for (0: none); the application runs them, then calls _advance_done(). */
+uint32_t pmstep_console_advance_request(pmstep_console_t *c);
+
+/** Replies to the SIM_ADVANCE once its periods have run; @p period: the period count now. */
+void pmstep_console_advance_done(pmstep_console_t *c, uint32_t period);
+
+/** Whether a SIM_FINISH was received (simulation images). */
+bool pmstep_console_finish_requested(const pmstep_console_t *c);
+
+/** The request waiting in the mailbox (0 if none), e.g. for a port's own part of CLEAR_FAULT. */
+uint8_t pmstep_console_pending_command(const pmstep_console_t *c);
+
+/** Takes up to @p max bytes to transmit into @p out. @return the count. */
+uint32_t pmstep_console_transmit(pmstep_console_t *c, uint8_t *out, uint32_t max);
+
+/** CRC-16/CCITT-FALSE of @p n bytes, continuing from @p crc (start with 0xFFFF). */
+uint16_t pmstep_console_crc16(uint16_t crc, const uint8_t *data, uint32_t n);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PMSTEP_CONSOLE_H */

@@ -1,0 +1,305 @@
+/*
+ * Processor in the loop with the console: the closed loop of pil_closed_loop.c (plant model
+ * (1) from sil/ on the emulated Cortex-M4, the real core in the port's control interrupt,
+ * the SIL's paper scenario and metrics) driven from the host through the command and
+ * telemetry interface on UART0 (QEMU's first -serial backend) instead of a built-in
+ * profile. The image starts with the motor in IDLE and waits for commands; simulated time
+ * moves only on SIM_ADVANCE (so the host decides at which period each command lands, and
+ * the run can be compared with the host SIL period by period); SIM_FINISH ends the run.
+ * Between any two periods the main loop reads the UART, parses, applies a waiting command
+ * at the period boundary and sends replies and telemetry; bad input is dropped or answered.
+ *
+ * usage (semihosting command line):
+ *   pil-console [--duration S] [--substeps N] [--summary FILE] [--cost FILE]
+ * --summary: the closed-loop metrics (the keys of pil-closed-loop's summary);
+ * --cost: the control step's cost per mode from SysTick (with -icount shift=0), and the
+ * console's counters.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cmsdk_uart.h"
+#include "pmstep/pmstep_text.h"
+#include "pmstep_console.h"
+#include "pmstep_hal_qemu_mps2.h"
+#include "sil/inverter.h"
+#include "sil/metrics.h"
+#include "sil/plant.h"
+
+#ifndef PMSTEP_VERSION_TEXT
+#define PMSTEP_VERSION_TEXT "0.0.0"
+#endif
+
+#define SYST_CVR (*(volatile uint32_t *)0xE000E018u)
+#define SYSTICK_HZ 25000000u /* QEMU's mps2 SysTick reference clock */
+
+static pmstep_t motor;
+static pmstep_config_t config; /* outlives the instance, as pmstep_init() requires */
+static pmstep_console_t console;
+static const char *const mode_names[MPS2_PIL_MODES] = {"IDLE", "S_ALIGN", "C_ALIGN", "RUN", "FAULT"};
+
+/* ---- the console's side of the main loop ---- */
+
+static uint64_t systick_total;
+static uint32_t systick_last;
+static uint8_t tx_buf[64];
+static uint32_t tx_len;
+static uint32_t tx_pos;
+
+/* Milliseconds of virtual time from SysTick (free running over 24 bits; polled far more often
+ * than it wraps, every 0.67 s). */
+static uint32_t now_ms(void)
+{
+    const uint32_t now = SYST_CVR;
+    systick_total += (systick_last - now) & 0x00FFFFFFu;
+    systick_last = now;
+    return (uint32_t)(systick_total / (SYSTICK_HZ / 1000u));
+}
+
+static void service_uart(void)
+{
+    uint8_t rx[16];
+    const uint32_t n = cmsdk_uart_read(rx, sizeof rx);
+    uint32_t sent;
+    pmstep_console_receive(&console, rx, n, now_ms());
+    do { /* as much as the transmitter takes now */
+        if (tx_pos == tx_len) {
+            tx_len = pmstep_console_transmit(&console, tx_buf, sizeof tx_buf);
+            tx_pos = 0u;
+        }
+        sent = cmsdk_uart_write(&tx_buf[tx_pos], tx_len - tx_pos);
+        tx_pos += sent;
+    } while (sent > 0u);
+}
+
+static void flush_uart(void)
+{
+    uint32_t guard;
+    for (guard = 0; guard < 1000000u && (tx_pos != tx_len || console.tx_head != console.tx_tail); ++guard) {
+        service_uart();
+    }
+}
+
+/* ---- the closed loop (as pil_closed_loop.c) ---- */
+
+typedef struct {
+    sil_scenario_t sc;
+    plant_t plant;
+    sil_inverter_t inv;
+    sil_metrics_t metrics;
+    sil_summary_t s;
+    double period_s;
+    double p;
+} loop_t;
+
+static void run_period(loop_t *L, long k, pmstep_console_snapshot_t *snap)
+{
+    const double t_s = (double)k * L->period_s;
+    pmstep_meas_t meas;
+    pmstep_output_t out;
+    sil_sample_t sample;
+    L->plant.time_s = t_s;
+    sample.step = k;
+    sample.t_s = t_s;
+    sample.theta_rad = L->plant.x.theta_rad;
+    sample.omega_rad_s = L->plant.x.omega_rad_s;
+    sample.i_a_A = L->plant.x.i_a_A;
+    sample.i_b_A = L->plant.x.i_b_A;
+    sample.load_Nm = plant_load_torque(&L->plant.load, t_s, L->plant.x.omega_rad_s);
+    meas.i_a_A = (float)sample.i_a_A;
+    meas.i_b_A = (float)sample.i_b_A;
+    meas.bus_voltage_V = (float)sil_inverter_bus_voltage(&L->inv, t_s);
+    meas.load_torque_Nm = (float)sample.load_Nm;
+    mps2_pil_control_period(&meas, &out);
+    sil_inverter_apply(&L->inv, &out, (double)meas.bus_voltage_V);
+    sil_drive_advance(&L->plant, &L->inv, L->period_s, L->sc.substeps);
+    sample.cos_ptheta = cos(L->p * sample.theta_rad);
+    sample.sin_ptheta = sin(L->p * sample.theta_rad);
+    sample.u_a_V = L->inv.applied_a_V;
+    sample.u_b_V = L->inv.applied_b_V;
+    sample.out = &out;
+    sample.inst = &motor;
+    sil_metrics_add(&L->metrics, &sample, &L->s);
+    snap->period = (uint32_t)k;
+    snap->out = out;
+    snap->meas = meas;
+}
+
+static void write_summary(FILE *f, const sil_summary_t *s, double duration_s, int substeps)
+{
+    fprintf(f, "{\n");
+    fprintf(f, "  \"scenario\": \"paper\",\n  \"target\": \"qemu mps2-an386 (Cortex-M4F), console-driven\",\n");
+    fprintf(f, "  \"duration_s\": %.17g,\n  \"substeps\": %d,\n", duration_s, substeps);
+    fprintf(f, "  \"alignment\": {\n");
+    fprintf(f, "    \"cos_ptheta_at_ts\": %.17g,\n    \"sin_ptheta_at_ts\": %.17g,\n", s->cos_ptheta_at_ts,
+            s->sin_ptheta_at_ts);
+    fprintf(f, "    \"i_b_minus_ucs_over_r_at_ts_A\": %.17g,\n", s->i_b_residual_at_ts_A);
+    fprintf(f, "    \"cos_ptheta_at_tc\": %.17g,\n    \"sin_ptheta_at_tc\": %.17g,\n", s->cos_ptheta_at_tc,
+            s->sin_ptheta_at_tc);
+    fprintf(f, "    \"i_a_minus_ucc_over_r_at_tc_A\": %.17g\n  },\n", s->i_a_residual_at_tc_A);
+    fprintf(f, "  \"speed\": {\n");
+    fprintf(f, "    \"transient_max_abs_error_rad_s\": %.17g,\n    \"transient_rms_error_rad_s\": %.17g,\n",
+            s->transient_max_speed_error_rad_s, s->transient_rms_speed_error_rad_s);
+    fprintf(f, "    \"tracking_max_abs_error_rad_s\": %.17g,\n    \"tracking_rms_error_rad_s\": %.17g\n  },\n",
+            s->tracking_max_speed_error_rad_s, s->tracking_rms_speed_error_rad_s);
+    fprintf(f, "  \"final_load_hat_Nm\": %.17g,\n  \"final_load_Nm\": %.17g,\n", s->final_load_hat_Nm,
+            s->final_load_Nm);
+    fprintf(f, "  \"final_load_abs_error_Nm\": %.17g,\n", s->final_load_error_Nm);
+    fprintf(f, "  \"angle_estimate\": {\n    \"max_abs_cos_error\": %.17g,\n    \"max_abs_sin_error\": %.17g\n  },\n",
+            s->max_cos_error, s->max_sin_error);
+    fprintf(f, "  \"max_abs_phase_voltage_V\": %.17g,\n  \"max_abs_phase_current_a\": %.17g,\n",
+            s->max_phase_voltage_V, s->max_phase_current_A);
+    fprintf(f, "  \"voltage_limited_periods\": %ld,\n  \"inverter_clipped_periods\": %ld,\n",
+            s->voltage_limited_periods, s->inverter_limited_periods);
+    fprintf(f, "  \"final_mode\": \"%s\",\n", pmstep_mode_str(s->final_mode));
+    fprintf(f, "  \"fault\": {\n    \"code\": %d,\n    \"text\": \"%s\",\n    \"step\": %ld,\n    \"time_s\": %.17g\n  },\n",
+            (int)s->fault, pmstep_fault_str(s->fault), s->fault_step, s->fault_time_s);
+    fprintf(f, "  \"timing\": {\n    \"steps\": %ld\n  }\n}\n", s->steps);
+}
+
+static void write_cost(FILE *f, double insns_per_tick, long periods)
+{
+    const mps2_pil_cost_t *cost = mps2_pil_cost();
+    const pmstep_console_counters_t *n = &console.count;
+    unsigned m;
+    fprintf(f, "pil_cost 1\nperiods %ld\ninstructions_per_tick %.6f\n", periods, insns_per_tick);
+    for (m = 0; m < MPS2_PIL_MODES; ++m) {
+        if (cost->steps[m] > 0u) {
+            /* step bracket minus empty bracket, plus the empty function's one instruction (BX LR) */
+            const double steps = (double)cost->steps[m];
+            const double insns =
+                ((double)cost->step_ticks[m] - (double)cost->empty_ticks[m]) * insns_per_tick / steps + 1.0;
+            fprintf(f, "mode %s steps %lu step_ticks %llu empty_ticks %llu instructions_mean %.2f stack_max_bytes %lu\n",
+                    mode_names[m], (unsigned long)cost->steps[m], (unsigned long long)cost->step_ticks[m],
+                    (unsigned long long)cost->empty_ticks[m], insns, (unsigned long)cost->stack_max_bytes[m]);
+        }
+    }
+    fprintf(f,
+            "console rx_bytes %lu rx_frames %lu rx_garbage_bytes %lu rx_bad_length %lu rx_crc_errors %lu "
+            "rx_truncated %lu rx_error_replies %lu commands_applied %lu tx_frames %lu tx_dropped %lu "
+            "telemetry_frames %lu\n",
+            (unsigned long)n->rx_bytes, (unsigned long)n->rx_frames, (unsigned long)n->rx_garbage_bytes,
+            (unsigned long)n->rx_bad_length, (unsigned long)n->rx_crc_errors, (unsigned long)n->rx_truncated,
+            (unsigned long)n->rx_error_replies, (unsigned long)n->commands_applied, (unsigned long)n->tx_frames,
+            (unsigned long)n->tx_dropped, (unsigned long)n->telemetry_frames);
+}
+
+static int write_file(const char *path, int which, loop_t *L, double insns_per_tick, long steps)
+{
+    FILE *f = fopen(path, "w");
+    if (f == NULL) {
+        fprintf(stderr, "pil-console: cannot write '%s'\n", path);
+        return 2;
+    }
+    if (which == 0) {
+        write_summary(f, &L->s, L->sc.duration_s, L->sc.substeps);
+    } else {
+        write_cost(f, insns_per_tick, steps);
+    }
+    return fclose(f) == 0 ? 0 : 2;
+}
+
+int main(int argc, char **argv)
+{
+    static loop_t L;
+    static pmstep_console_snapshot_t snap;
+    const char *summary_path = NULL;
+    const char *cost_path = NULL;
+    double insns_per_tick;
+    pmstep_status_t st;
+    long steps;
+    long k = 0;
+    int i;
+
+    sil_scenario_paper(&L.sc);
+    L.sc.duration_s = 0.9;
+    L.sc.substeps = 10;
+    for (i = 1; i < argc; ++i) {
+        if (strcmp(argv[i], "--duration") == 0 && i + 1 < argc) {
+            L.sc.duration_s = strtod(argv[++i], NULL);
+        } else if (strcmp(argv[i], "--substeps") == 0 && i + 1 < argc) {
+            L.sc.substeps = atoi(argv[++i]);
+        } else if (strcmp(argv[i], "--summary") == 0 && i + 1 < argc) {
+            summary_path = argv[++i];
+        } else if (strcmp(argv[i], "--cost") == 0 && i + 1 < argc) {
+            cost_path = argv[++i];
+        } else {
+            fprintf(stderr, "usage: pil-console [--duration S] [--substeps N] [--summary FILE] [--cost FILE]\n");
+            return 2;
+        }
+    }
+    if (!(L.sc.duration_s > 0.0) || L.sc.substeps < 1) {
+        fprintf(stderr, "pil-console: --duration must be > 0 and --substeps >= 1\n");
+        return 2;
+    }
+    config = L.sc.controller;
+    st = pmstep_init(&motor, &config);
+    if (st != PMSTEP_OK) {
+        fprintf(stderr, "pil-console: pmstep_init: %s\n", pmstep_status_str(st));
+        return 2;
+    }
+    L.period_s = (double)pmstep_console_config_period_s(&config);
+    steps = sil_periods_in(L.sc.duration_s, L.period_s);
+    sil_metrics_init(&L.metrics, &L.sc, &L.s);
+    memset(&L.plant, 0, sizeof L.plant);
+    L.plant.params = L.sc.motor;
+    L.plant.load = L.sc.load;
+    L.plant.x.theta_rad = L.sc.theta0_rad;
+    L.plant.x.omega_rad_s = L.sc.omega0_rad_s;
+    L.plant.x.i_a_A = L.sc.i_a0_A;
+    L.plant.x.i_b_A = L.sc.i_b0_A;
+    L.p = (double)L.plant.params.pole_pairs;
+    sil_inverter_init(&L.inv, &L.sc.inverter, &L.sc.bus, L.sc.bus_voltage_V,
+                      pmstep_console_config_delay_periods(&config));
+
+    mps2_pil_init(&motor);
+    insns_per_tick = mps2_pil_instructions_per_tick(100000u);
+    cmsdk_uart_init(16u);
+    pmstep_console_init(&console, "pmstep " PMSTEP_VERSION_TEXT " qemu-mps2-an386", true);
+    snap.period = UINT32_MAX; /* no step yet */
+    systick_last = SYST_CVR;
+
+    while (!pmstep_console_finish_requested(&console)) {
+        uint32_t n;
+        service_uart();
+        pmstep_console_boundary(&console, &motor, &config, &snap);
+        n = pmstep_console_advance_request(&console);
+        if (n == 0u) {
+            continue;
+        }
+        /* SIM_ADVANCE: n periods (at most to the end of the run), the console served between them. */
+        while (n > 0u && k < steps) {
+            service_uart();
+            pmstep_console_boundary(&console, &motor, &config, &snap); /* a command lands between two periods */
+            run_period(&L, k, &snap);
+            pmstep_console_telemetry(&console, &snap);
+            ++k;
+            --n;
+        }
+        flush_uart(); /* room for the reply, whatever a flood left in the transmit buffer */
+        pmstep_console_advance_done(&console, (uint32_t)k);
+    }
+    flush_uart();
+    {
+        /* The SIM_FINISH reply on its way before QEMU exits and closes the socket. */
+        const uint32_t t0 = now_ms();
+        while (now_ms() - t0 < 200u) {
+            service_uart();
+        }
+    }
+
+    sil_metrics_finish(&L.metrics, &L.s);
+    L.s.inverter_limited_periods = (long)L.inv.limited_periods;
+    if (k != steps) {
+        fprintf(stderr, "pil-console: finished after %ld of %ld periods\n", k, steps);
+    }
+    if (summary_path != NULL && write_file(summary_path, 0, &L, insns_per_tick, k) != 0) {
+        return 2;
+    }
+    if (cost_path != NULL && write_file(cost_path, 1, &L, insns_per_tick, k) != 0) {
+        return 2;
+    }
+    return k != steps ? 4 : (L.s.fault != PMSTEP_FAULT_NONE ? 3 : 0);
+}

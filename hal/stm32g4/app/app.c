@@ -1,0 +1,123 @@
+/*
+ * The STM32G431 application (see main.c and app.h): the port, the core and the console, and one
+ * turn of the main loop. The control step itself runs in the port's ADC interrupt.
+ */
+#include "app.h"
+
+#include "pmstep_console.h"
+#include "pmstep_hal_stm32g4.h"
+#include "stm32g4_regs.h"
+
+#ifndef PMSTEP_VERSION_TEXT
+#define PMSTEP_VERSION_TEXT "0.0.0"
+#endif
+
+static pmstep_t motor;
+static pmstep_config_t motor_config;       /* must outlive the instance */
+static pmstep_stm32g4_config_t board;      /* must outlive the port */
+static pmstep_console_t console;
+static uint32_t uart_errors;
+static uint8_t tx[64];
+static uint32_t tx_len;
+static uint32_t tx_pos;
+
+/* Milliseconds and control periods since start, from the DWT cycle counter the port runs (the
+ * main loop polls it far more often than it wraps, every 25 s at 170 MHz). 32-bit arithmetic. */
+static struct {
+    uint32_t last;
+    uint32_t cycles_per_ms;
+    uint32_t cycles_per_period;
+    uint32_t rem_ms;
+    uint32_t rem_period;
+    uint32_t ms;
+    uint32_t periods;
+} clk;
+
+static void clock_update(void)
+{
+    const uint32_t now = STM32G4_DWT->CYCCNT;
+    const uint32_t d = now - clk.last;
+    clk.last = now;
+    clk.rem_ms += d;
+    clk.ms += clk.rem_ms / clk.cycles_per_ms;
+    clk.rem_ms %= clk.cycles_per_ms;
+    clk.rem_period += d;
+    clk.periods += clk.rem_period / clk.cycles_per_period;
+    clk.rem_period %= clk.cycles_per_period;
+}
+
+static void snapshot(pmstep_console_snapshot_t *snap)
+{
+    snap->period = clk.periods - 1u; /* the period that just ended (counted from the timer's start) */
+    pmstep_stm32g4_last_period(&snap->out, &snap->meas, &snap->port_fault);
+}
+
+int32_t pmstep_app_init(void)
+{
+    pmstep_status_t st;
+    pmstep_stm32g4_status_t port_st;
+    uint32_t sysclk_Hz;
+
+    board = pmstep_stm32g4_default_config();
+    port_st = pmstep_stm32g4_clock_init(&board.clock);
+    if (port_st != PMSTEP_STM32G4_OK) {
+        return (int32_t)port_st;
+    }
+    motor_config = pmstep_console_app_config(pmstep_stm32g4_period_s(&board), 1u); /* duties load one period later */
+    st = pmstep_init(&motor, &motor_config);
+    if (st != PMSTEP_OK) {
+        return -100 + (int32_t)st;
+    }
+    port_st = pmstep_stm32g4_init(&board, &motor);
+    if (port_st != PMSTEP_STM32G4_OK) {
+        return (int32_t)port_st;
+    }
+    sysclk_Hz = pmstep_stm32g4_sysclk_Hz(&board.clock);
+    port_st = pmstep_stm32g4_lpuart_init(&board, sysclk_Hz); /* PCLK1 = SYSCLK */
+    if (port_st != PMSTEP_STM32G4_OK) {
+        return (int32_t)port_st;
+    }
+    pmstep_console_init(&console, "pmstep " PMSTEP_VERSION_TEXT " stm32g431", false);
+    uart_errors = 0u;
+    tx_len = 0u;
+    tx_pos = 0u;
+    clk.cycles_per_period = (uint32_t)((float)sysclk_Hz * pmstep_stm32g4_period_s(&board) + 0.5f); /* 2 ARR */
+    clk.cycles_per_ms = sysclk_Hz / 1000u;
+    clk.last = STM32G4_DWT->CYCCNT;
+    clk.rem_ms = 0u;
+    clk.rem_period = 0u;
+    clk.ms = 0u;
+    clk.periods = 0u;
+    pmstep_stm32g4_start();
+    return 0;
+}
+
+void pmstep_app_poll(void)
+{
+    uint8_t rx[32];
+    const uint32_t n = pmstep_stm32g4_lpuart_read(rx, sizeof rx, &uart_errors);
+    pmstep_console_snapshot_t snap;
+    clock_update();
+    pmstep_console_receive(&console, rx, n, clk.ms);
+    if (pmstep_console_pending(&console)
+        || (console.decimation != 0u && (int32_t)(clk.periods - 1u - console.next_telemetry) >= 0)) {
+        pmstep_stm32g4_hold_control();
+        snapshot(&snap);
+        if (pmstep_console_pending_command(&console) == PMSTEP_CONSOLE_CLEAR_FAULT) {
+            (void)pmstep_stm32g4_clear_fault(); /* the port's latch too (break, driver fault input) */
+        }
+        pmstep_console_boundary(&console, &motor, &motor_config, &snap);
+        pmstep_stm32g4_release_control();
+        pmstep_console_telemetry(&console, &snap);
+    }
+    if (tx_pos == tx_len) {
+        tx_len = pmstep_console_transmit(&console, tx, sizeof tx);
+        tx_pos = 0u;
+    }
+    tx_pos += pmstep_stm32g4_lpuart_write(&tx[tx_pos], tx_len - tx_pos);
+}
+
+uint32_t pmstep_app_uart_errors(void)
+{
+    return uart_errors;
+}

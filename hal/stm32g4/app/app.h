@@ -1,0 +1,33 @@
+/**
+ * @file app.h
+ * @brief The STM32G431 application: the port, the core and the console (main.c runs it; the
+ *        host tests run it against the behavioural model of the peripherals).
+ */
+#ifndef PMSTEP_STM32G4_APP_H
+#define PMSTEP_STM32G4_APP_H
+
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/**
+ * Clock to 170 MHz, the core (paper configuration, the port's period, one period of delay), the
+ * port (bridge off, motor IDLE), the console on LPUART1, then TIM1 started.
+ * @return 0, or the failing step's status: a pmstep_stm32g4_status_t, or -100 + a pmstep_status_t.
+ */
+int32_t pmstep_app_init(void);
+
+/** One turn of the main loop: receive, apply a waiting command at a period boundary, telemetry,
+ *  transmit. Never waits. */
+void pmstep_app_poll(void);
+
+/** Receive errors of the console's UART (overrun, framing, noise) since init. */
+uint32_t pmstep_app_uart_errors(void);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PMSTEP_STM32G4_APP_H */

@@ -1,0 +1,443 @@
+#!/usr/bin/env python3
+"""Host console of a pmstep drive: talks the framed command and telemetry protocol of
+firmware/console/include/pmstep_console.h over a serial port (the NUCLEO-G431RB's ST-LINK virtual COM
+port), a pty, or a TCP socket (QEMU's -serial tcp:...).
+
+Endpoints (--port):
+  /dev/ttyACM0, COM5, /dev/pts/7   a serial port or a pty (--baud, default 115200)
+  tcp:HOST:PORT                    a TCP socket (e.g. QEMU -serial tcp:127.0.0.1:5555,server=on)
+  any pyserial URL                 e.g. socket://HOST:PORT, loop://
+
+Commands (one per run, or several in the interactive mode):
+  hello | status | counters | commissioning | start | stop | clear
+  speed TARGET_RAD_S [--ramp RAD_S2]     speed target with a ramp rate (default 50 rad/s^2)
+  id TARGET_A                            i_d target
+  config                                 every configuration value, by id and name
+  get NAME|ID      set NAME|ID VALUE     one configuration value (set: motor stopped only)
+  telemetry --decimation N [--seconds S] [--csv FILE] [--plot]   stream to CSV, plot live
+  plot FILE.csv                          plot a telemetry CSV afterwards
+  interactive                            a prompt for all of the above
+
+Needs pyserial (pinned in tools/requirements.txt); plots need matplotlib (same file).
+"""
+import argparse
+import cmd
+import csv
+import math
+import shlex
+import struct
+import sys
+import time
+
+SYNC = 0xA5
+MAX_PAYLOAD = 64
+
+HELLO, START, STOP, CLEAR_FAULT, SPEED_TARGET, ID_TARGET = 0x01, 0x02, 0x03, 0x04, 0x05, 0x06
+GET_STATUS, GET_CONFIG, SET_CONFIG, GET_COMMISSIONING, TELEMETRY, GET_COUNTERS = 0x07, 0x08, 0x09, 0x0A, 0x0B, 0x0C
+SIM_ADVANCE, SIM_FINISH = 0x40, 0x41
+TELEMETRY_FRAME, ERROR_FRAME = 0x90, 0xFF
+
+MODES = {0: "IDLE", 1: "S_ALIGN", 2: "C_ALIGN", 3: "RUN", 4: "FAULT", 5: "OFFSET_CAL"}
+ERRORS = {1: "unknown command", 2: "bad length", 3: "bad value (NaN, Inf or out of range)",
+          4: "unknown configuration value", 5: "read-only value", 6: "refused while the motor runs",
+          7: "busy: the previous command has not reached the core yet", 8: "not supported by this image"}
+STATUS_FIELDS = ["speed_ref_rad_s", "speed_hat_rad_s", "load_hat_Nm", "cos_hat", "sin_hat", "i_a_A", "i_b_A",
+                 "bus_voltage_V", "u_a_V", "u_b_V", "i_d_A", "i_q_A"]
+TELEMETRY_FIELDS = ["period", "mode", "fault", "speed_ref_rad_s", "speed_hat_rad_s", "load_hat_Nm", "cos_hat",
+                    "sin_hat", "i_a_A", "i_b_A", "bus_voltage_V", "u_a_V", "u_b_V", "i_q_A"]
+COUNTER_FIELDS = ["rx_bytes", "rx_frames", "rx_garbage_bytes", "rx_bad_length", "rx_crc_errors", "rx_truncated",
+                  "rx_error_replies", "commands_applied", "tx_frames", "tx_dropped", "telemetry_frames"]
+COMMISSIONING_FIELDS = ["offset_a_A", "offset_b_A", "resistance_Ohm", "phase_a_current_scale", "inductance_H",
+                        "torque_constant_Nm_A", "voltage_bias_a_V", "voltage_bias_b_V"]
+CONFIG_TYPES = {0: "f32", 1: "u32", 2: "i32", 3: "bool"}
+
+
+def crc16(data, crc=0xFFFF):
+    """CRC-16/CCITT-FALSE (poly 0x1021, init 0xFFFF)."""
+    for b in data:
+        crc ^= b << 8
+        for _ in range(8):
+            crc = ((crc << 1) ^ 0x1021) if crc & 0x8000 else (crc << 1)
+            crc &= 0xFFFF
+    return crc
+
+
+def encode(ftype, seq, data=b""):
+    """A frame: sync, length, type, seq, data, CRC (little-endian)."""
+    payload = bytes([ftype, seq]) + bytes(data)
+    if len(payload) > MAX_PAYLOAD:
+        raise ValueError("payload too long")
+    body = bytes([len(payload)]) + payload
+    return bytes([SYNC]) + body + struct.pack("<H", crc16(body))
+
+
+class Decoder:
+    """Frames out of a byte stream (the same rules as the firmware's receiver)."""
+
+    def __init__(self):
+        self.buf = bytearray()
+        self.bad = 0
+
+    def feed(self, data):
+        self.buf += data
+        frames = []
+        while True:
+            start = self.buf.find(bytes([SYNC]))
+            if start < 0:
+                self.bad += len(self.buf)
+                self.buf.clear()
+                return frames
+            if start > 0:
+                self.bad += start
+                del self.buf[:start]
+            if len(self.buf) < 2:
+                return frames
+            n = self.buf[1]
+            if n < 2 or n > MAX_PAYLOAD:
+                self.bad += 1
+                del self.buf[:1]
+                continue
+            if len(self.buf) < n + 4:
+                return frames
+            body = bytes(self.buf[1:2 + n])
+            (crc,) = struct.unpack_from("<H", self.buf, 2 + n)
+            if crc16(body) != crc:
+                self.bad += 1
+                del self.buf[:1]
+                continue
+            frames.append((body[1], body[2], body[3:]))
+            del self.buf[:n + 4]
+
+
+class DeviceError(Exception):
+    """The drive answered with an error frame, or the core refused a command."""
+
+
+def open_endpoint(port, baud=115200, timeout=0.05):
+    import serial  # pyserial, pinned in tools/requirements.txt
+    if port.startswith("tcp:"):
+        host, _, tcp_port = port[4:].rpartition(":")
+        return serial.serial_for_url(f"socket://{host or '127.0.0.1'}:{tcp_port}", timeout=timeout)
+    return serial.serial_for_url(port, baudrate=baud, timeout=timeout)
+
+
+class Console:
+    """One drive: requests with replies matched by sequence number; telemetry frames go to
+    the on_telemetry callback (and are kept in self.telemetry)."""
+
+    def __init__(self, link, reply_timeout=2.0):
+        self.link = link
+        self.decoder = Decoder()
+        self.seq = 0
+        self.reply_timeout = reply_timeout
+        self.telemetry = []
+        self.on_telemetry = None
+        self.pending = []
+
+    # ---- transport ----
+    def _dispatch(self, frame):
+        ftype, seq, data = frame
+        if ftype == TELEMETRY_FRAME and len(data) == 50:
+            values = struct.unpack("<IBB11f", data)
+            row = dict(zip(TELEMETRY_FIELDS, values))
+            self.telemetry.append(row)
+            if self.on_telemetry:
+                self.on_telemetry(row)
+            return None
+        return frame
+
+    def pump(self, wait=0.0):
+        """Reads what has arrived (waiting up to @p wait s for something), dispatches telemetry."""
+        deadline = time.monotonic() + wait
+        while True:
+            # What has arrived, or one byte within the link's timeout: a peer that closes right
+            # after its last frame (an image that exits) loses nothing.
+            data = self.link.read(max(1, self.link.in_waiting))
+            if data:
+                for frame in self.decoder.feed(data):
+                    kept = self._dispatch(frame)
+                    if kept is not None:
+                        self.pending.append(kept)
+            if not data and time.monotonic() >= deadline:
+                return
+
+    def send(self, ftype, data=b""):
+        """Sends a request without waiting; @return its sequence number (for wait_reply)."""
+        self.seq = (self.seq + 1) & 0xFF
+        self.link.write(encode(ftype, self.seq, data))
+        self.link.flush()
+        return self.seq
+
+    def request(self, ftype, data=b"", timeout=None):
+        return self.wait_reply(ftype, self.send(ftype, data), timeout)
+
+    def wait_reply(self, ftype, seq, timeout=None):
+        deadline = time.monotonic() + (self.reply_timeout if timeout is None else timeout)
+        while True:
+            for i, (rtype, rseq, rdata) in enumerate(self.pending):
+                if rseq == seq and rtype in (ftype | 0x80, ERROR_FRAME):
+                    del self.pending[i]
+                    if rtype == ERROR_FRAME:
+                        code = rdata[1] if len(rdata) > 1 else 0
+                        raise DeviceError(f"request 0x{ftype:02x}: {ERRORS.get(code, f'error {code}')}")
+                    return rdata
+            if time.monotonic() > deadline:
+                raise TimeoutError(f"no reply to request 0x{ftype:02x} (seq {seq})")
+            self.pump(0.01)
+
+    def _ack(self, ftype, data=b"", timeout=None):
+        rdata = self.request(ftype, data, timeout)
+        status, period = struct.unpack("<hI", rdata[:6])
+        if status != 0:
+            raise DeviceError(f"the core refused request 0x{ftype:02x}: status {status}")
+        return period
+
+    # ---- commands ----
+    def hello(self):
+        d = self.request(HELLO)
+        return {"protocol": d[0], "max_payload": d[1], "identity": d[2:].decode("ascii", "replace")}
+
+    def start(self):
+        return self._ack(START)
+
+    def stop(self):
+        return self._ack(STOP)
+
+    def clear_fault(self):
+        return self._ack(CLEAR_FAULT)
+
+    def speed(self, target_rad_s, ramp_rad_s2=50.0):
+        return self._ack(SPEED_TARGET, struct.pack("<ff", target_rad_s, ramp_rad_s2))
+
+    def id_target(self, target_a):
+        return self._ack(ID_TARGET, struct.pack("<f", target_a))
+
+    def status(self):
+        d = self.request(GET_STATUS)
+        period, mode, fault, port_fault, flags, fault_step = struct.unpack_from("<IBBBBI", d)
+        values = struct.unpack_from("<12f", d, 12)
+        s = {"period": period, "mode": MODES.get(mode, str(mode)), "fault": fault, "port_fault": port_fault,
+             "bridge_enable": bool(flags & 1), "voltage_limited": bool(flags & 2), "fault_step": fault_step}
+        s.update(zip(STATUS_FIELDS, values))
+        return s
+
+    def counters(self):
+        return dict(zip(COUNTER_FIELDS, struct.unpack("<11I", self.request(GET_COUNTERS))))
+
+    def commissioning(self):
+        d = self.request(GET_COMMISSIONING)
+        measured, samples, realignments = struct.unpack_from("<BII", d)
+        c = {"measured": bool(measured), "offset_samples": samples, "realignments": realignments}
+        c.update(zip(COMMISSIONING_FIELDS, struct.unpack_from("<8f", d, 9)))
+        return c
+
+    @staticmethod
+    def _key(key):
+        if isinstance(key, int) or (isinstance(key, str) and key.isdigit()):
+            return bytes([int(key)])
+        return b"\xff", key.encode("ascii")
+
+    def get_config(self, key):
+        k = self._key(key)
+        d = self.request(GET_CONFIG, k if isinstance(k, bytes) else k[0] + k[1])
+        cid, ctype, flags = d[0], d[1], d[2]
+        (value,) = struct.unpack_from("<f", d, 3)
+        return {"id": cid, "name": d[7:].decode("ascii"), "type": CONFIG_TYPES.get(ctype, "?"),
+                "read_only": bool(flags & 1), "value": value}
+
+    def set_config(self, key, value):
+        k = self._key(key)
+        v = struct.pack("<f", float(value))
+        return self._ack(SET_CONFIG, k + v if isinstance(k, bytes) else k[0] + v + k[1])
+
+    def list_config(self):
+        out = []
+        for cid in range(255):
+            try:
+                out.append(self.get_config(cid))
+            except DeviceError:
+                break
+        return out
+
+    def set_telemetry(self, decimation):
+        return self._ack(TELEMETRY, struct.pack("<I", decimation))
+
+    def sim_advance(self, periods, timeout=120.0):
+        return self._ack(SIM_ADVANCE, struct.pack("<I", periods), timeout=timeout)
+
+    def sim_finish(self):
+        return self._ack(SIM_FINISH)
+
+
+# ---- telemetry to CSV, plots ----
+def write_csv(path, rows):
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=TELEMETRY_FIELDS)
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: (repr(v) if isinstance(v, float) else v) for k, v in r.items()})
+
+
+def read_csv(path):
+    with open(path, newline="") as f:
+        return [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f)]
+
+
+PLOTS = [("speed_hat_rad_s", "speed_ref_rad_s", "rad/s"), ("load_hat_Nm", None, "Nm"),
+         ("i_a_A", "i_b_A", "A"), ("cos_hat", "sin_hat", "")]
+
+
+def plot_rows(rows, period_s=50e-6, path=None):
+    import matplotlib
+    if path:
+        matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(len(PLOTS), 1, sharex=True, figsize=(8, 8))
+    t = [r["period"] * period_s for r in rows]
+    for ax, (a, b, unit) in zip(axes, PLOTS):
+        ax.plot(t, [r[a] for r in rows], label=a)
+        if b:
+            ax.plot(t, [r[b] for r in rows], label=b)
+        ax.set_ylabel(unit)
+        ax.legend(loc="upper left", fontsize="small")
+    axes[-1].set_xlabel("t (s)")
+    if path:
+        fig.savefig(path)
+    else:
+        plt.show()
+
+
+def stream(con, decimation, seconds, csv_path=None, live_plot=False):
+    rows = []
+    con.telemetry = rows
+    con.set_telemetry(decimation)
+    end = time.monotonic() + seconds
+    if live_plot:
+        import matplotlib.pyplot as plt
+        plt.ion()
+        fig, ax = plt.subplots()
+        (line_hat,) = ax.plot([], [], label="speed_hat_rad_s")
+        (line_ref,) = ax.plot([], [], label="speed_ref_rad_s")
+        ax.legend()
+        while time.monotonic() < end:
+            con.pump(0.1)
+            if rows:
+                x = [r["period"] for r in rows]
+                line_hat.set_data(x, [r["speed_hat_rad_s"] for r in rows])
+                line_ref.set_data(x, [r["speed_ref_rad_s"] for r in rows])
+                ax.relim()
+                ax.autoscale_view()
+                plt.pause(0.01)
+    else:
+        while time.monotonic() < end:
+            con.pump(0.1)
+    con.set_telemetry(0)
+    con.pump(0.1)
+    if csv_path:
+        write_csv(csv_path, rows)
+    return rows
+
+
+# ---- command line ----
+def print_dict(d):
+    for k, v in d.items():
+        print(f"  {k:26s} {v:.6g}" if isinstance(v, float) else f"  {k:26s} {v}")
+
+
+def run_command(con, argv):
+    """One command; returns False for an unknown one."""
+    p = argparse.ArgumentParser(prog="pmstep-console command", add_help=False)
+    p.add_argument("what")
+    p.add_argument("args", nargs="*")
+    p.add_argument("--ramp", type=float, default=50.0)
+    p.add_argument("--decimation", type=int, default=200)
+    p.add_argument("--seconds", type=float, default=5.0)
+    p.add_argument("--csv")
+    p.add_argument("--plot", action="store_true")
+    p.add_argument("--period", type=float, default=50e-6)
+    a = p.parse_args(argv)
+    w = a.what
+    if w == "hello":
+        print_dict(con.hello())
+    elif w == "status":
+        print_dict(con.status())
+    elif w == "counters":
+        print_dict(con.counters())
+    elif w == "commissioning":
+        print_dict(con.commissioning())
+    elif w in ("start", "stop", "clear"):
+        period = {"start": con.start, "stop": con.stop, "clear": con.clear_fault}[w]()
+        print(f"{w}: done from period {period}")
+    elif w == "speed":
+        print(f"speed target {a.args[0]} rad/s at {a.ramp} rad/s^2: from period {con.speed(float(a.args[0]), a.ramp)}")
+    elif w == "id":
+        print(f"i_d target {a.args[0]} A: from period {con.id_target(float(a.args[0]))}")
+    elif w == "config":
+        for c in con.list_config():
+            ro = " (read-only)" if c["read_only"] else ""
+            print(f"  {c['id']:3d} {c['name']:34s} {c['value']:.7g} {c['type']}{ro}")
+    elif w == "get":
+        c = con.get_config(a.args[0])
+        print(f"  {c['id']} {c['name']} = {c['value']:.7g} ({c['type']})")
+    elif w == "set":
+        print(f"set {a.args[0]} = {a.args[1]}: done (core re-initialised) at period {con.set_config(a.args[0], a.args[1])}")
+    elif w == "telemetry":
+        rows = stream(con, a.decimation, a.seconds, a.csv, a.plot)
+        print(f"{len(rows)} telemetry frames" + (f" written to {a.csv}" if a.csv else ""))
+    else:
+        return False
+    return True
+
+
+class Shell(cmd.Cmd):
+    intro = "pmstep console: hello, status, start, stop, clear, speed T [--ramp R], id A, config, get K, " \
+            "set K V, commissioning, counters, telemetry [--decimation N --seconds S --csv F --plot], quit"
+    prompt = "pmstep> "
+
+    def __init__(self, con):
+        super().__init__()
+        self.con = con
+
+    def default(self, line):
+        try:
+            if not run_command(self.con, shlex.split(line)):
+                print(f"unknown command: {line}")
+        except (DeviceError, TimeoutError, ValueError, IndexError, SystemExit) as e:
+            print(f"error: {e}")
+
+    def do_quit(self, _):
+        return True
+
+    do_EOF = do_quit
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter, epilog=__doc__)
+    ap.add_argument("--port", help="serial device, pty, tcp:HOST:PORT or a pyserial URL")
+    ap.add_argument("--baud", type=int, default=115200)
+    ap.add_argument("command", nargs=argparse.REMAINDER, help="see below")
+    a = ap.parse_args(argv)
+    if a.command and a.command[0] == "plot":
+        plot_rows(read_csv(a.command[1]), path=a.command[2] if len(a.command) > 2 else None)
+        return 0
+    if not a.port:
+        ap.error("--port is required")
+    link = open_endpoint(a.port, a.baud)
+    con = Console(link)
+    try:
+        if not a.command or a.command[0] == "interactive":
+            Shell(con).cmdloop()
+            return 0
+        if not run_command(con, a.command):
+            ap.error(f"unknown command {a.command[0]}")
+    except (DeviceError, TimeoutError) as e:
+        print(f"pmstep-console: {e}", file=sys.stderr)
+        return 1
+    finally:
+        link.close()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
