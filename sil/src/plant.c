@@ -1,4 +1,5 @@
-/* Model (1) of the paper, RK4 with voltages held over the control period. */
+/* Model (1) of the paper with voltages held over each step: RK4, or the exponential
+ * time-differencing RK4 of plant.h. */
 #include "sil/plant.h"
 
 #include <math.h>
@@ -72,6 +73,19 @@ void plant_derivative(const plant_params_t *params, const plant_load_t *load, do
     derivative_at(params, load, t_s, x, sin(angle), cos(angle), u_a_v, u_b_v, dx);
 }
 
+void plant_sin_cos(plant_t *plant, double *sin_ptheta, double *cos_ptheta)
+{
+    const double angle = (double)plant->params.pole_pairs * plant->x.theta_rad;
+    if (!plant->trig_valid || angle != plant->trig_angle_rad) {
+        plant->trig_sin = sin(angle);
+        plant->trig_cos = cos(angle);
+        plant->trig_angle_rad = angle;
+        plant->trig_valid = true;
+    }
+    *sin_ptheta = plant->trig_sin;
+    *cos_ptheta = plant->trig_cos;
+}
+
 /* sin and cos of (angle + delta) from those of angle. Within a substep delta = p (theta_stage -
  * theta) is tiny, so its sine and cosine come from their Taylor series (truncation below
  * 1e-17 for |delta| < 0.01): one sincos per substep instead of four. */
@@ -111,17 +125,17 @@ static void hold_open(plant_state_t *dx, bool open_a, bool open_b)
     }
 }
 
-void plant_substep(plant_t *plant, double t_s, double h, double u_a_v, double u_b_v, double *charge_a_c,
-                   double *charge_b_c)
+static void rk4_substep(plant_t *plant, double t_s, double h, double u_a_v, double u_b_v, double *charge_a_c,
+                        double *charge_b_c)
 {
     const plant_state_t x = plant->x;
     const double p = (double)plant->params.pole_pairs;
-    const double s0 = sin(p * x.theta_rad);
-    const double c0 = cos(p * x.theta_rad);
+    double s0, c0;
     const bool oa = plant->open_a;
     const bool ob = plant->open_b;
     plant_state_t k1, k2, k3, k4, y2, y3, y4;
     double s, c;
+    plant_sin_cos(plant, &s0, &c0);
     derivative_at(&plant->params, &plant->load, t_s, &x, s0, c0, u_a_v, u_b_v, &k1);
     hold_open(&k1, oa, ob);
     y2 = axpy(&x, 0.5 * h, &k1);
@@ -145,6 +159,205 @@ void plant_substep(plant_t *plant, double t_s, double h, double u_a_v, double u_
         *charge_a_c = h / 6.0 * (x.i_a_a + 2.0 * (y2.i_a_a + y3.i_a_a) + y4.i_a_a);
         *charge_b_c = h / 6.0 * (x.i_b_a + 2.0 * (y2.i_b_a + y3.i_b_a) + y4.i_b_a);
     }
+}
+
+/* N(t, y) of plant.h: (1) less its linear part A (y - y*), with sin and cos of p theta given. */
+static void coupling_at(const plant_params_t *params, const plant_load_t *load, double t_s, const plant_state_t *y,
+                        double s, double c, plant_state_t *n)
+{
+    const double k_m = params->torque_constant_nm_per_a;
+    const double load_nm = plant_load_torque(load, t_s, y->omega_rad_s);
+    const double emf_per_l = k_m * y->omega_rad_s / params->inductance_h;
+    n->theta_rad = y->omega_rad_s;
+    n->omega_rad_s = (k_m * (-y->i_a_a * s + y->i_b_a * c) - load_nm) / params->inertia_kg_m2;
+    n->i_a_a = emf_per_l * s;
+    n->i_b_a = -emf_per_l * c;
+}
+
+/* e^z and phi_1, phi_2, phi_3 of z (phi_k(z) = sum_j z^j / (j + k)!): by their series for
+ * |z| < 1 (no cancellation; the terms are summed until they no longer change the sums, a
+ * handful for the |z| of a control period), by phi_{k+1} = (phi_k - 1/k!) / z above. */
+static double phi_functions(double z, double phi[3])
+{
+    if (z == 0.0) {
+        phi[0] = 1.0;
+        phi[1] = 0.5;
+        phi[2] = 1.0 / 6.0;
+        return 1.0;
+    }
+    if (fabs(z) < 1.0) {
+        double term3 = 1.0 / 6.0;
+        int j;
+        phi[0] = 1.0;
+        phi[1] = 0.5;
+        phi[2] = 0.0;
+        /* phi_3 by its series; phi_2 = 1/2 + z phi_3, phi_1 = 1 + z phi_2 (no cancellation: |z| < 1). */
+        for (j = 0; j < 40; ++j) { /* |z|^40 / 43! is far below the double epsilon */
+            const double before = phi[2];
+            phi[2] += term3;
+            if (phi[2] == before) {
+                break;
+            }
+            term3 *= z / (double)(j + 4);
+        }
+        phi[1] = 0.5 + z * phi[2];
+        phi[0] = 1.0 + z * phi[1];
+        return 1.0 + z * phi[0];
+    }
+    phi[0] = (exp(z) - 1.0) / z;
+    phi[1] = (phi[0] - 1.0) / z;
+    phi[2] = (phi[1] - 0.5) / z;
+    return exp(z);
+}
+
+/* The ETDRK4 weights of a component with linear coefficient lambda over a step h. */
+static void etd_weights(double lambda, double h, plant_etd_weights_t *w)
+{
+    const double z = lambda * h;
+    double phi[3], phi_half[3];
+    w->decay = phi_functions(z, phi);
+    w->decay_half = phi_functions(0.5 * z, phi_half);
+    w->half = 0.5 * h * phi_half[0];
+    w->w_start = h * (phi[0] - 3.0 * phi[1] + 4.0 * phi[2]);
+    w->w_mid = h * (phi[1] - 2.0 * phi[2]);
+    w->w_end = h * (4.0 * phi[2] - phi[1]);
+}
+
+/* The weights for h, R/L and F/J, recomputed only when one of them changes. */
+static void update_weights(plant_t *plant, double h)
+{
+    const double r_over_l = plant->params.resistance_ohm / plant->params.inductance_h;
+    const double f_over_j = plant->params.friction_nm_s_per_rad / plant->params.inertia_kg_m2;
+    if (h != plant->cache_h_s || r_over_l != plant->cache_r_over_l || f_over_j != plant->cache_f_over_j) {
+        plant->cache_h_s = h;
+        plant->cache_r_over_l = r_over_l;
+        plant->cache_f_over_j = f_over_j;
+        etd_weights(-r_over_l, h, &plant->cache_current);
+        etd_weights(0.0, h, &plant->cache_free);
+        if (f_over_j == 0.0) {
+            plant->cache_speed = plant->cache_free;
+        } else {
+            etd_weights(-f_over_j, h, &plant->cache_speed);
+        }
+    }
+}
+
+/* One component of ETDRK4 (Cox and Matthews): w = y - y*, n0..n3 = N at the start, the two
+ * midpoint stages and the end stage. */
+static double etd_stage_a(const plant_etd_weights_t *w, double w0, double n0)
+{
+    return w->decay_half * w0 + w->half * n0;
+}
+
+static double etd_stage_c(const plant_etd_weights_t *w, double wa, double n0, double nb)
+{
+    return w->decay_half * wa + w->half * (2.0 * nb - n0);
+}
+
+static double etd_end(const plant_etd_weights_t *w, double w0, double n0, double na, double nb, double nc)
+{
+    return w->decay * w0 + w->w_start * n0 + 2.0 * w->w_mid * (na + nb) + w->w_end * nc;
+}
+
+/* Exponential time differencing RK4 on w = y - y* (plant.h). theta has no linear part;
+ * an open phase has none either and its N is zero, so it holds. */
+static void exponential_substep(plant_t *plant, double t_s, double h, double u_a_v, double u_b_v,
+                                double *charge_a_c, double *charge_b_c)
+{
+    const plant_params_t *par = &plant->params;
+    const plant_state_t x = plant->x;
+    const double p = (double)par->pole_pairs;
+    const bool oa = plant->open_a;
+    const bool ob = plant->open_b;
+    const plant_etd_weights_t *wt, *ww, *wa, *wb;
+    double star_a, star_b;
+    plant_state_t w0, n0, na, nb, nc, ya, yb, yc;
+    double s0, c0, s, c;
+    plant_sin_cos(plant, &s0, &c0);
+    update_weights(plant, h);
+    wt = &plant->cache_free;
+    ww = &plant->cache_speed;
+    wa = oa ? &plant->cache_free : &plant->cache_current;
+    wb = ob ? &plant->cache_free : &plant->cache_current;
+    star_a = oa ? x.i_a_a : u_a_v / par->resistance_ohm;
+    star_b = ob ? x.i_b_a : u_b_v / par->resistance_ohm;
+    w0.theta_rad = x.theta_rad;
+    w0.omega_rad_s = x.omega_rad_s;
+    w0.i_a_a = x.i_a_a - star_a;
+    w0.i_b_a = x.i_b_a - star_b;
+
+    coupling_at(par, &plant->load, t_s, &x, s0, c0, &n0);
+    hold_open(&n0, oa, ob);
+    ya.theta_rad = etd_stage_a(wt, w0.theta_rad, n0.theta_rad);
+    ya.omega_rad_s = etd_stage_a(ww, w0.omega_rad_s, n0.omega_rad_s);
+    ya.i_a_a = etd_stage_a(wa, w0.i_a_a, n0.i_a_a) + star_a;
+    ya.i_b_a = etd_stage_a(wb, w0.i_b_a, n0.i_b_a) + star_b;
+    rotate(s0, c0, p * (ya.theta_rad - x.theta_rad), &s, &c);
+    coupling_at(par, &plant->load, t_s + 0.5 * h, &ya, s, c, &na);
+    hold_open(&na, oa, ob);
+    yb.theta_rad = etd_stage_a(wt, w0.theta_rad, na.theta_rad);
+    yb.omega_rad_s = etd_stage_a(ww, w0.omega_rad_s, na.omega_rad_s);
+    yb.i_a_a = etd_stage_a(wa, w0.i_a_a, na.i_a_a) + star_a;
+    yb.i_b_a = etd_stage_a(wb, w0.i_b_a, na.i_b_a) + star_b;
+    rotate(s0, c0, p * (yb.theta_rad - x.theta_rad), &s, &c);
+    coupling_at(par, &plant->load, t_s + 0.5 * h, &yb, s, c, &nb);
+    hold_open(&nb, oa, ob);
+    yc.theta_rad = etd_stage_c(wt, ya.theta_rad, n0.theta_rad, nb.theta_rad);
+    yc.omega_rad_s = etd_stage_c(ww, ya.omega_rad_s, n0.omega_rad_s, nb.omega_rad_s);
+    yc.i_a_a = etd_stage_c(wa, ya.i_a_a - star_a, n0.i_a_a, nb.i_a_a) + star_a;
+    yc.i_b_a = etd_stage_c(wb, ya.i_b_a - star_b, n0.i_b_a, nb.i_b_a) + star_b;
+    rotate(s0, c0, p * (yc.theta_rad - x.theta_rad), &s, &c);
+    coupling_at(par, &plant->load, t_s + h, &yc, s, c, &nc);
+    hold_open(&nc, oa, ob);
+
+    plant->x.theta_rad = etd_end(wt, w0.theta_rad, n0.theta_rad, na.theta_rad, nb.theta_rad, nc.theta_rad);
+    plant->x.omega_rad_s = etd_end(ww, w0.omega_rad_s, n0.omega_rad_s, na.omega_rad_s, nb.omega_rad_s, nc.omega_rad_s);
+    plant->x.i_a_a = oa ? x.i_a_a : etd_end(wa, w0.i_a_a, n0.i_a_a, na.i_a_a, nb.i_a_a, nc.i_a_a) + star_a;
+    plant->x.i_b_a = ob ? x.i_b_a : etd_end(wb, w0.i_b_a, n0.i_b_a, na.i_b_a, nb.i_b_a, nc.i_b_a) + star_b;
+    if (charge_a_c != NULL && charge_b_c != NULL) {
+        /* Simpson's rule, the midpoint as the mean of the two midpoint stages. */
+        *charge_a_c = h / 6.0 * (x.i_a_a + 2.0 * (ya.i_a_a + yb.i_a_a) + plant->x.i_a_a);
+        *charge_b_c = h / 6.0 * (x.i_b_a + 2.0 * (yb.i_b_a + ya.i_b_a) + plant->x.i_b_a);
+    }
+}
+
+static void method_substep(plant_t *plant, double t_s, double h, double u_a_v, double u_b_v, double *charge_a_c,
+                           double *charge_b_c)
+{
+    if (plant->integrator == PLANT_INTEGRATOR_EXPONENTIAL) {
+        exponential_substep(plant, t_s, h, u_a_v, u_b_v, charge_a_c, charge_b_c);
+    } else {
+        rk4_substep(plant, t_s, h, u_a_v, u_b_v, charge_a_c, charge_b_c);
+    }
+}
+
+void plant_substep(plant_t *plant, double t_s, double h, double u_a_v, double u_b_v, double *charge_a_c,
+                   double *charge_b_c)
+{
+    const double t_step_s = plant->load.step_time_s;
+    if (plant->load.kind == PLANT_LOAD_STEP && t_s < t_step_s && t_step_s <= t_s + h) {
+        /* A load step inside the step (or at its end): integrate up to it without the load
+         * and on from it with the load, so no stage samples the jump (which would make the
+         * error first order in h). */
+        const plant_load_t load = plant->load;
+        const double h1 = t_step_s - t_s;
+        const double h2 = h - h1;
+        double qa1 = 0.0, qb1 = 0.0, qa2 = 0.0, qb2 = 0.0;
+        const bool charges = charge_a_c != NULL && charge_b_c != NULL;
+        plant->load.kind = PLANT_LOAD_NONE;
+        method_substep(plant, t_s, h1, u_a_v, u_b_v, charges ? &qa1 : NULL, charges ? &qb1 : NULL);
+        plant->load.kind = PLANT_LOAD_CONSTANT;
+        if (h2 > 0.0) {
+            method_substep(plant, t_step_s, h2, u_a_v, u_b_v, charges ? &qa2 : NULL, charges ? &qb2 : NULL);
+        }
+        plant->load = load;
+        if (charges) {
+            *charge_a_c = qa1 + qa2;
+            *charge_b_c = qb1 + qb2;
+        }
+        return;
+    }
+    method_substep(plant, t_s, h, u_a_v, u_b_v, charge_a_c, charge_b_c);
 }
 
 void plant_advance(plant_t *plant, double u_a_v, double u_b_v, double period_s, int substeps)
