@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Shared set-up of the scripts for people (run_paper.sh, run_doa.sh, run_monte_carlo.sh):
 # installs the Debian packages that are missing, builds the optimised host tree (preset
-# host-release: pmstep-sil, pmstep-gain-check) and makes the plotting environment .venv with
-# the pinned packages of tools/requirements.txt. Run from the repository root.
+# host-release: pmstep-sil, pmstep-gain-check) and makes the Python environment .venv with
+# the pinned packages of tools/requirements.txt (tools/setup_venv.sh). Run from the repository root.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -12,12 +12,4 @@ echo "== build (preset host-release)"
 cmake --preset host-release >/dev/null
 cmake --build --preset host-release
 
-echo "== plotting environment (.venv, tools/requirements.txt)"
-if [ ! -x .venv/bin/python ]; then
-  if ! python3 -m venv .venv 2>/dev/null; then
-    rm -rf .venv
-    tools/install_deps.sh python3-venv
-    python3 -m venv .venv
-  fi
-fi
-.venv/bin/python -m pip install --quiet --disable-pip-version-check -r tools/requirements.txt
+tools/setup_venv.sh

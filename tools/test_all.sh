@@ -6,6 +6,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 tools/install_deps.sh
+# Python packages of the tools and their tests (the Monte Carlo campaigns on Dask) into .venv.
+tools/setup_venv.sh
 
 echo "== host build (preset host: ASan + UBSan)"
 cmake --preset host >/dev/null
