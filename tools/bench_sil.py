@@ -19,12 +19,15 @@ import sys
 import tempfile
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "tools"))
+from scenario_keys import KEYS  # noqa: E402  (the one place that names the scenario keys)
+
 # (label, --set overrides, target real-time factor or None)
 SETTINGS = [
     ("default (exponential x1), averaged", [], 150.0),
-    ("default (exponential x1), switching", ["inverter.model=switching"], 60.0),
-    ("rk4 x25 (reference), averaged", ["run.integrator=rk4", "run.substeps=25"], None),
-    ("rk4 x10 (former default), averaged", ["run.integrator=rk4", "run.substeps=10"], None),
+    ("default (exponential x1), switching", [f"{KEYS['inverter_model']}=switching"], 60.0),
+    ("rk4 x25 (reference), averaged", [f"{KEYS['integrator']}=rk4", f"{KEYS['substeps']}=25"], None),
+    ("rk4 x10 (former default), averaged", [f"{KEYS['integrator']}=rk4", f"{KEYS['substeps']}=10"], None),
 ]
 
 
