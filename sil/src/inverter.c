@@ -152,7 +152,7 @@ static double substep_bus_v(const period_t *p, double t_s, double h_s)
     return p->inv->bus.ripple_v > 0.0 ? sil_inverter_bus_voltage(p->inv, t_s + 0.5 * h_s) : p->bus_v;
 }
 
-/* One RK4 substep with u held. bus_fraction[k] = u_k / V_bus (for i_bus). A non-zero
+/* One step of the plant's integrator with u held. bus_fraction[k] = u_k / V_bus (for i_bus). A non-zero
  * diode_sign[k] marks a phase conducting through the freewheel diodes: if its current
  * reaches or crosses zero within the substep it is set to exactly 0 and the phase opens. */
 static void substep(period_t *p, double t_s, double h_s, const double u_v[2], const double bus_fraction[2],
@@ -209,13 +209,47 @@ static void freewheel(period_t *p, double period_s, int substeps)
     }
 }
 
-/* Averaged bridge: u = d V_bus - 2 sign(i) V_bus t_d / T, sign at each substep's start. */
+/* The dead-time branch of a phase at the present state: +1 or -1 with the current's sign;
+ * at zero current the branch the current leaves into, or 0 (held at zero) when neither
+ * branch drives it away: with u0 the duty's voltage and dead_v = 2 V_bus t_d / T, the
+ * positive branch has L di/dt = e + u0 - dead_v at i = 0 and the negative e + u0 + dead_v
+ * (e the back EMF). */
+static int dead_time_branch(const plant_t *plant, int k, double u0_v, double dead_v)
+{
+    const double i_a = k == 0 ? plant->x.i_a_a : plant->x.i_b_a;
+    double s, c, emf_v;
+    if (i_a != 0.0) {
+        return sign_of(i_a);
+    }
+    s = sin((double)plant->params.pole_pairs * plant->x.theta_rad);
+    c = cos((double)plant->params.pole_pairs * plant->x.theta_rad);
+    emf_v = plant->params.torque_constant_nm_per_a * plant->x.omega_rad_s * (k == 0 ? s : -c);
+    if (emf_v + u0_v - dead_v > 0.0) {
+        return 1;
+    }
+    if (emf_v + u0_v + dead_v < 0.0) {
+        return -1;
+    }
+    return 0;
+}
+
+#define DEAD_TIME_EVENTS_MAX 8   /* zero crossings located per substep */
+#define CROSSING_REFINEMENTS 3   /* regula falsi steps on the crossing time */
+
+/* Averaged bridge: u = d V_bus - 2 sign(i) V_bus t_d / T. With dead time the voltage jumps
+ * where a current crosses zero: the substep is cut at the crossing (located by regula falsi
+ * on re-integrations from the substep's start), the current set to exactly 0 there, and the
+ * rest integrated on the branch it leaves into. A current that neither branch drives away
+ * from zero stays at zero (the dead time's zero-current clamp): the phase is held open
+ * until a later substep finds a branch. */
 static void averaged(period_t *p, double period_s, int substeps)
 {
     static const int no_diode[2] = {0, 0};
     const sil_inverter_t *inv = p->inv;
+    plant_t *plant = p->plant;
     const double h = period_s / (double)substeps;
     const double dead_fraction = 2.0 * inv->cfg.dead_time_s / period_s;
+    const bool dead_time = inv->cfg.dead_time_s > 0.0;
     const double command_v[2] = {inv->command_a_v, inv->command_b_v};
     const bool bus_ok = inv->command_bus_v > 0.0;
     int n, k;
@@ -224,19 +258,90 @@ static void averaged(period_t *p, double period_s, int substeps)
         const double bus_v = substep_bus_v(p, t, h);
         /* d V_bus as u (V_bus / V_measured): exactly the command when the two agree. */
         const double ratio = bus_ok ? bus_v / inv->command_bus_v : 0.0;
-        double u_v[2], fraction[2];
+        const double dead_v = bus_v * dead_fraction;
+        double u0_v[2], fraction0[2];
+        double done_s = 0.0;
+        int events = 0;
         for (k = 0; k < 2; ++k) {
-            u_v[k] = command_v[k] * ratio;
-            fraction[k] = bus_ok ? command_v[k] / inv->command_bus_v : 0.0;
-            if (inv->cfg.dead_time_s > 0.0) {
-                const int s = sign_of(*phase_current(p->plant, k));
-                if (s != 0) {
-                    u_v[k] -= (double)s * bus_v * dead_fraction;
-                    fraction[k] -= (double)s * dead_fraction;
+            u0_v[k] = command_v[k] * ratio;
+            fraction0[k] = bus_ok ? command_v[k] / inv->command_bus_v : 0.0;
+        }
+        if (!dead_time) {
+            substep(p, t, h, u0_v, fraction0, no_diode);
+            continue;
+        }
+        while (done_s < h) {
+            const double rest_s = h - done_s;
+            const plant_state_t start = plant->x;
+            double u_v[2], fraction[2];
+            int branch[2];
+            double cut_s = rest_s;
+            int crossing = -1;
+            period_t saved;
+            for (k = 0; k < 2; ++k) {
+                branch[k] = dead_time_branch(plant, k, u0_v[k], dead_v);
+                u_v[k] = u0_v[k] - (double)branch[k] * dead_v;
+                fraction[k] = fraction0[k] - (double)branch[k] * dead_fraction;
+                if (branch[k] == 0) {
+                    /* Held at zero: the voltage that holds it there, no bus current. */
+                    const double angle = (double)plant->params.pole_pairs * plant->x.theta_rad;
+                    u_v[k] = -plant->params.torque_constant_nm_per_a * plant->x.omega_rad_s
+                             * (k == 0 ? sin(angle) : -cos(angle));
+                    fraction[k] = 0.0;
+                }
+                *phase_open(plant, k) = branch[k] == 0;
+            }
+            /* The rest of the substep; undone if a current crossed zero within it. */
+            saved = *p;
+            substep(p, t + done_s, rest_s, u_v, fraction, no_diode);
+            if (events < DEAD_TIME_EVENTS_MAX) {
+                double lo_s = 0.0, hi_s = rest_s;
+                double i_lo[2], i_hi[2];
+                for (k = 0; k < 2; ++k) {
+                    i_lo[k] = k == 0 ? start.i_a_a : start.i_b_a;
+                    i_hi[k] = *phase_current(plant, k);
+                    if (branch[k] != 0 && sign_of(i_hi[k]) != branch[k]) {
+                        /* The earliest crossing by linear interpolation. */
+                        const double f_s = rest_s * i_lo[k] / (i_lo[k] - i_hi[k]);
+                        if (crossing < 0 || f_s < cut_s) {
+                            crossing = k;
+                            cut_s = f_s;
+                        }
+                    }
+                }
+                if (crossing >= 0) {
+                    int r;
+                    double at_lo = i_lo[crossing], at_hi = i_hi[crossing];
+                    for (r = 0; r < CROSSING_REFINEMENTS; ++r) {
+                        double i_cut;
+                        plant->x = start;
+                        plant_substep(plant, t + done_s, cut_s, u_v[0], u_v[1], NULL, NULL);
+                        i_cut = *phase_current(plant, crossing);
+                        if (sign_of(i_cut) == branch[crossing]) {
+                            lo_s = cut_s;
+                            at_lo = i_cut;
+                        } else {
+                            hi_s = cut_s;
+                            at_hi = i_cut;
+                        }
+                        if (i_cut == 0.0 || !(hi_s > lo_s)) {
+                            break;
+                        }
+                        cut_s = lo_s + (hi_s - lo_s) * at_lo / (at_lo - at_hi);
+                    }
+                    cut_s = hi_s; /* end the piece at or just past the crossing */
+                    /* Up to the crossing only, the current there exactly zero. */
+                    *p = saved;
+                    plant->x = start; /* (the open flags are the branches', as before) */
+                    substep(p, t + done_s, cut_s, u_v, fraction, no_diode);
+                    *phase_current(plant, crossing) = 0.0;
+                    ++events;
                 }
             }
+            done_s = crossing >= 0 ? done_s + cut_s : h;
         }
-        substep(p, t, h, u_v, fraction, no_diode);
+        plant->open_a = false;
+        plant->open_b = false;
     }
 }
 

@@ -73,19 +73,6 @@ void plant_derivative(const plant_params_t *params, const plant_load_t *load, do
     derivative_at(params, load, t_s, x, sin(angle), cos(angle), u_a_v, u_b_v, dx);
 }
 
-void plant_sin_cos(plant_t *plant, double *sin_ptheta, double *cos_ptheta)
-{
-    const double angle = (double)plant->params.pole_pairs * plant->x.theta_rad;
-    if (!plant->trig_valid || angle != plant->trig_angle_rad) {
-        plant->trig_sin = sin(angle);
-        plant->trig_cos = cos(angle);
-        plant->trig_angle_rad = angle;
-        plant->trig_valid = true;
-    }
-    *sin_ptheta = plant->trig_sin;
-    *cos_ptheta = plant->trig_cos;
-}
-
 /* sin and cos of (angle + delta) from those of angle. Within a substep delta = p (theta_stage -
  * theta) is tiny, so its sine and cosine come from their Taylor series (truncation below
  * 1e-17 for |delta| < 0.01): one sincos per substep instead of four. */
@@ -102,6 +89,25 @@ static void rotate(double s0, double c0, double delta, double *s, double *c)
     }
     *s = s0 * cd + c0 * sd;
     *c = c0 * cd - s0 * sd;
+}
+
+void plant_sin_cos(plant_t *plant, double *sin_ptheta, double *cos_ptheta)
+{
+    const double angle = (double)plant->params.pole_pairs * plant->x.theta_rad;
+    const double delta = angle - plant->trig_angle_rad;
+    if (!plant->trig_valid || !(fabs(delta) < 0.01)) {
+        /* A new base angle: one sincos. */
+        plant->trig_sin = sin(angle);
+        plant->trig_cos = cos(angle);
+        plant->trig_angle_rad = angle;
+        plant->trig_valid = true;
+        *sin_ptheta = plant->trig_sin;
+        *cos_ptheta = plant->trig_cos;
+        return;
+    }
+    /* Within 0.01 rad of the base (the steps of a period, a slow rotor): rotated from the
+     * base, never from a rotated value, so nothing accumulates. */
+    rotate(plant->trig_sin, plant->trig_cos, delta, sin_ptheta, cos_ptheta);
 }
 
 static plant_state_t axpy(const plant_state_t *x, double h, const plant_state_t *dx)
@@ -174,6 +180,8 @@ static void coupling_at(const plant_params_t *params, const plant_load_t *load, 
     n->i_b_a = -emf_per_l * c;
 }
 
+#define PHI_TERMS 20
+
 /* e^z and phi_1, phi_2, phi_3 of z (phi_k(z) = sum_j z^j / (j + k)!): by their series for
  * |z| < 1 (no cancellation; the terms are summed until they no longer change the sums, a
  * handful for the |z| of a control period), by phi_{k+1} = (phi_k - 1/k!) / z above. */
@@ -186,19 +194,23 @@ static double phi_functions(double z, double phi[3])
         return 1.0;
     }
     if (fabs(z) < 1.0) {
+        /* 1 / (j + 4) for the series' terms (no division in the loop). */
+        static const double inv[PHI_TERMS] = {
+            1.0 / 4,  1.0 / 5,  1.0 / 6,  1.0 / 7,  1.0 / 8,  1.0 / 9,  1.0 / 10, 1.0 / 11, 1.0 / 12, 1.0 / 13,
+            1.0 / 14, 1.0 / 15, 1.0 / 16, 1.0 / 17, 1.0 / 18, 1.0 / 19, 1.0 / 20, 1.0 / 21, 1.0 / 22, 1.0 / 23};
         double term3 = 1.0 / 6.0;
         int j;
         phi[0] = 1.0;
         phi[1] = 0.5;
         phi[2] = 0.0;
         /* phi_3 by its series; phi_2 = 1/2 + z phi_3, phi_1 = 1 + z phi_2 (no cancellation: |z| < 1). */
-        for (j = 0; j < 40; ++j) { /* |z|^40 / 43! is far below the double epsilon */
+        for (j = 0; j < PHI_TERMS; ++j) { /* |z|^20 / 23! is far below the double epsilon */
             const double before = phi[2];
             phi[2] += term3;
             if (phi[2] == before) {
                 break;
             }
-            term3 *= z / (double)(j + 4);
+            term3 *= z * inv[j];
         }
         phi[1] = 0.5 + z * phi[2];
         phi[0] = 1.0 + z * phi[1];
@@ -233,7 +245,7 @@ static void update_weights(plant_t *plant, double h)
         plant->cache_r_over_l = r_over_l;
         plant->cache_f_over_j = f_over_j;
         etd_weights(-r_over_l, h, &plant->cache_current);
-        etd_weights(0.0, h, &plant->cache_free);
+        etd_weights(0.0, h, &plant->cache_free); /* constants times h: no series for z = 0 */
         if (f_over_j == 0.0) {
             plant->cache_speed = plant->cache_free;
         } else {

@@ -102,6 +102,71 @@ static void averaged_dead_time_shifts_the_steady_current(void **state)
     assert_true(fabs(inv.applied_a_v - (u_v - error_v)) < 1e-9);
 }
 
+static void averaged_dead_time_clamps_a_small_command_at_zero(void **state)
+{
+    /* A command below the dead time's voltage error (1.92 V) drives no current: neither
+     * branch of the averaged model moves a zero current away from zero (the zero-current
+     * clamp), so the current stays exactly 0 and the applied voltage is the one that holds it. */
+    const double dead_time_s = 1e-6;
+    plant_t plant = rl_plant();
+    sil_inverter_t inv = make_inverter(SIL_INVERTER_AVERAGED, dead_time_s, 0.0);
+    (void)state;
+    run(&plant, &inv, 1.5, -1.0, 400);
+    print_message("averaged, t_d = 1 us, commands 1.5 V and -1 V: i_a = %g A, i_b = %g A, mean u_a = %g V\n",
+                  plant.x.i_a_a, plant.x.i_b_a, inv.applied_a_v);
+    assert_true(plant.x.i_a_a == 0.0 && plant.x.i_b_a == 0.0);
+    assert_true(inv.applied_a_v == 0.0 && inv.applied_b_v == 0.0);
+    /* Above the error the current rises, on the positive branch. */
+    run(&plant, &inv, 3.0, 0.0, 2000);
+    assert_true(fabs(plant.x.i_a_a - (3.0 - 2.0 * BUS_V * dead_time_s / PERIOD_S) / R_OHM) < 1e-9);
+}
+
+/* The motor (back EMF, k_M = 2) driven by a rotating voltage through the averaged bridge with
+ * dead time, whose currents cross zero many times; the state after 0.2 s. */
+static plant_state_t dead_time_crossings_run(int substeps, plant_integrator_t method)
+{
+    plant_t plant;
+    sil_inverter_t inv = make_inverter(SIL_INVERTER_AVERAGED, 1e-6, 0.0);
+    pmstep_output_t out;
+    long k;
+    memset(&plant, 0, sizeof plant);
+    plant.params = plant_paper_params();
+    plant.load.kind = PLANT_LOAD_NONE;
+    plant.integrator = method;
+    memset(&out, 0, sizeof out);
+    out.bridge_enable = true;
+    for (k = 0; k < 4000; ++k) {
+        const double t = (double)k * PERIOD_S;
+        const double angle = 6.0 * 10.0 * t * t * 10.0; /* electrical angle of the command, accelerating */
+        plant.time_s = t;
+        out.u_a_v = (float)(8.0 * cos(angle));
+        out.u_b_v = (float)(8.0 * sin(angle));
+        sil_inverter_apply(&inv, &out, BUS_V);
+        sil_drive_advance(&plant, &inv, PERIOD_S, substeps);
+    }
+    return plant.x;
+}
+
+static void averaged_dead_time_converges_across_zero_crossings(void **state)
+{
+    /* Each zero crossing cuts the step where the current crosses: the error against fine
+     * steps falls quickly with the step count (held signs per step were first order). */
+    static const plant_integrator_t methods[] = {PLANT_INTEGRATOR_RK4, PLANT_INTEGRATOR_EXPONENTIAL};
+    int m;
+    (void)state;
+    for (m = 0; m < 2; ++m) {
+        const plant_state_t ref = dead_time_crossings_run(200, PLANT_INTEGRATOR_RK4);
+        const plant_state_t s1 = dead_time_crossings_run(1, methods[m]);
+        const plant_state_t s4 = dead_time_crossings_run(4, methods[m]);
+        const double e1 = fabs(s1.i_a_a - ref.i_a_a) + fabs(s1.i_b_a - ref.i_b_a) + fabs(s1.omega_rad_s - ref.omega_rad_s);
+        const double e4 = fabs(s4.i_a_a - ref.i_a_a) + fabs(s4.i_b_a - ref.i_b_a) + fabs(s4.omega_rad_s - ref.omega_rad_s);
+        print_message("%s, dead time across zero crossings: error at 1 and 4 steps a period %.3g, %.3g (ratio %.1f)\n",
+                      m == 0 ? "rk4" : "exponential", e1, e4, e1 / e4);
+        assert_true(e1 < 1e-5);
+        assert_true(e1 / e4 > 8.0); /* better than first order (4) */
+    }
+}
+
 static void switching_dead_time_shifts_the_mean_current_alike(void **state)
 {
     /* The switching model's edge shifts give the same mean voltage error, so the same mean current. */
@@ -278,6 +343,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(ideal_averaged_is_plant_advance_bit_for_bit),
         cmocka_unit_test(averaged_dead_time_shifts_the_steady_current),
+        cmocka_unit_test(averaged_dead_time_clamps_a_small_command_at_zero),
+        cmocka_unit_test(averaged_dead_time_converges_across_zero_crossings),
         cmocka_unit_test(switching_dead_time_shifts_the_mean_current_alike),
         cmocka_unit_test(switching_matches_averaged_and_the_rl_ripple),
         cmocka_unit_test(bridge_off_freewheels_to_exactly_zero_and_holds),

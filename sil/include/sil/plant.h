@@ -104,7 +104,7 @@ typedef struct {
     plant_etd_weights_t cache_current; /**< lambda = -R/L */
     plant_etd_weights_t cache_speed;   /**< lambda = -F/J */
     plant_etd_weights_t cache_free;    /**< lambda = 0 (theta, an open phase) */
-    /* sin and cos of p theta for the theta they were computed at (plant_sin_cos()). */
+    /* sin and cos of p theta at a base angle (plant_sin_cos()). */
     bool trig_valid;
     double trig_angle_rad, trig_sin, trig_cos;
     bool open_a;   /**< phase a open (bridge off, current extinguished): i_a' = 0, i_a held at exactly 0 */
@@ -122,8 +122,10 @@ void plant_derivative(const plant_params_t *params, const plant_load_t *load, do
                       const plant_state_t *x, double u_a_v, double u_b_v, plant_state_t *dx);
 
 /**
- * sin(p theta) and cos(p theta) of the present state. Computed once per state: a sample
- * taken before a step and the step's first stage share one evaluation.
+ * sin(p theta) and cos(p theta) of the present state: one sincos for a base angle, and
+ * for angles within 0.01 rad of it (the steps of a control period) a rotation of the
+ * base's by the small difference, with its sine and cosine from their Taylor series
+ * (exact to double rounding).
  */
 void plant_sin_cos(plant_t *plant, double *sin_ptheta, double *cos_ptheta);
 
