@@ -222,15 +222,22 @@ def main(argv):
         print("0 passed, 0 failed")
         return 2
     wall_s = time.monotonic() - wall_start
-    case_walls = [r["metrics"].get("wall_s") for r in records if r["metrics"].get("wall_s") is not None]
+    def mean_of(name):
+        values = [r["metrics"].get(name) for r in records if r["metrics"].get(name) is not None]
+        return sum(values) / len(values) if values else None
 
     agg = aggregate(records, args)
     agg.update({"scenario": args.scenario, "command": shlex.join(args.argv), "date": started_utc,
                 "pmstep_sil_version": version, "duration_s": args.duration,
                 "execution": {"engine": engine, "workers": workers, "cases_run": len(records) - resumed,
                               "cases_resumed": resumed, "wall_s": wall_s,
-                              "sil_wall_s_per_case_mean": (sum(case_walls) / len(case_walls)) if case_walls
-                              else None},
+                              "campaign_wall_s_per_case": wall_s / (len(records) - resumed)
+                              if len(records) > resumed else None,
+                              # Inside pmstep-sil, per case: the run's loop, its CPU time, the firmware and
+                              # plant shares (sampled), as each summary.json's timing reports them.
+                              "sil_loop_wall_s_mean": mean_of("wall_s"), "sil_loop_cpu_s_mean": mean_of("cpu_s"),
+                              "sil_firmware_wall_s_mean": mean_of("firmware_wall_s"),
+                              "sil_plant_wall_s_mean": mean_of("plant_wall_s")},
                 "distribution_table": [list(row) for row in DISTRIBUTIONS],
                 "worst_cases": [{"seed": r["seed"], "class": r["class"], "reason": r["reason"],
                                  "max_speed_error_rad_s": r["metrics"].get("max_speed_error_rad_s"),
@@ -263,6 +270,11 @@ def main(argv):
         print(f"... and {len(crashed) - WORST_CASES} more crashed cases (cases.csv)")
     print(f"{engine}, {workers} workers: {len(records) - resumed} cases run ({resumed} resumed) in {wall_s:.1f} s"
           + (f", {(wall_s / (len(records) - resumed)):.3f} s per case" if len(records) > resumed else ""))
+    ex = agg["execution"]
+    if ex["sil_loop_wall_s_mean"] is not None:
+        print(f"per case inside pmstep-sil (mean): loop {ex['sil_loop_wall_s_mean']:.3f} s wall, "
+              f"{ex['sil_loop_cpu_s_mean']:.3f} s CPU; firmware {ex['sil_firmware_wall_s_mean']:.3f} s, "
+              f"plant {ex['sil_plant_wall_s_mean']:.3f} s")
     print(f"report: {os.path.join(args.out, 'report.md')}")
     status = 0
     if args.check:

@@ -171,6 +171,7 @@ static cJSON *summary_json(const sil_scenario_t *sc, const sil_summary_t *s)
     cJSON_AddNumberToObject(timing, "steps", (double)s->steps);
     cJSON_AddNumberToObject(timing, "simulated_s", s->sim_time_s);
     cJSON_AddNumberToObject(timing, "wall_s", s->wall_time_s);
+    cJSON_AddNumberToObject(timing, "cpu_s", s->cpu_time_s);
     cJSON_AddNumberToObject(timing, "plant_wall_s", s->plant_time_s);
     cJSON_AddNumberToObject(timing, "firmware_wall_s", s->firmware_time_s);
     cJSON_AddNumberToObject(timing, "real_time_factor", s->real_time_factor);

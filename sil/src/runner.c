@@ -23,6 +23,13 @@ static double now_s(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+static double cpu_now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
 /* The record of sil/record.h; a write error is kept and reported at the end. */
 typedef struct {
     FILE *file;
@@ -94,7 +101,7 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
     record_t *rec = NULL;
     int next_segment = 0;
     int next_progress_decile = 1;
-    double wall_start;
+    double wall_start, cpu_start;
     double timed_firmware_s = 0.0, timed_plant_s = 0.0, clock_read_s;
     long timed_periods = 0;
     long k;
@@ -139,6 +146,7 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
         }
         clock_read_s = (now_s() - c0) / 65.0;
     }
+    cpu_start = cpu_now_s();
     wall_start = now_s();
     for (k = 0; k < steps; ++k) {
         const double t_s = (double)k * period_s;
@@ -198,6 +206,7 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
         }
     }
     s->wall_time_s = now_s() - wall_start;
+    s->cpu_time_s = cpu_now_s() - cpu_start;
     if (timed_periods > 0) {
         s->firmware_time_s = timed_firmware_s * (double)s->steps / (double)timed_periods;
         s->plant_time_s = timed_plant_s * (double)s->steps / (double)timed_periods;

@@ -36,6 +36,7 @@ typedef struct {
     long steps;
     double sim_time_s;
     double wall_time_s;
+    double cpu_time_s;               /**< CPU time of the process over the same loop (waiting for a core excluded) */
     double plant_time_s;             /**< wall time inside the plant integration (every 16th period timed, scaled) */
     double firmware_time_s;          /**< wall time inside read + pmstep_step + apply (sampled likewise) */
     double real_time_factor;         /**< simulated s per wall s */
