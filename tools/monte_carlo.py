@@ -272,9 +272,11 @@ def main(argv):
           + (f", {(wall_s / (len(records) - resumed)):.3f} s per case" if len(records) > resumed else ""))
     ex = agg["execution"]
     if ex["sil_loop_wall_s_mean"] is not None:
-        print(f"per case inside pmstep-sil (mean): loop {ex['sil_loop_wall_s_mean']:.3f} s wall, "
-              f"{ex['sil_loop_cpu_s_mean']:.3f} s CPU; firmware {ex['sil_firmware_wall_s_mean']:.3f} s, "
-              f"plant {ex['sil_plant_wall_s_mean']:.3f} s")
+        def secs(name):
+            return "-" if ex[name] is None else f"{ex[name]:.3f} s"
+        print(f"per case inside pmstep-sil (mean): loop {secs('sil_loop_wall_s_mean')} wall, "
+              f"{secs('sil_loop_cpu_s_mean')} CPU; firmware {secs('sil_firmware_wall_s_mean')}, "
+              f"plant {secs('sil_plant_wall_s_mean')}")
     print(f"report: {os.path.join(args.out, 'report.md')}")
     status = 0
     if args.check:
