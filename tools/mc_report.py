@@ -8,7 +8,8 @@ import statistics
 
 from mc_distributions import DURATION_KEY, KEY_PARAMETERS, SEED_KEY, SEED_STRIDE, DISTRIBUTIONS, \
     distribution_rows, format_value
-from mc_execution import CLASSES, CLASS_TEXT, rerun_command
+from mc_execution import rerun_command
+from mc_outcome import CLASSES, CLASS_TEXT
 
 WILSON_Z_95 = 1.959963984540054
 WORST_CASES = 10

@@ -8,7 +8,8 @@ Usage:
   tools/monte_carlo.py --sil PATH/pmstep-sil --scenario FILE --out DIR --case CASE_SEED
 
 Parts: mc_distributions.py (what is drawn), mc_execution.py (running the cases on an
-engine, classifying them, resuming), mc_report.py (aggregate, report, cases.csv); every
+engine, resuming), mc_outcome.py (a case's class and numbers), mc_report.py (aggregate,
+report, cases.csv); every
 scenario key they set is named in scenario_keys.py.
 
 Engines (--engine): "dask" (default) runs the cases on dask.distributed, by default on a
@@ -80,10 +81,10 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from mc_distributions import (DISTRIBUTIONS, DURATION_KEY, KEY_PARAMETERS, SEED_KEY, SEED_STRIDE,  # noqa: E402,F401
                               ToolError, base_values, case_seed, distribution_rows, draw_parameters,
                               format_value, missing_keys, parse_scenario, split_case_seed)
-from mc_execution import (CLASSES, CLASS_TEXT, ENGINES, FAULT_EXIT_STATUS, REQUIRED_FIELDS,  # noqa: E402,F401
-                          check_keys, classify, extract_metrics, fault_name, get_path, number_or_none,
-                          read_scenario, rerun_command, run_all, run_case, sil_command, sil_version,
-                          summary_problem)
+from mc_execution import (ENGINES, check_keys, read_scenario, rerun_command, run_all,  # noqa: E402,F401
+                          run_case, sil_command, sil_version)
+from mc_outcome import (CLASSES, CLASS_TEXT, FAULT_EXIT_STATUS, REQUIRED_FIELDS, classify,  # noqa: E402,F401
+                        extract_metrics, fault_name, get_path, number_or_none, summary_problem)
 from mc_report import (CSV_METRICS, WORST_CASES, aggregate, check_verdict, make_plots,  # noqa: E402,F401
                        percentile, spans_decades, wilson_interval, worst_order, write_cases_csv,
                        write_report)
