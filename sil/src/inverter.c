@@ -383,16 +383,16 @@ static int leg_high(const window_t *w, double t_s)
     return t_s > w->on_s && t_s < w->off_s;
 }
 
-/* Switching bridge: constant phase voltages between the sorted edges of both phases. */
-static void switching(period_t *p, double period_s, int substeps)
+/* The period's segments between the sorted edges of both phases: start, length and the level
+ * (-1, 0, +1) of each phase on each. Returns their number (zero-length segments left out). */
+static int switching_segments(const period_t *p, double period_s, double start_s[EDGES_MAX],
+                              double length_s[EDGES_MAX], double level[EDGES_MAX][2])
 {
-    static const int no_diode[2] = {0, 0};
     const sil_inverter_t *inv = p->inv;
     const double command_v[2] = {inv->command_a_v, inv->command_b_v};
-    const double h_max = period_s / (double)substeps;
     window_t legs[2][2]; /* [phase][leg A, leg B] */
     double edges[EDGES_MAX];
-    int n_edges = 0;
+    int n_edges = 0, n = 0;
     int j, k, m;
     edges[n_edges++] = 0.0;
     edges[n_edges++] = period_s;
@@ -415,30 +415,153 @@ static void switching(period_t *p, double period_s, int substeps)
         edges[m] = e;
     }
     for (j = 0; j + 1 < n_edges; ++j) {
-        const double start_s = edges[j];
-        const double length_s = edges[j + 1] - start_s;
-        const double mid_s = start_s + 0.5 * length_s;
-        double level[2];
-        int count;
-        double h;
-        if (!(length_s > 0.0)) {
+        const double length = edges[j + 1] - edges[j];
+        const double mid_s = edges[j] + 0.5 * length;
+        if (!(length > 0.0)) {
             continue;
         }
+        start_s[n] = edges[j];
+        length_s[n] = length;
         for (k = 0; k < 2; ++k) {
-            level[k] = (double)(leg_high(&legs[k][0], mid_s) - leg_high(&legs[k][1], mid_s));
+            level[n][k] = (double)(leg_high(&legs[k][0], mid_s) - leg_high(&legs[k][1], mid_s));
         }
-        count = (int)ceil(length_s / h_max - 1e-9);
+        ++n;
+    }
+    return n;
+}
+
+/* Switching bridge, segment by segment: constant phase voltages between the edges, in steps of
+ * at most T / substeps. */
+static void switching(period_t *p, double period_s, int substeps)
+{
+    static const int no_diode[2] = {0, 0};
+    const double h_max = period_s / (double)substeps;
+    double start[EDGES_MAX], length[EDGES_MAX], level[EDGES_MAX][2];
+    const int n = switching_segments(p, period_s, start, length, level);
+    int j, m;
+    for (j = 0; j < n; ++j) {
+        int count = (int)ceil(length[j] / h_max - 1e-9);
+        double h;
         if (count < 1) {
             count = 1;
         }
-        h = length_s / (double)count;
+        h = length[j] / (double)count;
         for (m = 0; m < count; ++m) {
-            const double t = p->t0_s + start_s + (double)m * h;
+            const double t = p->t0_s + start[j] + (double)m * h;
             const double bus_v = substep_bus_v(p, t, h);
-            const double u_v[2] = {level[0] * bus_v, level[1] * bus_v};
-            substep(p, t, h, u_v, level, no_diode);
+            const double u_v[2] = {level[j][0] * bus_v, level[j][1] * bus_v};
+            substep(p, t, h, u_v, level[j], no_diode);
         }
     }
+}
+
+/* e^x, by its series for the small |x| of a segment (no libm call), else exp(). */
+static double exp_small(double x)
+{
+    if (fabs(x) < 0.05) { /* x^7 / 7! < 2e-16 */
+        return 1.0 + x * (1.0 + x * (0.5 + x * (1.0 / 6.0 + x * (1.0 / 24.0 + x * (1.0 / 120.0 + x / 720.0)))));
+    }
+    return exp(x);
+}
+
+/* Switching bridge in one exponential step a period. The currents are linear in the voltage,
+ * so i = i-bar + r: i-bar under the period's mean voltage u-bar (one step of the exponential
+ * integrator, with the back EMF and the mechanics), and the PWM ripple r, r' = -(R/L) r +
+ * (u - u-bar)/L, r(0) = 0, solved exactly segment by segment. The ripple's torque enters the
+ * step through the projection of r onto quadratics over the period (its exact moments of
+ * order 0, 1, 2, by Simpson's rule on each segment), so the torque's integral against the
+ * slowly turning sin, cos of p theta is kept. At the end i = i-bar + r(T). The mean currents,
+ * the bus current and the currents at the segment ends come from i-bar's quadratic through
+ * its start, middle and end, plus r. */
+static void switching_one_step(period_t *p, double period_s)
+{
+    plant_t *plant = p->plant;
+    const double inv_l = 1.0 / plant->params.inductance_h;
+    const double lambda = -plant->params.resistance_ohm * inv_l;
+    const double to_offset = inv_l / lambda;  /* voltage to minus the steady ripple current (A/V) */
+    const double inv_t = 1.0 / period_s;
+    const double t0 = p->t0_s;
+    const double bus_v = substep_bus_v(p, t0, period_s);
+    double start[EDGES_MAX], length[EDGES_MAX], level[EDGES_MAX][2];
+    double seg_r_end[EDGES_MAX][2], seg_r_int[EDGES_MAX][2];
+    double u_mean[2] = {0.0, 0.0}, r[2] = {0.0, 0.0}, m0[2] = {0.0, 0.0}, m1[2] = {0.0, 0.0}, m2[2] = {0.0, 0.0};
+    double i0[2], q_c[2], i_mid[2], i_end[2];
+    bool constant[2] = {true, true};
+    const int n = switching_segments(p, period_s, start, length, level);
+    int j, k;
+    for (j = 0; j < n; ++j) {
+        for (k = 0; k < 2; ++k) {
+            u_mean[k] += level[j][k] * bus_v * length[j] * inv_t;
+            if (level[j][k] != level[0][k]) {
+                constant[k] = false;
+            }
+        }
+    }
+    for (j = 0; j < n; ++j) {
+        const double e_half = exp_small(0.5 * lambda * length[j]);
+        const double e_full = e_half * e_half;
+        const double ts = start[j], tm = start[j] + 0.5 * length[j], te = start[j] + length[j];
+        for (k = 0; k < 2; ++k) {
+            const double offset = (level[j][k] * bus_v - u_mean[k]) * to_offset; /* -steady state */
+            const double rs = r[k];
+            const double rm = (rs + offset) * e_half - offset;
+            const double re = (rs + offset) * e_full - offset;
+            const double w = length[j] / 6.0;
+            seg_r_int[j][k] = w * (rs + 4.0 * rm + re);
+            m0[k] += seg_r_int[j][k];
+            m1[k] += w * (rs * ts + 4.0 * rm * tm + re * te);
+            m2[k] += w * (rs * ts * ts + 4.0 * rm * tm * tm + re * te * te);
+            seg_r_end[j][k] = re;
+            r[k] = re;
+        }
+    }
+    for (k = 0; k < 2; ++k) {
+        /* Legendre coefficients on [0, T], x = 2 t/T - 1: q = a0 + a1 x + a2 (3 x^2 - 1)/2. */
+        const double int_x = 2.0 * inv_t * m1[k] - m0[k];
+        const double int_x2 = 4.0 * inv_t * inv_t * m2[k] - 4.0 * inv_t * m1[k] + m0[k];
+        const double a0 = m0[k] * inv_t;
+        const double a1 = 3.0 * int_x * inv_t;
+        const double a2 = 2.5 * (3.0 * int_x2 - m0[k]) * inv_t;
+        double *extra = k == 0 ? plant->torque_extra_a_a : plant->torque_extra_b_a;
+        extra[0] = a0 - a1 + a2;
+        extra[1] = a0 - 0.5 * a2;
+        extra[2] = a0 + a1 + a2;
+        i0[k] = *phase_current(plant, k);
+    }
+    plant_substep(plant, t0, period_s, u_mean[0], u_mean[1], &q_c[0], &q_c[1]);
+    for (k = 0; k < 2; ++k) {
+        double *extra = k == 0 ? plant->torque_extra_a_a : plant->torque_extra_b_a;
+        extra[0] = extra[1] = extra[2] = 0.0;
+        i_end[k] = *phase_current(plant, k);
+        /* i-bar at mid-period from Simpson's charge: Q = T/6 (i0 + 4 i_mid + i_end). */
+        i_mid[k] = 0.25 * (6.0 * q_c[k] * inv_t - i0[k] - i_end[k]);
+        *phase_current(plant, k) = i_end[k] + r[k];
+    }
+    /* Bookkeeping of the period, as substep() keeps it. */
+    for (k = 0; k < 2; ++k) {
+        /* i-bar(t) = c0 + c1 t + c2 t^2 through (0, i0), (T/2, i_mid), (T, i_end). */
+        const double c0 = i0[k];
+        const double c2 = 2.0 * (i_end[k] - 2.0 * i_mid[k] + i0[k]) * inv_t * inv_t;
+        const double c1 = (i_end[k] - i0[k]) * inv_t - c2 * period_s;
+        p->volt_s[k] += u_mean[k] * period_s;
+        p->charge_c[k] += q_c[k] + m0[k];
+        p->first_u_v[k] = n > 0 ? level[0][k] * bus_v : 0.0;
+        for (j = 0; j < n; ++j) {
+            const double a = start[j], b = start[j] + length[j];
+            const double bar_int = c0 * (b - a) + 0.5 * c1 * (b * b - a * a) + c2 * (1.0 / 3.0) * (b * b * b - a * a * a);
+            const double at_end = c0 + c1 * b + c2 * b * b + seg_r_end[j][k];
+            p->bus_charge_c += level[j][k] * (bar_int + seg_r_int[j][k]);
+            if (at_end < p->min_a[k]) {
+                p->min_a[k] = at_end;
+            } else if (at_end > p->max_a[k]) {
+                p->max_a[k] = at_end;
+            }
+        }
+        if (!constant[k]) {
+            p->constant_u = false;
+        }
+    }
+    p->started = true;
 }
 
 void sil_drive_advance(plant_t *plant, sil_inverter_t *inv, double period_s, int substeps)
@@ -465,7 +588,14 @@ void sil_drive_advance(plant_t *plant, sil_inverter_t *inv, double period_s, int
         plant->open_a = false;
         plant->open_b = false;
         if (inv->cfg.model == SIL_INVERTER_SWITCHING) {
-            switching(&p, period_s, substeps);
+            const plant_load_t *load = &plant->load;
+            const bool load_step_inside = load->kind == PLANT_LOAD_STEP && p.t0_s < load->step_time_s
+                                          && load->step_time_s <= p.t0_s + period_s;
+            if (substeps == 1 && plant->integrator == PLANT_INTEGRATOR_EXPONENTIAL && !load_step_inside) {
+                switching_one_step(&p, period_s);
+            } else {
+                switching(&p, period_s, substeps);
+            }
         } else {
             averaged(&p, period_s, substeps);
         }

@@ -271,6 +271,16 @@ static double etd_end(const plant_etd_weights_t *w, double w0, double n0, double
     return w->decay * w0 + w->w_start * n0 + 2.0 * w->w_mid * (na + nb) + w->w_end * nc;
 }
 
+/* The torque of the extra currents at stage k (0 start, 1 middle, 2 end). */
+static void add_extra_torque(const plant_t *plant, int k, double s, double c, plant_state_t *n)
+{
+    const double ia = plant->torque_extra_a_a[k];
+    const double ib = plant->torque_extra_b_a[k];
+    if (ia != 0.0 || ib != 0.0) {
+        n->omega_rad_s += plant->params.torque_constant_nm_per_a * (-ia * s + ib * c) / plant->params.inertia_kg_m2;
+    }
+}
+
 /* Exponential time differencing RK4 on w = y - y* (plant.h). theta has no linear part;
  * an open phase has none either and its N is zero, so it holds. */
 static void exponential_substep(plant_t *plant, double t_s, double h, double u_a_v, double u_b_v,
@@ -299,6 +309,7 @@ static void exponential_substep(plant_t *plant, double t_s, double h, double u_a
     w0.i_b_a = x.i_b_a - star_b;
 
     coupling_at(par, &plant->load, t_s, &x, s0, c0, &n0);
+    add_extra_torque(plant, 0, s0, c0, &n0);
     hold_open(&n0, oa, ob);
     ya.theta_rad = etd_stage_a(wt, w0.theta_rad, n0.theta_rad);
     ya.omega_rad_s = etd_stage_a(ww, w0.omega_rad_s, n0.omega_rad_s);
@@ -306,6 +317,7 @@ static void exponential_substep(plant_t *plant, double t_s, double h, double u_a
     ya.i_b_a = etd_stage_a(wb, w0.i_b_a, n0.i_b_a) + star_b;
     rotate(s0, c0, p * (ya.theta_rad - x.theta_rad), &s, &c);
     coupling_at(par, &plant->load, t_s + 0.5 * h, &ya, s, c, &na);
+    add_extra_torque(plant, 1, s, c, &na);
     hold_open(&na, oa, ob);
     yb.theta_rad = etd_stage_a(wt, w0.theta_rad, na.theta_rad);
     yb.omega_rad_s = etd_stage_a(ww, w0.omega_rad_s, na.omega_rad_s);
@@ -313,6 +325,7 @@ static void exponential_substep(plant_t *plant, double t_s, double h, double u_a
     yb.i_b_a = etd_stage_a(wb, w0.i_b_a, na.i_b_a) + star_b;
     rotate(s0, c0, p * (yb.theta_rad - x.theta_rad), &s, &c);
     coupling_at(par, &plant->load, t_s + 0.5 * h, &yb, s, c, &nb);
+    add_extra_torque(plant, 1, s, c, &nb);
     hold_open(&nb, oa, ob);
     yc.theta_rad = etd_stage_c(wt, ya.theta_rad, n0.theta_rad, nb.theta_rad);
     yc.omega_rad_s = etd_stage_c(ww, ya.omega_rad_s, n0.omega_rad_s, nb.omega_rad_s);
@@ -320,6 +333,7 @@ static void exponential_substep(plant_t *plant, double t_s, double h, double u_a
     yc.i_b_a = etd_stage_c(wb, ya.i_b_a - star_b, n0.i_b_a, nb.i_b_a) + star_b;
     rotate(s0, c0, p * (yc.theta_rad - x.theta_rad), &s, &c);
     coupling_at(par, &plant->load, t_s + h, &yc, s, c, &nc);
+    add_extra_torque(plant, 2, s, c, &nc);
     hold_open(&nc, oa, ob);
 
     plant->x.theta_rad = etd_end(wt, w0.theta_rad, n0.theta_rad, na.theta_rad, nb.theta_rad, nc.theta_rad);

@@ -229,6 +229,84 @@ static void switching_matches_averaged_and_the_rl_ripple(void **state)
     assert_true(sw.x.i_b_a == 0.0 && inv_sw.applied_b_v == 0.0);
 }
 
+static void switching_in_one_exponential_step_keeps_the_ripple(void **state)
+{
+    /* The one-step path (exponential integrator, one step a period): the mean-voltage step plus
+     * the exact ripple gives the same steady state as the segment-by-segment integration above. */
+    const double d = 0.25, u_v = d * BUS_V;
+    const double a_s = d * PERIOD_S / 2.0, b_s = PERIOD_S / 2.0 - a_s;
+    const double i_max = BUS_V / R_OHM * (1.0 - exp(-a_s / TAU_S)) / (1.0 - exp(-PERIOD_S / (2.0 * TAU_S)));
+    const double i_min = i_max * exp(-b_s / TAU_S);
+    const double i_valley = i_max * exp(-b_s / (2.0 * TAU_S));
+    plant_t sw = rl_plant();
+    sil_inverter_t inv = make_inverter(SIL_INVERTER_SWITCHING, 0.0, 0.0);
+    pmstep_output_t out;
+    long k;
+    (void)state;
+    sw.integrator = PLANT_INTEGRATOR_EXPONENTIAL;
+    memset(&out, 0, sizeof out);
+    out.u_a_v = (float)u_v;
+    out.bridge_enable = true;
+    for (k = 0; k < 2000; ++k) {
+        sw.time_s = (double)k * PERIOD_S;
+        sil_inverter_apply(&inv, &out, BUS_V);
+        sil_drive_advance(&sw, &inv, PERIOD_S, 1);
+    }
+    print_message("one step a period: mean %.12f A (dV/R %.12f), valley %.12f A (analytic %.12f), max %.12f "
+                  "(%.12f), min %.12f (%.12f)\n", inv.mean_current_a[0], u_v / R_OHM, sw.x.i_a_a, i_valley,
+                  inv.max_current_a[0], i_max, inv.min_current_a[0], i_min);
+    assert_true(fabs(inv.mean_current_a[0] - u_v / R_OHM) < 1e-9);
+    assert_true(fabs(sw.x.i_a_a - i_valley) < 1e-9);
+    assert_true(fabs(inv.max_current_a[0] - i_max) < 1e-9);
+    assert_true(fabs(inv.min_current_a[0] - i_min) < 1e-9);
+    assert_true(sw.x.i_b_a == 0.0 && inv.applied_b_v == 0.0);
+}
+
+/* The motor (k_M = 2) under a rotating command through the switching bridge with dead time. */
+static plant_state_t switching_motor_run(plant_integrator_t method, int substeps, double *mean_bus_a)
+{
+    plant_t plant;
+    sil_inverter_t inv = make_inverter(SIL_INVERTER_SWITCHING, 1e-6, 0.2);
+    pmstep_output_t out;
+    long k;
+    memset(&plant, 0, sizeof plant);
+    plant.params = plant_paper_params();
+    plant.load.kind = PLANT_LOAD_PROPORTIONAL;
+    plant.load.coefficient_nm_s_per_rad = 0.05;
+    plant.integrator = method;
+    memset(&out, 0, sizeof out);
+    out.bridge_enable = true;
+    for (k = 0; k < 4000; ++k) {
+        const double t = (double)k * PERIOD_S;
+        const double angle = 600.0 * t * t;
+        plant.time_s = t;
+        out.u_a_v = (float)(20.0 * cos(angle));
+        out.u_b_v = (float)(20.0 * sin(angle));
+        sil_inverter_apply(&inv, &out, BUS_V);
+        sil_drive_advance(&plant, &inv, PERIOD_S, substeps);
+    }
+    *mean_bus_a = inv.mean_bus_current_a;
+    return plant.x;
+}
+
+static void switching_one_step_matches_the_segments(void **state)
+{
+    /* 0.2 s, the rotor dragged up to speed: one exponential step a period against RK4 at
+     * 20 steps a period segment by segment. */
+    double bus_one, bus_ref;
+    const plant_state_t one = switching_motor_run(PLANT_INTEGRATOR_EXPONENTIAL, 1, &bus_one);
+    const plant_state_t ref = switching_motor_run(PLANT_INTEGRATOR_RK4, 20, &bus_ref);
+    (void)state;
+    print_message("switching, one exponential step vs segments: d theta %.3g rad, d omega %.3g rad/s, d i %.3g / %.3g A, "
+                  "d i_bus %.3g A (omega %.3f rad/s)\n", one.theta_rad - ref.theta_rad, one.omega_rad_s - ref.omega_rad_s,
+                  one.i_a_a - ref.i_a_a, one.i_b_a - ref.i_b_a, bus_one - bus_ref, ref.omega_rad_s);
+    assert_true(fabs(ref.omega_rad_s) > 1.0);
+    assert_true(fabs(one.theta_rad - ref.theta_rad) < 1e-8);
+    assert_true(fabs(one.omega_rad_s - ref.omega_rad_s) < 1e-7);
+    assert_true(fabs(one.i_a_a - ref.i_a_a) < 1e-7 && fabs(one.i_b_a - ref.i_b_a) < 1e-7);
+    assert_true(fabs(bus_one - bus_ref) < 1e-7);
+}
+
 static void bridge_off_freewheels_to_exactly_zero_and_holds(void **state)
 {
     /* Diodes: L di/dt = -R i - sign(i) V until i = 0, i.e. zero at tau ln(1 + R |i0| / V); then open. */
@@ -347,6 +425,8 @@ int main(void)
         cmocka_unit_test(averaged_dead_time_converges_across_zero_crossings),
         cmocka_unit_test(switching_dead_time_shifts_the_mean_current_alike),
         cmocka_unit_test(switching_matches_averaged_and_the_rl_ripple),
+        cmocka_unit_test(switching_in_one_exponential_step_keeps_the_ripple),
+        cmocka_unit_test(switching_one_step_matches_the_segments),
         cmocka_unit_test(bridge_off_freewheels_to_exactly_zero_and_holds),
         cmocka_unit_test(open_phase_holds_zero_against_back_emf),
         cmocka_unit_test(bus_sags_with_the_source_resistance),

@@ -25,10 +25,15 @@
  *    by t_d when the current flows out of that leg, its turn-off edge when it flows in
  *    (a leg at d = +/-1 does not switch and has no dead time; a delayed edge is held
  *    inside the period). Simplification: the current's sign is taken once, at the start
- *    of the period, for all edges of that period. The plant is integrated segment by
- *    segment between the sorted edges of both phases (the voltage is constant on each, so
- *    the exponential integrator solves its R/L part exactly), in steps of at most
- *    T / substeps; zero-length segments are skipped.
+ *    of the period, for all edges of that period. With the exponential integrator at one
+ *    step a period, the currents are split into the response to the period's mean voltage
+ *    (one step, with the back EMF and the mechanics) and the PWM ripple, which solves
+ *    r' = -(R/L) r + (u - u_mean)/L, r(0) = 0, exactly between the edges; the ripple's
+ *    torque enters the step as its projection onto quadratics over the period (exact
+ *    moments of order 0 to 2), and the currents at the end are the sum (a load step inside
+ *    the period falls back to the segments). Otherwise the plant is integrated segment by
+ *    segment between the sorted edges of both phases, in steps of at most T / substeps;
+ *    zero-length segments are skipped.
  *  - bridge off (either model): every switch off. A phase with current conducts
  *    through the freewheel diodes, u = -sign(i) V_bus, sign held over each substep; at
  *    the end of the substep in which the current reaches or crosses zero it is set to

@@ -104,6 +104,10 @@ typedef struct {
     plant_etd_weights_t cache_current; /**< lambda = -R/L */
     plant_etd_weights_t cache_speed;   /**< lambda = -F/J */
     plant_etd_weights_t cache_free;    /**< lambda = 0 (theta, an open phase) */
+    /* Currents (A) that act in the torque only, at the start, middle and end of the next
+     * exponential step: the smooth part of the PWM ripple that the switching inverter adds
+     * to the currents outside the step (sil/inverter.c); zero otherwise. */
+    double torque_extra_a_a[3], torque_extra_b_a[3];
     /* sin and cos of p theta at a base angle (plant_sin_cos()). */
     bool trig_valid;
     double trig_angle_rad, trig_sin, trig_cos;
