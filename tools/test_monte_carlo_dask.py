@@ -155,7 +155,7 @@ class DaskCampaigns(unittest.TestCase):
     def test_killed_campaign_resumes(self):
         out = os.path.join(self.tmp.name, "resumed")
         cmd = campaign(out, "--jobs", "2")
-        # Its own session, so that one signal kills the client and its local cluster together.
+        # Its own process group, so that one signal kills the client and its local cluster together.
         first = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
         try:
             wait_for(lambda: len(finished(out)) >= 3 or first.poll() is not None, TIMEOUT_S, "three finished cases")
