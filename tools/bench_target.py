@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Cost of the control step on a Cortex-M4F, measured on QEMU's mps2-an386.
 
-The replay image (hal/qemu_mps2/pil/pil_replay.c, built by the qemu-pil preset with the
+The replay image (tests/pil/target/pil_replay.c, built by the qemu-pil preset with the
 STM32G431 image's flags: -Os and link-time optimisation) runs every period of the paper
 scenario, recorded by the host SIL, through the real pmstep_step() from the port's
 control interrupt. Two measurements:
@@ -50,7 +50,7 @@ PIL = ROOT / "build" / "qemu-pil"
 BENCH = PIL / "bench"
 SIL = ROOT / "build" / "host-release" / "sil" / "pmstep-sil"
 ARM_M4F = ROOT / "build" / "arm-m4f"
-REPLAY = PIL / "hal" / "qemu_mps2" / "pmstep-pil-replay.elf"
+REPLAY = PIL / "tests" / "pil" / "target" / "pmstep-pil-replay.elf"
 PLUGIN_SRC = ROOT / "hal" / "qemu_mps2" / "tools" / "pil_insn_plugin.c"
 MODES = ["IDLE", "S_ALIGN", "C_ALIGN", "RUN", "FAULT"]
 CPU_HZ = 170e6

@@ -1,8 +1,12 @@
 #!/usr/bin/env bash
-# The tools' Python environment: .venv with the pinned packages of tools/requirements.txt
-# (plots, the host console's pyserial). Used by tools/setup_host.sh and tools/test_all.sh.
+# The project's Python environment: .venv at the repository root with the pinned packages of
+# tools/requirements.txt (plots: numpy, matplotlib; the host console: pyserial; Monte Carlo
+# campaigns: dask.distributed). Used by tools/setup_host.sh (people) and tools/test_all.sh (CI);
+# safe to run again.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+
+echo "== Python environment (.venv, tools/requirements.txt)"
 if [ ! -x .venv/bin/python ]; then
   if ! python3 -m venv .venv 2>/dev/null; then
     rm -rf .venv

@@ -6,8 +6,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 tools/install_deps.sh
-
-echo "== Python environment (.venv, tools/requirements.txt: the console's pyserial, plots)"
+# Python packages of the tools and their tests (the console's pyserial, the Monte Carlo
+# campaigns on Dask, plots) into .venv.
 tools/setup_venv.sh
 
 echo "== host build (preset host: ASan + UBSan)"

@@ -349,7 +349,7 @@ class EndToEnd(unittest.TestCase):
 
     def run_tool(self, *extra):
         cmd = [sys.executable, SCRIPT, "--sil", self.sil, "--scenario", self.scenario, "--out", self.out,
-               "--no-plots", *extra]
+               "--no-plots", "--engine", "threads", *extra]
         return subprocess.run(cmd, capture_output=True, text=True, timeout=120)
 
     def test_run_and_check(self):

@@ -125,6 +125,7 @@ static cJSON *summary_json(const sil_scenario_t *sc, const sil_summary_t *s)
     cJSON_AddNumberToObject(root, "pole_pairs", sc->motor.pole_pairs);
     cJSON_AddNumberToObject(root, "control_period_s", (double)sc->controller.timing.period_s);
     cJSON_AddNumberToObject(root, "substeps", sc->substeps);
+    cJSON_AddStringToObject(root, "integrator", sc->integrator == PLANT_INTEGRATOR_RK4 ? "rk4" : "exponential");
     cJSON_AddNumberToObject(root, "delay_periods", sc->controller.timing.computational_delay_periods);
     cJSON_AddNumberToObject(root, "s_align_time_s", (double)sc->controller.alignment.s_align_time_s);
     cJSON_AddNumberToObject(root, "c_align_time_s", (double)sc->controller.alignment.c_align_time_s);
@@ -170,6 +171,7 @@ static cJSON *summary_json(const sil_scenario_t *sc, const sil_summary_t *s)
     cJSON_AddNumberToObject(timing, "steps", (double)s->steps);
     cJSON_AddNumberToObject(timing, "simulated_s", s->sim_time_s);
     cJSON_AddNumberToObject(timing, "wall_s", s->wall_time_s);
+    cJSON_AddNumberToObject(timing, "cpu_s", s->cpu_time_s);
     cJSON_AddNumberToObject(timing, "plant_wall_s", s->plant_time_s);
     cJSON_AddNumberToObject(timing, "firmware_wall_s", s->firmware_time_s);
     cJSON_AddNumberToObject(timing, "real_time_factor", s->real_time_factor);
@@ -329,8 +331,9 @@ int main(int argc, char **argv)
         }
     }
     if (!quiet) {
-        fprintf(stderr, "pmstep-sil: scenario '%s', %.3f s at %.0f Hz, %d RK4 substeps, delay %u, %s inverter, seed %lu\n",
+        fprintf(stderr, "pmstep-sil: scenario '%s', %.3f s at %.0f Hz, %d %s steps a period, delay %u, %s inverter, seed %lu\n",
                 sc.name, sc.duration_s, 1.0 / (double)sc.controller.timing.period_s, sc.substeps,
+                sc.integrator == PLANT_INTEGRATOR_RK4 ? "rk4" : "exponential",
                 (unsigned)sc.controller.timing.computational_delay_periods,
                 sc.inverter.model == SIL_INVERTER_SWITCHING ? "switching" : "averaged", (unsigned long)sc.seed);
     }

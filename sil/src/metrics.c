@@ -4,6 +4,8 @@
 #include <math.h>
 #include <string.h>
 
+#define PI 3.14159265358979323846
+
 long sil_periods_in(double duration_s, double period_s)
 {
     return (long)floor(duration_s / period_s + 0.5);
@@ -30,14 +32,21 @@ void sil_metrics_init(sil_metrics_t *m, const sil_scenario_t *sc, sil_summary_t 
     s->detection_latency_s = NAN;
     m->s_align_current_A = (double)sc->controller.alignment.s_align_voltage_V / sc->motor.resistance_Ohm;
     m->c_align_current_A = (double)sc->controller.alignment.c_align_voltage_V / sc->motor.resistance_Ohm;
+    m->loss_angle_reachable = m->loss_angle_error_rad < PI;
+    m->loss_angle_cos = cos(m->loss_angle_error_rad);
+    m->loss_angle_sin = sin(m->loss_angle_error_rad);
+    m->max_angle_cos = 1.0;
+    m->max_angle_sin = 0.0;
 }
 
-/* Electrical angle of (c-hat, s-hat) minus p theta, wrapped to (-pi, pi]. */
-static double angle_error_rad(const pmstep_output_t *out, const sil_sample_t *x)
+/* Electrical angle of (c-hat, s-hat) minus p theta as (x, |y|): its magnitude, wrapped to
+ * [0, pi], is atan2(|y|, x). */
+static void angle_error_xy(const pmstep_output_t *out, const sil_sample_t *x, double *ex, double *ey)
 {
     const double c = (double)out->cos_hat;
     const double s = (double)out->sin_hat;
-    return atan2(s * x->cos_ptheta - c * x->sin_ptheta, c * x->cos_ptheta + s * x->sin_ptheta);
+    *ex = c * x->cos_ptheta + s * x->sin_ptheta;
+    *ey = fabs(s * x->cos_ptheta - c * x->sin_ptheta);
 }
 
 static bool sample_finite(const sil_sample_t *x)
@@ -88,14 +97,22 @@ void sil_metrics_add(sil_metrics_t *m, const sil_sample_t *x, sil_summary_t *s)
         s->final_load_hat_Nm = (double)out->load_hat_Nm;
         s->final_load_Nm = x->load_Nm;
         {
-            const double angle_error = fabs(angle_error_rad(out, x));
-            s->final_angle_error_rad = angle_error;
+            double ex, ey;
+            angle_error_xy(out, x, &ex, &ey);
+            m->last_angle_x = ex;
+            m->last_angle_y = ey;
             if (x->step >= m->settle_step) {
-                s->max_angle_error_rad = fmax(s->max_angle_error_rad, angle_error);
+                if (ey * m->max_angle_cos - ex * m->max_angle_sin > 0.0) { /* above the max so far */
+                    const double r = hypot(ex, ey);
+                    s->max_angle_error_rad = atan2(ey, ex);
+                    m->max_angle_cos = ex / r;
+                    m->max_angle_sin = ey / r;
+                }
                 s->max_speed_error_after_settle_rad_s = fmax(s->max_speed_error_after_settle_rad_s, speed_error);
             }
             if (s->loss_of_control_time_s < 0.0
-                && (speed_error > m->loss_speed_error_rad_s || angle_error > m->loss_angle_error_rad)) {
+                && (speed_error > m->loss_speed_error_rad_s
+                    || (m->loss_angle_reachable && ey * m->loss_angle_cos - ex * m->loss_angle_sin > 0.0))) {
                 s->loss_of_control_time_s = x->t_s;
             }
         }
@@ -114,6 +131,9 @@ void sil_metrics_finish(const sil_metrics_t *m, sil_summary_t *s)
     s->transient_rms_speed_error_rad_s = m->transient_n ? sqrt(m->transient_sq / (double)m->transient_n) : 0.0;
     s->tracking_rms_speed_error_rad_s = m->tracking_n ? sqrt(m->tracking_sq / (double)m->tracking_n) : 0.0;
     s->final_load_error_Nm = fabs(s->final_load_hat_Nm - s->final_load_Nm);
+    if (m->last_angle_x != 0.0 || m->last_angle_y != 0.0) {
+        s->final_angle_error_rad = atan2(m->last_angle_y, m->last_angle_x);
+    }
     if (s->loss_of_control_time_s >= 0.0 && s->fault != PMSTEP_FAULT_NONE) {
         s->detection_latency_s = s->fault_time_s - s->loss_of_control_time_s;
     }

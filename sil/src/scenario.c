@@ -14,7 +14,7 @@
 #define PI 3.14159265358979323846
 
 typedef enum { KEY_DOUBLE, KEY_FLOAT, KEY_INT, KEY_UINT, KEY_BOOL, KEY_ANGLE_DEG, KEY_SPEED_POINTS,
-               KEY_LOAD_POINTS, KEY_LOAD_KIND, KEY_INVERTER_MODEL, KEY_ADC_BITS } key_type_t;
+               KEY_LOAD_POINTS, KEY_LOAD_KIND, KEY_INVERTER_MODEL, KEY_ADC_BITS, KEY_INTEGRATOR } key_type_t;
 
 /* Range of a numeric key: min/max, each inclusive or exclusive. */
 typedef struct {
@@ -82,7 +82,8 @@ static const key_t_ keys[] = {
     /* 3600 s / 1 us = 3.6e9 periods: the core's uint32 step counter does not wrap. */
     {"run.duration_s", KEY_DOUBLE, OFF(duration_s), 0, 1, 3600, 0, "simulated time (s)"},
     {"run.period_s", KEY_FLOAT, OFF(controller.timing.period_s), 1e-6, 0, 0.01, 0, "control period T_s (s)"},
-    {"run.substeps", KEY_INT, OFF(substeps), 1, 0, 10000, 0, "RK4 steps per control period"},
+    {"run.substeps", KEY_INT, OFF(substeps), 1, 0, 10000, 0, "plant integration steps per control period"},
+    {"run.integrator", KEY_INTEGRATOR, OFF(integrator), 0, 0, 0, 0, "exponential (R/L exact, fourth order) | rk4 (classical, the reference)"},
     {"run.delay_periods", KEY_UINT, OFF(controller.timing.computational_delay_periods), 0, 0, 1, 0, "computational delay (0 or 1 period)"},
     {"run.bus_voltage_V", KEY_DOUBLE, OFF(bus_voltage_V), 0, 1, 10000, 0, "DC bus (V)"},
     {"run.theta0_deg", KEY_ANGLE_DEG, OFF(theta0_rad), -1e6, 0, 1e6, 0, "initial rotor angle (mechanical deg)"},
@@ -125,6 +126,7 @@ static const key_t_ keys[] = {
 
 static const char *const load_kind_names[] = {"none", "constant", "step", "proportional", "table"};
 static const char *const inverter_model_names[] = {"averaged", "switching"};
+static const char *const integrator_names[] = {"rk4", "exponential"}; /* in plant_integrator_t order */
 
 static int fail(char *err, size_t err_size, const char *fmt, ...)
 {
@@ -242,6 +244,16 @@ int sil_scenario_set(sil_scenario_t *sc, const char *key, const char *value, cha
                 }
             }
             return fail(err, err_size, "%s: '%s' is not one of averaged, switching", key, value);
+        }
+        case KEY_INTEGRATOR: {
+            size_t j;
+            for (j = 0; j < sizeof integrator_names / sizeof integrator_names[0]; ++j) {
+                if (strcmp(value, integrator_names[j]) == 0) {
+                    sc->integrator = (plant_integrator_t)j;
+                    return 0;
+                }
+            }
+            return fail(err, err_size, "%s: '%s' is not one of exponential, rk4", key, value);
         }
         case KEY_BOOL:
             if (strcmp(value, "true") == 0 || strcmp(value, "1") == 0) {
@@ -579,6 +591,7 @@ void sil_scenario_print(const sil_scenario_t *sc, FILE *file)
             break;
         case KEY_LOAD_KIND: fprintf(file, "%s\n", load_kind_names[sc->load.kind]); break;
         case KEY_INVERTER_MODEL: fprintf(file, "%s\n", inverter_model_names[sc->inverter.model]); break;
+        case KEY_INTEGRATOR: fprintf(file, "%s\n", integrator_names[sc->integrator]); break;
         case KEY_ADC_BITS: fprintf(file, "%u\n", *(const unsigned *)(base + k->offset)); break;
         }
     }

@@ -1,5 +1,5 @@
 /* Closed loop on the paper's scenario (Section III): the real core through the
- * host HAL with the RK4 plant. Bounds for 20 kHz are the issue's; the others are
+ * host HAL with the plant model. Bounds for 20 kHz are the issue's; the others are
  * about 3x the values measured when they were written (see README). */
 #include <stdarg.h>
 #include <stddef.h>

@@ -1,6 +1,6 @@
 /**
  * @file sil_capture.hpp
- * @brief Runs a SIL scenario (the real float32 firmware + the RK4 plant, through
+ * @brief Runs a SIL scenario (the real float32 firmware + the plant model, through
  *        sil_run()) and keeps every control period's sample, for comparisons with
  *        the oracle and for the theorem checks.
  */

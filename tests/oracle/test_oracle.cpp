@@ -1,4 +1,4 @@
-// The SIL (float32 firmware at 1/T_s, RK4 plant) against the continuous-time oracle
+// The SIL (float32 firmware at 1/T_s, plant (1) in double) against the continuous-time oracle
 // (double, Dormand-Prince 5(4) at 1e-10 relative), and the theorems checked along both:
 // Theorem 1 (U_s), Theorem 2 (U_c), Remark 1 (exponential decay of the speed error).
 // Every test prints what it measured.

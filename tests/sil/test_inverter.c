@@ -102,6 +102,71 @@ static void averaged_dead_time_shifts_the_steady_current(void **state)
     assert_true(fabs(inv.applied_a_V - (u_V - error_v)) < 1e-9);
 }
 
+static void averaged_dead_time_clamps_a_small_command_at_zero(void **state)
+{
+    /* A command below the dead time's voltage error (1.92 V) drives no current: neither
+     * branch of the averaged model moves a zero current away from zero (the zero-current
+     * clamp), so the current stays exactly 0 and the applied voltage is the one that holds it. */
+    const double dead_time_s = 1e-6;
+    plant_t plant = rl_plant();
+    sil_inverter_t inv = make_inverter(SIL_INVERTER_AVERAGED, dead_time_s, 0.0);
+    (void)state;
+    run(&plant, &inv, 1.5, -1.0, 400);
+    print_message("averaged, t_d = 1 us, commands 1.5 V and -1 V: i_a = %g A, i_b = %g A, mean u_a = %g V\n",
+                  plant.x.i_a_A, plant.x.i_b_A, inv.applied_a_V);
+    assert_true(plant.x.i_a_A == 0.0 && plant.x.i_b_A == 0.0);
+    assert_true(inv.applied_a_V == 0.0 && inv.applied_b_V == 0.0);
+    /* Above the error the current rises, on the positive branch. */
+    run(&plant, &inv, 3.0, 0.0, 2000);
+    assert_true(fabs(plant.x.i_a_A - (3.0 - 2.0 * BUS_V * dead_time_s / PERIOD_S) / R_OHM) < 1e-9);
+}
+
+/* The motor (back EMF, k_M = 2) driven by a rotating voltage through the averaged bridge with
+ * dead time, whose currents cross zero many times; the state after 0.2 s. */
+static plant_state_t dead_time_crossings_run(int substeps, plant_integrator_t method)
+{
+    plant_t plant;
+    sil_inverter_t inv = make_inverter(SIL_INVERTER_AVERAGED, 1e-6, 0.0);
+    pmstep_output_t out;
+    long k;
+    memset(&plant, 0, sizeof plant);
+    plant.params = plant_paper_params();
+    plant.load.kind = PLANT_LOAD_NONE;
+    plant.integrator = method;
+    memset(&out, 0, sizeof out);
+    out.bridge_enable = true;
+    for (k = 0; k < 4000; ++k) {
+        const double t = (double)k * PERIOD_S;
+        const double angle = 6.0 * 10.0 * t * t * 10.0; /* electrical angle of the command, accelerating */
+        plant.time_s = t;
+        out.u_a_V = (float)(8.0 * cos(angle));
+        out.u_b_V = (float)(8.0 * sin(angle));
+        sil_inverter_apply(&inv, &out, BUS_V);
+        sil_drive_advance(&plant, &inv, PERIOD_S, substeps);
+    }
+    return plant.x;
+}
+
+static void averaged_dead_time_converges_across_zero_crossings(void **state)
+{
+    /* Each zero crossing cuts the step where the current crosses: the error against fine
+     * steps falls quickly with the step count (held signs per step were first order). */
+    static const plant_integrator_t methods[] = {PLANT_INTEGRATOR_RK4, PLANT_INTEGRATOR_EXPONENTIAL};
+    int m;
+    (void)state;
+    for (m = 0; m < 2; ++m) {
+        const plant_state_t ref = dead_time_crossings_run(200, PLANT_INTEGRATOR_RK4);
+        const plant_state_t s1 = dead_time_crossings_run(1, methods[m]);
+        const plant_state_t s4 = dead_time_crossings_run(4, methods[m]);
+        const double e1 = fabs(s1.i_a_A - ref.i_a_A) + fabs(s1.i_b_A - ref.i_b_A) + fabs(s1.omega_rad_s - ref.omega_rad_s);
+        const double e4 = fabs(s4.i_a_A - ref.i_a_A) + fabs(s4.i_b_A - ref.i_b_A) + fabs(s4.omega_rad_s - ref.omega_rad_s);
+        print_message("%s, dead time across zero crossings: error at 1 and 4 steps a period %.3g, %.3g (ratio %.1f)\n",
+                      m == 0 ? "rk4" : "exponential", e1, e4, e1 / e4);
+        assert_true(e1 < 1e-5);
+        assert_true(e1 / e4 > 8.0); /* better than first order (4) */
+    }
+}
+
 static void switching_dead_time_shifts_the_mean_current_alike(void **state)
 {
     /* The switching model's edge shifts give the same mean voltage error, so the same mean current. */
@@ -162,6 +227,84 @@ static void switching_matches_averaged_and_the_rl_ripple(void **state)
     assert_true(fabs((inv_sw.max_current_A[0] - inv_sw.min_current_A[0]) - (i_max - i_min)) < 1e-9);
     /* Phase b at d = 0: both legs switch together, no voltage, no current. */
     assert_true(sw.x.i_b_A == 0.0 && inv_sw.applied_b_V == 0.0);
+}
+
+static void switching_in_one_exponential_step_keeps_the_ripple(void **state)
+{
+    /* The one-step path (exponential integrator, one step a period): the mean-voltage step plus
+     * the exact ripple gives the same steady state as the segment-by-segment integration above. */
+    const double d = 0.25, u_V = d * BUS_V;
+    const double a_s = d * PERIOD_S / 2.0, b_s = PERIOD_S / 2.0 - a_s;
+    const double i_max = BUS_V / R_OHM * (1.0 - exp(-a_s / TAU_S)) / (1.0 - exp(-PERIOD_S / (2.0 * TAU_S)));
+    const double i_min = i_max * exp(-b_s / TAU_S);
+    const double i_valley = i_max * exp(-b_s / (2.0 * TAU_S));
+    plant_t sw = rl_plant();
+    sil_inverter_t inv = make_inverter(SIL_INVERTER_SWITCHING, 0.0, 0.0);
+    pmstep_output_t out;
+    long k;
+    (void)state;
+    sw.integrator = PLANT_INTEGRATOR_EXPONENTIAL;
+    memset(&out, 0, sizeof out);
+    out.u_a_V = (float)u_V;
+    out.bridge_enable = true;
+    for (k = 0; k < 2000; ++k) {
+        sw.time_s = (double)k * PERIOD_S;
+        sil_inverter_apply(&inv, &out, BUS_V);
+        sil_drive_advance(&sw, &inv, PERIOD_S, 1);
+    }
+    print_message("one step a period: mean %.12f A (dV/R %.12f), valley %.12f A (analytic %.12f), max %.12f "
+                  "(%.12f), min %.12f (%.12f)\n", inv.mean_current_A[0], u_V / R_OHM, sw.x.i_a_A, i_valley,
+                  inv.max_current_A[0], i_max, inv.min_current_A[0], i_min);
+    assert_true(fabs(inv.mean_current_A[0] - u_V / R_OHM) < 1e-9);
+    assert_true(fabs(sw.x.i_a_A - i_valley) < 1e-9);
+    assert_true(fabs(inv.max_current_A[0] - i_max) < 1e-9);
+    assert_true(fabs(inv.min_current_A[0] - i_min) < 1e-9);
+    assert_true(sw.x.i_b_A == 0.0 && inv.applied_b_V == 0.0);
+}
+
+/* The motor (k_M = 2) under a rotating command through the switching bridge with dead time. */
+static plant_state_t switching_motor_run(plant_integrator_t method, int substeps, double *mean_bus_a)
+{
+    plant_t plant;
+    sil_inverter_t inv = make_inverter(SIL_INVERTER_SWITCHING, 1e-6, 0.2);
+    pmstep_output_t out;
+    long k;
+    memset(&plant, 0, sizeof plant);
+    plant.params = plant_paper_params();
+    plant.load.kind = PLANT_LOAD_PROPORTIONAL;
+    plant.load.coefficient_Nms_rad = 0.05;
+    plant.integrator = method;
+    memset(&out, 0, sizeof out);
+    out.bridge_enable = true;
+    for (k = 0; k < 4000; ++k) {
+        const double t = (double)k * PERIOD_S;
+        const double angle = 600.0 * t * t;
+        plant.time_s = t;
+        out.u_a_V = (float)(20.0 * cos(angle));
+        out.u_b_V = (float)(20.0 * sin(angle));
+        sil_inverter_apply(&inv, &out, BUS_V);
+        sil_drive_advance(&plant, &inv, PERIOD_S, substeps);
+    }
+    *mean_bus_a = inv.mean_bus_current_A;
+    return plant.x;
+}
+
+static void switching_one_step_matches_the_segments(void **state)
+{
+    /* 0.2 s, the rotor dragged up to speed: one exponential step a period against RK4 at
+     * 20 steps a period segment by segment. */
+    double bus_one, bus_ref;
+    const plant_state_t one = switching_motor_run(PLANT_INTEGRATOR_EXPONENTIAL, 1, &bus_one);
+    const plant_state_t ref = switching_motor_run(PLANT_INTEGRATOR_RK4, 20, &bus_ref);
+    (void)state;
+    print_message("switching, one exponential step vs segments: d theta %.3g rad, d omega %.3g rad/s, d i %.3g / %.3g A, "
+                  "d i_bus %.3g A (omega %.3f rad/s)\n", one.theta_rad - ref.theta_rad, one.omega_rad_s - ref.omega_rad_s,
+                  one.i_a_A - ref.i_a_A, one.i_b_A - ref.i_b_A, bus_one - bus_ref, ref.omega_rad_s);
+    assert_true(fabs(ref.omega_rad_s) > 1.0);
+    assert_true(fabs(one.theta_rad - ref.theta_rad) < 1e-8);
+    assert_true(fabs(one.omega_rad_s - ref.omega_rad_s) < 1e-7);
+    assert_true(fabs(one.i_a_A - ref.i_a_A) < 1e-7 && fabs(one.i_b_A - ref.i_b_A) < 1e-7);
+    assert_true(fabs(bus_one - bus_ref) < 1e-7);
 }
 
 static void bridge_off_freewheels_to_exactly_zero_and_holds(void **state)
@@ -278,8 +421,12 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(ideal_averaged_is_plant_advance_bit_for_bit),
         cmocka_unit_test(averaged_dead_time_shifts_the_steady_current),
+        cmocka_unit_test(averaged_dead_time_clamps_a_small_command_at_zero),
+        cmocka_unit_test(averaged_dead_time_converges_across_zero_crossings),
         cmocka_unit_test(switching_dead_time_shifts_the_mean_current_alike),
         cmocka_unit_test(switching_matches_averaged_and_the_rl_ripple),
+        cmocka_unit_test(switching_in_one_exponential_step_keeps_the_ripple),
+        cmocka_unit_test(switching_one_step_matches_the_segments),
         cmocka_unit_test(bridge_off_freewheels_to_exactly_zero_and_holds),
         cmocka_unit_test(open_phase_holds_zero_against_back_emf),
         cmocka_unit_test(bus_sags_with_the_source_resistance),

@@ -1,4 +1,5 @@
-/* Plant model (1) and its RK4 integration against analytic cases. */
+/* Plant model (1) and its integrators (RK4, exponential time-differencing RK4) against
+ * analytic cases and against finer steps. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -66,15 +67,39 @@ static void free_rotor_with_zero_current(void **state)
     assert_true(max_theta_err < 1e-10);
 }
 
+static void exponential_locked_rotor_is_exact_in_one_step(void **state)
+{
+    /* The R/L rise under a held voltage has no truncation error in the exponential method:
+     * one step per period (and one step of 5 ms) matches the analytic response to round-off. */
+    plant_t plant = paper_plant();
+    const double u = 12.0, period = 50e-6;
+    double max_err = 0.0;
+    int k;
+    (void)state;
+    plant.integrator = PLANT_INTEGRATOR_EXPONENTIAL;
+    for (k = 1; k <= 400; ++k) {
+        plant_advance(&plant, u, 0.0, period, 1);
+        max_err = fmax(max_err, fabs(plant.x.i_a_A - u / 3.0 * (1.0 - exp(-500.0 * k * period))));
+    }
+    plant_advance(&plant, 0.0, 0.0, 5e-3, 1); /* ten time constants in one step: decays exactly */
+    max_err = fmax(max_err, fabs(plant.x.i_a_A - u / 3.0 * (1.0 - exp(-500.0 * 0.02)) * exp(-500.0 * 5e-3)));
+    print_message("exponential, locked rotor, one step a period: max |i_a - analytic| = %.3g A\n", max_err);
+    assert_true(max_err < 1e-13);
+    assert_true(plant.x.theta_rad == 0.0 && plant.x.omega_rad_s == 0.0 && plant.x.i_b_A == 0.0);
+}
+
 /* A coupled run: rotating voltage drags the rotor, with a load step inside the interval. */
-static plant_state_t coupled_run(int substeps)
+static plant_state_t coupled_run_with(plant_integrator_t method, int substeps, plant_load_kind_t load_kind)
 {
     plant_t plant = paper_plant();
     const double period = 200e-6; /* long steps: the RK4 error stays far above round-off */
     int k;
+    plant.integrator = method;
     plant.x.theta_rad = 0.3;
-    plant.load.kind = PLANT_LOAD_PROPORTIONAL;
+    plant.load.kind = load_kind;
     plant.load.coefficient_Nms_rad = 0.05;
+    plant.load.torque_Nm = 0.5;
+    plant.load.step_time_s = 0.0101234; /* inside a period and inside its substeps */
     for (k = 0; k < 100; ++k) {
         const double t = k * period;
         const double angle = 6.0 * 30.0 * t * t;
@@ -82,6 +107,11 @@ static plant_state_t coupled_run(int substeps)
         plant_advance(&plant, 20.0 * cos(angle), 20.0 * sin(angle), period, substeps);
     }
     return plant.x;
+}
+
+static plant_state_t coupled_run(int substeps)
+{
+    return coupled_run_with(PLANT_INTEGRATOR_RK4, substeps, PLANT_LOAD_PROPORTIONAL);
 }
 
 static double distance(const plant_state_t *a, const plant_state_t *b)
@@ -103,6 +133,32 @@ static void halving_the_substep_cuts_the_error_16_times(void **state)
     print_message("RK4 error at 200, 100, 50 us: %.3g, %.3g, %.3g; ratios %.2f, %.2f\n", e1, e2, e4, e1 / e2, e2 / e4);
     assert_true(e1 / e2 > 12.0 && e1 / e2 < 20.0);
     assert_true(e2 / e4 > 12.0 && e2 / e4 < 20.0);
+}
+
+/* Fourth order for both methods, with a smooth load and with a load step inside a step
+ * (the step is split at the jump, so the jump costs no order). */
+static void both_methods_are_fourth_order(void **state)
+{
+    static const plant_integrator_t methods[] = {PLANT_INTEGRATOR_RK4, PLANT_INTEGRATOR_EXPONENTIAL};
+    static const plant_load_kind_t loads[] = {PLANT_LOAD_PROPORTIONAL, PLANT_LOAD_STEP};
+    int m, l;
+    (void)state;
+    for (m = 0; m < 2; ++m) {
+        for (l = 0; l < 2; ++l) {
+            const plant_state_t reference = coupled_run_with(PLANT_INTEGRATOR_RK4, 512, loads[l]);
+            const plant_state_t coarse = coupled_run_with(methods[m], 1, loads[l]);
+            const plant_state_t medium = coupled_run_with(methods[m], 2, loads[l]);
+            const plant_state_t fine = coupled_run_with(methods[m], 4, loads[l]);
+            const double e1 = distance(&coarse, &reference);
+            const double e2 = distance(&medium, &reference);
+            const double e4 = distance(&fine, &reference);
+            print_message("%s, %s load: error at 200, 100, 50 us: %.3g, %.3g, %.3g; ratios %.2f, %.2f\n",
+                          m == 0 ? "rk4" : "exponential", l == 0 ? "proportional" : "step", e1, e2, e4, e1 / e2,
+                          e2 / e4);
+            assert_true(e1 / e2 > 12.0 && e1 / e2 < 20.0);
+            assert_true(e2 / e4 > 12.0 && e2 / e4 < 20.0);
+        }
+    }
 }
 
 static void load_profiles(void **state)
@@ -135,6 +191,8 @@ int main(void)
         cmocka_unit_test(locked_rotor_rl_step_response),
         cmocka_unit_test(free_rotor_with_zero_current),
         cmocka_unit_test(halving_the_substep_cuts_the_error_16_times),
+        cmocka_unit_test(exponential_locked_rotor_is_exact_in_one_step),
+        cmocka_unit_test(both_methods_are_fourth_order),
         cmocka_unit_test(load_profiles),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

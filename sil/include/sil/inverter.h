@@ -13,17 +13,27 @@
  * B). Leg A carries +i out to the winding, leg B carries -i. The bridge applies the duty
  * to the actual bus, d V_bus:
  *  - averaged model: u = d V_bus - 2 sign(i) V_bus t_d / T (dead time t_d per leg, T the
- *    control period = PWM period, sign(0) = 0). sign(i) is taken at the start of each RK4
- *    substep and held over it, so the phase voltage is constant within a substep.
+ *    control period = PWM period). The voltage is constant between zero crossings of the
+ *    current: a step in which a current crosses zero is cut where it crosses (located by
+ *    regula falsi on re-integrations of the step), the current set to exactly 0 there, and
+ *    the rest integrated on the branch the current leaves into. A zero current that neither
+ *    branch drives away (|back EMF + d V_bus| <= 2 V_bus t_d / T) stays at zero, the phase
+ *    held open (the dead time's zero-current clamp) until a later step finds a branch.
  *  - switching model: centre-aligned carrier, valley at the period boundary (where the
  *    ADC samples). Leg A is high for (1+d)/2 T and leg B for (1-d)/2 T, both windows
  *    centred on mid-period; u = V_bus (s_A - s_B). Dead time delays a leg's turn-on edge
  *    by t_d when the current flows out of that leg, its turn-off edge when it flows in
  *    (a leg at d = +/-1 does not switch and has no dead time; a delayed edge is held
  *    inside the period). Simplification: the current's sign is taken once, at the start
- *    of the period, for all edges of that period. The plant is integrated segment by
- *    segment between the sorted edges of both phases, in RK4 substeps of at most
- *    T / substeps; zero-length segments are skipped.
+ *    of the period, for all edges of that period. With the exponential integrator at one
+ *    step a period, the currents are split into the response to the period's mean voltage
+ *    (one step, with the back EMF and the mechanics) and the PWM ripple, which solves
+ *    r' = -(R/L) r + (u - u_mean)/L, r(0) = 0, exactly between the edges; the ripple's
+ *    torque enters the step as its projection onto quadratics over the period (exact
+ *    moments of order 0 to 2), and the currents at the end are the sum (a load step inside
+ *    the period falls back to the segments). Otherwise the plant is integrated segment by
+ *    segment between the sorted edges of both phases, in steps of at most T / substeps;
+ *    zero-length segments are skipped.
  *  - bridge off (either model): every switch off. A phase with current conducts
  *    through the freewheel diodes, u = -sign(i) V_bus, sign held over each substep; at
  *    the end of the substep in which the current reaches or crosses zero it is set to
@@ -34,7 +44,7 @@
  * Bus: V_bus(t) = V0 - R_src i_bus + ripple_V sin(2 pi ripple_Hz t), clamped at >= 0.
  * i_bus = (u_a i_a + u_b i_b)/V_bus is taken as the mean over the previous period
  * (a stiff DC-link capacitor holding the sag of the last period), computed from the
- * RK4 quadrature of the currents; the ripple is evaluated at each substep's midpoint
+ * integrators' quadrature of the currents; the ripple is evaluated at each substep's midpoint
  * and at the sample.
  *
  * With the defaults (averaged, t_d = 0, R_src = 0, ripple 0) and a constant bus the
@@ -113,7 +123,7 @@ double sil_inverter_bus_voltage(const sil_inverter_t *inv, double t_s);
 
 /**
  * Advances @p plant by @p period_s from plant->time_s through the inverter and bus
- * (RK4 substeps of at most period_s / @p substeps), sets plant->time_s to the end of
+ * (steps of plant->integrator of at most period_s / @p substeps), sets plant->time_s to the end of
  * the period and the inverter's applied voltages, currents and bus current.
  */
 void sil_drive_advance(plant_t *plant, sil_inverter_t *inv, double period_s, int substeps);

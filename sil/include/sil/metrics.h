@@ -36,8 +36,9 @@ typedef struct {
     long steps;
     double sim_time_s;
     double wall_time_s;
-    double plant_time_s;             /**< wall time inside the plant integration */
-    double firmware_time_s;          /**< wall time inside read + pmstep_step + apply */
+    double cpu_time_s;               /**< CPU time of the process over the same loop (waiting for a core excluded) */
+    double plant_time_s;             /**< wall time inside the plant integration (every 16th period timed, scaled) */
+    double firmware_time_s;          /**< wall time inside read + pmstep_step + apply (sampled likewise) */
     double real_time_factor;         /**< simulated s per wall s */
     /* Alignment residuals, from the plant at the sample nearest t_s and t_c. */
     double cos_ptheta_at_ts, sin_ptheta_at_ts, i_b_residual_at_ts_A;
@@ -77,6 +78,12 @@ typedef struct {
     double loss_speed_error_rad_s, loss_angle_error_rad; /**< the scenario's loss-of-control bounds */
     double transient_sq, tracking_sq;
     long transient_n, tracking_n;
+    /* The angle error without an atan2 per period: the error of (x, y) = (cos, sin) of
+     * (estimate - p theta) exceeds an angle a in [0, pi) exactly when |y| cos a - x sin a > 0. */
+    bool loss_angle_reachable;                 /**< loss_angle_error_rad < pi */
+    double loss_angle_cos, loss_angle_sin;
+    double max_angle_cos, max_angle_sin;       /**< of summary->max_angle_error_rad */
+    double last_angle_x, last_angle_y;         /**< of the last RUN sample (final_angle_error_rad) */
 } sil_metrics_t;
 
 /** Periods nearest to @p duration_s. */

@@ -1,8 +1,10 @@
 /**
  * @file plant.h
- * @brief Model (1) of the PM step motor in double precision, integrated by RK4
- *        with the phase voltages held over each step (sil/inverter.h decides
- *        them within a control period). Its parameters may differ from the firmware's.
+ * @brief Model (1) of the PM step motor in double precision, integrated with the
+ *        phase voltages held over each step (sil/inverter.h decides them within a
+ *        control period) by one of two fourth-order methods: classical RK4, or
+ *        exponential time-differencing RK4 that solves the R/L and F/J parts exactly.
+ *        Its parameters may differ from the firmware's.
  *
  *   theta' = omega
  *   omega' = -(F/J) omega + (k_M/J)(-i_a sin p theta + i_b cos p theta) - T_L/J
@@ -56,11 +58,59 @@ typedef struct {
     double i_b_A;
 } plant_state_t;
 
+/**
+ * Integration method of one step of length h with (u_a, u_b) held.
+ *
+ * PLANT_INTEGRATOR_RK4: classical Runge-Kutta 4 on (1).
+ *
+ * PLANT_INTEGRATOR_EXPONENTIAL: (1) split as y' = lambda (y - y*) + N(t, y), per component
+ * lambda = (0, -F/J, -R/L, -R/L) and y* = (., 0, u_a/R, u_b/R) constant over the step
+ * (the steady currents of the held voltages), N = (omega, (k_M/J)(-i_a sin p theta +
+ * i_b cos p theta) - T_L/J, (k_M/L) omega sin p theta, -(k_M/L) omega cos p theta): the
+ * back EMF, the torque and the load. With w = y - y*, w(h) = e^{lambda h} w(0) + the
+ * integral of e^{lambda (h - s)} N ds, taken by exponential time differencing RK4 (Cox and
+ * Matthews 2002), z = lambda h, phi_k(z) = sum_j z^j / (j + k)!:
+ *   a  = e^{z/2} w0 + (h/2) phi_1(z/2) N(t, y0)
+ *   b  = e^{z/2} w0 + (h/2) phi_1(z/2) N(t + h/2, a)
+ *   c  = e^{z/2} a  + (h/2) phi_1(z/2) (2 N(t + h/2, b) - N(t, y0))
+ *   w1 = e^{z} w0 + h [(phi_1 - 3 phi_2 + 4 phi_3) N0 + 2 (phi_2 - 2 phi_3)(Na + Nb)
+ *                      + (4 phi_3 - phi_2) Nc]
+ * Fourth order like RK4 (to which it reduces when lambda = 0), and exact when N is zero:
+ * the R/L rise of the currents under a held voltage and the F/J decay carry no truncation
+ * error whatever the step; what remains is the error of the back-EMF and torque coupling,
+ * which vary at the electrical speed p omega and the electromechanical frequency.
+ */
+typedef enum {
+    PLANT_INTEGRATOR_RK4 = 0,
+    PLANT_INTEGRATOR_EXPONENTIAL = 1
+} plant_integrator_t;
+
+/** Weights of one component in one step of the exponential integrator (plant.c). */
+typedef struct {
+    double decay_half, decay;        /**< e^{z/2}, e^{z} */
+    double half;                     /**< (h/2) phi_1(z/2) */
+    double w_start, w_mid, w_end;    /**< h (phi_1 - 3 phi_2 + 4 phi_3), h (phi_2 - 2 phi_3), h (4 phi_3 - phi_2) */
+} plant_etd_weights_t;
+
 typedef struct {
     plant_params_t params;
     plant_load_t load;
     plant_state_t x;
     double time_s;
+    plant_integrator_t integrator; /**< method of plant_substep() (0 = RK4) */
+    /* The exponential integrator's weights for the last step length (recomputed when h,
+     * R/L or F/J change). */
+    double cache_h_s, cache_r_over_l, cache_f_over_j;
+    plant_etd_weights_t cache_current; /**< lambda = -R/L */
+    plant_etd_weights_t cache_speed;   /**< lambda = -F/J */
+    plant_etd_weights_t cache_free;    /**< lambda = 0 (theta, an open phase) */
+    /* Currents (A) that act in the torque only, at the start, middle and end of the next
+     * exponential step: the smooth part of the PWM ripple that the switching inverter adds
+     * to the currents outside the step (sil/inverter.c); zero otherwise. */
+    double torque_extra_a_a[3], torque_extra_b_a[3];
+    /* sin and cos of p theta at a base angle (plant_sin_cos()). */
+    bool trig_valid;
+    double trig_angle_rad, trig_sin, trig_cos;
     bool open_a;   /**< phase a open (bridge off, current extinguished): i_a' = 0, i_a held at exactly 0 */
     bool open_b;   /**< same for phase b */
 } plant_t;
@@ -75,13 +125,23 @@ double plant_load_torque(const plant_load_t *load, double t_s, double omega_rad_
 void plant_derivative(const plant_params_t *params, const plant_load_t *load, double t_s,
                       const plant_state_t *x, double u_a_V, double u_b_V, plant_state_t *dx);
 
-/** Advances by @p period_s with (u_a, u_b) held, in @p substeps RK4 steps. */
+/**
+ * sin(p theta) and cos(p theta) of the present state: one sincos for a base angle, and
+ * for angles within 0.01 rad of it (the steps of a control period) a rotation of the
+ * base's by the small difference, with its sine and cosine from their Taylor series
+ * (exact to double rounding).
+ */
+void plant_sin_cos(plant_t *plant, double *sin_ptheta, double *cos_ptheta);
+
+/** Advances by @p period_s with (u_a, u_b) held, in @p substeps steps of plant->integrator. */
 void plant_advance(plant_t *plant, double u_a_V, double u_b_V, double period_s, int substeps);
 
 /**
- * One RK4 step of @p h_s from time @p t_s with (u_a, u_b) held (an open phase ignores its
- * voltage). Leaves plant->time_s alone. When @p charge_a_c and @p charge_b_c are not NULL
- * they receive the integrals of i_a and i_b over the step (C), by the same RK4 quadrature.
+ * One step of @p h_s of plant->integrator from time @p t_s with (u_a, u_b) held (an open
+ * phase ignores its voltage). Leaves plant->time_s alone. When @p charge_a_c and
+ * @p charge_b_c are not NULL they receive the integrals of i_a and i_b over the step (C):
+ * RK4 weights the stage currents as it weights the derivatives; the exponential method
+ * uses Simpson's rule on the start, the mean of the two midpoint stages and the end.
  */
 void plant_substep(plant_t *plant, double t_s, double h_s, double u_a_V, double u_b_V, double *charge_a_c,
                    double *charge_b_c);

@@ -33,7 +33,8 @@ typedef struct {
     plant_load_t load;               /**< [load] */
     pmstep_config_t controller;      /**< [controller]: what the firmware is told */
     double duration_s;               /**< run.duration_s */
-    int substeps;                    /**< run.substeps: RK4 steps per control period */
+    int substeps;                    /**< run.substeps: plant integration steps per control period */
+    plant_integrator_t integrator;   /**< run.integrator: exponential | rk4 (sil/plant.h) */
     double bus_voltage_V;            /**< run.bus_voltage_V */
     double theta0_rad;               /**< run.theta0_deg (stored in rad) */
     double omega0_rad_s;             /**< run.omega0_rad_s */

@@ -250,6 +250,7 @@ int main(int argc, char **argv)
     L.plant.x.omega_rad_s = L.sc.omega0_rad_s;
     L.plant.x.i_a_A = L.sc.i_a0_A;
     L.plant.x.i_b_A = L.sc.i_b0_A;
+    L.plant.integrator = L.sc.integrator; /* as the host runner */
     L.p = (double)L.plant.params.pole_pairs;
     sil_inverter_init(&L.inv, &L.sc.inverter, &L.sc.bus, L.sc.bus_voltage_V,
                       pmstep_console_config_delay_periods(&config));

@@ -8,7 +8,8 @@
  * (sil_drive_advance) and every metric come from sil/ (scenario_profile.c,
  * inverter.c, metrics.c), as in the host runner, so the summary can be compared key
  * by key with
- * `pmstep-sil --set run.duration_s=... --set run.substeps=...`.
+ * `pmstep-sil --set run.duration_s=... --set run.substeps=...` (the plant integrator is
+ * the scenario's default, run.integrator, on both sides).
  *
  * usage (semihosting command line): pil-closed-loop [--duration S] [--substeps N] [--summary FILE]
  */
@@ -62,7 +63,7 @@ int main(int argc, char **argv)
 {
     static sil_scenario_t sc;
     double duration_s = 0.9;
-    int substeps = 2;
+    int substeps = 0; /* 0: the scenario's default */
     const char *summary_path = NULL;
     plant_t plant;
     sil_inverter_t inv;
@@ -87,14 +88,17 @@ int main(int argc, char **argv)
             return 2;
         }
     }
-    if (!(duration_s > 0.0) || substeps < 1) {
-        fprintf(stderr, "pil-closed-loop: --duration must be > 0 and --substeps >= 1\n");
+    if (!(duration_s > 0.0) || substeps < 0) {
+        fprintf(stderr, "pil-closed-loop: --duration must be > 0 and --substeps >= 1 (0: the scenario's)\n");
         return 2;
     }
 
     sil_scenario_paper(&sc);
     sc.duration_s = duration_s;
-    sc.substeps = substeps;
+    if (substeps > 0) {
+        sc.substeps = substeps;
+    }
+    substeps = sc.substeps;
     config = sc.controller;
     st = pmstep_init(&motor, &config);
     if (st != PMSTEP_OK) {
@@ -112,6 +116,7 @@ int main(int argc, char **argv)
     plant.x.omega_rad_s = sc.omega0_rad_s;
     plant.x.i_a_A = sc.i_a0_A;
     plant.x.i_b_A = sc.i_b0_A;
+    plant.integrator = sc.integrator; /* as the host runner */
     p = (double)plant.params.pole_pairs;
     sil_inverter_init(&inv, &sc.inverter, &sc.bus, sc.bus_voltage_V, config.timing.computational_delay_periods);
 
