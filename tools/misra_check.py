@@ -122,6 +122,9 @@ def rule_key(rule):
 
 
 def main():
+    if shutil.which("cppcheck") is None:
+        print("misra_check: cppcheck not installed (tools/install_deps.sh installs it): skipped")
+        return 77
     found = findings()
     reasons, recorded = read_record()
     if "--write-record" in sys.argv[1:]:
