@@ -16,7 +16,7 @@
  *   byte 0: bit 7 set: the configuration is the next sizeof(pmstep_config_t) bytes, raw;
  *           else bits 0-1 choose a base configuration (config_fields.h) and bits 2-6 give the
  *           number of perturbations, each 6 bytes: word index, kind, 4 payload bytes;
- *   then operations, one opcode byte each with its payload, until the input or the step budget
+ *   then operations (fuzz_core.c, LLVMFuzzerTestOneInput: op % 13), one opcode byte each with its payload, until the input or the step budget
  *   (FUZZ_MAX_STEPS) runs out. */
 #include <math.h>
 #include <stdint.h>
@@ -290,7 +290,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 
     while (r.pos < r.size && st->steps < FUZZ_MAX_STEPS) {
         const uint8_t op = read_u8(&r);
-        switch (op % 12u) {
+        switch (op % 13u) {
         case 0:
             status = pmstep_start(&st->inst);
             expect_command(st, status, false);
@@ -357,6 +357,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             step(st, &meas);
             break;
         }
+        case 12:
+            /* a missing argument is refused, never dereferenced */
+            CHECK(pmstep_init(NULL, &st->cfg) == PMSTEP_ERR_NULL_ARGUMENT
+                      && pmstep_validate_config(NULL) == PMSTEP_ERR_NULL_ARGUMENT
+                      && pmstep_start(NULL) == PMSTEP_ERR_NULL_ARGUMENT && pmstep_stop(NULL) == PMSTEP_ERR_NULL_ARGUMENT
+                      && pmstep_clear_fault(NULL) == PMSTEP_ERR_NULL_ARGUMENT
+                      && pmstep_set_speed_target(NULL, 1.0f, 1.0f) == PMSTEP_ERR_NULL_ARGUMENT
+                      && pmstep_set_id_target(NULL, 0.0f) == PMSTEP_ERR_NULL_ARGUMENT,
+                  "a missing argument not refused");
+            break;
         default: {
             /* the model's state jumps: a stalled or pushed rotor, a current step */
             st->theta += 0.05 * ((double)read_u8(&r) - 128.0);

@@ -11,7 +11,7 @@ import struct
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
-START, STOP, CLEAR, RESET, SPEED_RAW, SPEED, ID_RAW, PLANT, _, MEAS_RAW, MEAS_EDGE, JUMP = range(12)
+START, STOP, CLEAR, RESET, SPEED_RAW, SPEED, ID_RAW, PLANT, _, MEAS_RAW, MEAS_EDGE, JUMP, NULLS = range(13)
 
 
 def head(base, perturbations):
@@ -73,6 +73,9 @@ core = {
     + struct.pack("<ff", 3e38, 3e38) + bytes([ID_RAW]) + struct.pack("<f", 14.0) + bytes([START]) + plant(2000),
     # a raw configuration: the paper's bytes are not needed, any 156 bytes are an input
     "raw_config": bytes([0x80]) + bytes(range(156)) + bytes([START]) + plant(100),
+    # R from one steady state per phase (voltage bias off), and missing arguments
+    "features_no_bias": head(1, [perturb(29, 0, 0.0)]) + bytes([NULLS, START]) + speed(168, 10) + run(4)
+    + plant(4095, load=90),
     # 100 us period and the longest alignment the paper allows for it
     "period_100us": head(3, [perturb(6, 2)]) + bytes([START]) + speed(168, 10) + run(3),
 }
