@@ -62,6 +62,41 @@ static void check_accepted(const sil_scenario_t *sc)
     }
 }
 
+/* --print-scenario writes every key in INI form, "a template users can edit": read back on top
+ * of the paper scenario, it must load, pass the check, and print the same text again. */
+static void round_trip(const sil_scenario_t *sc)
+{
+    static sil_scenario_t again;
+    static char printed[2][1 << 16];
+    char err[SIL_ERROR_MAX];
+    int pass;
+    for (pass = 0; pass < 2; ++pass) {
+        FILE *file = fopen(path, "wb");
+        size_t length;
+        if (file == NULL) {
+            fail("cannot write the scratch file", path);
+        }
+        sil_scenario_print(pass == 0 ? sc : &again, file);
+        if (fclose(file) != 0) {
+            fail("cannot write the scratch file", path);
+        }
+        file = fopen(path, "rb");
+        length = fread(printed[pass], 1u, sizeof printed[pass] - 1u, file);
+        fclose(file);
+        printed[pass][length] = '\0';
+        sil_scenario_paper(&again);
+        if (sil_scenario_load(&again, path, err, sizeof err) != 0) {
+            fail("the printed scenario does not load", err);
+        }
+        if (sil_scenario_check(&again, err, sizeof err) != 0) {
+            fail("the printed scenario does not pass the check", err);
+        }
+    }
+    if (strcmp(printed[0], printed[1]) != 0) {
+        fail("the printed scenario does not print the same after a reload", printed[0]);
+    }
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     static sil_scenario_t sc;
@@ -129,5 +164,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         return 0;
     }
     check_accepted(&sc);
+    round_trip(&sc);
     return 0;
 }
