@@ -377,8 +377,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         }
     }
     if (getenv("FUZZ_CORE_VERBOSE") != NULL) {
+        pmstep_commissioning_t commissioning;
+        pmstep_get_commissioning(&st->inst, &commissioning);
         fprintf(stderr, "fuzz_core: %u steps, mode %d, fault %d, realignments %u\n", st->steps, (int)st->out.mode,
-                (int)st->out.fault, (unsigned)st->inst.commissioning.realignments);
+                (int)st->out.fault, (unsigned)commissioning.realignments);
     }
     return 0;
 }
