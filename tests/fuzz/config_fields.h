@@ -74,6 +74,12 @@ static inline float fuzz_max_bus_v(const pmstep_config_t *cfg)
     return cfg->max_bus_voltage_v;
 }
 
+/* Re-alignments allowed after a detection. */
+static inline uint32_t fuzz_max_realignments(const pmstep_config_t *cfg)
+{
+    return cfg->max_realignments;
+}
+
 /* A float32 value is finite. */
 static inline bool fuzz_finite(float x)
 {

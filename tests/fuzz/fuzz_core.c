@@ -9,7 +9,7 @@
  *   - bridge off => u_a = u_b = 0 and not voltage_limited;
  *   - mode FAULT <=> fault != NONE; a FAULT stays (same code, same step) until clear_fault or
  *     reset; start and stop are refused in FAULT;
- *   - telemetry is zero outside RUN.
+ *   - telemetry is zero outside RUN; re-alignments never exceed max_realignments.
  * A broken invariant aborts with a message (a crash for libFuzzer and for the replay driver).
  *
  * Input layout (every read past the end gives zeros, so any input is valid):
@@ -168,6 +168,11 @@ static void check_output(state_t *st, const pmstep_meas_t *meas)
         for (n = 2; n < sizeof floats / sizeof floats[0]; ++n) {
             CHECK(floats[n] == 0.0f, "telemetry not zero outside RUN");
         }
+    }
+    {
+        pmstep_commissioning_t commissioning;
+        pmstep_get_commissioning(&st->inst, &commissioning);
+        CHECK(commissioning.realignments <= fuzz_max_realignments(&st->cfg), "more re-alignments than configured");
     }
     if (st->in_fault) {
         CHECK(o->mode == PMSTEP_MODE_FAULT && o->fault == st->fault && o->fault_step == st->fault_step,
