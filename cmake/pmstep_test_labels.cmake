@@ -11,7 +11,9 @@ function(pmstep_label_tests_here)
            OR test MATCHES "^gain_check\\.(theory_and_sil|cli_doa_smoke)$"
            OR test MATCHES "^sil_cli\\.scenario_"
            OR test MATCHES "^hal\\.stm32g4_image"
-           OR test MATCHES "^console\\.host_tool$")
+           OR test MATCHES "^console\\.host_tool$"
+           OR test MATCHES "^fuzz\\.(core|scenario)_run$"
+           OR test MATCHES "^eva\\.")
       set(speed slow)
     else()
       set(speed fast)

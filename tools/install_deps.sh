@@ -12,8 +12,26 @@ packages=(
   qemu-system-arm                          # processor-in-the-loop on an emulated Cortex-M4
   python3                                  # benchmark scripts (tools/bench_sil.py, tools/bench_target.py)
   libeigen3-dev libboost-dev               # C++ test oracle and gain checker
+  clang llvm                               # libFuzzer harnesses (tests/fuzz), llvm-cov for their coverage
+  frama-c-base                             # proof of absence of runtime errors (Frama-C EVA, tests/eva)
+  cppcheck                                 # static analysis and the MISRA C:2012 addon (tests/static)
   "$@"
 )
+
+# libFuzzer ships apart from clang on Debian (libclang-rt-<major>-dev): asked for once clang is there.
+libfuzzer_package() {
+  command -v clang >/dev/null 2>&1 || return 0
+  local probe major
+  probe=$(mktemp -d)
+  echo 'int LLVMFuzzerTestOneInput(const unsigned char *d, unsigned long n) { (void)d; (void)n; return 0; }' > "$probe/p.c"
+  if ! clang -fsanitize=fuzzer "$probe/p.c" -o "$probe/p" 2>/dev/null; then
+    major=$(clang -dumpversion | cut -d. -f1)
+    echo "libclang-rt-$major-dev"
+  fi
+  rm -rf "$probe"
+}
+extra=$(libfuzzer_package)
+[ -n "$extra" ] && packages+=("$extra")
 
 missing=()
 for pkg in "${packages[@]}"; do
@@ -38,4 +56,10 @@ else
 fi
 $SUDO apt-get update -qq
 DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+if [ -z "$extra" ]; then
+  extra=$(libfuzzer_package)
+  if [ -n "$extra" ]; then
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "$extra" >/dev/null
+  fi
+fi
 echo "install_deps: done"

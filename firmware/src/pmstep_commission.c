@@ -129,6 +129,8 @@ pmstep_fault_t pmstep_commission_finish(const pmstep_commission_sums_t *sums, co
     const float offset_a = mean_or_zero(sums->zero_sum_a_A, sums->zero_count_a);
     const float offset_b = mean_or_zero(sums->zero_sum_b_A, sums->zero_count_b);
     const bool windows = plan->window_steps > 0u;
+    /* Both phases start at the configured R on purpose; each is then measured apart. */
+    /* cppcheck-suppress duplicateAssignExpression ; the same start value for both phases, intended */
     float r_a = cfg->motor.resistance_Ohm;
     float r_b = cfg->motor.resistance_Ohm;
     float inductance_H = cfg->motor.inductance_H;

@@ -15,51 +15,17 @@ static bool duration_ok(float duration_s, float period_s)
 
 /* Every float setting, with the sign it must have and the code of each, group by group. One
  * table instead of a comparison each keeps the core within its flash budget. */
-typedef enum { SIGN_ANY = 0, SIGN_NON_NEGATIVE = 1, SIGN_POSITIVE = 2 } sign_t;
+#define SIGN_ANY 0u          /* any finite value */
+#define SIGN_NON_NEGATIVE 1u /* >= 0 */
+#define SIGN_POSITIVE 2u     /* > 0 */
 typedef struct {
     unsigned char offset; /* offsetof the float in pmstep_config_t */
-    unsigned char sign;   /* sign_t */
+    unsigned char sign;   /* SIGN_ANY, SIGN_NON_NEGATIVE or SIGN_POSITIVE */
     signed char status;   /* pmstep_status_t when the sign is wrong */
 } sign_rule_t;
 
 #define SIGN_RULE(field, sign, status) {(unsigned char)offsetof(pmstep_config_t, field), sign, (signed char)(status)}
 
-static const sign_rule_t sign_rules[] = {
-    SIGN_RULE(motor.resistance_Ohm, SIGN_POSITIVE, PMSTEP_ERR_RESISTANCE),
-    SIGN_RULE(motor.inductance_H, SIGN_POSITIVE, PMSTEP_ERR_INDUCTANCE),
-    SIGN_RULE(motor.inertia_kgm2, SIGN_POSITIVE, PMSTEP_ERR_INERTIA),
-    SIGN_RULE(motor.torque_constant_Nm_A, SIGN_POSITIVE, PMSTEP_ERR_TORQUE_CONSTANT),
-    SIGN_RULE(motor.friction_Nms_rad, SIGN_NON_NEGATIVE, PMSTEP_ERR_FRICTION),
-    SIGN_RULE(gains.speed_gain_per_s, SIGN_POSITIVE, PMSTEP_ERR_SPEED_GAIN),
-    SIGN_RULE(gains.observer_gain_per_s, SIGN_POSITIVE, PMSTEP_ERR_OBSERVER_GAIN),
-    SIGN_RULE(gains.current_gain_per_s, SIGN_POSITIVE, PMSTEP_ERR_CURRENT_GAIN),
-    SIGN_RULE(gains.adapt_gamma, SIGN_POSITIVE, PMSTEP_ERR_ADAPT_GAMMA),
-    SIGN_RULE(gains.adapt_lambda, SIGN_POSITIVE, PMSTEP_ERR_ADAPT_LAMBDA),
-    SIGN_RULE(gains.adapt_r, SIGN_POSITIVE, PMSTEP_ERR_ADAPT_R),
-    SIGN_RULE(gains.sat_kappa_rad_s, SIGN_POSITIVE, PMSTEP_ERR_SAT_KAPPA),
-    SIGN_RULE(gains.reference_bandwidth_rad_s, SIGN_POSITIVE, PMSTEP_ERR_REFERENCE_BANDWIDTH),
-    SIGN_RULE(gains.angle_correction_gain_per_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_ANGLE_CORRECTION_GAIN),
-    SIGN_RULE(limits.max_phase_current_A, SIGN_POSITIVE, PMSTEP_ERR_MAX_CURRENT),
-    SIGN_RULE(limits.min_bus_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_MIN_BUS),
-    SIGN_RULE(alignment.s_align_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_ALIGNMENT_VOLTAGE),
-    SIGN_RULE(alignment.c_align_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_ALIGNMENT_VOLTAGE),
-    SIGN_RULE(commissioning.offset_calibration_time_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_OFFSET_CALIBRATION_TIME),
-    SIGN_RULE(commissioning.steady_state_window_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_STEADY_STATE_WINDOW),
-    SIGN_RULE(commissioning.inductance_window_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_INDUCTANCE_WINDOW),
-    SIGN_RULE(commissioning.voltage_bias_level_fraction, SIGN_NON_NEGATIVE, PMSTEP_ERR_VOLTAGE_BIAS_FRACTION),
-    SIGN_RULE(inverter.dead_time_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DEAD_TIME),
-    SIGN_RULE(inverter.dead_time_current_band_A, SIGN_NON_NEGATIVE, PMSTEP_ERR_DEAD_TIME_BAND),
-    SIGN_RULE(detection.angle_magnitude_bound, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_BOUND),
-    SIGN_RULE(detection.speed_consistency_bound_rad_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_BOUND),
-    SIGN_RULE(detection.stall_speed_error_rad_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_BOUND),
-    SIGN_RULE(detection.observer_residual_bound_A, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_BOUND),
-    SIGN_RULE(detection.persistence_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_TIME),
-    /* Checked by range below. */
-    SIGN_RULE(timing.period_s, SIGN_ANY, PMSTEP_OK),
-    SIGN_RULE(alignment.s_align_time_s, SIGN_ANY, PMSTEP_OK),
-    SIGN_RULE(alignment.c_align_time_s, SIGN_ANY, PMSTEP_OK),
-    SIGN_RULE(limits.max_bus_voltage_V, SIGN_ANY, PMSTEP_OK),
-};
 
 /* The float at @p rule's offset. */
 static float rule_value(const pmstep_config_t *cfg, const sign_rule_t *rule)
@@ -72,6 +38,42 @@ static float rule_value(const pmstep_config_t *cfg, const sign_rule_t *rule)
 /* Every float finite first (whatever its place), then the signs in table order. */
 static pmstep_status_t validate_signs(const pmstep_config_t *cfg)
 {
+    static const sign_rule_t sign_rules[] = {
+        SIGN_RULE(motor.resistance_Ohm, SIGN_POSITIVE, PMSTEP_ERR_RESISTANCE),
+        SIGN_RULE(motor.inductance_H, SIGN_POSITIVE, PMSTEP_ERR_INDUCTANCE),
+        SIGN_RULE(motor.inertia_kgm2, SIGN_POSITIVE, PMSTEP_ERR_INERTIA),
+        SIGN_RULE(motor.torque_constant_Nm_A, SIGN_POSITIVE, PMSTEP_ERR_TORQUE_CONSTANT),
+        SIGN_RULE(motor.friction_Nms_rad, SIGN_NON_NEGATIVE, PMSTEP_ERR_FRICTION),
+        SIGN_RULE(gains.speed_gain_per_s, SIGN_POSITIVE, PMSTEP_ERR_SPEED_GAIN),
+        SIGN_RULE(gains.observer_gain_per_s, SIGN_POSITIVE, PMSTEP_ERR_OBSERVER_GAIN),
+        SIGN_RULE(gains.current_gain_per_s, SIGN_POSITIVE, PMSTEP_ERR_CURRENT_GAIN),
+        SIGN_RULE(gains.adapt_gamma, SIGN_POSITIVE, PMSTEP_ERR_ADAPT_GAMMA),
+        SIGN_RULE(gains.adapt_lambda, SIGN_POSITIVE, PMSTEP_ERR_ADAPT_LAMBDA),
+        SIGN_RULE(gains.adapt_r, SIGN_POSITIVE, PMSTEP_ERR_ADAPT_R),
+        SIGN_RULE(gains.sat_kappa_rad_s, SIGN_POSITIVE, PMSTEP_ERR_SAT_KAPPA),
+        SIGN_RULE(gains.reference_bandwidth_rad_s, SIGN_POSITIVE, PMSTEP_ERR_REFERENCE_BANDWIDTH),
+        SIGN_RULE(gains.angle_correction_gain_per_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_ANGLE_CORRECTION_GAIN),
+        SIGN_RULE(limits.max_phase_current_A, SIGN_POSITIVE, PMSTEP_ERR_MAX_CURRENT),
+        SIGN_RULE(limits.min_bus_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_MIN_BUS),
+        SIGN_RULE(alignment.s_align_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_ALIGNMENT_VOLTAGE),
+        SIGN_RULE(alignment.c_align_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_ALIGNMENT_VOLTAGE),
+        SIGN_RULE(commissioning.offset_calibration_time_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_OFFSET_CALIBRATION_TIME),
+        SIGN_RULE(commissioning.steady_state_window_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_STEADY_STATE_WINDOW),
+        SIGN_RULE(commissioning.inductance_window_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_INDUCTANCE_WINDOW),
+        SIGN_RULE(commissioning.voltage_bias_level_fraction, SIGN_NON_NEGATIVE, PMSTEP_ERR_VOLTAGE_BIAS_FRACTION),
+        SIGN_RULE(inverter.dead_time_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DEAD_TIME),
+        SIGN_RULE(inverter.dead_time_current_band_A, SIGN_NON_NEGATIVE, PMSTEP_ERR_DEAD_TIME_BAND),
+        SIGN_RULE(detection.angle_magnitude_bound, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_BOUND),
+        SIGN_RULE(detection.speed_consistency_bound_rad_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_BOUND),
+        SIGN_RULE(detection.stall_speed_error_rad_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_BOUND),
+        SIGN_RULE(detection.observer_residual_bound_A, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_BOUND),
+        SIGN_RULE(detection.persistence_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_TIME),
+        /* Checked by range below. */
+        SIGN_RULE(timing.period_s, SIGN_ANY, PMSTEP_OK),
+        SIGN_RULE(alignment.s_align_time_s, SIGN_ANY, PMSTEP_OK),
+        SIGN_RULE(alignment.c_align_time_s, SIGN_ANY, PMSTEP_OK),
+        SIGN_RULE(limits.max_bus_voltage_V, SIGN_ANY, PMSTEP_OK),
+    };
     size_t n;
     for (n = 0; n < sizeof sign_rules / sizeof sign_rules[0]; ++n) {
         if (!isfinite(rule_value(cfg, &sign_rules[n]))) {
@@ -80,8 +82,8 @@ static pmstep_status_t validate_signs(const pmstep_config_t *cfg)
     }
     for (n = 0; n < sizeof sign_rules / sizeof sign_rules[0]; ++n) {
         const float value = rule_value(cfg, &sign_rules[n]);
-        if ((sign_rules[n].sign == (unsigned char)SIGN_POSITIVE && !(value > 0.0f))
-            || (sign_rules[n].sign == (unsigned char)SIGN_NON_NEGATIVE && value < 0.0f)) {
+        if ((sign_rules[n].sign == SIGN_POSITIVE && !(value > 0.0f))
+            || (sign_rules[n].sign == SIGN_NON_NEGATIVE && value < 0.0f)) {
             return (pmstep_status_t)sign_rules[n].status;
         }
     }

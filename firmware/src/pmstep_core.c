@@ -58,20 +58,16 @@ static bool floats_finite(const void *first, size_t count)
     return sum == 0.0f;
 }
 
-/* The two runs of derived floats in pmstep_t (pmstep_instance.h): no member but floats between
- * their ends, checked here at compile time (a negative array size otherwise). */
-#define FLOATS_BETWEEN(first, end) ((offsetof(pmstep_t, end) - offsetof(pmstep_t, first)) / sizeof(float))
-typedef char detect_then_actuate_floats[(offsetof(pmstep_t, actuate_coeffs.compensate)
-                                         == offsetof(pmstep_t, detect_coeffs.alpha) + 5u * sizeof(float))
-                                            ? 1
-                                            : -1];
-
 bool pmstep_derived_coefficients_finite(const pmstep_config_t *cfg)
 {
     pmstep_t scratch; /* init's derivation, on the stack of the caller of init/validate */
     derive(&scratch, cfg);
-    return floats_finite(&scratch.detect_coeffs.alpha, FLOATS_BETWEEN(detect_coeffs.alpha, actuate_coeffs.compensate))
-           && floats_finite(&scratch.ref_coeffs, FLOATS_BETWEEN(ref_coeffs, law_coeffs.linear_speed_term));
+    return floats_finite(&scratch.ref_coeffs, sizeof scratch.ref_coeffs / sizeof(float))
+           && floats_finite(&scratch.angle_coeffs, sizeof scratch.angle_coeffs / sizeof(float))
+           && floats_finite(&scratch.observer_coeffs, sizeof scratch.observer_coeffs / sizeof(float))
+           && floats_finite(&scratch.law_coeffs, offsetof(pmstep_law_coeffs_t, linear_speed_term) / sizeof(float))
+           && floats_finite(&scratch.detect_coeffs.alpha, 3u)          /* alpha, angle step, consistency bound */
+           && floats_finite(&scratch.actuate_coeffs.dead_time_duty, 2u); /* duty, 1/band */
 }
 
 pmstep_status_t pmstep_init(pmstep_t *inst, const pmstep_config_t *cfg)

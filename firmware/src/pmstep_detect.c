@@ -30,7 +30,7 @@ static bool persists(uint32_t *count, bool condition, uint32_t limit)
     return *count >= limit;
 }
 
-pmstep_fault_t pmstep_detect_check(pmstep_detector_t *d, const pmstep_detect_coeffs_t *coeffs,
+pmstep_fault_t pmstep_detect_check(pmstep_detector_t *detector, const pmstep_detect_coeffs_t *coeffs,
                                    const pmstep_detection_config_t *cfg, const pmstep_output_t *out,
                                    const pmstep_meas_t *sample)
 {
@@ -38,30 +38,30 @@ pmstep_fault_t pmstep_detect_check(pmstep_detector_t *d, const pmstep_detect_coe
     pmstep_fault_t found = PMSTEP_FAULT_NONE;
     if (cfg->angle_magnitude_bound > 0.0f) {
         const float magnitude_error = out->cos_hat * out->cos_hat + out->sin_hat * out->sin_hat - 1.0f;
-        if (persists(&d->magnitude_count, pmstep_abs(magnitude_error) > cfg->angle_magnitude_bound, limit)) {
+        if (persists(&detector->magnitude_count, pmstep_abs(magnitude_error) > cfg->angle_magnitude_bound, limit)) {
             found = PMSTEP_FAULT_ANGLE_MAGNITUDE;
         }
     }
     if (cfg->speed_consistency_bound_rad_s > 0.0f) {
         /* sin of the estimate's electrical step since the last check, against p w-hat x check period. */
-        const float angle_step = d->prev_cos_hat * out->sin_hat - d->prev_sin_hat * out->cos_hat;
+        const float angle_step = detector->prev_cos_hat * out->sin_hat - detector->prev_sin_hat * out->cos_hat;
         const float gap = angle_step - coeffs->angle_step_per_speed * out->speed_hat_rad_s;
-        d->rotation_gap_rad += coeffs->alpha * (gap - d->rotation_gap_rad);
-        d->prev_cos_hat = out->cos_hat;
-        d->prev_sin_hat = out->sin_hat;
-        if (persists(&d->consistency_count, pmstep_abs(d->rotation_gap_rad) > coeffs->consistency_bound_rad, limit)) {
+        detector->rotation_gap_rad += coeffs->alpha * (gap - detector->rotation_gap_rad);
+        detector->prev_cos_hat = out->cos_hat;
+        detector->prev_sin_hat = out->sin_hat;
+        if (persists(&detector->consistency_count, pmstep_abs(detector->rotation_gap_rad) > coeffs->consistency_bound_rad, limit)) {
             found = PMSTEP_FAULT_SPEED_INCONSISTENT;
         }
     }
     if (cfg->stall_speed_error_rad_s > 0.0f
-        && persists(&d->stall_count, pmstep_abs(out->speed_hat_rad_s - out->speed_ref_rad_s) > cfg->stall_speed_error_rad_s,
+        && persists(&detector->stall_count, pmstep_abs(out->speed_hat_rad_s - out->speed_ref_rad_s) > cfg->stall_speed_error_rad_s,
                     limit)) {
         found = PMSTEP_FAULT_STALL;
     }
     if (cfg->observer_residual_bound_A > 0.0f) {
         const float residual = pmstep_abs(sample->i_a_A - out->i_a_hat_A) + pmstep_abs(sample->i_b_A - out->i_b_hat_A);
-        d->residual_A += coeffs->alpha * (residual - d->residual_A);
-        if (persists(&d->residual_count, d->residual_A > cfg->observer_residual_bound_A, limit)) {
+        detector->residual_A += coeffs->alpha * (residual - detector->residual_A);
+        if (persists(&detector->residual_count, detector->residual_A > cfg->observer_residual_bound_A, limit)) {
             found = PMSTEP_FAULT_OBSERVER_RESIDUAL;
         }
     }

@@ -25,9 +25,7 @@ typedef struct {
     const pmstep_config_t *cfg;
 
     /* Derived from the configuration at init (the angle, observer and law coefficients again
-     * at t_c, for the commissioned model). Their floats lie in two runs that init checks
-     * finite: detect_coeffs.alpha .. actuate_coeffs.inv_band_per_A, and ref_coeffs .. the last
-     * float of law_coeffs (pmstep_core.c). */
+     * at t_c, for the commissioned model); init checks every float of them finite. */
     pmstep_commission_plan_t commission_plan; /**< alignment timing (t_s, t_c in periods) and windows */
     uint32_t offset_cal_steps;                /**< periods of bridge-off offset calibration */
     pmstep_detect_coeffs_t detect_coeffs;

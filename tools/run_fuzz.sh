@@ -1,0 +1,84 @@
+#!/usr/bin/env bash
+# Runs one libFuzzer harness (tests/fuzz) for a bounded time and prints its figures:
+# executions, executions per second, and the edges of firmware/ (core) or sil/src/scenario*.c
+# (scenario) that the run covered (libFuzzer -print_coverage).
+# Usage: tools/run_fuzz.sh core|scenario [seconds=60]
+# Builds the fuzz tree (preset fuzz, clang) first. Exit 77 (skipped) if clang cannot build a
+# libFuzzer binary (install clang and libclang-rt-14-dev: tools/install_deps.sh does).
+# The committed corpus is copied, never written; what the run adds stays in build/fuzz/corpus-<name>.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+target=${1:?usage: run_fuzz.sh core|scenario [seconds]}
+seconds=${2:-60}
+core_sources=(firmware/src/pmstep_{core,config,control,detect,actuate,ref,angle,commission,observer,law,presets}.c)
+case $target in
+  core) sources='firmware/src/'; harness_sources=("${core_sources[@]}"); libs=(-lm) ;;
+  scenario) sources='sil/src/scenario'
+    harness_sources=(sil/src/{scenario,scenario_profile,plant,inverter,sensors}.c "${core_sources[@]}")
+    libs=($(pkg-config --libs inih gsl) -lm) ;;
+  *) echo "run_fuzz: unknown fuzzer '$target'" >&2; exit 2 ;;
+esac
+
+probe=$(mktemp -d)
+trap 'rm -rf "$probe"' EXIT
+echo 'int LLVMFuzzerTestOneInput(const unsigned char *d, unsigned long n) { (void)d; (void)n; return 0; }' \
+  > "$probe/probe.c"
+if ! command -v clang >/dev/null 2>&1 || ! clang -fsanitize=fuzzer "$probe/probe.c" -o "$probe/probe" 2>/dev/null; then
+  echo "run_fuzz: clang with libFuzzer not available: skipped"
+  exit 77
+fi
+
+cmake --preset fuzz >/dev/null
+cmake --build --preset fuzz -j2 >/dev/null
+
+work=build/fuzz/corpus-$target
+rm -rf "$work" build/fuzz/artifacts-$target
+mkdir -p "$work" build/fuzz/artifacts-$target
+cp tests/fuzz/corpus/$target/* "$work/"
+log=build/fuzz/fuzz-$target.log
+status=0
+# -timeout: one input may take at most 10 s (a hang fails the run); -rss_limit_mb: memory bound.
+build/fuzz/tests/fuzz/fuzz_$target -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+  -print_final_stats=1 -print_coverage=1 -artifact_prefix=build/fuzz/artifacts-$target/ "$work" >"$log" 2>&1 \
+  || status=$?
+if [ $status -ne 0 ]; then
+  grep -v '^COVERED_FUNC\|^UNCOVERED_FUNC' "$log" | tail -40
+  echo "run_fuzz: $target FAILED (exit $status); the input is in build/fuzz/artifacts-$target/"
+  exit 1
+fi
+execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log")
+rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log")
+# COVERED_FUNC: hits: H edges: c/t name file:line  (UNCOVERED_FUNC: no edges reached)
+read -r covered total functions reached < <(awk -v src="$sources" '
+  /^(COVERED|UNCOVERED)_FUNC:/ && index($0, src) {
+    split($0, f, "edges: "); split(f[2], e, "[/ ]");
+    c += e[1]; t += e[2]; n++; if ($1 == "COVERED_FUNC:") r++
+  }
+  END { printf "%d %d %d %d\n", c, t, n, r }' "$log")
+corpus=$(ls "$work" | wc -l)
+echo "run_fuzz: $target: $execs executions in $seconds s ($rate/s), corpus $corpus inputs, no invariant broken;" \
+     "functions of ${sources}* reached: $reached of $functions"
+
+# Line coverage of the final corpus (source-based, llvm-cov): the harness rebuilt without
+# sanitizers (their checks are not source lines) and the replay driver.
+llvm_cov=$(command -v llvm-cov || ls /usr/bin/llvm-cov-* 2>/dev/null | sort -V | tail -1 || true)
+llvm_profdata=$(command -v llvm-profdata || ls /usr/bin/llvm-profdata-* 2>/dev/null | sort -V | tail -1 || true)
+if [ -z "$llvm_cov" ] || [ -z "$llvm_profdata" ]; then
+  echo "run_fuzz: llvm-cov not found: no line coverage"
+  exit 0
+fi
+cov=build/fuzz/cov-$target
+rm -rf "$cov" && mkdir -p "$cov"
+clang -std=c99 -D_POSIX_C_SOURCE=200809L -O1 -fprofile-instr-generate -fcoverage-mapping -w \
+  -Ifirmware/include -Isil/include -Itests/fuzz $(pkg-config --cflags inih gsl) \
+  tests/fuzz/fuzz_$target.c tests/fuzz/replay_main.c "${harness_sources[@]}" "${libs[@]}" -o "$cov/replay"
+LLVM_PROFILE_FILE="$cov/replay.profraw" "$cov/replay" "$work" >/dev/null
+"$llvm_profdata" merge -sparse "$cov/replay.profraw" -o "$cov/replay.profdata"
+report_files=()
+for f in "${harness_sources[@]}"; do
+  case $f in "$sources"*) report_files+=("$f") ;; esac
+done
+"$llvm_cov" report "$cov/replay" -instr-profile="$cov/replay.profdata" "${report_files[@]}" > "$cov/report.txt"
+awk -v t="$target" '$1 == "TOTAL" {
+  printf "run_fuzz: %s: line coverage of the final corpus: %s of lines (%s missed of %s), regions %s, branches %s\n",
+         t, $10, $9, $8, $4, $13 }' "$cov/report.txt"
