@@ -61,7 +61,7 @@ def main():
         print("run_eva: frama-c not installed (tools/install_deps.sh installs frama-c-base): skipped")
         return 77
     harness, config = HARNESSES[name]
-    cpp = "-Ifirmware/include -Ifirmware/src -Itests/eva" + (f" -DEVA_CONFIG={config}" if config else "")
+    cpp = "-Ifirmware/include -Ifirmware/src -Itests/eva -Itests/include" + (f" -DEVA_CONFIG={config}" if config else "")
     cmd = (["frama-c", "-cpp-extra-args=" + cpp, "tests/eva/" + harness]
            + [f"firmware/src/{c}.c" for c in CORE] + OPTIONS + ["-then", "-metrics", "-metrics-eva-cover"])
     start = time.monotonic()

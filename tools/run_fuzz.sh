@@ -70,7 +70,7 @@ fi
 cov=build/fuzz/cov-$target
 rm -rf "$cov" && mkdir -p "$cov"
 clang -std=c99 -D_POSIX_C_SOURCE=200809L -O1 -fprofile-instr-generate -fcoverage-mapping -w \
-  -Ifirmware/include -Isil/include -Itests/fuzz $(pkg-config --cflags inih gsl) \
+  -Ifirmware/include -Isil/include -Itests/fuzz -Itests/include $(pkg-config --cflags inih gsl) \
   tests/fuzz/fuzz_$target.c tests/fuzz/replay_main.c "${harness_sources[@]}" "${libs[@]}" -o "$cov/replay"
 LLVM_PROFILE_FILE="$cov/replay.profraw" "$cov/replay" "$work" >/dev/null
 "$llvm_profdata" merge -sparse "$cov/replay.profraw" -o "$cov/replay.profdata"

@@ -8,6 +8,7 @@
 
 #include "__fc_builtin.h"
 #include "pmstep/pmstep.h"
+#include "pmstep_test_configs.h"
 
 /* The configurations the step harnesses analyse. */
 static pmstep_config_t eva_paper_config(void)
@@ -15,26 +16,10 @@ static pmstep_config_t eva_paper_config(void)
     return pmstep_paper_config();
 }
 
-/* Every optional feature on: offset calibration, alignment windows with the voltage bias,
- * inductance window, commissioned R, L, k_M used, dead-time compensation, drift-free angle,
- * every detector (the paper's bounds), re-alignments, one period of delay. */
+/* Every optional feature on (tests/include/pmstep_test_configs.h, shared with the fuzzer). */
 static pmstep_config_t eva_features_config(void)
 {
-    pmstep_config_t cfg = pmstep_paper_config();
-    cfg.commissioning.offset_calibration_time_s = 0.005f;
-    cfg.commissioning.alignment_offset_calibration = true;
-    cfg.commissioning.steady_state_window_s = 0.05f;
-    cfg.commissioning.voltage_bias_level_fraction = 0.5f;
-    cfg.commissioning.inductance_window_s = 0.0005f;
-    cfg.commissioning.use_measured_resistance = true;
-    cfg.commissioning.use_measured_inductance = true;
-    cfg.commissioning.use_measured_torque_constant = true;
-    cfg.inverter.dead_time_s = 1e-6f;
-    cfg.inverter.dead_time_current_band_A = 0.005f;
-    cfg.gains.angle_correction_gain_per_s = 20.0f;
-    cfg.detection.max_realignments = 2u;
-    cfg.timing.computational_delay_periods = 1u;
-    return cfg;
+    return pmstep_test_features_config();
 }
 
 /* As eva_features_config in known-load mode (Remark 1), R from one steady state per phase

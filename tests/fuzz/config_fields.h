@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "pmstep/pmstep.h"
+#include "pmstep_test_configs.h"
 
 /* Offsets of the bool fields: a fuzzed byte written over one is reduced to 0 or 1 (any other
  * value in a bool is undefined behaviour in the harness, not a finding in the core). */
@@ -31,19 +32,7 @@ static inline pmstep_config_t fuzz_base_config(unsigned which)
 {
     pmstep_config_t cfg = pmstep_paper_config();
     if (which == 1u || which == 2u) {
-        cfg.commissioning.offset_calibration_time_s = 0.005f;
-        cfg.commissioning.alignment_offset_calibration = true;
-        cfg.commissioning.steady_state_window_s = 0.05f;
-        cfg.commissioning.voltage_bias_level_fraction = 0.5f;
-        cfg.commissioning.inductance_window_s = 0.0005f;
-        cfg.commissioning.use_measured_resistance = true;
-        cfg.commissioning.use_measured_inductance = true;
-        cfg.commissioning.use_measured_torque_constant = true;
-        cfg.inverter.dead_time_s = 1e-6f;
-        cfg.inverter.dead_time_current_band_A = 0.005f;
-        cfg.gains.angle_correction_gain_per_s = 20.0f;
-        cfg.detection.max_realignments = 2u;
-        cfg.timing.computational_delay_periods = 1u;
+        cfg = pmstep_test_features_config(); /* tests/include, shared with the EVA harnesses */
         cfg.known_load_mode = which == 2u;
     } else if (which == 3u) {
         cfg.alignment.s_align_time_s = 0.01f;

@@ -21,6 +21,7 @@
 
 #include "oracle.hpp"
 #include "sil_capture.hpp"
+#include "sil_grid.hpp"
 #include "pmstep_hal_host.h"
 
 using namespace pmstep_oracle;
@@ -106,35 +107,6 @@ Errors max_errors(const Trajectory &a, const Trajectory &ref, int pole_pairs)
         e.current_a = std::fmax(e.current_a, std::fmax(std::fabs(x.i_a_A - r.i_a_A), std::fabs(x.i_b_A - r.i_b_A)));
     }
     return e;
-}
-
-/** The first sample time k T_s >= t, as the SIL runner issues a set-point command. */
-double first_sample_at_or_after(double t_s, double period_s)
-{
-    double k = std::floor(t_s / period_s);
-    while (k * period_s < t_s) {
-        k += 1.0;
-    }
-    while (k > 0.0 && (k - 1.0) * period_s >= t_s) {
-        k -= 1.0;
-    }
-    return k * period_s;
-}
-
-/** The oracle on the SIL's sample grid (as tests/oracle/test_oracle.cpp builds it). */
-Scenario oracle_on_sil_grid(const sil_scenario_t &sil)
-{
-    Scenario sc = paper_scenario();
-    const double period_s = static_cast<double>(sil.controller.timing.period_s);
-    sc.s_align_time_s = static_cast<double>(sil_period_index(sil, static_cast<double>(sil.controller.alignment.s_align_time_s)))
-                        * period_s;
-    sc.c_align_time_s = static_cast<double>(sil_period_index(sil, static_cast<double>(sil.controller.alignment.c_align_time_s)))
-                        * period_s;
-    for (RampCommand &cmd : sc.speed_commands) {
-        cmd.time_s = first_sample_at_or_after(cmd.time_s, period_s);
-        cmd.rate_rad_s2 = static_cast<double>(static_cast<float>(cmd.rate_rad_s2));
-    }
-    return sc;
 }
 
 struct OracleDiff {

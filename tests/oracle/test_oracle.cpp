@@ -11,6 +11,7 @@
 
 #include "oracle.hpp"
 #include "sil_capture.hpp"
+#include "sil_grid.hpp"
 
 // cmocka last (its fail() macro must not meet the C++ library's basic_ios::fail()), with C linkage
 // (its header declares most functions without extern "C").
@@ -25,38 +26,6 @@ extern "C" {
 using namespace pmstep_oracle;
 
 namespace {
-
-/** The first sample time k T_s >= t, as the SIL runner issues a set-point command. */
-double first_sample_at_or_after(double t_s, double period_s)
-{
-    double k = std::floor(t_s / period_s);
-    while (k * period_s < t_s) {
-        k += 1.0;
-    }
-    while (k > 0.0 && (k - 1.0) * period_s >= t_s) {
-        k -= 1.0;
-    }
-    return k * period_s;
-}
-
-/** The paper's scenario for the oracle, with the timing the SIL actually realises at its period:
- *  t_s, t_c and the ramp commands on the sample grid (the runner issues a command at the first
- *  period whose time is >= the breakpoint), ramp rates as the firmware holds them (float).
- *  The motor and gains stay the oracle's own (from the paper), not the SIL's. */
-Scenario oracle_on_sil_grid(const sil_scenario_t &sil)
-{
-    Scenario sc = paper_scenario();
-    const double period_s = static_cast<double>(sil.controller.timing.period_s);
-    sc.s_align_time_s = static_cast<double>(sil_period_index(sil, static_cast<double>(sil.controller.alignment.s_align_time_s)))
-                        * period_s;
-    sc.c_align_time_s = static_cast<double>(sil_period_index(sil, static_cast<double>(sil.controller.alignment.c_align_time_s)))
-                        * period_s;
-    for (RampCommand &cmd : sc.speed_commands) {
-        cmd.time_s = first_sample_at_or_after(cmd.time_s, period_s);
-        cmd.rate_rad_s2 = static_cast<double>(static_cast<float>(cmd.rate_rad_s2));
-    }
-    return sc;
-}
 
 struct Comparison {
     double max_speed_diff_rad_s;      ///< max |w_SIL - w_oracle| on [t_c, end]

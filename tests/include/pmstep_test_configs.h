@@ -1,0 +1,30 @@
+/* Configurations the reliability harnesses share (tests/fuzz, tests/eva): one definition of
+ * "every optional feature on", so the fuzzer and the proof analyse the same firmware paths. */
+#ifndef PMSTEP_TEST_CONFIGS_H
+#define PMSTEP_TEST_CONFIGS_H
+
+#include "pmstep/pmstep.h"
+
+/* Every optional feature on: offset calibration, alignment windows with the voltage bias,
+ * inductance window, commissioned R, L, k_M used, dead-time compensation, drift-free angle,
+ * every detector (the paper's bounds), two re-alignments, one period of delay. */
+static inline pmstep_config_t pmstep_test_features_config(void)
+{
+    pmstep_config_t cfg = pmstep_paper_config();
+    cfg.commissioning.offset_calibration_time_s = 0.005f;
+    cfg.commissioning.alignment_offset_calibration = true;
+    cfg.commissioning.steady_state_window_s = 0.05f;
+    cfg.commissioning.voltage_bias_level_fraction = 0.5f;
+    cfg.commissioning.inductance_window_s = 0.0005f;
+    cfg.commissioning.use_measured_resistance = true;
+    cfg.commissioning.use_measured_inductance = true;
+    cfg.commissioning.use_measured_torque_constant = true;
+    cfg.inverter.dead_time_s = 1e-6f;
+    cfg.inverter.dead_time_current_band_A = 0.005f;
+    cfg.gains.angle_correction_gain_per_s = 20.0f;
+    cfg.detection.max_realignments = 2u;
+    cfg.timing.computational_delay_periods = 1u;
+    return cfg;
+}
+
+#endif /* PMSTEP_TEST_CONFIGS_H */
