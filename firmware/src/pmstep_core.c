@@ -182,11 +182,6 @@ pmstep_status_t pmstep_set_id_target(pmstep_t *inst, float target_A)
     return PMSTEP_OK;
 }
 
-void pmstep_get_commissioning(const pmstep_t *inst, pmstep_commissioning_t *out)
-{
-    *out = inst->commissioning;
-}
-
 static void output_off(pmstep_output_t *out, const pmstep_t *inst)
 {
     static const pmstep_output_t zero_output = {0};

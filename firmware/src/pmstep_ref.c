@@ -1,8 +1,15 @@
 /* Reference generator: ramp-limited set-point through H(s) = w0^3/(s+w0)^3 (Section III.B). */
 #include "pmstep/pmstep_ref.h"
 
+#include <math.h> /* fabsf: one vabs.f32 / andps, no libm call */
+
 /* Terms of the series for a = w0 T_s <= 0.5: a^j/j! < 1e-12 beyond j = 16. */
 #define REF_SERIES_TERMS 18
+
+/* A filter whose differences and error are all below this (in the channel's unit; a moving
+ * set-point keeps them far above) is snapped onto its set-point: left alone, its state would
+ * decay through the subnormal floats, far below any meaning and slow on some FPUs. */
+#define REF_SETTLED 1e-30f
 
 void pmstep_ref_coeffs_init(pmstep_ref_coeffs_t *coeffs, float bandwidth_rad_s, float period_s)
 {
@@ -128,6 +135,12 @@ void pmstep_ref_advance(const pmstep_ref_coeffs_t *coeffs, pmstep_ref_t *ref, fl
         const float corrected = increment - ref->value_compensation;
         y = ref->value + corrected;
         ref->value_compensation = (y - ref->value) - corrected;
+    }
+    if (fabsf(d1) + fabsf(d2) + fabsf(error) < REF_SETTLED) {
+        d1 = 0.0f;
+        d2 = 0.0f;
+        y = next;
+        ref->value_compensation = 0.0f;
     }
     ref->diff12 = d1;
     ref->diff23 = d2;

@@ -87,7 +87,10 @@ pmstep_status_t pmstep_set_id_target(pmstep_t *inst, float target_A);
 void pmstep_step(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out);
 
 /** Calibration and commissioning results so far (telemetry; see pmstep_commissioning_t). */
-void pmstep_get_commissioning(const pmstep_t *inst, pmstep_commissioning_t *out);
+static inline void pmstep_get_commissioning(const pmstep_t *inst, pmstep_commissioning_t *out)
+{
+    *out = inst->commissioning;
+}
 
 /** Configuration of the paper's Section III (motor, gains, t_s = 0.3 s, t_c = 0.6 s), 20 kHz.
  *  In the library pmstep_presets, apart from the core. */

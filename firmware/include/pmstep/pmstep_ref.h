@@ -8,7 +8,9 @@
  * y'' = w0^2 (x1 - 2 x2 + x3). The state kept is (x1 - x2, x2 - x3, x3): the
  * derivatives then need no difference of nearly equal floats. The set-point is
  * piecewise linear between samples, so the first-order-hold discretisation
- * used here is exact.
+ * used here is exact. A settled filter (differences and error below 1e-30 in the
+ * channel's unit) is snapped onto its set-point rather than left to decay through
+ * the subnormal floats.
  */
 #ifndef PMSTEP_REF_H
 #define PMSTEP_REF_H
