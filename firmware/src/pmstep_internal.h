@@ -4,10 +4,12 @@
 
 #include "pmstep/pmstep.h"
 
-/* |x| without libm. */
+#include <math.h>
+
+/* |x|: fabsf compiles to one instruction (vabs.f32, andps), never a libm call. */
 static inline float pmstep_abs(float x)
 {
-    return x < 0.0f ? -x : x;
+    return fabsf(x);
 }
 
 /* x - x is 0 for every finite x and NaN for NaN and +/-Inf, so one compare checks a sum of

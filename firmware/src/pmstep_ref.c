@@ -1,7 +1,7 @@
 /* Reference generator: ramp-limited set-point through H(s) = w0^3/(s+w0)^3 (Section III.B). */
 #include "pmstep/pmstep_ref.h"
 
-#include <math.h> /* fabsf: one vabs.f32 / andps, no libm call */
+#include "pmstep_internal.h"
 
 /* Terms of the series for a = w0 T_s <= 0.5: a^j/j! < 1e-12 beyond j = 16. */
 #define REF_SERIES_TERMS 18
@@ -136,7 +136,7 @@ void pmstep_ref_advance(const pmstep_ref_coeffs_t *coeffs, pmstep_ref_t *ref, fl
         y = ref->value + corrected;
         ref->value_compensation = (y - ref->value) - corrected;
     }
-    if (fabsf(d1) + fabsf(d2) + fabsf(error) < REF_SETTLED) {
+    if (pmstep_abs(d1) + pmstep_abs(d2) + pmstep_abs(error) < REF_SETTLED) {
         d1 = 0.0f;
         d2 = 0.0f;
         y = next;
