@@ -32,6 +32,10 @@ typedef struct {
 #define BIG 1e12
 
 static const key_t_ keys[] = {
+    {"datasheet.rated_current_A", KEY_DOUBLE, OFF(datasheet.rated_current_A), 0, 1, 1e4, 0, "rated phase current (A)"},
+    {"datasheet.holding_torque_Nm", KEY_DOUBLE, OFF(datasheet.holding_torque_Nm), 0, 1, 1e6, 0, "holding torque, both phases at rated current (Nm)"},
+    {"datasheet.detent_torque_Nm", KEY_DOUBLE, OFF(datasheet.detent_torque_Nm), 0, 0, 1e6, 0, "unpowered detent torque (Nm); 0 = not given"},
+
     {"motor.resistance_Ohm", KEY_DOUBLE, OFF(motor.resistance_Ohm), 0, 1, BIG, 0, "plant R (Ohm)"},
     {"motor.inductance_H", KEY_DOUBLE, OFF(motor.inductance_H), 0, 1, BIG, 0, "plant L (H)"},
     {"motor.inertia_kgm2", KEY_DOUBLE, OFF(motor.inertia_kgm2), 0, 1, BIG, 0, "plant J (kg m^2)"},

@@ -14,6 +14,11 @@ void sil_scenario_paper(sil_scenario_t *sc)
     int k;
     memset(sc, 0, sizeof *sc);
     snprintf(sc->name, sizeof sc->name, "paper");
+    /* The paper gives no rating: its alignment current 24 V / 3 Ohm = 8 A is taken as rated,
+     * holding torque sqrt(2) k_M I = 22.6 Nm. */
+    sc->datasheet.rated_current_A = 8.0;
+    sc->datasheet.holding_torque_Nm = 22.627417;
+    sc->datasheet.detent_torque_Nm = 0.0;
     sc->motor = plant_paper_params();
     sc->controller = pmstep_paper_config();
     sc->load.kind = PLANT_LOAD_STEP;

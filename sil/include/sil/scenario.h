@@ -27,8 +27,16 @@ extern "C" {
 /** Bytes of one run.csv row at most (21 columns), for the output-size check. */
 #define SIL_CSV_ROW_MAX_BYTES 330.0
 
+/** [datasheet]: the motor's ratings, for the gain designer and the baselines (not used by the plant). */
+typedef struct {
+    double rated_current_A;   /**< datasheet.rated_current_A: rated phase current (A, amplitude of each phase) */
+    double holding_torque_Nm; /**< datasheet.holding_torque_Nm: holding torque with both phases at rated current */
+    double detent_torque_Nm;  /**< datasheet.detent_torque_Nm: unpowered detent torque (0 = not given) */
+} sil_datasheet_t;
+
 typedef struct {
     char name[64];
+    sil_datasheet_t datasheet;       /**< [datasheet] */
     plant_params_t motor;            /**< [motor]: the plant (may differ from [controller]) */
     plant_load_t load;               /**< [load] */
     pmstep_config_t controller;      /**< [controller]: what the firmware is told */
