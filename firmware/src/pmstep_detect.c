@@ -2,6 +2,7 @@
 #include "pmstep/pmstep_detect.h"
 
 #include "pmstep_internal.h"
+#include "pmstep/pmstep_rotation.h"
 
 /* The low-passes' time constant is the persistence over this. */
 #define PERSISTENCE_PER_TIME_CONSTANT 4.0f
@@ -43,9 +44,16 @@ pmstep_fault_t pmstep_detect_check(pmstep_detector_t *detector, const pmstep_det
         }
     }
     if (cfg->speed_consistency_bound_rad_s > 0.0f) {
-        /* sin of the estimate's electrical step since the last check, against p w-hat x check period. */
-        const float angle_step = detector->prev_cos_hat * out->sin_hat - detector->prev_sin_hat * out->cos_hat;
-        const float gap = angle_step - coeffs->angle_step_per_speed * out->speed_hat_rad_s;
+        /* The last check's estimate turned by p w-hat x check period, against the estimate now:
+         * gap = sin of the angle between them. */
+        float cos_turn;
+        float sin_turn;
+        float cos_expected;
+        float sin_expected;
+        float gap;
+        pmstep_small_rotation(coeffs->angle_step_per_speed * out->speed_hat_rad_s, &cos_turn, &sin_turn);
+        pmstep_turn(detector->prev_cos_hat, detector->prev_sin_hat, cos_turn, sin_turn, &cos_expected, &sin_expected);
+        gap = cos_expected * out->sin_hat - sin_expected * out->cos_hat;
         detector->rotation_gap_rad += coeffs->alpha * (gap - detector->rotation_gap_rad);
         detector->prev_cos_hat = out->cos_hat;
         detector->prev_sin_hat = out->sin_hat;

@@ -1,6 +1,8 @@
 /* Adaptive speed and current law of controller (6); (13) when the load is known. */
 #include "pmstep/pmstep_law.h"
 
+#include "pmstep/pmstep_rotation.h"
+
 #include <math.h> /* sqrtf: one vsqrt.f32 / sqrtss with -fno-math-errno, no libm call */
 
 void pmstep_law_coeffs_init(pmstep_law_coeffs_t *coeffs, const pmstep_config_t *cfg,
@@ -17,6 +19,15 @@ void pmstep_law_coeffs_init(pmstep_law_coeffs_t *coeffs, const pmstep_config_t *
     coeffs->pole_pairs = (float)cfg->motor.pole_pairs;
     coeffs->kappa_rad_s = cfg->gains.sat_kappa_rad_s;
     coeffs->linear_speed_term = cfg->known_load_mode;
+    {
+        const float turn_per_speed = coeffs->pole_pairs * cfg->timing.period_s;
+        const float a = turn_per_speed * ((float)cfg->timing.computational_delay_periods + 0.5f);
+        const float k = turn_per_speed * turn_per_speed * (1.0f / 24.0f);
+        coeffs->turn_cos_w2 = -(0.5f * a * a + k);
+        coeffs->turn_cos_w4 = a * a * a * a * (1.0f / 24.0f) + 0.5f * k * a * a;
+        coeffs->turn_sin_w1 = a;
+        coeffs->turn_sin_w3 = -(a * a * a * (1.0f / 6.0f) + k * a);
+    }
 }
 
 void pmstep_sat(float x, float kappa, float *sat, float *sat_slope)
@@ -80,7 +91,13 @@ void pmstep_law_voltages(const pmstep_law_coeffs_t *coeffs, const pmstep_law_ref
                         - coeffs->km_over_l * speed_hat_rad_s - i_q_ref_rate;
     const float u_d = coeffs->inductance_H * (-phi_d - coeffs->current_gain_per_s * (i_d_A - refs->i_d_ref_A));
     const float u_q = coeffs->inductance_H * (-phi_q - coeffs->current_gain_per_s * (i_q_A - i_q_ref_A));
-    /* Inverse Park with the estimated angle. */
-    *u_a_V = cos_hat * u_d - sin_hat * u_q;
-    *u_b_V = sin_hat * u_d + cos_hat * u_q;
+    const float w2 = speed_hat_rad_s * speed_hat_rad_s;
+    const float cos_turn = 1.0f + w2 * (coeffs->turn_cos_w2 + w2 * coeffs->turn_cos_w4);
+    const float sin_turn = speed_hat_rad_s * (coeffs->turn_sin_w1 + w2 * coeffs->turn_sin_w3);
+    float cos_act;
+    float sin_act;
+    /* Inverse Park at the angle the voltage acts at, shortened for the hold. */
+    pmstep_turn(cos_hat, sin_hat, cos_turn, sin_turn, &cos_act, &sin_act);
+    *u_a_V = cos_act * u_d - sin_act * u_q;
+    *u_b_V = sin_act * u_d + cos_act * u_q;
 }

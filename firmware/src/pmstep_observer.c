@@ -1,6 +1,8 @@
 /* Current, speed and load observer of controller (6); speed observer (13) of Remark 1. */
 #include "pmstep/pmstep_observer.h"
 
+#include "pmstep/pmstep_rotation.h"
+
 void pmstep_observer_coeffs_init(pmstep_observer_coeffs_t *coeffs, const pmstep_config_t *cfg,
                                  const pmstep_electrical_t *model)
 {
@@ -23,6 +25,17 @@ void pmstep_observer_coeffs_init(pmstep_observer_coeffs_t *coeffs, const pmstep_
     coeffs->speed_injection_gain = (2.0f * g * g + r * f * l * j * j) / den;
     coeffs->load_injection_gain = (2.0f * g * g * f + l * j * g + l * j * j * r * f * f) / den;
     coeffs->inv_lambda = 1.0f / l;
+    {
+        const float half_z = 0.5f * coeffs->r_over_l_per_s * cfg->timing.period_s;
+        coeffs->current_decay = (1.0f - half_z) / (1.0f + half_z);
+        coeffs->current_step_s = cfg->timing.period_s / (1.0f + half_z);
+    }
+    {
+        const float h = 0.5f * coeffs->pole_pairs * cfg->timing.period_s;
+        coeffs->mean_cos_w2 = -(2.0f / 3.0f) * h * h;
+        coeffs->mean_sin_w1 = h;
+        coeffs->mean_sin_w3 = -(1.0f / 3.0f) * h * h * h;
+    }
 }
 
 void pmstep_observer_start(pmstep_observer_t *obs, float i_a_A, float i_b_A)
@@ -67,13 +80,20 @@ void pmstep_observer_advance(pmstep_observer_t *obs, const pmstep_observer_coeff
     const float err_b = in->i_b_A - obs->i_b_hat_A;
     const float w = obs->speed_hat_rad_s;
     const float pw = coeffs->pole_pairs * w;
-    const float rate_a = -coeffs->r_over_l_per_s * obs->i_a_hat_A + coeffs->km_over_l * w * in->sin_hat
-                         + coeffs->inv_l_per_H * u_a_V + coeffs->observer_gain_per_s * err_a + pw * err_b;
-    const float rate_b = -coeffs->r_over_l_per_s * obs->i_b_hat_A - coeffs->km_over_l * w * in->cos_hat
-                         + coeffs->inv_l_per_H * u_b_V + coeffs->observer_gain_per_s * err_b - pw * err_a;
-
-    obs->i_a_hat_A += period_s * rate_a;
-    obs->i_b_hat_A += period_s * rate_b;
+    const float w2 = w * w;
+    float mean_cos;
+    float mean_sin;
+    pmstep_turn(in->cos_hat, in->sin_hat, 1.0f + coeffs->mean_cos_w2 * w2,
+                w * (coeffs->mean_sin_w1 + coeffs->mean_sin_w3 * w2), &mean_cos, &mean_sin);
+    {
+        /* The rates of (6) but -(R/L) i-hat, which the trapezoid rule takes. */
+        const float drive_a = coeffs->km_over_l * w * mean_sin + coeffs->inv_l_per_H * u_a_V
+                              + coeffs->observer_gain_per_s * err_a + pw * err_b;
+        const float drive_b = -coeffs->km_over_l * w * mean_cos + coeffs->inv_l_per_H * u_b_V
+                              + coeffs->observer_gain_per_s * err_b - pw * err_a;
+        obs->i_a_hat_A = coeffs->current_decay * obs->i_a_hat_A + coeffs->current_step_s * drive_a;
+        obs->i_b_hat_A = coeffs->current_decay * obs->i_b_hat_A + coeffs->current_step_s * drive_b;
+    }
     obs->speed_hat_rad_s += period_s * mech->speed_hat_rate_rad_s2;
     obs->load_hat_Nm += period_s * mech->load_hat_rate_Nm_s;
 }

@@ -53,13 +53,18 @@ static void park_and_inverse_are_orthogonal(void **state)
 static void current_loop_gives_error_dynamics_8(void **state)
 {
     /* With the exact angle and w-hat = w, (6) on model (2) must give
-     * d(i_q - i_q*)/dt = -(R/L + K_i)(i_q - i_q*) (first lines of (8) with e_w = 0). */
+     * d(i_q - i_q*)/dt = -(R/L + K_i)(i_q - i_q*) (first lines of (8) with e_w = 0).
+     * The law places its voltage at the angle it acts at (p w T_s / 2 on, no delay) and
+     * shortens it by 1 - (p w T_s)^2/24 for the hold: undo both to read (u_d, u_q). */
     const pmstep_config_t cfg = pmstep_paper_config();
     const pmstep_electrical_t model = pmstep_configured_electrical(&cfg);
     pmstep_law_coeffs_t coeffs;
     pmstep_law_refs_t refs = {3.0f, 20.0f, 0.0f, 0.0f, 0.0f};
     const float angle = 0.8f, speed = 3.0f, i_d = 0.3f, i_q = 1.7f, load = 1.0f;
     const float c = cosf(angle), s = sinf(angle);
+    const double turn = 6.0 * speed * 5e-5;
+    const double held_gain = 1.0 - turn * turn / 24.0;
+    const float c_act = (float)cos(angle + 0.5 * turn), s_act = (float)sin(angle + 0.5 * turn);
     float u_a, u_b, u_d, u_q, i_q_ref, i_q_ref_rate;
     double di_q, di_d;
     (void)state;
@@ -67,7 +72,9 @@ static void current_loop_gives_error_dynamics_8(void **state)
     i_q_ref = pmstep_law_iq_ref(&coeffs, &refs, speed, load);
     i_q_ref_rate = pmstep_law_iq_ref_rate(&coeffs, &refs, speed, 0.0f, 0.0f);
     pmstep_law_voltages(&coeffs, &refs, c, s, i_d, i_q, speed, i_q_ref, i_q_ref_rate, &u_a, &u_b);
-    pmstep_park(c, s, u_a, u_b, &u_d, &u_q);
+    pmstep_park(c_act, s_act, u_a, u_b, &u_d, &u_q);
+    u_d = (float)(u_d / held_gain);
+    u_q = (float)(u_q / held_gain);
     /* (2): di_q/dt = -(R/L) i_q - p w i_d - (k_M/L) w + u_q/L, di_d/dt = -(R/L) i_d + p w i_q + u_d/L */
     di_q = -500.0 * i_q - 6.0 * speed * i_d - (2.0 / 0.006) * speed + u_q / 0.006;
     di_d = -500.0 * i_d + 6.0 * speed * i_q + u_d / 0.006;

@@ -27,7 +27,15 @@ typedef struct {
     float inductance_H;       /**< L */
     float pole_pairs;         /**< p */
     float kappa_rad_s;        /**< kappa */
-    bool linear_speed_term;   /**< Remark 1 (13): k_w (w-hat - w*) without saturation */
+    /* The voltage's angle and length (see pmstep_law_voltages), as polynomials in w-hat:
+     * (1 - x^2/6)(cos d, sin d), d = p T_s (delay + 1/2) w-hat, x = p T_s w-hat / 2, is
+     * (1 + c2 w^2 + c4 w^4, w (s1 + s3 w^2)) to fourth and third order. */
+    float turn_cos_w2;        /**< c2 = -(a^2/2 + k), a = p T_s (delay + 1/2), k = (p T_s)^2/24 */
+    float turn_cos_w4;        /**< c4 = a^4/24 + k a^2/2 */
+    float turn_sin_w1;        /**< s1 = a */
+    float turn_sin_w3;        /**< s3 = -(a^3/6 + k a) */
+    bool linear_speed_term;   /**< Remark 1 (13): k_w (w-hat - w*) without saturation (last: the floats
+                                   before it are checked as a run) */
 } pmstep_law_coeffs_t;
 
 /** References at one sample. */
@@ -57,7 +65,12 @@ float pmstep_law_iq_ref_rate(const pmstep_law_coeffs_t *coeffs, const pmstep_law
 /**
  * phi_d = -(R/L) i_d* + p w-hat i_q - i_d*',  phi_q = -(R/L) i_q* - p w-hat i_d - (k_M/L) w-hat - i_q*',
  * u_d = L[-phi_d - K_i (i_d - i_d*)], u_q = L[-phi_q - K_i (i_q - i_q*)],
- * u_a = c u_d - s u_q, u_b = s u_d + c u_q.
+ * u_a = c u_d - s u_q, u_b = s u_d + c u_q, with (c, s) the estimate turned by the angle the
+ * rotor turns from the sample to the middle of the period the voltage acts in (p w-hat T_s
+ * (delay + 1/2)) and (u_d, u_q) shortened by 1 - x^2/6, x = p w-hat T_s/2. A voltage held in the
+ * stator frame over a period, placed there, drives the currents at the samples as the continuous
+ * law's (u_d, u_q) would times 1 + x^2/6 + O(x^3) (steady state of the sampled R-L circuit in the
+ * rotor frame; firmware/design/DESIGN.md), so the step stays accurate at p w T_s ~ 0.3 rad.
  */
 void pmstep_law_voltages(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs,
                          float cos_hat, float sin_hat, float i_d_A, float i_q_A,

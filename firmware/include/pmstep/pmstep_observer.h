@@ -8,7 +8,15 @@
  *       w-hat'   = -(F/J) w-hat - T_L-hat/J + (k_M/J) i_q + g_w eps
  *       T_L-hat' = -g_T eps,   eps = (k_M/L)(s-hat i~_a - c-hat i~_b)
  * (13): w-hat'   = -(F/J) w-hat + (k_M/J) i_q - T_L^* / J + (1/lambda)[p i_q i~_d - p i_d i~_q - (k_M/L) i~_q]
- * Discretised by forward Euler at the control period.
+ * Discretised at the control period T_s so that it stays accurate when the electrical angle
+ * turns p w T_s ~ 0.3 rad per period (hybrid steppers at speed):
+ *  - currents: the R/L decay by the trapezoid rule (second order, A-stable); the held voltage
+ *    exactly; the back-EMF, which turns with the rotor, at its mean over the period (the
+ *    angle turned by h = p w-hat T_s/2 and shortened by sin(h)/h: e^{jh} sin(h)/h =
+ *    (1 - 2h^2/3) + j h (1 - h^2/3) + O(h^4));
+ *    the injections K_e i~ and p w-hat J i~ from the sample (a discrete-time correction:
+ *    zero when i-hat matches the sample, so the prediction is the model's alone);
+ *  - w-hat, T_L-hat: forward Euler (mechanics are slow against T_s).
  */
 #ifndef PMSTEP_OBSERVER_H
 #define PMSTEP_OBSERVER_H
@@ -38,6 +46,12 @@ typedef struct {
     float speed_injection_gain; /**< g_w = (2 g^2 + r F l J^2)/(g^2 l + r F l^2 J^2) */
     float load_injection_gain;  /**< g_T = (2 g^2 F + l J g + l J^2 r F^2)/(g^2 l + r F l^2 J^2) */
     float inv_lambda;         /**< 1/lambda, Remark 1 */
+    float current_decay;      /**< (1 - z/2)/(1 + z/2), z = (R/L) T_s: trapezoid-rule decay of i-hat per period */
+    float current_step_s;     /**< T_s/(1 + z/2): weight of the current rate's other terms */
+    /* The back-EMF's mean over a period: the estimate turned by (1 + c2 w^2, w (s1 + s3 w^2)). */
+    float mean_cos_w2;        /**< c2 = -(2/3) h^2, h = p T_s / 2 (per rad/s) */
+    float mean_sin_w1;        /**< s1 = h */
+    float mean_sin_w3;        /**< s3 = -h^3/3 */
 } pmstep_observer_coeffs_t;
 
 /** Signals the mechanical part of the observer needs at one sample. */
@@ -68,7 +82,8 @@ pmstep_observer_mech_rates_t pmstep_observer_mech_rates(const pmstep_observer_t 
                                                         const pmstep_observer_input_t *in,
                                                         bool known_load);
 
-/** Forward-Euler step of all four states, with the voltage applied over the next period. */
+/** Step of all four states over the next period (see the discretisation above), with the
+ *  voltage applied over that period. */
 void pmstep_observer_advance(pmstep_observer_t *obs, const pmstep_observer_coeffs_t *coeffs,
                              const pmstep_observer_input_t *in,
                              const pmstep_observer_mech_rates_t *mech,
