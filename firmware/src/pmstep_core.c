@@ -337,7 +337,10 @@ static pmstep_fault_t supervise_stage(pmstep_t *inst, const pmstep_output_t *out
  * swing); left alone, its dead time would clamp it open. The sign of the current: in RUN from
  * the current references (i_d*, i_q*) turned by (c-hat, s-hat), which pass through zero
  * smoothly where a sampled current would sit in the ADC's zero code and let the phase clamp;
- * in the alignments from the offset-corrected samples. */
+ * in the alignments, for the driven phase the current its voltage drives it to (u/R > 0), so
+ * that the compensation acts from the first period (a sample still at zero would leave the
+ * phase clamped open when u is below the dead time's loss: hybrid steppers align at about
+ * 1 V on a 24-48 V bus), and for the undriven phase the offset-corrected sample. */
 static pmstep_compensation_input_t compensation_input(const pmstep_t *inst, const pmstep_meas_t *sample,
                                                       const pmstep_output_t *out)
 {
@@ -347,6 +350,12 @@ static pmstep_compensation_input_t compensation_input(const pmstep_t *inst, cons
     if (inst->mode == PMSTEP_MODE_RUN) {
         in.sign_current_a_A = out->cos_hat * out->i_d_ref_A - out->sin_hat * out->i_q_ref_A;
         in.sign_current_b_A = out->sin_hat * out->i_d_ref_A + out->cos_hat * out->i_q_ref_A;
+    } else if (out->u_a_V > 0.0f) {
+        in.sign_current_a_A = out->u_a_V / inst->cfg->motor.resistance_Ohm;
+    } else if (out->u_b_V > 0.0f) {
+        in.sign_current_b_A = out->u_b_V / inst->cfg->motor.resistance_Ohm;
+    } else {
+        /* bridge-off modes and an alignment's first sample: the samples */
     }
     in.bias_a_V = inst->commissioning.voltage_bias_a_V;
     in.bias_b_V = inst->commissioning.voltage_bias_b_V;

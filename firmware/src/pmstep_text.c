@@ -54,6 +54,9 @@ const char *pmstep_status_str(pmstep_status_t status)
     case PMSTEP_ERR_DEAD_TIME_BAND: return "band outside [1e-4 A, current limit]";
     case PMSTEP_ERR_DETECTION_BOUND: return "detection bound < 0";
     case PMSTEP_ERR_DETECTION_TIME: return "persistence: 0, or 1 check to 2^24 periods";
+    case PMSTEP_ERR_RATED_CURRENT: return "rated current must be > 0";
+    case PMSTEP_ERR_BUS_BELOW_RATED: return "bus too low for R x rated current";
+    case PMSTEP_ERR_RATE_TOO_SLOW: return "control rate too slow for R/L";
     }
     return "unknown status";
 }

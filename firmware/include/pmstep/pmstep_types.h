@@ -77,9 +77,14 @@ typedef enum {
                                                  [PMSTEP_MIN_CURRENT_BAND_A, max_phase_current_A] */
     /* detection */
     PMSTEP_ERR_DETECTION_BOUND = -100,      /**< a detection bound < 0 */
-    PMSTEP_ERR_DETECTION_TIME = -101        /**< persistence not 0 (only with every detector off) or within
+    PMSTEP_ERR_DETECTION_TIME = -101,       /**< persistence not 0 (only with every detector off) or within
                                                  [PMSTEP_DETECTION_DECIMATION periods (one check),
                                                  PMSTEP_MAX_DURATION_PERIODS periods] */
+    /* gain designer (pmstep_design.h): motor data it cannot design for */
+    PMSTEP_ERR_RATED_CURRENT = -110,        /**< rated current <= 0 */
+    PMSTEP_ERR_BUS_BELOW_RATED = -111,      /**< bus voltage <= 0, or R x rated current above the usable bus */
+    PMSTEP_ERR_RATE_TOO_SLOW = -112         /**< control rate too slow for the motor: R/L above the bandwidth
+                                                 the designer gives the current loop and the observer */
 } pmstep_status_t;
 
 /** Shortest and longest control period accepted (s): 1 MHz down to 100 Hz. */

@@ -1,0 +1,70 @@
+/**
+ * @file pmstep_design.h
+ * @brief Gain designer: every setting of pmstep_config_t from a motor's data, by the rules
+ *        derived in firmware/design/DESIGN.md (pole placement on the linearised error
+ *        dynamics, bandwidths as fractions of the control rate).
+ *
+ * Portable C99 like the core (no heap, no stdio, float32; sqrtf only), in a library of its
+ * own (pmstep_design) so that an image that does not design its gains does not carry it. An
+ * MCU can call it at boot from datasheet values, or again from what commissioning measured.
+ */
+#ifndef PMSTEP_DESIGN_H
+#define PMSTEP_DESIGN_H
+
+#include "pmstep/pmstep_types.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** What the designer needs to know of the motor and the drive. */
+typedef struct {
+    pmstep_motor_config_t motor;          /**< R, L, J, F, k_M, p (datasheet or measured) */
+    float rated_current_A;                /**< rated phase current (amplitude) */
+    float bus_voltage_V;                  /**< nominal DC bus */
+    float period_s;                       /**< control period T_s */
+    uint32_t computational_delay_periods; /**< 0 or 1 */
+    bool self_commissioning;              /**< robust mode: Remark 2 offsets and voltage bias, R/L/k_M measured
+                                               at t_c, drift-free angle, dead-time compensation */
+    float dead_time_s;                    /**< the bridge's dead time (robust mode; 0 = none) */
+    float current_resolution_A;           /**< current measurement resolution (ADC step or noise, whichever is
+                                               larger): the dead-time compensation's band (robust mode) */
+} pmstep_design_input_t;
+
+/** The design's figures, for people and for the SIL's validation. */
+typedef struct {
+    float top_speed_rad_s;           /**< speed at which rated current takes 90 % of the bus (i_d = 0) */
+    float top_electrical_step_rad;   /**< p x top speed x T_s: electrical angle turned per period at top speed */
+    float current_bandwidth_rad_s;   /**< R/L + K_i: pole of the current error */
+    float observer_bandwidth_rad_s;  /**< w_o: triple pole of the linearised speed/load observer */
+    float speed_bandwidth_rad_s;     /**< k_w */
+    float alignment_current_A;       /**< u_cs/R = u_cc/R */
+    float alignment_frequency_rad_s; /**< sqrt(p k_M I_al / J): natural frequency of the alignment swing */
+    float alignment_damping;         /**< its damping ratio (electrical damping through the winding, and F) */
+    float condition_4_margin;        /**< left side of (4) over its right side (> 1 when (4) holds) */
+    float magnetising_current_A;     /**< i_d* the robust mode should run with (0 in paper mode) */
+    float rated_torque_Nm;           /**< k_M x rated current (torque of one phase at rated current) */
+} pmstep_design_report_t;
+
+/**
+ * Designs every setting of @p cfg for the motor and drive in @p in (see DESIGN.md); the
+ * result passes pmstep_validate_config().
+ * @retval PMSTEP_OK
+ * @retval PMSTEP_ERR_NULL_ARGUMENT        a pointer is NULL
+ * @retval PMSTEP_ERR_NONFINITE_PARAMETER  an input is NaN or Inf
+ * @retval PMSTEP_ERR_RESISTANCE ... PMSTEP_ERR_POLE_PAIRS  bad motor data (as pmstep_validate_config())
+ * @retval PMSTEP_ERR_PERIOD, PMSTEP_ERR_DELAY  bad timing
+ * @retval PMSTEP_ERR_RATED_CURRENT        rated current <= 0
+ * @retval PMSTEP_ERR_BUS_BELOW_RATED      bus <= 0, or R x rated current above 90 % of it
+ * @retval PMSTEP_ERR_RATE_TOO_SLOW        R/L too large for the control period
+ * @retval PMSTEP_ERR_DEAD_TIME            dead time < 0 or 4 t_d >= T_s
+ * @retval other                           the designed configuration fails pmstep_validate_config()
+ */
+pmstep_status_t pmstep_design(const pmstep_design_input_t *in, pmstep_config_t *cfg,
+                              pmstep_design_report_t *report);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PMSTEP_DESIGN_H */

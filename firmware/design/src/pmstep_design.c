@@ -1,0 +1,266 @@
+/* Gain designer (pmstep_design.h): the rules of firmware/design/DESIGN.md, one function per group. */
+#include "pmstep/pmstep_design.h"
+
+#include "pmstep/pmstep.h"
+
+#include <math.h> /* sqrtf, isfinite: one FPU instruction / a classification macro, no libm call */
+#include <stddef.h>
+
+/* Bandwidths as fractions of the control rate 1/T_s (DESIGN.md, section 2). */
+#define CURRENT_BANDWIDTH_X_PERIOD 0.1f   /* (R/L + K_i) T_s */
+#define OBSERVER_BANDWIDTH_X_PERIOD 0.05f /* w_o T_s: the observer's triple pole */
+#define SPEED_PER_OBSERVER_BANDWIDTH (1.0f / 3.0f) /* k_w = w_o / 3 */
+#define REFERENCE_PER_SPEED_BANDWIDTH 3.0f         /* varpi_0 = 3 k_w */
+#define DRIFT_FREE_PER_OBSERVER_BANDWIDTH (1.0f / 30.0f) /* robust mode's angle correction g = w_o / 30 */
+/* Speed correction k_w kappa at most this fraction of the rated current's acceleration k_M I / J. */
+#define KAPPA_CURRENT_FRACTION 0.5f
+/* Alignment current at most this fraction of k_M/(p L), where condition (4) runs out. */
+#define CONDITION_4_FRACTION 0.5f
+/* The alignments last until the swing has decayed by e^-13.8 (1e-6), plus 5 L/R of current rise. */
+#define SETTLING_DECAY 13.8155f
+#define CURRENT_RISE_TIME_CONSTANTS 5.0f
+#define TIME_GRANULARITY_S 0.01f
+/* Protections. */
+#define USABLE_BUS_FRACTION 0.9f
+#define TRIP_CURRENT_PER_RATED 2.0f
+#define MIN_BUS_FRACTION 0.625f
+#define MAX_BUS_FRACTION 1.25f
+/* Detection (DESIGN.md, section 5). */
+#define ANGLE_MAGNITUDE_BOUND 0.25f
+#define STALL_FRACTION_OF_TOP_SPEED 0.2f
+#define RESIDUAL_PER_RATED_CURRENT 0.04f
+#define PERSISTENCE_S 0.02f
+/* Robust mode's commissioning (DESIGN.md, section 4). */
+#define OFFSET_CALIBRATION_S 0.05f
+#define MIN_STEADY_STATE_WINDOW_S 0.01f
+#define STEADY_STATE_WINDOW_TIME_CONSTANTS 10.0f
+#define INDUCTANCE_WINDOW_PER_TIME_CONSTANT 0.25f
+#define MIN_INDUCTANCE_WINDOW_PERIODS 4.0f
+#define VOLTAGE_BIAS_LEVEL 0.5f
+#define MAGNETISING_PER_RATED_CURRENT 0.125f
+#define MIN_DEAD_TIME_BAND_A 1e-4f
+/* Paper's r: only matters with F > 0 (DESIGN.md, section 3). */
+#define ADAPT_R 1.0f
+
+static float max2(float a, float b)
+{
+    return a > b ? a : b;
+}
+
+static float min2(float a, float b)
+{
+    return a < b ? a : b;
+}
+
+/* @p t_s rounded up to a whole number of TIME_GRANULARITY_S. */
+static float round_up_time(float t_s)
+{
+    const float units = t_s / TIME_GRANULARITY_S;
+    uint32_t whole = (uint32_t)units;
+    if ((float)whole < units) {
+        ++whole;
+    }
+    return (float)whole * TIME_GRANULARITY_S;
+}
+
+static bool finite_input(const pmstep_design_input_t *in)
+{
+    const pmstep_motor_config_t *m = &in->motor;
+    return isfinite(m->resistance_Ohm) && isfinite(m->inductance_H) && isfinite(m->inertia_kgm2)
+           && isfinite(m->friction_Nms_rad) && isfinite(m->torque_constant_Nm_A) && isfinite(in->rated_current_A)
+           && isfinite(in->bus_voltage_V) && isfinite(in->period_s) && isfinite(in->dead_time_s)
+           && isfinite(in->current_resolution_A);
+}
+
+static pmstep_status_t check_input(const pmstep_design_input_t *in)
+{
+    const pmstep_motor_config_t *m = &in->motor;
+    if (!finite_input(in)) {
+        return PMSTEP_ERR_NONFINITE_PARAMETER;
+    }
+    if (!(m->resistance_Ohm > 0.0f)) {
+        return PMSTEP_ERR_RESISTANCE;
+    }
+    if (!(m->inductance_H > 0.0f)) {
+        return PMSTEP_ERR_INDUCTANCE;
+    }
+    if (!(m->inertia_kgm2 > 0.0f)) {
+        return PMSTEP_ERR_INERTIA;
+    }
+    if (!(m->torque_constant_Nm_A > 0.0f)) {
+        return PMSTEP_ERR_TORQUE_CONSTANT;
+    }
+    if (!(m->friction_Nms_rad >= 0.0f)) {
+        return PMSTEP_ERR_FRICTION;
+    }
+    if (m->pole_pairs < 1) {
+        return PMSTEP_ERR_POLE_PAIRS;
+    }
+    if (!(in->period_s >= PMSTEP_MIN_PERIOD_S && in->period_s <= PMSTEP_MAX_PERIOD_S)) {
+        return PMSTEP_ERR_PERIOD;
+    }
+    if (in->computational_delay_periods > 1u) {
+        return PMSTEP_ERR_DELAY;
+    }
+    if (!(in->rated_current_A > 0.0f)) {
+        return PMSTEP_ERR_RATED_CURRENT;
+    }
+    if (!(in->bus_voltage_V > 0.0f)
+        || !(m->resistance_Ohm * in->rated_current_A < USABLE_BUS_FRACTION * in->bus_voltage_V)) {
+        return PMSTEP_ERR_BUS_BELOW_RATED;
+    }
+    if (!(in->dead_time_s >= 0.0f && 4.0f * in->dead_time_s < in->period_s)) {
+        return PMSTEP_ERR_DEAD_TIME;
+    }
+    /* The current loop's and the observer's poles must lie well beyond the winding's own R/L
+     * (K_i, K_e > 0): R/L below 80 % of the observer's current pole 3 w_o. */
+    if (!(m->resistance_Ohm / m->inductance_H * in->period_s < 0.8f * 3.0f * OBSERVER_BANDWIDTH_X_PERIOD)) {
+        return PMSTEP_ERR_RATE_TOO_SLOW;
+    }
+    return PMSTEP_OK;
+}
+
+/* Top speed: (R I + k_M w)^2 + (p w L I)^2 = (0.9 V)^2 at rated current, i_d = 0 (DESIGN.md, 6). */
+static float top_speed(const pmstep_design_input_t *in)
+{
+    const pmstep_motor_config_t *m = &in->motor;
+    const float i = in->rated_current_A;
+    const float x = (float)m->pole_pairs * m->inductance_H * i;
+    const float a = m->torque_constant_Nm_A * m->torque_constant_Nm_A + x * x;
+    const float b = 2.0f * m->resistance_Ohm * i * m->torque_constant_Nm_A;
+    const float usable_V = USABLE_BUS_FRACTION * in->bus_voltage_V;
+    const float c = m->resistance_Ohm * i * m->resistance_Ohm * i - usable_V * usable_V;
+    return (-b + sqrtf(b * b - 4.0f * a * c)) / (2.0f * a);
+}
+
+/* Current loop, observer (triple pole at -w_o of s^3 + (a_e + F/J) s^2 + (a_e F/J + g_w b^2) s
+ * + g_T b^2 / J, b = k_M/L), speed loop and reference filter (DESIGN.md, 2-3). */
+static void design_gains(const pmstep_design_input_t *in, pmstep_gains_config_t *gains, pmstep_design_report_t *report)
+{
+    const pmstep_motor_config_t *m = &in->motor;
+    const float r_over_l = m->resistance_Ohm / m->inductance_H;
+    const float f_over_j = m->friction_Nms_rad / m->inertia_kgm2;
+    const float b = m->torque_constant_Nm_A / m->inductance_H;
+    const float w_o = OBSERVER_BANDWIDTH_X_PERIOD / in->period_s;
+    const float a_e = 3.0f * w_o - f_over_j;
+    const float g_w = (3.0f * w_o * w_o - a_e * f_over_j) / (b * b);
+    const float g_t = m->inertia_kgm2 * w_o * w_o * w_o / (b * b);
+    const float lambda = 2.0f / g_w;
+    const float speed_gain = SPEED_PER_OBSERVER_BANDWIDTH * w_o;
+    const float current_bandwidth = CURRENT_BANDWIDTH_X_PERIOD / in->period_s;
+
+    gains->current_gain_per_s = current_bandwidth - r_over_l;
+    gains->observer_gain_per_s = a_e - r_over_l;
+    gains->adapt_lambda = lambda;
+    /* With r F small against gamma: g_w = 2/lambda, g_T = 2F/lambda + J/gamma. */
+    gains->adapt_gamma = m->inertia_kgm2 / max2(g_t - 2.0f * m->friction_Nms_rad / lambda, 1e-3f * g_t);
+    gains->adapt_r = ADAPT_R;
+    gains->speed_gain_per_s = speed_gain;
+    gains->sat_kappa_rad_s = KAPPA_CURRENT_FRACTION * in->rated_current_A * m->torque_constant_Nm_A
+                             / (m->inertia_kgm2 * speed_gain);
+    gains->reference_bandwidth_rad_s = REFERENCE_PER_SPEED_BANDWIDTH * speed_gain;
+    gains->angle_correction_gain_per_s = in->self_commissioning ? DRIFT_FREE_PER_OBSERVER_BANDWIDTH * w_o : 0.0f;
+
+    report->current_bandwidth_rad_s = current_bandwidth;
+    report->observer_bandwidth_rad_s = w_o;
+    report->speed_bandwidth_rad_s = speed_gain;
+}
+
+/* Alignment voltages from condition (4) and the rated current; times from the swing's decay
+ * (DESIGN.md, 4). Returns the steady-state window the robust mode uses (0 in paper mode). */
+static float design_alignment(const pmstep_design_input_t *in, pmstep_config_t *cfg, pmstep_design_report_t *report)
+{
+    const pmstep_motor_config_t *m = &in->motor;
+    const float p = (float)m->pole_pairs;
+    const float r = m->resistance_Ohm;
+    const float l_over_r = m->inductance_H / r;
+    const float condition_limit_A = m->torque_constant_Nm_A / (p * m->inductance_H);
+    const float current_A = min2(in->rated_current_A, CONDITION_4_FRACTION * condition_limit_A);
+    const float stiffness = p * m->torque_constant_Nm_A * current_A;
+    const float natural = sqrtf(stiffness / m->inertia_kgm2);
+    const float lag = natural * l_over_r;
+    const float electrical_damping = m->torque_constant_Nm_A * m->torque_constant_Nm_A / r / (1.0f + lag * lag);
+    const float zeta = (electrical_damping + m->friction_Nms_rad) / (2.0f * sqrtf(stiffness * m->inertia_kgm2));
+    /* Slowest mode's decay rate: zeta w_n if under-damped, w_n (zeta - sqrt(zeta^2 - 1)) if not. */
+    const float decay = zeta < 1.0f ? zeta * natural : natural * (zeta - sqrtf(zeta * zeta - 1.0f));
+    const float settle_s = SETTLING_DECAY / decay + CURRENT_RISE_TIME_CONSTANTS * l_over_r;
+    float window_s = 0.0f;
+    float align_s = settle_s;
+
+    if (in->self_commissioning) {
+        window_s = round_up_time(max2(MIN_STEADY_STATE_WINDOW_S, STEADY_STATE_WINDOW_TIME_CONSTANTS * l_over_r));
+        align_s = max2(settle_s + 2.0f * window_s, 4.0f * window_s);
+    }
+    align_s = round_up_time(align_s);
+    cfg->alignment.s_align_voltage_V = r * current_A;
+    cfg->alignment.c_align_voltage_V = r * current_A;
+    cfg->alignment.s_align_time_s = align_s;
+    cfg->alignment.c_align_time_s = 2.0f * align_s;
+
+    report->alignment_current_A = current_A;
+    report->alignment_frequency_rad_s = natural;
+    report->alignment_damping = zeta;
+    /* (4) with u_cs = u_cc = R I: k_M I/(p L) > I^2, i.e. condition_limit_A / I > 1. */
+    report->condition_4_margin = condition_limit_A / current_A;
+    return window_s;
+}
+
+static void design_commissioning(const pmstep_design_input_t *in, float window_s, pmstep_config_t *cfg,
+                                 pmstep_design_report_t *report)
+{
+    pmstep_commissioning_config_t *c = &cfg->commissioning;
+    const float l_over_r = in->motor.inductance_H / in->motor.resistance_Ohm;
+    const bool robust = in->self_commissioning;
+    c->offset_calibration_time_s = robust ? OFFSET_CALIBRATION_S : 0.0f;
+    c->alignment_offset_calibration = false;
+    c->steady_state_window_s = window_s;
+    c->inductance_window_s = robust ? max2(INDUCTANCE_WINDOW_PER_TIME_CONSTANT * l_over_r,
+                                           MIN_INDUCTANCE_WINDOW_PERIODS * in->period_s)
+                                    : 0.0f;
+    c->use_measured_resistance = robust;
+    c->use_measured_inductance = robust;
+    c->use_measured_torque_constant = robust;
+    c->voltage_bias_level_fraction = robust ? VOLTAGE_BIAS_LEVEL : 0.0f;
+    cfg->inverter.dead_time_s = robust ? in->dead_time_s : 0.0f;
+    /* The band of the compensation, which the voltage bias uses too. */
+    cfg->inverter.dead_time_current_band_A = robust ? max2(in->current_resolution_A, MIN_DEAD_TIME_BAND_A) : 0.0f;
+    report->magnetising_current_A = robust ? MAGNETISING_PER_RATED_CURRENT * in->rated_current_A : 0.0f;
+}
+
+static void design_protection(const pmstep_design_input_t *in, pmstep_config_t *cfg, float top_speed_rad_s)
+{
+    cfg->limits.max_phase_current_A = TRIP_CURRENT_PER_RATED * in->rated_current_A;
+    cfg->limits.min_bus_voltage_V = MIN_BUS_FRACTION * in->bus_voltage_V;
+    cfg->limits.max_bus_voltage_V = MAX_BUS_FRACTION * in->bus_voltage_V;
+    cfg->detection.angle_magnitude_bound = ANGLE_MAGNITUDE_BOUND;
+    cfg->detection.stall_speed_error_rad_s = STALL_FRACTION_OF_TOP_SPEED * top_speed_rad_s;
+    cfg->detection.speed_consistency_bound_rad_s = STALL_FRACTION_OF_TOP_SPEED * top_speed_rad_s;
+    cfg->detection.observer_residual_bound_A = RESIDUAL_PER_RATED_CURRENT * in->rated_current_A;
+    cfg->detection.persistence_s = PERSISTENCE_S;
+    cfg->detection.max_realignments = 0u;
+}
+
+pmstep_status_t pmstep_design(const pmstep_design_input_t *in, pmstep_config_t *cfg, pmstep_design_report_t *report)
+{
+    pmstep_status_t status;
+    float window_s;
+    if (in == NULL || cfg == NULL || report == NULL) {
+        return PMSTEP_ERR_NULL_ARGUMENT;
+    }
+    status = check_input(in);
+    if (status != PMSTEP_OK) {
+        return status;
+    }
+    cfg->motor = in->motor;
+    cfg->timing.period_s = in->period_s;
+    cfg->timing.computational_delay_periods = in->computational_delay_periods;
+    cfg->known_load_mode = false;
+    report->top_speed_rad_s = top_speed(in);
+    report->top_electrical_step_rad = (float)in->motor.pole_pairs * report->top_speed_rad_s * in->period_s;
+    report->rated_torque_Nm = in->motor.torque_constant_Nm_A * in->rated_current_A;
+    design_gains(in, &cfg->gains, report);
+    window_s = design_alignment(in, cfg, report);
+    design_commissioning(in, window_s, cfg, report);
+    design_protection(in, cfg, report->top_speed_rad_s);
+    return pmstep_validate_config(cfg);
+}

@@ -1,0 +1,176 @@
+/* Gain designer (firmware/design): each preset's design meets condition (4) and the rated
+ * current, passes validation, places the observer's poles where DESIGN.md says; bad motor data
+ * gets its named error. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+
+#include <math.h>
+
+#include "pmstep/pmstep.h"
+#include "pmstep/pmstep_design.h"
+
+typedef struct {
+    const char *name;
+    float r, l, j, f, k_m;
+    int32_t p;
+    float rated_A, bus_V;
+} motor_data_t;
+
+/* sil/scenarios/motors/ */
+static const motor_data_t presets[] = {
+    {"paper", 3.0f, 0.006f, 0.01f, 0.0f, 2.0f, 6, 8.0f, 48.0f},
+    {"17hs4401", 1.5f, 0.0028f, 5.4e-6f, 1e-4f, 0.16638f, 50, 1.7f, 24.0f},
+    {"bj42d29", 1.4f, 0.0026f, 7.6e-6f, 1e-4f, 0.19328f, 50, 1.5f, 24.0f},
+    {"as1050", 0.28f, 0.00086f, 3.6e-5f, 3e-4f, 0.16971f, 50, 5.0f, 48.0f},
+};
+
+static pmstep_design_input_t input_of(const motor_data_t *m, bool robust)
+{
+    pmstep_design_input_t in;
+    in.motor.resistance_Ohm = m->r;
+    in.motor.inductance_H = m->l;
+    in.motor.inertia_kgm2 = m->j;
+    in.motor.friction_Nms_rad = m->f;
+    in.motor.torque_constant_Nm_A = m->k_m;
+    in.motor.pole_pairs = m->p;
+    in.rated_current_A = m->rated_A;
+    in.bus_voltage_V = m->bus_V;
+    in.period_s = 50e-6f;
+    in.computational_delay_periods = robust ? 1u : 0u;
+    in.self_commissioning = robust;
+    in.dead_time_s = robust ? 1e-6f : 0.0f;
+    in.current_resolution_A = robust ? 0.005f : 0.0f;
+    return in;
+}
+
+static void every_preset_gets_a_valid_design(void **state)
+{
+    size_t n;
+    int robust;
+    (void)state;
+    for (n = 0; n < sizeof presets / sizeof presets[0]; ++n) {
+        for (robust = 0; robust <= 1; ++robust) {
+            const pmstep_design_input_t in = input_of(&presets[n], robust != 0);
+            const float p = (float)in.motor.pole_pairs;
+            pmstep_config_t cfg;
+            pmstep_design_report_t report;
+            pmstep_t inst;
+            float lhs;
+            float rhs;
+            print_message("%s robust=%d\n", presets[n].name, robust);
+            assert_int_equal(pmstep_design(&in, &cfg, &report), PMSTEP_OK);
+            assert_int_equal(pmstep_validate_config(&cfg), PMSTEP_OK);
+            assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
+            /* (4): k_M u_cc/(p L R) - (u_cs^2 + u_cc^2)/(2 R^2) > 0, with margin 2 by the rule. */
+            lhs = in.motor.torque_constant_Nm_A * cfg.alignment.c_align_voltage_V
+                  / (p * in.motor.inductance_H * in.motor.resistance_Ohm);
+            rhs = (cfg.alignment.s_align_voltage_V * cfg.alignment.s_align_voltage_V
+                   + cfg.alignment.c_align_voltage_V * cfg.alignment.c_align_voltage_V)
+                  / (2.0f * in.motor.resistance_Ohm * in.motor.resistance_Ohm);
+            assert_true(lhs > rhs);
+            assert_true(report.condition_4_margin >= 1.99f);
+            /* Alignment current at most the rated current. */
+            assert_true(cfg.alignment.s_align_voltage_V / in.motor.resistance_Ohm <= in.rated_current_A * 1.0001f);
+            assert_true(cfg.alignment.c_align_voltage_V / in.motor.resistance_Ohm <= in.rated_current_A * 1.0001f);
+            assert_true(cfg.limits.max_phase_current_A > in.rated_current_A);
+            /* Top speed: the bus takes (R I + k_M w)^2 + (p w L I)^2 = (0.9 V)^2 there. */
+            {
+                const double w = (double)report.top_speed_rad_s;
+                const double i = (double)in.rated_current_A;
+                const double u_q = (double)in.motor.resistance_Ohm * i + (double)in.motor.torque_constant_Nm_A * w;
+                const double u_d = (double)p * w * (double)in.motor.inductance_H * i;
+                assert_true(fabs(sqrt(u_q * u_q + u_d * u_d) - 0.9 * (double)in.bus_voltage_V)
+                            < 1e-3 * (double)in.bus_voltage_V);
+            }
+        }
+    }
+}
+
+static void observer_poles_are_placed(void **state)
+{
+    /* s^3 + (a_e + F/J) s^2 + (a_e F/J + g_w b^2) s + g_T b^2/J = (s + w_o)^3, b = k_M/L,
+     * a_e = R/L + K_e, g_w = 2/lambda, g_T = J/gamma + 2F/lambda (r F negligible). */
+    size_t n;
+    (void)state;
+    for (n = 0; n < sizeof presets / sizeof presets[0]; ++n) {
+        const pmstep_design_input_t in = input_of(&presets[n], false);
+        const double r = (double)in.motor.resistance_Ohm, l = (double)in.motor.inductance_H;
+        const double j = (double)in.motor.inertia_kgm2, f = (double)in.motor.friction_Nms_rad;
+        const double b = (double)in.motor.torque_constant_Nm_A / l;
+        pmstep_config_t cfg;
+        pmstep_design_report_t report;
+        double a_e, g_w, g_t, w_o;
+        assert_int_equal(pmstep_design(&in, &cfg, &report), PMSTEP_OK);
+        w_o = (double)report.observer_bandwidth_rad_s;
+        a_e = r / l + (double)cfg.gains.observer_gain_per_s;
+        g_w = 2.0 / (double)cfg.gains.adapt_lambda;
+        g_t = j / (double)cfg.gains.adapt_gamma + 2.0 * f / (double)cfg.gains.adapt_lambda;
+        assert_true(fabs((a_e + f / j) / (3.0 * w_o) - 1.0) < 1e-4);
+        assert_true(fabs((a_e * f / j + g_w * b * b) / (3.0 * w_o * w_o) - 1.0) < 1e-4);
+        assert_true(fabs(g_t * b * b / j / (w_o * w_o * w_o) - 1.0) < 1e-4);
+        /* Current loop R/L + K_i = 0.1 / T_s; speed loop w_o / 3. */
+        assert_true(fabs((r / l + (double)cfg.gains.current_gain_per_s) * 50e-6 - 0.1) < 1e-5);
+        assert_true(fabs((double)cfg.gains.speed_gain_per_s - w_o / 3.0) < 1e-3 * w_o);
+    }
+}
+
+typedef void (*input_edit_t)(pmstep_design_input_t *in);
+static void zero_r(pmstep_design_input_t *in) { in->motor.resistance_Ohm = 0.0f; }
+static void negative_l(pmstep_design_input_t *in) { in->motor.inductance_H = -1e-3f; }
+static void zero_j(pmstep_design_input_t *in) { in->motor.inertia_kgm2 = 0.0f; }
+static void zero_km(pmstep_design_input_t *in) { in->motor.torque_constant_Nm_A = 0.0f; }
+static void negative_f(pmstep_design_input_t *in) { in->motor.friction_Nms_rad = -1e-4f; }
+static void zero_p(pmstep_design_input_t *in) { in->motor.pole_pairs = 0; }
+static void nan_r(pmstep_design_input_t *in) { in->motor.resistance_Ohm = NAN; }
+static void inf_j(pmstep_design_input_t *in) { in->motor.inertia_kgm2 = INFINITY; }
+static void zero_rated(pmstep_design_input_t *in) { in->rated_current_A = 0.0f; }
+static void low_bus(pmstep_design_input_t *in) { in->bus_voltage_V = 2.5f; } /* R I = 2.55 V > 0.9 x 2.5 V */
+static void zero_bus(pmstep_design_input_t *in) { in->bus_voltage_V = 0.0f; }
+static void slow_rate(pmstep_design_input_t *in) { in->period_s = 1e-3f; } /* (R/L) T_s = 0.54 */
+static void bad_period(pmstep_design_input_t *in) { in->period_s = 0.1f; }
+static void bad_delay(pmstep_design_input_t *in) { in->computational_delay_periods = 2u; }
+static void long_dead_time(pmstep_design_input_t *in) { in->dead_time_s = 20e-6f; }
+
+static void bad_motor_data_gets_a_named_error(void **state)
+{
+    static const struct {
+        input_edit_t edit;
+        pmstep_status_t expected;
+    } cases[] = {
+        {zero_r, PMSTEP_ERR_RESISTANCE},         {negative_l, PMSTEP_ERR_INDUCTANCE},
+        {zero_j, PMSTEP_ERR_INERTIA},            {zero_km, PMSTEP_ERR_TORQUE_CONSTANT},
+        {negative_f, PMSTEP_ERR_FRICTION},       {zero_p, PMSTEP_ERR_POLE_PAIRS},
+        {nan_r, PMSTEP_ERR_NONFINITE_PARAMETER}, {inf_j, PMSTEP_ERR_NONFINITE_PARAMETER},
+        {zero_rated, PMSTEP_ERR_RATED_CURRENT},  {low_bus, PMSTEP_ERR_BUS_BELOW_RATED},
+        {zero_bus, PMSTEP_ERR_BUS_BELOW_RATED},  {slow_rate, PMSTEP_ERR_RATE_TOO_SLOW},
+        {bad_period, PMSTEP_ERR_PERIOD},         {bad_delay, PMSTEP_ERR_DELAY},
+        {long_dead_time, PMSTEP_ERR_DEAD_TIME},
+    };
+    size_t n;
+    pmstep_config_t cfg;
+    pmstep_design_report_t report;
+    (void)state;
+    for (n = 0; n < sizeof cases / sizeof cases[0]; ++n) {
+        pmstep_design_input_t in = input_of(&presets[1], true);
+        cases[n].edit(&in);
+        assert_int_equal(pmstep_design(&in, &cfg, &report), cases[n].expected);
+    }
+    {
+        const pmstep_design_input_t in = input_of(&presets[1], false);
+        assert_int_equal(pmstep_design(NULL, &cfg, &report), PMSTEP_ERR_NULL_ARGUMENT);
+        assert_int_equal(pmstep_design(&in, NULL, &report), PMSTEP_ERR_NULL_ARGUMENT);
+        assert_int_equal(pmstep_design(&in, &cfg, NULL), PMSTEP_ERR_NULL_ARGUMENT);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(every_preset_gets_a_valid_design),
+        cmocka_unit_test(observer_poles_are_placed),
+        cmocka_unit_test(bad_motor_data_gets_a_named_error),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
