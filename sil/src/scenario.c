@@ -42,6 +42,7 @@ static const key_t_ keys[] = {
     {"motor.friction_Nms_rad", KEY_DOUBLE, OFF(motor.friction_Nms_rad), 0, 0, BIG, 0, "plant F (Nm s/rad)"},
     {"motor.torque_constant_Nm_A", KEY_DOUBLE, OFF(motor.torque_constant_Nm_A), 0, 1, BIG, 0, "plant k_M (Nm/A)"},
     {"motor.pole_pairs", KEY_INT, OFF(motor.pole_pairs), 1, 0, 1000, 0, "plant p"},
+    {"motor.detent_torque_Nm", KEY_DOUBLE, OFF(motor.detent_torque_Nm), 0, 0, 1e6, 0, "plant detent torque T_d, -T_d sin(4 p theta) (Nm); 0 = none"},
 
     {"controller.motor.resistance_Ohm", KEY_FLOAT, OFF(controller.motor.resistance_Ohm), -BIG, 0, BIG, 0, "R the firmware assumes (Ohm)"},
     {"controller.motor.inductance_H", KEY_FLOAT, OFF(controller.motor.inductance_H), -BIG, 0, BIG, 0, "L (H)"},
