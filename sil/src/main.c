@@ -9,6 +9,7 @@
 #include <sys/stat.h>
 
 #include "pmstep_hal_host.h"
+#include "sil/microstep.h"
 #include "sil/runner.h"
 #include "pmstep/pmstep_text.h"
 
@@ -24,7 +25,9 @@ static void usage(FILE *f)
             "  --quiet      no progress line, no printed summary\n"
             "  --print-scenario  print every key with its value (INI) and exit\n"
             "  --record     write the core's inputs and outputs of every period to FILE (binary,\n"
-            "               see sil/include/sil/runner.h), for replay on a target (tests/pil/)\n");
+            "               see sil/include/sil/runner.h), for replay on a target (tests/pil/)\n"
+            "exit status: 0 done, 2 bad input or a write error, 3 a fault latched,\n"
+            "             4 run.controller = microstep lost synchronism\n");
 }
 
 typedef struct {
@@ -113,6 +116,24 @@ static void add_robustness_json(cJSON *root, const sil_summary_t *s)
     cJSON_AddItemToObject(root, "commissioning", comm);
 }
 
+/* The figures both drives report, for the comparison with the microstepping baseline. */
+static void add_baseline_json(cJSON *root, const sil_scenario_t *sc, const sil_summary_t *s)
+{
+    cJSON_AddBoolToObject(root, "loss_of_synchronism", s->loss_of_synchronism);
+    cJSON_AddNumberToObject(root, "loss_of_synchronism_time_s", s->loss_of_synchronism_time_s);
+    cJSON_AddNumberToObject(root, "max_load_angle_rad", s->max_load_angle_rad);
+    cJSON_AddNumberToObject(root, "rms_phase_current_A", s->rms_phase_current_A);
+    cJSON_AddNumberToObject(root, "metrics_start_s", s->metrics_start_time_s);
+    if (sc->drive == SIL_DRIVE_MICROSTEP) {
+        cJSON *drive = cJSON_CreateObject();
+        cJSON_AddNumberToObject(drive, "current_A", sc->datasheet.rated_current_A);
+        cJSON_AddNumberToObject(drive, "current_gain_per_s",
+                                SIL_MICROSTEP_GAIN_FRACTION / (double)sc->controller.timing.period_s);
+        cJSON_AddNumberToObject(drive, "pull_out_torque_Nm", sc->motor.torque_constant_Nm_A * sc->datasheet.rated_current_A);
+        cJSON_AddItemToObject(root, "microstep", drive);
+    }
+}
+
 static cJSON *summary_json(const sil_scenario_t *sc, const sil_summary_t *s)
 {
     cJSON *root = cJSON_CreateObject();
@@ -122,6 +143,7 @@ static cJSON *summary_json(const sil_scenario_t *sc, const sil_summary_t *s)
     cJSON *timing = cJSON_CreateObject();
     cJSON *fault = cJSON_CreateObject();
     cJSON_AddStringToObject(root, "scenario", sc->name);
+    cJSON_AddStringToObject(root, "controller", sc->drive == SIL_DRIVE_MICROSTEP ? "microstep" : "pmstep");
     cJSON_AddNumberToObject(root, "pole_pairs", sc->motor.pole_pairs);
     cJSON_AddNumberToObject(root, "control_period_s", (double)sc->controller.timing.period_s);
     cJSON_AddNumberToObject(root, "substeps", sc->substeps);
@@ -160,6 +182,7 @@ static cJSON *summary_json(const sil_scenario_t *sc, const sil_summary_t *s)
     cJSON_AddNumberToObject(root, "inverter_clipped_periods", (double)s->inverter_limited_periods);
     cJSON_AddStringToObject(root, "final_mode", pmstep_mode_str(s->final_mode));
     add_robustness_json(root, s);
+    add_baseline_json(root, sc, s);
 
     cJSON_AddNumberToObject(fault, "code", (double)s->fault);
     cJSON_AddStringToObject(fault, "name", pmstep_fault_str(s->fault));
@@ -289,6 +312,10 @@ int main(int argc, char **argv)
         fprintf(stderr, "pmstep-sil: %s\n", err);
         return 2;
     }
+    if (sc.drive == SIL_DRIVE_MICROSTEP && record_path != NULL) {
+        fprintf(stderr, "pmstep-sil: --record needs run.controller = pmstep (the microstep baseline has no firmware to replay)\n");
+        return 2;
+    }
     if (write_csv) {
         /* Refuse a run whose time series would fill the disk, before it starts. */
         const double rows = sc.duration_s / (double)sc.controller.timing.period_s / (double)sc.decimation;
@@ -336,6 +363,12 @@ int main(int argc, char **argv)
                 sc.integrator == PLANT_INTEGRATOR_RK4 ? "rk4" : "exponential",
                 (unsigned)sc.controller.timing.computational_delay_periods,
                 sc.inverter.model == SIL_INVERTER_SWITCHING ? "switching" : "averaged", (unsigned long)sc.seed);
+    }
+    if (!quiet && sc.drive == SIL_DRIVE_MICROSTEP) {
+        fprintf(stderr, "pmstep-sil: microstep baseline at %g A; the drive is told R = %g Ohm, L = %g H, p = %d%s\n",
+                sc.datasheet.rated_current_A, (double)sc.controller.motor.resistance_Ohm,
+                (double)sc.controller.motor.inductance_H, (int)sc.controller.motor.pole_pairs,
+                sc.controller.motor.pole_pairs != sc.motor.pole_pairs ? " (the plant's p differs: set controller.motor.*)" : "");
     }
     run_status = sil_run_record(&sc, write_csv ? write_row : NULL, &csv, !quiet, &summary, record);
     if (record != NULL && fclose(record) != 0 && run_status == 0) {
@@ -388,10 +421,17 @@ int main(int argc, char **argv)
     }
     cJSON_free(text);
     cJSON_Delete(json);
+    if (summary.loss_of_synchronism) {
+        fprintf(stderr, "pmstep-sil: LOSS OF SYNCHRONISM at t = %.6f s (%s)\n", summary.loss_of_synchronism_time_s,
+                sc.drive == SIL_DRIVE_MICROSTEP ? "load angle beyond pi" : "angle-estimate error above run.loss_angle_error_rad");
+    }
     if (summary.fault != PMSTEP_FAULT_NONE) {
         fprintf(stderr, "pmstep-sil: FAULT latched at t = %.6f s: %s\n", summary.fault_time_s,
                 pmstep_fault_str(summary.fault));
         return 3;
+    }
+    if (summary.loss_of_synchronism && sc.drive == SIL_DRIVE_MICROSTEP) {
+        return 4;
     }
     return 0;
 }

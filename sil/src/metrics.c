@@ -11,6 +11,19 @@ long sil_periods_in(double duration_s, double period_s)
     return (long)floor(duration_s / period_s + 0.5);
 }
 
+/* The first period k with k T_s >= t_s, as the runner issues a command due at t_s. */
+static long first_step_at_or_after(double t_s, double period_s)
+{
+    long k = (long)ceil(t_s / period_s);
+    while (k > 0 && (double)(k - 1) * period_s >= t_s) {
+        --k;
+    }
+    while ((double)k * period_s < t_s) {
+        ++k;
+    }
+    return k;
+}
+
 void sil_metrics_init(sil_metrics_t *m, const sil_scenario_t *sc, sil_summary_t *s)
 {
     const double period_s = (double)sc->controller.timing.period_s;
@@ -37,6 +50,20 @@ void sil_metrics_init(sil_metrics_t *m, const sil_scenario_t *sc, sil_summary_t 
     m->loss_angle_sin = sin(m->loss_angle_error_rad);
     m->max_angle_cos = 1.0;
     m->max_angle_sin = 0.0;
+    m->microstep = sc->drive == SIL_DRIVE_MICROSTEP;
+    m->pole_pairs = (double)sc->motor.pole_pairs;
+    if (m->microstep) {
+        /* No alignment: the "run" starts when the hold ends (the first speed command). */
+        m->ts_step = -1;
+        m->tc_step = first_step_at_or_after(sil_scenario_hold_end_s(sc), period_s);
+        m->transient_end_step = m->tc_step + sil_periods_in(sc->transient_window_s, period_s);
+        m->settle_step = m->transient_end_step;
+        s->run_start_time_s = (double)m->tc_step * period_s;
+        s->settle_time_s = (double)m->settle_step * period_s;
+    }
+    m->metrics_start_step = sc->metrics_start_s < 0.0 ? m->tc_step : first_step_at_or_after(sc->metrics_start_s, period_s);
+    s->metrics_start_time_s = (double)m->metrics_start_step * period_s;
+    s->loss_of_synchronism_time_s = -1.0;
 }
 
 /* Electrical angle of (c-hat, s-hat) minus p theta as (x, |y|): its magnitude, wrapped to
@@ -59,19 +86,51 @@ static bool sample_finite(const sil_sample_t *x)
     return isfinite(sum) != 0;
 }
 
+/* Microstep: the load angle theta_e* - p theta, continuous, offset by 2 pi n so that it starts in
+ * (-pi, pi] (the rotor aligns to the nearest p theta = 0 mod 2 pi); beyond +/- pi the rotor has
+ * slipped a pole pair: loss of synchronism. */
+static void add_load_angle(sil_metrics_t *m, const sil_sample_t *x, sil_summary_t *s)
+{
+    double angle = x->angle_ref_rad - m->pole_pairs * x->theta_rad;
+    if (!m->load_angle_ready) {
+        m->load_angle_offset_rad = -2.0 * PI * ceil((angle - PI) / (2.0 * PI));
+        m->load_angle_ready = true;
+    }
+    angle = fabs(angle + m->load_angle_offset_rad);
+    if (x->step >= m->metrics_start_step) {
+        s->max_load_angle_rad = fmax(s->max_load_angle_rad, angle);
+    }
+    if (angle > PI && !s->loss_of_synchronism) {
+        s->loss_of_synchronism = true;
+        s->loss_of_synchronism_time_s = x->t_s;
+        if (s->loss_of_control_time_s < 0.0) {
+            s->loss_of_control_time_s = x->t_s;
+        }
+    }
+}
+
 void sil_metrics_add(sil_metrics_t *m, const sil_sample_t *x, sil_summary_t *s)
 {
     const pmstep_output_t *out = x->out;
     if (!sample_finite(x)) {
         s->nonfinite_seen = true;
     }
-    pmstep_get_commissioning(x->inst, &s->commissioning);
+    if (!m->microstep) {
+        pmstep_get_commissioning(x->inst, &s->commissioning);
+    }
+    if (x->step >= m->metrics_start_step) {
+        m->current_sq += 0.5 * (x->i_a_A * x->i_a_A + x->i_b_A * x->i_b_A);
+        ++m->current_n;
+    }
+    if (m->microstep) {
+        add_load_angle(m, x, s);
+    }
     if (x->step == m->ts_step) {
         s->cos_ptheta_at_ts = x->cos_ptheta;
         s->sin_ptheta_at_ts = x->sin_ptheta;
         s->i_b_residual_at_ts_A = x->i_b_A - m->s_align_current_A;
     }
-    if (x->step == m->tc_step) {
+    if (x->step == m->tc_step && !m->microstep) {
         s->cos_ptheta_at_tc = x->cos_ptheta;
         s->sin_ptheta_at_tc = x->sin_ptheta;
         s->i_a_residual_at_tc_A = x->i_a_A - m->c_align_current_A;
@@ -83,8 +142,6 @@ void sil_metrics_add(sil_metrics_t *m, const sil_sample_t *x, sil_summary_t *s)
     }
     if (out->mode == PMSTEP_MODE_RUN) {
         const double speed_error = fabs(x->omega_rad_s - (double)out->speed_ref_rad_s);
-        s->max_cos_error = fmax(s->max_cos_error, fabs((double)out->cos_hat - x->cos_ptheta));
-        s->max_sin_error = fmax(s->max_sin_error, fabs((double)out->sin_hat - x->sin_ptheta));
         if (x->step < m->transient_end_step) {
             s->transient_max_speed_error_rad_s = fmax(s->transient_max_speed_error_rad_s, speed_error);
             m->transient_sq += speed_error * speed_error;
@@ -96,8 +153,16 @@ void sil_metrics_add(sil_metrics_t *m, const sil_sample_t *x, sil_summary_t *s)
         }
         s->final_load_hat_Nm = (double)out->load_hat_Nm;
         s->final_load_Nm = x->load_Nm;
-        {
+        if (m->microstep) {
+            if (x->step >= m->settle_step) {
+                s->max_speed_error_after_settle_rad_s = fmax(s->max_speed_error_after_settle_rad_s, speed_error);
+            }
+        } else {
+            /* The angle estimate (c-hat, s-hat) against the plant's p theta. */
+            bool angle_lost;
             double ex, ey;
+            s->max_cos_error = fmax(s->max_cos_error, fabs((double)out->cos_hat - x->cos_ptheta));
+            s->max_sin_error = fmax(s->max_sin_error, fabs((double)out->sin_hat - x->sin_ptheta));
             angle_error_xy(out, x, &ex, &ey);
             m->last_angle_x = ex;
             m->last_angle_y = ey;
@@ -110,10 +175,13 @@ void sil_metrics_add(sil_metrics_t *m, const sil_sample_t *x, sil_summary_t *s)
                 }
                 s->max_speed_error_after_settle_rad_s = fmax(s->max_speed_error_after_settle_rad_s, speed_error);
             }
-            if (s->loss_of_control_time_s < 0.0
-                && (speed_error > m->loss_speed_error_rad_s
-                    || (m->loss_angle_reachable && ey * m->loss_angle_cos - ex * m->loss_angle_sin > 0.0))) {
+            angle_lost = m->loss_angle_reachable && ey * m->loss_angle_cos - ex * m->loss_angle_sin > 0.0;
+            if (s->loss_of_control_time_s < 0.0 && (speed_error > m->loss_speed_error_rad_s || angle_lost)) {
                 s->loss_of_control_time_s = x->t_s;
+            }
+            if (angle_lost && !s->loss_of_synchronism) {
+                s->loss_of_synchronism = true;
+                s->loss_of_synchronism_time_s = x->t_s;
             }
         }
     }
@@ -133,6 +201,10 @@ void sil_metrics_finish(const sil_metrics_t *m, sil_summary_t *s)
     s->final_load_error_Nm = fabs(s->final_load_hat_Nm - s->final_load_Nm);
     if (m->last_angle_x != 0.0 || m->last_angle_y != 0.0) {
         s->final_angle_error_rad = atan2(m->last_angle_y, m->last_angle_x);
+    }
+    s->rms_phase_current_A = m->current_n ? sqrt(m->current_sq / (double)m->current_n) : 0.0;
+    if (!m->microstep) {
+        s->max_load_angle_rad = s->max_angle_error_rad;
     }
     if (s->loss_of_control_time_s >= 0.0 && s->fault != PMSTEP_FAULT_NONE) {
         s->detection_latency_s = s->fault_time_s - s->loss_of_control_time_s;

@@ -14,6 +14,7 @@ plant_params_t plant_paper_params(void)
     p.friction_Nms_rad = 0.0;
     p.torque_constant_Nm_A = 2.0;
     p.pole_pairs = 6;
+    p.detent_torque_Nm = 0.0;
     return p;
 }
 
@@ -50,7 +51,15 @@ double plant_load_torque(const plant_load_t *load, double t_s, double omega_rad_
     return 0.0;
 }
 
-/* (1) with sin p theta and cos p theta given. */
+/* Detent torque -T_d sin 4 p theta (Nm) from s = sin p theta, c = cos p theta:
+ * sin 4x = 2 sin 2x cos 2x = 4 s c (c^2 - s^2), no further sincos. */
+static double detent_torque(const plant_params_t *params, double s, double c)
+{
+    return -params->detent_torque_Nm * 4.0 * s * c * (c * c - s * s);
+}
+
+/* (1) with sin p theta and cos p theta given. The detent term is added only when T_d != 0, so
+ * T_d = 0 leaves every result bit for bit as it was without it. */
 static void derivative_at(const plant_params_t *params, const plant_load_t *load, double t_s, const plant_state_t *x,
                           double s, double c, double u_a_V, double u_b_V, plant_state_t *dx)
 {
@@ -58,10 +67,13 @@ static void derivative_at(const plant_params_t *params, const plant_load_t *load
     const double inv_j = 1.0 / params->inertia_kgm2;
     const double k_m = params->torque_constant_Nm_A;
     const double load_Nm = plant_load_torque(load, t_s, x->omega_rad_s);
+    double torque_Nm = -params->friction_Nms_rad * x->omega_rad_s + k_m * (-x->i_a_A * s + x->i_b_A * c) - load_Nm;
 
+    if (params->detent_torque_Nm != 0.0) {
+        torque_Nm += detent_torque(params, s, c);
+    }
     dx->theta_rad = x->omega_rad_s;
-    dx->omega_rad_s = inv_j * (-params->friction_Nms_rad * x->omega_rad_s
-                               + k_m * (-x->i_a_A * s + x->i_b_A * c) - load_Nm);
+    dx->omega_rad_s = inv_j * torque_Nm;
     dx->i_a_A = inv_l * (-params->resistance_Ohm * x->i_a_A + k_m * x->omega_rad_s * s + u_a_V);
     dx->i_b_A = inv_l * (-params->resistance_Ohm * x->i_b_A - k_m * x->omega_rad_s * c + u_b_V);
 }
@@ -167,15 +179,20 @@ static void rk4_substep(plant_t *plant, double t_s, double h, double u_a_V, doub
     }
 }
 
-/* N(t, y) of plant.h: (1) less its linear part A (y - y*), with sin and cos of p theta given. */
+/* N(t, y) of plant.h: (1) less its linear part A (y - y*), with sin and cos of p theta given;
+ * the detent torque is part of N. */
 static void coupling_at(const plant_params_t *params, const plant_load_t *load, double t_s, const plant_state_t *y,
                         double s, double c, plant_state_t *n)
 {
     const double k_m = params->torque_constant_Nm_A;
     const double load_Nm = plant_load_torque(load, t_s, y->omega_rad_s);
     const double emf_per_l = k_m * y->omega_rad_s / params->inductance_H;
+    double torque_Nm = k_m * (-y->i_a_A * s + y->i_b_A * c) - load_Nm;
+    if (params->detent_torque_Nm != 0.0) {
+        torque_Nm += detent_torque(params, s, c); /* T_d = 0: bit for bit as without the term */
+    }
     n->theta_rad = y->omega_rad_s;
-    n->omega_rad_s = (k_m * (-y->i_a_A * s + y->i_b_A * c) - load_Nm) / params->inertia_kgm2;
+    n->omega_rad_s = torque_Nm / params->inertia_kgm2;
     n->i_a_A = emf_per_l * s;
     n->i_b_A = -emf_per_l * c;
 }

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "pmstep_hal_host.h"
+#include "sil/microstep.h"
 
 /* The firmware and plant shares are timed on every SIL_TIMING_STRIDE-th period only (three
  * clock reads there, none elsewhere) and scaled to the run: a clock read costs about as
@@ -79,6 +80,16 @@ static void command_speed(pmstep_t *inst, const sil_scenario_t *sc, double t_s, 
     }
 }
 
+/* The same speed commands for the microstep drive (a plain ramp, no record). */
+static void command_microstep_speed(sil_microstep_t *drive, const sil_scenario_t *sc, double t_s, int *next_segment)
+{
+    float target_rad_s;
+    float ramp_rate_rad_s2;
+    while (sil_scenario_speed_command(sc, t_s, next_segment, &target_rad_s, &ramp_rate_rad_s2)) {
+        sil_microstep_set_speed_target(drive, (double)target_rad_s, (double)ramp_rate_rad_s2);
+    }
+}
+
 int sil_run(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user, bool progress, sil_summary_t *s)
 {
     return sil_run_record(sc, on_sample, user, progress, s, NULL);
@@ -88,6 +99,8 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
                    FILE *record)
 {
     static pmstep_t inst; /* as on the MCU: one static instance */
+    const bool microstep = sc->drive == SIL_DRIVE_MICROSTEP;
+    sil_microstep_t drive;
     const pmstep_config_t *cfg = &sc->controller;
     const double period_s = (double)cfg->timing.period_s;
     const long steps = sil_periods_in(sc->duration_s, period_s);
@@ -107,7 +120,14 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
     long k;
 
     memset(s, 0, sizeof *s);
-    s->init_status = pmstep_init(&inst, cfg);
+    if (microstep) {
+        /* The baseline: no firmware at all, and nothing to record for a replay. */
+        sil_microstep_init(&drive, sc);
+        record = NULL;
+        s->init_status = PMSTEP_OK;
+    } else {
+        s->init_status = pmstep_init(&inst, cfg);
+    }
     if (s->init_status != PMSTEP_OK) {
         return -1;
     }
@@ -131,8 +151,10 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
         pmstep_hal_host_release();
         return -3;
     }
-    (void)pmstep_set_id_target(&inst, (float)sc->id_target_A);
-    (void)pmstep_start(&inst);
+    if (!microstep) {
+        (void)pmstep_set_id_target(&inst, (float)sc->id_target_A);
+        (void)pmstep_start(&inst);
+    }
     if (record != NULL) {
         rec_state.file = record;
         rec = &rec_state;
@@ -158,7 +180,11 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
         double t0 = 0.0, t1 = 0.0;
 
         plant.time_s = t_s;
-        command_speed(&inst, sc, t_s, &next_segment, rec);
+        if (microstep) {
+            command_microstep_speed(&drive, sc, t_s, &next_segment);
+        } else {
+            command_speed(&inst, sc, t_s, &next_segment, rec);
+        }
         sample.theta_rad = plant.x.theta_rad;
         sample.omega_rad_s = plant.x.omega_rad_s;
         sample.i_a_A = plant.x.i_a_A;
@@ -171,7 +197,13 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
             t0 = now_s();
         }
         pmstep_hal_read_measurements(&meas);
-        pmstep_step(&inst, &meas, &out);
+        if (microstep) {
+            sample.angle_ref_rad = drive.angle_ref_rad; /* theta_e*(t_k), before the step advances it */
+            sil_microstep_step(&drive, &meas, &out);
+        } else {
+            sample.angle_ref_rad = 0.0;
+            pmstep_step(&inst, &meas, &out);
+        }
         pmstep_hal_apply_output(&out);
         if (timed) {
             t1 = now_s();
@@ -192,7 +224,7 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
         sample.u_a_V = inverter->applied_a_V;
         sample.u_b_V = inverter->applied_b_V;
         sample.out = &out;
-        sample.inst = &inst;
+        sample.inst = microstep ? NULL : &inst;
         sil_metrics_add(&metrics, &sample, s);
 
         if (progress && k + 1 >= steps * next_progress_decile / 10) {

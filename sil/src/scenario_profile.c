@@ -46,6 +46,19 @@ void sil_scenario_paper(sil_scenario_t *sc)
     sc->sensors = sil_sensors_ideal();
     sc->inverter = sil_inverter_ideal_config();
     sc->bus = sil_bus_ideal_config();
+    sc->drive = SIL_DRIVE_PMSTEP;
+    sc->metrics_start_s = -1.0;
+}
+
+double sil_scenario_hold_end_s(const sil_scenario_t *sc)
+{
+    int k;
+    for (k = 0; k + 1 < sc->speed_points; ++k) {
+        if (sc->speed_value_rad_s[k + 1] != sc->speed_value_rad_s[k]) {
+            return sc->speed_time_s[k];
+        }
+    }
+    return sc->duration_s;
 }
 
 int sil_scenario_speed_command(const sil_scenario_t *sc, double t_s, int *next_segment, float *target_rad_s,

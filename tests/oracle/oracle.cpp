@@ -37,13 +37,25 @@ Scenario paper_scenario()
     return sc;
 }
 
+/** The detent's potential energy over L, T_d (1 - cos 4 p theta)/(4 p L) >= 0: its rate, (T_d/L) sin(4 p theta) w,
+ *  cancels the detent's share of d/dt (J/(2L)) w^2, so U_s and U_c keep their derivatives with a detent. */
+static double detent_energy(const Motor &m, double theta_rad)
+{
+    if (m.detent_torque_Nm == 0.0) {
+        return 0.0;
+    }
+    const double p = m.pole_pairs;
+    return m.detent_torque_Nm * (1.0 - std::cos(4.0 * p * theta_rad)) / (4.0 * p * m.inductance_H);
+}
+
 double lyapunov_s(const Motor &m, double u_cs_V, double theta_rad, double omega_rad_s, double i_a_A, double i_b_A)
 {
     const double i_b_err = i_b_A - u_cs_V / m.resistance_Ohm;
     const double p = m.pole_pairs;
     return 0.5 * (m.inertia_kgm2 / m.inductance_H * omega_rad_s * omega_rad_s + i_a_A * i_a_A + i_b_err * i_b_err)
            - m.torque_constant_Nm_A * u_cs_V / (p * m.inductance_H * m.resistance_Ohm)
-                 * (std::sin(p * theta_rad) - 2.0);
+                 * (std::sin(p * theta_rad) - 2.0)
+           + detent_energy(m, theta_rad);
 }
 
 double lyapunov_c(const Motor &m, double u_cc_V, double theta_rad, double omega_rad_s, double i_a_A, double i_b_A)
@@ -52,7 +64,8 @@ double lyapunov_c(const Motor &m, double u_cc_V, double theta_rad, double omega_
     const double p = m.pole_pairs;
     return 0.5 * (m.inertia_kgm2 / m.inductance_H * omega_rad_s * omega_rad_s + i_a_err * i_a_err + i_b_A * i_b_A)
            - m.torque_constant_Nm_A * u_cc_V / (p * m.inductance_H * m.resistance_Ohm)
-                 * (std::cos(p * theta_rad) - 2.0);
+                 * (std::cos(p * theta_rad) - 2.0)
+           + detent_energy(m, theta_rad);
 }
 
 double speed_injection_gain(const Motor &m, const Gains &g)
@@ -290,6 +303,10 @@ struct ClosedLoop {
             // Plant (1).
             d[idx::theta] = omega;
             d[idx::omega] = -(F / J) * omega + (kM / J) * (-i_a * sin_pt + i_b * cos_pt) - load_Nm / J;
+            if (m.detent_torque_Nm != 0.0) {
+                // Detent of a hybrid stepper: four periods per electrical period.
+                d[idx::omega] -= (m.detent_torque_Nm / J) * std::sin(4.0 * p * theta);
+            }
             d[idx::i_a] = -(R / L) * i_a + (kM / L) * omega * sin_pt + u_a / L;
             d[idx::i_b] = -(R / L) * i_b - (kM / L) * omega * cos_pt + u_b / L;
             d[idx::phi1] = d_phi1;

@@ -31,6 +31,7 @@ struct Motor {
     double friction_Nms_rad;   ///< F >= 0
     double torque_constant_Nm_A;///< k_M
     int pole_pairs;                 ///< p
+    double detent_torque_Nm = 0.0;  ///< T_d >= 0: detent torque -T_d sin(4 p theta) (not in the paper)
 };
 
 /** Gains of controller (6). */
@@ -138,10 +139,12 @@ struct Stats {
 std::vector<Sample> simulate(const Scenario &sc, const std::vector<double> &sample_times_s,
                              const Options &opt = Options(), Stats *stats = nullptr);
 
-/** U_s of Theorem 1's proof: (1/2)(J/L w^2 + i_a^2 + (i_b - u_cs/R)^2) - k_M u_cs/(p L R) (sin p theta - 2). */
+/** U_s of Theorem 1's proof: (1/2)(J/L w^2 + i_a^2 + (i_b - u_cs/R)^2) - k_M u_cs/(p L R) (sin p theta - 2),
+ *  plus the detent's potential T_d (1 - cos 4 p theta)/(4 p L) when T_d > 0 (so U_s' is unchanged). */
 double lyapunov_s(const Motor &m, double u_cs_V, double theta_rad, double omega_rad_s, double i_a_A, double i_b_A);
 
-/** U_c of Theorem 2's proof: (1/2)(J/L w^2 + (i_a - u_cc/R)^2 + i_b^2) - k_M u_cc/(p L R) (cos p theta - 2). */
+/** U_c of Theorem 2's proof: (1/2)(J/L w^2 + (i_a - u_cc/R)^2 + i_b^2) - k_M u_cc/(p L R) (cos p theta - 2),
+ *  plus the same detent potential. */
 double lyapunov_c(const Motor &m, double u_cc_V, double theta_rad, double omega_rad_s, double i_a_A, double i_b_A);
 
 /** Injection gains of (6): g_w = (2g^2 + rF l J^2)/(g^2 l + rF l^2 J^2), g_T = (2g^2 F + l J g + l J^2 r F^2)/(same). */

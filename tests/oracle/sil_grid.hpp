@@ -26,10 +26,12 @@ inline double first_sample_at_or_after(double t_s, double period_s)
 /** The paper's scenario for the oracle, with the timing the SIL actually realises at its period:
  *  t_s, t_c and the ramp commands on the sample grid (the runner issues a command at the first
  *  period whose time is >= the breakpoint), ramp rates as the firmware holds them (float).
- *  The motor and gains stay the oracle's own (from the paper), not the SIL's. */
+ *  The motor and gains stay the oracle's own (from the paper), not the SIL's, except the detent
+ *  torque, which the paper does not have. */
 inline pmstep_oracle::Scenario oracle_on_sil_grid(const sil_scenario_t &sil)
 {
     pmstep_oracle::Scenario sc = pmstep_oracle::paper_scenario();
+    sc.motor.detent_torque_Nm = sil.motor.detent_torque_Nm; // not in the paper: the SIL plant's, like for like
     const double period_s = static_cast<double>(sil.controller.timing.period_s);
     sc.s_align_time_s = static_cast<double>(sil_period_index(sil, static_cast<double>(sil.controller.alignment.s_align_time_s)))
                         * period_s;

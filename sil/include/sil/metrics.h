@@ -24,9 +24,11 @@ typedef struct {
     double cos_ptheta, sin_ptheta;   /**< true electrical angle */
     double u_a_V, u_b_V;             /**< voltage the plant sees over [t_k, t_k+1] */
     double load_Nm;                  /**< true T_L */
-    const pmstep_output_t *out;      /**< the step's output (estimates, mode, fault) */
+    const pmstep_output_t *out;      /**< the step's output (estimates, mode, fault); in microstep mode the
+                                          drive's (sil/microstep.h) */
     pmstep_t *inst;                  /**< the core's instance, for tests that inspect or perturb its state
-                                          (a change takes effect from the next period) */
+                                          (a change takes effect from the next period); NULL in microstep mode */
+    double angle_ref_rad;            /**< microstep mode only (not read otherwise): theta_e*, electrical, unwrapped */
 } sil_sample_t;
 
 /** Called once per period; return false to stop the run early. */
@@ -68,6 +70,14 @@ typedef struct {
     double detection_latency_s;            /**< fault time - loss time (negative: fault first); NaN if not both */
     bool nonfinite_seen;                   /**< a NaN/Inf in the plant state or the core's output */
     pmstep_commissioning_t commissioning;  /**< what the core measured (pmstep_get_commissioning), last sample */
+    /* Both drives (run.controller), for the comparison with the microstepping baseline. */
+    double metrics_start_time_s;           /**< start of the window below (run.metrics_start_s or its default) */
+    double rms_phase_current_A;            /**< sqrt(mean((i_a^2 + i_b^2)/2)) over the window: per-phase RMS */
+    double max_load_angle_rad;             /**< microstep: max |theta_e* - p theta| (unwrapped) over the window;
+                                                pmstep: max_angle_error_rad (the angle-estimate error) */
+    bool loss_of_synchronism;              /**< microstep: |theta_e* - p theta| > pi at any sample; pmstep: the
+                                                angle-estimate error above run.loss_angle_error_rad in RUN */
+    double loss_of_synchronism_time_s;     /**< its first sample, -1 if none */
 } sil_summary_t;
 
 /** Running sums behind the summary. */
@@ -84,6 +94,13 @@ typedef struct {
     double loss_angle_cos, loss_angle_sin;
     double max_angle_cos, max_angle_sin;       /**< of summary->max_angle_error_rad */
     double last_angle_x, last_angle_y;         /**< of the last RUN sample (final_angle_error_rad) */
+    bool microstep;                            /**< run.controller = microstep */
+    double pole_pairs;                         /**< the plant's p */
+    long metrics_start_step;                   /**< first sample of the RMS-current and load-angle window */
+    double current_sq;                         /**< sum of (i_a^2 + i_b^2)/2 over the window */
+    long current_n;
+    bool load_angle_ready;                     /**< the offset below is set (first sample) */
+    double load_angle_offset_rad;              /**< 2 pi n: the load angle starts in (-pi, pi] */
 } sil_metrics_t;
 
 /** Periods nearest to @p duration_s. */
@@ -95,7 +112,7 @@ void sil_metrics_init(sil_metrics_t *m, const sil_scenario_t *sc, sil_summary_t 
 /** Adds one period. */
 void sil_metrics_add(sil_metrics_t *m, const sil_sample_t *x, sil_summary_t *summary);
 
-/** RMS values and the final load error. */
+/** RMS values, the final load error and max_load_angle_rad. */
 void sil_metrics_finish(const sil_metrics_t *m, sil_summary_t *summary);
 
 #ifdef __cplusplus

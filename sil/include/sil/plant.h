@@ -8,8 +8,12 @@
  *
  *   theta' = omega
  *   omega' = -(F/J) omega + (k_M/J)(-i_a sin p theta + i_b cos p theta) - T_L/J
+ *            - (T_d/J) sin 4 p theta
  *   i_a'   = -(R/L) i_a + (k_M/L) omega sin p theta + u_a/L
  *   i_b'   = -(R/L) i_b - (k_M/L) omega cos p theta + u_b/L
+ *
+ * The detent term (T_d = 0 in the paper) is the cogging of a hybrid stepper: four periods
+ * per electrical period, zero at the full steps p theta = k pi/2 (the alignment equilibria).
  */
 #ifndef SIL_PLANT_H
 #define SIL_PLANT_H
@@ -28,6 +32,7 @@ typedef struct {
     double friction_Nms_rad;   /**< F */
     double torque_constant_Nm_A;/**< k_M */
     int pole_pairs;                 /**< p */
+    double detent_torque_Nm;        /**< T_d >= 0: detent torque amplitude, -T_d sin 4 p theta (0 = none) */
 } plant_params_t;
 
 /** Load torque T_L(t, omega). */
@@ -66,8 +71,8 @@ typedef struct {
  * PLANT_INTEGRATOR_EXPONENTIAL: (1) split as y' = lambda (y - y*) + N(t, y), per component
  * lambda = (0, -F/J, -R/L, -R/L) and y* = (., 0, u_a/R, u_b/R) constant over the step
  * (the steady currents of the held voltages), N = (omega, (k_M/J)(-i_a sin p theta +
- * i_b cos p theta) - T_L/J, (k_M/L) omega sin p theta, -(k_M/L) omega cos p theta): the
- * back EMF, the torque and the load. With w = y - y*, w(h) = e^{lambda h} w(0) + the
+ * i_b cos p theta) - T_L/J - (T_d/J) sin 4 p theta, (k_M/L) omega sin p theta,
+ * -(k_M/L) omega cos p theta): the back EMF, the torque, the load and the detent. With w = y - y*, w(h) = e^{lambda h} w(0) + the
  * integral of e^{lambda (h - s)} N ds, taken by exponential time differencing RK4 (Cox and
  * Matthews 2002), z = lambda h, phi_k(z) = sum_j z^j / (j + k)!:
  *   a  = e^{z/2} w0 + (h/2) phi_1(z/2) N(t, y0)
@@ -115,7 +120,7 @@ typedef struct {
     bool open_b;   /**< same for phase b */
 } plant_t;
 
-/** The motor of the paper's Section III.B. */
+/** The motor of the paper's Section III.B (no detent torque). */
 plant_params_t plant_paper_params(void);
 
 /** Load torque (Nm) at time @p t_s and speed @p omega_rad_s. */

@@ -2,7 +2,9 @@
  * @file runner.h
  * @brief Runs a scenario: the real control core (pmstep_step through the host
  *        HAL port) in closed loop with the plant model, one control period at a
- *        time, and gathers the metrics of the run.
+ *        time, and gathers the metrics of the run. With run.controller = microstep
+ *        the open-loop microstepping drive of sil/microstep.h takes the core's place
+ *        (same period, measurement chain, inverter and bus; the core is not called).
  */
 #ifndef SIL_RUNNER_H
 #define SIL_RUNNER_H
@@ -29,7 +31,7 @@ int sil_run(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user, bool 
 
 /**
  * sil_run() that also writes the record of sil/record.h to @p record (binary
- * stream; NULL records nothing). @return 0, -1 when pmstep_init rejected the
+ * stream; NULL records nothing; microstep mode records nothing: there is no core). @return 0, -1 when pmstep_init rejected the
  * configuration, -2 when writing the record failed, -3 as sil_run().
  */
 int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user, bool progress,

@@ -34,6 +34,12 @@ typedef struct {
     double detent_torque_Nm;  /**< datasheet.detent_torque_Nm: unpowered detent torque (0 = not given) */
 } sil_datasheet_t;
 
+/** run.controller: what drives the plant. */
+typedef enum {
+    SIL_DRIVE_PMSTEP = 0,    /**< the firmware: pmstep_step() through the host HAL port */
+    SIL_DRIVE_MICROSTEP = 1  /**< open-loop microstepping at rated current (sil/microstep.h); no firmware */
+} sil_drive_t;
+
 typedef struct {
     char name[64];
     sil_datasheet_t datasheet;       /**< [datasheet] */
@@ -61,6 +67,9 @@ typedef struct {
     sil_sensor_config_t sensors;     /**< [sensors]: measurement chain (ideal by default) */
     sil_inverter_config_t inverter;  /**< [inverter]: averaged | switching, dead time */
     sil_bus_config_t bus;            /**< [bus]: source resistance and ripple on run.bus_voltage_V */
+    sil_drive_t drive;               /**< run.controller: pmstep | microstep */
+    double metrics_start_s;          /**< run.metrics_start_s: start of the RMS-current and load-angle window (s);
+                                          < 0: the start of RUN (t_c) or the end of the microstep hold */
 } sil_scenario_t;
 
 /** The paper's Section III: t_s = 0.3 s, t_c = 0.6 s, 2 Nm at 0.63 s, theta0 = 30 deg, 2.4 s, 20 kHz. */
@@ -74,6 +83,13 @@ void sil_scenario_paper(sil_scenario_t *sc);
  */
 int sil_scenario_speed_command(const sil_scenario_t *sc, double t_s, int *next_segment, float *target_rad_s,
                                float *ramp_rate_rad_s2);
+
+/**
+ * End of the hold (s): the start of the first segment of the speed profile that changes the
+ * speed, or run.duration_s if the speed never changes. The microstep drive holds
+ * theta_e* = 0 until the runner issues that segment's command.
+ */
+double sil_scenario_hold_end_s(const sil_scenario_t *sc);
 
 /**
  * Sets `section.key` from text. @return 0, or -1 with a message in @p err
