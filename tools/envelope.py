@@ -1,0 +1,272 @@
+#!/usr/bin/env python3
+"""Operating envelope of the motor presets with the gain designer's settings, against open-loop
+microstepping at rated current (issue 11). A benchmark that prints and writes figures; not a test.
+
+For each preset (sil/scenarios/motors/) and chain (ideal; realistic = sil/scenarios/robust.ini's
+measurement chain with the robust mode), it designs the gains with pmstep-tune (no hand tuning),
+then runs pmstep-sil:
+  ramps     RUN of --duration s: ramps to +-80 % and +-5 % of the top speed and holds, repeated;
+            fault, max |w - w*| after the transients (% of top), max angle-estimate error
+  steps     half the holding torque stepped on at 50 % and 5 % of the top speed: fault, loss of
+            synchronism, speed dip, recovery time (back within 2 % of top speed)
+  pull-out  the largest load step (fraction of the holding torque, bisection) survived at 50 %
+            of the top speed without a fault or a loss of synchronism, ours and microstepping
+  copper    per-phase RMS current at 50 % of the top speed without load, ours and microstepping
+
+  tools/envelope.py --sil build/host-release/sil/pmstep-sil --tune build/host-release/sil/pmstep-tune \\
+      --out out/envelope
+"""
+import argparse
+import csv
+import json
+import os
+import re
+import subprocess
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+PRESETS = ("paper", "17hs4401", "bj42d29", "as1050")
+# sil/scenarios/robust.ini's measurement chain; the ADC span is sized to the motor (3 x rated).
+REALISTIC = ("sensors.adc_bits=12", "sensors.offset_a_A=0.02", "sensors.offset_b_A=-0.02",
+             "sensors.noise_rms_A=0.005", "inverter.model=switching", "inverter.dead_time_s=1e-6",
+             "run.delay_periods=1")
+HOLD_S = 1.0
+SETTLE_S = 0.1  # after each ramp, before the tracking error counts ("after transients")
+BISECTION_STEPS = 6
+
+
+def run(cmd):
+    return subprocess.run(cmd, capture_output=True, text=True, check=False)
+
+
+def sets(pairs):
+    out = []
+    for p in pairs:
+        out += ["--set", p]
+    return out
+
+
+def read_preset(name):
+    text = open(os.path.join(ROOT, "sil", "scenarios", "motors", name + ".ini")).read()
+    def value(key):
+        return float(re.search(r"^%s\s*=\s*([0-9.eE+-]+)" % key, text, re.M).group(1))
+    return {"rated_current_A": value("rated_current_A"), "holding_torque_Nm": value("holding_torque_Nm")}
+
+
+def design(args, name, chain, out_dir):
+    preset = read_preset(name)
+    chain_sets = []
+    if chain == "realistic":
+        chain_sets = list(REALISTIC) + ["sensors.current_full_scale_A=%g" % (3.0 * preset["rated_current_A"])]
+    ini = os.path.join(out_dir, "design.ini")
+    cmd = [args.tune, "--motor", os.path.join(ROOT, "sil", "scenarios", "motors", name + ".ini"),
+           "--write-ini", ini] + (["--robust"] if chain == "realistic" else []) + sets(chain_sets)
+    r = run(cmd)
+    if r.returncode != 0:
+        raise SystemExit("pmstep-tune failed: %s\n%s" % (" ".join(cmd), r.stderr))
+    top = float(re.search(r"V\): ([0-9.]+) rad/s", r.stdout).group(1))
+    t_c = float(re.search(r"t_c ([0-9.]+) s", r.stdout).group(1))
+    start = t_c + (0.05 if chain == "realistic" else 0.0) + 0.1
+    return ini, top, start, preset
+
+
+def profile(start, legs):
+    """Speed points: 0 until start, then (ramp time, level, hold) legs."""
+    t = start
+    pts = ["0:0", "%.6f:0" % t]
+    for ramp_s, level, hold_s in legs:
+        t += ramp_s
+        pts.append("%.6f:%.6g" % (t, level))
+        t += hold_s
+        pts.append("%.6f:%.6g" % (t, level))
+    return ", ".join(pts), t
+
+
+def sil(args, ini, out_dir, extra, csv_out=False):
+    cmd = [args.sil, "--scenario", ini, "--out", out_dir, "--quiet"] + ([] if csv_out else ["--no-csv"]) + sets(extra)
+    r = run(cmd)
+    summary_path = os.path.join(out_dir, "summary.json")
+    if not os.path.exists(summary_path):
+        raise SystemExit("pmstep-sil wrote no summary: %s\n%s" % (" ".join(cmd), r.stderr))
+    return json.load(open(summary_path)), r.returncode
+
+
+def fault_name(summary):
+    return summary["fault"]["name"]
+
+
+def ok(summary):
+    return fault_name(summary) == "NONE" and summary.get("final_mode") == "RUN" \
+        and not summary.get("loss_of_synchronism", False)
+
+
+def ok_microstep(summary):
+    return not summary.get("loss_of_synchronism", True)
+
+
+def dip_and_recovery(out_dir, step_time_s, bound):
+    dip, last_above = 0.0, step_time_s
+    with open(os.path.join(out_dir, "run.csv")) as f:
+        for row in csv.DictReader(f):
+            t = float(row["t_s"])
+            if t < step_time_s:
+                continue
+            e = abs(float(row["omega_rad_s"]) - float(row["omega_ref_rad_s"]))
+            dip = max(dip, e)
+            if e > bound:
+                last_above = t
+    return dip, last_above - step_time_s
+
+
+def hold_error(out_dir, holds, settle_s):
+    """Max |w - w*| within the holds [a, b), from a + settle_s on (after the ramp's transient)."""
+    worst = 0.0
+    with open(os.path.join(out_dir, "run.csv")) as f:
+        for row in csv.DictReader(f):
+            t = float(row["t_s"])
+            if any(a + settle_s <= t < b for a, b in holds):
+                worst = max(worst, abs(float(row["omega_rad_s"]) - float(row["omega_ref_rad_s"])))
+    return worst
+
+
+def envelope(args, name, chain):
+    out = os.path.join(args.out, name, chain)
+    os.makedirs(out, exist_ok=True)
+    ini, top, start, preset = design(args, name, chain, out)
+    ramp_s = max(0.05, 0.8 * top / 2000.0)
+    row = {"preset": name, "chain": chain, "top_speed_rad_s": top}
+    # Ramps for --duration s of RUN.
+    legs, t = [], 0.0
+    while t < args.duration:
+        for level in (0.8, -0.8, 0.05, -0.05):
+            legs.append((ramp_s, level * top, HOLD_S))
+            t += ramp_s + HOLD_S
+    points, end = profile(start, legs)
+    holds, t = [], start
+    for ramp, _, hold in legs:
+        t += ramp
+        holds.append((t, t + hold))
+        t += hold
+    s, _ = sil(args, ini, os.path.join(out, "ramps"), ["speed.points=" + points, "run.duration_s=%g" % end,
+                                                         "load.type=none"], csv_out=True)
+    row["ramps_fault"] = fault_name(s)
+    row["ramps_speed_error_pct_top"] = 100.0 * hold_error(os.path.join(out, "ramps"), holds, SETTLE_S) / top
+    row["ramps_angle_error_rad"] = s["robustness"]["max_angle_error_rad"]
+    print("%-9s %-9s top %6.1f rad/s  ramps: fault %s, |w-w*| %.2f %% of top, angle %.4f rad" % (
+        name, chain, top, row["ramps_fault"], row["ramps_speed_error_pct_top"], row["ramps_angle_error_rad"]),
+        flush=True)
+
+    def step_run(fraction_of_top, load_fraction, microstep, csv_out=False):
+        pts, end = profile(start, [(ramp_s, fraction_of_top * top, 1.0)])
+        step_time = end - 0.5
+        extra = ["speed.points=" + pts, "run.duration_s=%g" % end, "load.type=step",
+                 "load.torque_Nm=%g" % (load_fraction * preset["holding_torque_Nm"]), "load.step_time_s=%g" % step_time]
+        if microstep:
+            extra.append("run.controller=microstep")
+        d = os.path.join(out, "step_%s_%g_%g" % ("ms" if microstep else "ours", fraction_of_top, load_fraction))
+        summary, _ = sil(args, ini, d, extra, csv_out)
+        return summary, d, step_time
+
+    for fraction in (0.5, 0.05):
+        s, d, t_step = step_run(fraction, 0.5, False, csv_out=True)
+        dip, recovery = dip_and_recovery(d, t_step, 0.02 * top)
+        key = "step_at_%g" % fraction
+        row[key] = {"fault": fault_name(s), "lost_sync": s.get("loss_of_synchronism"), "dip_rad_s": dip,
+                    "recovery_ms": 1e3 * recovery, "max_angle_error_rad": s["robustness"]["max_angle_error_rad"]}
+        print("%-9s %-9s 0.5 T_H at %g top: fault %s, sync lost %s, dip %.2f rad/s, recovery %.1f ms" % (
+            name, chain, fraction, fault_name(s), s.get("loss_of_synchronism"), dip, 1e3 * recovery), flush=True)
+
+    for microstep in (False, True):
+        lo, hi = 0.0, 1.0
+        for _ in range(BISECTION_STEPS):
+            mid = 0.5 * (lo + hi)
+            s, _, _ = step_run(0.5, mid, microstep)
+            if (ok_microstep(s) if microstep else ok(s)):
+                lo = mid
+            else:
+                hi = mid
+        row["pullout_%s_of_holding" % ("microstep" if microstep else "ours")] = lo
+    # Copper loss at light load.
+    pts, end = profile(start, [(ramp_s, 0.5 * top, 1.0)])
+    for microstep in (False, True):
+        extra = ["speed.points=" + pts, "run.duration_s=%g" % end, "load.type=none", "run.metrics_start_s=%g" % (end - 0.5)]
+        if microstep:
+            extra.append("run.controller=microstep")
+        s, _ = sil(args, ini, os.path.join(out, "rms_%s" % ("ms" if microstep else "ours")), extra)
+        row["rms_current_%s_A" % ("microstep" if microstep else "ours")] = s.get("rms_phase_current_A")
+    print("%-9s %-9s largest step at 0.5 top: ours %.3f, microstepping %.3f of T_H; rms current ours %.3f A, "
+          "microstepping %.3f A" % (name, chain, row["pullout_ours_of_holding"], row["pullout_microstep_of_holding"],
+                                    row["rms_current_ours_A"] or -1, row["rms_current_microstep_A"] or -1), flush=True)
+    return row
+
+
+def markdown(rows):
+    lines = ["| preset | chain | top speed (rad/s) | ramps: fault, max |w-w*| (% top), angle error (rad) | "
+             "0.5 T_H step at 50 % / 5 % top: dip (rad/s), recovery (ms) | largest step at 50 % top, ours / "
+             "microstepping (x T_H) | RMS phase current at 50 % top, no load: ours / microstepping (A) |",
+             "|---|---|---|---|---|---|---|"]
+    for r in rows:
+        def step(k):
+            x = r[k]
+            if x["fault"] not in ("NONE", None) or x["lost_sync"]:
+                return "%s%s" % (x["fault"], ", sync lost" if x["lost_sync"] else "")
+            return "%.1f, %.0f" % (x["dip_rad_s"], x["recovery_ms"])
+        lines.append("| %s | %s | %.1f | %s, %.2f, %.4f | %s / %s | %.3f / %.3f | %.3f / %.3f |" % (
+            r["preset"], r["chain"], r["top_speed_rad_s"], r["ramps_fault"], r["ramps_speed_error_pct_top"],
+            r["ramps_angle_error_rad"] or float("nan"), step("step_at_0.5"), step("step_at_0.05"),
+            r["pullout_ours_of_holding"], r["pullout_microstep_of_holding"], r["rms_current_ours_A"] or float("nan"),
+            r["rms_current_microstep_A"] or float("nan")))
+    return "\n".join(lines) + "\n"
+
+
+def plot(rows, path):
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        print("envelope: matplotlib not installed, no plot", file=sys.stderr)
+        return
+    labels = ["%s\n%s" % (r["preset"], r["chain"]) for r in rows]
+    x = range(len(rows))
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4))
+    axes[0].bar([i - 0.2 for i in x], [r["pullout_ours_of_holding"] for r in rows], 0.4, label="pmstep (sensorless)")
+    axes[0].bar([i + 0.2 for i in x], [r["pullout_microstep_of_holding"] for r in rows], 0.4,
+                label="open-loop microstepping")
+    axes[0].set_ylabel("largest load step survived at 50 % top speed (x holding torque)")
+    axes[1].bar([i - 0.2 for i in x], [r["rms_current_ours_A"] or 0 for r in rows], 0.4, label="pmstep")
+    axes[1].bar([i + 0.2 for i in x], [r["rms_current_microstep_A"] or 0 for r in rows], 0.4, label="microstepping")
+    axes[1].set_ylabel("RMS phase current, no load, 50 % top speed (A)")
+    for ax in axes:
+        ax.set_xticks(list(x))
+        ax.set_xticklabels(labels, fontsize=7)
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    print("envelope: wrote %s" % path)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--sil", required=True)
+    ap.add_argument("--tune", required=True)
+    ap.add_argument("--out", required=True)
+    ap.add_argument("--presets", default=",".join(PRESETS))
+    ap.add_argument("--chains", default="ideal,realistic")
+    ap.add_argument("--duration", type=float, default=20.0, help="RUN time of the ramps run (s)")
+    args = ap.parse_args()
+    rows = []
+    for name in args.presets.split(","):
+        for chain in args.chains.split(","):
+            rows.append(envelope(args, name, chain))
+    os.makedirs(args.out, exist_ok=True)
+    json.dump(rows, open(os.path.join(args.out, "envelope.json"), "w"), indent=1)
+    table = markdown(rows)
+    open(os.path.join(args.out, "envelope.md"), "w").write(table)
+    print(table)
+    plot(rows, os.path.join(args.out, "envelope.png"))
+
+
+if __name__ == "__main__":
+    main()
