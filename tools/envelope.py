@@ -17,6 +17,7 @@ then runs pmstep-sil:
       --out out/envelope
 """
 import argparse
+import configparser
 import csv
 import json
 import os
@@ -48,10 +49,10 @@ def sets(pairs):
 
 
 def read_preset(name):
-    text = open(os.path.join(ROOT, "sil", "scenarios", "motors", name + ".ini")).read()
-    def value(key):
-        return float(re.search(r"^%s\s*=\s*([0-9.eE+-]+)" % key, text, re.M).group(1))
-    return {"rated_current_A": value("rated_current_A"), "holding_torque_Nm": value("holding_torque_Nm")}
+    ini = configparser.ConfigParser(inline_comment_prefixes=(";",))
+    ini.read(os.path.join(ROOT, "sil", "scenarios", "motors", name + ".ini"))
+    return {"rated_current_A": ini.getfloat("datasheet", "rated_current_A"),
+            "holding_torque_Nm": ini.getfloat("datasheet", "holding_torque_Nm")}
 
 
 def design(args, name, chain, out_dir):

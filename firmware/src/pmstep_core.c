@@ -355,7 +355,7 @@ static pmstep_compensation_input_t compensation_input(const pmstep_t *inst, cons
     } else if (out->u_b_V > 0.0f) {
         in.sign_current_b_A = out->u_b_V / inst->cfg->motor.resistance_Ohm;
     } else {
-        /* bridge-off modes and an alignment's first sample: the samples */
+        /* bridge off (idle, offset calibration, fault): the samples */
     }
     in.bias_a_V = inst->commissioning.voltage_bias_a_V;
     in.bias_b_V = inst->commissioning.voltage_bias_b_V;

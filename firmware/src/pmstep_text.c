@@ -56,7 +56,7 @@ const char *pmstep_status_str(pmstep_status_t status)
     case PMSTEP_ERR_DETECTION_TIME: return "persistence: 0, or 1 check to 2^24 periods";
     case PMSTEP_ERR_RATED_CURRENT: return "rated current must be > 0";
     case PMSTEP_ERR_BUS_BELOW_RATED: return "bus too low for R x rated current";
-    case PMSTEP_ERR_RATE_TOO_SLOW: return "control rate too slow for R/L";
+    case PMSTEP_ERR_RATE_TOO_SLOW: return "control rate too slow for R/L or F/J";
     }
     return "unknown status";
 }

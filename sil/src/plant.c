@@ -298,6 +298,16 @@ static void add_extra_torque(const plant_t *plant, int k, double s, double c, pl
     }
 }
 
+/* N at one stage of the exponential step (k: 0 start, 1 middle, 2 end): the coupling, the
+ * extra currents' torque, an open phase held. */
+static void stage_coupling(const plant_t *plant, int k, double t_s, const plant_state_t *y, double s, double c,
+                           plant_state_t *n)
+{
+    coupling_at(&plant->params, &plant->load, t_s, y, s, c, n);
+    add_extra_torque(plant, k, s, c, n);
+    hold_open(n, plant->open_a, plant->open_b);
+}
+
 /* Exponential time differencing RK4 on w = y - y* (plant.h). theta has no linear part;
  * an open phase has none either and its N is zero, so it holds. */
 static void exponential_substep(plant_t *plant, double t_s, double h, double u_a_V, double u_b_V,
@@ -325,33 +335,25 @@ static void exponential_substep(plant_t *plant, double t_s, double h, double u_a
     w0.i_a_A = x.i_a_A - star_a;
     w0.i_b_A = x.i_b_A - star_b;
 
-    coupling_at(par, &plant->load, t_s, &x, s0, c0, &n0);
-    add_extra_torque(plant, 0, s0, c0, &n0);
-    hold_open(&n0, oa, ob);
+    stage_coupling(plant, 0, t_s, &x, s0, c0, &n0);
     ya.theta_rad = etd_stage_a(wt, w0.theta_rad, n0.theta_rad);
     ya.omega_rad_s = etd_stage_a(ww, w0.omega_rad_s, n0.omega_rad_s);
     ya.i_a_A = etd_stage_a(wa, w0.i_a_A, n0.i_a_A) + star_a;
     ya.i_b_A = etd_stage_a(wb, w0.i_b_A, n0.i_b_A) + star_b;
     rotate(s0, c0, p * (ya.theta_rad - x.theta_rad), &s, &c);
-    coupling_at(par, &plant->load, t_s + 0.5 * h, &ya, s, c, &na);
-    add_extra_torque(plant, 1, s, c, &na);
-    hold_open(&na, oa, ob);
+    stage_coupling(plant, 1, t_s + 0.5 * h, &ya, s, c, &na);
     yb.theta_rad = etd_stage_a(wt, w0.theta_rad, na.theta_rad);
     yb.omega_rad_s = etd_stage_a(ww, w0.omega_rad_s, na.omega_rad_s);
     yb.i_a_A = etd_stage_a(wa, w0.i_a_A, na.i_a_A) + star_a;
     yb.i_b_A = etd_stage_a(wb, w0.i_b_A, na.i_b_A) + star_b;
     rotate(s0, c0, p * (yb.theta_rad - x.theta_rad), &s, &c);
-    coupling_at(par, &plant->load, t_s + 0.5 * h, &yb, s, c, &nb);
-    add_extra_torque(plant, 1, s, c, &nb);
-    hold_open(&nb, oa, ob);
+    stage_coupling(plant, 1, t_s + 0.5 * h, &yb, s, c, &nb);
     yc.theta_rad = etd_stage_c(wt, ya.theta_rad, n0.theta_rad, nb.theta_rad);
     yc.omega_rad_s = etd_stage_c(ww, ya.omega_rad_s, n0.omega_rad_s, nb.omega_rad_s);
     yc.i_a_A = etd_stage_c(wa, ya.i_a_A - star_a, n0.i_a_A, nb.i_a_A) + star_a;
     yc.i_b_A = etd_stage_c(wb, ya.i_b_A - star_b, n0.i_b_A, nb.i_b_A) + star_b;
     rotate(s0, c0, p * (yc.theta_rad - x.theta_rad), &s, &c);
-    coupling_at(par, &plant->load, t_s + h, &yc, s, c, &nc);
-    add_extra_torque(plant, 2, s, c, &nc);
-    hold_open(&nc, oa, ob);
+    stage_coupling(plant, 2, t_s + h, &yc, s, c, &nc);
 
     plant->x.theta_rad = etd_end(wt, w0.theta_rad, n0.theta_rad, na.theta_rad, nb.theta_rad, nc.theta_rad);
     plant->x.omega_rad_s = etd_end(ww, w0.omega_rad_s, n0.omega_rad_s, na.omega_rad_s, nb.omega_rad_s, nc.omega_rad_s);

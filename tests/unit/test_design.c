@@ -129,6 +129,10 @@ static void zero_rated(pmstep_design_input_t *in) { in->rated_current_A = 0.0f; 
 static void low_bus(pmstep_design_input_t *in) { in->bus_voltage_V = 2.5f; } /* R I = 2.55 V > 0.9 x 2.5 V */
 static void zero_bus(pmstep_design_input_t *in) { in->bus_voltage_V = 0.0f; }
 static void slow_rate(pmstep_design_input_t *in) { in->period_s = 1e-3f; } /* (R/L) T_s = 0.54 */
+/* (R/L) T_s = 0.085: above 80 % of the current loop's 0.1, below 80 % of the observer's 0.15 */
+static void rate_for_current_loop(pmstep_design_input_t *in) { in->period_s = 1.6e-4f; }
+/* F/J = 1850/s: above 80 % of the observer's 1000 rad/s */
+static void heavy_friction(pmstep_design_input_t *in) { in->motor.friction_Nms_rad = 0.01f; }
 static void bad_period(pmstep_design_input_t *in) { in->period_s = 0.1f; }
 static void bad_delay(pmstep_design_input_t *in) { in->computational_delay_periods = 2u; }
 static void long_dead_time(pmstep_design_input_t *in) { in->dead_time_s = 20e-6f; }
@@ -145,6 +149,7 @@ static void bad_motor_data_gets_a_named_error(void **state)
         {nan_r, PMSTEP_ERR_NONFINITE_PARAMETER}, {inf_j, PMSTEP_ERR_NONFINITE_PARAMETER},
         {zero_rated, PMSTEP_ERR_RATED_CURRENT},  {low_bus, PMSTEP_ERR_BUS_BELOW_RATED},
         {zero_bus, PMSTEP_ERR_BUS_BELOW_RATED},  {slow_rate, PMSTEP_ERR_RATE_TOO_SLOW},
+        {rate_for_current_loop, PMSTEP_ERR_RATE_TOO_SLOW}, {heavy_friction, PMSTEP_ERR_RATE_TOO_SLOW},
         {bad_period, PMSTEP_ERR_PERIOD},         {bad_delay, PMSTEP_ERR_DELAY},
         {long_dead_time, PMSTEP_ERR_DEAD_TIME},
     };

@@ -113,8 +113,11 @@ static pmstep_status_t check_input(const pmstep_design_input_t *in)
         return PMSTEP_ERR_DEAD_TIME;
     }
     /* The current loop's and the observer's poles must lie well beyond the winding's own R/L
-     * (K_i, K_e > 0): R/L below 80 % of the observer's current pole 3 w_o. */
-    if (!(m->resistance_Ohm / m->inductance_H * in->period_s < 0.8f * 3.0f * OBSERVER_BANDWIDTH_X_PERIOD)) {
+     * (K_i, K_e > 0): R/L at most 80 % of the slower of the two, 0.1/T_s and 3 w_o. The
+     * observer's triple pole must lie beyond the mechanics' F/J (DESIGN.md, 3). */
+    if (!(m->resistance_Ohm / m->inductance_H * in->period_s
+          < 0.8f * min2(CURRENT_BANDWIDTH_X_PERIOD, 3.0f * OBSERVER_BANDWIDTH_X_PERIOD))
+        || !(m->friction_Nms_rad / m->inertia_kgm2 * in->period_s < 0.8f * OBSERVER_BANDWIDTH_X_PERIOD)) {
         return PMSTEP_ERR_RATE_TOO_SLOW;
     }
     return PMSTEP_OK;
@@ -144,16 +147,17 @@ static void design_gains(const pmstep_design_input_t *in, pmstep_gains_config_t 
     const float w_o = OBSERVER_BANDWIDTH_X_PERIOD / in->period_s;
     const float a_e = 3.0f * w_o - f_over_j;
     const float g_w = (3.0f * w_o * w_o - a_e * f_over_j) / (b * b);
-    const float g_t = m->inertia_kgm2 * w_o * w_o * w_o / (b * b);
     const float lambda = 2.0f / g_w;
+    const float w_slow = w_o - f_over_j; /* > 0: check_input */
     const float speed_gain = SPEED_PER_OBSERVER_BANDWIDTH * w_o;
     const float current_bandwidth = CURRENT_BANDWIDTH_X_PERIOD / in->period_s;
 
     gains->current_gain_per_s = current_bandwidth - r_over_l;
     gains->observer_gain_per_s = a_e - r_over_l;
     gains->adapt_lambda = lambda;
-    /* With r F small against gamma: g_w = 2/lambda, g_T = 2F/lambda + J/gamma. */
-    gains->adapt_gamma = m->inertia_kgm2 / max2(g_t - 2.0f * m->friction_Nms_rad / lambda, 1e-3f * g_t);
+    /* With r F small against gamma: g_w = 2/lambda and g_T = 2F/lambda + J/gamma = J w_o^3 / b^2,
+     * so J/gamma = J (w_o - F/J)^3 / b^2. */
+    gains->adapt_gamma = b * b / (w_slow * w_slow * w_slow);
     gains->adapt_r = ADAPT_R;
     gains->speed_gain_per_s = speed_gain;
     gains->sat_kappa_rad_s = KAPPA_CURRENT_FRACTION * in->rated_current_A * m->torque_constant_Nm_A

@@ -83,8 +83,8 @@ typedef enum {
     /* gain designer (pmstep_design.h): motor data it cannot design for */
     PMSTEP_ERR_RATED_CURRENT = -110,        /**< rated current <= 0 */
     PMSTEP_ERR_BUS_BELOW_RATED = -111,      /**< bus voltage <= 0, or R x rated current above the usable bus */
-    PMSTEP_ERR_RATE_TOO_SLOW = -112         /**< control rate too slow for the motor: R/L above the bandwidth
-                                                 the designer gives the current loop and the observer */
+    PMSTEP_ERR_RATE_TOO_SLOW = -112         /**< control rate too slow for the motor: R/L, or F/J, not well below
+                                                 the bandwidths the designer gives the current loop and the observer */
 } pmstep_status_t;
 
 /** Shortest and longest control period accepted (s): 1 MHz down to 100 Hz. */

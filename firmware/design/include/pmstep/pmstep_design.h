@@ -56,7 +56,7 @@ typedef struct {
  * @retval PMSTEP_ERR_PERIOD, PMSTEP_ERR_DELAY  bad timing
  * @retval PMSTEP_ERR_RATED_CURRENT        rated current <= 0
  * @retval PMSTEP_ERR_BUS_BELOW_RATED      bus <= 0, or R x rated current above 90 % of it
- * @retval PMSTEP_ERR_RATE_TOO_SLOW        R/L too large for the control period
+ * @retval PMSTEP_ERR_RATE_TOO_SLOW        R/L or F/J too large for the control period
  * @retval PMSTEP_ERR_DEAD_TIME            dead time < 0 or 4 t_d >= T_s
  * @retval other                           the designed configuration fails pmstep_validate_config()
  */
