@@ -44,6 +44,7 @@ static pmstep_status_t validate_signs(const pmstep_config_t *cfg)
         SIGN_RULE(motor.inertia_kgm2, SIGN_POSITIVE, PMSTEP_ERR_INERTIA),
         SIGN_RULE(motor.torque_constant_Nm_A, SIGN_POSITIVE, PMSTEP_ERR_TORQUE_CONSTANT),
         SIGN_RULE(motor.friction_Nms_rad, SIGN_NON_NEGATIVE, PMSTEP_ERR_FRICTION),
+        SIGN_RULE(motor.detent_torque_Nm, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETENT_TORQUE),
         SIGN_RULE(gains.speed_gain_per_s, SIGN_POSITIVE, PMSTEP_ERR_SPEED_GAIN),
         SIGN_RULE(gains.observer_gain_per_s, SIGN_POSITIVE, PMSTEP_ERR_OBSERVER_GAIN),
         SIGN_RULE(gains.current_gain_per_s, SIGN_POSITIVE, PMSTEP_ERR_CURRENT_GAIN),
@@ -53,6 +54,7 @@ static pmstep_status_t validate_signs(const pmstep_config_t *cfg)
         SIGN_RULE(gains.sat_kappa_rad_s, SIGN_POSITIVE, PMSTEP_ERR_SAT_KAPPA),
         SIGN_RULE(gains.reference_bandwidth_rad_s, SIGN_POSITIVE, PMSTEP_ERR_REFERENCE_BANDWIDTH),
         SIGN_RULE(gains.angle_correction_gain_per_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_ANGLE_CORRECTION_GAIN),
+        SIGN_RULE(gains.current_integral_gain_per_s2, SIGN_NON_NEGATIVE, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN),
         SIGN_RULE(limits.max_phase_current_A, SIGN_POSITIVE, PMSTEP_ERR_MAX_CURRENT),
         SIGN_RULE(limits.min_bus_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_MIN_BUS),
         SIGN_RULE(alignment.s_align_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_ALIGNMENT_VOLTAGE),
@@ -118,6 +120,13 @@ static pmstep_status_t validate_gains(const pmstep_config_t *cfg)
     }
     if (gains->angle_correction_gain_per_s * period_s >= 0.5f) {
         return PMSTEP_ERR_ANGLE_CORRECTION_GAIN;
+    }
+    {
+        /* e'' + K e' + K_I e = 0, K = R/L + K_i: real poles need K_I <= K^2/4. */
+        const float loop_per_s = r_over_l + gains->current_gain_per_s;
+        if (gains->current_integral_gain_per_s2 > 0.25f * loop_per_s * loop_per_s) {
+            return PMSTEP_ERR_CURRENT_INTEGRAL_GAIN;
+        }
     }
     return PMSTEP_OK;
 }

@@ -9,6 +9,8 @@ static void start_run(pmstep_t *inst, const pmstep_meas_t *sample)
     const pmstep_ref_t i_d_cmd = inst->i_d_ref;
     pmstep_angle_start(&inst->angle, sample->i_a_A, sample->i_b_A);
     pmstep_observer_start(&inst->observer, sample->i_a_A, sample->i_b_A);
+    inst->current_integral.i_d_error_integral_As = 0.0f;
+    inst->current_integral.i_q_error_integral_As = 0.0f;
     pmstep_ref_reset(&inst->speed_ref, 0.0f);
     pmstep_ref_set_target(&inst->speed_ref, speed_cmd.target, speed_cmd.ramp_rate_per_s);
     pmstep_ref_reset(&inst->i_d_ref, 0.0f);
@@ -33,6 +35,7 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
     float load_rate;
     float i_q_ref;
     float i_q_ref_rate;
+    pmstep_detent_t detent;
 
     if (!inst->run_started) {
         start_run(inst, sample);
@@ -53,7 +56,9 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
     ref = pmstep_ref_output(&inst->ref_coeffs, &inst->scratch.run.known_load_filter); /* T_L*, Remark 1 */
 
     load_Nm = known_load ? ref.value : inst->observer.load_hat_Nm;
-    i_q_ref = pmstep_law_iq_ref(&inst->law_coeffs, &refs, inst->observer.speed_hat_rad_s, load_Nm);
+    /* The detent torque is known in form: the law supplies it, the observer expects it. */
+    detent = pmstep_law_detent(&inst->law_coeffs, cos_hat, sin_hat, inst->observer.speed_hat_rad_s);
+    i_q_ref = pmstep_law_iq_ref(&inst->law_coeffs, &refs, inst->observer.speed_hat_rad_s, load_Nm - detent.torque_Nm);
 
     obs_in->i_a_A = sample->i_a_A;
     obs_in->i_b_A = sample->i_b_A;
@@ -64,13 +69,16 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
     obs_in->i_d_err_A = i_d - refs.i_d_ref_A;
     obs_in->i_q_err_A = i_q - i_q_ref;
     obs_in->known_load_Nm = ref.value;
+    obs_in->detent_torque_Nm = detent.torque_Nm;
     scratch->mech_rates = pmstep_observer_mech_rates(&inst->observer, &inst->observer_coeffs, obs_in, known_load);
 
     load_rate = known_load ? ref.rate : scratch->mech_rates.load_hat_rate_Nm_s;
     i_q_ref_rate = pmstep_law_iq_ref_rate(&inst->law_coeffs, &refs, inst->observer.speed_hat_rad_s,
-                                          scratch->mech_rates.speed_hat_rate_rad_s2, load_rate);
+                                          scratch->mech_rates.speed_hat_rate_rad_s2, load_rate - detent.rate_Nm_s);
     pmstep_law_voltages(&inst->law_coeffs, &refs, cos_hat, sin_hat, i_d, i_q, inst->observer.speed_hat_rad_s,
-                        i_q_ref, i_q_ref_rate, &out->u_a_V, &out->u_b_V);
+                        i_q_ref, i_q_ref_rate, &inst->current_integral, &out->u_a_V, &out->u_b_V);
+    scratch->i_d_error_A = obs_in->i_d_err_A;
+    scratch->i_q_error_A = obs_in->i_q_err_A;
 
     out->cos_hat = cos_hat;
     out->sin_hat = sin_hat;
@@ -96,6 +104,10 @@ bool pmstep_control_advance(pmstep_t *inst, const pmstep_control_scratch_t *scra
     }
     pmstep_observer_advance(&inst->observer, &inst->observer_coeffs, &scratch->observer_input, &scratch->mech_rates,
                             inst->actuator.u_applied_a_V, inst->actuator.u_applied_b_V, period_s);
+    if (!out->voltage_limited) { /* anti-windup: the integral holds while the bus limits the voltage */
+        pmstep_law_integrate(&inst->current_integral, &inst->law_coeffs, scratch->i_d_error_A, scratch->i_q_error_A,
+                             period_s);
+    }
     pmstep_ref_advance(&inst->ref_coeffs, &inst->speed_ref, period_s);
     pmstep_ref_advance(&inst->ref_coeffs, &inst->i_d_ref, period_s);
     if (cfg->known_load_mode) {
@@ -104,5 +116,6 @@ bool pmstep_control_advance(pmstep_t *inst, const pmstep_control_scratch_t *scra
     }
     return pmstep_all_finite4(inst->observer.speed_hat_rad_s, inst->observer.load_hat_Nm, inst->observer.i_a_hat_A,
                               inst->observer.i_b_hat_A)
-           && pmstep_all_finite4(inst->angle.phi_a, inst->angle.phi_b, 0.0f, 0.0f);
+           && pmstep_all_finite4(inst->angle.phi_a, inst->angle.phi_b, inst->current_integral.i_d_error_integral_As,
+                                 inst->current_integral.i_q_error_integral_As);
 }

@@ -11,6 +11,8 @@
 #include "pmstep/pmstep.h"
 #include "pmstep_internal.h"
 
+#include "pmstep/pmstep_rotation.h"
+
 #include <stddef.h>
 #include <string.h>
 
@@ -332,11 +334,43 @@ static pmstep_fault_t supervise_stage(pmstep_t *inst, const pmstep_output_t *out
     return pmstep_detect_check(&inst->scratch.run.detector, &inst->detect_coeffs, &inst->cfg->detection, out, sample);
 }
 
+/* Dead-time compensation in RUN: the current references (i_d*, i_q*) in the stator frame at the
+ * angle the voltage acts at (the law's turn, p w-hat T_s (delay + 1/2)). Over the period a phase
+ * current sweeps +-h = |the other phase's current| p |w-hat| T_s / 2 about that value, so where it
+ * crosses zero within the period the bridge loses the dead time for the part of the period on
+ * each side: the mean of sign(i) is i_mid / h within the sweep. It is handed on scaled so that
+ * the compensation's linear band (b) gives that mean: i_mid b / h where h > b. */
+static void reference_current_over_period(const pmstep_t *inst, const pmstep_output_t *out,
+                                          pmstep_compensation_input_t *in)
+{
+    const float band_A = inst->cfg->inverter.dead_time_current_band_A;
+    const float half_turn = 0.5f * inst->law_coeffs.pole_pairs * inst->cfg->timing.period_s
+                            * pmstep_abs(out->speed_hat_rad_s);
+    float cos_turn;
+    float sin_turn;
+    float cos_act;
+    float sin_act;
+    float sweep_a_A;
+    float sweep_b_A;
+    pmstep_law_act_turn(&inst->law_coeffs, out->speed_hat_rad_s, &cos_turn, &sin_turn);
+    pmstep_turn(out->cos_hat, out->sin_hat, cos_turn, sin_turn, &cos_act, &sin_act);
+    in->sign_current_a_A = cos_act * out->i_d_ref_A - sin_act * out->i_q_ref_A;
+    in->sign_current_b_A = sin_act * out->i_d_ref_A + cos_act * out->i_q_ref_A;
+    sweep_a_A = pmstep_abs(in->sign_current_b_A) * half_turn;
+    sweep_b_A = pmstep_abs(in->sign_current_a_A) * half_turn;
+    if (sweep_a_A > band_A) {
+        in->sign_current_a_A *= band_A / sweep_a_A;
+    }
+    if (sweep_b_A > band_A) {
+        in->sign_current_b_A *= band_A / sweep_b_A;
+    }
+}
+
 /* What the dead-time compensation works from. Both phases in every mode: the undriven phase
  * of an alignment must really be at 0 V (a short through the bridge: it damps the rotor's
  * swing); left alone, its dead time would clamp it open. The sign of the current: in RUN from
- * the current references (i_d*, i_q*) turned by (c-hat, s-hat), which pass through zero
- * smoothly where a sampled current would sit in the ADC's zero code and let the phase clamp;
+ * the current references over the period (above), which pass through zero smoothly where a
+ * sampled current would sit in the ADC's zero code and let the phase clamp;
  * in the alignments, for the driven phase the current its voltage drives it to (u/R > 0), so
  * that the compensation acts from the first period (a sample still at zero would leave the
  * phase clamped open when u is below the dead time's loss: hybrid steppers align at about
@@ -348,8 +382,7 @@ static pmstep_compensation_input_t compensation_input(const pmstep_t *inst, cons
     in.sign_current_a_A = sample->i_a_A;
     in.sign_current_b_A = sample->i_b_A;
     if (inst->mode == PMSTEP_MODE_RUN) {
-        in.sign_current_a_A = out->cos_hat * out->i_d_ref_A - out->sin_hat * out->i_q_ref_A;
-        in.sign_current_b_A = out->sin_hat * out->i_d_ref_A + out->cos_hat * out->i_q_ref_A;
+        reference_current_over_period(inst, out, &in);
     } else if (out->u_a_V > 0.0f) {
         in.sign_current_a_A = out->u_a_V / inst->cfg->motor.resistance_Ohm;
     } else if (out->u_b_V > 0.0f) {

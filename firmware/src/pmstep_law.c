@@ -19,6 +19,9 @@ void pmstep_law_coeffs_init(pmstep_law_coeffs_t *coeffs, const pmstep_config_t *
     coeffs->pole_pairs = (float)cfg->motor.pole_pairs;
     coeffs->kappa_rad_s = cfg->gains.sat_kappa_rad_s;
     coeffs->linear_speed_term = cfg->known_load_mode;
+    coeffs->current_integral_gain_per_s2 = cfg->gains.current_integral_gain_per_s2;
+    coeffs->detent_torque_Nm = cfg->motor.detent_torque_Nm;
+    coeffs->detent_order = 4.0f * coeffs->pole_pairs;
     {
         const float turn_per_speed = coeffs->pole_pairs * cfg->timing.period_s;
         const float a = turn_per_speed * ((float)cfg->timing.computational_delay_periods + 0.5f);
@@ -28,6 +31,20 @@ void pmstep_law_coeffs_init(pmstep_law_coeffs_t *coeffs, const pmstep_config_t *
         coeffs->turn_sin_w1 = a;
         coeffs->turn_sin_w3 = -(a * a * a * (1.0f / 6.0f) + k * a);
     }
+}
+
+pmstep_detent_t pmstep_law_detent(const pmstep_law_coeffs_t *coeffs, float cos_hat, float sin_hat,
+                                  float speed_hat_rad_s)
+{
+    pmstep_detent_t detent = {0.0f, 0.0f};
+    if (coeffs->detent_torque_Nm > 0.0f) {
+        const float cos_2x = cos_hat * cos_hat - sin_hat * sin_hat;
+        const float sin_2x = 2.0f * cos_hat * sin_hat;
+        detent.torque_Nm = -coeffs->detent_torque_Nm * 2.0f * sin_2x * cos_2x;
+        detent.rate_Nm_s = -coeffs->detent_torque_Nm * coeffs->detent_order * speed_hat_rad_s
+                           * (cos_2x * cos_2x - sin_2x * sin_2x);
+    }
+    return detent;
 }
 
 void pmstep_sat(float x, float kappa, float *sat, float *sat_slope)
@@ -83,21 +100,32 @@ float pmstep_law_iq_ref_rate(const pmstep_law_coeffs_t *coeffs, const pmstep_law
 void pmstep_law_voltages(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs,
                          float cos_hat, float sin_hat, float i_d_A, float i_q_A,
                          float speed_hat_rad_s, float i_q_ref_A, float i_q_ref_rate,
-                         float *u_a_V, float *u_b_V)
+                         const pmstep_law_integral_t *integral, float *u_a_V, float *u_b_V)
 {
     const float pw = coeffs->pole_pairs * speed_hat_rad_s;
     const float phi_d = -coeffs->r_over_l_per_s * refs->i_d_ref_A + pw * i_q_A - refs->i_d_ref_rate_A_s;
     const float phi_q = -coeffs->r_over_l_per_s * i_q_ref_A - pw * i_d_A
                         - coeffs->km_over_l * speed_hat_rad_s - i_q_ref_rate;
-    const float u_d = coeffs->inductance_H * (-phi_d - coeffs->current_gain_per_s * (i_d_A - refs->i_d_ref_A));
-    const float u_q = coeffs->inductance_H * (-phi_q - coeffs->current_gain_per_s * (i_q_A - i_q_ref_A));
-    const float w2 = speed_hat_rad_s * speed_hat_rad_s;
-    const float cos_turn = 1.0f + w2 * (coeffs->turn_cos_w2 + w2 * coeffs->turn_cos_w4);
-    const float sin_turn = speed_hat_rad_s * (coeffs->turn_sin_w1 + w2 * coeffs->turn_sin_w3);
+    const float u_d = coeffs->inductance_H * (-phi_d - coeffs->current_gain_per_s * (i_d_A - refs->i_d_ref_A)
+                                              - coeffs->current_integral_gain_per_s2 * integral->i_d_error_integral_As);
+    const float u_q = coeffs->inductance_H * (-phi_q - coeffs->current_gain_per_s * (i_q_A - i_q_ref_A)
+                                              - coeffs->current_integral_gain_per_s2 * integral->i_q_error_integral_As);
+    float cos_turn;
+    float sin_turn;
     float cos_act;
     float sin_act;
+    pmstep_law_act_turn(coeffs, speed_hat_rad_s, &cos_turn, &sin_turn);
     /* Inverse Park at the angle the voltage acts at, shortened for the hold. */
     pmstep_turn(cos_hat, sin_hat, cos_turn, sin_turn, &cos_act, &sin_act);
     *u_a_V = cos_act * u_d - sin_act * u_q;
     *u_b_V = sin_act * u_d + cos_act * u_q;
+}
+
+void pmstep_law_integrate(pmstep_law_integral_t *integral, const pmstep_law_coeffs_t *coeffs, float i_d_error_A,
+                          float i_q_error_A, float period_s)
+{
+    if (coeffs->current_integral_gain_per_s2 > 0.0f) {
+        integral->i_d_error_integral_As += period_s * i_d_error_A;
+        integral->i_q_error_integral_As += period_s * i_q_error_A;
+    }
 }

@@ -52,7 +52,8 @@ pmstep_observer_mech_rates_t pmstep_observer_mech_rates(const pmstep_observer_t 
                                                         bool known_load)
 {
     pmstep_observer_mech_rates_t rates;
-    const float drive = -coeffs->f_over_j_per_s * obs->speed_hat_rad_s + coeffs->km_over_j * in->i_q_A;
+    const float drive = -coeffs->f_over_j_per_s * obs->speed_hat_rad_s + coeffs->km_over_j * in->i_q_A
+                        + in->detent_torque_Nm * coeffs->inv_j;
 
     if (known_load) {
         /* (13): (1/lambda)[p i_q i~_d - p i_d i~_q - (k_M/L) i~_q] */

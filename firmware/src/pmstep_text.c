@@ -17,6 +17,7 @@ const char *pmstep_status_str(pmstep_status_t status)
     case PMSTEP_ERR_TORQUE_CONSTANT: return "k_M must be > 0";
     case PMSTEP_ERR_FRICTION: return "F must be >= 0";
     case PMSTEP_ERR_POLE_PAIRS: return "p must be >= 1";
+    case PMSTEP_ERR_DETENT_TORQUE: return "detent torque must be >= 0";
     case PMSTEP_ERR_PERIOD: return "need 1 us <= T_s <= 10 ms";
     case PMSTEP_ERR_DELAY: return "delay must be 0 or 1 period";
     case PMSTEP_ERR_SPEED_GAIN: return "k_w must be > 0";
@@ -30,6 +31,7 @@ const char *pmstep_status_str(pmstep_status_t status)
     case PMSTEP_ERR_CURRENT_GAIN_FOR_PERIOD: return "need (R/L + K_i) T_s < 0.5";
     case PMSTEP_ERR_REFERENCE_BANDWIDTH: return "need 0 < varpi_0 T_s <= 0.5";
     case PMSTEP_ERR_ANGLE_CORRECTION_GAIN: return "need 0 <= g T_s < 0.5";
+    case PMSTEP_ERR_CURRENT_INTEGRAL_GAIN: return "need 0 <= K_I <= (R/L + K_i)^2 / 4";
     case PMSTEP_ERR_MAX_CURRENT: return "current limit must be > 0";
     case PMSTEP_ERR_MIN_BUS: return "min bus must be > 0";
     case PMSTEP_ERR_BUS_ORDER: return "need min bus < max bus";

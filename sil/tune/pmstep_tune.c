@@ -81,11 +81,14 @@ static void print_design(const sil_scenario_t *sc, const pmstep_design_report_t 
     printf("  bandwidths: current %.0f rad/s, observer %.0f rad/s (triple pole), speed %.0f rad/s\n",
            (double)r->current_bandwidth_rad_s, (double)r->observer_bandwidth_rad_s,
            (double)r->speed_bandwidth_rad_s);
-    printf("  gains: k_w %g, K_e %g, K_i %g, gamma %g, lambda %g, r %g, kappa %g rad/s, varpi_0 %g rad/s, g %g 1/s\n",
+    printf("  gains: k_w %g, K_e %g, K_i %g, K_I %g, gamma %g, lambda %g, r %g, kappa %g rad/s, varpi_0 %g rad/s, "
+           "g %g 1/s\n",
            (double)c->gains.speed_gain_per_s, (double)c->gains.observer_gain_per_s,
-           (double)c->gains.current_gain_per_s, (double)c->gains.adapt_gamma, (double)c->gains.adapt_lambda,
+           (double)c->gains.current_gain_per_s, (double)c->gains.current_integral_gain_per_s2,
+           (double)c->gains.adapt_gamma, (double)c->gains.adapt_lambda,
            (double)c->gains.adapt_r, (double)c->gains.sat_kappa_rad_s, (double)c->gains.reference_bandwidth_rad_s,
            (double)c->gains.angle_correction_gain_per_s);
+    printf("  detent torque compensated: %g Nm\n", (double)c->motor.detent_torque_Nm);
     printf("  alignment: %.3f A (u = %.3f V), t_s %.2f s, t_c %.2f s; swing %.0f rad/s, damping %.2f; "
            "condition (4) holds %.2fx over\n",
            (double)r->alignment_current_A, (double)c->alignment.s_align_voltage_V,
@@ -97,11 +100,13 @@ static void print_design(const sil_scenario_t *sc, const pmstep_design_report_t 
            (double)c->detection.observer_residual_bound_A, (double)c->detection.persistence_s);
     if (robust) {
         printf("  commissioning: offsets %.3f s, windows %.3f s, L window %.5f s, bias level %.2f, "
-               "dead time %g s (band %g A), i_d* %.3f A\n",
+               "dead time %g s (band %g A), i_d* %.3f A; RUN uses the measured R%s\n",
                (double)c->commissioning.offset_calibration_time_s, (double)c->commissioning.steady_state_window_s,
                (double)c->commissioning.inductance_window_s, (double)c->commissioning.voltage_bias_level_fraction,
                (double)c->inverter.dead_time_s, (double)c->inverter.dead_time_current_band_A,
-               (double)r->magnetising_current_A);
+               (double)r->magnetising_current_A,
+               c->commissioning.use_measured_inductance ? ", L and k_M"
+                                                        : " (L, k_M from the datasheet: the rotor swings within the L window)");
     }
 }
 
@@ -116,9 +121,11 @@ static int write_c(const char *path, const sil_scenario_t *sc)
     fprintf(f, "/* Designed by pmstep-tune for %s (firmware/design/DESIGN.md). */\n", sc->name);
     fprintf(f, "#include \"pmstep/pmstep.h\"\n\nconst pmstep_config_t pmstep_designed_config = {\n");
     fprintf(f, "    .motor = {.resistance_Ohm = %.9gf, .inductance_H = %.9gf, .inertia_kgm2 = %.9gf,\n"
-               "              .friction_Nms_rad = %.9gf, .torque_constant_Nm_A = %.9gf, .pole_pairs = %d},\n",
+               "              .friction_Nms_rad = %.9gf, .torque_constant_Nm_A = %.9gf, .pole_pairs = %d,\n"
+               "              .detent_torque_Nm = %.9gf},\n",
             (double)c->motor.resistance_Ohm, (double)c->motor.inductance_H, (double)c->motor.inertia_kgm2,
-            (double)c->motor.friction_Nms_rad, (double)c->motor.torque_constant_Nm_A, (int)c->motor.pole_pairs);
+            (double)c->motor.friction_Nms_rad, (double)c->motor.torque_constant_Nm_A, (int)c->motor.pole_pairs,
+            (double)c->motor.detent_torque_Nm);
     fprintf(f, "    .timing = {.period_s = %.9gf, .computational_delay_periods = %uu},\n", (double)c->timing.period_s,
             (unsigned)c->timing.computational_delay_periods);
     fprintf(f, "    .alignment = {.s_align_time_s = %.9gf, .c_align_time_s = %.9gf, .s_align_voltage_V = %.9gf,\n"
@@ -127,11 +134,12 @@ static int write_c(const char *path, const sil_scenario_t *sc)
             (double)c->alignment.s_align_voltage_V, (double)c->alignment.c_align_voltage_V);
     fprintf(f, "    .gains = {.speed_gain_per_s = %.9gf, .observer_gain_per_s = %.9gf, .current_gain_per_s = %.9gf,\n"
                "              .adapt_gamma = %.9gf, .adapt_lambda = %.9gf, .adapt_r = %.9gf, .sat_kappa_rad_s = %.9gf,\n"
-               "              .reference_bandwidth_rad_s = %.9gf, .angle_correction_gain_per_s = %.9gf},\n",
+               "              .reference_bandwidth_rad_s = %.9gf, .angle_correction_gain_per_s = %.9gf,\n"
+               "              .current_integral_gain_per_s2 = %.9gf},\n",
             (double)c->gains.speed_gain_per_s, (double)c->gains.observer_gain_per_s,
             (double)c->gains.current_gain_per_s, (double)c->gains.adapt_gamma, (double)c->gains.adapt_lambda,
             (double)c->gains.adapt_r, (double)c->gains.sat_kappa_rad_s, (double)c->gains.reference_bandwidth_rad_s,
-            (double)c->gains.angle_correction_gain_per_s);
+            (double)c->gains.angle_correction_gain_per_s, (double)c->gains.current_integral_gain_per_s2);
     fprintf(f, "    .limits = {.max_phase_current_A = %.9gf, .min_bus_voltage_V = %.9gf, .max_bus_voltage_V = %.9gf},\n",
             (double)c->limits.max_phase_current_A, (double)c->limits.min_bus_voltage_V,
             (double)c->limits.max_bus_voltage_V);
@@ -308,6 +316,7 @@ int main(int argc, char **argv)
     in.motor.friction_Nms_rad = (float)sc.motor.friction_Nms_rad;
     in.motor.torque_constant_Nm_A = (float)sc.motor.torque_constant_Nm_A;
     in.motor.pole_pairs = (int32_t)sc.motor.pole_pairs;
+    in.motor.detent_torque_Nm = (float)sc.datasheet.detent_torque_Nm; /* the law compensates the datasheet's */
     in.rated_current_A = (float)sc.datasheet.rated_current_A;
     in.bus_voltage_V = (float)sc.bus_voltage_V;
     in.period_s = sc.controller.timing.period_s;

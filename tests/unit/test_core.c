@@ -26,11 +26,13 @@ static pmstep_meas_t nominal_meas(void)
 static const pmstep_status_t all_status_codes[] = {
     PMSTEP_OK, PMSTEP_ERR_NULL_ARGUMENT, PMSTEP_ERR_BAD_MODE, PMSTEP_ERR_BAD_COMMAND_VALUE,
     PMSTEP_ERR_NONFINITE_PARAMETER, PMSTEP_ERR_DERIVED_NONFINITE, PMSTEP_ERR_RESISTANCE, PMSTEP_ERR_INDUCTANCE,
-    PMSTEP_ERR_INERTIA, PMSTEP_ERR_TORQUE_CONSTANT, PMSTEP_ERR_FRICTION, PMSTEP_ERR_POLE_PAIRS, PMSTEP_ERR_PERIOD,
+    PMSTEP_ERR_INERTIA, PMSTEP_ERR_TORQUE_CONSTANT, PMSTEP_ERR_FRICTION, PMSTEP_ERR_POLE_PAIRS, PMSTEP_ERR_DETENT_TORQUE,
+    PMSTEP_ERR_PERIOD,
     PMSTEP_ERR_DELAY, PMSTEP_ERR_SPEED_GAIN, PMSTEP_ERR_OBSERVER_GAIN, PMSTEP_ERR_CURRENT_GAIN,
     PMSTEP_ERR_ADAPT_GAMMA, PMSTEP_ERR_ADAPT_LAMBDA, PMSTEP_ERR_ADAPT_R, PMSTEP_ERR_SAT_KAPPA,
     PMSTEP_ERR_OBSERVER_GAIN_FOR_PERIOD, PMSTEP_ERR_CURRENT_GAIN_FOR_PERIOD, PMSTEP_ERR_REFERENCE_BANDWIDTH,
-    PMSTEP_ERR_ANGLE_CORRECTION_GAIN, PMSTEP_ERR_MAX_CURRENT, PMSTEP_ERR_MIN_BUS, PMSTEP_ERR_BUS_ORDER,
+    PMSTEP_ERR_ANGLE_CORRECTION_GAIN, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN, PMSTEP_ERR_MAX_CURRENT, PMSTEP_ERR_MIN_BUS,
+    PMSTEP_ERR_BUS_ORDER,
     PMSTEP_ERR_ALIGNMENT_VOLTAGE, PMSTEP_ERR_ALIGNMENT_ABOVE_BUS, PMSTEP_ERR_ALIGNMENT_CURRENT,
     PMSTEP_ERR_S_ALIGN_TIME, PMSTEP_ERR_C_ALIGN_TIME, PMSTEP_ERR_ALIGNMENT_TOO_LONG, PMSTEP_ERR_ALIGNMENT_CONDITION,
     PMSTEP_ERR_OFFSET_CALIBRATION_TIME, PMSTEP_ERR_STEADY_STATE_WINDOW, PMSTEP_ERR_INDUCTANCE_WINDOW,
@@ -43,6 +45,11 @@ static const pmstep_status_t all_status_codes[] = {
 
 typedef void (*config_edit_t)(pmstep_config_t *cfg);
 static void bad_r(pmstep_config_t *c) { c->motor.resistance_Ohm = 0.0f; }
+static void negative_detent(pmstep_config_t *c) { c->motor.detent_torque_Nm = -1e-3f; }
+static void negative_current_integral(pmstep_config_t *c) { c->gains.current_integral_gain_per_s2 = -1.0f; }
+/* Paper: R/L + K_i = 500 + 20 = 520 1/s, so K_I may reach 520^2/4 = 67600 1/s^2. */
+static void current_integral_complex_poles(pmstep_config_t *c) { c->gains.current_integral_gain_per_s2 = 68000.0f; }
+static void current_integral_at_bound(pmstep_config_t *c) { c->gains.current_integral_gain_per_s2 = 67000.0f; }
 static void bad_l(pmstep_config_t *c) { c->motor.inductance_H = -1e-3f; }
 static void bad_j(pmstep_config_t *c) { c->motor.inertia_kgm2 = 0.0f; }
 static void bad_km(pmstep_config_t *c) { c->motor.torque_constant_Nm_A = 0.0f; }
@@ -104,6 +111,9 @@ static const struct {
     {bad_km, PMSTEP_ERR_TORQUE_CONSTANT},
     {bad_f, PMSTEP_ERR_FRICTION},
     {bad_p, PMSTEP_ERR_POLE_PAIRS},
+    {negative_detent, PMSTEP_ERR_DETENT_TORQUE},
+    {negative_current_integral, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN},
+    {current_integral_complex_poles, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN},
     {bad_period, PMSTEP_ERR_PERIOD},
     {bad_k_omega, PMSTEP_ERR_SPEED_GAIN},
     {bad_k_e, PMSTEP_ERR_OBSERVER_GAIN},
@@ -165,6 +175,16 @@ static const pmstep_status_t codes_tested_in_test_commission[] = {
     PMSTEP_ERR_INDUCTANCE_WINDOW, PMSTEP_ERR_ALIGNMENT_OFFSETS_UNMEASURED, PMSTEP_ERR_RESISTANCE_UNMEASURED,
     PMSTEP_ERR_INDUCTANCE_UNMEASURED, PMSTEP_ERR_TORQUE_CONSTANT_UNMEASURED, PMSTEP_ERR_VOLTAGE_BIAS_FRACTION,
     PMSTEP_ERR_VOLTAGE_BIAS_WINDOW, PMSTEP_ERR_VOLTAGE_BIAS_SETTLING, PMSTEP_ERR_DEAD_TIME, PMSTEP_ERR_DETECTION_BOUND};
+
+static void current_integral_within_its_bound_is_accepted(void **state)
+{
+    pmstep_config_t cfg = pmstep_paper_config();
+    (void)state;
+    current_integral_at_bound(&cfg);
+    assert_int_equal(pmstep_validate_config(&cfg), PMSTEP_OK);
+    cfg.motor.detent_torque_Nm = 0.01f;
+    assert_int_equal(pmstep_validate_config(&cfg), PMSTEP_OK);
+}
 
 static void every_validation_code_is_provoked(void **state)
 {
@@ -486,6 +506,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(every_invalid_configuration_has_its_code),
+        cmocka_unit_test(current_integral_within_its_bound_is_accepted),
         cmocka_unit_test(every_code_has_its_own_text),
         cmocka_unit_test(every_validation_code_is_provoked),
         cmocka_unit_test(condition4_cases_are_on_the_right_side),

@@ -35,6 +35,7 @@ static pmstep_design_input_t input_of(const motor_data_t *m, bool robust)
     in.motor.friction_Nms_rad = m->f;
     in.motor.torque_constant_Nm_A = m->k_m;
     in.motor.pole_pairs = m->p;
+    in.motor.detent_torque_Nm = 0.0f;
     in.rated_current_A = m->rated_A;
     in.bus_voltage_V = m->bus_V;
     in.period_s = 50e-6f;
@@ -75,6 +76,19 @@ static void every_preset_gets_a_valid_design(void **state)
             assert_true(cfg.alignment.s_align_voltage_V / in.motor.resistance_Ohm <= in.rated_current_A * 1.0001f);
             assert_true(cfg.alignment.c_align_voltage_V / in.motor.resistance_Ohm <= in.rated_current_A * 1.0001f);
             assert_true(cfg.limits.max_phase_current_A > in.rated_current_A);
+            /* PI current loop: K_I = K^2/8, K = R/L + K_i (poles 0.15 K and 0.85 K, real). */
+            {
+                const float k = in.motor.resistance_Ohm / in.motor.inductance_H + cfg.gains.current_gain_per_s;
+                assert_float_equal(cfg.gains.current_integral_gain_per_s2, 0.125f * k * k, 1e-3f * k * k);
+            }
+            /* RUN takes the measured L and k_M only where the rotor stays still over the L window:
+             * the paper's motor (w_n T_L ~ 0.05), not the hybrids (~0.45-0.75). */
+            assert_true(cfg.commissioning.use_measured_inductance
+                        == (robust != 0 && report.alignment_frequency_rad_s * cfg.commissioning.inductance_window_s < 0.1f));
+            assert_true(cfg.commissioning.use_measured_inductance == cfg.commissioning.use_measured_torque_constant);
+            if (robust != 0) {
+                assert_true(cfg.commissioning.use_measured_inductance == (n == 0));
+            }
             /* Top speed: the bus takes (R I + k_M w)^2 + (p w L I)^2 = (0.9 V)^2 there. */
             {
                 const double w = (double)report.top_speed_rad_s;

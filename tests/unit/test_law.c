@@ -60,6 +60,7 @@ static void current_loop_gives_error_dynamics_8(void **state)
     const pmstep_electrical_t model = pmstep_configured_electrical(&cfg);
     pmstep_law_coeffs_t coeffs;
     pmstep_law_refs_t refs = {3.0f, 20.0f, 0.0f, 0.0f, 0.0f};
+    const pmstep_law_integral_t no_integral = {0.0f, 0.0f};
     const float angle = 0.8f, speed = 3.0f, i_d = 0.3f, i_q = 1.7f, load = 1.0f;
     const float c = cosf(angle), s = sinf(angle);
     const double turn = 6.0 * speed * 5e-5;
@@ -71,7 +72,7 @@ static void current_loop_gives_error_dynamics_8(void **state)
     pmstep_law_coeffs_init(&coeffs, &cfg, &model);
     i_q_ref = pmstep_law_iq_ref(&coeffs, &refs, speed, load);
     i_q_ref_rate = pmstep_law_iq_ref_rate(&coeffs, &refs, speed, 0.0f, 0.0f);
-    pmstep_law_voltages(&coeffs, &refs, c, s, i_d, i_q, speed, i_q_ref, i_q_ref_rate, &u_a, &u_b);
+    pmstep_law_voltages(&coeffs, &refs, c, s, i_d, i_q, speed, i_q_ref, i_q_ref_rate, &no_integral, &u_a, &u_b);
     pmstep_park(c_act, s_act, u_a, u_b, &u_d, &u_q);
     u_d = (float)(u_d / held_gain);
     u_q = (float)(u_q / held_gain);
@@ -82,12 +83,77 @@ static void current_loop_gives_error_dynamics_8(void **state)
     assert_true(fabs(di_d - (-(520.0) * i_d)) < 1e-2);
 }
 
+static void detent_torque_and_rate_follow_the_angle(void **state)
+{
+    /* -T_d sin(4x) and -4 p T_d w cos(4x), from (cos x, sin x) by polynomials. */
+    pmstep_config_t cfg = pmstep_paper_config();
+    pmstep_law_coeffs_t coeffs;
+    pmstep_electrical_t model;
+    const float speed = 7.0f;
+    double worst_torque = 0.0, worst_rate = 0.0;
+    int k;
+    (void)state;
+    cfg.motor.detent_torque_Nm = 0.05f;
+    model = pmstep_configured_electrical(&cfg);
+    pmstep_law_coeffs_init(&coeffs, &cfg, &model);
+    for (k = 0; k < 360; ++k) {
+        const double x = 2.0 * 3.14159265358979 * k / 360.0;
+        const pmstep_detent_t d = pmstep_law_detent(&coeffs, (float)cos(x), (float)sin(x), speed);
+        const double torque = -0.05 * sin(4.0 * x);
+        const double rate = -0.05 * 4.0 * 6.0 * (double)speed * cos(4.0 * x);
+        worst_torque = fmax(worst_torque, fabs((double)d.torque_Nm - torque));
+        worst_rate = fmax(worst_rate, fabs((double)d.rate_Nm_s - rate));
+    }
+    print_message("detent: worst torque error %.3g Nm, rate error %.3g Nm/s\n", worst_torque, worst_rate);
+    assert_true(worst_torque < 1e-6 * 0.05);
+    assert_true(worst_rate < 1e-6 * 0.05 * 4.0 * 6.0 * (double)speed);
+    /* No detent torque in the model: exactly zero. */
+    cfg.motor.detent_torque_Nm = 0.0f;
+    pmstep_law_coeffs_init(&coeffs, &cfg, &model);
+    {
+        const pmstep_detent_t d = pmstep_law_detent(&coeffs, 0.6f, 0.8f, speed);
+        assert_true(d.torque_Nm == 0.0f && d.rate_Nm_s == 0.0f);
+    }
+}
+
+static void current_integral_adds_its_voltage_and_integrates(void **state)
+{
+    /* u_dq changes by -L K_I z with the integral z; z advances by T_s (i - i*) only with K_I > 0. */
+    pmstep_config_t cfg = pmstep_paper_config();
+    pmstep_law_coeffs_t coeffs;
+    const pmstep_electrical_t model = pmstep_configured_electrical(&cfg);
+    const pmstep_law_refs_t refs = {3.0f, 0.0f, 0.0f, 0.5f, 0.0f};
+    const pmstep_law_integral_t none = {0.0f, 0.0f};
+    const pmstep_law_integral_t some = {2e-4f, -3e-4f};
+    pmstep_law_integral_t z = {0.0f, 0.0f};
+    float u_a0, u_b0, u_a1, u_b1, du_d, du_q;
+    (void)state;
+    cfg.gains.current_integral_gain_per_s2 = 5e4f;
+    pmstep_law_coeffs_init(&coeffs, &cfg, &model);
+    pmstep_law_voltages(&coeffs, &refs, 1.0f, 0.0f, 0.4f, 1.0f, 0.0f, 1.2f, 0.0f, &none, &u_a0, &u_b0);
+    pmstep_law_voltages(&coeffs, &refs, 1.0f, 0.0f, 0.4f, 1.0f, 0.0f, 1.2f, 0.0f, &some, &u_a1, &u_b1);
+    /* At w-hat = 0 the turn is zero: (u_a, u_b) = (u_d, u_q). */
+    du_d = u_a1 - u_a0;
+    du_q = u_b1 - u_b0;
+    assert_float_equal(du_d, -0.006f * 5e4f * 2e-4f, 1e-5f);
+    assert_float_equal(du_q, -0.006f * 5e4f * -3e-4f, 1e-5f);
+    pmstep_law_integrate(&z, &coeffs, 0.1f, -0.2f, 5e-5f);
+    assert_float_equal(z.i_d_error_integral_As, 5e-6f, 1e-12f);
+    assert_float_equal(z.i_q_error_integral_As, -1e-5f, 1e-12f);
+    cfg.gains.current_integral_gain_per_s2 = 0.0f;
+    pmstep_law_coeffs_init(&coeffs, &cfg, &model);
+    pmstep_law_integrate(&z, &coeffs, 0.1f, -0.2f, 5e-5f);
+    assert_float_equal(z.i_d_error_integral_As, 5e-6f, 1e-12f); /* unchanged: the paper's law */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(saturation_is_smooth_odd_bounded_with_unit_slope),
         cmocka_unit_test(park_and_inverse_are_orthogonal),
         cmocka_unit_test(current_loop_gives_error_dynamics_8),
+        cmocka_unit_test(detent_torque_and_rate_follow_the_angle),
+        cmocka_unit_test(current_integral_adds_its_voltage_and_integrates),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

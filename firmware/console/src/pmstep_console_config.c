@@ -59,6 +59,8 @@ static const pmstep_console_config_entry_t table[] = {
     F32(detection.observer_residual_bound_A),
     F32(detection.persistence_s),
     U32(detection.max_realignments),
+    F32(motor.detent_torque_Nm),
+    F32(gains.current_integral_gain_per_s2),
 };
 
 const pmstep_console_config_entry_t *pmstep_console_config_table(uint32_t *count)

@@ -12,6 +12,8 @@
 #define SPEED_PER_OBSERVER_BANDWIDTH (1.0f / 3.0f) /* k_w = w_o / 3 */
 #define REFERENCE_PER_SPEED_BANDWIDTH 3.0f         /* varpi_0 = 3 k_w */
 #define DRIFT_FREE_PER_OBSERVER_BANDWIDTH (1.0f / 30.0f) /* robust mode's angle correction g = w_o / 30 */
+#define CURRENT_INTEGRAL_PER_BANDWIDTH_SQUARED 0.125f   /* K_I = K^2/8, K = R/L + K_i: PI poles 0.15 K, 0.85 K */
+#define STILL_ROTOR_SWING_PHASE 0.1f /* RUN takes the measured L, k_M only if w_n x L window is below this */
 /* Speed correction k_w kappa at most this fraction of the rated current's acceleration k_M I / J. */
 #define KAPPA_CURRENT_FRACTION 0.5f
 /* Alignment current at most this fraction of k_M/(p L), where condition (4) runs out. */
@@ -153,6 +155,7 @@ static void design_gains(const pmstep_design_input_t *in, pmstep_gains_config_t 
     const float current_bandwidth = CURRENT_BANDWIDTH_X_PERIOD / in->period_s;
 
     gains->current_gain_per_s = current_bandwidth - r_over_l;
+    gains->current_integral_gain_per_s2 = CURRENT_INTEGRAL_PER_BANDWIDTH_SQUARED * current_bandwidth * current_bandwidth;
     gains->observer_gain_per_s = a_e - r_over_l;
     gains->adapt_lambda = lambda;
     /* With r F small against gamma: g_w = 2/lambda and g_T = 2F/lambda + J/gamma = J w_o^3 / b^2,
@@ -215,15 +218,22 @@ static void design_commissioning(const pmstep_design_input_t *in, float window_s
     pmstep_commissioning_config_t *c = &cfg->commissioning;
     const float l_over_r = in->motor.inductance_H / in->motor.resistance_Ohm;
     const bool robust = in->self_commissioning;
+    bool rotor_still;
     c->offset_calibration_time_s = robust ? OFFSET_CALIBRATION_S : 0.0f;
     c->alignment_offset_calibration = false;
     c->steady_state_window_s = window_s;
     c->inductance_window_s = robust ? max2(INDUCTANCE_WINDOW_PER_TIME_CONSTANT * l_over_r,
                                            MIN_INDUCTANCE_WINDOW_PERIODS * in->period_s)
                                     : 0.0f;
+    /* L comes from the first current rise of s-alignment, with the rotor taken as still; where
+     * the alignment swing's natural frequency turns the rotor within that window (hybrid
+     * steppers: w_n ~ 1000 rad/s), its back EMF enters the measurement, and k_M's measurement
+     * uses that L: RUN then keeps the datasheet's L and k_M (they are still measured and
+     * reported). */
+    rotor_still = report->alignment_frequency_rad_s * c->inductance_window_s < STILL_ROTOR_SWING_PHASE;
     c->use_measured_resistance = robust;
-    c->use_measured_inductance = robust;
-    c->use_measured_torque_constant = robust;
+    c->use_measured_inductance = robust && rotor_still;
+    c->use_measured_torque_constant = robust && rotor_still;
     c->voltage_bias_level_fraction = robust ? VOLTAGE_BIAS_LEVEL : 0.0f;
     cfg->inverter.dead_time_s = robust ? in->dead_time_s : 0.0f;
     /* The band of the compensation, which the voltage bias uses too. */

@@ -48,6 +48,7 @@ typedef struct {
     pmstep_ref_t i_d_ref;
     pmstep_angle_t angle;
     pmstep_observer_t observer;
+    pmstep_law_integral_t current_integral; /**< PI current loop (K_I > 0) */
     pmstep_actuator_t actuator;
 
     pmstep_commissioning_t commissioning; /**< offsets (subtracted from every sample once measured), R, L, k_M */

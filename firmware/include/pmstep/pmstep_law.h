@@ -34,6 +34,9 @@ typedef struct {
     float turn_cos_w4;        /**< c4 = a^4/24 + k a^2/2 */
     float turn_sin_w1;        /**< s1 = a */
     float turn_sin_w3;        /**< s3 = -(a^3/6 + k a) */
+    float current_integral_gain_per_s2; /**< K_I of the PI current loop (0 = the paper's law) */
+    float detent_torque_Nm;   /**< T_d of the detent model (0 = none) */
+    float detent_order;       /**< 4 p: the detent's harmonic of the mechanical angle */
     bool linear_speed_term;   /**< Remark 1 (13): k_w (w-hat - w*) without saturation (last: the floats
                                    before it are checked as a run) */
 } pmstep_law_coeffs_t;
@@ -43,6 +46,38 @@ typedef struct {
     float speed_ref_rad_s, speed_ref_rate_rad_s2, speed_ref_accel_rad_s3; /**< w*, w*', w*'' */
     float i_d_ref_A, i_d_ref_rate_A_s;                          /**< i_d*, i_d*' */
 } pmstep_law_refs_t;
+
+/** Integrals of the current errors, the PI current loop's state (zero with K_I = 0). */
+typedef struct {
+    float i_d_error_integral_As; /**< integral of i_d - i_d* */
+    float i_q_error_integral_As; /**< integral of i_q - i_q* */
+} pmstep_law_integral_t;
+
+/** The detent torque the model expects at the estimated angle, and its rate. */
+typedef struct {
+    float torque_Nm;     /**< -T_d sin(4 p theta-hat) */
+    float rate_Nm_s;     /**< its derivative along w-hat: -4 p T_d w-hat cos(4 p theta-hat) */
+} pmstep_detent_t;
+
+/**
+ * Detent torque at (c-hat, s-hat): sin 4x = 2 sin 2x cos 2x with sin 2x = 2 c s and
+ * cos 2x = c^2 - s^2 (no libm call). Zero when the model has no detent torque.
+ */
+pmstep_detent_t pmstep_law_detent(const pmstep_law_coeffs_t *coeffs, float cos_hat, float sin_hat,
+                                  float speed_hat_rad_s);
+
+/**
+ * The turn from the sample to the middle of the period the voltage acts in, p w-hat T_s
+ * (delay + 1/2), with the hold's shortening 1 - x^2/6 (see pmstep_law_voltages), as
+ * (cos, sin) polynomials in w-hat.
+ */
+static inline void pmstep_law_act_turn(const pmstep_law_coeffs_t *coeffs, float speed_hat_rad_s, float *cos_turn,
+                                       float *sin_turn)
+{
+    const float w2 = speed_hat_rad_s * speed_hat_rad_s;
+    *cos_turn = 1.0f + w2 * (coeffs->turn_cos_w2 + w2 * coeffs->turn_cos_w4);
+    *sin_turn = speed_hat_rad_s * (coeffs->turn_sin_w1 + w2 * coeffs->turn_sin_w3);
+}
 
 /** Coefficients for the gains and mechanics of @p cfg and the electrical model @p model. */
 void pmstep_law_coeffs_init(pmstep_law_coeffs_t *coeffs, const pmstep_config_t *cfg,
@@ -64,7 +99,8 @@ float pmstep_law_iq_ref_rate(const pmstep_law_coeffs_t *coeffs, const pmstep_law
 
 /**
  * phi_d = -(R/L) i_d* + p w-hat i_q - i_d*',  phi_q = -(R/L) i_q* - p w-hat i_d - (k_M/L) w-hat - i_q*',
- * u_d = L[-phi_d - K_i (i_d - i_d*)], u_q = L[-phi_q - K_i (i_q - i_q*)],
+ * u_d = L[-phi_d - K_i (i_d - i_d*) - K_I z_d], u_q = L[-phi_q - K_i (i_q - i_q*) - K_I z_q]
+ * (z: the integrals of the current errors; K_I = 0 in the paper's law),
  * u_a = c u_d - s u_q, u_b = s u_d + c u_q, with (c, s) the estimate turned by the angle the
  * rotor turns from the sample to the middle of the period the voltage acts in (p w-hat T_s
  * (delay + 1/2)) and (u_d, u_q) shortened by 1 - x^2/6, x = p w-hat T_s/2. A voltage held in the
@@ -75,7 +111,12 @@ float pmstep_law_iq_ref_rate(const pmstep_law_coeffs_t *coeffs, const pmstep_law
 void pmstep_law_voltages(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs,
                          float cos_hat, float sin_hat, float i_d_A, float i_q_A,
                          float speed_hat_rad_s, float i_q_ref_A, float i_q_ref_rate,
-                         float *u_a_V, float *u_b_V);
+                         const pmstep_law_integral_t *integral, float *u_a_V, float *u_b_V);
+
+/** Advances the current-error integrals by one period (when K_I > 0; the caller skips periods whose voltage
+ *  the bus limited: anti-windup). */
+void pmstep_law_integrate(pmstep_law_integral_t *integral, const pmstep_law_coeffs_t *coeffs, float i_d_error_A,
+                          float i_q_error_A, float period_s);
 
 #ifdef __cplusplus
 }

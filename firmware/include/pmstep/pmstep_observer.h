@@ -61,6 +61,7 @@ typedef struct {
     float i_d_A, i_q_A;       /**< Park of the currents with (c-hat, s-hat) */
     float i_d_err_A, i_q_err_A; /**< i_d - i_d*, i_q - i_q* (Remark 1 only) */
     float known_load_Nm;      /**< T_L* (Remark 1 only) */
+    float detent_torque_Nm;   /**< the model's detent torque at the estimated angle (0 = none) */
 } pmstep_observer_input_t;
 
 /** Time derivatives of the speed and load estimates. */

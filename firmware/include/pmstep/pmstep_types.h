@@ -33,6 +33,7 @@ typedef enum {
     PMSTEP_ERR_TORQUE_CONSTANT = -23,       /**< k_M <= 0 */
     PMSTEP_ERR_FRICTION = -24,              /**< F < 0 */
     PMSTEP_ERR_POLE_PAIRS = -25,            /**< p < 1 */
+    PMSTEP_ERR_DETENT_TORQUE = -26,         /**< detent torque < 0 */
     /* timing */
     PMSTEP_ERR_PERIOD = -30,                /**< T_s outside [PMSTEP_MIN_PERIOD_S, PMSTEP_MAX_PERIOD_S] */
     PMSTEP_ERR_DELAY = -31,                 /**< computational delay not 0 or 1 period */
@@ -48,6 +49,8 @@ typedef enum {
     PMSTEP_ERR_CURRENT_GAIN_FOR_PERIOD = -48,  /**< (R/L + K_i) T_s >= 0.5: current loop too fast for the period */
     PMSTEP_ERR_REFERENCE_BANDWIDTH = -49,   /**< varpi_0 <= 0 or varpi_0 T_s > 0.5 */
     PMSTEP_ERR_ANGLE_CORRECTION_GAIN = -50, /**< drift-free gain g < 0 or g T_s >= 0.5 */
+    PMSTEP_ERR_CURRENT_INTEGRAL_GAIN = -51, /**< current-loop integral gain < 0, or above (R/L + K_i)^2 / 4 (the
+                                                 loop's poles would turn complex) */
     /* limits */
     PMSTEP_ERR_MAX_CURRENT = -60,           /**< max_phase_current_A <= 0 */
     PMSTEP_ERR_MIN_BUS = -61,               /**< min_bus_voltage_V <= 0 */
@@ -133,6 +136,8 @@ typedef struct {
     float friction_Nms_rad;     /**< F >= 0 */
     float torque_constant_Nm_A; /**< k_M */
     int32_t pole_pairs;         /**< p >= 1 */
+    float detent_torque_Nm;     /**< T_d >= 0: detent (cogging) torque -T_d sin(4 p theta) in the model, not in the
+                                     paper's (1); the observer and the law compensate it. 0 = none (the paper) */
 } pmstep_motor_config_t;
 
 /** Control period and delay of the drive. */
@@ -161,6 +166,9 @@ typedef struct {
     float reference_bandwidth_rad_s; /**< varpi_0 of H(s) = varpi_0^3/(s+varpi_0)^3 */
     float angle_correction_gain_per_s; /**< drift-free option: pulls (c-hat, s-hat) onto the unit circle at this
                                             rate (flux-magnitude correction); 0 = the paper's open integrals */
+    float current_integral_gain_per_s2; /**< K_I: integral of the current error in the law's voltage (a PI current
+                                             loop); holds i_q = i_q* against voltage the model does not know, which
+                                             (6) otherwise turns into a speed offset. 0 = the paper's law */
 } pmstep_gains_config_t;
 
 /** Protections. */
