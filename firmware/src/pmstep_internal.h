@@ -36,8 +36,6 @@ bool pmstep_derived_coefficients_finite(const pmstep_config_t *cfg);
 typedef struct {
     pmstep_observer_input_t observer_input;
     pmstep_observer_mech_rates_t mech_rates;
-    float i_d_error_A; /**< i_d - i_d*, for the PI current loop's integral */
-    float i_q_error_A; /**< i_q - i_q* */
 } pmstep_control_scratch_t;
 
 /* Control stage: at t_c starts controller (6) (phi = 0, i-hat = i(t_c), w-hat = T_L-hat = 0,

@@ -33,20 +33,6 @@ void pmstep_law_coeffs_init(pmstep_law_coeffs_t *coeffs, const pmstep_config_t *
     }
 }
 
-pmstep_detent_t pmstep_law_detent(const pmstep_law_coeffs_t *coeffs, float cos_hat, float sin_hat,
-                                  float speed_hat_rad_s)
-{
-    pmstep_detent_t detent = {0.0f, 0.0f};
-    if (coeffs->detent_torque_Nm > 0.0f) {
-        const float cos_2x = cos_hat * cos_hat - sin_hat * sin_hat;
-        const float sin_2x = 2.0f * cos_hat * sin_hat;
-        detent.torque_Nm = -coeffs->detent_torque_Nm * 2.0f * sin_2x * cos_2x;
-        detent.rate_Nm_s = -coeffs->detent_torque_Nm * coeffs->detent_order * speed_hat_rad_s
-                           * (cos_2x * cos_2x - sin_2x * sin_2x);
-    }
-    return detent;
-}
-
 void pmstep_sat(float x, float kappa, float *sat, float *sat_slope)
 {
     const float ratio = x / kappa;
@@ -121,11 +107,3 @@ void pmstep_law_voltages(const pmstep_law_coeffs_t *coeffs, const pmstep_law_ref
     *u_b_V = sin_act * u_d + cos_act * u_q;
 }
 
-void pmstep_law_integrate(pmstep_law_integral_t *integral, const pmstep_law_coeffs_t *coeffs, float i_d_error_A,
-                          float i_q_error_A, float period_s)
-{
-    if (coeffs->current_integral_gain_per_s2 > 0.0f) {
-        integral->i_d_error_integral_As += period_s * i_d_error_A;
-        integral->i_q_error_integral_As += period_s * i_q_error_A;
-    }
-}

@@ -63,8 +63,19 @@ typedef struct {
  * Detent torque at (c-hat, s-hat): sin 4x = 2 sin 2x cos 2x with sin 2x = 2 c s and
  * cos 2x = c^2 - s^2 (no libm call). Zero when the model has no detent torque.
  */
-pmstep_detent_t pmstep_law_detent(const pmstep_law_coeffs_t *coeffs, float cos_hat, float sin_hat,
-                                  float speed_hat_rad_s);
+static inline pmstep_detent_t pmstep_law_detent(const pmstep_law_coeffs_t *coeffs, float cos_hat, float sin_hat,
+                                                float speed_hat_rad_s)
+{
+    pmstep_detent_t detent = {0.0f, 0.0f};
+    if (coeffs->detent_torque_Nm > 0.0f) {
+        const float cos_2x = cos_hat * cos_hat - sin_hat * sin_hat;
+        const float sin_2x = 2.0f * cos_hat * sin_hat;
+        detent.torque_Nm = -coeffs->detent_torque_Nm * 2.0f * sin_2x * cos_2x;
+        detent.rate_Nm_s = -coeffs->detent_torque_Nm * coeffs->detent_order * speed_hat_rad_s
+                           * (cos_2x * cos_2x - sin_2x * sin_2x);
+    }
+    return detent;
+}
 
 /**
  * The turn from the sample to the middle of the period the voltage acts in, p w-hat T_s
@@ -115,8 +126,14 @@ void pmstep_law_voltages(const pmstep_law_coeffs_t *coeffs, const pmstep_law_ref
 
 /** Advances the current-error integrals by one period (when K_I > 0; the caller skips periods whose voltage
  *  the bus limited: anti-windup). */
-void pmstep_law_integrate(pmstep_law_integral_t *integral, const pmstep_law_coeffs_t *coeffs, float i_d_error_A,
-                          float i_q_error_A, float period_s);
+static inline void pmstep_law_integrate(pmstep_law_integral_t *integral, const pmstep_law_coeffs_t *coeffs,
+                                        float i_d_error_A, float i_q_error_A, float period_s)
+{
+    if (coeffs->current_integral_gain_per_s2 > 0.0f) {
+        integral->i_d_error_integral_As += period_s * i_d_error_A;
+        integral->i_q_error_integral_As += period_s * i_q_error_A;
+    }
+}
 
 #ifdef __cplusplus
 }
