@@ -110,12 +110,15 @@ def sil_command(args, seed, params, case_dir, csv_output):
 
 def rerun_command(args, seed):
     """The command that re-runs one case with this tool (same bounds, same output folder)."""
-    cmd = ["python3", args.script, "--sil", args.sil, "--scenario", args.scenario, "--out", args.out]
+    if getattr(args, "preset", None):
+        cmd = ["python3", args.script, "--sil", args.sil, "--preset", args.preset, "--tune", args.tune, "--out", args.out]
+    else:
+        cmd = ["python3", args.script, "--sil", args.sil, "--scenario", args.scenario, "--out", args.out]
     if args.duration is not None:
         cmd += ["--duration", format_value(args.duration)]
     for option, default in (("speed_bound", 0.5), ("angle_bound", 0.05), ("latency_bound", 0.05)):
         value = getattr(args, option)
-        if value != default:
+        if value != default or (option == "speed_bound" and getattr(args, "preset", None)):
             cmd += ["--" + option.replace("_", "-"), format_value(value)]
     for key in getattr(args, "exclude", []):
         cmd += ["--exclude", key]

@@ -6,6 +6,12 @@ Usage:
       --cases N --seed S --out DIR [--engine dask|threads] [--jobs J] [--scheduler ADDRESS [--ship-sil]]
       [--duration SECONDS] [--no-plots] [--check]
   tools/monte_carlo.py --sil PATH/pmstep-sil --scenario FILE --out DIR --case CASE_SEED
+  tools/monte_carlo.py --sil PATH/pmstep-sil --preset sil/scenarios/motors/17hs4401.ini --cases N --out DIR ...
+
+--preset FILE runs the campaign on a motor preset instead of a scenario file: the gain
+designer's settings (pmstep-tune --robust, --tune PATH, by default next to --sil) behind the
+realistic chain, and a distribution table scaled to the motor (mc_preset.py says how); the
+speed bound is then 2 % of the designer's top speed unless --speed-bound is given.
 
 Parts: mc_distributions.py (what is drawn), mc_execution.py (running the cases on an
 engine, resuming), mc_outcome.py (a case's class and numbers), mc_report.py (aggregate,
@@ -85,6 +91,7 @@ from mc_execution import (ENGINES, check_keys, read_scenario, rerun_command, run
                           run_case, sil_command, sil_version)
 from mc_outcome import (CLASSES, CLASS_TEXT, FAULT_EXIT_STATUS, REQUIRED_FIELDS, classify,  # noqa: E402,F401
                         extract_metrics, fault_name, get_path, number_or_none, summary_problem)
+from mc_preset import design_scenario, preset_distributions, read_preset  # noqa: E402
 from mc_report import (CSV_METRICS, WORST_CASES, aggregate, check_verdict, make_plots,  # noqa: E402,F401
                        percentile, spans_decades, wilson_interval, worst_order, write_cases_csv,
                        write_report)
@@ -95,7 +102,12 @@ def parse_args(argv):
         description="Monte Carlo robustness runner for pmstep-sil (see the module docstring).",
         formatter_class=argparse.RawDescriptionHelpFormatter, epilog=__doc__.split("\n\n", 1)[1])
     parser.add_argument("--sil", required=True, help="the pmstep-sil executable")
-    parser.add_argument("--scenario", required=True, help="scenario INI file the cases start from")
+    parser.add_argument("--scenario", default=None, help="scenario INI file the cases start from")
+    parser.add_argument("--preset", default=None, metavar="FILE",
+                        help="a motor preset (sil/scenarios/motors/*.ini) instead of --scenario: the designer's gains, "
+                             "the realistic chain, distributions scaled to the motor (mc_preset.py)")
+    parser.add_argument("--tune", default=None, metavar="PATH",
+                        help="pmstep-tune for --preset (default: the one next to --sil)")
     parser.add_argument("--out", required=True, help="output folder")
     parser.add_argument("--cases", type=int, default=100, help="number of cases N (default 100)")
     parser.add_argument("--seed", type=int, default=1, help="base seed S: case k has seed S*100000+k (default 1)")
@@ -113,8 +125,9 @@ def parse_args(argv):
     parser.add_argument("--check", action="store_true", help="exit 1 unless the run meets the criteria")
     parser.add_argument("--case", type=int, default=None, metavar="CASE_SEED",
                         help="re-run the one case with this case seed and print its summary")
-    parser.add_argument("--speed-bound", type=float, default=0.5, metavar="RAD_S",
-                        help="max |w - w*| after settling for success (default 0.5 rad/s)")
+    parser.add_argument("--speed-bound", type=float, default=None, metavar="RAD_S",
+                        help="max |w - w*| after settling for success (default 0.5 rad/s; with --preset 2 %% of the "
+                             "designer's top speed)")
     parser.add_argument("--angle-bound", type=float, default=0.05, metavar="RAD",
                         help="max angle-estimate error after settling for success (default 0.05 rad)")
     parser.add_argument("--latency-bound", type=float, default=0.05, metavar="SECONDS",
@@ -126,6 +139,12 @@ def parse_args(argv):
     parser.add_argument("--case-timeout", type=float, default=600.0, metavar="SECONDS",
                         help="wall time after which one run counts as crashed (default 600 s)")
     args = parser.parse_args(argv[1:])
+    if (args.scenario is None) == (args.preset is None):
+        parser.error("give one of --scenario and --preset")
+    if args.tune is not None and args.preset is None:
+        parser.error("--tune is for --preset")
+    if args.preset is not None and args.tune is None:
+        args.tune = os.path.join(os.path.dirname(os.path.abspath(args.sil)), "pmstep-tune")
     if args.case is None and not 1 <= args.cases <= SEED_STRIDE:
         parser.error(f"--cases must be between 1 and {SEED_STRIDE}")
     if args.seed < 0 or (args.case is not None and args.case < 0):
@@ -169,8 +188,39 @@ def run_one(args, scenario, base):
     return 1 if args.check and not passed else 0
 
 
+def use_preset(args):
+    """--preset: designs the campaign's scenario into DIR, puts the preset's distribution table in
+    place of the paper's, and sets the speed bound; returns what the report says of the preset."""
+    if not os.path.isfile(args.preset):
+        raise ToolError(f"motor preset {args.preset} not found")
+    if not (os.path.isfile(args.tune) and os.access(args.tune, os.X_OK)):
+        raise ToolError(f"{args.tune} is not an executable file (pmstep-tune, built beside pmstep-sil; or give --tune)")
+    read_preset(args.preset)  # a clear error for a bad preset before the designer runs
+    args.scenario, info = design_scenario(args.tune, args.preset, args.out)
+    # In place, so every function's default table (the same list object) sees it.
+    DISTRIBUTIONS[:] = preset_distributions(info["figures"], info["peak_speed_rad_s"], info["paper_holding_torque_Nm"])
+    if args.speed_bound is None:
+        args.speed_bound = info["speed_bound_rad_s"]
+    print(f"monte_carlo: preset {info['preset']}: top speed {info['top_speed_rad_s']:g} rad/s, profile peak "
+          f"{info['peak_speed_rad_s']:g} rad/s, load step {info['load_Nm']:.4g} N m, speed bound "
+          f"{args.speed_bound:.4g} rad/s; scenario {args.scenario}", file=sys.stderr)
+    return {key: info[key] for key in ("preset", "preset_file", "top_speed_rad_s", "t_c_s", "peak_speed_rad_s",
+                                       "load_Nm", "speed_bound_rad_s", "tune_command")}
+
+
 def main(argv):
     args = parse_args(argv)
+    preset_info = None
+    if args.preset is not None:
+        try:
+            os.makedirs(args.out, exist_ok=True)
+            preset_info = use_preset(args)
+        except (ToolError, OSError) as e:
+            sys.stderr.write(f"monte_carlo: {e}\n")
+            print("0 passed, 0 failed")
+            return 2
+    elif args.speed_bound is None:
+        args.speed_bound = 0.5
     unknown = [key for key in args.exclude if key not in [row[0] for row in DISTRIBUTIONS]]
     if unknown:
         print(f"monte_carlo: --exclude {', '.join(unknown)}: not in the distribution table", file=sys.stderr)
@@ -240,6 +290,7 @@ def main(argv):
                               "sil_firmware_wall_s_mean": mean_of("firmware_wall_s"),
                               "sil_plant_wall_s_mean": mean_of("plant_wall_s")},
                 "distribution_table": [list(row) for row in DISTRIBUTIONS],
+                "preset": preset_info,
                 "worst_cases": [{"seed": r["seed"], "class": r["class"], "reason": r["reason"],
                                  "max_speed_error_rad_s": r["metrics"].get("max_speed_error_rad_s"),
                                  "command": shlex.join(r["command"])}

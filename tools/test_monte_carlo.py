@@ -18,6 +18,7 @@ import unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import monte_carlo as mc  # noqa: E402  (after the path is set)
+import mc_preset  # noqa: E402
 
 SCRIPT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "monte_carlo.py")
 
@@ -258,6 +259,126 @@ class Statistics(unittest.TestCase):
         cases = [case(1, "success", 0.4), case(2, "detected", 0.0), case(3, "success", 0.45),
                  case(4, "crashed", None), case(5, "out_of_spec", 3.0)]
         self.assertEqual([c["seed"] for c in mc.worst_order(cases)], [4, 5, 2, 3, 1])
+
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+PRESET_17HS = os.path.join(ROOT, "sil", "scenarios", "motors", "17hs4401.ini")
+
+FAKE_TUNE = textwrap.dedent('''\
+    """Stand-in for pmstep-tune: prints the two lines mc_preset reads and writes a design INI."""
+    import sys
+    args = sys.argv[1:]
+    assert "--robust" in args and "--motor" in args
+    path = args[args.index("--write-ini") + 1]
+    print("  top speed at the bus (rated current, 90 % of 24 V): 69.0 rad/s (659 rpm)")
+    print("  alignment: 0.594 A (u = 0.891 V), t_s 0.09 s, t_c 0.18 s; swing 957 rad/s")
+    with open(path, "w") as f:
+        f.write("[scenario]\\nname = 17hs4401\\n[motor]\\nresistance_Ohm = 1.5\\n[run]\\nloss_speed_error_rad_s = 2\\n"
+                "[speed]\\npoints = 0:0, 0.33:0, 0.38:55.2,\\n    0.68:55.2, 0.73:-55.2, 1.0:0\\n"
+                "[load]\\ntype = none\\ntorque_Nm = 2\\nstep_time_s = 0.63\\n"
+                "[sensors]\\nadc_bits = 12\\n")
+    ''')
+
+
+class PresetDistributions(unittest.TestCase):
+    """--preset: the table scaled to the motor (17HS4401: 0.40 N m holding, 1.5 Ohm, 24 V bus)."""
+
+    @classmethod
+    def setUpClass(cls):
+        import configparser
+        cls.preset = mc.read_preset(PRESET_17HS)
+        cls.paper_holding = mc_preset.paper_holding_torque()
+        cls.peak = 55.2
+        cls.table = mc.preset_distributions(cls.preset, cls.peak, cls.paper_holding)
+        ini = configparser.ConfigParser(inline_comment_prefixes=(";",))
+        ini.read(PRESET_17HS)
+        cls.motor = {key: ini.getfloat("motor", key.split(".")[1]) for key in
+                     ("motor.resistance_Ohm", "motor.inductance_H", "motor.torque_constant_Nm_A",
+                      "motor.inertia_kgm2")}
+        cls.load = 2.0 * 0.40 / cls.paper_holding  # the paper's 2 N m of its 22.6 N m holding torque
+        cls.base = dict(cls.motor, **{"load.torque_Nm": cls.load})
+
+    def test_preset_figures(self):
+        self.assertEqual(self.preset["holding_torque_Nm"], 0.40)
+        self.assertEqual(self.preset["bus_voltage_V"], 24.0)
+        self.assertAlmostEqual(self.paper_holding, 2.0 * 8.0 * math.sqrt(2.0), places=5)
+
+    def test_same_rows_as_the_paper_table(self):
+        self.assertEqual([row[0] for row in self.table], [row[0] for row in mc.DISTRIBUTIONS])
+        paper = {row[0]: row for row in mc.DISTRIBUTIONS}
+        for key in ("sensors.offset_a_A", "sensors.offset_b_A", "sensors.gain_error_a", "sensors.gain_error_b",
+                    "sensors.noise_rms_A", "inverter.dead_time_s", "controller.inverter.dead_time_s",
+                    "run.theta0_deg"):
+            self.assertIn(paper[key], self.table, key)  # the chain's rows unchanged
+
+    def test_draws_scaled_to_the_preset(self):
+        drawn = [mc.draw_parameters(seed, self.base, self.table) for seed in range(2000)]
+        factors = {"motor.resistance_Ohm": (0.9, 1.1), "motor.inductance_H": (0.9, 1.1),
+                   "motor.torque_constant_Nm_A": (0.9, 1.1), "motor.inertia_kgm2": (0.8, 1.2)}
+        for key, (low, high) in factors.items():
+            ratios = [p[key] / self.motor[key] for p in drawn]
+            self.assertGreaterEqual(min(ratios), low, key)
+            self.assertLess(max(ratios), high, key)
+            self.assertLess(min(ratios), low + 0.01 * (high - low), key)   # the whole range is used
+            self.assertGreater(max(ratios), high - 0.01 * (high - low), key)
+        limits = {"load.torque_Nm": self.load,                     # 8.8 % of 0.40 N m, not 2 N m
+                  "bus.ripple_V": 2.0 * 24.0 / 48.0,               # 1 V on 24 V, not 2 V
+                  "bus.source_resistance_Ohm": 0.2 * 1.5 / 3.0,    # 0.1 Ohm, not 0.2 Ohm
+                  "motor.friction_Nms_rad": 2.0 * 1e-4}            # twice the preset's assumed friction
+        for key, limit in limits.items():
+            values = [p[key] for p in drawn]
+            self.assertGreaterEqual(min(values), 0.0, key)
+            self.assertLess(max(values), limit, key)
+            self.assertGreater(max(values), 0.99 * limit, key)
+        self.assertLess(self.load, 0.036)
+        # The paper's absolute friction bound (0.005 N m s, 50 times this motor's) is not drawn.
+        self.assertLess(max(p["motor.friction_Nms_rad"] for p in drawn), 0.005 / 20)
+
+    def test_friction_floor_from_the_paper_table(self):
+        # A preset without a friction: the paper table's friction torque at its peak speed,
+        # as the same fraction of the holding torque, at this profile's peak speed.
+        frictionless = dict(self.preset, friction_Nms_rad=0.0)
+        table = {row[0]: row for row in mc.preset_distributions(frictionless, self.peak, self.paper_holding)}
+        expected = 0.005 * 10.0 * (0.40 / self.paper_holding) / self.peak
+        self.assertEqual(table["motor.friction_Nms_rad"][1:3], ("uniform", 0.0))
+        self.assertAlmostEqual(table["motor.friction_Nms_rad"][3], expected, places=15)
+
+    def test_designed_scenario(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            tune = os.path.join(tmp, "fake-tune")
+            with open(tune, "w") as f:
+                f.write(f"#!{sys.executable}\n" + FAKE_TUNE)
+            os.chmod(tune, 0o755)
+            path, info = mc_preset.design_scenario(tune, PRESET_17HS, tmp)
+            with open(path) as f:
+                text = f.read()
+        self.assertEqual(info["top_speed_rad_s"], 69.0)
+        self.assertEqual(info["peak_speed_rad_s"], 55.2)
+        self.assertAlmostEqual(info["load_Nm"], self.load, places=15)
+        self.assertAlmostEqual(info["speed_bound_rad_s"], 0.02 * 69.0, places=12)
+        scenario = mc.parse_scenario(text)
+        self.assertEqual(scenario["load.type"], "step")
+        self.assertAlmostEqual(float(scenario["load.torque_Nm"]), self.load, places=15)
+        self.assertAlmostEqual(float(scenario["load.step_time_s"]), 0.18 + 0.03, places=12)
+        self.assertAlmostEqual(float(scenario["run.loss_speed_error_rad_s"]), 4 * 0.02 * 69.0, places=12)
+        command = info["tune_command"]
+        self.assertIn("--robust", command)
+        for item in ("sensors.current_full_scale_A=5.1",   # 3 x the rated 1.7 A
+                     "inverter.model=switching", "sensors.noise_rms_A=0.005", "run.delay_periods=1"):
+            self.assertEqual(command[command.index(item) - 1], "--set", item)
+        self.assertTrue(all(len(line) < 197 for line in text.splitlines()))  # the INI reader's limit
+
+    def test_bad_preset(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            bad = os.path.join(tmp, "bad.ini")
+            with open(bad, "w") as f:
+                f.write("[datasheet]\nrated_current_A = 1.7\n[motor]\nresistance_Ohm = 1.5\n")
+            with self.assertRaises(mc.ToolError):
+                mc.read_preset(bad)
+        proc = subprocess.run([sys.executable, SCRIPT, "--sil", sys.executable, "--scenario", PRESET_17HS,
+                               "--preset", PRESET_17HS, "--out", "unused"], capture_output=True, text=True, timeout=60)
+        self.assertEqual(proc.returncode, 2)
+        self.assertIn("one of --scenario and --preset", proc.stderr)
 
 
 FAKE_SIL = textwrap.dedent('''\

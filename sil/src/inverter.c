@@ -51,6 +51,12 @@ void sil_inverter_init(sil_inverter_t *inv, const sil_inverter_config_t *cfg, co
     }
     inv->mean_bus_current_A = 0.0;
     inv->limited_periods = 0;
+    for (k = 0; k < 2; ++k) {
+        inv->ripple_memo_t_s[k] = 0.0;
+        inv->ripple_memo_hz[k] = 0.0;
+        inv->ripple_memo_sin[k] = 0.0; /* sin(2 pi 0 0) */
+    }
+    inv->ripple_memo_next = 0u;
 }
 
 static double clip(double u_V, double limit_V, bool *clipped)
@@ -104,14 +110,32 @@ void sil_inverter_apply(sil_inverter_t *inv, const pmstep_output_t *out, double 
     inv->applied_b_V = next_b_V;
 }
 
-double sil_inverter_bus_voltage(const sil_inverter_t *inv, double t_s)
+/* sin(2 pi f t) of the ripple, from the memo when (t, f) is one of its two entries. */
+static double ripple_sin(sil_inverter_t *inv, double t_s)
+{
+    const double hz = inv->bus.ripple_Hz;
+    unsigned k;
+    for (k = 0; k < 2u; ++k) {
+        if (inv->ripple_memo_t_s[k] == t_s && inv->ripple_memo_hz[k] == hz) {
+            return inv->ripple_memo_sin[k];
+        }
+    }
+    k = inv->ripple_memo_next & 1u;
+    inv->ripple_memo_next = k ^ 1u;
+    inv->ripple_memo_t_s[k] = t_s;
+    inv->ripple_memo_hz[k] = hz;
+    inv->ripple_memo_sin[k] = sin(2.0 * PI * hz * t_s);
+    return inv->ripple_memo_sin[k];
+}
+
+double sil_inverter_bus_voltage(sil_inverter_t *inv, double t_s)
 {
     double v = inv->nominal_bus_voltage_V;
     if (inv->bus.source_resistance_Ohm > 0.0) {
         v -= inv->bus.source_resistance_Ohm * inv->mean_bus_current_A;
     }
     if (inv->bus.ripple_V > 0.0) {
-        v += inv->bus.ripple_V * sin(2.0 * PI * inv->bus.ripple_Hz * t_s);
+        v += inv->bus.ripple_V * ripple_sin(inv, t_s);
     }
     return v > 0.0 ? v : 0.0;
 }
@@ -124,7 +148,7 @@ static int sign_of(double x)
 /* Sums over one period. */
 typedef struct {
     plant_t *plant;
-    const sil_inverter_t *inv;
+    sil_inverter_t *inv;
     double t0_s;
     double bus_V;          /* bus voltage at the period start (held over the period without ripple) */
     bool started;
@@ -147,7 +171,7 @@ static bool *phase_open(plant_t *plant, int k)
 }
 
 /* Bus voltage held over the substep [t, t + h]: at its midpoint when there is ripple. */
-static double substep_bus_V(const period_t *p, double t_s, double h_s)
+static double substep_bus_V(period_t *p, double t_s, double h_s)
 {
     return p->inv->bus.ripple_V > 0.0 ? sil_inverter_bus_voltage(p->inv, t_s + 0.5 * h_s) : p->bus_V;
 }

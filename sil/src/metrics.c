@@ -6,6 +6,16 @@
 
 #define PI 3.14159265358979323846
 
+/* fmax as the C library defines it (a NaN argument gives the other one), inline: fmax is a
+ * libm call on x86-64, and these maxima are taken every period. */
+static double max_of(double a, double b)
+{
+    if (b > a) {
+        return b;
+    }
+    return isnan(a) ? b : a;
+}
+
 long sil_periods_in(double duration_s, double period_s)
 {
     return (long)floor(duration_s / period_s + 0.5);
@@ -98,7 +108,7 @@ static void add_load_angle(sil_metrics_t *m, const sil_sample_t *x, sil_summary_
     }
     angle = fabs(angle + m->load_angle_offset_rad);
     if (x->step >= m->metrics_start_step) {
-        s->max_load_angle_rad = fmax(s->max_load_angle_rad, angle);
+        s->max_load_angle_rad = max_of(s->max_load_angle_rad, angle);
     }
     if (angle > PI && !s->loss_of_synchronism) {
         s->loss_of_synchronism = true;
@@ -135,19 +145,19 @@ void sil_metrics_add(sil_metrics_t *m, const sil_sample_t *x, sil_summary_t *s)
         s->sin_ptheta_at_tc = x->sin_ptheta;
         s->i_a_residual_at_tc_A = x->i_a_A - m->c_align_current_A;
     }
-    s->max_phase_voltage_V = fmax(s->max_phase_voltage_V, fmax(fabs(x->u_a_V), fabs(x->u_b_V)));
-    s->max_phase_current_A = fmax(s->max_phase_current_A, fmax(fabs(x->i_a_A), fabs(x->i_b_A)));
+    s->max_phase_voltage_V = max_of(s->max_phase_voltage_V, max_of(fabs(x->u_a_V), fabs(x->u_b_V)));
+    s->max_phase_current_A = max_of(s->max_phase_current_A, max_of(fabs(x->i_a_A), fabs(x->i_b_A)));
     if (out->voltage_limited) {
         s->voltage_limited_periods++;
     }
     if (out->mode == PMSTEP_MODE_RUN) {
         const double speed_error = fabs(x->omega_rad_s - (double)out->speed_ref_rad_s);
         if (x->step < m->transient_end_step) {
-            s->transient_max_speed_error_rad_s = fmax(s->transient_max_speed_error_rad_s, speed_error);
+            s->transient_max_speed_error_rad_s = max_of(s->transient_max_speed_error_rad_s, speed_error);
             m->transient_sq += speed_error * speed_error;
             ++m->transient_n;
         } else {
-            s->tracking_max_speed_error_rad_s = fmax(s->tracking_max_speed_error_rad_s, speed_error);
+            s->tracking_max_speed_error_rad_s = max_of(s->tracking_max_speed_error_rad_s, speed_error);
             m->tracking_sq += speed_error * speed_error;
             ++m->tracking_n;
         }
@@ -155,14 +165,14 @@ void sil_metrics_add(sil_metrics_t *m, const sil_sample_t *x, sil_summary_t *s)
         s->final_load_Nm = x->load_Nm;
         if (m->microstep) {
             if (x->step >= m->settle_step) {
-                s->max_speed_error_after_settle_rad_s = fmax(s->max_speed_error_after_settle_rad_s, speed_error);
+                s->max_speed_error_after_settle_rad_s = max_of(s->max_speed_error_after_settle_rad_s, speed_error);
             }
         } else {
             /* The angle estimate (c-hat, s-hat) against the plant's p theta. */
             bool angle_lost;
             double ex, ey;
-            s->max_cos_error = fmax(s->max_cos_error, fabs((double)out->cos_hat - x->cos_ptheta));
-            s->max_sin_error = fmax(s->max_sin_error, fabs((double)out->sin_hat - x->sin_ptheta));
+            s->max_cos_error = max_of(s->max_cos_error, fabs((double)out->cos_hat - x->cos_ptheta));
+            s->max_sin_error = max_of(s->max_sin_error, fabs((double)out->sin_hat - x->sin_ptheta));
             angle_error_xy(out, x, &ex, &ey);
             m->last_angle_x = ex;
             m->last_angle_y = ey;
@@ -173,7 +183,7 @@ void sil_metrics_add(sil_metrics_t *m, const sil_sample_t *x, sil_summary_t *s)
                     m->max_angle_cos = ex / r;
                     m->max_angle_sin = ey / r;
                 }
-                s->max_speed_error_after_settle_rad_s = fmax(s->max_speed_error_after_settle_rad_s, speed_error);
+                s->max_speed_error_after_settle_rad_s = max_of(s->max_speed_error_after_settle_rad_s, speed_error);
             }
             angle_lost = m->loss_angle_reachable && ey * m->loss_angle_cos - ex * m->loss_angle_sin > 0.0;
             if (s->loss_of_control_time_s < 0.0 && (speed_error > m->loss_speed_error_rad_s || angle_lost)) {

@@ -211,8 +211,10 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
         sil_drive_advance(&plant, inverter, period_s, sc->substeps);
         if (timed) {
             const double t2 = now_s();
-            timed_firmware_s += fmax(0.0, t1 - t0 - clock_read_s);
-            timed_plant_s += fmax(0.0, t2 - t1 - clock_read_s);
+            const double firmware_s = t1 - t0 - clock_read_s;
+            const double plant_s = t2 - t1 - clock_read_s;
+            timed_firmware_s += firmware_s > 0.0 ? firmware_s : 0.0;
+            timed_plant_s += plant_s > 0.0 ? plant_s : 0.0;
             ++timed_periods;
         }
         if (rec != NULL) {

@@ -31,7 +31,8 @@ void sil_sensors_release(sil_sensors_t *s)
 
 double sil_adc_quantise(double x, double low, double high, unsigned bits, int *clipped)
 {
-    const double codes = ldexp(1.0, (int)bits);
+    /* 2^bits: a shift for the ADC's widths (no libm call a sample), ldexp beyond them. */
+    const double codes = bits < 31u ? (double)(1UL << bits) : ldexp(1.0, (int)bits);
     const double q = (high - low) / codes;
     double k = floor((x - low) / q + 0.5);
     *clipped = 0;

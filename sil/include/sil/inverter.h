@@ -103,6 +103,13 @@ typedef struct {
     double max_current_A[2];
     double mean_bus_current_A;     /**< mean i_bus, which sets the sag of the next period */
     unsigned long limited_periods; /**< periods the MCU had to clip its duty to +/- 1 */
+    /* The ripple's last two sines, sin(2 pi f t) for (t, f): a period asks for the same instant
+     * twice (the measurement at t_k, the period's start), so one sine of three is reused. A
+     * zeroed memo holds t = f = 0, whose sine is 0: consistent without an init. */
+    double ripple_memo_t_s[2];
+    double ripple_memo_hz[2];
+    double ripple_memo_sin[2];
+    unsigned ripple_memo_next;
 } sil_inverter_t;
 
 /** Averaged model, no dead time. */
@@ -119,7 +126,7 @@ void sil_inverter_init(sil_inverter_t *inv, const sil_inverter_config_t *cfg, co
 void sil_inverter_apply(sil_inverter_t *inv, const pmstep_output_t *out, double measured_bus_V);
 
 /** The actual bus voltage at time @p t_s of the coming period (sag of the last period, ripple at t). */
-double sil_inverter_bus_voltage(const sil_inverter_t *inv, double t_s);
+double sil_inverter_bus_voltage(sil_inverter_t *inv, double t_s);
 
 /**
  * Advances @p plant by @p period_s from plant->time_s through the inverter and bus
