@@ -145,7 +145,7 @@ def parse_args(argv):
     if args.tune is not None and args.preset is None:
         parser.error("--tune is for --preset")
     if args.preset is not None and args.tune is None:
-        args.tune = os.path.join(os.path.dirname(os.path.abspath(args.sil)), "pmstep-tune")
+        args.tune = os.path.join(os.path.dirname(args.sil) or ".", "pmstep-tune")
     if args.case is None and not 1 <= args.cases <= SEED_STRIDE:
         parser.error(f"--cases must be between 1 and {SEED_STRIDE}")
     if args.seed < 0 or (args.case is not None and args.case < 0):
