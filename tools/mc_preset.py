@@ -9,7 +9,7 @@ values that mean nothing for a NEMA 17. For a preset (sil/scenarios/motors/*.ini
   chain (sil/scenarios/robust.ini's: 12-bit ADC with a span of 3 x the rated current, +-20 mA
   offsets, 5 mA noise, 1 us dead time, one period of delay, switching inverter), with the
   designer's validation profile (ramps to +-80 % and +-5 % of the top speed) and a load step
-  at t_c + 30 ms, as in the paper;
+  30 ms after the start of RUN (the offset calibration and both alignments), as in the paper;
 - the plant's R, L, k_M are drawn x U[0.9, 1.1] and J x U[0.8, 1.2] of the preset's values;
 - what the paper table gives in absolute units is carried over as the same fraction of the
   motor's own figure: the load as a fraction of the holding torque (2 N m of the paper
@@ -20,9 +20,11 @@ values that mean nothing for a NEMA 17. For a preset (sil/scenarios/motors/*.ini
 - the measurement chain's rows (offsets, gain errors, noise, dead time and the firmware's
   programmed dead time) and the initial angle are the paper table's, unchanged.
 
-The success bounds scale too: the speed bound is 2 % of the designer's top speed (issue 11's
-tracking bound) unless --speed-bound is given, and the SIL's loss-of-control speed threshold
-is four times it, as 2 rad/s is four times the paper campaign's 0.5 rad/s.
+The speed thresholds scale with the top speed the designer gives (rated current at 90 % of
+the bus): the paper campaign's are 0.5 rad/s (success) and 2 rad/s (loss of control) on the
+paper motor, whose top speed is 9.6 rad/s, so a preset's are the same fractions of its own top
+speed (5.2 % and 21 %); --speed-bound overrides the first. The angle bounds (0.05 rad for
+success, 0.5 rad for a loss of control) are electrical angles and stay as they are.
 """
 import configparser
 import os
@@ -50,9 +52,9 @@ REALISTIC_CHAIN = ("sensors.adc_bits=12", "sensors.offset_a_A=0.02", "sensors.of
                    "sensors.noise_rms_A=0.005", "inverter.model=switching", "inverter.dead_time_s=1e-6",
                    "run.delay_periods=1")
 ADC_SPAN_RATED = 3.0
-LOAD_STEP_AFTER_TC_S = 0.03      # the paper's: 30 ms after t_c
-SPEED_BOUND_OF_TOP = 0.02        # issue 11: tracking within 2 % of the top speed
-LOSS_SPEED_OF_BOUND = 4.0        # the paper campaign: loss at 2 rad/s, bound 0.5 rad/s
+LOAD_STEP_AFTER_RUN_S = 0.03     # robust.ini's: 30 ms after RUN starts (0.68 s)
+PAPER_SPEED_BOUND_RAD_S = 0.5    # the paper campaign's success bound (monte_carlo.py --speed-bound)
+PAPER_LOSS_SPEED_RAD_S = 2.0     # robust.ini's run.loss_speed_error_rad_s
 
 
 def _ini(path):
@@ -115,6 +117,20 @@ def _design(tune, preset_path, chain_sets):
     return cmd
 
 
+def _run_designer(cmd):
+    """Runs pmstep-tune; returns the top speed (rad/s) it prints."""
+    try:
+        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
+    except (OSError, subprocess.TimeoutExpired) as e:
+        raise ToolError(f"cannot run {cmd[0]}: {e}") from None
+    if proc.returncode != 0:
+        raise ToolError(f"{' '.join(cmd)} failed (status {proc.returncode}):\n{proc.stderr.strip()}")
+    top = re.search(r"V\): ([0-9.eE+-]+) rad/s", proc.stdout)
+    if top is None:
+        raise ToolError(f"cannot read the top speed from the output of {' '.join(cmd)}:\n{proc.stdout}")
+    return float(top.group(1))
+
+
 def _points_lines(points):
     """speed.points as an INI value on continuation lines of six points (short lines)."""
     rows = [", ".join(points[i:i + 6]) for i in range(0, len(points), 6)]
@@ -124,43 +140,42 @@ def _points_lines(points):
 def design_scenario(tune, preset_path, out_dir):
     """Designs the preset with pmstep-tune (robust mode, realistic chain) and writes the
     campaign's scenario to out_dir/preset_scenario.ini. Returns (its path, info) with info =
-    {"preset", "top_speed_rad_s", "t_c_s", "peak_speed_rad_s", "load_Nm", "tune_command"}."""
+    {"preset", "top_speed_rad_s", "run_start_s", "peak_speed_rad_s", "load_Nm", "tune_command", ...}."""
     preset = read_preset(preset_path)
     paper_holding = paper_holding_torque()
     chain = list(REALISTIC_CHAIN) + [f"sensors.current_full_scale_A={ADC_SPAN_RATED * preset['rated_current_A']:g}"]
     os.makedirs(out_dir, exist_ok=True)
     design_path = os.path.join(out_dir, "preset_design.ini")
     cmd = _design(tune, preset_path, chain) + ["--write-ini", design_path]
-    try:
-        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
-    except (OSError, subprocess.TimeoutExpired) as e:
-        raise ToolError(f"cannot run {tune}: {e}") from None
-    if proc.returncode != 0:
-        raise ToolError(f"{' '.join(cmd)} failed (status {proc.returncode}):\n{proc.stderr.strip()}")
-    top = re.search(r"V\): ([0-9.eE+-]+) rad/s", proc.stdout)
-    t_c = re.search(r"t_c ([0-9.eE+-]+) s", proc.stdout)
-    if top is None or t_c is None:
-        raise ToolError(f"cannot read the top speed and t_c from the output of {' '.join(cmd)}:\n{proc.stdout}")
+    top = _run_designer(cmd)
+    # The paper motor's top speed, which the paper campaign's speed thresholds are relative to.
+    paper_span = ADC_SPAN_RATED * read_preset(PAPER_PRESET)["rated_current_A"]
+    paper_chain = list(REALISTIC_CHAIN) + [f"sensors.current_full_scale_A={paper_span:g}"]
+    paper_top = _run_designer(_design(tune, PAPER_PRESET, paper_chain))
     ini = _ini(design_path)
     try:
         points = [p.strip() for p in ini.get("speed", "points").replace("\n", " ").split(",") if p.strip()]
         peak = max(abs(float(p.split(":")[1])) for p in points)
+        # RUN starts after the offset calibration and the two alignments (t_c counts from their start).
+        run_start = (float(ini.get("controller.commissioning", "offset_calibration_time_s", fallback="0"))
+                     + float(ini.get("controller.alignment", "c_align_time_s")))
     except (configparser.Error, ValueError, IndexError) as e:
-        raise ToolError(f"{design_path}: cannot read speed.points ({e})") from None
-    info = {"preset": preset["name"], "preset_file": preset_path, "top_speed_rad_s": float(top.group(1)),
-            "t_c_s": float(t_c.group(1)), "peak_speed_rad_s": peak,
+        raise ToolError(f"{design_path}: cannot read speed.points and the alignment times ({e})") from None
+    info = {"preset": preset["name"], "preset_file": preset_path, "top_speed_rad_s": top,
+            "paper_top_speed_rad_s": paper_top, "run_start_s": run_start, "peak_speed_rad_s": peak,
             "load_Nm": PAPER_LOAD_NM * preset["holding_torque_Nm"] / paper_holding,
             "tune_command": cmd, "figures": preset, "paper_holding_torque_Nm": paper_holding}
-    speed_bound = SPEED_BOUND_OF_TOP * info["top_speed_rad_s"]
+    speed_bound = PAPER_SPEED_BOUND_RAD_S * top / paper_top
+    loss_speed = PAPER_LOSS_SPEED_RAD_S * top / paper_top
     ini.set("scenario", "name", f"{preset['name']}_mc")
     ini.set("load", "type", "step")
     ini.set("load", "torque_Nm", repr(info["load_Nm"]))
-    ini.set("load", "step_time_s", repr(info["t_c_s"] + LOAD_STEP_AFTER_TC_S))
-    ini.set("run", "loss_speed_error_rad_s", repr(LOSS_SPEED_OF_BOUND * speed_bound))
+    ini.set("load", "step_time_s", repr(run_start + LOAD_STEP_AFTER_RUN_S))
+    ini.set("run", "loss_speed_error_rad_s", repr(loss_speed))
     lines = ["; Monte Carlo scenario of the motor preset " + os.path.basename(preset_path) + " (monte_carlo.py --preset):",
              "; pmstep-tune --robust behind the realistic chain (tools/mc_preset.py), with a load step",
-             f"; of {info['load_Nm']:.6g} N m at t_c + {LOAD_STEP_AFTER_TC_S:g} s and loss of control at",
-             f"; |w - w*| > {LOSS_SPEED_OF_BOUND:g} x 2 % of the top speed"]
+             f"; of {info['load_Nm']:.6g} N m {LOAD_STEP_AFTER_RUN_S:g} s into RUN and loss of control at",
+             f"; |w - w*| > {loss_speed:.6g} rad/s (2 rad/s x top speed / the paper motor's)"]
     for section in ini.sections():
         lines.append(f"[{section}]")
         for key, value in ini.items(section):

@@ -201,7 +201,7 @@ def write_report(path, records, agg, args, scenario, version, plots, started_utc
     if preset:
         lines.append(f"- motor preset: `{preset['preset_file']}`, designed by `{shlex.join(preset['tune_command'])}`: "
                      f"top speed {preset['top_speed_rad_s']:g} rad/s, profile peak {preset['peak_speed_rad_s']:g} rad/s, "
-                     f"load step {preset['load_Nm']:.4g} N m at t_c + 30 ms (distributions scaled to the motor: "
+                     f"load step {preset['load_Nm']:.4g} N m 30 ms into RUN (distributions scaled to the motor: "
                      "tools/mc_preset.py)")
     if version:
         lines.append(f"- pmstep-sil: {version}")

@@ -11,7 +11,8 @@ Usage:
 --preset FILE runs the campaign on a motor preset instead of a scenario file: the gain
 designer's settings (pmstep-tune --robust, --tune PATH, by default next to --sil) behind the
 realistic chain, and a distribution table scaled to the motor (mc_preset.py says how); the
-speed bound is then 2 % of the designer's top speed unless --speed-bound is given.
+speed bounds are then the paper campaign's as fractions of the designer's top speed (the
+success bound 0.5 rad/s x top speed / 9.6 rad/s, the paper motor's) unless --speed-bound is given.
 
 Parts: mc_distributions.py (what is drawn), mc_execution.py (running the cases on an
 engine, resuming), mc_outcome.py (a case's class and numbers), mc_report.py (aggregate,
@@ -126,8 +127,8 @@ def parse_args(argv):
     parser.add_argument("--case", type=int, default=None, metavar="CASE_SEED",
                         help="re-run the one case with this case seed and print its summary")
     parser.add_argument("--speed-bound", type=float, default=None, metavar="RAD_S",
-                        help="max |w - w*| after settling for success (default 0.5 rad/s; with --preset 2 %% of the "
-                             "designer's top speed)")
+                        help="max |w - w*| after settling for success (default 0.5 rad/s; with --preset the same "
+                             "fraction of the designer's top speed as 0.5 rad/s of the paper motor's)")
     parser.add_argument("--angle-bound", type=float, default=0.05, metavar="RAD",
                         help="max angle-estimate error after settling for success (default 0.05 rad)")
     parser.add_argument("--latency-bound", type=float, default=0.05, metavar="SECONDS",
@@ -144,7 +145,7 @@ def parse_args(argv):
     if args.tune is not None and args.preset is None:
         parser.error("--tune is for --preset")
     if args.preset is not None and args.tune is None:
-        args.tune = os.path.join(os.path.dirname(os.path.abspath(args.sil)), "pmstep-tune")
+        args.tune = os.path.join(os.path.dirname(args.sil) or ".", "pmstep-tune")
     if args.case is None and not 1 <= args.cases <= SEED_STRIDE:
         parser.error(f"--cases must be between 1 and {SEED_STRIDE}")
     if args.seed < 0 or (args.case is not None and args.case < 0):
@@ -204,7 +205,7 @@ def use_preset(args):
     print(f"monte_carlo: preset {info['preset']}: top speed {info['top_speed_rad_s']:g} rad/s, profile peak "
           f"{info['peak_speed_rad_s']:g} rad/s, load step {info['load_Nm']:.4g} N m, speed bound "
           f"{args.speed_bound:.4g} rad/s; scenario {args.scenario}", file=sys.stderr)
-    return {key: info[key] for key in ("preset", "preset_file", "top_speed_rad_s", "t_c_s", "peak_speed_rad_s",
+    return {key: info[key] for key in ("preset", "preset_file", "top_speed_rad_s", "run_start_s", "peak_speed_rad_s",
                                        "load_Nm", "speed_bound_rad_s", "tune_command")}
 
 

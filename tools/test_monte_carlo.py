@@ -269,14 +269,18 @@ FAKE_TUNE = textwrap.dedent('''\
     import sys
     args = sys.argv[1:]
     assert "--robust" in args and "--motor" in args
-    path = args[args.index("--write-ini") + 1]
-    print("  top speed at the bus (rated current, 90 % of 24 V): 69.0 rad/s (659 rpm)")
+    top = 9.6 if args[args.index("--motor") + 1].endswith("paper.ini") else 69.0
+    print(f"  top speed at the bus (rated current, 90 % of 24 V): {top} rad/s (659 rpm)")
     print("  alignment: 0.594 A (u = 0.891 V), t_s 0.09 s, t_c 0.18 s; swing 957 rad/s")
+    if "--write-ini" not in args:
+        sys.exit(0)
+    path = args[args.index("--write-ini") + 1]
     with open(path, "w") as f:
         f.write("[scenario]\\nname = 17hs4401\\n[motor]\\nresistance_Ohm = 1.5\\n[run]\\nloss_speed_error_rad_s = 2\\n"
                 "[speed]\\npoints = 0:0, 0.33:0, 0.38:55.2,\\n    0.68:55.2, 0.73:-55.2, 1.0:0\\n"
                 "[load]\\ntype = none\\ntorque_Nm = 2\\nstep_time_s = 0.63\\n"
-                "[sensors]\\nadc_bits = 12\\n")
+                "[sensors]\\nadc_bits = 12\\n[controller.alignment]\\nc_align_time_s = 0.18\\n"
+                "[controller.commissioning]\\noffset_calibration_time_s = 0.05\\n")
     ''')
 
 
@@ -355,12 +359,16 @@ class PresetDistributions(unittest.TestCase):
         self.assertEqual(info["top_speed_rad_s"], 69.0)
         self.assertEqual(info["peak_speed_rad_s"], 55.2)
         self.assertAlmostEqual(info["load_Nm"], self.load, places=15)
-        self.assertAlmostEqual(info["speed_bound_rad_s"], 0.02 * 69.0, places=12)
+        # The paper campaign's 0.5 rad/s and 2 rad/s on a motor of 9.6 rad/s top speed, scaled to 69 rad/s.
+        self.assertEqual(info["paper_top_speed_rad_s"], 9.6)
+        self.assertAlmostEqual(info["speed_bound_rad_s"], 0.5 * 69.0 / 9.6, places=12)
         scenario = mc.parse_scenario(text)
         self.assertEqual(scenario["load.type"], "step")
         self.assertAlmostEqual(float(scenario["load.torque_Nm"]), self.load, places=15)
-        self.assertAlmostEqual(float(scenario["load.step_time_s"]), 0.18 + 0.03, places=12)
-        self.assertAlmostEqual(float(scenario["run.loss_speed_error_rad_s"]), 4 * 0.02 * 69.0, places=12)
+        # 30 ms into RUN, which starts after the offset calibration and the alignments.
+        self.assertAlmostEqual(info["run_start_s"], 0.05 + 0.18, places=12)
+        self.assertAlmostEqual(float(scenario["load.step_time_s"]), 0.05 + 0.18 + 0.03, places=12)
+        self.assertAlmostEqual(float(scenario["run.loss_speed_error_rad_s"]), 2.0 * 69.0 / 9.6, places=12)
         command = info["tune_command"]
         self.assertIn("--robust", command)
         for item in ("sensors.current_full_scale_A=5.1",   # 3 x the rated 1.7 A

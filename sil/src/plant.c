@@ -60,6 +60,24 @@ double plant_load_torque(const plant_load_t *load, double t_s, double omega_rad_
     return 0.0;
 }
 
+/* plant_load_torque with the kinds a step meets most (none, constant, a step) inline: it is
+ * taken at every stage of every step. */
+PLANT_INLINE double load_torque_at(const plant_load_t *load, double t_s, double omega_rad_s)
+{
+    switch (load->kind) {
+    case PLANT_LOAD_NONE:
+        return 0.0;
+    case PLANT_LOAD_CONSTANT:
+        return load->torque_Nm;
+    case PLANT_LOAD_STEP:
+        return t_s >= load->step_time_s ? load->torque_Nm : 0.0;
+    case PLANT_LOAD_PROPORTIONAL:
+    case PLANT_LOAD_TABLE:
+        break;
+    }
+    return plant_load_torque(load, t_s, omega_rad_s);
+}
+
 /* Detent torque -T_d sin 4 p theta (Nm) from s = sin p theta, c = cos p theta:
  * sin 4x = 2 sin 2x cos 2x = 4 s c (c^2 - s^2), no further sincos. */
 static double detent_torque(const plant_params_t *params, double s, double c)
@@ -75,7 +93,7 @@ static void derivative_at(const plant_params_t *params, const plant_load_t *load
     const double inv_l = 1.0 / params->inductance_H;
     const double inv_j = 1.0 / params->inertia_kgm2;
     const double k_m = params->torque_constant_Nm_A;
-    const double load_Nm = plant_load_torque(load, t_s, x->omega_rad_s);
+    const double load_Nm = load_torque_at(load, t_s, x->omega_rad_s);
     double torque_Nm = -params->friction_Nms_rad * x->omega_rad_s + k_m * (-x->i_a_A * s + x->i_b_A * c) - load_Nm;
 
     if (params->detent_torque_Nm != 0.0) {
@@ -194,7 +212,7 @@ PLANT_INLINE void coupling_at(const plant_params_t *params, const plant_load_t *
                               const plant_state_t *y, double s, double c, plant_state_t *n)
 {
     const double k_m = params->torque_constant_Nm_A;
-    const double load_Nm = plant_load_torque(load, t_s, y->omega_rad_s);
+    const double load_Nm = load_torque_at(load, t_s, y->omega_rad_s);
     const double emf_per_l = k_m * y->omega_rad_s / params->inductance_H;
     double torque_Nm = k_m * (-y->i_a_A * s + y->i_b_A * c) - load_Nm;
     if (params->detent_torque_Nm != 0.0) {
