@@ -11,8 +11,6 @@
 #include "pmstep/pmstep.h"
 #include "pmstep_internal.h"
 
-#include "pmstep/pmstep_rotation.h"
-
 #include <stddef.h>
 #include <string.h>
 
@@ -346,14 +344,11 @@ static void reference_current_over_period(const pmstep_t *inst, const pmstep_out
     const float band_A = inst->cfg->inverter.dead_time_current_band_A;
     const float half_turn = 0.5f * inst->law_coeffs.pole_pairs * inst->cfg->timing.period_s
                             * pmstep_abs(out->speed_hat_rad_s);
-    float cos_turn;
-    float sin_turn;
     float cos_act;
     float sin_act;
     float sweep_a_A;
     float sweep_b_A;
-    pmstep_law_act_turn(&inst->law_coeffs, out->speed_hat_rad_s, &cos_turn, &sin_turn);
-    pmstep_turn(out->cos_hat, out->sin_hat, cos_turn, sin_turn, &cos_act, &sin_act);
+    pmstep_law_acting_angle(&inst->law_coeffs, out->cos_hat, out->sin_hat, out->speed_hat_rad_s, &cos_act, &sin_act);
     in->sign_current_a_A = cos_act * out->i_d_ref_A - sin_act * out->i_q_ref_A;
     in->sign_current_b_A = sin_act * out->i_d_ref_A + cos_act * out->i_q_ref_A;
     sweep_a_A = pmstep_abs(in->sign_current_b_A) * half_turn;

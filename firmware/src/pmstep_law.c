@@ -96,13 +96,10 @@ void pmstep_law_voltages(const pmstep_law_coeffs_t *coeffs, const pmstep_law_ref
                                               - coeffs->current_integral_gain_per_s2 * integral->i_d_error_integral_As);
     const float u_q = coeffs->inductance_H * (-phi_q - coeffs->current_gain_per_s * (i_q_A - i_q_ref_A)
                                               - coeffs->current_integral_gain_per_s2 * integral->i_q_error_integral_As);
-    float cos_turn;
-    float sin_turn;
     float cos_act;
     float sin_act;
-    pmstep_law_act_turn(coeffs, speed_hat_rad_s, &cos_turn, &sin_turn);
     /* Inverse Park at the angle the voltage acts at, shortened for the hold. */
-    pmstep_turn(cos_hat, sin_hat, cos_turn, sin_turn, &cos_act, &sin_act);
+    pmstep_law_acting_angle(coeffs, cos_hat, sin_hat, speed_hat_rad_s, &cos_act, &sin_act);
     *u_a_V = cos_act * u_d - sin_act * u_q;
     *u_b_V = sin_act * u_d + cos_act * u_q;
 }

@@ -27,40 +27,31 @@ plant_params_t plant_paper_params(void)
     return p;
 }
 
-double plant_load_torque(const plant_load_t *load, double t_s, double omega_rad_s)
+/* The loads that vary within a step: proportional to the speed, or a table in time. */
+static double varying_load_torque(const plant_load_t *load, double t_s, double omega_rad_s)
 {
-    switch (load->kind) {
-    case PLANT_LOAD_NONE:
-        return 0.0;
-    case PLANT_LOAD_CONSTANT:
-        return load->torque_Nm;
-    case PLANT_LOAD_STEP:
-        return t_s >= load->step_time_s ? load->torque_Nm : 0.0;
-    case PLANT_LOAD_PROPORTIONAL:
+    int k;
+    const int n = load->table_points;
+    if (load->kind == PLANT_LOAD_PROPORTIONAL) {
         return load->coefficient_Nms_rad * omega_rad_s;
-    case PLANT_LOAD_TABLE: {
-        int k;
-        const int n = load->table_points;
-        if (n <= 0) {
-            return 0.0;
-        }
-        if (t_s <= load->table_time_s[0]) {
-            return load->table_torque_Nm[0];
-        }
-        for (k = 1; k < n; ++k) {
-            if (t_s < load->table_time_s[k]) {
-                const double t0 = load->table_time_s[k - 1];
-                const double w = (t_s - t0) / (load->table_time_s[k] - t0);
-                return load->table_torque_Nm[k - 1] + w * (load->table_torque_Nm[k] - load->table_torque_Nm[k - 1]);
-            }
-        }
-        return load->table_torque_Nm[n - 1];
     }
+    if (n <= 0) {
+        return 0.0;
     }
-    return 0.0;
+    if (t_s <= load->table_time_s[0]) {
+        return load->table_torque_Nm[0];
+    }
+    for (k = 1; k < n; ++k) {
+        if (t_s < load->table_time_s[k]) {
+            const double t0 = load->table_time_s[k - 1];
+            const double w = (t_s - t0) / (load->table_time_s[k] - t0);
+            return load->table_torque_Nm[k - 1] + w * (load->table_torque_Nm[k] - load->table_torque_Nm[k - 1]);
+        }
+    }
+    return load->table_torque_Nm[n - 1];
 }
 
-/* plant_load_torque with the kinds a step meets most (none, constant, a step) inline: it is
+/* The load torque, with the kinds a step meets most (none, constant, a step) inline: it is
  * taken at every stage of every step. */
 PLANT_INLINE double load_torque_at(const plant_load_t *load, double t_s, double omega_rad_s)
 {
@@ -75,7 +66,12 @@ PLANT_INLINE double load_torque_at(const plant_load_t *load, double t_s, double 
     case PLANT_LOAD_TABLE:
         break;
     }
-    return plant_load_torque(load, t_s, omega_rad_s);
+    return varying_load_torque(load, t_s, omega_rad_s);
+}
+
+double plant_load_torque(const plant_load_t *load, double t_s, double omega_rad_s)
+{
+    return load_torque_at(load, t_s, omega_rad_s);
 }
 
 /* Detent torque -T_d sin 4 p theta (Nm) from s = sin p theta, c = cos p theta:

@@ -79,6 +79,8 @@ static void eva_any_config(pmstep_config_t *cfg)
     cfg->inverter.dead_time_s = eva_any_finite();
     cfg->inverter.dead_time_current_band_A = eva_any_finite();
     cfg->gains.angle_correction_gain_per_s = eva_any_finite();
+    cfg->gains.current_integral_gain_per_s2 = eva_any_finite();
+    cfg->motor.detent_torque_Nm = eva_any_finite();
     cfg->detection.angle_magnitude_bound = eva_any_finite();
     cfg->detection.speed_consistency_bound_rad_s = eva_any_finite();
     cfg->detection.stall_speed_error_rad_s = eva_any_finite();

@@ -25,7 +25,8 @@ static const size_t fuzz_bool_fields[] = {
 
 /* Base configurations the fuzzer perturbs. 0: the paper's. 1: every optional feature on
  * (offset calibration, alignment windows with the voltage bias, inductance window, commissioned
- * R, L, k_M used, dead-time compensation, drift-free angle, all detectors, re-alignments).
+ * R, L, k_M used, dead-time compensation, drift-free angle, detent compensation, PI current loop, all
+ * detectors, re-alignments).
  * 2: as 1 in known-load mode. 3: the paper's with short alignments (RUN after 400 periods). */
 #define FUZZ_BASE_CONFIGS 4u
 static inline pmstep_config_t fuzz_base_config(unsigned which)

@@ -7,6 +7,7 @@
 
 /* Every optional feature on: offset calibration, alignment windows with the voltage bias,
  * inductance window, commissioned R, L, k_M used, dead-time compensation, drift-free angle,
+ * detent compensation, PI current loop,
  * every detector (the paper's bounds), two re-alignments, one period of delay. */
 static inline pmstep_config_t pmstep_test_features_config(void)
 {
@@ -22,6 +23,8 @@ static inline pmstep_config_t pmstep_test_features_config(void)
     cfg.inverter.dead_time_s = 1e-6f;
     cfg.inverter.dead_time_current_band_A = 0.005f;
     cfg.gains.angle_correction_gain_per_s = 20.0f;
+    cfg.gains.current_integral_gain_per_s2 = 33800.0f; /* (R/L + K_i)^2 / 8 = 520^2 / 8 */
+    cfg.motor.detent_torque_Nm = 0.05f;
     cfg.detection.max_realignments = 2u;
     cfg.timing.computational_delay_periods = 1u;
     return cfg;

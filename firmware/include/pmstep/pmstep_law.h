@@ -11,6 +11,7 @@
 #define PMSTEP_LAW_H
 
 #include "pmstep/pmstep_types.h"
+#include "pmstep/pmstep_rotation.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -78,16 +79,17 @@ static inline pmstep_detent_t pmstep_law_detent(const pmstep_law_coeffs_t *coeff
 }
 
 /**
- * The turn from the sample to the middle of the period the voltage acts in, p w-hat T_s
- * (delay + 1/2), with the hold's shortening 1 - x^2/6 (see pmstep_law_voltages), as
- * (cos, sin) polynomials in w-hat.
+ * (c-hat, s-hat) turned from the sample to the middle of the period the voltage acts in,
+ * p w-hat T_s (delay + 1/2), and shortened for the hold by 1 - x^2/6 (see pmstep_law_voltages):
+ * the turn as (cos, sin) polynomials in w-hat.
  */
-static inline void pmstep_law_act_turn(const pmstep_law_coeffs_t *coeffs, float speed_hat_rad_s, float *cos_turn,
-                                       float *sin_turn)
+static inline void pmstep_law_acting_angle(const pmstep_law_coeffs_t *coeffs, float cos_hat, float sin_hat,
+                                           float speed_hat_rad_s, float *cos_act, float *sin_act)
 {
     const float w2 = speed_hat_rad_s * speed_hat_rad_s;
-    *cos_turn = 1.0f + w2 * (coeffs->turn_cos_w2 + w2 * coeffs->turn_cos_w4);
-    *sin_turn = speed_hat_rad_s * (coeffs->turn_sin_w1 + w2 * coeffs->turn_sin_w3);
+    const float cos_turn = 1.0f + w2 * (coeffs->turn_cos_w2 + w2 * coeffs->turn_cos_w4);
+    const float sin_turn = speed_hat_rad_s * (coeffs->turn_sin_w1 + w2 * coeffs->turn_sin_w3);
+    pmstep_turn(cos_hat, sin_hat, cos_turn, sin_turn, cos_act, sin_act);
 }
 
 /** Coefficients for the gains and mechanics of @p cfg and the electrical model @p model. */
