@@ -59,6 +59,8 @@ const char *pmstep_status_str(pmstep_status_t status)
     case PMSTEP_ERR_RATED_CURRENT: return "rated current must be > 0";
     case PMSTEP_ERR_BUS_BELOW_RATED: return "bus too low for R x rated current";
     case PMSTEP_ERR_RATE_TOO_SLOW: return "control rate too slow for R/L or F/J";
+    case PMSTEP_ERR_POSITION_GAIN: return "need 0 < k_theta <= k_w/2";
+    case PMSTEP_ERR_POSITION_INTEGRAL_GAIN: return "need 0 <= k_I <= k_theta^2/4";
     }
     return "unknown status";
 }

@@ -86,8 +86,12 @@ typedef enum {
     /* gain designer (pmstep_design.h): motor data it cannot design for */
     PMSTEP_ERR_RATED_CURRENT = -110,        /**< rated current <= 0 */
     PMSTEP_ERR_BUS_BELOW_RATED = -111,      /**< bus voltage <= 0, or R x rated current above the usable bus */
-    PMSTEP_ERR_RATE_TOO_SLOW = -112         /**< control rate too slow for the motor: R/L, or F/J, not well below
+    PMSTEP_ERR_RATE_TOO_SLOW = -112,        /**< control rate too slow for the motor: R/L, or F/J, not well below
                                                  the bandwidths the designer gives the current loop and the observer */
+    /* position control (pmstep_position.h) */
+    PMSTEP_ERR_POSITION_GAIN = -120,        /**< position gain k_theta <= 0, or above k_w/2 (the speed loop's) */
+    PMSTEP_ERR_POSITION_INTEGRAL_GAIN = -121 /**< position integral gain k_I < 0, or above k_theta^2/4 (the loop's
+                                                 poles would turn complex) */
 } pmstep_status_t;
 
 /** Shortest and longest control period accepted (s): 1 MHz down to 100 Hz. */
