@@ -84,6 +84,8 @@ static void not_tracked_before_run(void **state)
     fixture_init(&f);
     assert_int_equal(pmstep_get_position(&f.pos, &position), PMSTEP_ERR_BAD_MODE);
     assert_int_equal(pmstep_position_set_zero(&f.pos), PMSTEP_ERR_BAD_MODE);
+    assert_int_equal(pmstep_position_move_to(&f.pos, 1.0f, 1.0f, 1.0f, 0.0f), PMSTEP_ERR_BAD_MODE);
+    assert_int_equal(pmstep_position_hold(&f.pos, 1.0f), PMSTEP_ERR_BAD_MODE);
     out.mode = PMSTEP_MODE_C_ALIGN;
     pmstep_position_update(&f.pos, &out, &pos_out);
     assert_false(pos_out.tracked);
@@ -187,6 +189,174 @@ static void leaving_run_loses_the_position_and_run_restarts_at_zero(void **state
     assert_float_equal(pos_out.position_rad, 0.0f, 0.0f);
 }
 
+/* ---- position loop ---- */
+
+static void init_validates_the_gains_with_named_codes(void **state)
+{
+    fixture_t f;
+    pmstep_position_config_t c;
+    pmstep_t fresh = {0};
+    (void)state;
+    fixture_init(&f); /* paper: k_w = 100 1/s */
+    c.gain_per_s = 25.0f;
+    c.integral_gain_per_s2 = 0.0f;
+    assert_int_equal(pmstep_position_init(NULL, &f.inst, &c), PMSTEP_ERR_NULL_ARGUMENT);
+    assert_int_equal(pmstep_position_init(&f.pos, NULL, &c), PMSTEP_ERR_NULL_ARGUMENT);
+    assert_int_equal(pmstep_position_init(&f.pos, &f.inst, NULL), PMSTEP_ERR_NULL_ARGUMENT);
+    assert_int_equal(pmstep_position_init(&f.pos, &fresh, &c), PMSTEP_ERR_NULL_ARGUMENT); /* not initialised */
+    c.gain_per_s = NAN;
+    assert_int_equal(pmstep_position_init(&f.pos, &f.inst, &c), PMSTEP_ERR_NONFINITE_PARAMETER);
+    c.gain_per_s = 25.0f;
+    c.integral_gain_per_s2 = INFINITY;
+    assert_int_equal(pmstep_position_init(&f.pos, &f.inst, &c), PMSTEP_ERR_NONFINITE_PARAMETER);
+    c.integral_gain_per_s2 = 0.0f;
+    c.gain_per_s = 0.0f;
+    assert_int_equal(pmstep_position_init(&f.pos, &f.inst, &c), PMSTEP_ERR_POSITION_GAIN);
+    c.gain_per_s = 50.5f; /* above k_w/2 */
+    assert_int_equal(pmstep_position_init(&f.pos, &f.inst, &c), PMSTEP_ERR_POSITION_GAIN);
+    c.gain_per_s = 50.0f; /* at it */
+    assert_int_equal(pmstep_position_init(&f.pos, &f.inst, &c), PMSTEP_OK);
+    c.integral_gain_per_s2 = -1.0f;
+    assert_int_equal(pmstep_position_init(&f.pos, &f.inst, &c), PMSTEP_ERR_POSITION_INTEGRAL_GAIN);
+    c.integral_gain_per_s2 = 626.0f; /* above 50^2/4 */
+    assert_int_equal(pmstep_position_init(&f.pos, &f.inst, &c), PMSTEP_ERR_POSITION_INTEGRAL_GAIN);
+    c.integral_gain_per_s2 = 625.0f;
+    assert_int_equal(pmstep_position_init(&f.pos, &f.inst, &c), PMSTEP_OK);
+    /* the designer's rule passes validation */
+    assert_int_equal(pmstep_position_design(&f.cfg, &c), PMSTEP_OK);
+    assert_float_equal(c.gain_per_s, 25.0f, 0.0f);
+    assert_float_equal(c.integral_gain_per_s2, 25.0f * 25.0f / 8.0f, 1e-4f);
+    assert_int_equal(pmstep_position_init(&f.pos, &f.inst, &c), PMSTEP_OK);
+    assert_int_equal(pmstep_position_design(NULL, &c), PMSTEP_ERR_NULL_ARGUMENT);
+}
+
+static void move_commands_refuse_bad_values(void **state)
+{
+    fixture_t f;
+    pmstep_position_output_t pos_out;
+    const pmstep_output_t out = run_output(0.0, 1.0, 0.0);
+    (void)state;
+    fixture_init(&f);
+    pmstep_position_update(&f.pos, &out, &pos_out);
+    assert_int_equal(pmstep_position_move_to(NULL, 1.0f, 1.0f, 1.0f, 0.0f), PMSTEP_ERR_NULL_ARGUMENT);
+    assert_int_equal(pmstep_position_move_to(&f.pos, NAN, 1.0f, 1.0f, 0.0f), PMSTEP_ERR_BAD_COMMAND_VALUE);
+    assert_int_equal(pmstep_position_move_to(&f.pos, INFINITY, 1.0f, 1.0f, 0.0f), PMSTEP_ERR_BAD_COMMAND_VALUE);
+    assert_int_equal(pmstep_position_move_to(&f.pos, 1.0f, 0.0f, 1.0f, 0.0f), PMSTEP_ERR_BAD_COMMAND_VALUE);
+    assert_int_equal(pmstep_position_move_to(&f.pos, 1.0f, INFINITY, 1.0f, 0.0f), PMSTEP_ERR_BAD_COMMAND_VALUE);
+    assert_int_equal(pmstep_position_move_to(&f.pos, 1.0f, 1.0f, -1.0f, 0.0f), PMSTEP_ERR_BAD_COMMAND_VALUE);
+    assert_int_equal(pmstep_position_move_to(&f.pos, 1.0f, 1.0f, NAN, 0.0f), PMSTEP_ERR_BAD_COMMAND_VALUE);
+    assert_int_equal(pmstep_position_move_to(&f.pos, 1.0f, 1.0f, 1.0f, -1.0f), PMSTEP_ERR_BAD_COMMAND_VALUE);
+    assert_int_equal(pmstep_position_move_to(&f.pos, 1.0f, 1.0f, 1.0f, INFINITY), PMSTEP_ERR_BAD_COMMAND_VALUE);
+    /* p |target| beyond PMSTEP_POSITION_MAX_ELECTRICAL_RAD (paper: p = 6) */
+    assert_int_equal(pmstep_position_move_to(&f.pos, 5462.0f, 1.0f, 1.0f, 0.0f), PMSTEP_ERR_BAD_COMMAND_VALUE);
+    assert_int_equal(pmstep_position_move_to(&f.pos, -5461.0f, 1.0f, 1.0f, 0.0f), PMSTEP_OK);
+    assert_int_equal(pmstep_position_hold(NULL, 1.0f), PMSTEP_ERR_NULL_ARGUMENT);
+    assert_int_equal(pmstep_position_move_to(&f.pos, 1.0f, 1.0f, 1.0f, 0.0f), PMSTEP_OK);
+    assert_int_equal(pmstep_position_hold(&f.pos, NAN), PMSTEP_OK); /* in position mode: the move's limits */
+}
+
+/* A rotor that follows the speed reference exactly (w = w-hat = w*, read back from the core's
+ * reference channel as the law would read it, which then advances as in pmstep_step): after each
+ * period the estimate is the rotor's angle.
+ * A bias @p speed_bias is added to w-hat (a speed-estimate error the loop must absorb). */
+typedef struct {
+    double theta_rad;
+    double max_overshoot;
+    double max_error;
+} kinematic_t;
+
+static void kinematic_run(fixture_t *f, kinematic_t *k, long periods, double target, double start, double speed_bias)
+{
+    const double period = (double)f->cfg.timing.period_s;
+    const double direction = target >= start ? 1.0 : -1.0;
+    long n;
+    for (n = 0; n < periods; ++n) {
+        const pmstep_ref_out_t ref = pmstep_ref_output(&f->inst.ref_coeffs, &f->inst.speed_ref);
+        pmstep_output_t out;
+        pmstep_position_output_t pos_out;
+        k->theta_rad += period * (double)ref.value;
+        pmstep_ref_advance(&f->inst.ref_coeffs, &f->inst.speed_ref, f->cfg.timing.period_s); /* as pmstep_step */
+        out = run_output(6.0 * k->theta_rad, 1.0, (double)ref.value + speed_bias);
+        out.speed_ref_rad_s = ref.value;
+        pmstep_position_update(&f->pos, &out, &pos_out);
+        k->max_overshoot = fmax(k->max_overshoot, direction * (k->theta_rad - target));
+        k->max_error = fmax(k->max_error, fabs((double)pos_out.position_error_rad));
+    }
+}
+
+static void loop_drives_the_reference_to_the_target_and_holds(void **state)
+{
+    fixture_t f;
+    kinematic_t k = {0.0, 0.0, 0.0};
+    pmstep_position_output_t pos_out;
+    const pmstep_output_t out = run_output(0.0, 1.0, 0.0);
+    float position;
+    (void)state;
+    fixture_init(&f);
+    pmstep_position_update(&f.pos, &out, &pos_out);
+    assert_int_equal(pmstep_position_move_to(&f.pos, 3.0f, 2.0f, 20.0f, 0.0f), PMSTEP_OK);
+    kinematic_run(&f, &k, 60000, 3.0, 0.0, 0.0); /* the move takes 1.6 s; 3 s */
+    assert_int_equal(pmstep_get_position(&f.pos, &position), PMSTEP_OK);
+    print_message("kinematic move of 3 rad: final error %.3g rad, overshoot %.3g rad, max |theta* - theta-hat| %.3g\n",
+                  3.0 - k.theta_rad, k.max_overshoot, k.max_error);
+    assert_true(fabs(k.theta_rad - 3.0) < 1e-4);
+    assert_true(k.max_overshoot < 1e-4);
+    assert_true(k.max_error < 1e-3);
+    assert_float_equal(position, 3.0f, 1e-4f);
+}
+
+static void loop_absorbs_a_speed_estimate_bias_with_the_integral(void **state)
+{
+    fixture_t f;
+    kinematic_t k = {0.0, 0.0, 0.0};
+    pmstep_position_output_t pos_out;
+    const pmstep_output_t out = run_output(0.0, 1.0, 0.0);
+    (void)state;
+    fixture_init(&f);
+    f.pos_cfg.integral_gain_per_s2 = 25.0f * 25.0f / 8.0f;
+    assert_int_equal(pmstep_position_init(&f.pos, &f.inst, &f.pos_cfg), PMSTEP_OK);
+    pmstep_position_update(&f.pos, &out, &pos_out);
+    assert_int_equal(pmstep_position_hold(&f.pos, 10.0f), PMSTEP_OK);
+    /* w-hat reads 0.05 rad/s more than the rotor turns: a P loop alone would sit 0.05/25 = 2 mrad off */
+    kinematic_run(&f, &k, 100000, 0.0, 0.0, 0.05);
+    print_message("speed-estimate bias 0.05 rad/s, 5 s hold with k_I: position %.3g rad\n", k.theta_rad);
+    assert_true(fabs(k.theta_rad) < 1e-4);
+}
+
+static void speed_command_leaves_position_mode_and_hold_stops(void **state)
+{
+    fixture_t f;
+    kinematic_t k = {0.0, 0.0, 0.0};
+    pmstep_position_output_t pos_out;
+    const pmstep_output_t out = run_output(0.0, 1.0, 0.0);
+    pmstep_ref_out_t ref;
+    float position;
+    (void)state;
+    fixture_init(&f);
+    pmstep_position_update(&f.pos, &out, &pos_out);
+    assert_int_equal(pmstep_position_move_to(&f.pos, 30.0f, 2.0f, 20.0f, 0.0f), PMSTEP_OK);
+    kinematic_run(&f, &k, 20000, 30.0, 0.0, 0.0); /* 1 s: cruising at 2 rad/s */
+    assert_int_equal(pmstep_set_speed_target(&f.inst, -1.0f, 10.0f), PMSTEP_OK);
+    kinematic_run(&f, &k, 1, 30.0, 0.0, 0.0);
+    assert_false(f.pos.position_mode);
+    kinematic_run(&f, &k, 20000, 30.0, 0.0, 0.0);
+    ref = pmstep_ref_output(&f.inst.ref_coeffs, &f.inst.speed_ref);
+    assert_float_equal(ref.value, -1.0f, 1e-4f); /* the speed command, ramped from where the move was */
+    /* hold from speed mode: stops at 10 rad/s^2 and stays where the stop ends */
+    assert_int_equal(pmstep_position_hold(&f.pos, 10.0f), PMSTEP_OK);
+    assert_true(f.pos.position_mode);
+    kinematic_run(&f, &k, 40000, f.pos.motion.target, 0.0, 0.0);
+    assert_int_equal(pmstep_get_position(&f.pos, &position), PMSTEP_OK);
+    assert_float_equal(position, f.pos.motion.target, 1e-4f);
+    assert_float_equal((float)k.theta_rad, f.pos.motion.target, 1e-4f);
+    /* set zero in position mode: theta*, the target and theta-hat move together */
+    assert_int_equal(pmstep_position_set_zero(&f.pos), PMSTEP_OK);
+    kinematic_run(&f, &k, 1000, 0.0, 0.0, 0.0);
+    assert_int_equal(pmstep_get_position(&f.pos, &position), PMSTEP_OK);
+    assert_float_equal(position, 0.0f, 1e-4f);
+    assert_float_equal(f.pos.motion.target, 0.0f, 1e-4f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -196,6 +366,11 @@ int main(void)
         cmocka_unit_test(turn_count_follows_many_turns_both_ways),
         cmocka_unit_test(position_zero_moves_the_origin),
         cmocka_unit_test(leaving_run_loses_the_position_and_run_restarts_at_zero),
+        cmocka_unit_test(init_validates_the_gains_with_named_codes),
+        cmocka_unit_test(move_commands_refuse_bad_values),
+        cmocka_unit_test(loop_drives_the_reference_to_the_target_and_holds),
+        cmocka_unit_test(loop_absorbs_a_speed_estimate_bias_with_the_integral),
+        cmocka_unit_test(speed_command_leaves_position_mode_and_hold_stops),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

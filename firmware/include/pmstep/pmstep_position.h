@@ -34,10 +34,15 @@
 #define PMSTEP_POSITION_H
 
 #include "pmstep/pmstep.h"
+#include "pmstep/pmstep_motion.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
+
+/** Largest |electrical angle| p |theta| the position estimate and commands accept (rad): there
+ *  the float32 angle still resolves 4e-3 rad (2^-8), 1/25 of a 0.1 rad position bound. */
+#define PMSTEP_POSITION_MAX_ELECTRICAL_RAD 32768.0f
 
 /** Gains of the position loop. */
 typedef struct {
@@ -70,8 +75,17 @@ typedef struct {
     int32_t sin_negative;     /**< 1 if s-hat < 0 in the last period, else 0 */
     bool tracked;             /**< in RUN since the last turn count reset */
     bool position_mode;
+    float position_ref_rad;   /**< theta* of the period being run */
     float error_integral_rad_s; /**< z, integral of theta* - theta-hat (rad s) */
+    pmstep_motion_t motion;   /**< theta* and its derivatives (position mode) */
 } pmstep_position_t;
+
+/**
+ * The designer's rule (DESIGN.md, "Position loop"): k_theta = k_w/4, k_I = k_theta^2/8 (poles
+ * of s^2 + k_theta s + k_I at 0.15 and 0.85 k_theta, both below the speed loop's k_w).
+ * @retval PMSTEP_OK, PMSTEP_ERR_NULL_ARGUMENT
+ */
+pmstep_status_t pmstep_position_design(const pmstep_config_t *cfg, pmstep_position_config_t *pos_cfg);
 
 /**
  * Polynomial atan2(y, x) in (-pi, pi], no libm: an odd polynomial of degree 9 on
@@ -115,6 +129,28 @@ pmstep_status_t pmstep_get_position(const pmstep_position_t *pos, float *positio
  * @retval PMSTEP_OK, PMSTEP_ERR_NULL_ARGUMENT, PMSTEP_ERR_BAD_MODE (not tracked)
  */
 pmstep_status_t pmstep_position_set_zero(pmstep_position_t *pos);
+
+/**
+ * Moves to @p target_rad (mechanical, from the zero) by a jerk-limited profile from the present
+ * reference (pmstep_motion_plan()); re-targets a move under way. From speed mode the profile
+ * starts at theta-hat with the present w* and w*'.
+ * @param j_max_rad_s3 jerk limit; 0 = a_max times the reference bandwidth varpi_0
+ * @retval PMSTEP_OK                     position mode, moving
+ * @retval PMSTEP_ERR_NULL_ARGUMENT      @p pos is NULL
+ * @retval PMSTEP_ERR_BAD_MODE           not tracked (not in RUN)
+ * @retval PMSTEP_ERR_BAD_COMMAND_VALUE  a value not finite, a limit not > 0 (j_max < 0), or
+ *                                       p |target| above PMSTEP_POSITION_MAX_ELECTRICAL_RAD
+ */
+pmstep_status_t pmstep_position_move_to(pmstep_position_t *pos, float target_rad, float v_max_rad_s,
+                                        float a_max_rad_s2, float j_max_rad_s3);
+
+/**
+ * Stops as fast as the last move's limits allow (from speed mode: at the present w* at
+ * @p a_max_rad_s2 and varpi_0 a_max) and holds where the stop ends.
+ * @retval PMSTEP_OK, PMSTEP_ERR_NULL_ARGUMENT, PMSTEP_ERR_BAD_MODE (not tracked),
+ *         PMSTEP_ERR_BAD_COMMAND_VALUE (from speed mode: a_max not finite or not > 0)
+ */
+pmstep_status_t pmstep_position_hold(pmstep_position_t *pos, float a_max_rad_s2);
 
 #ifdef __cplusplus
 }
