@@ -3,28 +3,22 @@
 
 #include <math.h> /* fabsf, sqrtf: single FPU instructions (-fno-math-errno), no libm call */
 
+/* 1/6 of the cubic term, a multiplication (no division in the period's work). */
+#define MOTION_SIXTH (1.0f / 6.0f)
+
 /* Bisection steps for the peak speed of a short move: 2^-32 of v_max, below float resolution. */
 #define MOTION_BISECTION_STEPS 32
 
-/* Where the profile is: the present segment, its start and the state there. */
-typedef struct {
-    uint32_t index;
-    float start_s;
-    float position;
-    float speed;
-    float accel;
-} motion_cursor_t;
-
 /* State after @p d seconds of constant jerk @p jerk from (p, v, a) in @p c. */
-static void advance_state(motion_cursor_t *c, float d, float jerk)
+static void advance_state(pmstep_motion_cursor_t *c, float d, float jerk)
 {
-    c->position += d * (c->speed + d * (0.5f * c->accel + d * (jerk / 6.0f)));
+    c->position += d * (c->speed + d * (0.5f * c->accel + d * (jerk * MOTION_SIXTH)));
     c->speed += d * (c->accel + d * (0.5f * jerk));
     c->accel += d * jerk;
 }
 
 /* Moves @p c on to the segment that contains @p t_s (or to the end of the plan). */
-static void locate(const pmstep_motion_t *m, motion_cursor_t *c, float t_s)
+static void locate(const pmstep_motion_t *m, pmstep_motion_cursor_t *c, float t_s)
 {
     while (c->index < m->count && t_s >= m->segment[c->index].end_s) {
         const pmstep_motion_segment_t *seg = &m->segment[c->index];
@@ -36,7 +30,7 @@ static void locate(const pmstep_motion_t *m, motion_cursor_t *c, float t_s)
     }
 }
 
-static pmstep_motion_sample_t sample_at(const pmstep_motion_t *m, const motion_cursor_t *c, float t_s)
+static pmstep_motion_sample_t sample_at(const pmstep_motion_t *m, const pmstep_motion_cursor_t *c, float t_s)
 {
     pmstep_motion_sample_t s;
     if (c->index >= m->count) {
@@ -47,7 +41,7 @@ static pmstep_motion_sample_t sample_at(const pmstep_motion_t *m, const motion_c
     } else {
         const float jerk = m->segment[c->index].jerk;
         const float d = t_s - c->start_s;
-        s.position = c->position + d * (c->speed + d * (0.5f * c->accel + d * (jerk / 6.0f)));
+        s.position = c->position + d * (c->speed + d * (0.5f * c->accel + d * (jerk * MOTION_SIXTH)));
         s.speed = c->speed + d * (c->accel + d * (0.5f * jerk));
         s.accel = c->accel + d * jerk;
         s.jerk = jerk;
@@ -55,27 +49,16 @@ static pmstep_motion_sample_t sample_at(const pmstep_motion_t *m, const motion_c
     return s;
 }
 
-static motion_cursor_t cursor_of(const pmstep_motion_t *m)
-{
-    motion_cursor_t c;
-    c.index = m->index;
-    c.start_s = m->start_s;
-    c.position = m->position;
-    c.speed = m->speed;
-    c.accel = m->accel;
-    return c;
-}
-
 void pmstep_motion_reset(pmstep_motion_t *m, float position, float period_s)
 {
     m->count = 0u;
-    m->index = 0u;
     m->periods = 0u;
     m->period_s = period_s;
-    m->start_s = 0.0f;
-    m->position = position;
-    m->speed = 0.0f;
-    m->accel = 0.0f;
+    m->cursor.index = 0u;
+    m->cursor.start_s = 0.0f;
+    m->cursor.position = position;
+    m->cursor.speed = 0.0f;
+    m->cursor.accel = 0.0f;
     m->target = position;
     m->v_max = 0.0f;
     m->a_max = 0.0f;
@@ -85,7 +68,7 @@ void pmstep_motion_reset(pmstep_motion_t *m, float position, float period_s)
 pmstep_motion_sample_t pmstep_motion_peek(const pmstep_motion_t *m)
 {
     const float t_s = (float)m->periods * m->period_s;
-    motion_cursor_t c = cursor_of(m);
+    pmstep_motion_cursor_t c = m->cursor;
     locate(m, &c, t_s);
     return sample_at(m, &c, t_s);
 }
@@ -93,24 +76,16 @@ pmstep_motion_sample_t pmstep_motion_peek(const pmstep_motion_t *m)
 pmstep_motion_sample_t pmstep_motion_next(pmstep_motion_t *m)
 {
     const float t_s = (float)m->periods * m->period_s;
-    motion_cursor_t c = cursor_of(m);
-    pmstep_motion_sample_t s;
-    locate(m, &c, t_s);
-    s = sample_at(m, &c, t_s);
-    m->index = c.index;
-    m->start_s = c.start_s;
-    m->position = c.position;
-    m->speed = c.speed;
-    m->accel = c.accel;
-    if (c.index < m->count) {
+    locate(m, &m->cursor, t_s);
+    if (m->cursor.index < m->count) {
         m->periods++; /* a finished plan stays put: no count to overflow while holding */
     }
-    return s;
+    return sample_at(m, &m->cursor, t_s);
 }
 
 void pmstep_motion_shift(pmstep_motion_t *m, float offset)
 {
-    m->position += offset;
+    m->cursor.position += offset;
     m->target += offset;
 }
 
@@ -119,7 +94,7 @@ void pmstep_motion_shift(pmstep_motion_t *m, float offset)
 /* Appends segments to a plan, keeping the state at its end. */
 typedef struct {
     pmstep_motion_t *m;
-    motion_cursor_t end; /* start_s: the plan's end time so far */
+    pmstep_motion_cursor_t end; /* start_s: the plan's end time so far */
 } builder_t;
 
 static void add_segment(builder_t *b, float duration_s, float jerk)
@@ -206,12 +181,8 @@ static void builder_start(builder_t *b, pmstep_motion_t *m, float position, floa
     b->end.speed = speed;
     b->end.accel = accel;
     m->count = 0u;
-    m->index = 0u;
     m->periods = 0u;
-    m->start_s = 0.0f;
-    m->position = position;
-    m->speed = speed;
-    m->accel = accel;
+    m->cursor = b->end;
 }
 
 void pmstep_motion_plan(pmstep_motion_t *m, float position, float speed, float accel, float target,

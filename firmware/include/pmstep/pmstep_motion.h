@@ -47,17 +47,22 @@ typedef struct {
     float jerk;
 } pmstep_motion_sample_t;
 
-/** A plan and where the profile is in it. */
+/** Where the profile is in its plan: the present segment, its start and the state there. */
 typedef struct {
-    pmstep_motion_segment_t segment[PMSTEP_MOTION_SEGMENTS];
-    uint32_t count;        /**< segments in the plan */
-    uint32_t index;        /**< present segment (count: finished, at the target) */
-    uint32_t periods;      /**< periods since the plan started */
-    float period_s;        /**< T_s */
+    uint32_t index;        /**< present segment (the plan's count: finished, at the target) */
     float start_s;         /**< start of the present segment (s from the plan's start) */
     float position;        /**< state at the start of the present segment */
     float speed;
     float accel;
+} pmstep_motion_cursor_t;
+
+/** A plan and where the profile is in it. */
+typedef struct {
+    pmstep_motion_segment_t segment[PMSTEP_MOTION_SEGMENTS];
+    uint32_t count;        /**< segments in the plan */
+    uint32_t periods;      /**< periods since the plan started */
+    float period_s;        /**< T_s */
+    pmstep_motion_cursor_t cursor;
     float target;          /**< where the plan ends, at rest */
     float v_max;           /**< the plan's limits (kept for a stop) */
     float a_max;
@@ -87,7 +92,7 @@ pmstep_motion_sample_t pmstep_motion_peek(const pmstep_motion_t *m);
 /** True once the plan has ended (the profile is at the target, at rest). */
 static inline bool pmstep_motion_finished(const pmstep_motion_t *m)
 {
-    return m->index >= m->count;
+    return m->cursor.index >= m->count;
 }
 
 /** Adds @p offset to every position of the plan (a new zero). */
