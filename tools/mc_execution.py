@@ -128,6 +128,8 @@ def rerun_command(args, seed):
         value = getattr(args, option)
         if value != default or (option == "speed_bound" and getattr(args, "preset", None)):
             cmd += ["--" + option.replace("_", "-"), format_value(value)]
+    if getattr(args, "position_bound", None) is not None:
+        cmd += ["--position-bound", format_value(args.position_bound)]
     for key in getattr(args, "exclude", []):
         cmd += ["--exclude", key]
     return cmd + ["--case", str(seed)]
@@ -238,7 +240,7 @@ def make_record(args, result, params, base, command):
     summary = result["summary"]
     exit_status = result["exit_status"]
     outcome = classify(summary, exit_status, args.speed_bound, args.angle_bound, args.latency_bound,
-                       result["problem"])
+                       result["problem"], getattr(args, "position_bound", None))
     seed = result["seed"]
     return {
         "seed": seed,

@@ -73,12 +73,14 @@ def fault_name(summary):
 
 
 def classify(summary, exit_status, speed_bound_rad_s=0.5, angle_bound_rad=0.05, latency_bound_s=0.05,
-             problem=None):
+             problem=None, position_bound_rad=None):
     """Class of one run: dict with "class", "false_trip", "latency_s", "reason".
 
     summary: the parsed summary.json (None if missing or unparsable); exit_status: the
     process's exit status (negative: killed by that signal; None: timed out); problem: a
-    text that makes the run "crashed" whatever the summary says (e.g. a timeout).
+    text that makes the run "crashed" whatever the summary says (e.g. a timeout);
+    position_bound_rad: a position scenario's success also needs every move issued, finished and
+    ending within this many electrical rad of its target (summary.json "position").
     """
     def result(cls, reason, false_trip=False, latency_s=None):
         return {"class": cls, "false_trip": false_trip, "latency_s": latency_s, "reason": reason}
@@ -133,9 +135,26 @@ def classify(summary, exit_status, speed_bound_rad_s=0.5, angle_bound_rad=0.05, 
         exceeded.append(f"max speed error {rob['max_speed_error_rad_s']} rad/s >= {speed_bound_rad_s:g}")
     if angle_error is None or angle_error >= angle_bound_rad:
         exceeded.append(f"max angle error {rob['max_angle_error_rad']} rad >= {angle_bound_rad:g}")
+    if position_bound_rad is not None:
+        exceeded += position_exceeded(summary.get("position"), position_bound_rad)
     if exceeded:
         return result("out_of_spec", "; ".join(exceeded))
     return result("success", "")
+
+
+def position_exceeded(position, bound_rad):
+    """What a position scenario's summary misses of "every move ends within bound_rad" (empty: nothing)."""
+    if not isinstance(position, dict):
+        return ["no position figures in summary.json (not a position scenario?)"]
+    problems = []
+    for key in ("rejected_moves", "unfinished_moves"):
+        if number_or_none(position.get(key)) != 0:
+            problems.append(f"{position.get(key)} {key.replace('_', ' ')}")
+    final = number_or_none(position.get("max_final_error_electrical_rad"))
+    if final is None or final >= bound_rad:
+        problems.append(f"move {position.get('worst_move')} ends {position.get('max_final_error_electrical_rad')} "
+                        f"electrical rad off >= {bound_rad:g}")
+    return problems
 
 
 def extract_metrics(summary, params, base):

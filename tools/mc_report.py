@@ -106,7 +106,8 @@ def aggregate(records, args):
                                 "median": statistics.median(latencies) if latencies else None},
         "distributions": distributions,
         "bounds": {"speed_bound_rad_s": args.speed_bound, "angle_bound_rad": args.angle_bound,
-                   "latency_bound_s": args.latency_bound},
+                   "latency_bound_s": args.latency_bound,
+                   "position_bound_electrical_rad": getattr(args, "position_bound", None)},
     }
 
 
@@ -209,6 +210,9 @@ def write_report(path, records, agg, args, scenario, version, plots, started_utc
         lines.append(f"- duration: {args.duration:g} s per case (`--set {DURATION_KEY}`)")
     lines.append(f"- bounds: max speed error < {args.speed_bound:g} rad/s, max angle error < {args.angle_bound:g} rad "
                  f"(after settling), fault within {args.latency_bound:g} s of a loss of control")
+    if getattr(args, "position_bound", None) is not None:
+        lines.append(f"- position: every move issued, finished and ending within {args.position_bound:g} electrical "
+                     f"rad of its target")
     lines.append("")
     rate = agg["success_rate"]
     lines += ["## Result", "",

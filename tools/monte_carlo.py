@@ -54,7 +54,9 @@ pmstep-sil command line, the drawn parameters, the class and the summary.
 
 Classes (see classify()):
   success      no fault latched, no non-finite value, and after settling
-               max |w - w*| < --speed-bound (0.5 rad/s), max angle error < --angle-bound (0.05 rad)
+               max |w - w*| < --speed-bound (0.5 rad/s), max angle error < --angle-bound (0.05 rad);
+               with --position-bound (a position scenario), every move issued, finished and
+               ending within that many electrical rad of its target
   detected     a fault latched; if the SIL saw a loss of control, the fault came at most
                --latency-bound (0.05 s) after it (the latency is recorded); without a loss of
                control the fault is a false trip (still "detected", counted apart)
@@ -131,6 +133,9 @@ def parse_args(argv):
                              "fraction of the designer's top speed as 0.5 rad/s of the paper motor's)")
     parser.add_argument("--angle-bound", type=float, default=0.05, metavar="RAD",
                         help="max angle-estimate error after settling for success (default 0.05 rad)")
+    parser.add_argument("--position-bound", type=float, default=None, metavar="RAD",
+                        help="a position scenario (position.points): success also needs every move to end within "
+                             "this many electrical rad of its target (default: not checked)")
     parser.add_argument("--latency-bound", type=float, default=0.05, metavar="SECONDS",
                         help="a fault later than this after a loss of control is a silent failure (default 0.05 s)")
     parser.add_argument("--min-success", type=float, default=0.99, help="--check: minimum success rate (default 0.99)")

@@ -20,6 +20,7 @@ rad after every move and overshoot < 1 % of the move; realistic chain, the true 
 usage: tools/position_acceptance.py [--sil PATH] [--tune PATH] [--motors paper,17hs4401,...]
                                     [--chains ideal,realistic] [--moves 50] [--seed 1]
                                     [--hold-s 60] [--out DIR] [--check] [--json FILE]
+                                    [--write-scenarios] [--speed-fraction F] [--accel-fraction F]
 """
 import argparse
 import configparser
@@ -121,6 +122,8 @@ def main():
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "position_acceptance"))
     ap.add_argument("--check", action="store_true", help="exit 1 if a criterion fails")
     ap.add_argument("--json", help="also write every run's figures to this file")
+    ap.add_argument("--write-scenarios", action="store_true",
+                    help="also write each run's whole scenario to OUT/<motor>_<chain>_run.ini")
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
     results = []
@@ -155,6 +158,14 @@ def main():
                 sets += [f"motor.resistance_Ohm={1.2 * preset['R']:.9g}",  # the plant's; the firmware keeps R
                          "load.type=step", f"load.torque_Nm={load:.9g}", f"load.step_time_s={end_s:.6f}",
                          f"position.hold_start_s={end_s:.6f}", f"run.duration_s={end_s + args.hold_s:.6f}"]
+            if args.write_scenarios:
+                # the whole scenario of this run, e.g. for tools/monte_carlo.py --scenario
+                cmd = [args.sil, "--scenario", base, "--print-scenario"]
+                for s in sets:
+                    cmd += ["--set", s]
+                text = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
+                with open(os.path.join(args.out, f"{motor}_{chain}_run.ini"), "w") as f:
+                    f.write(text)
             rc, summary = run_sil(args.sil, base, sets, os.path.join(args.out, f"{motor}_{chain}"))
             pos = summary.get("position", {})
             fault = summary["fault"]["name"]

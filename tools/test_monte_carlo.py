@@ -140,6 +140,21 @@ class Classification(unittest.TestCase):
         self.assertEqual(self.cls(summary(nonfinite=True))["class"], "out_of_spec")
         self.assertEqual(self.cls(summary(speed=0.7), speed_bound_rad_s=1.0)["class"], "success")
 
+    def test_position_bound(self):
+        """Issue 13: with --position-bound, every move issued, finished and within the bound."""
+        base = summary()
+        self.assertEqual(self.cls(base, position_bound_rad=0.5)["class"], "out_of_spec")  # no position figures
+        good = {"moves": 50, "rejected_moves": 0, "unfinished_moves": 0, "worst_move": 7,
+                "max_final_error_electrical_rad": 0.138}
+        self.assertEqual(self.cls(dict(base, position=good), position_bound_rad=0.5)["class"], "success")
+        self.assertEqual(self.cls(dict(base, position=good))["class"], "success")        # not checked by default
+        far = dict(good, max_final_error_electrical_rad=0.5)                               # bound is strict
+        r = self.cls(dict(base, position=far), position_bound_rad=0.5)
+        self.assertEqual(r["class"], "out_of_spec")
+        self.assertIn("move 7 ends 0.5 electrical rad off", r["reason"])
+        late = dict(good, unfinished_moves=1)
+        self.assertEqual(self.cls(dict(base, position=late), position_bound_rad=0.5)["class"], "out_of_spec")
+
     def test_detected_loss_with_latency(self):
         r = self.cls(summary(fault_code=2, fault_time_s=1.23, loss_s=1.2, latency_s=0.03))
         self.assertEqual(r["class"], "detected")

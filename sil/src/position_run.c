@@ -102,6 +102,7 @@ void sil_position_run_sample(sil_position_run_t *run, sil_sample_t *sample, sil_
         run->last_error_rad = 0.0;
     }
     if (run->sc->hold_start_s > 0.0 && sample->t_s >= run->sc->hold_start_s) {
+        close_move(run, s); /* the last move ends where the hold begins (its figures are the hold's) */
         const double t = sample->t_s - run->sc->hold_start_s;
         const double e = (theta - (double)out->position_ref_rad) * p_pairs;
         p->hold_max_error_rad = fmax(p->hold_max_error_rad, fabs(e));

@@ -40,7 +40,8 @@ typedef struct {
     int moves;                             /**< moves issued */
     int rejected_moves;                    /**< pmstep_position_move_to() refused (none expected) */
     int unfinished_moves;                  /**< profile still running when the next move came or the run ended */
-    double max_final_error_rad;            /**< max |theta - target| p at the end of each move's window */
+    double max_final_error_rad;            /**< max |theta - target| p at the end of each move's window (the next
+                                                move, the hold window's start, or the end of the run) */
     double mean_final_error_rad;
     int worst_move;                        /**< 1-based index of that maximum */
     double max_overshoot_fraction;         /**< max over moves of (travel beyond the target) / |move| */
