@@ -5,6 +5,7 @@
  *   check      measurements against the protections (here)
  *   commission alignment timing, Remark 2 sums, the commissioned model at t_c (pmstep_commission.c)
  *   control    alignment voltages (here), or controller (6) (pmstep_control.c)
+ *   identify   in RUN's first window: the J and F fit's sums, at its end J and F (pmstep_identify.c)
  *   supervise  detection every PMSTEP_DETECTION_DECIMATION periods in RUN (pmstep_detect.c)
  *   actuate    dead-time compensation, bus limit, output check, delay (pmstep_actuate.c)
  *   advance    observer and references over the coming period (pmstep_control.c) */
@@ -14,7 +15,7 @@
 #include <stddef.h>
 #include <string.h>
 
-/* Coefficients of the angle, observer and law for the electrical model @p model. */
+/* Coefficients of the angle, observer and law for the model @p model. */
 static void apply_model(pmstep_t *inst, const pmstep_electrical_t *model)
 {
     pmstep_angle_coeffs_init(&inst->angle_coeffs, inst->cfg, model);
@@ -39,6 +40,7 @@ static void derive(pmstep_t *inst, const pmstep_config_t *cfg)
     plan->inductance_start_step = 2u + cfg->timing.computational_delay_periods;
     plan->offsets_from_alignment = cfg->commissioning.alignment_offset_calibration;
     plan->bias_estimation = cfg->commissioning.voltage_bias_level_fraction > 0.0f;
+    plan->identification_steps = pmstep_periods_in(cfg->commissioning.identification_time_s, period_s);
     inst->offset_cal_steps = pmstep_periods_in(cfg->commissioning.offset_calibration_time_s, period_s);
     pmstep_detect_coeffs_init(&inst->detect_coeffs, cfg);
     pmstep_actuate_coeffs_init(&inst->actuate_coeffs, cfg);
@@ -245,18 +247,13 @@ static void offset_calibration_stage(pmstep_t *inst, const pmstep_meas_t *meas, 
     }
 }
 
-/* At t_c, before the first RUN period: Remark 2 offsets and the commissioned model.
- * @return a fault, or PMSTEP_FAULT_NONE. */
-static pmstep_fault_t finish_commissioning(pmstep_t *inst, const pmstep_meas_t *raw)
+/* The model RUN works with: the configured one, with what commissioning measured (R, L, k_M at t_c)
+ * and identified (J, F at the end of the identification window) in place where configured so. */
+static pmstep_electrical_t commissioned_model(const pmstep_t *inst)
 {
     const pmstep_config_t *cfg = inst->cfg;
-    pmstep_commissioning_t *result = &inst->commissioning;
+    const pmstep_commissioning_t *result = &inst->commissioning;
     pmstep_electrical_t model = pmstep_configured_electrical(cfg);
-    const pmstep_fault_t fault = pmstep_commission_finish(&inst->scratch.sums, &inst->commission_plan, cfg, raw->i_a_A,
-                                                          inst->actuator.u_applied_a_V, result);
-    if (fault != PMSTEP_FAULT_NONE) {
-        return fault;
-    }
     if (cfg->commissioning.use_measured_resistance) {
         model.resistance_Ohm = result->resistance_Ohm;
     }
@@ -266,8 +263,53 @@ static pmstep_fault_t finish_commissioning(pmstep_t *inst, const pmstep_meas_t *
     if (cfg->commissioning.use_measured_torque_constant) {
         model.torque_constant_Nm_A = result->torque_constant_Nm_A;
     }
+    if (cfg->commissioning.use_identified_mechanics && (result->identification == PMSTEP_IDENT_DONE
+                                                        || result->identification == PMSTEP_IDENT_FRICTION_NEGATIVE)) {
+        model.inertia_kgm2 = result->inertia_kgm2;
+        /* F < 0 is below what the fit resolves (PMSTEP_IDENT_FRICTION_NEGATIVE says so): none. */
+        model.friction_Nms_rad = result->friction_Nms_rad > 0.0f ? result->friction_Nms_rad : 0.0f;
+    }
+    return model;
+}
+
+/* At t_c, before the first RUN period: Remark 2 offsets and the commissioned model; the
+ * identification window opens. @return a fault, or PMSTEP_FAULT_NONE. */
+static pmstep_fault_t finish_commissioning(pmstep_t *inst, const pmstep_meas_t *raw)
+{
+    pmstep_commissioning_t *result = &inst->commissioning;
+    pmstep_electrical_t model;
+    const pmstep_fault_t fault = pmstep_commission_finish(&inst->scratch.sums, &inst->commission_plan, inst->cfg,
+                                                          raw->i_a_A, inst->actuator.u_applied_a_V, result);
+    if (fault != PMSTEP_FAULT_NONE) {
+        return fault;
+    }
+    if (inst->commission_plan.identification_steps > 0u) {
+        result->identification = PMSTEP_IDENT_RUNNING; /* RUN's start clears the sums */
+    }
+    model = commissioned_model(inst);
     apply_model(inst, &model);
     return PMSTEP_FAULT_NONE;
+}
+
+/* Identify stage, in RUN while the window is open: the period's sample of the fit i_q = c_0 +
+ * c_a w*' + c_w w* (when |w*| is at least the configured lowest speed); at the window's end J
+ * and F, and with use_identified_mechanics the observer's and the law's coefficients for them. */
+static void identify_stage(pmstep_t *inst, const pmstep_output_t *out)
+{
+    const pmstep_commissioning_config_t *comm = &inst->cfg->commissioning;
+    pmstep_identify_sums_t *sums = &inst->scratch.run.identify;
+    if (pmstep_abs(out->speed_ref_rad_s) >= comm->identification_min_speed_rad_s) {
+        pmstep_identify_add(sums, out->speed_ref_rate_rad_s2, out->speed_ref_rad_s, out->i_q_A);
+    }
+    if (++sums->periods >= inst->commission_plan.identification_steps) {
+        pmstep_electrical_t model = commissioned_model(inst); /* k_M as RUN uses it */
+        pmstep_identify_finish(sums, model.torque_constant_Nm_A, inst->cfg->motor.inertia_kgm2,
+                               inst->cfg->timing.period_s, &inst->commissioning);
+        if (comm->use_identified_mechanics) {
+            model = commissioned_model(inst);
+            apply_model(inst, &model);
+        }
+    }
 }
 
 /* Commission stage: the mode of this period from the alignment timing; the alignment's samples
@@ -374,6 +416,9 @@ static pmstep_fault_t bridge_on_stages(pmstep_t *inst, const pmstep_meas_t *meas
         out->fault = PMSTEP_FAULT_NONE;
         out->fault_step = inst->fault_step;
         pmstep_control_compute(inst, &sample, out, &control);
+        if (inst->commissioning.identification == PMSTEP_IDENT_RUNNING) {
+            identify_stage(inst, out);
+        }
         fault = supervise_stage(inst, out, &sample);
         if (fault != PMSTEP_FAULT_NONE) {
             if (inst->commissioning.realignments >= inst->cfg->detection.max_realignments) {
