@@ -247,29 +247,22 @@ static void offset_calibration_stage(pmstep_t *inst, const pmstep_meas_t *meas, 
     }
 }
 
-/* The model RUN works with: the configured one, with what commissioning measured (R, L, k_M at t_c)
- * and identified (J, F at the end of the identification window) in place where configured so. */
-static pmstep_electrical_t commissioned_model(const pmstep_t *inst)
+/* The model RUN works with from t_c: the configured one, with what commissioning measured in
+ * place where configured so. */
+static void commissioned_model(const pmstep_t *inst, pmstep_electrical_t *model)
 {
     const pmstep_config_t *cfg = inst->cfg;
     const pmstep_commissioning_t *result = &inst->commissioning;
-    pmstep_electrical_t model = pmstep_configured_electrical(cfg);
+    *model = pmstep_configured_electrical(cfg);
     if (cfg->commissioning.use_measured_resistance) {
-        model.resistance_Ohm = result->resistance_Ohm;
+        model->resistance_Ohm = result->resistance_Ohm;
     }
     if (cfg->commissioning.use_measured_inductance) {
-        model.inductance_H = result->inductance_H;
+        model->inductance_H = result->inductance_H;
     }
     if (cfg->commissioning.use_measured_torque_constant) {
-        model.torque_constant_Nm_A = result->torque_constant_Nm_A;
+        model->torque_constant_Nm_A = result->torque_constant_Nm_A;
     }
-    if (cfg->commissioning.use_identified_mechanics && (result->identification == PMSTEP_IDENT_DONE
-                                                        || result->identification == PMSTEP_IDENT_FRICTION_NEGATIVE)) {
-        model.inertia_kgm2 = result->inertia_kgm2;
-        /* F < 0 is below what the fit resolves (PMSTEP_IDENT_FRICTION_NEGATIVE says so): none. */
-        model.friction_Nms_rad = result->friction_Nms_rad > 0.0f ? result->friction_Nms_rad : 0.0f;
-    }
-    return model;
 }
 
 /* At t_c, before the first RUN period: Remark 2 offsets and the commissioned model; the
@@ -286,27 +279,21 @@ static pmstep_fault_t finish_commissioning(pmstep_t *inst, const pmstep_meas_t *
     if (inst->commission_plan.identification_steps > 0u) {
         result->identification = PMSTEP_IDENT_RUNNING; /* RUN's start clears the sums */
     }
-    model = commissioned_model(inst);
+    commissioned_model(inst, &model);
     apply_model(inst, &model);
     return PMSTEP_FAULT_NONE;
 }
 
-/* Identify stage, in RUN while the window is open: the period's sample of the fit i_q = c_0 +
- * c_a w*' + c_w w* (when |w*| is at least the configured lowest speed); at the window's end J
- * and F, and with use_identified_mechanics the observer's and the law's coefficients for them. */
+/* Identify stage, in RUN while the window is open: the period's sample of the fit (pmstep_identify.h);
+ * at the window's end J and F, and with use_identified_mechanics the observer's and the law's
+ * coefficients for them (a one-off, like t_c's). */
 static void identify_stage(pmstep_t *inst, const pmstep_output_t *out)
 {
-    const pmstep_commissioning_config_t *comm = &inst->cfg->commissioning;
-    pmstep_identify_sums_t *sums = &inst->scratch.run.identify;
-    if (pmstep_abs(out->speed_ref_rad_s) >= comm->identification_min_speed_rad_s) {
-        pmstep_identify_add(sums, out->speed_ref_rate_rad_s2, out->speed_ref_rad_s, out->i_q_A);
-    }
-    if (++sums->periods >= inst->commission_plan.identification_steps) {
-        pmstep_electrical_t model = commissioned_model(inst); /* k_M as RUN uses it */
-        pmstep_identify_finish(sums, model.torque_constant_Nm_A, inst->cfg->motor.inertia_kgm2,
-                               inst->cfg->timing.period_s, &inst->commissioning);
-        if (comm->use_identified_mechanics) {
-            model = commissioned_model(inst);
+    if (pmstep_identify_sample(&inst->scratch.run.identify, &inst->cfg->commissioning,
+                               inst->commission_plan.identification_steps, out)) {
+        pmstep_electrical_t model;
+        commissioned_model(inst, &model);
+        if (pmstep_identify_finish(&inst->scratch.run.identify, inst->cfg, &model, &inst->commissioning)) {
             apply_model(inst, &model);
         }
     }

@@ -1,7 +1,7 @@
 /* Identification of J and F at the start of RUN (see pmstep_identify.h). */
 #include "pmstep/pmstep_identify.h"
 
-#include <math.h> /* sqrtf: one vsqrt.f32 / sqrtss with -fno-math-errno; isfinite: a classification macro */
+#include <math.h> /* fabsf: one vabs.f32, no libm call */
 #include <string.h>
 
 void pmstep_identify_clear(pmstep_identify_sums_t *sums)
@@ -9,87 +9,84 @@ void pmstep_identify_clear(pmstep_identify_sums_t *sums)
     memset(sums, 0, sizeof *sums);
 }
 
-/* det [[a, b, c], [b, d, e], [c, e, f]] of a symmetric 3x3 matrix. */
-static float det3_symmetric(float a, float b, float c, float d, float e, float f)
-{
-    return a * (d * f - e * e) - b * (b * f - c * e) + c * (b * e - c * d);
-}
-
-/* det of the 3x3 matrix with columns (u, v, w). */
-static float det3_columns(const float u[3], const float v[3], const float w[3])
-{
-    return u[0] * (v[1] * w[2] - v[2] * w[1]) - v[0] * (u[1] * w[2] - u[2] * w[1])
-           + w[0] * (u[1] * v[2] - u[2] * v[1]);
-}
-
 bool pmstep_identify_solve(const pmstep_identify_sums_t *sums, float min_determinant, pmstep_identify_fit_t *fit)
 {
-    float s0;
-    float sa;
-    float sw;
-    float col_1[3];
-    float col_a[3];
-    float col_w[3];
-    float rhs[3];
+    /* The constant's equation gives c_0 = (sum y - c_a sum a - c_w sum w)/n; the other two,
+     * centred (S_xz = sum x z - sum x sum z / n), are a 2x2 system solved by Cramer's rule. Its
+     * determinant over sum a^2 sum w^2 is the determinant of the 3x3 system normalised by its
+     * diagonal (the cosine matrix of the columns 1, a, w): the conditioning, in any units. */
+    float inv_n;
+    float s_aa;
+    float s_aw;
+    float s_ww;
+    float s_ay;
+    float s_wy;
     float det;
-    float c_0;
     float c_a;
     float c_w;
-    if (!(sums->n > 0.0f && sums->aa > 0.0f && sums->ww > 0.0f)) {
-        return false; /* a regressor without energy: the system is singular */
-    }
-    /* Normalised system: D^-1 N D^-1 z = D^-1 b, D = diag(sqrt(N_ii)), c = D^-1 z. */
-    s0 = 1.0f / sqrtf(sums->n);
-    sa = 1.0f / sqrtf(sums->aa);
-    sw = 1.0f / sqrtf(sums->ww);
-    col_1[0] = 1.0f;
-    col_1[1] = sums->a * s0 * sa;
-    col_1[2] = sums->w * s0 * sw;
-    col_a[0] = col_1[1];
-    col_a[1] = 1.0f;
-    col_a[2] = sums->aw * sa * sw;
-    col_w[0] = col_1[2];
-    col_w[1] = col_a[2];
-    col_w[2] = 1.0f;
-    rhs[0] = sums->y * s0;
-    rhs[1] = sums->ay * sa;
-    rhs[2] = sums->wy * sw;
-    det = det3_symmetric(1.0f, col_1[1], col_1[2], 1.0f, col_a[2], 1.0f);
-    if (!(det >= min_determinant)) {
-        return false; /* also NaN */
-    }
-    /* Cramer's rule. */
-    c_0 = det3_columns(rhs, col_a, col_w) / det * s0;
-    c_a = det3_columns(col_1, rhs, col_w) / det * sa;
-    c_w = det3_columns(col_1, col_a, rhs) / det * sw;
-    if (!(isfinite(c_0) && isfinite(c_a) && isfinite(c_w))) {
+    if (!(sums->n > 0.0f)) {
         return false;
     }
-    fit->offset = c_0;
+    inv_n = 1.0f / sums->n;
+    s_aa = sums->aa - sums->a * sums->a * inv_n;
+    s_aw = sums->aw - sums->a * sums->w * inv_n;
+    s_ww = sums->ww - sums->w * sums->w * inv_n;
+    s_ay = sums->ay - sums->a * sums->y * inv_n;
+    s_wy = sums->wy - sums->w * sums->y * inv_n;
+    det = s_aa * s_ww - s_aw * s_aw;
+    if (!(det > 0.0f && det >= min_determinant * (sums->aa * sums->ww))) {
+        return false; /* also a regressor without energy, and NaN */
+    }
+    c_a = (s_ay * s_ww - s_wy * s_aw) / det;
+    c_w = (s_wy * s_aa - s_ay * s_aw) / det;
+    fit->offset = (sums->y - c_a * sums->a - c_w * sums->w) * inv_n;
     fit->accel_coeff = c_a;
     fit->speed_coeff = c_w;
     return true;
 }
 
-void pmstep_identify_finish(const pmstep_identify_sums_t *sums, float torque_constant_Nm_A, float inertia_kgm2,
-                            float period_s, pmstep_commissioning_t *result)
+bool pmstep_identify_sample(pmstep_identify_sums_t *sums, const pmstep_commissioning_config_t *comm,
+                            uint32_t window_periods, const pmstep_output_t *out)
+{
+    const float w = out->speed_ref_rad_s;
+    if (fabsf(w) >= comm->identification_min_speed_rad_s) {
+        const float a = out->speed_ref_rate_rad_s2;
+        const float y = out->i_q_A;
+        sums->n += 1.0f;
+        sums->a += a;
+        sums->w += w;
+        sums->aa += a * a;
+        sums->aw += a * w;
+        sums->ww += w * w;
+        sums->y += y;
+        sums->ay += a * y;
+        sums->wy += w * y;
+    }
+    return ++sums->periods >= window_periods;
+}
+
+bool pmstep_identify_finish(const pmstep_identify_sums_t *sums, const pmstep_config_t *cfg, pmstep_electrical_t *model,
+                            pmstep_commissioning_t *result)
 {
     pmstep_identify_fit_t fit;
     float j;
     float f;
+    result->identification = PMSTEP_IDENT_POOR_EXCITATION;
     if (!pmstep_identify_solve(sums, PMSTEP_IDENTIFICATION_MIN_DETERMINANT, &fit)) {
-        result->identification = PMSTEP_IDENT_POOR_EXCITATION;
-        return;
+        return false;
     }
-    j = torque_constant_Nm_A * fit.accel_coeff;
-    f = torque_constant_Nm_A * fit.speed_coeff;
+    /* i_q = (J w*' + F w* + T_L)/k_M */
+    j = model->torque_constant_Nm_A * fit.accel_coeff;
+    f = model->torque_constant_Nm_A * fit.speed_coeff;
     result->inertia_kgm2 = j;
     result->friction_Nms_rad = f;
-    if (!(j >= 0.5f * inertia_kgm2 && j <= 2.0f * inertia_kgm2 && isfinite(f) && f * period_s < 0.5f * j)) {
-        result->identification = PMSTEP_IDENT_IMPLAUSIBLE;
-    } else if (f < 0.0f) {
-        result->identification = PMSTEP_IDENT_FRICTION_NEGATIVE;
-    } else {
-        result->identification = PMSTEP_IDENT_DONE;
+    result->identification = PMSTEP_IDENT_IMPLAUSIBLE;
+    if (!(j >= 0.5f * cfg->motor.inertia_kgm2 && j <= 2.0f * cfg->motor.inertia_kgm2
+          && fabsf(f) * cfg->timing.period_s < 0.5f * j)) {
+        return false; /* also J or F not finite */
     }
+    result->identification = f < 0.0f ? PMSTEP_IDENT_FRICTION_NEGATIVE : PMSTEP_IDENT_DONE;
+    model->inertia_kgm2 = j;
+    model->friction_Nms_rad = f < 0.0f ? 0.0f : f; /* below what the fit resolves: none (the outcome says so) */
+    return cfg->commissioning.use_identified_mechanics;
 }

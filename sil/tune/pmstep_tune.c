@@ -43,9 +43,6 @@ static void usage(FILE *f)
 #define ANGLE_BOUND_RAD 0.05
 #define LOAD_STEP_OF_HOLDING 0.5
 #define SYNC_ANGLE_BOUND_RAD 0.5
-/* Identification (README, "Self-commissioning"): periods with |w*| under this fraction of the top
- * speed stay out of the fit (the detent torque does not average out at low speed). */
-#define IDENTIFY_MIN_SPEED_OF_TOP 0.2
 
 static double ramp_time_s(const sil_scenario_t *sc, double speed_change_rad_s)
 {
@@ -306,8 +303,8 @@ static void design_input(const sil_scenario_t *sc, bool robust, pmstep_design_in
     }
 }
 
-/* Identification window over the profile +0.8 top, -0.8 top (each held), from t_c; only speeds
- * of at least IDENTIFY_MIN_SPEED_OF_TOP of the top speed enter the fit. */
+/* Identification window over the profile +0.8 top, -0.8 top (each held), from t_c; the lowest
+ * speed that enters the fit is the designer's (DESIGN.md, section 10). */
 static void set_identification(sil_scenario_t *sc, double top_speed_rad_s, bool use_in_run)
 {
     const double levels[] = {0.8 * top_speed_rad_s, -0.8 * top_speed_rad_s};
@@ -315,7 +312,6 @@ static void set_identification(sil_scenario_t *sc, double top_speed_rad_s, bool 
                        + (double)sc->controller.commissioning.offset_calibration_time_s;
     set_profile(sc, levels, 2);
     sc->controller.commissioning.identification_time_s = (float)(sc->duration_s - t_c);
-    sc->controller.commissioning.identification_min_speed_rad_s = (float)(IDENTIFY_MIN_SPEED_OF_TOP * top_speed_rad_s);
     sc->controller.commissioning.use_identified_mechanics = use_in_run;
 }
 

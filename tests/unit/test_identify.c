@@ -50,6 +50,19 @@ static float noise(uint32_t *state)
     return (float)(*state >> 8) / 8388608.0f - 1.0f;
 }
 
+/* One sample through the core's own accumulation (every speed enters: lowest speed 0). */
+static void add(pmstep_identify_sums_t *sums, float a, float w, float y)
+{
+    pmstep_commissioning_config_t comm;
+    pmstep_output_t out;
+    memset(&comm, 0, sizeof comm);
+    memset(&out, 0, sizeof out);
+    out.speed_ref_rate_rad_s2 = a;
+    out.speed_ref_rad_s = w;
+    out.i_q_A = y;
+    (void)pmstep_identify_sample(sums, &comm, UINT32_MAX, &out);
+}
+
 /* Sums of y = c0 + ca a + cw w (+ noise of amplitude @p noise_A) over @p n samples. */
 static pmstep_identify_sums_t synthetic(uint32_t n, float c0, float ca, float cw, float noise_A)
 {
@@ -61,7 +74,7 @@ static pmstep_identify_sums_t synthetic(uint32_t n, float c0, float ca, float cw
         float w;
         float a;
         profile(k, n, 55.0f, &w, &a);
-        pmstep_identify_add(&sums, a, w, c0 + ca * a + cw * w + noise_A * noise(&state));
+        add(&sums, a, w, c0 + ca * a + cw * w + noise_A * noise(&state));
     }
     return sums;
 }
@@ -101,25 +114,25 @@ static void solver_refuses_poor_excitation(void **state)
     /* A constant speed: no acceleration at all. */
     pmstep_identify_clear(&sums);
     for (k = 0; k < 1000u; ++k) {
-        pmstep_identify_add(&sums, 0.0f, 20.0f, 0.1f);
+        add(&sums, 0.0f, 20.0f, 0.1f);
     }
     assert_false(pmstep_identify_solve(&sums, PMSTEP_IDENTIFICATION_MIN_DETERMINANT, &fit));
     /* A constant acceleration from rest, w = a t: the columns 1, a are collinear. */
     pmstep_identify_clear(&sums);
     for (k = 0; k < 1000u; ++k) {
-        pmstep_identify_add(&sums, 1000.0f, 1000.0f * (float)k * PERIOD_S, 0.1f);
+        add(&sums, 1000.0f, 1000.0f * (float)k * PERIOD_S, 0.1f);
     }
     assert_false(pmstep_identify_solve(&sums, PMSTEP_IDENTIFICATION_MIN_DETERMINANT, &fit));
     /* Acceleration proportional to speed (w = e^t): the columns a, w are collinear. */
     pmstep_identify_clear(&sums);
     for (k = 0; k < 1000u; ++k) {
         const float w = 1.0f + 0.001f * (float)k;
-        pmstep_identify_add(&sums, 3.0f * w, w, 0.1f * w);
+        add(&sums, 3.0f * w, w, 0.1f * w);
     }
     assert_false(pmstep_identify_solve(&sums, PMSTEP_IDENTIFICATION_MIN_DETERMINANT, &fit));
-    /* Non-finite sums. */
+    /* A sum that is not a number. */
     sums = synthetic(1000u, 0.05f, 3.2e-5f, 6e-4f, 0.0f);
-    sums.ay = NAN;
+    sums.aa = NAN;
     assert_false(pmstep_identify_solve(&sums, PMSTEP_IDENTIFICATION_MIN_DETERMINANT, &fit));
     /* The fit is left as it was. */
     assert_true(fit.offset == 1.0f && fit.accel_coeff == 2.0f && fit.speed_coeff == 3.0f);
@@ -138,7 +151,7 @@ static void solver_threshold_is_the_normalised_determinant(void **state)
     for (k = 0; k < 4000u; ++k) {
         const float a = k < 200u ? 5000.0f : 0.0f;
         const float w = k < 200u ? 5000.0f * PERIOD_S * (float)k : 50.0f;
-        pmstep_identify_add(&sums, a, w, 0.05f + 3.2e-5f * a + 6e-4f * w);
+        add(&sums, a, w, 0.05f + 3.2e-5f * a + 6e-4f * w);
     }
     {
         const float c1a = sums.a / sqrtf(sums.n * sums.aa);
@@ -152,38 +165,82 @@ static void solver_threshold_is_the_normalised_determinant(void **state)
     assert_false(pmstep_identify_solve(&sums, 2.0f * det, &fit));
 }
 
+static void sample_skips_low_speeds_and_closes_the_window(void **state)
+{
+    pmstep_identify_sums_t sums;
+    pmstep_commissioning_config_t comm;
+    pmstep_output_t out;
+    (void)state;
+    memset(&comm, 0, sizeof comm);
+    memset(&out, 0, sizeof out);
+    comm.identification_min_speed_rad_s = 10.0f;
+    pmstep_identify_clear(&sums);
+    out.speed_ref_rad_s = -9.9f;
+    assert_false(pmstep_identify_sample(&sums, &comm, 3u, &out));
+    assert_true(sums.n == 0.0f);
+    out.speed_ref_rad_s = -10.0f;
+    out.speed_ref_rate_rad_s2 = 100.0f;
+    out.i_q_A = 0.5f;
+    assert_false(pmstep_identify_sample(&sums, &comm, 3u, &out));
+    assert_true(sums.n == 1.0f && sums.w == -10.0f && sums.aw == -1000.0f && sums.wy == -5.0f && sums.ay == 50.0f);
+    assert_true(pmstep_identify_sample(&sums, &comm, 3u, &out)); /* the third period closes the window */
+    assert_int_equal(sums.periods, 3u);
+}
+
 static void finish_judges_the_result(void **state)
 {
     const float k_m = 0.16638f;
     const float j = 5.4e-6f;
+    pmstep_config_t cfg = pmstep_paper_config();
     pmstep_commissioning_t result;
     pmstep_identify_sums_t sums;
+    pmstep_electrical_t model;
     (void)state;
-    /* J = k_M c_a, F = k_M c_w. */
+    cfg.motor.inertia_kgm2 = 1.2f * j;
+    cfg.motor.friction_Nms_rad = 0.0f;
+    cfg.motor.torque_constant_Nm_A = 2.0f * k_m; /* the model's k_M is the one used */
+    cfg.timing.period_s = PERIOD_S;
+    cfg.commissioning.use_identified_mechanics = true;
     memset(&result, 0, sizeof result);
+    /* J = k_M c_a, F = k_M c_w, into the model. */
     sums = synthetic(16000u, 0.05f, j / k_m, 1e-4f / k_m, 0.0f);
-    pmstep_identify_finish(&sums, k_m, 1.2f * j, PERIOD_S, &result);
+    model = pmstep_configured_electrical(&cfg);
+    model.torque_constant_Nm_A = k_m;
+    assert_true(pmstep_identify_finish(&sums, &cfg, &model, &result));
     assert_int_equal(result.identification, PMSTEP_IDENT_DONE);
     assert_float_equal(result.inertia_kgm2, j, j * 1e-3f);
     assert_float_equal(result.friction_Nms_rad, 1e-4f, 1e-4f * 1e-2f);
-    /* Negative friction: reported as such. */
+    assert_true(model.inertia_kgm2 == result.inertia_kgm2 && model.friction_Nms_rad == result.friction_Nms_rad);
+    /* Identified but not to be used. */
+    cfg.commissioning.use_identified_mechanics = false;
+    assert_false(pmstep_identify_finish(&sums, &cfg, &model, &result));
+    assert_int_equal(result.identification, PMSTEP_IDENT_DONE);
+    cfg.commissioning.use_identified_mechanics = true;
+    /* Negative friction: reported as such; the model gets none. */
     sums = synthetic(16000u, 0.05f, j / k_m, -1e-5f / k_m, 0.0f);
-    pmstep_identify_finish(&sums, k_m, j, PERIOD_S, &result);
+    assert_true(pmstep_identify_finish(&sums, &cfg, &model, &result));
     assert_int_equal(result.identification, PMSTEP_IDENT_FRICTION_NEGATIVE);
-    assert_true(result.friction_Nms_rad < 0.0f);
-    /* J three times the configured one: implausible, reported, not to be used. */
-    sums = synthetic(16000u, 0.05f, 3.0f * j / k_m, 1e-4f / k_m, 0.0f);
-    pmstep_identify_finish(&sums, k_m, j, PERIOD_S, &result);
+    assert_true(result.friction_Nms_rad < 0.0f && model.friction_Nms_rad == 0.0f);
+    /* J three times the configured one: implausible, reported, not used. */
+    model = pmstep_configured_electrical(&cfg);
+    model.torque_constant_Nm_A = k_m;
+    sums = synthetic(16000u, 0.05f, 3.0f * 1.2f * j / k_m, 1e-4f / k_m, 0.0f);
+    assert_false(pmstep_identify_finish(&sums, &cfg, &model, &result));
     assert_int_equal(result.identification, PMSTEP_IDENT_IMPLAUSIBLE);
-    assert_float_equal(result.inertia_kgm2, 3.0f * j, 3.0f * j * 1e-3f);
-    /* F/J at the control rate: implausible. */
+    assert_float_equal(result.inertia_kgm2, 3.6f * j, 3.6f * j * 1e-3f);
+    assert_true(model.inertia_kgm2 == cfg.motor.inertia_kgm2);
+    /* F/J at the control rate, and a sum that is not finite: implausible. */
     sums = synthetic(16000u, 0.05f, j / k_m, j / PERIOD_S / k_m, 0.0f);
-    pmstep_identify_finish(&sums, k_m, j, PERIOD_S, &result);
+    assert_false(pmstep_identify_finish(&sums, &cfg, &model, &result));
+    assert_int_equal(result.identification, PMSTEP_IDENT_IMPLAUSIBLE);
+    sums = synthetic(16000u, 0.05f, j / k_m, 1e-4f / k_m, 0.0f);
+    sums.ay = INFINITY;
+    assert_false(pmstep_identify_finish(&sums, &cfg, &model, &result));
     assert_int_equal(result.identification, PMSTEP_IDENT_IMPLAUSIBLE);
     /* No excitation. */
     memset(&result, 0, sizeof result);
     pmstep_identify_clear(&sums);
-    pmstep_identify_finish(&sums, k_m, j, PERIOD_S, &result);
+    assert_false(pmstep_identify_finish(&sums, &cfg, &model, &result));
     assert_int_equal(result.identification, PMSTEP_IDENT_POOR_EXCITATION);
     assert_true(result.inertia_kgm2 == 0.0f);
 }
@@ -241,6 +298,7 @@ int main(void)
         cmocka_unit_test(solver_averages_noise),
         cmocka_unit_test(solver_refuses_poor_excitation),
         cmocka_unit_test(solver_threshold_is_the_normalised_determinant),
+        cmocka_unit_test(sample_skips_low_speeds_and_closes_the_window),
         cmocka_unit_test(finish_judges_the_result),
         cmocka_unit_test(config_checks_have_named_errors),
         cmocka_unit_test(identified_model_sets_the_mechanical_coefficients),

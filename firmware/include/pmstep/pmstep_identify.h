@@ -13,9 +13,10 @@
  * 17HS4401 in the SIL where the current's fit is within 0.5 % (README, "Self-commissioning").
  *
  * Each period in the window adds to the normal equations' sums (a few multiply-adds); at the
- * end of the window the 3x3 system is solved once by Cramer's rule on its normalised form
- * (each column scaled by the root of its diagonal entry, so that the determinant of the
- * cosine matrix measures the conditioning whatever the units): below
+ * end of the window the system is solved once: the constant eliminated (sums centred), the
+ * remaining 2x2 system by Cramer's rule. Its determinant over sum a^2 sum w^2 equals the
+ * determinant of the 3x3 normal matrix normalised by its diagonal (the cosine matrix of the
+ * columns 1, a, w), which measures the conditioning whatever the units: below
  * PMSTEP_IDENTIFICATION_MIN_DETERMINANT the data cannot separate the regressors (no
  * acceleration, or a speed that never changes) and nothing is identified.
  */
@@ -46,37 +47,35 @@ typedef struct {
 
 void pmstep_identify_clear(pmstep_identify_sums_t *sums);
 
-/** One sample: @p accel_rad_s2 = w*', @p speed_rad_s = w*, @p y = i_q (A). */
-static inline void pmstep_identify_add(pmstep_identify_sums_t *sums, float accel_rad_s2, float speed_rad_s, float y)
-{
-    sums->n += 1.0f;
-    sums->a += accel_rad_s2;
-    sums->w += speed_rad_s;
-    sums->aa += accel_rad_s2 * accel_rad_s2;
-    sums->aw += accel_rad_s2 * speed_rad_s;
-    sums->ww += speed_rad_s * speed_rad_s;
-    sums->y += y;
-    sums->ay += accel_rad_s2 * y;
-    sums->wy += speed_rad_s * y;
-}
+/**
+ * One RUN period of the window: adds the sample (a = out->speed_ref_rate_rad_s2, w =
+ * out->speed_ref_rad_s, y = out->i_q_A) when |w| is at least comm->identification_min_speed_rad_s.
+ * @return true when this period closes the window of @p window_periods periods.
+ */
+bool pmstep_identify_sample(pmstep_identify_sums_t *sums, const pmstep_commissioning_config_t *comm,
+                            uint32_t window_periods, const pmstep_output_t *out);
 
 /**
- * Solves the normal equations of @p sums (Cramer's rule on the normalised system).
- * @return true and @p fit when the normalised determinant is at least @p min_determinant and
- *         the coefficients are finite; false (@p fit untouched) when the data are too poorly
- *         excited: a regressor with no energy, a determinant below @p min_determinant, or
- *         anything not finite.
+ * Solves the normal equations of @p sums (see above).
+ * @return true and @p fit when the normalised determinant is at least @p min_determinant (the
+ *         coefficients may still be non-finite if a sum is: pmstep_identify_finish() judges
+ *         them); false, @p fit untouched, when the data are too poorly excited (a regressor
+ *         with no energy, a determinant below @p min_determinant or not a number).
  */
 bool pmstep_identify_solve(const pmstep_identify_sums_t *sums, float min_determinant, pmstep_identify_fit_t *fit);
 
 /**
- * J and F from the fit of i_q with the model's @p torque_constant_Nm_A, judged against the
- * configured @p inertia_kgm2 and the control period: writes result->inertia_kgm2,
- * friction_Nms_rad and identification (PMSTEP_IDENT_DONE, _FRICTION_NEGATIVE, _POOR_EXCITATION
- * or _IMPLAUSIBLE, see pmstep_identification_t).
+ * At the end of the window: J and F from the fit of i_q, with the k_M of @p model (the model RUN
+ * uses), judged against the configured J of @p cfg and its control period. Writes
+ * result->inertia_kgm2, friction_Nms_rad and identification (PMSTEP_IDENT_DONE,
+ * _FRICTION_NEGATIVE, _POOR_EXCITATION or _IMPLAUSIBLE: J outside [1/2, 2] x the configured
+ * one, or |F|/J T_s >= 1/2, which also catches J or F not finite; see pmstep_identification_t).
+ * When J is usable, puts J and F (0 for F < 0) into @p model.
+ * @return true when @p model was updated and cfg->commissioning.use_identified_mechanics asks
+ *         for it to be used.
  */
-void pmstep_identify_finish(const pmstep_identify_sums_t *sums, float torque_constant_Nm_A, float inertia_kgm2,
-                            float period_s, pmstep_commissioning_t *result);
+bool pmstep_identify_finish(const pmstep_identify_sums_t *sums, const pmstep_config_t *cfg, pmstep_electrical_t *model,
+                            pmstep_commissioning_t *result);
 
 #ifdef __cplusplus
 }

@@ -296,8 +296,8 @@ typedef enum {
     PMSTEP_IDENT_POOR_EXCITATION = 4,  /**< the window held too little acceleration or speed variation (the fit's
                                             determinant below PMSTEP_IDENTIFICATION_MIN_DETERMINANT): nothing
                                             identified, the configured J and F stay */
-    PMSTEP_IDENT_IMPLAUSIBLE = 5       /**< J outside [1/2, 2] x the configured one, or F not finite or F/J not
-                                            below 0.5/T_s: reported, not used */
+    PMSTEP_IDENT_IMPLAUSIBLE = 5       /**< J outside [1/2, 2] x the configured one, or |F|/J not below 0.5/T_s
+                                            (or either not finite): reported, not used */
 } pmstep_identification_t;
 
 /** Remark 2 calibration and self-commissioning results (pmstep_get_commissioning()). */
