@@ -292,8 +292,13 @@ static void identify_stage(pmstep_t *inst, const pmstep_output_t *out)
     if (pmstep_identify_sample(&inst->scratch.run.identify, &inst->cfg->commissioning,
                                inst->commission_plan.identification_steps, out)) {
         pmstep_electrical_t model;
+        float friction_Nms_rad;
         commissioned_model(inst, &model);
+        friction_Nms_rad = model.friction_Nms_rad;
         if (pmstep_identify_finish(&inst->scratch.run.identify, inst->cfg, &model, &inst->commissioning)) {
+            /* Bumpless: T_L-hat takes over the friction torque the new F no longer leaves to it,
+             * so F w-hat + T_L-hat, the torque the law asks for at constant speed, is unchanged. */
+            inst->observer.load_hat_Nm += (friction_Nms_rad - model.friction_Nms_rad) * inst->observer.speed_hat_rad_s;
             apply_model(inst, &model);
         }
     }

@@ -59,6 +59,9 @@ static const pmstep_console_config_entry_t table[] = {
     F32(detection.observer_residual_bound_A),
     F32(detection.persistence_s),
     U32(detection.max_realignments),
+    F32(commissioning.identification_time_s),
+    F32(commissioning.identification_min_speed_rad_s),
+    BOOL(commissioning.use_identified_mechanics),
 };
 
 const pmstep_console_config_entry_t *pmstep_console_config_table(uint32_t *count)

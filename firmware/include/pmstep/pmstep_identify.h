@@ -32,9 +32,14 @@ extern "C" {
 /** Sums of the normal equations of the fit y = c_0 + c_a a + c_w w (a = w*', w = w*, y = i_q). */
 typedef struct {
     float n;                  /**< samples */
-    float a, w;               /**< sum a, sum w */
-    float aa, aw, ww;         /**< sum a^2, sum a w, sum w^2 */
-    float y, ay, wy;          /**< sum y, sum a y, sum w y */
+    float a;                  /**< sum a */
+    float w;                  /**< sum w */
+    float aa;                 /**< sum a^2 */
+    float aw;                 /**< sum a w */
+    float ww;                 /**< sum w^2 */
+    float y;                  /**< sum y */
+    float ay;                 /**< sum a y */
+    float wy;                 /**< sum w y */
     uint32_t periods;         /**< RUN periods since the window opened (samples or not) */
 } pmstep_identify_sums_t;
 
