@@ -5,7 +5,8 @@
  *   check      measurements against the protections (here)
  *   commission alignment timing, Remark 2 sums, the commissioned model at t_c (pmstep_commission.c)
  *   control    alignment voltages (here), or controller (6) (pmstep_control.c)
- *   identify   in RUN's first window: the J and F fit's sums, at its end J and F (pmstep_identify.c)
+ *   identify   in RUN's first window, every PMSTEP_IDENTIFICATION_DECIMATION periods: the J and F
+ *              fit's sums, at its end J and F (pmstep_identify.c)
  *   supervise  detection every PMSTEP_DETECTION_DECIMATION periods in RUN (pmstep_detect.c)
  *   actuate    dead-time compensation, bus limit, output check, delay (pmstep_actuate.c)
  *   advance    observer and references over the coming period (pmstep_control.c) */
@@ -284,7 +285,8 @@ static pmstep_fault_t finish_commissioning(pmstep_t *inst, const pmstep_meas_t *
     return PMSTEP_FAULT_NONE;
 }
 
-/* Identify stage, in RUN while the window is open: the period's sample of the fit (pmstep_identify.h);
+/* Identify stage, in RUN while the window is open, every PMSTEP_IDENTIFICATION_DECIMATION periods: a
+ * sample of the fit (pmstep_identify.h);
  * at the window's end J and F, and with use_identified_mechanics the observer's and the law's
  * coefficients for them (a one-off, like t_c's). */
 static void identify_stage(pmstep_t *inst, const pmstep_output_t *out)
@@ -408,7 +410,8 @@ static pmstep_fault_t bridge_on_stages(pmstep_t *inst, const pmstep_meas_t *meas
         out->fault = PMSTEP_FAULT_NONE;
         out->fault_step = inst->fault_step;
         pmstep_control_compute(inst, &sample, out, &control);
-        if (inst->commissioning.identification == PMSTEP_IDENT_RUNNING) {
+        if (inst->commissioning.identification == PMSTEP_IDENT_RUNNING
+            && (inst->step_count % PMSTEP_IDENTIFICATION_DECIMATION) == 2u) {
             identify_stage(inst, out);
         }
         fault = supervise_stage(inst, out, &sample);

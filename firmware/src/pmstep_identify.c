@@ -62,7 +62,8 @@ bool pmstep_identify_sample(pmstep_identify_sums_t *sums, const pmstep_commissio
         sums->ay += a * y;
         sums->wy += w * y;
     }
-    return ++sums->periods >= window_periods;
+    sums->periods += PMSTEP_IDENTIFICATION_DECIMATION;
+    return sums->periods >= window_periods;
 }
 
 bool pmstep_identify_finish(const pmstep_identify_sums_t *sums, const pmstep_config_t *cfg, pmstep_electrical_t *model,

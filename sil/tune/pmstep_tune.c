@@ -324,6 +324,7 @@ static int identify(const sil_scenario_t *designed, double top_speed_rad_s, pmst
     int rc;
     sc = *designed;
     set_identification(&sc, top_speed_rad_s, false);
+    sc.duration_s += 0.01; /* the window closes on a sample, up to PMSTEP_IDENTIFICATION_DECIMATION periods late */
     sc.load.kind = PLANT_LOAD_NONE;
     rc = sil_run(&sc, NULL, NULL, false, &s);
     if (!run_ok("identification run", &s, rc)) {

@@ -176,15 +176,16 @@ static void sample_skips_low_speeds_and_closes_the_window(void **state)
     comm.identification_min_speed_rad_s = 10.0f;
     pmstep_identify_clear(&sums);
     out.speed_ref_rad_s = -9.9f;
-    assert_false(pmstep_identify_sample(&sums, &comm, 3u, &out));
+    assert_false(pmstep_identify_sample(&sums, &comm, 3u * PMSTEP_IDENTIFICATION_DECIMATION, &out));
     assert_true(sums.n == 0.0f);
     out.speed_ref_rad_s = -10.0f;
     out.speed_ref_rate_rad_s2 = 100.0f;
     out.i_q_A = 0.5f;
-    assert_false(pmstep_identify_sample(&sums, &comm, 3u, &out));
+    assert_false(pmstep_identify_sample(&sums, &comm, 3u * PMSTEP_IDENTIFICATION_DECIMATION, &out));
     assert_true(sums.n == 1.0f && sums.w == -10.0f && sums.aw == -1000.0f && sums.wy == -5.0f && sums.ay == 50.0f);
-    assert_true(pmstep_identify_sample(&sums, &comm, 3u, &out)); /* the third period closes the window */
-    assert_int_equal(sums.periods, 3u);
+    /* the third sample covers 3 x PMSTEP_IDENTIFICATION_DECIMATION periods: the window's end */
+    assert_true(pmstep_identify_sample(&sums, &comm, 3u * PMSTEP_IDENTIFICATION_DECIMATION, &out));
+    assert_int_equal(sums.periods, 3u * PMSTEP_IDENTIFICATION_DECIMATION);
 }
 
 static void finish_judges_the_result(void **state)

@@ -12,7 +12,9 @@
  * (J - J_0) w' through the observer's triple pole, and that lag took 4.5 % off J on the
  * 17HS4401 in the SIL where the current's fit is within 0.5 % (README, "Self-commissioning").
  *
- * Each period in the window adds to the normal equations' sums (a few multiply-adds); at the
+ * Every PMSTEP_IDENTIFICATION_DECIMATION-th period of the window adds to the normal equations'
+ * sums (nine multiply-adds: about 29 instructions on the Cortex-M4, so a sample every period
+ * would have taken the RUN step's mean over 600 while the window is open); at the
  * end of the window the system is solved once: the constant eliminated (sums centred), the
  * remaining 2x2 system by Cramer's rule. Its determinant over sum a^2 sum w^2 equals the
  * determinant of the 3x3 normal matrix normalised by its diagonal (the cosine matrix of the
@@ -40,7 +42,7 @@ typedef struct {
     float y;                  /**< sum y */
     float ay;                 /**< sum a y */
     float wy;                 /**< sum w y */
-    uint32_t periods;         /**< RUN periods since the window opened (samples or not) */
+    uint32_t periods;         /**< RUN periods the window has covered (PMSTEP_IDENTIFICATION_DECIMATION a sample) */
 } pmstep_identify_sums_t;
 
 /** Coefficients of the fit, in the units of y per unit of each regressor. */
@@ -53,9 +55,10 @@ typedef struct {
 void pmstep_identify_clear(pmstep_identify_sums_t *sums);
 
 /**
- * One RUN period of the window: adds the sample (a = out->speed_ref_rate_rad_s2, w =
- * out->speed_ref_rad_s, y = out->i_q_A) when |w| is at least comm->identification_min_speed_rad_s.
- * @return true when this period closes the window of @p window_periods periods.
+ * One sample of the window, taken every PMSTEP_IDENTIFICATION_DECIMATION RUN periods: adds
+ * (a = out->speed_ref_rate_rad_s2, w = out->speed_ref_rad_s, y = out->i_q_A) when |w| is at least
+ * comm->identification_min_speed_rad_s, and counts the periods it stands for.
+ * @return true when the window of @p window_periods periods is covered.
  */
 bool pmstep_identify_sample(pmstep_identify_sums_t *sums, const pmstep_commissioning_config_t *comm,
                             uint32_t window_periods, const pmstep_output_t *out);

@@ -106,6 +106,9 @@ typedef enum {
 #define PMSTEP_IDENTIFICATION_MIN_DETERMINANT 0.02f
 /** Detection runs in RUN every this many periods (supervision at a fraction of the control rate). */
 #define PMSTEP_DETECTION_DECIMATION 4u
+/** The identification of J and F takes a sample every this many periods of its window, two periods
+ *  after each detection check (so that the two never share a step). */
+#define PMSTEP_IDENTIFICATION_DECIMATION 4u
 
 /** Operating mode of the strategy (Section III.A). */
 typedef enum {
