@@ -69,7 +69,7 @@ bool pmstep_identify_sample(pmstep_identify_sums_t *sums, const pmstep_commissio
 bool pmstep_identify_finish(const pmstep_identify_sums_t *sums, const pmstep_config_t *cfg, pmstep_electrical_t *model,
                             pmstep_commissioning_t *result)
 {
-    pmstep_identify_fit_t fit;
+    pmstep_identify_fit_t fit = {0.0f, 0.0f, 0.0f}; /* set by the solve when it succeeds */
     float j;
     float f;
     result->identification = PMSTEP_IDENT_POOR_EXCITATION;
