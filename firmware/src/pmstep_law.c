@@ -8,16 +8,17 @@
 void pmstep_law_coeffs_init(pmstep_law_coeffs_t *coeffs, const pmstep_config_t *cfg,
                             const pmstep_electrical_t *model)
 {
-    coeffs->j_over_km = cfg->motor.inertia_kgm2 / model->torque_constant_Nm_A;
-    coeffs->f_over_j_per_s = cfg->motor.friction_Nms_rad / cfg->motor.inertia_kgm2;
-    coeffs->inv_j = 1.0f / cfg->motor.inertia_kgm2;
+    coeffs->j_over_km = model->inertia_kgm2 / model->torque_constant_Nm_A;
+    coeffs->f_over_j_per_s = model->friction_Nms_rad / model->inertia_kgm2;
+    coeffs->inv_j = 1.0f / model->inertia_kgm2;
     coeffs->speed_gain_per_s = cfg->gains.speed_gain_per_s;
     coeffs->current_gain_per_s = cfg->gains.current_gain_per_s;
     coeffs->r_over_l_per_s = model->resistance_Ohm / model->inductance_H;
     coeffs->km_over_l = model->torque_constant_Nm_A / model->inductance_H;
     coeffs->inductance_H = model->inductance_H;
     coeffs->pole_pairs = (float)cfg->motor.pole_pairs;
-    coeffs->kappa_rad_s = cfg->gains.sat_kappa_rad_s;
+    /* kappa bounds the speed correction's torque J k_w kappa: an identified J keeps that bound. */
+    coeffs->kappa_rad_s = cfg->gains.sat_kappa_rad_s * (cfg->motor.inertia_kgm2 / model->inertia_kgm2);
     coeffs->linear_speed_term = cfg->known_load_mode;
     coeffs->current_integral_gain_per_s2 = cfg->gains.current_integral_gain_per_s2;
     coeffs->detent_torque_Nm = cfg->motor.detent_torque_Nm;
