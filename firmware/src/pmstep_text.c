@@ -62,6 +62,8 @@ const char *pmstep_status_str(pmstep_status_t status)
     case PMSTEP_ERR_IDENTIFICATION_WINDOW: return "identification: 0 to 2^24 periods";
     case PMSTEP_ERR_IDENTIFICATION_SPEED: return "identification speed < 0";
     case PMSTEP_ERR_MECHANICS_UNIDENTIFIED: return "identified J, F used without a window";
+    case PMSTEP_ERR_POSITION_GAIN: return "need 0 < k_theta <= k_w/2";
+    case PMSTEP_ERR_POSITION_INTEGRAL_GAIN: return "need 0 <= k_I <= k_theta^2/4";
     }
     return "unknown status";
 }

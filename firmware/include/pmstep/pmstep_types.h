@@ -91,7 +91,11 @@ typedef enum {
     /* commissioning: identification of J and F at the start of RUN (pmstep_identify.h) */
     PMSTEP_ERR_IDENTIFICATION_WINDOW = -120, /**< identification window < 0 or longer than PMSTEP_MAX_DURATION_PERIODS */
     PMSTEP_ERR_IDENTIFICATION_SPEED = -121,  /**< identification's lowest speed < 0 */
-    PMSTEP_ERR_MECHANICS_UNIDENTIFIED = -122 /**< identified J and F used without an identification window */
+    PMSTEP_ERR_MECHANICS_UNIDENTIFIED = -122, /**< identified J and F used without an identification window */
+    /* position control (pmstep_position.h) */
+    PMSTEP_ERR_POSITION_GAIN = -130,        /**< position gain k_theta <= 0, or above k_w/2 (the speed loop's) */
+    PMSTEP_ERR_POSITION_INTEGRAL_GAIN = -131 /**< position integral gain k_I < 0, or above k_theta^2/4 (the loop's
+                                                 poles would turn complex) */
 } pmstep_status_t;
 
 /** Shortest and longest control period accepted (s): 1 MHz down to 100 Hz. */

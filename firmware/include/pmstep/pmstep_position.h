@@ -1,0 +1,159 @@
+/**
+ * @file pmstep_position.h
+ * @brief Sensorless position control on top of the speed controller: the position estimate
+ *        from the estimated angle (c-hat, s-hat), a motion profile (pmstep_motion.h) and an
+ *        outer position loop. A library of its own (pmstep_position): the core's step, its
+ *        instance and its flash budget do not carry it, and a drive in speed mode pays nothing.
+ *
+ * Position estimate, mechanical rad:
+ *   theta-hat = (2 pi n + atan2(s-hat, c-hat) - zero) / p
+ * n counts electrical turns: it follows the crossings of (c-hat, s-hat) between the second and
+ * the third quadrant (c-hat < 0, s-hat changing sign), one compare and one add a period; the
+ * fine angle is pmstep_atan2_poly() (within 1.2e-5 rad, no libm), computed only where it is read.
+ * theta-hat = 0 is the c-alignment's equilibrium (theta = 0 mod 2 pi/p, where RUN starts) until
+ * pmstep_position_set_zero() moves it.
+ *
+ * Position loop (position mode only): the profile's (theta*, w_p, a_p, j_p) and
+ *   w*   = w_p + k_theta e + k_I z,     e = theta* - theta-hat,  z' = e
+ *   w*'  = a_p + k_theta (w_p - w-hat) + k_I e
+ *   w*'' = j_p + (k_I - k_theta^2)(w_p - w-hat)
+ * go to the speed law (6) as its reference and derivatives. With the speed loop tracking, the
+ * position error obeys (s + k_w)(s^2 + k_theta s + k_I) = 0: the loop's poles are set by
+ * k_theta and k_I alone, below the speed loop's k_w (validation: k_theta <= k_w/2,
+ * k_I <= k_theta^2/4; the designer's rule k_theta = k_w/4, DESIGN.md). At standstill the
+ * law's T-hat_L carries the load; k_I takes out what is left of a speed-estimate bias.
+ *
+ * Use: pmstep_init() the core, then pmstep_position_init() with the same instance, and call
+ * pmstep_position_step() in place of pmstep_step() every period. pmstep_set_speed_target()
+ * (any time) returns the drive to speed mode; pmstep_position_move_to() and
+ * pmstep_position_hold() put it in position mode. The reference for period k+1 is formed after
+ * step k, from the estimate of period k moved on by w-hat T_s: the loop acts one period later
+ * than the speed law, far below its bandwidth.
+ */
+#ifndef PMSTEP_POSITION_H
+#define PMSTEP_POSITION_H
+
+#include "pmstep/pmstep.h"
+#include "pmstep/pmstep_motion.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Largest |electrical angle| p |theta| the position estimate and commands accept (rad): there
+ *  the float32 angle still resolves 4e-3 rad (2^-8), 1/25 of a 0.1 rad position bound. */
+#define PMSTEP_POSITION_MAX_ELECTRICAL_RAD 32768.0f
+
+/** Gains of the position loop. */
+typedef struct {
+    float gain_per_s;           /**< k_theta > 0, at most k_w/2 (designer: k_w/4) */
+    float integral_gain_per_s2; /**< k_I >= 0, at most k_theta^2/4 (a double pole); 0 = none */
+} pmstep_position_config_t;
+
+/** What one pmstep_position_step() estimated and commanded (mechanical rad, rad/s). */
+typedef struct {
+    float position_rad;       /**< theta-hat (0 while not tracked) */
+    float position_ref_rad;   /**< theta* in position mode; theta-hat in speed mode */
+    float position_error_rad; /**< theta* - theta-hat in position mode; 0 in speed mode */
+    bool tracked;             /**< RUN: the estimate is valid */
+    bool position_mode;       /**< the position loop drives the speed reference */
+    bool moving;              /**< the profile is still running (false: holding theta*) */
+} pmstep_position_output_t;
+
+/** State of the position control of one pmstep_t (allocate it statically next to it). */
+typedef struct {
+    pmstep_t *inst;
+    pmstep_position_config_t cfg;
+    float inv_pole_pairs;     /**< 1/p */
+    float period_s;           /**< T_s */
+    float inv_bandwidth_s;    /**< 1/varpi_0 of the speed reference filter */
+    float cos_hat;            /**< c-hat of the last period */
+    float sin_hat;            /**< s-hat of the last period */
+    float speed_hat_rad_s;    /**< w-hat of the last period */
+    float zero_rad;           /**< electrical angle subtracted (set zero) */
+    int32_t turns;            /**< electrical turns counted since RUN began */
+    int32_t sin_negative;     /**< 1 if s-hat < 0 in the last period, else 0 */
+    bool tracked;             /**< in RUN since the last turn count reset */
+    bool position_mode;
+    float position_ref_rad;   /**< theta* of the period being run */
+    float error_integral_rad_s; /**< z, integral of theta* - theta-hat (rad s) */
+    pmstep_motion_t motion;   /**< theta* and its derivatives (position mode) */
+} pmstep_position_t;
+
+/**
+ * The designer's rule (DESIGN.md, "Position loop"): k_theta = k_w/4, k_I = k_theta^2/8 (poles
+ * of s^2 + k_theta s + k_I at 0.15 and 0.85 k_theta, both below the speed loop's k_w).
+ * @retval PMSTEP_OK, PMSTEP_ERR_NULL_ARGUMENT
+ */
+pmstep_status_t pmstep_position_design(const pmstep_config_t *cfg, pmstep_position_config_t *pos_cfg);
+
+/**
+ * Polynomial atan2(y, x) in (-pi, pi], no libm: an odd polynomial of degree 9 on
+ * min(|x|,|y|)/max(|x|,|y|), then the octant. Error below 1.2e-5 rad (unit test); 0 at (0, 0).
+ */
+float pmstep_atan2_poly(float y, float x);
+
+/**
+ * Attaches position control to @p inst (already initialised by pmstep_init()) and validates
+ * @p cfg against the speed loop's gains. Speed mode, not tracked.
+ * @retval PMSTEP_OK                           attached
+ * @retval PMSTEP_ERR_NULL_ARGUMENT            an argument is NULL, or @p inst not initialised
+ * @retval PMSTEP_ERR_NONFINITE_PARAMETER      a gain is NaN or Inf
+ * @retval PMSTEP_ERR_POSITION_GAIN            k_theta <= 0 or above k_w/2
+ * @retval PMSTEP_ERR_POSITION_INTEGRAL_GAIN   k_I < 0 or above k_theta^2/4
+ */
+pmstep_status_t pmstep_position_init(pmstep_position_t *pos, pmstep_t *inst, const pmstep_position_config_t *cfg);
+
+/**
+ * One control period: pmstep_step() on the attached instance, then the position estimate and,
+ * in position mode, the speed reference of the next period. Never fails; leaving RUN (stop,
+ * fault, re-alignment) loses the position (not tracked, speed mode).
+ */
+void pmstep_position_step(pmstep_position_t *pos, const pmstep_meas_t *meas, pmstep_output_t *out,
+                          pmstep_position_output_t *pos_out);
+
+/** The part of pmstep_position_step() after pmstep_step(), for a caller that runs the step itself
+ *  (with the output of that step). */
+void pmstep_position_update(pmstep_position_t *pos, const pmstep_output_t *out, pmstep_position_output_t *pos_out);
+
+/**
+ * theta-hat, mechanical rad from the zero.
+ * @retval PMSTEP_OK                 @p position_rad set
+ * @retval PMSTEP_ERR_NULL_ARGUMENT  an argument is NULL
+ * @retval PMSTEP_ERR_BAD_MODE       not tracked (not in RUN): no estimate
+ */
+pmstep_status_t pmstep_get_position(const pmstep_position_t *pos, float *position_rad);
+
+/**
+ * The present position becomes 0 (theta-hat and, in position mode, theta* and the target move with it).
+ * @retval PMSTEP_OK, PMSTEP_ERR_NULL_ARGUMENT, PMSTEP_ERR_BAD_MODE (not tracked)
+ */
+pmstep_status_t pmstep_position_set_zero(pmstep_position_t *pos);
+
+/**
+ * Moves to @p target_rad (mechanical, from the zero) by a jerk-limited profile from the present
+ * reference (pmstep_motion_plan()); re-targets a move under way. From speed mode the profile
+ * starts at theta-hat with the present w* and w*'.
+ * @param j_max_rad_s3 jerk limit; 0 = a_max times the reference bandwidth varpi_0
+ * @retval PMSTEP_OK                     position mode, moving
+ * @retval PMSTEP_ERR_NULL_ARGUMENT      @p pos is NULL
+ * @retval PMSTEP_ERR_BAD_MODE           not tracked (not in RUN)
+ * @retval PMSTEP_ERR_BAD_COMMAND_VALUE  a value not finite, a limit not > 0 (j_max < 0), or
+ *                                       p |target| above PMSTEP_POSITION_MAX_ELECTRICAL_RAD
+ */
+pmstep_status_t pmstep_position_move_to(pmstep_position_t *pos, float target_rad, float v_max_rad_s,
+                                        float a_max_rad_s2, float j_max_rad_s3);
+
+/**
+ * Stops as fast as the last move's limits allow (from speed mode: at the present w* at
+ * @p a_max_rad_s2 and varpi_0 a_max) and holds where the stop ends.
+ * @retval PMSTEP_OK, PMSTEP_ERR_NULL_ARGUMENT, PMSTEP_ERR_BAD_MODE (not tracked),
+ *         PMSTEP_ERR_BAD_COMMAND_VALUE (from speed mode: a_max not finite or not > 0)
+ */
+pmstep_status_t pmstep_position_hold(pmstep_position_t *pos, float a_max_rad_s2);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PMSTEP_POSITION_H */
