@@ -5,7 +5,8 @@ Usage: tools/plot_run.py RUN_DIR [--out DIR]
 
 Reads RUN_DIR/run.csv and RUN_DIR/summary.json (written by pmstep-sil) and writes
 fig1_reference_and_load.png, fig2_alignment.png and fig3_tracking.png into DIR
-(default RUN_DIR), printing each path. Exit status 2 if a file, a key or a column is
+(default RUN_DIR), printing each path; a position scenario's run (columns position_ref_rad,
+position_hat_rad, position_rad) also gives fig4_position.png: the position and its errors. Exit status 2 if a file, a key or a column is
 missing or unreadable.
 """
 import argparse
@@ -24,6 +25,7 @@ from matplotlib.ticker import FuncFormatter, MultipleLocator  # noqa: E402
 
 COLUMNS = ("t_s", "theta_rad", "omega_rad_s", "omega_ref_rad_s", "i_a_A", "i_b_A", "u_a_V", "u_b_V",
            "cos_hat", "sin_hat", "cos_ptheta", "sin_ptheta", "load_hat_Nm", "load_Nm", "mode")
+POSITION_COLUMNS = ("position_ref_rad", "position_hat_rad", "position_rad")
 KEYS = ("pole_pairs", "s_align_time_s", "c_align_time_s")
 MODE_RUN, MODE_FAULT = 3, 4
 WIDTH_IN, DPI = 8.0, 120
@@ -63,7 +65,8 @@ def load(run_dir):
         table = np.array(rows, dtype=float)
     except ValueError as e:
         fail(f"{csv_path}: non-numeric value: {e}")
-    return {c: table[:, header.index(c)] for c in COLUMNS}, summary
+    present = COLUMNS + tuple(c for c in POSITION_COLUMNS if c in header)
+    return {c: table[:, header.index(c)] for c in present}, summary
 
 
 def mark(ax, t, label, color="0.35"):
@@ -177,6 +180,25 @@ def main():
         mark(axes[0], t_load, "$T_L$ step")
     finish(axes)
     save(fig, out_dir, "fig3_tracking.png")
+
+    if all(c in d for c in POSITION_COLUMNS):
+        # Fig. 4 (position scenario): theta*, theta-hat, theta, and the errors in electrical rad.
+        fig, (a1, a2) = plt.subplots(2, 1, sharex=True, figsize=(WIDTH_IN, 6.5))
+        a1.plot(t[run], d["position_ref_rad"][run], color="tab:blue", label="θ* commanded")
+        a1.plot(t[run], d["position_hat_rad"][run], color="k", ls="--", lw=1, label="$\\hat{θ}$ estimate")
+        a1.plot(t[run], d["position_rad"][run], color="tab:orange", lw=1, label="θ true")
+        a1.set_ylabel("position (rad, mechanical)")
+        a1.set_title(f"Fig. 4 — Position control ({name}): position and position error", pad=16)
+        a1.legend(loc="best", fontsize=9)
+        a2.plot(t[run], p * (d["position_ref_rad"] - d["position_rad"])[run], color="tab:blue",
+                label="p (θ* − θ)")
+        a2.plot(t[run], p * (d["position_hat_rad"] - d["position_rad"])[run], color="tab:red", lw=1,
+                label="p ($\\hat{θ}$ − θ)")
+        a2.set_ylabel("error (electrical rad)")
+        a2.ticklabel_format(axis="y", style="sci", scilimits=(-2, 3), useOffset=False)
+        a2.legend(loc="best", fontsize=9)
+        finish((a1, a2))
+        save(fig, out_dir, "fig4_position.png")
     return 0
 
 

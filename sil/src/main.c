@@ -44,12 +44,39 @@ static bool write_row(const sil_sample_t *x, void *user)
         return true;
     }
     fprintf(csv->file,
-            "%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%.9g,%.9g,%.9g,%.9g\n",
+            "%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%.9g,%.9g,%.9g,%.9g",
             x->t_s, x->theta_rad, x->omega_rad_s, (double)o->speed_ref_rad_s, x->i_a_A, x->i_b_A, x->u_a_V, x->u_b_V,
             (double)o->cos_hat, (double)o->sin_hat, x->cos_ptheta, x->sin_ptheta, (double)o->speed_hat_rad_s,
             (double)o->load_hat_Nm, x->load_Nm, (int)o->mode, (int)o->fault, (double)port->meas.i_a_A,
             (double)port->meas.i_b_A, port->bus_V, (double)port->meas.bus_voltage_V);
+    if (x->position != NULL) {
+        /* A position scenario's row goes on: theta*, theta-hat, theta (from the c-alignment equilibrium). */
+        fprintf(csv->file, ",%.9g,%.9g,%.9g", (double)x->position->position_ref_rad, (double)x->position->position_rad,
+                x->position_rad);
+    }
+    fputc('\n', csv->file);
     return true;
+}
+
+/* A position scenario's figures (sil_position_summary_t; electrical rad = p times mechanical). */
+static void add_position_json(cJSON *root, const sil_summary_t *s)
+{
+    const sil_position_summary_t *p = &s->position;
+    cJSON *position = cJSON_CreateObject();
+    cJSON_AddNumberToObject(position, "moves", p->moves);
+    cJSON_AddNumberToObject(position, "rejected_moves", p->rejected_moves);
+    cJSON_AddNumberToObject(position, "unfinished_moves", p->unfinished_moves);
+    cJSON_AddNumberToObject(position, "max_final_error_electrical_rad", p->max_final_error_rad);
+    cJSON_AddNumberToObject(position, "mean_final_error_electrical_rad", p->mean_final_error_rad);
+    cJSON_AddNumberToObject(position, "worst_move", p->worst_move);
+    cJSON_AddNumberToObject(position, "max_overshoot_fraction", p->max_overshoot_fraction);
+    cJSON_AddNumberToObject(position, "max_estimate_error_electrical_rad", p->max_estimate_error_rad);
+    cJSON_AddNumberToObject(position, "max_tracking_error_electrical_rad", p->max_tracking_error_rad);
+    cJSON_AddNumberToObject(position, "hold_duration_s", p->hold_duration_s);
+    cJSON_AddNumberToObject(position, "hold_max_error_electrical_rad", p->hold_max_error_rad);
+    cJSON_AddNumberToObject(position, "hold_max_estimate_error_electrical_rad", p->hold_max_estimate_error_rad);
+    cJSON_AddNumberToObject(position, "hold_drift_electrical_rad_s", p->hold_drift_rad_s);
+    cJSON_AddItemToObject(root, "position", position);
 }
 
 /* The [sensors], [inverter] and [bus] settings and what the ADC clipped. */
@@ -186,6 +213,9 @@ static cJSON *summary_json(const sil_scenario_t *sc, const sil_summary_t *s)
     cJSON_AddStringToObject(root, "final_mode", pmstep_mode_str(s->final_mode));
     add_robustness_json(root, s);
     add_baseline_json(root, sc, s);
+    if (sc->position_moves > 0) {
+        add_position_json(root, s);
+    }
 
     cJSON_AddNumberToObject(fault, "code", (double)s->fault);
     cJSON_AddStringToObject(fault, "name", pmstep_fault_str(s->fault));
@@ -322,7 +352,7 @@ int main(int argc, char **argv)
     if (write_csv) {
         /* Refuse a run whose time series would fill the disk, before it starts. */
         const double rows = sc.duration_s / (double)sc.controller.timing.period_s / (double)sc.decimation;
-        const double csv_MB = rows * SIL_CSV_ROW_MAX_BYTES / 1e6;
+        const double csv_MB = rows * (SIL_CSV_ROW_MAX_BYTES + (sc.position_moves > 0 ? 48.0 : 0.0)) / 1e6;
         if (csv_MB > sc.max_csv_MB) {
             fprintf(stderr,
                     "pmstep-sil: run.csv would take up to %.0f MB (%.0f rows), more than run.max_csv_MB = %g: raise "
@@ -348,7 +378,15 @@ int main(int argc, char **argv)
         csv.decimation = sc.decimation;
         fprintf(csv.file, "t_s,theta_rad,omega_rad_s,omega_ref_rad_s,i_a_A,i_b_A,u_a_V,u_b_V,cos_hat,sin_hat,"
                           "cos_ptheta,sin_ptheta,omega_hat_rad_s,load_hat_Nm,load_Nm,mode,fault,"
-                          "i_a_meas_A,i_b_meas_A,bus_voltage_V,bus_voltage_meas_V\n");
+                          "i_a_meas_A,i_b_meas_A,bus_voltage_V,bus_voltage_meas_V%s\n",
+                sc.position_moves > 0 ? ",position_ref_rad,position_hat_rad,position_rad" : "");
+    }
+    if (record_path != NULL && sc.position_moves > 0) {
+        fprintf(stderr, "pmstep-sil: --record replays pmstep_step alone: not for a position scenario (position.points)\n");
+        if (csv.file != NULL) {
+            fclose(csv.file);
+        }
+        return 2;
     }
     if (record_path != NULL) {
         record = fopen(record_path, "wb");

@@ -11,6 +11,7 @@
 
 #include "pmstep_hal_host.h"
 #include "sil/microstep.h"
+#include "sil/position_run.h"
 
 /* The firmware and plant shares are timed on every SIL_TIMING_STRIDE-th period only (three
  * clock reads there, none elsewhere) and scaled to the run: a clock read costs about as
@@ -99,7 +100,11 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
                    FILE *record)
 {
     static pmstep_t inst; /* as on the MCU: one static instance */
+    static pmstep_position_t pos; /* a position scenario's position control of inst */
     const bool microstep = sc->drive == SIL_DRIVE_MICROSTEP;
+    const bool positional = !microstep && sc->position_moves > 0;
+    sil_position_run_t position_run;
+    pmstep_position_output_t pos_out;
     sil_microstep_t drive;
     const pmstep_config_t *cfg = &sc->controller;
     const double period_s = (double)cfg->timing.period_s;
@@ -128,9 +133,16 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
     } else {
         s->init_status = pmstep_init(&inst, cfg);
     }
+    if (s->init_status == PMSTEP_OK && positional) {
+        const pmstep_position_config_t position_cfg = sil_position_config(sc);
+        s->init_status = pmstep_position_init(&pos, &inst, &position_cfg);
+        record = NULL; /* a replay of pmstep_step alone would not see the position loop's reference */
+    }
     if (s->init_status != PMSTEP_OK) {
         return -1;
     }
+    memset(&pos_out, 0, sizeof pos_out);
+    sil_position_run_init(&position_run, sc);
     sil_metrics_init(&metrics, sc, s); /* its period counts need a configuration init accepted; clears s */
     s->init_status = PMSTEP_OK;
     memset(&plant, 0, sizeof plant);
@@ -185,6 +197,9 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
         } else {
             command_speed(&inst, sc, t_s, &next_segment, rec);
         }
+        if (positional) {
+            sil_position_run_command(&position_run, &pos, t_s, s);
+        }
         sample.theta_rad = plant.x.theta_rad;
         sample.omega_rad_s = plant.x.omega_rad_s;
         sample.i_a_A = plant.x.i_a_A;
@@ -202,7 +217,11 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
             sil_microstep_step(&drive, &meas, &out);
         } else {
             sample.angle_ref_rad = 0.0;
-            pmstep_step(&inst, &meas, &out);
+            if (positional) {
+                pmstep_position_step(&pos, &meas, &out, &pos_out);
+            } else {
+                pmstep_step(&inst, &meas, &out);
+            }
         }
         pmstep_hal_apply_output(&out);
         if (timed) {
@@ -227,6 +246,12 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
         sample.u_b_V = inverter->applied_b_V;
         sample.out = &out;
         sample.inst = microstep ? NULL : &inst;
+        sample.position = NULL;
+        sample.position_rad = 0.0;
+        if (positional) {
+            sample.position = &pos_out;
+            sil_position_run_sample(&position_run, &sample, s);
+        }
         sil_metrics_add(&metrics, &sample, s);
 
         if (progress && k + 1 >= steps * next_progress_decile / 10) {
@@ -250,6 +275,9 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
     s->sim_time_s = (double)s->steps * period_s;
     s->real_time_factor = s->wall_time_s > 0.0 ? s->sim_time_s / s->wall_time_s : 0.0;
     sil_metrics_finish(&metrics, s);
+    if (positional) {
+        sil_position_run_finish(&position_run, s);
+    }
     s->inverter_limited_periods = (long)inverter->limited_periods;
     pmstep_hal_host_release();
     if (rec != NULL) {

@@ -15,7 +15,7 @@
 
 typedef enum { KEY_DOUBLE, KEY_FLOAT, KEY_INT, KEY_UINT, KEY_BOOL, KEY_ANGLE_DEG, KEY_SPEED_POINTS,
                KEY_LOAD_POINTS, KEY_LOAD_KIND, KEY_INVERTER_MODEL, KEY_ADC_BITS, KEY_INTEGRATOR,
-               KEY_DRIVE } key_type_t;
+               KEY_DRIVE, KEY_MOVES } key_type_t;
 
 /* Range of a numeric key: min/max, each inclusive or exclusive. */
 typedef struct {
@@ -118,6 +118,14 @@ static const key_t_ keys[] = {
     {"load.step_time_s", KEY_DOUBLE, OFF(load.step_time_s), 0, 0, 3600, 0, "time of the step (s)"},
     {"load.coefficient_Nms_rad", KEY_DOUBLE, OFF(load.coefficient_Nms_rad), -1e6, 0, 1e6, 0, "proportional load T_L = c omega"},
     {"load.points", KEY_LOAD_POINTS, 0, 0, 0, 0, 0, "table t:T_L pairs (s:Nm), piecewise linear"},
+
+    {"position.points", KEY_MOVES, 0, 0, 0, 0, 0, "moves t:theta (s : mechanical rad from the c-alignment equilibrium); 0:0 alone = a speed scenario"},
+    {"position.v_max_rad_s", KEY_DOUBLE, OFF(move_speed_rad_s), 0, 1, 1e6, 0, "speed limit of every move (rad/s)"},
+    {"position.a_max_rad_s2", KEY_DOUBLE, OFF(move_accel_rad_s2), 0, 1, 1e9, 0, "acceleration limit (rad/s^2)"},
+    {"position.j_max_rad_s3", KEY_DOUBLE, OFF(move_jerk_rad_s3), 0, 0, 1e12, 0, "jerk limit (rad/s^3); 0 = a_max varpi_0"},
+    {"position.hold_start_s", KEY_DOUBLE, OFF(hold_start_s), 0, 0, 3600, 0, "start of the hold window of the position metrics (s); 0 = none"},
+    {"controller.position.gain_per_s", KEY_FLOAT, OFF(position.gain_per_s), 0, 0, BIG, 0, "k_theta (1/s); 0 = the designer's rule k_w/4 and k_theta^2/8"},
+    {"controller.position.integral_gain_per_s2", KEY_FLOAT, OFF(position.integral_gain_per_s2), -BIG, 0, BIG, 0, "k_I of the position loop (1/s^2)"},
 
     {"sensors.adc_bits", KEY_ADC_BITS, OFF(sensors.adc_bits), 0, 0, 16, 0, "ADC resolution: 0 = ideal (no quantisation), or 8..16 bits"},
     {"sensors.current_full_scale_A", KEY_DOUBLE, OFF(sensors.current_full_scale_A), 0, 1, 1e6, 0, "current ADC span +/- this, mid-tread, clips beyond (A)"},
@@ -239,6 +247,15 @@ int sil_scenario_set(sil_scenario_t *sc, const char *key, const char *value, cha
         case KEY_LOAD_POINTS:
             return parse_points(key, value, sc->load.table_time_s, sc->load.table_torque_Nm, PLANT_LOAD_TABLE_MAX,
                                 &sc->load.table_points, err, err_size);
+        case KEY_MOVES:
+            if (parse_points(key, value, sc->move_time_s, sc->move_target_rad, SIL_POSITION_MOVES_MAX,
+                             &sc->position_moves, err, err_size) != 0) {
+                return -1;
+            }
+            if (sc->position_moves == 1 && sc->move_time_s[0] == 0.0 && sc->move_target_rad[0] == 0.0) {
+                sc->position_moves = 0; /* 0:0 alone: no moves */
+            }
+            return 0;
         case KEY_LOAD_KIND: {
             size_t j;
             for (j = 0; j < sizeof load_kind_names / sizeof load_kind_names[0]; ++j) {
@@ -558,6 +575,31 @@ int sil_scenario_check(const sil_scenario_t *sc, char *err, size_t err_size)
                     (double)sc->controller.motor.resistance_Ohm, (double)sc->controller.motor.inductance_H,
                     (int)sc->controller.motor.pole_pairs);
     }
+    if (sc->position_moves > 0) {
+        const double run_start_s = (double)sc->controller.commissioning.offset_calibration_time_s
+                                   + (double)sc->controller.alignment.c_align_time_s;
+        int n;
+        if (sc->drive != SIL_DRIVE_PMSTEP) {
+            return fail(err, err_size, "position.points: moves need run.controller = pmstep");
+        }
+        for (n = 0; n < sc->speed_points; ++n) {
+            if (sc->speed_value_rad_s[n] != 0.0) {
+                return fail(err, err_size, "position.points with a speed profile: set speed.points = 0:0 (a speed command "
+                                           "would leave position mode)");
+            }
+        }
+        if (sc->move_time_s[0] < run_start_s) {
+            return fail(err, err_size, "position.points: the first move at %g s is before RUN starts (%g s)",
+                        sc->move_time_s[0], run_start_s);
+        }
+        for (n = 0; n < sc->position_moves; ++n) {
+            if (!(fabs(sc->move_target_rad[n]) * (double)sc->controller.motor.pole_pairs
+                  <= (double)PMSTEP_POSITION_MAX_ELECTRICAL_RAD)) {
+                return fail(err, err_size, "position.points: move %d: p |theta| above %g electrical rad", n + 1,
+                            (double)PMSTEP_POSITION_MAX_ELECTRICAL_RAD);
+            }
+        }
+    }
     if (!(sc->bus.ripple_V < sc->bus_voltage_V)) {
         return fail(err, err_size, "bus.ripple_V = %g is not below run.bus_voltage_V = %g: the bus would reach zero",
                     sc->bus.ripple_V, sc->bus_voltage_V);
@@ -627,6 +669,13 @@ void sil_scenario_print(const sil_scenario_t *sc, FILE *file)
         case KEY_INVERTER_MODEL: fprintf(file, "%s\n", inverter_model_names[sc->inverter.model]); break;
         case KEY_INTEGRATOR: fprintf(file, "%s\n", integrator_names[sc->integrator]); break;
         case KEY_DRIVE: fprintf(file, "%s\n", drive_names[sc->drive]); break;
+        case KEY_MOVES:
+            if (sc->position_moves > 0) {
+                print_points(file, sc->move_time_s, sc->move_target_rad, sc->position_moves);
+            } else {
+                fprintf(file, "0:0\n");
+            }
+            break;
         case KEY_ADC_BITS: fprintf(file, "%u\n", *(const unsigned *)(base + k->offset)); break;
         }
     }

@@ -48,6 +48,9 @@ void sil_scenario_paper(sil_scenario_t *sc)
     sc->bus = sil_bus_ideal_config();
     sc->drive = SIL_DRIVE_PMSTEP;
     sc->metrics_start_s = -1.0;
+    /* No moves (a speed scenario); the limits a position scenario starts from. */
+    sc->move_speed_rad_s = 5.0;
+    sc->move_accel_rad_s2 = 50.0;
 }
 
 double sil_scenario_hold_end_s(const sil_scenario_t *sc)

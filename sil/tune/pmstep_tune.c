@@ -438,6 +438,7 @@ int main(int argc, char **argv)
         return 1;
     }
     sc.id_target_A = (double)report.magnetising_current_A;
+    (void)pmstep_position_design(&sc.controller, &sc.position); /* position loop (DESIGN.md section 10) */
     {
         const double top = (double)report.top_speed_rad_s;
         const double levels[] = {0.8 * top, -0.8 * top, 0.05 * top, -0.05 * top, 0.0};
@@ -494,6 +495,8 @@ int main(int argc, char **argv)
                (double)sc.controller.commissioning.identification_time_s,
                (double)sc.controller.commissioning.identification_min_speed_rad_s);
     }
+    printf("  position loop: k_theta %g 1/s, k_I %g 1/s^2\n", (double)sc.position.gain_per_s,
+           (double)sc.position.integral_gain_per_s2);
     if (ini_path != NULL) {
         FILE *f = fopen(ini_path, "w");
         if (f == NULL) {

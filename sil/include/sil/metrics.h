@@ -29,7 +29,28 @@ typedef struct {
     pmstep_t *inst;                  /**< the core's instance, for tests that inspect or perturb its state
                                           (a change takes effect from the next period); NULL in microstep mode */
     double angle_ref_rad;            /**< microstep mode only (not read otherwise): theta_e*, electrical, unwrapped */
+    const pmstep_position_output_t *position; /**< a position scenario's position output; NULL otherwise */
+    double position_rad;             /**< position scenario: true theta from the c-alignment's equilibrium (the
+                                          estimate's origin) once RUN began; 0 before */
 } sil_sample_t;
+
+/** Position scenario (issue 13): the moves and the hold, judged on the true position (electrical rad: p times
+ *  mechanical) against the commanded one. */
+typedef struct {
+    int moves;                             /**< moves issued */
+    int rejected_moves;                    /**< pmstep_position_move_to() refused (none expected) */
+    int unfinished_moves;                  /**< profile still running when the next move came or the run ended */
+    double max_final_error_rad;            /**< max |theta - target| p at the end of each move's window */
+    double mean_final_error_rad;
+    int worst_move;                        /**< 1-based index of that maximum */
+    double max_overshoot_fraction;         /**< max over moves of (travel beyond the target) / |move| */
+    double max_estimate_error_rad;         /**< max |theta-hat - theta| p while tracked */
+    double max_tracking_error_rad;         /**< max |theta* - theta| p in position mode */
+    double hold_duration_s;                /**< position.hold_start_s to the end (0: no hold window) */
+    double hold_max_error_rad;             /**< max |theta - theta*| p over the hold window */
+    double hold_max_estimate_error_rad;    /**< max |theta-hat - theta| p over it */
+    double hold_drift_rad_s;               /**< least-squares slope of (theta - theta*) p over it (electrical rad/s) */
+} sil_position_summary_t;
 
 /** Called once per period; return false to stop the run early. */
 typedef bool (*sil_sample_fn)(const sil_sample_t *sample, void *user);
@@ -78,6 +99,7 @@ typedef struct {
     bool loss_of_synchronism;              /**< microstep: |theta_e* - p theta| > pi at any sample; pmstep: the
                                                 angle-estimate error above run.loss_angle_error_rad in RUN */
     double loss_of_synchronism_time_s;     /**< its first sample, -1 if none */
+    sil_position_summary_t position;       /**< position scenario only (zero otherwise) */
 } sil_summary_t;
 
 /** Running sums behind the summary. */

@@ -12,6 +12,7 @@
 #include <stdio.h>
 
 #include "pmstep/pmstep.h"
+#include "pmstep/pmstep_position.h"
 #include "sil/inverter.h"
 #include "sil/plant.h"
 #include "sil/sensors.h"
@@ -21,6 +22,8 @@ extern "C" {
 #endif
 
 #define SIL_SPEED_POINTS_MAX 64
+/** Moves of a position scenario at most ([position] points). */
+#define SIL_POSITION_MOVES_MAX 128
 #define SIL_ERROR_MAX 256
 /** Largest scenario file read (bytes). */
 #define SIL_SCENARIO_MAX_BYTES (1u << 20)
@@ -70,6 +73,18 @@ typedef struct {
     sil_drive_t drive;               /**< run.controller: pmstep | microstep */
     double metrics_start_s;          /**< run.metrics_start_s: start of the RMS-current and load-angle window (s);
                                           < 0: the start of RUN (t_c) or the end of the microstep hold */
+    /* A position scenario (issue 13): [position] points given. The firmware then runs under
+     * pmstep_position_step() and each move is a pmstep_position_move_to() at its time. */
+    int position_moves;                    /**< [position] points = t:theta, ... (s : mechanical rad from the
+                                                c-alignment's equilibrium); 0 = a speed scenario */
+    double move_time_s[SIL_POSITION_MOVES_MAX];
+    double move_target_rad[SIL_POSITION_MOVES_MAX];
+    double move_speed_rad_s;               /**< position.v_max_rad_s of every move */
+    double move_accel_rad_s2;              /**< position.a_max_rad_s2 */
+    double move_jerk_rad_s3;               /**< position.j_max_rad_s3 (0 = a_max varpi_0) */
+    double hold_start_s;                   /**< position.hold_start_s: the hold window's start (0 = none) */
+    pmstep_position_config_t position;     /**< [controller.position]: gain_per_s 0 = the designer's rule
+                                                (pmstep_position_design) for both gains */
 } sil_scenario_t;
 
 /** The paper's Section III: t_s = 0.3 s, t_c = 0.6 s, 2 Nm at 0.63 s, theta0 = 30 deg, 2.4 s, 20 kHz. */
