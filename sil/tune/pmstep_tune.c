@@ -438,7 +438,7 @@ int main(int argc, char **argv)
         return 1;
     }
     sc.id_target_A = (double)report.magnetising_current_A;
-    (void)pmstep_position_design(&sc.controller, &sc.position); /* position loop (DESIGN.md section 10) */
+    (void)pmstep_position_design(&sc.controller, &sc.position); /* position loop (DESIGN.md section 11) */
     {
         const double top = (double)report.top_speed_rad_s;
         const double levels[] = {0.8 * top, -0.8 * top, 0.05 * top, -0.05 * top, 0.0};
