@@ -263,6 +263,9 @@ def main():
     ap.add_argument("--no-pipelining", action="store_true",
                     help="charge every single load/store 2 cycles (no credit for neighbouring ones)")
     ap.add_argument("--json", help="also write the figures to this JSON file")
+    ap.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
+                    help="override a key of the paper scenario for the recorded run (pmstep-sil --set), e.g. "
+                         "controller.commissioning.identification_time_s=1.8 to count RUN with identification")
     args = ap.parse_args()
     for tool in ("qemu-system-arm", "arm-none-eabi-gcc", "cc"):
         if shutil.which(tool) is None:
@@ -272,7 +275,8 @@ def main():
     BENCH.mkdir(parents=True, exist_ok=True)
 
     rec = BENCH / "paper.rec"
-    run([SIL, "--quiet", "--no-csv", "--out", BENCH / "paper", "--record", rec])
+    sets = [a for kv in args.set for a in ("--set", kv)]
+    run([SIL, "--quiet", "--no-csv", "--out", BENCH / "paper", "--record", rec] + sets)
     plugin = BENCH / "pil_insn_plugin.so"
     run(["cc", "-shared", "-fPIC", "-O2", "-Wall", "-Wextra", "-o", plugin, PLUGIN_SRC])
     entry, ret = step_addresses(REPLAY)

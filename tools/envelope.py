@@ -85,7 +85,8 @@ def profile(start, legs):
 
 
 def sil(args, ini, out_dir, extra, csv_out=False):
-    cmd = [args.sil, "--scenario", ini, "--out", out_dir, "--quiet"] + ([] if csv_out else ["--no-csv"]) + sets(extra)
+    cmd = [args.sil, "--scenario", ini, "--out", out_dir, "--quiet"] + ([] if csv_out else ["--no-csv"]) \
+        + sets(extra) + sets(args.set)
     r = run(cmd)
     summary_path = os.path.join(out_dir, "summary.json")
     if not os.path.exists(summary_path):
@@ -256,6 +257,9 @@ def main():
     ap.add_argument("--presets", default=",".join(PRESETS))
     ap.add_argument("--chains", default="ideal,realistic")
     ap.add_argument("--duration", type=float, default=20.0, help="RUN time of the ramps run (s)")
+    ap.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
+                    help="a pmstep-sil --set applied to every run after the design (e.g. one impairment "
+                         "of the chain removed: --set inverter.dead_time_s=0 --set controller.inverter.dead_time_s=0)")
     args = ap.parse_args()
     rows = []
     for name in args.presets.split(","):

@@ -63,6 +63,8 @@ static pmstep_status_t validate_signs(const pmstep_config_t *cfg)
         SIGN_RULE(commissioning.steady_state_window_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_STEADY_STATE_WINDOW),
         SIGN_RULE(commissioning.inductance_window_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_INDUCTANCE_WINDOW),
         SIGN_RULE(commissioning.voltage_bias_level_fraction, SIGN_NON_NEGATIVE, PMSTEP_ERR_VOLTAGE_BIAS_FRACTION),
+        SIGN_RULE(commissioning.identification_time_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_IDENTIFICATION_WINDOW),
+        SIGN_RULE(commissioning.identification_min_speed_rad_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_IDENTIFICATION_SPEED),
         SIGN_RULE(inverter.dead_time_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DEAD_TIME),
         SIGN_RULE(inverter.dead_time_current_band_A, SIGN_NON_NEGATIVE, PMSTEP_ERR_DEAD_TIME_BAND),
         SIGN_RULE(detection.angle_magnitude_bound, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_BOUND),
@@ -210,6 +212,13 @@ static pmstep_status_t validate_commissioning(const pmstep_config_t *cfg)
         if (comm->steady_state_window_s * cfg->motor.resistance_Ohm < 10.0f * cfg->motor.inductance_H) {
             return PMSTEP_ERR_VOLTAGE_BIAS_SETTLING;
         }
+    }
+    /* J and F identified in RUN: a window of whole periods; what is used must be identified. */
+    if (!duration_ok(comm->identification_time_s, cfg->timing.period_s)) {
+        return PMSTEP_ERR_IDENTIFICATION_WINDOW;
+    }
+    if (comm->use_identified_mechanics && !(comm->identification_time_s > 0.0f)) {
+        return PMSTEP_ERR_MECHANICS_UNIDENTIFIED;
     }
     return PMSTEP_OK;
 }

@@ -17,6 +17,7 @@ static void start_run(pmstep_t *inst, const pmstep_meas_t *sample)
     pmstep_ref_set_target(&inst->i_d_ref, i_d_cmd.target, 0.0f);
     pmstep_ref_reset(&inst->scratch.run.known_load_filter, inst->cfg->known_load_mode ? sample->load_torque_Nm : 0.0f);
     pmstep_detect_start(&inst->scratch.run.detector); /* the sums are spent */
+    pmstep_identify_clear(&inst->scratch.run.identify); /* a re-alignment reopens the window */
     inst->run_started = true;
 }
 
@@ -36,6 +37,7 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
     float i_q_ref;
     float i_q_ref_rate;
     pmstep_detent_t detent;
+    pmstep_speed_term_t speed;
 
     if (!inst->run_started) {
         start_run(inst, sample);
@@ -53,12 +55,18 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
     ref = pmstep_ref_output(&inst->ref_coeffs, &inst->i_d_ref);
     refs.i_d_ref_A = ref.value;
     refs.i_d_ref_rate_A_s = ref.rate;
-    ref = pmstep_ref_output(&inst->ref_coeffs, &inst->scratch.run.known_load_filter); /* T_L*, Remark 1 */
-
-    load_Nm = known_load ? ref.value : inst->observer.load_hat_Nm;
+    if (known_load) {
+        ref = pmstep_ref_output(&inst->ref_coeffs, &inst->scratch.run.known_load_filter); /* T_L*, Remark 1 */
+        load_Nm = ref.value;
+    } else {
+        ref.value = 0.0f; /* (6): no T_L* */
+        ref.rate = 0.0f;
+        load_Nm = inst->observer.load_hat_Nm;
+    }
     /* The detent torque is known in form: the law supplies it, the observer expects it. */
     detent = pmstep_law_detent(&inst->law_coeffs, cos_hat, sin_hat, inst->observer.speed_hat_rad_s);
-    i_q_ref = pmstep_law_iq_ref(&inst->law_coeffs, &refs, inst->observer.speed_hat_rad_s, load_Nm - detent.torque_Nm);
+    speed = pmstep_law_speed_term(&inst->law_coeffs, inst->observer.speed_hat_rad_s - refs.speed_ref_rad_s);
+    i_q_ref = pmstep_law_iq_ref(&inst->law_coeffs, &refs, speed.term, load_Nm - detent.torque_Nm);
 
     obs_in->i_a_A = sample->i_a_A;
     obs_in->i_b_A = sample->i_b_A;
@@ -73,7 +81,7 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
     scratch->mech_rates = pmstep_observer_mech_rates(&inst->observer, &inst->observer_coeffs, obs_in, known_load);
 
     load_rate = known_load ? ref.rate : scratch->mech_rates.load_hat_rate_Nm_s;
-    i_q_ref_rate = pmstep_law_iq_ref_rate(&inst->law_coeffs, &refs, inst->observer.speed_hat_rad_s,
+    i_q_ref_rate = pmstep_law_iq_ref_rate(&inst->law_coeffs, &refs, speed.slope,
                                           scratch->mech_rates.speed_hat_rate_rad_s2, load_rate - detent.rate_Nm_s);
     pmstep_law_voltages(&inst->law_coeffs, &refs, cos_hat, sin_hat, i_d, i_q, inst->observer.speed_hat_rad_s,
                         i_q_ref, i_q_ref_rate, &inst->current_integral, &out->u_a_V, &out->u_b_V);

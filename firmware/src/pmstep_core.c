@@ -5,6 +5,8 @@
  *   check      measurements against the protections (here)
  *   commission alignment timing, Remark 2 sums, the commissioned model at t_c (pmstep_commission.c)
  *   control    alignment voltages (here), or controller (6) (pmstep_control.c)
+ *   identify   in RUN's first window, every PMSTEP_IDENTIFICATION_DECIMATION periods: the J and F
+ *              fit's sums, at its end J and F (pmstep_identify.c)
  *   supervise  detection every PMSTEP_DETECTION_DECIMATION periods in RUN (pmstep_detect.c)
  *   actuate    dead-time compensation, bus limit, output check, delay (pmstep_actuate.c)
  *   advance    observer and references over the coming period (pmstep_control.c) */
@@ -14,7 +16,7 @@
 #include <stddef.h>
 #include <string.h>
 
-/* Coefficients of the angle, observer and law for the electrical model @p model. */
+/* Coefficients of the angle, observer and law for the model @p model. */
 static void apply_model(pmstep_t *inst, const pmstep_electrical_t *model)
 {
     pmstep_angle_coeffs_init(&inst->angle_coeffs, inst->cfg, model);
@@ -39,6 +41,7 @@ static void derive(pmstep_t *inst, const pmstep_config_t *cfg)
     plan->inductance_start_step = 2u + cfg->timing.computational_delay_periods;
     plan->offsets_from_alignment = cfg->commissioning.alignment_offset_calibration;
     plan->bias_estimation = cfg->commissioning.voltage_bias_level_fraction > 0.0f;
+    plan->identification_steps = pmstep_periods_in(cfg->commissioning.identification_time_s, period_s);
     inst->offset_cal_steps = pmstep_periods_in(cfg->commissioning.offset_calibration_time_s, period_s);
     pmstep_detect_coeffs_init(&inst->detect_coeffs, cfg);
     pmstep_actuate_coeffs_init(&inst->actuate_coeffs, cfg);
@@ -245,29 +248,62 @@ static void offset_calibration_stage(pmstep_t *inst, const pmstep_meas_t *meas, 
     }
 }
 
-/* At t_c, before the first RUN period: Remark 2 offsets and the commissioned model.
- * @return a fault, or PMSTEP_FAULT_NONE. */
-static pmstep_fault_t finish_commissioning(pmstep_t *inst, const pmstep_meas_t *raw)
+/* The model RUN works with from t_c: the configured one, with what commissioning measured in
+ * place where configured so. */
+static void commissioned_model(const pmstep_t *inst, pmstep_electrical_t *model)
 {
     const pmstep_config_t *cfg = inst->cfg;
+    const pmstep_commissioning_t *result = &inst->commissioning;
+    *model = pmstep_configured_electrical(cfg);
+    if (cfg->commissioning.use_measured_resistance) {
+        model->resistance_Ohm = result->resistance_Ohm;
+    }
+    if (cfg->commissioning.use_measured_inductance) {
+        model->inductance_H = result->inductance_H;
+    }
+    if (cfg->commissioning.use_measured_torque_constant) {
+        model->torque_constant_Nm_A = result->torque_constant_Nm_A;
+    }
+}
+
+/* At t_c, before the first RUN period: Remark 2 offsets and the commissioned model; the
+ * identification window opens. @return a fault, or PMSTEP_FAULT_NONE. */
+static pmstep_fault_t finish_commissioning(pmstep_t *inst, const pmstep_meas_t *raw)
+{
     pmstep_commissioning_t *result = &inst->commissioning;
-    pmstep_electrical_t model = pmstep_configured_electrical(cfg);
-    const pmstep_fault_t fault = pmstep_commission_finish(&inst->scratch.sums, &inst->commission_plan, cfg, raw->i_a_A,
-                                                          inst->actuator.u_applied_a_V, result);
+    pmstep_electrical_t model;
+    const pmstep_fault_t fault = pmstep_commission_finish(&inst->scratch.sums, &inst->commission_plan, inst->cfg,
+                                                          raw->i_a_A, inst->actuator.u_applied_a_V, result);
     if (fault != PMSTEP_FAULT_NONE) {
         return fault;
     }
-    if (cfg->commissioning.use_measured_resistance) {
-        model.resistance_Ohm = result->resistance_Ohm;
+    if (inst->commission_plan.identification_steps > 0u) {
+        result->identification = PMSTEP_IDENT_RUNNING; /* RUN's start clears the sums */
     }
-    if (cfg->commissioning.use_measured_inductance) {
-        model.inductance_H = result->inductance_H;
-    }
-    if (cfg->commissioning.use_measured_torque_constant) {
-        model.torque_constant_Nm_A = result->torque_constant_Nm_A;
-    }
+    commissioned_model(inst, &model);
     apply_model(inst, &model);
     return PMSTEP_FAULT_NONE;
+}
+
+/* Identify stage, in RUN while the window is open, every PMSTEP_IDENTIFICATION_DECIMATION periods: a
+ * sample of the fit (pmstep_identify.h);
+ * at the window's end J and F, and with use_identified_mechanics the observer's and the law's
+ * coefficients for them (a one-off, like t_c's). */
+static void identify_stage(pmstep_t *inst, const pmstep_output_t *out)
+{
+    if (pmstep_identify_sample(&inst->scratch.run.identify, &inst->cfg->commissioning,
+                               inst->commission_plan.identification_steps, out)) {
+        pmstep_electrical_t model;
+        float friction_Nms_rad;
+        commissioned_model(inst, &model);
+        friction_Nms_rad = model.friction_Nms_rad;
+        if (pmstep_identify_finish(&inst->scratch.run.identify, inst->cfg, &model, &inst->commissioning)) {
+            /* Bumpless: T_L-hat takes over the friction torque the new F no longer leaves to it,
+             * so F w-hat + T_L-hat, the torque the law asks for at constant speed, is unchanged. */
+            inst->observer.load_hat_Nm += (friction_Nms_rad - model.friction_Nms_rad) * inst->observer.speed_hat_rad_s;
+            apply_model(inst, &model);
+        }
+    }
 }
 
 /* Commission stage: the mode of this period from the alignment timing; the alignment's samples
@@ -402,6 +438,10 @@ static pmstep_fault_t bridge_on_stages(pmstep_t *inst, const pmstep_meas_t *meas
         out->fault = PMSTEP_FAULT_NONE;
         out->fault_step = inst->fault_step;
         pmstep_control_compute(inst, &sample, out, &control);
+        if (inst->commissioning.identification == PMSTEP_IDENT_RUNNING
+            && (inst->step_count % PMSTEP_IDENTIFICATION_DECIMATION) == 2u) {
+            identify_stage(inst, out);
+        }
         fault = supervise_stage(inst, out, &sample);
         if (fault != PMSTEP_FAULT_NONE) {
             if (inst->commissioning.realignments >= inst->cfg->detection.max_realignments) {

@@ -8,16 +8,17 @@
 void pmstep_law_coeffs_init(pmstep_law_coeffs_t *coeffs, const pmstep_config_t *cfg,
                             const pmstep_electrical_t *model)
 {
-    coeffs->j_over_km = cfg->motor.inertia_kgm2 / model->torque_constant_Nm_A;
-    coeffs->f_over_j_per_s = cfg->motor.friction_Nms_rad / cfg->motor.inertia_kgm2;
-    coeffs->inv_j = 1.0f / cfg->motor.inertia_kgm2;
+    coeffs->j_over_km = model->inertia_kgm2 / model->torque_constant_Nm_A;
+    coeffs->f_over_j_per_s = model->friction_Nms_rad / model->inertia_kgm2;
+    coeffs->inv_j = 1.0f / model->inertia_kgm2;
     coeffs->speed_gain_per_s = cfg->gains.speed_gain_per_s;
     coeffs->current_gain_per_s = cfg->gains.current_gain_per_s;
     coeffs->r_over_l_per_s = model->resistance_Ohm / model->inductance_H;
     coeffs->km_over_l = model->torque_constant_Nm_A / model->inductance_H;
     coeffs->inductance_H = model->inductance_H;
     coeffs->pole_pairs = (float)cfg->motor.pole_pairs;
-    coeffs->kappa_rad_s = cfg->gains.sat_kappa_rad_s;
+    /* kappa bounds the speed correction's torque J k_w kappa: an identified J keeps that bound. */
+    coeffs->kappa_rad_s = cfg->gains.sat_kappa_rad_s * (cfg->motor.inertia_kgm2 / model->inertia_kgm2);
     coeffs->linear_speed_term = cfg->known_load_mode;
     coeffs->current_integral_gain_per_s2 = cfg->gains.current_integral_gain_per_s2;
     coeffs->detent_torque_Nm = cfg->motor.detent_torque_Nm;
@@ -47,39 +48,34 @@ void pmstep_park(float cos_hat, float sin_hat, float a, float b, float *d, float
     *q = -sin_hat * a + cos_hat * b;
 }
 
-/* k_w sat(e) and k_w sat'(e) for (6); k_w e and k_w for (13). */
-static void speed_term(const pmstep_law_coeffs_t *coeffs, float error, float *term, float *slope)
+pmstep_speed_term_t pmstep_law_speed_term(const pmstep_law_coeffs_t *coeffs, float speed_error_rad_s)
 {
+    pmstep_speed_term_t speed;
     if (coeffs->linear_speed_term) {
-        *term = coeffs->speed_gain_per_s * error;
-        *slope = coeffs->speed_gain_per_s;
+        speed.term = coeffs->speed_gain_per_s * speed_error_rad_s;
+        speed.slope = coeffs->speed_gain_per_s;
     } else {
         float sat;
         float sat_slope;
-        pmstep_sat(error, coeffs->kappa_rad_s, &sat, &sat_slope);
-        *term = coeffs->speed_gain_per_s * sat;
-        *slope = coeffs->speed_gain_per_s * sat_slope;
+        pmstep_sat(speed_error_rad_s, coeffs->kappa_rad_s, &sat, &sat_slope);
+        speed.term = coeffs->speed_gain_per_s * sat;
+        speed.slope = coeffs->speed_gain_per_s * sat_slope;
     }
+    return speed;
 }
 
 float pmstep_law_iq_ref(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs,
-                        float speed_hat_rad_s, float load_Nm)
+                        float speed_term, float load_Nm)
 {
-    float term;
-    float slope;
-    speed_term(coeffs, speed_hat_rad_s - refs->speed_ref_rad_s, &term, &slope);
-    return coeffs->j_over_km * (coeffs->f_over_j_per_s * refs->speed_ref_rad_s - term
+    return coeffs->j_over_km * (coeffs->f_over_j_per_s * refs->speed_ref_rad_s - speed_term
                                 + load_Nm * coeffs->inv_j + refs->speed_ref_rate_rad_s2);
 }
 
 float pmstep_law_iq_ref_rate(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs,
-                             float speed_hat_rad_s, float speed_hat_rate, float load_rate)
+                             float speed_slope, float speed_hat_rate, float load_rate)
 {
-    float term;
-    float slope;
-    speed_term(coeffs, speed_hat_rad_s - refs->speed_ref_rad_s, &term, &slope);
     return coeffs->j_over_km * (coeffs->f_over_j_per_s * refs->speed_ref_rate_rad_s2
-                                - slope * (speed_hat_rate - refs->speed_ref_rate_rad_s2)
+                                - speed_slope * (speed_hat_rate - refs->speed_ref_rate_rad_s2)
                                 + load_rate * coeffs->inv_j + refs->speed_ref_accel_rad_s3);
 }
 

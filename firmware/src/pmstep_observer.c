@@ -6,8 +6,8 @@
 void pmstep_observer_coeffs_init(pmstep_observer_coeffs_t *coeffs, const pmstep_config_t *cfg,
                                  const pmstep_electrical_t *model)
 {
-    const float j = cfg->motor.inertia_kgm2;
-    const float f = cfg->motor.friction_Nms_rad;
+    const float j = model->inertia_kgm2;
+    const float f = model->friction_Nms_rad;
     const float g = cfg->gains.adapt_gamma;
     const float l = cfg->gains.adapt_lambda;
     const float r = cfg->gains.adapt_r;

@@ -113,6 +113,11 @@ void pmstep_ref_advance(const pmstep_ref_coeffs_t *coeffs, pmstep_ref_t *ref, fl
     float d2;
     float y;
 
+    /* At rest on its target (as the snap below leaves it): the period would change nothing. */
+    if (ref->diff12 == 0.0f && ref->diff23 == 0.0f && ref->value == next && start == next
+        && ref->value_compensation == 0.0f) {
+        return;
+    }
     if (ref->ramp_rate_per_s > 0.0f && next != start) {
         const float travel = ref->ramp_rate_per_s * ((float)(ref->ramp_periods + 1u) * period_s);
         if (next > ref->ramp_origin + travel) {

@@ -59,6 +59,9 @@ const char *pmstep_status_str(pmstep_status_t status)
     case PMSTEP_ERR_RATED_CURRENT: return "rated current must be > 0";
     case PMSTEP_ERR_BUS_BELOW_RATED: return "bus too low for R x rated current";
     case PMSTEP_ERR_RATE_TOO_SLOW: return "control rate too slow for R/L or F/J";
+    case PMSTEP_ERR_IDENTIFICATION_WINDOW: return "identification: 0 to 2^24 periods";
+    case PMSTEP_ERR_IDENTIFICATION_SPEED: return "identification speed < 0";
+    case PMSTEP_ERR_MECHANICS_UNIDENTIFIED: return "identified J, F used without a window";
     case PMSTEP_ERR_POSITION_GAIN: return "need 0 < k_theta <= k_w/2";
     case PMSTEP_ERR_POSITION_INTEGRAL_GAIN: return "need 0 <= k_I <= k_theta^2/4";
     }
@@ -94,4 +97,17 @@ const char *pmstep_mode_str(pmstep_mode_t mode)
     case PMSTEP_MODE_OFFSET_CAL: return "OFFSET_CAL";
     }
     return "unknown mode";
+}
+
+const char *pmstep_identification_str(pmstep_identification_t identification)
+{
+    switch (identification) {
+    case PMSTEP_IDENT_OFF: return "OFF";
+    case PMSTEP_IDENT_RUNNING: return "RUNNING";
+    case PMSTEP_IDENT_DONE: return "DONE";
+    case PMSTEP_IDENT_FRICTION_NEGATIVE: return "FRICTION_NEGATIVE";
+    case PMSTEP_IDENT_POOR_EXCITATION: return "POOR_EXCITATION";
+    case PMSTEP_IDENT_IMPLAUSIBLE: return "IMPLAUSIBLE";
+    }
+    return "UNKNOWN";
 }

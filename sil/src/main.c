@@ -138,6 +138,9 @@ static void add_robustness_json(cJSON *root, const sil_summary_t *s)
     cJSON_AddNumberToObject(comm, "torque_constant_Nm_A", (double)c->torque_constant_Nm_A);
     cJSON_AddNumberToObject(comm, "voltage_bias_a_V", (double)c->voltage_bias_a_V);
     cJSON_AddNumberToObject(comm, "voltage_bias_b_V", (double)c->voltage_bias_b_V);
+    cJSON_AddNumberToObject(comm, "inertia_kgm2", (double)c->inertia_kgm2);
+    cJSON_AddNumberToObject(comm, "friction_Nms_rad", (double)c->friction_Nms_rad);
+    cJSON_AddStringToObject(comm, "identification", pmstep_identification_str(c->identification));
     cJSON_AddNumberToObject(comm, "realignments", (double)c->realignments);
     cJSON_AddBoolToObject(comm, "measured", c->measured);
     cJSON_AddItemToObject(root, "commissioning", comm);

@@ -14,6 +14,8 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: pmstep-tune --motor FILE [--robust] [--set section.key=value]...\n"
             "                   [--write-ini FILE] [--write-c FILE] [--validate]\n"
+            "                   [--told-inertia J] [--told-friction F] [--identify [--max-inertia-error PCT]]\n"
+            "                   [--identify-in-run]\n"
             "  --motor      motor preset (sil/scenarios/motors/*.ini): [datasheet], [motor], run.bus_voltage_V;\n"
             "               run.period_s, run.delay_periods, [inverter] and [sensors] are the drive's\n"
             "  --robust     robust mode: Remark 2 calibration, commissioned R/L/k_M, drift-free angle,\n"
@@ -22,7 +24,15 @@ static void usage(FILE *f)
             "  --write-ini  the whole scenario with the designed [controller.*] and a validation profile\n"
             "  --write-c    the design as a C99 initialiser of pmstep_config_t\n"
             "  --validate   run the design in the SIL: speed ramps to +-80 %% and +-5 %% of the top speed,\n"
-            "               load steps of half the holding torque at 50 %% and 5 %% of it; exit 1 on a miss\n");
+            "               load steps of half the holding torque at 50 %% and 5 %% of it; exit 1 on a miss\n"
+            "  --told-inertia, --told-friction  design for this J (kg m^2) / F (N m s/rad) in place of the\n"
+            "               preset's; the plant keeps the preset's (a datasheet that is off)\n"
+            "  --identify   run commissioning and the identification window in the SIL (ramps to +-80 %% of the\n"
+            "               top speed), design again with the identified J and F, print both designs and the\n"
+            "               errors against the plant; --validate then validates the second design\n"
+            "  --max-inertia-error  with --identify: exit 1 unless J is identified within PCT %% of the plant's\n"
+            "  --identify-in-run  the design asks the firmware to identify J and F in each run's first\n"
+            "               window and use them (commissioning.use_identified_mechanics)\n");
 }
 
 /* Validation profile (DESIGN.md, section 7): hold, +0.8 top, -0.8 top, +0.05 top, -0.05 top, 0. */
@@ -146,14 +156,18 @@ static int write_c(const char *path, const sil_scenario_t *sc)
     fprintf(f, "    .commissioning = {.offset_calibration_time_s = %.9gf, .alignment_offset_calibration = %s,\n"
                "                      .steady_state_window_s = %.9gf, .inductance_window_s = %.9gf,\n"
                "                      .use_measured_resistance = %s, .use_measured_inductance = %s,\n"
-               "                      .use_measured_torque_constant = %s, .voltage_bias_level_fraction = %.9gf},\n",
+               "                      .use_measured_torque_constant = %s, .voltage_bias_level_fraction = %.9gf,\n"
+               "                      .identification_time_s = %.9gf, .identification_min_speed_rad_s = %.9gf,\n"
+               "                      .use_identified_mechanics = %s},\n",
             (double)c->commissioning.offset_calibration_time_s,
             c->commissioning.alignment_offset_calibration ? "true" : "false",
             (double)c->commissioning.steady_state_window_s, (double)c->commissioning.inductance_window_s,
             c->commissioning.use_measured_resistance ? "true" : "false",
             c->commissioning.use_measured_inductance ? "true" : "false",
             c->commissioning.use_measured_torque_constant ? "true" : "false",
-            (double)c->commissioning.voltage_bias_level_fraction);
+            (double)c->commissioning.voltage_bias_level_fraction, (double)c->commissioning.identification_time_s,
+            (double)c->commissioning.identification_min_speed_rad_s,
+            c->commissioning.use_identified_mechanics ? "true" : "false");
     fprintf(f, "    .inverter = {.dead_time_s = %.9gf, .dead_time_current_band_A = %.9gf},\n",
             (double)c->inverter.dead_time_s, (double)c->inverter.dead_time_current_band_A);
     fprintf(f, "    .detection = {.angle_magnitude_bound = %.9gf, .speed_consistency_bound_rad_s = %.9gf,\n"
@@ -203,7 +217,9 @@ static bool run_ok(const char *what, const sil_summary_t *s, int rc)
     return true;
 }
 
-static int validate(const sil_scenario_t *designed, double top_speed_rad_s)
+/* @p max_inertia_error_pct >= 0: with identification in RUN, the first run must identify J
+ * within that many percent of the plant's. */
+static int validate(const sil_scenario_t *designed, double top_speed_rad_s, double max_inertia_error_pct)
 {
     static sil_scenario_t sc;
     sil_summary_t s;
@@ -225,6 +241,17 @@ static int validate(const sil_scenario_t *designed, double top_speed_rad_s)
         printf("  %-34s %s: |w - w*| %.3f rad/s (bound %.3f), angle error %.4f rad (bound %.2f)\n",
                "ramps to +-80 % and +-5 % of top", pass ? "pass" : "FAIL", s.max_speed_error_after_settle_rad_s,
                tracking_bound, s.max_angle_error_rad, ANGLE_BOUND_RAD);
+        if (s.commissioning.identification != PMSTEP_IDENT_OFF) {
+            const double j_error_pct = 100.0 * ((double)s.commissioning.inertia_kgm2 / sc.motor.inertia_kgm2 - 1.0);
+            const bool used = s.commissioning.identification == PMSTEP_IDENT_DONE
+                              || s.commissioning.identification == PMSTEP_IDENT_FRICTION_NEGATIVE;
+            const bool ident_pass = max_inertia_error_pct < 0.0
+                                    || (used && fabs(j_error_pct) <= max_inertia_error_pct);
+            printf("  %-34s %s: %s, J %.4g kg m^2 (%+.2f %% off the plant's), F %.4g N m s/rad\n", "identified in RUN",
+                   ident_pass ? "pass" : "FAIL", pmstep_identification_str(s.commissioning.identification),
+                   (double)s.commissioning.inertia_kgm2, j_error_pct, (double)s.commissioning.friction_Nms_rad);
+            failures += ident_pass ? 0 : 1;
+        }
         failures += pass ? 0 : 1;
     } else {
         ++failures;
@@ -260,6 +287,68 @@ static int validate(const sil_scenario_t *designed, double top_speed_rad_s)
     return failures == 0 ? 0 : 1;
 }
 
+/* The designer's input for the motor the drive is told: the preset's [motor], J and F overridable. */
+static void design_input(const sil_scenario_t *sc, bool robust, pmstep_design_input_t *in)
+{
+    memset(in, 0, sizeof *in);
+    in->motor.resistance_Ohm = (float)sc->motor.resistance_Ohm;
+    in->motor.inductance_H = (float)sc->motor.inductance_H;
+    in->motor.inertia_kgm2 = (float)sc->motor.inertia_kgm2;
+    in->motor.friction_Nms_rad = (float)sc->motor.friction_Nms_rad;
+    in->motor.torque_constant_Nm_A = (float)sc->motor.torque_constant_Nm_A;
+    in->motor.pole_pairs = (int32_t)sc->motor.pole_pairs;
+    in->motor.detent_torque_Nm = (float)sc->datasheet.detent_torque_Nm; /* the law compensates the datasheet's */
+    in->rated_current_A = (float)sc->datasheet.rated_current_A;
+    in->bus_voltage_V = (float)sc->bus_voltage_V;
+    in->period_s = sc->controller.timing.period_s;
+    in->computational_delay_periods = sc->controller.timing.computational_delay_periods;
+    in->self_commissioning = robust;
+    in->dead_time_s = (float)sc->inverter.dead_time_s;
+    {
+        const double step_A = sc->sensors.adc_bits > 0 ? 2.0 * sc->sensors.current_full_scale_A
+                                                             / (double)(1L << sc->sensors.adc_bits)
+                                                       : 0.0;
+        in->current_resolution_A = (float)(step_A > sc->sensors.noise_rms_A ? step_A : sc->sensors.noise_rms_A);
+    }
+}
+
+/* Identification window over the profile +0.8 top, -0.8 top (each held), from t_c; the lowest
+ * speed that enters the fit is the designer's (DESIGN.md, section 10). */
+static void set_identification(sil_scenario_t *sc, double top_speed_rad_s, bool use_in_run)
+{
+    const double levels[] = {0.8 * top_speed_rad_s, -0.8 * top_speed_rad_s};
+    const double t_c = (double)sc->controller.alignment.c_align_time_s
+                       + (double)sc->controller.commissioning.offset_calibration_time_s;
+    set_profile(sc, levels, 2);
+    sc->controller.commissioning.identification_time_s = (float)(sc->duration_s - t_c);
+    sc->controller.commissioning.use_identified_mechanics = use_in_run;
+}
+
+/* --identify: commissioning and the identification window in the SIL with the first design.
+ * @return 0 and the identified J, F in @p result; 1 when the run faulted or identified nothing. */
+static int identify(const sil_scenario_t *designed, double top_speed_rad_s, pmstep_commissioning_t *result)
+{
+    static sil_scenario_t sc;
+    sil_summary_t s;
+    int rc;
+    sc = *designed;
+    set_identification(&sc, top_speed_rad_s, false);
+    sc.duration_s += 0.01; /* the window closes on a sample, up to PMSTEP_IDENTIFICATION_DECIMATION periods late */
+    sc.load.kind = PLANT_LOAD_NONE;
+    rc = sil_run(&sc, NULL, NULL, false, &s);
+    if (!run_ok("identification run", &s, rc)) {
+        return 1;
+    }
+    *result = s.commissioning;
+    printf("pmstep-tune: identification over %.3f s from t_c (|w*| >= %.1f rad/s): %s\n",
+           (double)sc.controller.commissioning.identification_time_s,
+           (double)sc.controller.commissioning.identification_min_speed_rad_s,
+           pmstep_identification_str(result->identification));
+    return result->identification == PMSTEP_IDENT_DONE || result->identification == PMSTEP_IDENT_FRICTION_NEGATIVE
+               ? 0
+               : 1;
+}
+
 int main(int argc, char **argv)
 {
     static sil_scenario_t sc;
@@ -271,6 +360,11 @@ int main(int argc, char **argv)
     const char *c_path = NULL;
     bool robust = false;
     bool run_validation = false;
+    bool run_identification = false;
+    bool identify_in_run = false;
+    double told_inertia = -1.0;
+    double told_friction = -1.0;
+    double max_inertia_error_pct = -1.0;
     char err[SIL_ERROR_MAX];
     int k;
 
@@ -295,6 +389,27 @@ int main(int argc, char **argv)
             c_path = argv[++k];
         } else if (strcmp(argv[k], "--validate") == 0) {
             run_validation = true;
+        } else if (strcmp(argv[k], "--identify") == 0) {
+            run_identification = true;
+        } else if (strcmp(argv[k], "--identify-in-run") == 0) {
+            identify_in_run = true;
+        } else if ((strcmp(argv[k], "--told-inertia") == 0 || strcmp(argv[k], "--told-friction") == 0
+                    || strcmp(argv[k], "--max-inertia-error") == 0)
+                   && k + 1 < argc) {
+            char *end = NULL;
+            const char *name = argv[k];
+            const double value = strtod(argv[++k], &end);
+            if (end == argv[k] || *end != '\0' || !isfinite(value) || value < 0.0) {
+                fprintf(stderr, "pmstep-tune: %s needs a finite number >= 0, not '%s'\n", name, argv[k]);
+                return 2;
+            }
+            if (strcmp(name, "--told-inertia") == 0) {
+                told_inertia = value;
+            } else if (strcmp(name, "--told-friction") == 0) {
+                told_friction = value;
+            } else {
+                max_inertia_error_pct = value;
+            }
         } else if (strcmp(argv[k], "--help") == 0) {
             usage(stdout);
             return 0;
@@ -308,26 +423,13 @@ int main(int argc, char **argv)
         return 2;
     }
 
-    /* The drive is told the datasheet's motor: the preset's [motor]. */
-    memset(&in, 0, sizeof in);
-    in.motor.resistance_Ohm = (float)sc.motor.resistance_Ohm;
-    in.motor.inductance_H = (float)sc.motor.inductance_H;
-    in.motor.inertia_kgm2 = (float)sc.motor.inertia_kgm2;
-    in.motor.friction_Nms_rad = (float)sc.motor.friction_Nms_rad;
-    in.motor.torque_constant_Nm_A = (float)sc.motor.torque_constant_Nm_A;
-    in.motor.pole_pairs = (int32_t)sc.motor.pole_pairs;
-    in.motor.detent_torque_Nm = (float)sc.datasheet.detent_torque_Nm; /* the law compensates the datasheet's */
-    in.rated_current_A = (float)sc.datasheet.rated_current_A;
-    in.bus_voltage_V = (float)sc.bus_voltage_V;
-    in.period_s = sc.controller.timing.period_s;
-    in.computational_delay_periods = sc.controller.timing.computational_delay_periods;
-    in.self_commissioning = robust;
-    in.dead_time_s = (float)sc.inverter.dead_time_s;
-    {
-        const double step_A = sc.sensors.adc_bits > 0 ? 2.0 * sc.sensors.current_full_scale_A
-                                                            / (double)(1L << sc.sensors.adc_bits)
-                                                      : 0.0;
-        in.current_resolution_A = (float)(step_A > sc.sensors.noise_rms_A ? step_A : sc.sensors.noise_rms_A);
+    /* The drive is told the datasheet's motor: the preset's [motor], J and F as --told-* say. */
+    design_input(&sc, robust, &in);
+    if (told_inertia >= 0.0) {
+        in.motor.inertia_kgm2 = (float)told_inertia;
+    }
+    if (told_friction >= 0.0) {
+        in.motor.friction_Nms_rad = (float)told_friction;
     }
     status = pmstep_design(&in, &sc.controller, &report);
     if (status != PMSTEP_OK) {
@@ -336,7 +438,7 @@ int main(int argc, char **argv)
         return 1;
     }
     sc.id_target_A = (double)report.magnetising_current_A;
-    (void)pmstep_position_design(&sc.controller, &sc.position); /* position loop (DESIGN.md section 10) */
+    (void)pmstep_position_design(&sc.controller, &sc.position); /* position loop (DESIGN.md section 11) */
     {
         const double top = (double)report.top_speed_rad_s;
         const double levels[] = {0.8 * top, -0.8 * top, 0.05 * top, -0.05 * top, 0.0};
@@ -344,6 +446,55 @@ int main(int argc, char **argv)
     }
     sc.load.kind = PLANT_LOAD_NONE;
     print_design(&sc, &report, robust);
+    if (run_identification) {
+        pmstep_commissioning_t ident;
+        const double j_plant = sc.motor.inertia_kgm2;
+        const double f_plant = sc.motor.friction_Nms_rad;
+        double j_error_pct;
+        if (identify(&sc, (double)report.top_speed_rad_s, &ident) != 0) {
+            return 1;
+        }
+        j_error_pct = 100.0 * ((double)ident.inertia_kgm2 / j_plant - 1.0);
+        printf("  told:       J %.4g kg m^2 (%+.1f %% off the plant's %.4g), F %.4g N m s/rad (plant %.4g)\n",
+               (double)in.motor.inertia_kgm2, 100.0 * ((double)in.motor.inertia_kgm2 / j_plant - 1.0), j_plant,
+               (double)in.motor.friction_Nms_rad, f_plant);
+        printf("  identified: J %.4g kg m^2 (%+.2f %% off the plant's), F %.4g N m s/rad (%+.3g off the plant's)\n",
+               (double)ident.inertia_kgm2, j_error_pct, (double)ident.friction_Nms_rad,
+               (double)ident.friction_Nms_rad - f_plant);
+        in.motor.inertia_kgm2 = ident.inertia_kgm2;
+        in.motor.friction_Nms_rad = ident.friction_Nms_rad > 0.0f ? ident.friction_Nms_rad : 0.0f;
+        status = pmstep_design(&in, &sc.controller, &report);
+        if (status != PMSTEP_OK) {
+            fprintf(stderr, "pmstep-tune: cannot design for the identified J, F: %s (%d)\n",
+                    pmstep_status_str(status), (int)status);
+            return 1;
+        }
+        printf("pmstep-tune: design for the identified J and F\n");
+        {
+            const double top = (double)report.top_speed_rad_s;
+            const double levels[] = {0.8 * top, -0.8 * top, 0.05 * top, -0.05 * top, 0.0};
+            set_profile(&sc, levels, 5);
+        }
+        print_design(&sc, &report, robust);
+        if (max_inertia_error_pct >= 0.0 && !(fabs(j_error_pct) <= max_inertia_error_pct)) {
+            printf("pmstep-tune: identified J %+.2f %% off the plant's: over the %.1f %% bound\n", j_error_pct,
+                   max_inertia_error_pct);
+            return 1;
+        }
+    }
+    if (identify_in_run) {
+        /* The firmware identifies over the window of the ramps to +-0.8 top, and uses J and F. */
+        static sil_scenario_t window;
+        window = sc;
+        set_identification(&window, (double)report.top_speed_rad_s, true);
+        sc.controller.commissioning.identification_time_s = window.controller.commissioning.identification_time_s;
+        sc.controller.commissioning.identification_min_speed_rad_s =
+            window.controller.commissioning.identification_min_speed_rad_s;
+        sc.controller.commissioning.use_identified_mechanics = true;
+        printf("  identification in RUN: %.3f s from t_c, |w*| >= %.1f rad/s, identified J and F used\n",
+               (double)sc.controller.commissioning.identification_time_s,
+               (double)sc.controller.commissioning.identification_min_speed_rad_s);
+    }
     printf("  position loop: k_theta %g 1/s, k_I %g 1/s^2\n", (double)sc.position.gain_per_s,
            (double)sc.position.integral_gain_per_s2);
     if (ini_path != NULL) {
@@ -367,5 +518,5 @@ int main(int argc, char **argv)
         }
         printf("pmstep-tune: wrote %s\n", c_path);
     }
-    return run_validation ? validate(&sc, (double)report.top_speed_rad_s) : 0;
+    return run_validation ? validate(&sc, (double)report.top_speed_rad_s, max_inertia_error_pct) : 0;
 }

@@ -73,7 +73,7 @@ class AgainstTheFirmwareConsole(unittest.TestCase):
         self.assertEqual(hello["protocol"], 1)
         self.assertEqual(hello["identity"], "pmstep host-drive")
         table = c.list_config()
-        self.assertEqual(len(table), 43)
+        self.assertEqual(len(table), 46)
         names = [e["name"] for e in table]
         self.assertEqual(len(set(names)), len(names))
         self.assertEqual(c.get_config("gains.speed_gain_per_s")["value"], 100.0)

@@ -87,6 +87,9 @@ static void eva_any_config(pmstep_config_t *cfg)
     cfg->detection.observer_residual_bound_A = eva_any_finite();
     cfg->detection.persistence_s = eva_any_finite();
     cfg->detection.max_realignments = Frama_C_unsigned_int_interval(0u, UINT32_MAX);
+    cfg->commissioning.identification_time_s = eva_any_finite();
+    cfg->commissioning.identification_min_speed_rad_s = eva_any_finite();
+    cfg->commissioning.use_identified_mechanics = Frama_C_nondet(0, 1) != 0;
 }
 
 #endif /* PMSTEP_EVA_CONFIGS_H */

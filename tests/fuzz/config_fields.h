@@ -20,6 +20,7 @@ static const size_t fuzz_bool_fields[] = {
     offsetof(pmstep_config_t, commissioning.use_measured_resistance),
     offsetof(pmstep_config_t, commissioning.use_measured_inductance),
     offsetof(pmstep_config_t, commissioning.use_measured_torque_constant),
+    offsetof(pmstep_config_t, commissioning.use_identified_mechanics),
 };
 #define FUZZ_BOOL_FIELDS (sizeof fuzz_bool_fields / sizeof fuzz_bool_fields[0])
 

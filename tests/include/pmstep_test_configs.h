@@ -6,8 +6,8 @@
 #include "pmstep/pmstep.h"
 
 /* Every optional feature on: offset calibration, alignment windows with the voltage bias,
- * inductance window, commissioned R, L, k_M used, dead-time compensation, drift-free angle,
- * detent compensation, PI current loop,
+ * inductance window, commissioned R, L, k_M used, J and F identified over 20 ms of RUN and
+ * used, dead-time compensation, drift-free angle, detent compensation, PI current loop,
  * every detector (the paper's bounds), two re-alignments, one period of delay. */
 static inline pmstep_config_t pmstep_test_features_config(void)
 {
@@ -20,6 +20,8 @@ static inline pmstep_config_t pmstep_test_features_config(void)
     cfg.commissioning.use_measured_resistance = true;
     cfg.commissioning.use_measured_inductance = true;
     cfg.commissioning.use_measured_torque_constant = true;
+    cfg.commissioning.identification_time_s = 0.02f;
+    cfg.commissioning.use_identified_mechanics = true;
     cfg.inverter.dead_time_s = 1e-6f;
     cfg.inverter.dead_time_current_band_A = 0.005f;
     cfg.gains.angle_correction_gain_per_s = 20.0f;

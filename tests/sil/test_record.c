@@ -34,6 +34,9 @@ static void config_round_trips_through_the_words(void **state)
     in.detection.observer_residual_bound_A = 0.25f;
     in.detection.persistence_s = 0.02f;
     in.detection.max_realignments = 3u;
+    in.commissioning.identification_time_s = 0.4f;
+    in.commissioning.identification_min_speed_rad_s = 12.5f;
+    in.commissioning.use_identified_mechanics = true;
     sil_record_config_to_words(&in, w);
     sil_record_config_from_words(w, &out);
     assert_memory_equal(&in.motor.resistance_Ohm, &out.motor.resistance_Ohm, sizeof(float));
@@ -51,8 +54,11 @@ static void config_round_trips_through_the_words(void **state)
     assert_true(out.detection.stall_speed_error_rad_s == in.detection.stall_speed_error_rad_s);
     assert_true(out.detection.observer_residual_bound_A == in.detection.observer_residual_bound_A);
     assert_true(out.detection.persistence_s == in.detection.persistence_s && out.detection.max_realignments == 3u);
+    assert_true(out.commissioning.identification_time_s == in.commissioning.identification_time_s
+                && out.commissioning.identification_min_speed_rad_s == in.commissioning.identification_min_speed_rad_s
+                && out.commissioning.use_identified_mechanics);
     /* The last word is the last field. */
-    assert_true(w[SIL_RECORD_CONFIG_WORDS - 1u] == 3u);
+    assert_true(w[SIL_RECORD_CONFIG_WORDS - 1u] == 1u);
 }
 
 int main(void)

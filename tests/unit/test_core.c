@@ -40,6 +40,7 @@ static const pmstep_status_t all_status_codes[] = {
     PMSTEP_ERR_TORQUE_CONSTANT_UNMEASURED, PMSTEP_ERR_VOLTAGE_BIAS_FRACTION, PMSTEP_ERR_VOLTAGE_BIAS_WINDOW,
     PMSTEP_ERR_VOLTAGE_BIAS_SETTLING, PMSTEP_ERR_DEAD_TIME, PMSTEP_ERR_DEAD_TIME_BAND, PMSTEP_ERR_DETECTION_BOUND,
     PMSTEP_ERR_DETECTION_TIME, PMSTEP_ERR_RATED_CURRENT, PMSTEP_ERR_BUS_BELOW_RATED, PMSTEP_ERR_RATE_TOO_SLOW,
+    PMSTEP_ERR_IDENTIFICATION_WINDOW, PMSTEP_ERR_IDENTIFICATION_SPEED, PMSTEP_ERR_MECHANICS_UNIDENTIFIED,
     PMSTEP_ERR_POSITION_GAIN, PMSTEP_ERR_POSITION_INTEGRAL_GAIN};
 
 /* ---- validation: each cause has its own code and text ---- */
@@ -102,10 +103,17 @@ static void detection_time_below_four_periods_with_detectors_off(pmstep_config_t
     c->detection.persistence_s = 1e-40f;
 }
 
+static void negative_identification_window(pmstep_config_t *c) { c->commissioning.identification_time_s = -0.1f; }
+static void negative_identification_speed(pmstep_config_t *c) { c->commissioning.identification_min_speed_rad_s = -1.0f; }
+static void identified_mechanics_without_window(pmstep_config_t *c) { c->commissioning.use_identified_mechanics = true; }
+
 static const struct {
     config_edit_t edit;
     pmstep_status_t expected;
 } validation_cases[] = {
+    {negative_identification_window, PMSTEP_ERR_IDENTIFICATION_WINDOW},
+    {negative_identification_speed, PMSTEP_ERR_IDENTIFICATION_SPEED},
+    {identified_mechanics_without_window, PMSTEP_ERR_MECHANICS_UNIDENTIFIED},
     {bad_r, PMSTEP_ERR_RESISTANCE},
     {bad_l, PMSTEP_ERR_INDUCTANCE},
     {bad_j, PMSTEP_ERR_INERTIA},
@@ -197,8 +205,11 @@ static void every_validation_code_is_provoked(void **state)
         const pmstep_status_t code = all_status_codes[n];
         bool found = false;
         size_t k;
-        if (code > PMSTEP_ERR_NONFINITE_PARAMETER || code <= PMSTEP_ERR_RATED_CURRENT) {
-            continue; /* ok and the command codes: commands_validate_their_values; the designer's: test_design.c */
+        if (code > PMSTEP_ERR_NONFINITE_PARAMETER
+            || (code <= PMSTEP_ERR_RATED_CURRENT && code >= PMSTEP_ERR_RATE_TOO_SLOW)
+            || code <= PMSTEP_ERR_POSITION_GAIN) {
+            continue; /* ok and the command codes: commands_validate_their_values; the designer's: test_design.c;
+                       * the position library's: test_position.c */
         }
         for (k = 0; k < sizeof validation_cases / sizeof validation_cases[0]; ++k) {
             found = found || validation_cases[k].expected == code;

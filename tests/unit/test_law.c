@@ -67,11 +67,13 @@ static void current_loop_gives_error_dynamics_8(void **state)
     const double held_gain = 1.0 - turn * turn / 24.0;
     const float c_act = (float)cos(angle + 0.5 * turn), s_act = (float)sin(angle + 0.5 * turn);
     float u_a, u_b, u_d, u_q, i_q_ref, i_q_ref_rate;
+    pmstep_speed_term_t speed_term;
     double di_q, di_d;
     (void)state;
     pmstep_law_coeffs_init(&coeffs, &cfg, &model);
-    i_q_ref = pmstep_law_iq_ref(&coeffs, &refs, speed, load);
-    i_q_ref_rate = pmstep_law_iq_ref_rate(&coeffs, &refs, speed, 0.0f, 0.0f);
+    speed_term = pmstep_law_speed_term(&coeffs, speed - refs.speed_ref_rad_s);
+    i_q_ref = pmstep_law_iq_ref(&coeffs, &refs, speed_term.term, load);
+    i_q_ref_rate = pmstep_law_iq_ref_rate(&coeffs, &refs, speed_term.slope, 0.0f, 0.0f);
     pmstep_law_voltages(&coeffs, &refs, c, s, i_d, i_q, speed, i_q_ref, i_q_ref_rate, &no_integral, &u_a, &u_b);
     pmstep_park(c_act, s_act, u_a, u_b, &u_d, &u_q);
     u_d = (float)(u_d / held_gain);

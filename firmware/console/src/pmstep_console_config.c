@@ -61,6 +61,9 @@ static const pmstep_console_config_entry_t table[] = {
     U32(detection.max_realignments),
     F32(motor.detent_torque_Nm),
     F32(gains.current_integral_gain_per_s2),
+    F32(commissioning.identification_time_s),
+    F32(commissioning.identification_min_speed_rad_s),
+    BOOL(commissioning.use_identified_mechanics),
 };
 
 const pmstep_console_config_entry_t *pmstep_console_config_table(uint32_t *count)

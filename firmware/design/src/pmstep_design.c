@@ -41,6 +41,9 @@
 #define VOLTAGE_BIAS_LEVEL 0.5f
 #define MAGNETISING_PER_RATED_CURRENT 0.125f
 #define MIN_DEAD_TIME_BAND_A 1e-4f
+/* Identification of J and F (pmstep_identify.h): periods with |w*| below this fraction of the top
+ * speed stay out of the fit (a hybrid's detent torque does not average out at low speed). */
+#define IDENTIFICATION_MIN_SPEED_OF_TOP 0.2f
 /* Paper's r: only matters with F > 0 (DESIGN.md, section 3). */
 #define ADAPT_R 1.0f
 
@@ -235,6 +238,10 @@ static void design_commissioning(const pmstep_design_input_t *in, float window_s
     c->use_measured_inductance = robust && rotor_still;
     c->use_measured_torque_constant = robust && rotor_still;
     c->voltage_bias_level_fraction = robust ? VOLTAGE_BIAS_LEVEL : 0.0f;
+    /* The window is the application's: it must hold the speed commands that excite the motor. */
+    c->identification_time_s = 0.0f;
+    c->identification_min_speed_rad_s = IDENTIFICATION_MIN_SPEED_OF_TOP * report->top_speed_rad_s;
+    c->use_identified_mechanics = false;
     cfg->inverter.dead_time_s = robust ? in->dead_time_s : 0.0f;
     /* The band of the compensation, which the voltage bias uses too. */
     cfg->inverter.dead_time_current_band_A = robust ? max2(in->current_resolution_A, MIN_DEAD_TIME_BAND_A) : 0.0f;

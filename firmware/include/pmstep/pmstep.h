@@ -35,6 +35,8 @@ pmstep_status_t pmstep_init(pmstep_t *inst, const pmstep_config_t *cfg);
  * @retval PMSTEP_ERR_NONFINITE_PARAMETER  a setting is NaN or Inf
  * @retval PMSTEP_ERR_RESISTANCE ... PMSTEP_ERR_DETECTION_TIME  the first violated condition, group by group in the
  *         order motor, timing, gains, limits, alignment, commissioning, inverter, detection (pmstep_types.h)
+ * @retval PMSTEP_ERR_IDENTIFICATION_WINDOW, PMSTEP_ERR_IDENTIFICATION_SPEED, PMSTEP_ERR_MECHANICS_UNIDENTIFIED
+ *         the identification settings of the commissioning group (checked with it)
  * @retval PMSTEP_ERR_DERIVED_NONFINITE    a coefficient derived from valid settings is not finite
  */
 pmstep_status_t pmstep_validate_config(const pmstep_config_t *cfg);

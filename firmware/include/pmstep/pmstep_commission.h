@@ -45,6 +45,7 @@ typedef struct {
     uint32_t inductance_start_step; /**< m0: first sample of the current-rise window */
     bool offsets_from_alignment;/**< take offsets from the alignment steady states too */
     bool bias_estimation;       /**< second, lower steady state at the end of each alignment */
+    uint32_t identification_steps; /**< RUN periods of the J and F identification window from t_c (0 = none) */
 } pmstep_commission_plan_t;
 
 /** Running sums (raw samples; offsets are removed at the end). */

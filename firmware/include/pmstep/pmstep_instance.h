@@ -13,6 +13,7 @@
 #include "pmstep/pmstep_observer.h"
 #include "pmstep/pmstep_law.h"
 #include "pmstep/pmstep_commission.h"
+#include "pmstep/pmstep_identify.h"
 #include "pmstep/pmstep_detect.h"
 #include "pmstep/pmstep_actuate.h"
 
@@ -51,12 +52,13 @@ typedef struct {
     pmstep_law_integral_t current_integral; /**< PI current loop (K_I > 0) */
     pmstep_actuator_t actuator;
 
-    pmstep_commissioning_t commissioning; /**< offsets (subtracted from every sample once measured), R, L, k_M */
+    pmstep_commissioning_t commissioning; /**< offsets (subtracted from every sample once measured), R, L, k_M, J, F */
     union {
         pmstep_commission_sums_t sums;    /**< until t_c */
         struct {
             pmstep_detector_t detector;
             pmstep_ref_t known_load_filter; /**< T_L* of Remark 1 */
+            pmstep_identify_sums_t identify; /**< J and F fit, while the identification window is open */
         } run;                            /**< from t_c */
     } scratch;
 } pmstep_t;

@@ -102,13 +102,25 @@ void pmstep_sat(float x, float kappa, float *sat, float *sat_slope);
 /** Park transform with (c, s): d = c a + s b, q = -s a + c b. */
 void pmstep_park(float cos_hat, float sin_hat, float a, float b, float *d, float *q);
 
-/** i_q* = (J/k_M)[(F/J) w* - k_w sat(w-hat - w*) + T/J + w*'], T = T_L-hat or T_L*. */
-float pmstep_law_iq_ref(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs,
-                        float speed_hat_rad_s, float load_Nm);
+/** The speed correction of (6), k_w sat(e), and its slope k_w sat'(e), e = w-hat - w*
+ *  ((13): k_w e and k_w). */
+typedef struct {
+    float term;  /**< k_w sat(e), rad/s^2 */
+    float slope; /**< k_w sat'(e), 1/s */
+} pmstep_speed_term_t;
 
-/** i_q*' = (J/k_M)[(F/J) w*' - k_w sat'(e)(w-hat' - w*') + T'/J + w*'']. */
+/** The speed correction and its slope for the speed error @p speed_error_rad_s = w-hat - w*. */
+pmstep_speed_term_t pmstep_law_speed_term(const pmstep_law_coeffs_t *coeffs, float speed_error_rad_s);
+
+/** i_q* = (J/k_M)[(F/J) w* - k_w sat(w-hat - w*) + T/J + w*'], T = T_L-hat or T_L*;
+ *  @p speed_term is k_w sat(w-hat - w*) (pmstep_law_speed_term). */
+float pmstep_law_iq_ref(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs,
+                        float speed_term, float load_Nm);
+
+/** i_q*' = (J/k_M)[(F/J) w*' - k_w sat'(e)(w-hat' - w*') + T'/J + w*''];
+ *  @p speed_slope is k_w sat'(e) (pmstep_law_speed_term). */
 float pmstep_law_iq_ref_rate(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs,
-                             float speed_hat_rad_s, float speed_hat_rate, float load_rate);
+                             float speed_slope, float speed_hat_rate, float load_rate);
 
 /**
  * phi_d = -(R/L) i_d* + p w-hat i_q - i_d*',  phi_q = -(R/L) i_q* - p w-hat i_d - (k_M/L) w-hat - i_q*',

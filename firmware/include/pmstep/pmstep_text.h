@@ -22,6 +22,9 @@ const char *pmstep_fault_str(pmstep_fault_t fault);
 /** Human-readable name of a mode. */
 const char *pmstep_mode_str(pmstep_mode_t mode);
 
+/** Name of an identification outcome, e.g. "POOR_EXCITATION" (the enum's suffix; pmstep_types.h). */
+const char *pmstep_identification_str(pmstep_identification_t identification);
+
 #ifdef __cplusplus
 }
 #endif

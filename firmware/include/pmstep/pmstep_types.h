@@ -88,9 +88,13 @@ typedef enum {
     PMSTEP_ERR_BUS_BELOW_RATED = -111,      /**< bus voltage <= 0, or R x rated current above the usable bus */
     PMSTEP_ERR_RATE_TOO_SLOW = -112,        /**< control rate too slow for the motor: R/L, or F/J, not well below
                                                  the bandwidths the designer gives the current loop and the observer */
+    /* commissioning: identification of J and F at the start of RUN (pmstep_identify.h) */
+    PMSTEP_ERR_IDENTIFICATION_WINDOW = -120, /**< identification window < 0 or longer than PMSTEP_MAX_DURATION_PERIODS */
+    PMSTEP_ERR_IDENTIFICATION_SPEED = -121,  /**< identification's lowest speed < 0 */
+    PMSTEP_ERR_MECHANICS_UNIDENTIFIED = -122, /**< identified J and F used without an identification window */
     /* position control (pmstep_position.h) */
-    PMSTEP_ERR_POSITION_GAIN = -120,        /**< position gain k_theta <= 0, or above k_w/2 (the speed loop's) */
-    PMSTEP_ERR_POSITION_INTEGRAL_GAIN = -121 /**< position integral gain k_I < 0, or above k_theta^2/4 (the loop's
+    PMSTEP_ERR_POSITION_GAIN = -130,        /**< position gain k_theta <= 0, or above k_w/2 (the speed loop's) */
+    PMSTEP_ERR_POSITION_INTEGRAL_GAIN = -131 /**< position integral gain k_I < 0, or above k_theta^2/4 (the loop's
                                                  poles would turn complex) */
 } pmstep_status_t;
 
@@ -103,8 +107,15 @@ typedef enum {
 /** Narrowest dead-time compensation band (A): keeps 1/band finite and its product with a
  *  current sample far from overflow. */
 #define PMSTEP_MIN_CURRENT_BAND_A 1e-4f
+/** Identification of J and F: the least-squares fit is refused (PMSTEP_IDENT_POOR_EXCITATION) when the
+ *  determinant of its regressors' normalised Gram matrix (cosines between the columns 1, w*', w*:
+ *  1 = orthogonal, 0 = collinear) is below this. */
+#define PMSTEP_IDENTIFICATION_MIN_DETERMINANT 0.02f
 /** Detection runs in RUN every this many periods (supervision at a fraction of the control rate). */
 #define PMSTEP_DETECTION_DECIMATION 4u
+/** The identification of J and F takes a sample every this many periods of its window, two periods
+ *  after each detection check (so that the two never share a step). */
+#define PMSTEP_IDENTIFICATION_DECIMATION 4u
 
 /** Operating mode of the strategy (Section III.A). */
 typedef enum {
@@ -197,6 +208,12 @@ typedef struct {
                                             each alignment runs at this fraction of its voltage, and the two steady
                                             states give R and the bias (the part of the dead time the compensation
                                             misses), which is then compensated too */
+    float identification_time_s;       /**< J and F identified over this long from t_c (pmstep_identify.h): the speed
+                                            commands in it must accelerate the motor; 0 = not identified */
+    float identification_min_speed_rad_s; /**< only periods with |w*| at least this enter the fit (the detent torque
+                                            and the low-speed transients do not average out below it); 0 = all */
+    bool use_identified_mechanics;     /**< at the end of the window RUN uses the identified J and F (the observer's
+                                            and the law's coefficients; kappa scaled by J/J-identified) */
 } pmstep_commissioning_config_t;
 
 /** What the controller knows of its inverter: dead-time compensation. */
@@ -230,20 +247,25 @@ typedef struct {
     bool known_load_mode; /**< Remark 1: load torque known, given each period in pmstep_meas_t */
 } pmstep_config_t;
 
-/** Electrical model the controller works with: the configured values, or commissioned ones. */
+/** Model the controller works with: the configured values, or commissioned (R, L, k_M at t_c) and
+ *  identified (J, F at the end of the identification window) ones. */
 typedef struct {
     float resistance_Ohm;           /**< R */
     float inductance_H;             /**< L */
     float torque_constant_Nm_A; /**< k_M */
+    float inertia_kgm2;             /**< J */
+    float friction_Nms_rad;         /**< F */
 } pmstep_electrical_t;
 
-/** The model of the configuration: R, L, k_M as configured. */
+/** The model of the configuration: R, L, k_M, J, F as configured. */
 static inline pmstep_electrical_t pmstep_configured_electrical(const pmstep_config_t *cfg)
 {
     pmstep_electrical_t model;
     model.resistance_Ohm = cfg->motor.resistance_Ohm;
     model.inductance_H = cfg->motor.inductance_H;
     model.torque_constant_Nm_A = cfg->motor.torque_constant_Nm_A;
+    model.inertia_kgm2 = cfg->motor.inertia_kgm2;
+    model.friction_Nms_rad = cfg->motor.friction_Nms_rad;
     return model;
 }
 
@@ -279,6 +301,20 @@ typedef struct {
     float i_q_ref_A;         /**< i_q* */
 } pmstep_output_t;
 
+/** Outcome of the identification of J and F (pmstep_commissioning_t.identification). */
+typedef enum {
+    PMSTEP_IDENT_OFF = 0,              /**< not configured (identification_time_s = 0), or t_c not reached */
+    PMSTEP_IDENT_RUNNING = 1,          /**< window open: the fit's sums are being taken */
+    PMSTEP_IDENT_DONE = 2,             /**< J and F identified (and used, with use_identified_mechanics) */
+    PMSTEP_IDENT_FRICTION_NEGATIVE = 3,/**< J identified; F came out < 0 (below what the data resolves): the value is
+                                            reported, and F = 0 is what RUN uses with use_identified_mechanics */
+    PMSTEP_IDENT_POOR_EXCITATION = 4,  /**< the window held too little acceleration or speed variation (the fit's
+                                            determinant below PMSTEP_IDENTIFICATION_MIN_DETERMINANT): nothing
+                                            identified, the configured J and F stay */
+    PMSTEP_IDENT_IMPLAUSIBLE = 5       /**< J outside [1/2, 2] x the configured one, or |F|/J not below 0.5/T_s
+                                            (or either not finite): reported, not used */
+} pmstep_identification_t;
+
 /** Remark 2 calibration and self-commissioning results (pmstep_get_commissioning()). */
 typedef struct {
     float offset_a_A;               /**< current-sensor offset subtracted from every i_a sample (A) */
@@ -291,6 +327,9 @@ typedef struct {
     float torque_constant_Nm_A; /**< k_M from the flux swing of c-alignment (0: not measured) */
     float voltage_bias_a_V;         /**< voltage phase a falls short by at positive current (0: not measured) */
     float voltage_bias_b_V;         /**< same for phase b */
+    float inertia_kgm2;             /**< J identified in RUN (0: not identified; see identification) */
+    float friction_Nms_rad;         /**< F identified in RUN (may be < 0: see identification) */
+    pmstep_identification_t identification; /**< state and outcome of the identification of J and F */
     uint32_t realignments;          /**< re-alignments after a detection since start */
     bool measured;                  /**< alignment finished and the values above were taken */
 } pmstep_commissioning_t;

@@ -40,8 +40,9 @@ extern "C" {
  * then the entries in order.
  */
 #define SIL_RECORD_MAGIC 0x52534D50u /* "PMSR" */
-#define SIL_RECORD_VERSION 4u /* 2: calibration, commissioning, angle, detection; 3: voltage bias; 4: residual */
-#define SIL_RECORD_CONFIG_WORDS 41u
+#define SIL_RECORD_VERSION 5u /* 2: calibration, commissioning, angle, detection; 3: voltage bias; 4: residual;
+                                 5: identification of J and F */
+#define SIL_RECORD_CONFIG_WORDS 44u
 #define SIL_RECORD_TAG_SPEED_TARGET 1u
 #define SIL_RECORD_TAG_PERIOD 2u
 #define SIL_RECORD_TAG_END 3u
@@ -148,6 +149,9 @@ static inline void sil_record_config_from_words(const uint32_t *w, pmstep_config
     c->detection.observer_residual_bound_A = sil_record_float(w[38]);
     c->detection.persistence_s = sil_record_float(w[39]);
     c->detection.max_realignments = w[40];
+    c->commissioning.identification_time_s = sil_record_float(w[41]);
+    c->commissioning.identification_min_speed_rad_s = sil_record_float(w[42]);
+    c->commissioning.use_identified_mechanics = w[43] != 0u;
 }
 
 static inline void sil_record_meas_from_words(const uint32_t *w, pmstep_meas_t *m)
@@ -225,6 +229,9 @@ static inline void sil_record_config_to_words(const pmstep_config_t *c, uint32_t
     w[38] = sil_record_bits(c->detection.observer_residual_bound_A);
     w[39] = sil_record_bits(c->detection.persistence_s);
     w[40] = c->detection.max_realignments;
+    w[41] = sil_record_bits(c->commissioning.identification_time_s);
+    w[42] = sil_record_bits(c->commissioning.identification_min_speed_rad_s);
+    w[43] = c->commissioning.use_identified_mechanics ? 1u : 0u;
 }
 
 static inline void sil_record_meas_to_words(const pmstep_meas_t *m, uint32_t *w)
