@@ -141,7 +141,12 @@ void pmstep_position_update(pmstep_position_t *pos, const pmstep_output_t *out, 
     int32_t sin_negative;
     float position_rad;
     if (out->mode != PMSTEP_MODE_RUN) {
-        /* Not in RUN (or left it: stop, fault, re-alignment): the position is lost. */
+        /* Not in RUN (or left it: stop, fault, re-alignment): the position is lost. Leaving position
+         * mode this way, the speed channel holds the move's last w* as its target: cleared, so that a
+         * new RUN (a re-alignment included) starts at rest, not at that speed. */
+        if (pos->position_mode) {
+            pmstep_ref_reset(&pos->inst->speed_ref, 0.0f);
+        }
         pos->tracked = false;
         pos->position_mode = false;
         pos_out->position_rad = 0.0f;

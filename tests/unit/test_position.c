@@ -357,6 +357,25 @@ static void speed_command_leaves_position_mode_and_hold_stops(void **state)
     assert_float_equal(f.pos.motion.target, 0.0f, 1e-4f);
 }
 
+static void leaving_run_in_position_mode_leaves_no_speed_command(void **state)
+{
+    fixture_t f;
+    kinematic_t k = {0.0, 0.0, 0.0};
+    pmstep_position_output_t pos_out;
+    pmstep_output_t out = run_output(0.0, 1.0, 0.0);
+    (void)state;
+    fixture_init(&f);
+    pmstep_position_update(&f.pos, &out, &pos_out);
+    assert_int_equal(pmstep_position_move_to(&f.pos, 30.0f, 2.0f, 20.0f, 0.0f), PMSTEP_OK);
+    kinematic_run(&f, &k, 20000, 30.0, 0.0, 0.0); /* cruising at 2 rad/s */
+    assert_true(f.inst.speed_ref.target > 1.9f);
+    out.mode = PMSTEP_MODE_S_ALIGN; /* a re-alignment mid-move */
+    pmstep_position_update(&f.pos, &out, &pos_out);
+    assert_false(f.pos.position_mode);
+    assert_float_equal(f.inst.speed_ref.target, 0.0f, 0.0f); /* the next RUN starts at rest */
+    assert_float_equal(f.inst.speed_ref.value, 0.0f, 0.0f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -371,6 +390,7 @@ int main(void)
         cmocka_unit_test(loop_drives_the_reference_to_the_target_and_holds),
         cmocka_unit_test(loop_absorbs_a_speed_estimate_bias_with_the_integral),
         cmocka_unit_test(speed_command_leaves_position_mode_and_hold_stops),
+        cmocka_unit_test(leaving_run_in_position_mode_leaves_no_speed_command),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
