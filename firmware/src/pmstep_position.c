@@ -102,15 +102,9 @@ static void put_speed_reference(pmstep_position_t *pos, float speed, float rate,
 {
     pmstep_ref_t *ref = &pos->inst->speed_ref;
     const float inv_w0 = pos->inv_bandwidth_s;
+    pmstep_ref_reset(ref, speed); /* at rest on w*, then the filter's differences for w*', w*'' */
     ref->diff23 = rate * inv_w0;
     ref->diff12 = accel * inv_w0 * inv_w0 + ref->diff23;
-    ref->value = speed;
-    ref->value_compensation = 0.0f;
-    ref->setpoint = speed;
-    ref->target = speed;
-    ref->ramp_rate_per_s = 0.0f;
-    ref->ramp_origin = speed;
-    ref->ramp_periods = 0u;
 }
 
 /* Position mode, after period k: the profile at k+1 and the loop on the estimate moved on to k+1. */

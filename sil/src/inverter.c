@@ -59,7 +59,7 @@ void sil_inverter_init(sil_inverter_t *inv, const sil_inverter_config_t *cfg, co
     inv->ripple_memo_next = 0u;
 }
 
-static double clip(double u_V, double limit_V, bool *clipped)
+double sil_inverter_clip(double u_V, double limit_V, bool *clipped)
 {
     if (u_V > limit_V) {
         *clipped = true;
@@ -81,8 +81,8 @@ void sil_inverter_apply(sil_inverter_t *inv, const pmstep_output_t *out, double 
     double next_a_V, next_b_V;
     bool clipped = false, next_clipped;
     if (enable && bus_ok) {
-        u_a_V = clip((double)out->u_a_V, measured_bus_V, &clipped);
-        u_b_V = clip((double)out->u_b_V, measured_bus_V, &clipped);
+        u_a_V = sil_inverter_clip((double)out->u_a_V, measured_bus_V, &clipped);
+        u_b_V = sil_inverter_clip((double)out->u_b_V, measured_bus_V, &clipped);
     }
     if (inv->delay_periods == 1u) {
         /* A disabled bridge stops switching at once: nothing stays pending. */

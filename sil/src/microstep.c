@@ -1,6 +1,8 @@
 /* Open-loop microstepping drive at rated current: the SIL's baseline (microstep.h). */
 #include "sil/microstep.h"
 
+#include "sil/inverter.h"
+
 #include <math.h>
 #include <string.h>
 
@@ -20,19 +22,6 @@ void sil_microstep_set_speed_target(sil_microstep_t *drive, double target_rad_s,
     drive->target_rad_s = target_rad_s;
     drive->ramp_rate_rad_s2 = ramp_rate_rad_s2;
     drive->moving = true;
-}
-
-static double clip(double u_V, double limit_V, bool *clipped)
-{
-    if (u_V > limit_V) {
-        *clipped = true;
-        return limit_V;
-    }
-    if (u_V < -limit_V) {
-        *clipped = true;
-        return -limit_V;
-    }
-    return u_V;
 }
 
 /* omega* over [t_k, t_k + T_s]: a ramp towards the target that stops there. Returns the
@@ -74,8 +63,8 @@ void sil_microstep_step(sil_microstep_t *drive, const pmstep_meas_t *meas, pmste
 
     memset(out, 0, sizeof *out);
     if (bus_V > 0.0 && isfinite(bus_V)) {
-        out->u_a_V = (float)clip(u_a, bus_V, &clipped);
-        out->u_b_V = (float)clip(u_b, bus_V, &clipped);
+        out->u_a_V = (float)sil_inverter_clip(u_a, bus_V, &clipped);
+        out->u_b_V = (float)sil_inverter_clip(u_b, bus_V, &clipped);
     }
     out->bridge_enable = true;
     out->voltage_limited = clipped;

@@ -122,6 +122,9 @@ sil_bus_config_t sil_bus_ideal_config(void);
 void sil_inverter_init(sil_inverter_t *inv, const sil_inverter_config_t *cfg, const sil_bus_config_t *bus,
                        double bus_voltage_V, unsigned delay_periods);
 
+/** @p u_V limited to +-@p limit_V (a phase voltage to the bus); sets *@p clipped when it was. */
+double sil_inverter_clip(double u_V, double limit_V, bool *clipped);
+
 /** Takes one step's output and the bus voltage the step was given; sets the command of the coming period. */
 void sil_inverter_apply(sil_inverter_t *inv, const pmstep_output_t *out, double measured_bus_V);
 
