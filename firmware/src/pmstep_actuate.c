@@ -9,6 +9,9 @@ void pmstep_actuate_coeffs_init(pmstep_actuate_coeffs_t *coeffs, const pmstep_co
     coeffs->delayed = cfg->timing.computational_delay_periods != 0u;
     coeffs->dead_time_duty = 2.0f * cfg->inverter.dead_time_s / cfg->timing.period_s;
     coeffs->inv_band_per_A = coeffs->compensate ? 1.0f / cfg->inverter.dead_time_current_band_A : 0.0f;
+    /* PWM ripple's half amplitude at its largest (d = 1/2): V_bus T / (16 L), plus 3 bands (noise). */
+    coeffs->sign_threshold_A_per_V = cfg->timing.period_s / (16.0f * cfg->motor.inductance_H);
+    coeffs->sign_threshold_A = 3.0f * cfg->inverter.dead_time_current_band_A;
 }
 
 void pmstep_actuate_reset(pmstep_actuator_t *actuator)
@@ -17,6 +20,10 @@ void pmstep_actuate_reset(pmstep_actuator_t *actuator)
     actuator->u_applied_b_V = 0.0f;
     actuator->u_pending_a_V = 0.0f;
     actuator->u_pending_b_V = 0.0f;
+    actuator->compensation_applied_a_V = 0.0f;
+    actuator->compensation_applied_b_V = 0.0f;
+    actuator->compensation_pending_a_V = 0.0f;
+    actuator->compensation_pending_b_V = 0.0f;
 }
 
 /* x within [-limit, limit]. */
@@ -71,11 +78,59 @@ bool pmstep_actuate(pmstep_actuator_t *actuator, const pmstep_actuate_coeffs_t *
         next_b_V = actuator->u_pending_b_V;
         actuator->u_pending_a_V = out->u_a_V - dead_time_a_V;
         actuator->u_pending_b_V = out->u_b_V - dead_time_b_V;
+        actuator->compensation_applied_a_V = actuator->compensation_pending_a_V;
+        actuator->compensation_applied_b_V = actuator->compensation_pending_b_V;
+        actuator->compensation_pending_a_V = dead_time_a_V;
+        actuator->compensation_pending_b_V = dead_time_b_V;
     } else {
         next_a_V = out->u_a_V - dead_time_a_V;
         next_b_V = out->u_b_V - dead_time_b_V;
+        actuator->compensation_applied_a_V = dead_time_a_V;
+        actuator->compensation_applied_b_V = dead_time_b_V;
     }
     actuator->u_applied_a_V = next_a_V;
     actuator->u_applied_b_V = next_b_V;
     return true;
+}
+
+/* +1 or -1 where the current was beyond the threshold, of one sign, at both ends of the period
+ * (it kept that sign at every edge), else 0 (unknown: near or through zero). */
+static float certain_sign(float i_start_A, float i_end_A, float threshold_A)
+{
+    if (i_start_A > threshold_A && i_end_A > threshold_A) {
+        return 1.0f;
+    }
+    if (i_start_A < -threshold_A && i_end_A < -threshold_A) {
+        return -1.0f;
+    }
+    return 0.0f;
+}
+
+/* One phase: the command less the loss of the known sign, or u_applied where it is unknown or
+ * where the command came within the dead time of the bus (a leg that hardly switches loses less). */
+static float phase_voltage_over_period(float applied_V, float compensation_V, float loss_full_V, float sign,
+                                       float switching_limit_V)
+{
+    const float command_V = applied_V + compensation_V;
+    if (sign == 0.0f || pmstep_abs(command_V) >= switching_limit_V) {
+        return applied_V;
+    }
+    return command_V - loss_full_V * sign;
+}
+
+void pmstep_actuate_voltage_over_period(const pmstep_actuator_t *actuator, const pmstep_actuate_coeffs_t *coeffs,
+                                        const pmstep_period_currents_t *currents, float bus_voltage_V,
+                                        float *u_a_V, float *u_b_V)
+{
+    const float threshold_A = coeffs->sign_threshold_A_per_V * bus_voltage_V + coeffs->sign_threshold_A;
+    const float dead_V = coeffs->dead_time_duty * bus_voltage_V;
+    const float switching_limit_V = bus_voltage_V - dead_V;
+    *u_a_V = phase_voltage_over_period(actuator->u_applied_a_V, actuator->compensation_applied_a_V,
+                                       dead_V + currents->bias_a_V,
+                                       certain_sign(currents->i_start_a_A, currents->i_end_a_A, threshold_A),
+                                       switching_limit_V);
+    *u_b_V = phase_voltage_over_period(actuator->u_applied_b_V, actuator->compensation_applied_b_V,
+                                       dead_V + currents->bias_b_V,
+                                       certain_sign(currents->i_start_b_A, currents->i_end_b_A, threshold_A),
+                                       switching_limit_V);
 }

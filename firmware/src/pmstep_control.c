@@ -42,8 +42,20 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
     if (!inst->run_started) {
         start_run(inst, sample);
     } else {
-        pmstep_angle_update(&inst->angle, &inst->angle_coeffs, sample->i_a_A, sample->i_b_A,
-                            inst->actuator.u_applied_a_V, inst->actuator.u_applied_b_V);
+        float u_a_V = inst->actuator.u_applied_a_V;
+        float u_b_V = inst->actuator.u_applied_b_V;
+        if (inst->actuate_coeffs.compensate) { /* the dead time's loss, where the samples fix it */
+            pmstep_period_currents_t currents;
+            currents.i_start_a_A = inst->angle.i_a_prev_A;
+            currents.i_start_b_A = inst->angle.i_b_prev_A;
+            currents.i_end_a_A = sample->i_a_A;
+            currents.i_end_b_A = sample->i_b_A;
+            currents.bias_a_V = inst->commissioning.voltage_bias_a_V;
+            currents.bias_b_V = inst->commissioning.voltage_bias_b_V;
+            pmstep_actuate_voltage_over_period(&inst->actuator, &inst->actuate_coeffs, &currents,
+                                               sample->bus_voltage_V, &u_a_V, &u_b_V);
+        }
+        pmstep_angle_update(&inst->angle, &inst->angle_coeffs, sample->i_a_A, sample->i_b_A, u_a_V, u_b_V);
     }
     pmstep_angle_estimate(&inst->angle, &inst->angle_coeffs, sample->i_a_A, sample->i_b_A, &cos_hat, &sin_hat);
     pmstep_park(cos_hat, sin_hat, sample->i_a_A, sample->i_b_A, &i_d, &i_q);

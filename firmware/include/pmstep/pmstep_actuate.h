@@ -30,12 +30,18 @@ typedef struct {
     float u_applied_b_V;
     float u_pending_a_V; /**< computed, waiting one period (delay = 1) */
     float u_pending_b_V;
+    float compensation_applied_a_V; /**< dead-time compensation within u_applied + it (same period) */
+    float compensation_applied_b_V;
+    float compensation_pending_a_V; /**< the compensation within u_pending */
+    float compensation_pending_b_V;
 } pmstep_actuator_t;
 
 /** Constants derived from the configuration. */
 typedef struct {
     float dead_time_duty;       /**< 2 t_d / T_s: compensation at full current, fraction of the bus */
     float inv_band_per_A;       /**< 1 / dead_time_current_band_A (0 without compensation) */
+    float sign_threshold_A_per_V; /**< a current's sign is known beyond this x V_bus + sign_threshold_A */
+    float sign_threshold_A;
     bool compensate;            /**< dead time configured or voltage bias estimated */
     bool delayed;               /**< one period of computational delay */
 } pmstep_actuate_coeffs_t;
@@ -62,6 +68,27 @@ typedef struct {
  */
 bool pmstep_actuate(pmstep_actuator_t *actuator, const pmstep_actuate_coeffs_t *coeffs,
                     const pmstep_compensation_input_t *compensation, float bus_voltage_V, pmstep_output_t *out);
+
+/** The currents sampled at the two ends of a period, and the voltage biases (Remark 2). */
+typedef struct {
+    float i_start_a_A, i_start_b_A; /**< at the period's start */
+    float i_end_a_A, i_end_b_A;     /**< at its end */
+    float bias_a_V, bias_b_V;       /**< measured voltage biases, 0 if none */
+} pmstep_period_currents_t;
+
+/**
+ * The voltage the bridge applied over the period that has just ended, for the flux integrals.
+ * Where a phase current was beyond the sign threshold, with one sign, at both ends of the period,
+ * it kept that sign at every switching edge, so the bridge lost (2 V_bus t_d / T + bias) sign(i)
+ * whatever the compensation assumed: the command less that loss. Elsewhere (near or through
+ * zero, or a command within the dead time of the bus, where a leg hardly switches) the loss is
+ * unknown and the compensation's own assumption stands: u_applied.
+ * Sign threshold: the PWM ripple's largest half amplitude, V_bus T / (16 L) at d = 1/2 (the
+ * edges sit at the ripple's extremes), plus three compensation bands (the sample noise).
+ */
+void pmstep_actuate_voltage_over_period(const pmstep_actuator_t *actuator, const pmstep_actuate_coeffs_t *coeffs,
+                                        const pmstep_period_currents_t *currents, float bus_voltage_V,
+                                        float *u_a_V, float *u_b_V);
 
 #ifdef __cplusplus
 }
