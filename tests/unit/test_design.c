@@ -46,6 +46,27 @@ static pmstep_design_input_t input_of(const motor_data_t *m, bool robust)
     return in;
 }
 
+/* DESIGN.md section 5: 0.04 I, plus the dead time's floor 4 V t_d / L in robust mode (on the
+ * AS1050 at 48 V and 1 us, 0.2 A + 0.223 A). */
+static void residual_bound_has_the_dead_time_floor(void **state)
+{
+    size_t n;
+    (void)state;
+    for (n = 0; n < sizeof presets / sizeof presets[0]; ++n) {
+        const pmstep_design_input_t ideal = input_of(&presets[n], false);
+        const pmstep_design_input_t robust = input_of(&presets[n], true);
+        const float rated_share_A = 0.04f * presets[n].rated_A;
+        const float floor_A = 4.0f * presets[n].bus_V * 1e-6f / presets[n].l;
+        pmstep_config_t cfg;
+        pmstep_design_report_t report;
+        assert_int_equal(pmstep_design(&ideal, &cfg, &report), PMSTEP_OK);
+        assert_float_equal(cfg.detection.observer_residual_bound_A, rated_share_A, 1e-6f * rated_share_A);
+        assert_int_equal(pmstep_design(&robust, &cfg, &report), PMSTEP_OK);
+        assert_float_equal(cfg.detection.observer_residual_bound_A, rated_share_A + floor_A,
+                           1e-5f * (rated_share_A + floor_A));
+    }
+}
+
 static void every_preset_gets_a_valid_design(void **state)
 {
     size_t n;
@@ -188,6 +209,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(every_preset_gets_a_valid_design),
+        cmocka_unit_test(residual_bound_has_the_dead_time_floor),
         cmocka_unit_test(observer_poles_are_placed),
         cmocka_unit_test(bad_motor_data_gets_a_named_error),
     };

@@ -256,7 +256,12 @@ static void design_protection(const pmstep_design_input_t *in, pmstep_config_t *
     cfg->detection.angle_magnitude_bound = ANGLE_MAGNITUDE_BOUND;
     cfg->detection.stall_speed_error_rad_s = STALL_FRACTION_OF_TOP_SPEED * top_speed_rad_s;
     cfg->detection.speed_consistency_bound_rad_s = STALL_FRACTION_OF_TOP_SPEED * top_speed_rad_s;
-    cfg->detection.observer_residual_bound_A = RESIDUAL_PER_RATED_CURRENT * in->rated_current_A;
+    /* Plus the dead time's floor: in a period in which a current crosses zero the observer's
+     * prediction (the compensated voltage) can be off by the whole 2 (2 V_bus t_d / T), which
+     * moves that period's current by 4 V_bus t_d / L (DESIGN.md section 5). */
+    cfg->detection.observer_residual_bound_A = RESIDUAL_PER_RATED_CURRENT * in->rated_current_A
+                                               + 4.0f * in->bus_voltage_V * cfg->inverter.dead_time_s
+                                                     / in->motor.inductance_H;
     cfg->detection.persistence_s = PERSISTENCE_S;
     cfg->detection.max_realignments = 0u;
 }
