@@ -65,6 +65,16 @@ bool pmstep_actuate(pmstep_actuator_t *actuator, const pmstep_actuate_coeffs_t *
                                           compensation->bias_a_V);
         dead_time_b_V = dead_time_voltage(coeffs, compensation->sign_current_b_A, bus_voltage_V,
                                           compensation->bias_b_V);
+        /* The compensation goes down the delay line beside its voltage (a non-finite one latches
+         * a fault, and the line is cleared before the bridge is on again). */
+        if (!coeffs->delayed) {
+            actuator->compensation_pending_a_V = dead_time_a_V;
+            actuator->compensation_pending_b_V = dead_time_b_V;
+        }
+        actuator->compensation_applied_a_V = actuator->compensation_pending_a_V;
+        actuator->compensation_applied_b_V = actuator->compensation_pending_b_V;
+        actuator->compensation_pending_a_V = dead_time_a_V;
+        actuator->compensation_pending_b_V = dead_time_b_V;
     }
     out->u_a_V += dead_time_a_V;
     out->u_b_V += dead_time_b_V;
@@ -78,15 +88,9 @@ bool pmstep_actuate(pmstep_actuator_t *actuator, const pmstep_actuate_coeffs_t *
         next_b_V = actuator->u_pending_b_V;
         actuator->u_pending_a_V = out->u_a_V - dead_time_a_V;
         actuator->u_pending_b_V = out->u_b_V - dead_time_b_V;
-        actuator->compensation_applied_a_V = actuator->compensation_pending_a_V;
-        actuator->compensation_applied_b_V = actuator->compensation_pending_b_V;
-        actuator->compensation_pending_a_V = dead_time_a_V;
-        actuator->compensation_pending_b_V = dead_time_b_V;
     } else {
         next_a_V = out->u_a_V - dead_time_a_V;
         next_b_V = out->u_b_V - dead_time_b_V;
-        actuator->compensation_applied_a_V = dead_time_a_V;
-        actuator->compensation_applied_b_V = dead_time_b_V;
     }
     actuator->u_applied_a_V = next_a_V;
     actuator->u_applied_b_V = next_b_V;
