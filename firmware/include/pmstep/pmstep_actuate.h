@@ -64,7 +64,8 @@ typedef struct {
  * @param[in] compensation   read only when coeffs->compensate
  * @param[in] bus_voltage_V  the bus measured this period (finite, > 0)
  * @retval true   @p out holds the finite command to apply, |u| <= bus on each phase
- * @retval false  the command is not finite; nothing was advanced (latch a fault)
+ * @retval false  the command is not finite; the voltages were not advanced (latch a fault; the
+ *               compensation's line may have been, and is cleared before the bridge is on again)
  */
 bool pmstep_actuate(pmstep_actuator_t *actuator, const pmstep_actuate_coeffs_t *coeffs,
                     const pmstep_compensation_input_t *compensation, float bus_voltage_V, pmstep_output_t *out);
