@@ -8,9 +8,10 @@ pmstep_position_update() (the two halves of pmstep_position_step()). The QEMU pl
 bench_target.py counts the instructions of each call, from its first instruction to the one
 its call returns to (callees included), in two runs of the same deterministic image; their sum
 per period is the cost of pmstep_position_step(). Printed per kind of period: RUN in position
-mode, RUN before the first move (speed mode: the estimate only), the alignments.
+mode, RUN before the first move (speed mode: the estimate only), the alignments. Exits 1 when the
+position-mode mean exceeds --max-mean (the issue's budget, 600 instructions).
 
-usage: tools/bench_position_target.py [--no-build] [--duration S] [--json FILE]
+usage: tools/bench_position_target.py [--no-build] [--duration S] [--json FILE] [--max-mean N]
 """
 import argparse
 import json
@@ -56,6 +57,8 @@ def main():
     ap.add_argument("--no-build", action="store_true", help="use the existing build/qemu-pil")
     ap.add_argument("--duration", default="3", help="simulated seconds (default 3: two moves and a hold)")
     ap.add_argument("--json", help="also write the figures to this JSON file")
+    ap.add_argument("--max-mean", type=float, default=600.0,
+                    help="budget of a position-mode period, mean instructions (default 600)")
     args = ap.parse_args()
     if not args.no_build:
         bt.run(["cmake", "--preset", "qemu-pil"], cwd=bt.ROOT, stdout=subprocess.DEVNULL)
@@ -94,7 +97,13 @@ def main():
                          "total": [min(t), statistics.fmean(t), max(t)]}
     if args.json:
         Path(args.json).write_text(json.dumps(figures, indent=1))
-    return 0
+    if "p" not in figures:
+        print("no period in position mode")
+        return 1
+    mean = figures["p"]["total"][1]
+    print("position-mode period: mean %.1f instructions, budget %.0f: %s" %
+          (mean, args.max_mean, "within" if mean <= args.max_mean else "OVER"))
+    return 0 if mean <= args.max_mean else 1
 
 
 if __name__ == "__main__":

@@ -15,6 +15,11 @@ Commands (one per run, or several in the interactive mode):
   config                                 every configuration value, by id and name
   get NAME|ID      set NAME|ID VALUE     one configuration value (set: motor stopped only)
   telemetry --decimation N [--seconds S] [--csv FILE] [--plot]   stream to CSV, plot live
+  move TARGET_RAD [--vmax RAD_S] [--amax RAD_S2] [--jmax RAD_S3]  position move (mechanical rad from
+                                         the zero; defaults 5 rad/s, 50 rad/s^2, jerk 0 = a_max varpi_0)
+  hold [--amax RAD_S2]                   stop and hold (a_max used only from speed mode)
+  position                               theta-hat, theta*, their difference, the flags
+  zero                                   the present position becomes 0
   plot FILE.csv                          plot a telemetry CSV afterwards
   interactive                            a prompt for all of the above
 
@@ -34,13 +39,16 @@ MAX_PAYLOAD = 64
 
 HELLO, START, STOP, CLEAR_FAULT, SPEED_TARGET, ID_TARGET = 0x01, 0x02, 0x03, 0x04, 0x05, 0x06
 GET_STATUS, GET_CONFIG, SET_CONFIG, GET_COMMISSIONING, TELEMETRY, GET_COUNTERS = 0x07, 0x08, 0x09, 0x0A, 0x0B, 0x0C
+MOVE_TO, HOLD, GET_POSITION, SET_POSITION_ZERO = 0x0D, 0x0E, 0x0F, 0x10
 SIM_ADVANCE, SIM_FINISH = 0x40, 0x41
 TELEMETRY_FRAME, ERROR_FRAME = 0x90, 0xFF
 
 MODES = {0: "IDLE", 1: "S_ALIGN", 2: "C_ALIGN", 3: "RUN", 4: "FAULT", 5: "OFFSET_CAL"}
 ERRORS = {1: "unknown command", 2: "bad length", 3: "bad value (NaN, Inf or out of range)",
           4: "unknown configuration value", 5: "read-only value", 6: "refused while the motor runs",
-          7: "busy: the previous command has not reached the core yet", 8: "not supported by this image"}
+          7: "busy: the previous command has not reached the core yet", 8: "not supported by this image",
+          9: "no position control in this image (speed mode only)"}
+POSITION_FLAGS = {1: "tracked", 2: "position_mode", 4: "moving"}
 STATUS_FIELDS = ["speed_ref_rad_s", "speed_hat_rad_s", "load_hat_Nm", "cos_hat", "sin_hat", "i_a_A", "i_b_A",
                  "bus_voltage_V", "u_a_V", "u_b_V", "i_d_A", "i_q_A"]
 TELEMETRY_FIELDS = ["period", "mode", "fault", "speed_ref_rad_s", "speed_hat_rad_s", "load_hat_Nm", "cos_hat",
@@ -262,6 +270,24 @@ class Console:
     def set_telemetry(self, decimation):
         return self._ack(TELEMETRY, struct.pack("<I", decimation))
 
+    def move_to(self, target_rad, v_max_rad_s=5.0, a_max_rad_s2=50.0, j_max_rad_s3=0.0):
+        return self._ack(MOVE_TO, struct.pack("<ffff", target_rad, v_max_rad_s, a_max_rad_s2, j_max_rad_s3))
+
+    def hold(self, a_max_rad_s2=None):
+        return self._ack(HOLD, b"" if a_max_rad_s2 is None else struct.pack("<f", a_max_rad_s2))
+
+    def set_position_zero(self):
+        return self._ack(SET_POSITION_ZERO)
+
+    def position(self):
+        """The present period's estimate and theta* (mechanical rad); status != 0 (e.g. -2: not
+        tracked, not in RUN) comes back in the dict with zero positions."""
+        status, period, pos, ref, err, flags = struct.unpack("<hIfffB", self.request(GET_POSITION))
+        p = {"status": status, "period": period, "position_rad": pos, "position_ref_rad": ref,
+             "position_error_rad": err}
+        p.update({name: bool(flags & bit) for bit, name in POSITION_FLAGS.items()})
+        return p
+
     def sim_advance(self, periods, timeout=120.0):
         return self._ack(SIM_ADVANCE, struct.pack("<I", periods), timeout=timeout)
 
@@ -355,6 +381,9 @@ def run_command(con, argv):
     p.add_argument("--csv")
     p.add_argument("--plot", action="store_true")
     p.add_argument("--period", type=float, default=50e-6)
+    p.add_argument("--vmax", type=float, default=5.0)
+    p.add_argument("--amax", type=float, default=None)
+    p.add_argument("--jmax", type=float, default=0.0)
     a = p.parse_args(argv)
     w = a.what
     if w == "hello":
@@ -381,6 +410,16 @@ def run_command(con, argv):
         print(f"  {c['id']} {c['name']} = {c['value']:.7g} ({c['type']})")
     elif w == "set":
         print(f"set {a.args[0]} = {a.args[1]}: done (core re-initialised) at period {con.set_config(a.args[0], a.args[1])}")
+    elif w == "move":
+        amax = 50.0 if a.amax is None else a.amax
+        period = con.move_to(float(a.args[0]), a.vmax, amax, a.jmax)
+        print(f"move to {a.args[0]} rad at {a.vmax} rad/s, {amax} rad/s^2: from period {period}")
+    elif w == "hold":
+        print(f"hold: from period {con.hold(a.amax)}")
+    elif w == "zero":
+        print(f"zero: the position is 0 from period {con.set_position_zero()}")
+    elif w == "position":
+        print_dict(con.position())
     elif w == "telemetry":
         rows = stream(con, a.decimation, a.seconds, a.csv, a.plot)
         print(f"{len(rows)} telemetry frames" + (f" written to {a.csv}" if a.csv else ""))
@@ -391,7 +430,8 @@ def run_command(con, argv):
 
 class Shell(cmd.Cmd):
     intro = "pmstep console: hello, status, start, stop, clear, speed T [--ramp R], id A, config, get K, " \
-            "set K V, commissioning, counters, telemetry [--decimation N --seconds S --csv F --plot], quit"
+            "set K V, commissioning, counters, telemetry [--decimation N --seconds S --csv F --plot], " \
+            "move X [--vmax V --amax A --jmax J], hold [--amax A], position, zero, quit"
     prompt = "pmstep> "
 
     def __init__(self, con):

@@ -4,6 +4,18 @@
 #include <math.h> /* fabsf: one instruction, no libm call */
 #include <stddef.h>
 
+/* The N-th period's update out of line (GCC, Clang): inlined into pmstep_position_update(), the
+ * registers it needs would be saved and restored every period. */
+#if defined(__GNUC__)
+#define POSITION_OUT_OF_LINE __attribute__((noinline))
+#else
+#define POSITION_OUT_OF_LINE
+#endif
+
+/* Terms of the series of hold_coefficients(): a = w0 N T_s <= 8 x 0.5 (validation: w0 T_s <= 0.5);
+ * a^j/j! below 1e-9 of e^a beyond j = 40. */
+#define POSITION_SERIES_TERMS 40
+
 #define POSITION_ONE ((int32_t)1)
 #define POSITION_ZERO ((int32_t)0)
 #define POSITION_PI 3.14159265358979f
@@ -60,6 +72,30 @@ static float estimate(const pmstep_position_t *pos)
     return (POSITION_TWO_PI_HI * turns + (POSITION_TWO_PI_LO * turns + fine)) * pos->inv_pole_pairs;
 }
 
+/* The reference filter's response over N periods to a held set-point (put_speed_reference), for
+ * a = w0 N T_s: y_N - y = g (r - y) + c23 (x2 - x3) + c12 (x1 - x2) with, from the chain of three
+ * lags, g = 1 - e^-a (1 + a + a^2/2) = e^-a sum_{j>=3} a^j/j! (summed: no cancellation),
+ * c23 = e^-a (a + a^2/2), c12 = e^-a a^2/2. Kept: 1/g, c23, c12. */
+static void hold_coefficients(pmstep_position_t *pos, float a)
+{
+    float term = 1.0f;
+    float exp_a = 1.0f;
+    float tail = 0.0f; /* sum_{j>=3} a^j/j! */
+    float e;
+    int32_t j;
+    for (j = 1; j < POSITION_SERIES_TERMS; ++j) {
+        term = term * a / (float)j;
+        exp_a += term;
+        if (j >= 3) {
+            tail += term;
+        }
+    }
+    e = 1.0f / exp_a;
+    pos->hold_inv_gain = exp_a / tail; /* 1/g = e^a / tail */
+    pos->hold_c23 = e * (a + 0.5f * a * a);
+    pos->hold_c12 = e * 0.5f * a * a;
+}
+
 pmstep_status_t pmstep_position_init(pmstep_position_t *pos, pmstep_t *inst, const pmstep_position_config_t *cfg)
 {
     const pmstep_config_t *core;
@@ -87,40 +123,72 @@ pmstep_status_t pmstep_position_init(pmstep_position_t *pos, pmstep_t *inst, con
     pos->zero_rad = 0.0f;
     pos->turns = 0;
     pos->sin_negative = 0;
-    pos->tracked = false;
-    pos->position_mode = false;
-    pos->position_ref_rad = 0.0f;
+    pos->out.tracked = false;
+    pos->out.position_mode = false;
     pos->error_integral_rad_s = 0.0f;
-    pmstep_motion_reset(&pos->motion, 0.0f, pos->period_s);
+    pos->loop_countdown = PMSTEP_POSITION_DECIMATION;
+    pos->out.moving = false;
+    pos->out.position_rad = 0.0f;
+    pos->out.position_ref_rad = 0.0f;
+    pos->out.position_error_rad = 0.0f;
+    /* the profile is sampled at the loop's updates, every PMSTEP_POSITION_DECIMATION periods */
+    pmstep_motion_reset(&pos->motion, 0.0f, (float)PMSTEP_POSITION_DECIMATION * pos->period_s);
+    pos->now = pmstep_motion_peek(&pos->motion);
+    pos->ahead = pos->now;
+    hold_coefficients(pos, inst->ref_coeffs.bandwidth_rad_s * pos->motion.period_s);
     return PMSTEP_OK;
 }
 
-/* Puts the speed reference channel at (w*, w*', w*'') with its set-point held at w*: the law
- * reads exactly these in the next period (pmstep_ref_output), and a speed command given
- * meanwhile ramps on from w* (pmstep_ref_set_target). */
-static void put_speed_reference(pmstep_position_t *pos, float speed, float rate, float accel)
+/* Puts the speed reference channel at (w*, w*', w*'') for the coming N periods: the law reads
+ * exactly these in the next period (pmstep_ref_output), then the core's own pmstep_ref_advance()
+ * runs the filter on, so w*, w*', w*'' stay one trajectory of H(s) (the law's derivatives are
+ * those of its reference). The filter's set-point r is held at the value that brings w* to
+ * @p end_speed after the N periods (hold_coefficients(): the discretisation is exact), the
+ * reference the next update will put: no step of w* at the update. A speed command given
+ * meanwhile ramps on from that set-point (pmstep_ref_set_target); the output stays continuous. */
+static void put_speed_reference(pmstep_position_t *pos, float speed, float rate, float accel, float end_speed)
 {
     pmstep_ref_t *ref = &pos->inst->speed_ref;
     const float inv_w0 = pos->inv_bandwidth_s;
-    pmstep_ref_reset(ref, speed); /* at rest on w*, then the filter's differences for w*', w*'' */
-    ref->diff23 = rate * inv_w0;
-    ref->diff12 = accel * inv_w0 * inv_w0 + ref->diff23;
+    const float diff23 = rate * inv_w0;
+    const float diff12 = accel * inv_w0 * inv_w0 + diff23;
+    const float free_change = pos->hold_c23 * diff23 + pos->hold_c12 * diff12;
+    pmstep_ref_reset(ref, speed + (end_speed - speed - free_change) * pos->hold_inv_gain);
+    ref->diff12 = diff12;
+    ref->diff23 = diff23;
+    ref->value = speed;
 }
 
-/* Position mode, after period k: the profile at k+1 and the loop on the estimate moved on to k+1. */
+/* Position mode, an update after period k: the profile's sample for period k+1 (pos->now, taken
+ * one update ahead) and the loop on the estimate moved on to k+1; the speed reference it puts
+ * serves periods k+1 .. k+N and ends where the next update's will begin: the profile's speed at
+ * k+N+1 (pos->ahead, sampled now) plus the feedback terms moved on by their derivatives
+ * (k_theta e + k_I z)(t + N T_s) ~ value + N T_s rate + (N T_s)^2/2 accel. z integrates the error
+ * sampled every N T_s. */
 static void position_loop(pmstep_position_t *pos, float position_rad)
 {
     const float k_p = pos->cfg.gain_per_s;
     const float k_i = pos->cfg.integral_gain_per_s2;
-    const pmstep_motion_sample_t ref = pmstep_motion_next(&pos->motion);
+    const float step_s = pos->motion.period_s;
+    const pmstep_motion_sample_t ref = pos->ahead; /* the sample for period k+1 */
+    const bool running = !pmstep_motion_finished(&pos->motion);
     const float predicted_rad = position_rad + pos->period_s * pos->speed_hat_rad_s;
     const float error_rad = ref.position - predicted_rad;
     const float speed_error = ref.speed - pos->speed_hat_rad_s;
-    pos->error_integral_rad_s += pos->period_s * error_rad;
-    put_speed_reference(pos, ref.speed + k_p * error_rad + k_i * pos->error_integral_rad_s,
-                        ref.accel + k_p * speed_error + k_i * error_rad,
-                        ref.jerk + (k_i - k_p * k_p) * speed_error);
-    pos->position_ref_rad = ref.position;
+    float feedback;
+    float feedback_rate;
+    float feedback_accel;
+    pos->now = ref;
+    pos->ahead = pmstep_motion_next(&pos->motion); /* the sample for period k+N+1 */
+    pos->error_integral_rad_s += step_s * error_rad;
+    feedback = k_p * error_rad + k_i * pos->error_integral_rad_s;
+    feedback_rate = k_p * speed_error + k_i * error_rad;
+    feedback_accel = (k_i - k_p * k_p) * speed_error;
+    put_speed_reference(pos, ref.speed + feedback, ref.accel + feedback_rate, ref.jerk + feedback_accel,
+                        pos->ahead.speed + feedback + step_s * (feedback_rate + 0.5f * step_s * feedback_accel));
+    pos->out.moving = running;
+    pos->out.position_ref_rad = ref.position;
+    pos->out.position_error_rad = error_rad;
 }
 
 void pmstep_position_step(pmstep_position_t *pos, const pmstep_meas_t *meas, pmstep_output_t *out,
@@ -130,62 +198,78 @@ void pmstep_position_step(pmstep_position_t *pos, const pmstep_meas_t *meas, pms
     pmstep_position_update(pos, out, pos_out);
 }
 
+/* Leaving RUN (stop, fault, re-alignment): the position is lost. Leaving position mode this way,
+ * the speed channel holds the move's last w* as its target: cleared, so that a new RUN (a
+ * re-alignment included) starts at rest, not at that speed. */
+POSITION_OUT_OF_LINE static void lose_position(pmstep_position_t *pos)
+{
+    if (pos->out.position_mode) {
+        pmstep_ref_reset(&pos->inst->speed_ref, 0.0f);
+    }
+    pos->out.tracked = false;
+    pos->out.position_mode = false;
+    pos->out.moving = false;
+    pos->out.position_rad = 0.0f;
+    pos->out.position_ref_rad = 0.0f;
+    pos->out.position_error_rad = 0.0f;
+}
+
+/* RUN's first period: (c-hat, s-hat) = (1, 0) at the c-alignment's equilibrium; the first update now. */
+static void start_tracking(pmstep_position_t *pos)
+{
+    pos->out.tracked = true;
+    pos->out.position_mode = false;
+    pos->turns = 0;
+    pos->zero_rad = 0.0f;
+    pos->sin_negative = 0;
+    pos->loop_countdown = 1;
+}
+
+/* Every N-th period: the estimate (the fine angle) and, in position mode, the loop. */
+POSITION_OUT_OF_LINE static void update(pmstep_position_t *pos)
+{
+    const float position_rad = estimate(pos);
+    pos->loop_countdown = PMSTEP_POSITION_DECIMATION;
+    pos->out.position_rad = position_rad;
+    if (pos->out.position_mode && pos->inst->speed_ref.ramp_rate_per_s > 0.0f) {
+        /* A speed command (pmstep_set_speed_target) since the last update: speed mode. The core has
+         * been ramping from the held set-point since; the loop writes nothing more. */
+        pos->out.position_mode = false;
+        pos->out.moving = false;
+    }
+    if (pos->out.position_mode) {
+        position_loop(pos, position_rad);
+    } else {
+        pos->out.position_ref_rad = position_rad;
+        pos->out.position_error_rad = 0.0f;
+    }
+}
+
 void pmstep_position_update(pmstep_position_t *pos, const pmstep_output_t *out, pmstep_position_output_t *pos_out)
 {
-    int32_t sin_negative;
-    float position_rad;
     if (out->mode != PMSTEP_MODE_RUN) {
-        /* Not in RUN (or left it: stop, fault, re-alignment): the position is lost. Leaving position
-         * mode this way, the speed channel holds the move's last w* as its target: cleared, so that a
-         * new RUN (a re-alignment included) starts at rest, not at that speed. */
-        if (pos->position_mode) {
-            pmstep_ref_reset(&pos->inst->speed_ref, 0.0f);
+        if (pos->out.tracked) {
+            lose_position(pos);
         }
-        pos->tracked = false;
-        pos->position_mode = false;
-        pos_out->position_rad = 0.0f;
-        pos_out->position_ref_rad = 0.0f;
-        pos_out->position_error_rad = 0.0f;
-        pos_out->tracked = false;
-        pos_out->position_mode = false;
-        pos_out->moving = false;
-        return;
-    }
-    if (!pos->tracked) {
-        /* RUN's first period: (c-hat, s-hat) = (1, 0) at the c-alignment's equilibrium. */
-        pos->tracked = true;
-        pos->turns = 0;
-        pos->zero_rad = 0.0f;
-        pos->sin_negative = 0;
-        pos->position_mode = false;
-    }
-    /* One turn on when s-hat goes negative with c-hat < 0 (through pi), one back the other way. */
-    sin_negative = (out->sin_hat < 0.0f) ? POSITION_ONE : POSITION_ZERO;
-    if (out->cos_hat < 0.0f) {
-        pos->turns += sin_negative - pos->sin_negative;
-    }
-    pos->sin_negative = sin_negative;
-    pos->cos_hat = out->cos_hat;
-    pos->sin_hat = out->sin_hat;
-    pos->speed_hat_rad_s = out->speed_hat_rad_s;
-    position_rad = estimate(pos);
-
-    if (pos->position_mode && pos->inst->speed_ref.ramp_rate_per_s > 0.0f) {
-        pos->position_mode = false; /* a speed command (pmstep_set_speed_target) since the last period */
-    }
-    pos_out->position_rad = position_rad;
-    pos_out->tracked = true;
-    pos_out->position_mode = pos->position_mode;
-    if (pos->position_mode) {
-        pos_out->position_ref_rad = pos->position_ref_rad; /* theta* of the period just run */
-        pos_out->position_error_rad = pos->position_ref_rad - position_rad;
-        position_loop(pos, position_rad);
-        pos_out->moving = !pmstep_motion_finished(&pos->motion);
     } else {
-        pos_out->position_ref_rad = position_rad;
-        pos_out->position_error_rad = 0.0f;
-        pos_out->moving = false;
+        /* Every period: one turn on when s-hat goes negative with c-hat < 0 (through pi), one back. */
+        const int32_t sin_negative = (out->sin_hat < 0.0f) ? POSITION_ONE : POSITION_ZERO;
+        if (!pos->out.tracked) {
+            start_tracking(pos);
+        }
+        if (out->cos_hat < 0.0f) {
+            pos->turns += sin_negative - pos->sin_negative;
+        }
+        pos->sin_negative = sin_negative;
+        pos->cos_hat = out->cos_hat;
+        pos->sin_hat = out->sin_hat;
+        pos->speed_hat_rad_s = out->speed_hat_rad_s;
+        pos->loop_countdown--;
+        if (pos->loop_countdown <= 0) {
+            update(pos);
+        }
     }
+    *pos_out = pos->out;
 }
 
 pmstep_status_t pmstep_get_position(const pmstep_position_t *pos, float *position_rad)
@@ -193,10 +277,32 @@ pmstep_status_t pmstep_get_position(const pmstep_position_t *pos, float *positio
     if (pos == NULL || position_rad == NULL) {
         return PMSTEP_ERR_NULL_ARGUMENT;
     }
-    if (!pos->tracked) {
+    if (!pos->out.tracked) {
         return PMSTEP_ERR_BAD_MODE;
     }
     *position_rad = estimate(pos);
+    return PMSTEP_OK;
+}
+
+pmstep_status_t pmstep_position_reference(const pmstep_position_t *pos, float *position_ref_rad)
+{
+    if (pos == NULL || position_ref_rad == NULL) {
+        return PMSTEP_ERR_NULL_ARGUMENT;
+    }
+    if (!pos->out.tracked) {
+        return PMSTEP_ERR_BAD_MODE;
+    }
+    if (!pos->out.position_mode) {
+        *position_ref_rad = estimate(pos);
+    } else {
+        /* The last update's sample is for the period after it; the period just run is
+         * N - countdown - 1 periods on (-1 right after the update): its cubic there. */
+        const pmstep_motion_sample_t *now = &pos->now;
+        const int32_t periods_on = PMSTEP_POSITION_DECIMATION - pos->loop_countdown - 1;
+        const float t_s = (float)periods_on * pos->period_s;
+        *position_ref_rad = now->position
+                            + t_s * (now->speed + t_s * (0.5f * now->accel + t_s * (now->jerk * (1.0f / 6.0f))));
+    }
     return PMSTEP_OK;
 }
 
@@ -206,14 +312,17 @@ pmstep_status_t pmstep_position_set_zero(pmstep_position_t *pos)
     if (pos == NULL) {
         return PMSTEP_ERR_NULL_ARGUMENT;
     }
-    if (!pos->tracked) {
+    if (!pos->out.tracked) {
         return PMSTEP_ERR_BAD_MODE;
     }
     position_rad = estimate(pos);
     pos->turns = 0;
     pos->zero_rad = pmstep_atan2_poly(pos->sin_hat, pos->cos_hat);
     pmstep_motion_shift(&pos->motion, -position_rad);
-    pos->position_ref_rad -= position_rad;
+    pos->now.position -= position_rad;
+    pos->ahead.position -= position_rad;
+    pos->out.position_rad -= position_rad;
+    pos->out.position_ref_rad -= position_rad;
     return PMSTEP_OK;
 }
 
@@ -222,8 +331,8 @@ pmstep_status_t pmstep_position_set_zero(pmstep_position_t *pos)
 static pmstep_motion_sample_t profile_start(const pmstep_position_t *pos)
 {
     pmstep_motion_sample_t start;
-    if (pos->position_mode) {
-        start = pmstep_motion_peek(&pos->motion);
+    if (pos->out.position_mode) {
+        start = pos->ahead; /* the next update's sample */
     } else {
         const pmstep_ref_out_t ref = pmstep_ref_output(&pos->inst->ref_coeffs, &pos->inst->speed_ref);
         start.position = estimate(pos) + pos->period_s * pos->speed_hat_rad_s;
@@ -234,19 +343,29 @@ static pmstep_motion_sample_t profile_start(const pmstep_position_t *pos)
     return start;
 }
 
-/* Enters position mode (the loop's integral starts at 0 when it was off). From speed mode the
+/* Enters position mode (the loop's integral starts at 0 when it was off, and its updates restart
+ * with the next period: the profile's start is that period's). From speed mode the
  * speed channel is put at its own present output with the set-point held there: the coming
  * period reads the same reference, and no ramp of the speed command is left to be taken for a
  * new speed command. */
-static void enter_position_mode(pmstep_position_t *pos, float start_position_rad)
+static void enter_position_mode(pmstep_position_t *pos)
 {
-    if (!pos->position_mode) {
+    const bool was_position_mode = pos->out.position_mode;
+    if (!was_position_mode) {
         const pmstep_ref_out_t ref = pmstep_ref_output(&pos->inst->ref_coeffs, &pos->inst->speed_ref);
-        put_speed_reference(pos, ref.value, ref.rate, ref.accel);
+        const float step_s = pos->motion.period_s;
+        /* the next period reads (w*, w*', w*''); the update after it puts the loop's own */
+        put_speed_reference(pos, ref.value, ref.rate, ref.accel,
+                            ref.value + step_s * (ref.rate + 0.5f * step_s * ref.accel));
         pos->error_integral_rad_s = 0.0f;
-        pos->position_ref_rad = start_position_rad;
+        pos->loop_countdown = 1; /* the loop's first update after the next period */
     }
-    pos->position_mode = true;
+    pos->out.position_mode = true;
+    pos->out.moving = !pmstep_motion_finished(&pos->motion);
+    pos->ahead = pmstep_motion_next(&pos->motion); /* the new plan's start, for the next update */
+    if (!was_position_mode) {
+        pos->now = pos->ahead; /* pmstep_position_reference() until then */
+    }
 }
 
 pmstep_status_t pmstep_position_move_to(pmstep_position_t *pos, float target_rad, float v_max_rad_s,
@@ -257,7 +376,7 @@ pmstep_status_t pmstep_position_move_to(pmstep_position_t *pos, float target_rad
     if (pos == NULL) {
         return PMSTEP_ERR_NULL_ARGUMENT;
     }
-    if (!pos->tracked) {
+    if (!pos->out.tracked) {
         return PMSTEP_ERR_BAD_MODE;
     }
     electrical = fabsf(target_rad) / pos->inv_pole_pairs;
@@ -269,7 +388,7 @@ pmstep_status_t pmstep_position_move_to(pmstep_position_t *pos, float target_rad
     start = profile_start(pos);
     pmstep_motion_plan(&pos->motion, start.position, start.speed, start.accel, target_rad, v_max_rad_s, a_max_rad_s2,
                        (j_max_rad_s3 > 0.0f) ? j_max_rad_s3 : (a_max_rad_s2 / pos->inv_bandwidth_s));
-    enter_position_mode(pos, start.position);
+    enter_position_mode(pos);
     return PMSTEP_OK;
 }
 
@@ -279,10 +398,10 @@ pmstep_status_t pmstep_position_hold(pmstep_position_t *pos, float a_max_rad_s2)
     if (pos == NULL) {
         return PMSTEP_ERR_NULL_ARGUMENT;
     }
-    if (!pos->tracked) {
+    if (!pos->out.tracked) {
         return PMSTEP_ERR_BAD_MODE;
     }
-    if (!pos->position_mode) {
+    if (!pos->out.position_mode) {
         if (!(a_max_rad_s2 > 0.0f) || (a_max_rad_s2 - a_max_rad_s2) != 0.0f) {
             return PMSTEP_ERR_BAD_COMMAND_VALUE;
         }
@@ -291,6 +410,6 @@ pmstep_status_t pmstep_position_hold(pmstep_position_t *pos, float a_max_rad_s2)
     }
     start = profile_start(pos);
     pmstep_motion_stop(&pos->motion, &start);
-    enter_position_mode(pos, start.position);
+    enter_position_mode(pos);
     return PMSTEP_OK;
 }

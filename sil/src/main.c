@@ -50,9 +50,9 @@ static bool write_row(const sil_sample_t *x, void *user)
             (double)o->load_hat_Nm, x->load_Nm, (int)o->mode, (int)o->fault, (double)port->meas.i_a_A,
             (double)port->meas.i_b_A, port->bus_V, (double)port->meas.bus_voltage_V);
     if (x->position != NULL) {
-        /* A position scenario's row goes on: theta*, theta-hat, theta (from the c-alignment equilibrium). */
-        fprintf(csv->file, ",%.9g,%.9g,%.9g", (double)x->position->position_ref_rad, (double)x->position->position_rad,
-                x->position_rad);
+        /* A position scenario's row goes on: theta*, theta-hat of the period (0 while not tracked), theta
+         * (from the c-alignment equilibrium). */
+        fprintf(csv->file, ",%.9g,%.9g,%.9g", x->position_reference_rad, x->position_estimate_rad, x->position_rad);
     }
     fputc('\n', csv->file);
     return true;

@@ -48,7 +48,7 @@ static void close_move(sil_position_run_t *run, sil_summary_t *s)
 void sil_position_run_command(sil_position_run_t *run, pmstep_position_t *pos, double t_s, sil_summary_t *s)
 {
     const sil_scenario_t *sc = run->sc;
-    while (run->next_move < sc->position_moves && t_s >= sc->move_time_s[run->next_move] && pos->tracked
+    while (run->next_move < sc->position_moves && t_s >= sc->move_time_s[run->next_move] && pos->out.tracked
            && run->origin_set) {
         const int n = run->next_move++;
         const pmstep_status_t status = pmstep_position_move_to(pos, (float)sc->move_target_rad[n],
@@ -69,16 +69,27 @@ void sil_position_run_command(sil_position_run_t *run, pmstep_position_t *pos, d
     }
 }
 
-void sil_position_run_sample(sil_position_run_t *run, sil_sample_t *sample, sil_summary_t *s)
+void sil_position_run_sample(sil_position_run_t *run, const pmstep_position_t *pos, sil_sample_t *sample,
+                             sil_summary_t *s)
 {
     sil_position_summary_t *p = &s->position;
     const pmstep_position_output_t *out = sample->position;
     const double p_pairs = run->pole_pairs;
     double theta;
+    double estimate;
+    double reference;
+    float value;
     if (!out->tracked) {
         sample->position_rad = 0.0;
         return;
     }
+    sample->position_updated = pos->loop_countdown == PMSTEP_POSITION_DECIMATION;
+    (void)pmstep_get_position(pos, &value);
+    estimate = (double)value;
+    (void)pmstep_position_reference(pos, &value);
+    reference = (double)value;
+    sample->position_estimate_rad = estimate;
+    sample->position_reference_rad = reference;
     if (!run->origin_set) {
         /* RUN's first period: the rotor sits at (near) an equilibrium of the c-alignment, theta = 0 mod 2 pi/p. */
         run->origin_rad = floor(sample->theta_rad * p_pairs / (2.0 * PI) + 0.5) * 2.0 * PI / p_pairs;
@@ -87,11 +98,11 @@ void sil_position_run_sample(sil_position_run_t *run, sil_sample_t *sample, sil_
     theta = sample->theta_rad - run->origin_rad;
     sample->position_rad = theta;
     run->last_theta_rad = theta;
-    if (fabs((double)out->position_rad - theta) * p_pairs > p->max_estimate_error_rad) {
-        p->max_estimate_error_rad = fabs((double)out->position_rad - theta) * p_pairs;
+    if (fabs(estimate - theta) * p_pairs > p->max_estimate_error_rad) {
+        p->max_estimate_error_rad = fabs(estimate - theta) * p_pairs;
     }
-    if (out->position_mode && fabs((double)out->position_ref_rad - theta) * p_pairs > p->max_tracking_error_rad) {
-        p->max_tracking_error_rad = fabs((double)out->position_ref_rad - theta) * p_pairs;
+    if (out->position_mode && fabs(reference - theta) * p_pairs > p->max_tracking_error_rad) {
+        p->max_tracking_error_rad = fabs(reference - theta) * p_pairs;
     }
     if (run->in_move) {
         const double direction = run->move_target_rad >= run->move_start_rad ? 1.0 : -1.0;
@@ -104,10 +115,10 @@ void sil_position_run_sample(sil_position_run_t *run, sil_sample_t *sample, sil_
     if (run->sc->hold_start_s > 0.0 && sample->t_s >= run->sc->hold_start_s) {
         close_move(run, s); /* the last move ends where the hold begins (its figures are the hold's) */
         const double t = sample->t_s - run->sc->hold_start_s;
-        const double e = (theta - (double)out->position_ref_rad) * p_pairs;
+        const double e = (theta - reference) * p_pairs;
         p->hold_max_error_rad = fmax(p->hold_max_error_rad, fabs(e));
         p->hold_max_estimate_error_rad = fmax(p->hold_max_estimate_error_rad,
-                                              fabs((double)out->position_rad - theta) * p_pairs);
+                                              fabs(estimate - theta) * p_pairs);
         run->hold_n++;
         run->hold_st += t;
         run->hold_sy += e;

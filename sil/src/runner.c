@@ -248,9 +248,12 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
         sample.inst = microstep ? NULL : &inst;
         sample.position = NULL;
         sample.position_rad = 0.0;
+        sample.position_estimate_rad = 0.0;
+        sample.position_reference_rad = 0.0;
+        sample.position_updated = false;
         if (positional) {
             sample.position = &pos_out;
-            sil_position_run_sample(&position_run, &sample, s);
+            sil_position_run_sample(&position_run, &pos, &sample, s);
         }
         sil_metrics_add(&metrics, &sample, s);
 

@@ -2,8 +2,11 @@
  * A drive on the host for the console's tests: the console (simulation mode) and the real
  * core on stdin/stdout as a byte stream (a pty or a pipe), with constant samples (0.3 A,
  * 0.2 A, 48 V) in place of a motor. Periods run on SIM_ADVANCE; SIM_FINISH ends it.
+ * usage: console-host-drive [--position]   (--position: position control attached, updated after
+ * every step; without it the drive is an image in speed mode)
  */
 #include <fcntl.h>
+#include <string.h>
 #include <poll.h>
 #include <stdint.h>
 #include <time.h>
@@ -36,8 +39,11 @@ static void drain(void)
     }
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
+    static pmstep_position_t position;
+    static pmstep_position_output_t pos_out;
+    const int with_position = argc > 1 && strcmp(argv[1], "--position") == 0;
     static pmstep_t motor;
     static pmstep_config_t cfg;
     static pmstep_console_snapshot_t snap; /* zero: no output yet */
@@ -48,6 +54,13 @@ int main(void)
         return 2;
     }
     pmstep_console_init(&con, "pmstep host-drive", true);
+    if (with_position) {
+        pmstep_position_config_t gains;
+        if (pmstep_position_design(&cfg, &gains) != PMSTEP_OK || pmstep_position_init(&position, &motor, &gains) != PMSTEP_OK) {
+            return 2;
+        }
+        pmstep_console_attach_position(&con, &position);
+    }
     (void)fcntl(0, F_SETFL, fcntl(0, F_GETFL) | O_NONBLOCK);
     while (!pmstep_console_finish_requested(&con)) {
         struct pollfd p = {0, POLLIN, 0};
@@ -64,6 +77,9 @@ int main(void)
         for (n = pmstep_console_advance_request(&con); n > 0u; --n) {
             pmstep_console_boundary(&con, &motor, &cfg, &snap);
             pmstep_step(&motor, &meas, &snap.out);
+            if (with_position) {
+                pmstep_position_update(&position, &snap.out, &pos_out);
+            }
             snap.meas = meas;
             snap.period++;
             pmstep_console_telemetry(&con, &snap);

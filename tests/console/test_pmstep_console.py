@@ -39,6 +39,13 @@ class Framing(unittest.TestCase):
         self.assertEqual(struct.unpack("<ff", got[1][2]), (10.0, 50.0))
         self.assertGreater(d.bad, 0)
 
+    def test_position_requests_encoded(self):
+        frame = pc.encode(pc.MOVE_TO, 9, struct.pack("<ffff", -1.5, 5.0, 50.0, 0.0))
+        ((ftype, seq, data),) = pc.Decoder().feed(frame)
+        self.assertEqual((ftype, seq, len(data)), (0x0D, 9, 16))
+        self.assertEqual(struct.unpack("<ffff", data), (-1.5, 5.0, 50.0, 0.0))
+        self.assertEqual((pc.HOLD, pc.GET_POSITION, pc.SET_POSITION_ZERO), (0x0E, 0x0F, 0x10))
+
     def test_too_long(self):
         with self.assertRaises(ValueError):
             pc.encode(pc.HELLO, 1, bytes(63))
@@ -46,12 +53,13 @@ class Framing(unittest.TestCase):
 
 class AgainstTheFirmwareConsole(unittest.TestCase):
     """The tool on one side of a pty, console-host-drive (the C console and the core) on the other."""
+    DRIVE_ARGS = []
 
     def setUp(self):
         self.master, slave = os.openpty()
         self.slave_name = os.ttyname(slave)
         os.close(slave)
-        self.drive = subprocess.Popen([DRIVE], stdin=self.master, stdout=self.master)
+        self.drive = subprocess.Popen([DRIVE] + self.DRIVE_ARGS, stdin=self.master, stdout=self.master)
         self.link = pc.open_endpoint(self.slave_name, 115200)
         self.con = pc.Console(self.link)
 
@@ -126,6 +134,13 @@ class AgainstTheFirmwareConsole(unittest.TestCase):
             self.assertEqual(pc.main(["plot", path, png]), 0)
             self.assertGreater(os.path.getsize(png), 1000)
 
+    def test_position_requests_without_position_control(self):
+        c = self.con
+        for call in (lambda: c.move_to(1.0), lambda: c.hold(), c.position, c.set_position_zero):
+            with self.assertRaisesRegex(pc.DeviceError, "no position control"):
+                call()
+        self.assertEqual(c.counters()["rx_error_replies"], 4)
+
     def test_interactive(self):
         out = io.StringIO()
         shell = pc.Shell(self.con)
@@ -153,6 +168,50 @@ class AgainstTheFirmwareConsole(unittest.TestCase):
         self.assertIn("IDLE", text)
         self.assertIn("inertia_kgm2 = 0.01", text)
         self.assertIn("start: done from period 0", text)
+        self.link = pc.open_endpoint(self.slave_name, 115200)
+        self.con = pc.Console(self.link)
+
+
+class AgainstAPositionDrive(AgainstTheFirmwareConsole):
+    """console-host-drive --position: position control attached. Its constant samples never reach
+    RUN, so the position requests come back with the core's status (the encoding of a move's
+    read-back in RUN is checked end to end on QEMU, console.qemu_e2e)."""
+    DRIVE_ARGS = ["--position"]
+
+    def test_position_requests_without_position_control(self):
+        pass  # attached here
+
+    def test_position_before_run(self):
+        c = self.con
+        p = c.position()
+        self.assertEqual((p["status"], p["tracked"], p["position_mode"], p["moving"]), (-2, False, False, False))
+        self.assertEqual(p["position_rad"], 0.0)
+        with self.assertRaisesRegex(pc.DeviceError, "status -2"):  # PMSTEP_ERR_BAD_MODE: not in RUN
+            c.move_to(1.0, 2.0, 20.0)
+        with self.assertRaisesRegex(pc.DeviceError, "status -2"):
+            c.hold(10.0)
+        with self.assertRaisesRegex(pc.DeviceError, "status -2"):
+            c.set_position_zero()
+        with self.assertRaisesRegex(pc.DeviceError, "bad value"):
+            c.move_to(math.inf, 2.0, 20.0)
+        self.assertEqual(c.start(), 0)
+        self.assertEqual(c.sim_advance(10), 10)
+        self.assertEqual(c.position()["period"], 9)
+        n = c.counters()
+        self.assertEqual((n["rx_error_replies"], n["commands_applied"]), (1, 6))
+
+    def test_command_line_position(self):
+        out = io.StringIO()
+        err = io.StringIO()
+        self.link.close()
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            self.assertEqual(pc.main(["--port", self.slave_name, "position"]), 0)
+            self.assertEqual(pc.main(["--port", self.slave_name, "move", "-1.5", "--vmax", "2", "--amax", "20"]), 1)
+            self.assertEqual(pc.main(["--port", self.slave_name, "hold"]), 1)
+            self.assertEqual(pc.main(["--port", self.slave_name, "zero"]), 1)
+        self.assertIn("status                     -2", out.getvalue())
+        self.assertIn("tracked                    False", out.getvalue())
+        self.assertEqual(err.getvalue().count("refused request"), 3)
         self.link = pc.open_endpoint(self.slave_name, 115200)
         self.con = pc.Console(self.link)
 

@@ -52,6 +52,7 @@ typedef struct {
     pmstep_t inst;
     pmstep_position_t pos;
     pmstep_position_config_t pos_cfg;
+    unsigned long updates; /* periods of sweep() that updated the output */
 } fixture_t;
 
 static void fixture_init(fixture_t *f)
@@ -61,6 +62,7 @@ static void fixture_init(fixture_t *f)
     f->pos_cfg.gain_per_s = 25.0f;
     f->pos_cfg.integral_gain_per_s2 = 0.0f;
     assert_int_equal(pmstep_position_init(&f->pos, &f->inst, &f->pos_cfg), PMSTEP_OK);
+    f->updates = 0u;
 }
 
 /* A RUN output with the estimate at electrical angle @p angle (radius @p radius). */
@@ -83,6 +85,9 @@ static void not_tracked_before_run(void **state)
     (void)state;
     fixture_init(&f);
     assert_int_equal(pmstep_get_position(&f.pos, &position), PMSTEP_ERR_BAD_MODE);
+    assert_int_equal(pmstep_position_reference(&f.pos, &position), PMSTEP_ERR_BAD_MODE);
+    assert_int_equal(pmstep_position_reference(NULL, &position), PMSTEP_ERR_NULL_ARGUMENT);
+    assert_int_equal(pmstep_position_reference(&f.pos, NULL), PMSTEP_ERR_NULL_ARGUMENT);
     assert_int_equal(pmstep_position_set_zero(&f.pos), PMSTEP_ERR_BAD_MODE);
     assert_int_equal(pmstep_position_move_to(&f.pos, 1.0f, 1.0f, 1.0f, 0.0f), PMSTEP_ERR_BAD_MODE);
     assert_int_equal(pmstep_position_hold(&f.pos, 1.0f), PMSTEP_ERR_BAD_MODE);
@@ -112,9 +117,16 @@ static double sweep(fixture_t *f, const double *path, int points, double steps_p
             const double radius = 1.0 + 0.1 * sin(0.05 * (double)k);
             const pmstep_output_t out = run_output(angle + noise, radius, 0.0);
             pmstep_position_output_t pos_out;
+            float now;
             pmstep_position_update(&f->pos, &out, &pos_out);
             assert_true(pos_out.tracked);
-            worst = fmax(worst, fabs((double)pos_out.position_rad - (angle + noise) / 6.0));
+            assert_int_equal(pmstep_get_position(&f->pos, &now), PMSTEP_OK); /* the present period's */
+            worst = fmax(worst, fabs((double)now - (angle + noise) / 6.0));
+            /* the output's estimate is the last update's: every PMSTEP_POSITION_DECIMATION periods */
+            if (f->pos.loop_countdown == PMSTEP_POSITION_DECIMATION) {
+                assert_float_equal(pos_out.position_rad, now, 0.0f);
+                f->updates++;
+            }
         }
     }
     return worst;
@@ -131,6 +143,7 @@ static void turn_count_follows_many_turns_both_ways(void **state)
     (void)state;
     fixture_init(&f);
     worst_fast = sweep(&f, path, 4, 1.0 / 0.3, 0.0);
+    assert_true(f.updates > 1000u); /* the output's contract was checked */
     assert_int_equal(pmstep_get_position(&f.pos, &position), PMSTEP_OK);
     assert_float_equal(position, 3.3f / 6.0f, 1e-4f);
     fixture_init(&f);
@@ -165,7 +178,8 @@ static void position_zero_moves_the_origin(void **state)
             const pmstep_output_t out = run_output(on[0] + (on[1] - on[0]) * n / 100.0, 1.0, 0.0);
             pmstep_position_update(&f.pos, &out, &pos_out);
         }
-        assert_float_equal(pos_out.position_rad, (float)(-2.5 * two_pi / 6.0), 1e-4f);
+        assert_int_equal(pmstep_get_position(&f.pos, &position), PMSTEP_OK);
+        assert_float_equal(position, (float)(-2.5 * two_pi / 6.0), 1e-4f);
     }
 }
 
@@ -263,6 +277,7 @@ typedef struct {
     double theta_rad;
     double max_overshoot;
     double max_error;
+    double max_reference_gap; /* |theta* of the period (pmstep_position_reference) - theta| */
 } kinematic_t;
 
 static void kinematic_run(fixture_t *f, kinematic_t *k, long periods, double target, double start, double speed_bias)
@@ -281,13 +296,18 @@ static void kinematic_run(fixture_t *f, kinematic_t *k, long periods, double tar
         pmstep_position_update(&f->pos, &out, &pos_out);
         k->max_overshoot = fmax(k->max_overshoot, direction * (k->theta_rad - target));
         k->max_error = fmax(k->max_error, fabs((double)pos_out.position_error_rad));
+        {
+            float reference;
+            assert_int_equal(pmstep_position_reference(&f->pos, &reference), PMSTEP_OK);
+            k->max_reference_gap = fmax(k->max_reference_gap, fabs((double)reference - k->theta_rad));
+        }
     }
 }
 
 static void loop_drives_the_reference_to_the_target_and_holds(void **state)
 {
     fixture_t f;
-    kinematic_t k = {0.0, 0.0, 0.0};
+    kinematic_t k = {0.0, 0.0, 0.0, 0.0};
     pmstep_position_output_t pos_out;
     const pmstep_output_t out = run_output(0.0, 1.0, 0.0);
     float position;
@@ -297,18 +317,22 @@ static void loop_drives_the_reference_to_the_target_and_holds(void **state)
     assert_int_equal(pmstep_position_move_to(&f.pos, 3.0f, 2.0f, 20.0f, 0.0f), PMSTEP_OK);
     kinematic_run(&f, &k, 60000, 3.0, 0.0, 0.0); /* the move takes 1.6 s; 3 s */
     assert_int_equal(pmstep_get_position(&f.pos, &position), PMSTEP_OK);
-    print_message("kinematic move of 3 rad: final error %.3g rad, overshoot %.3g rad, max |theta* - theta-hat| %.3g\n",
-                  3.0 - k.theta_rad, k.max_overshoot, k.max_error);
+    print_message("kinematic move of 3 rad: final error %.3g rad, overshoot %.3g rad, max |theta* - theta-hat| %.3g, "
+                  "|theta* - theta| every period %.3g\n", 3.0 - k.theta_rad, k.max_overshoot, k.max_error,
+                  k.max_reference_gap);
     assert_true(fabs(k.theta_rad - 3.0) < 1e-4);
     assert_true(k.max_overshoot < 1e-4);
     assert_true(k.max_error < 1e-3);
+    assert_true(k.max_reference_gap < 1e-3);
     assert_float_equal(position, 3.0f, 1e-4f);
+    assert_int_equal(pmstep_position_reference(&f.pos, &position), PMSTEP_OK);
+    assert_float_equal(position, 3.0f, 0.0f); /* the profile ended: exactly its target */
 }
 
 static void loop_absorbs_a_speed_estimate_bias_with_the_integral(void **state)
 {
     fixture_t f;
-    kinematic_t k = {0.0, 0.0, 0.0};
+    kinematic_t k = {0.0, 0.0, 0.0, 0.0};
     pmstep_position_output_t pos_out;
     const pmstep_output_t out = run_output(0.0, 1.0, 0.0);
     (void)state;
@@ -326,7 +350,7 @@ static void loop_absorbs_a_speed_estimate_bias_with_the_integral(void **state)
 static void speed_command_leaves_position_mode_and_hold_stops(void **state)
 {
     fixture_t f;
-    kinematic_t k = {0.0, 0.0, 0.0};
+    kinematic_t k = {0.0, 0.0, 0.0, 0.0};
     pmstep_position_output_t pos_out;
     const pmstep_output_t out = run_output(0.0, 1.0, 0.0);
     pmstep_ref_out_t ref;
@@ -338,13 +362,13 @@ static void speed_command_leaves_position_mode_and_hold_stops(void **state)
     kinematic_run(&f, &k, 20000, 30.0, 0.0, 0.0); /* 1 s: cruising at 2 rad/s */
     assert_int_equal(pmstep_set_speed_target(&f.inst, -1.0f, 10.0f), PMSTEP_OK);
     kinematic_run(&f, &k, 1, 30.0, 0.0, 0.0);
-    assert_false(f.pos.position_mode);
+    assert_false(f.pos.out.position_mode);
     kinematic_run(&f, &k, 20000, 30.0, 0.0, 0.0);
     ref = pmstep_ref_output(&f.inst.ref_coeffs, &f.inst.speed_ref);
     assert_float_equal(ref.value, -1.0f, 1e-4f); /* the speed command, ramped from where the move was */
     /* hold from speed mode: stops at 10 rad/s^2 and stays where the stop ends */
     assert_int_equal(pmstep_position_hold(&f.pos, 10.0f), PMSTEP_OK);
-    assert_true(f.pos.position_mode);
+    assert_true(f.pos.out.position_mode);
     kinematic_run(&f, &k, 40000, f.pos.motion.target, 0.0, 0.0);
     assert_int_equal(pmstep_get_position(&f.pos, &position), PMSTEP_OK);
     assert_float_equal(position, f.pos.motion.target, 1e-4f);
@@ -360,7 +384,7 @@ static void speed_command_leaves_position_mode_and_hold_stops(void **state)
 static void leaving_run_in_position_mode_leaves_no_speed_command(void **state)
 {
     fixture_t f;
-    kinematic_t k = {0.0, 0.0, 0.0};
+    kinematic_t k = {0.0, 0.0, 0.0, 0.0};
     pmstep_position_output_t pos_out;
     pmstep_output_t out = run_output(0.0, 1.0, 0.0);
     (void)state;
@@ -371,7 +395,7 @@ static void leaving_run_in_position_mode_leaves_no_speed_command(void **state)
     assert_true(f.inst.speed_ref.target > 1.9f);
     out.mode = PMSTEP_MODE_S_ALIGN; /* a re-alignment mid-move */
     pmstep_position_update(&f.pos, &out, &pos_out);
-    assert_false(f.pos.position_mode);
+    assert_false(f.pos.out.position_mode);
     assert_float_equal(f.inst.speed_ref.target, 0.0f, 0.0f); /* the next RUN starts at rest */
     assert_float_equal(f.inst.speed_ref.value, 0.0f, 0.0f);
 }

@@ -28,6 +28,17 @@
  *                              voltage biases a/b)
  *   0x0B TELEMETRY          decimation u32 (0: off)  -> ACK; then TELEMETRY frames
  *   0x0C GET_COUNTERS       -                        -> the counters, u32 each
+ *   0x0D MOVE_TO            target f32, v_max f32, a_max f32 [, j_max f32]
+ *                                                    -> ACK (pmstep_position_move_to; mechanical
+ *                              rad, rad/s, rad/s^2, rad/s^3; j_max absent or 0: a_max varpi_0)
+ *   0x0E HOLD               [a_max f32]              -> ACK (pmstep_position_hold; a_max only from
+ *                              speed mode, absent = 0: refused there, -7 BAD_COMMAND_VALUE)
+ *   0x0F GET_POSITION       -                        -> status i16, period u32, position f32,
+ *                              position_ref f32, position_error f32 (rad, mechanical, of that
+ *                              period: pmstep_get_position, pmstep_position_reference), flags u8
+ *                              (1 tracked, 2 position mode, 4 moving); status -2 BAD_MODE and
+ *                              zeros while not tracked
+ *   0x10 SET_POSITION_ZERO  -                        -> ACK (pmstep_position_set_zero)
  *   0x40 SIM_ADVANCE        periods u32              -> (simulation images only) reply when run:
  *                                                       status i16 (0), period u32
  *   0x41 SIM_FINISH         -                        -> (simulation images only) ACK, then the
@@ -35,7 +46,9 @@
  *
  * ACK status: 0 done, a negative pmstep_status_t when the core refused (e.g. -2
  * PMSTEP_ERR_BAD_MODE), and the period from which the command takes effect (the first
- * step that sees it). STATUS and TELEMETRY carry the index of the period whose step they
+ * step that sees it). The position requests 0x0D..0x10 need position control attached
+ * (pmstep_console_attach_position); without it (an image in speed mode) they get the error
+ * reply PMSTEP_CONSOLE_ERR_NO_POSITION (9). STATUS and TELEMETRY carry the index of the period whose step they
  * report; telemetry comes for the periods that are multiples of the decimation.
  *
  * Timing: pmstep_console_receive() runs in the main loop, never in the control interrupt.
@@ -55,6 +68,7 @@
 #include <stdint.h>
 
 #include "pmstep/pmstep.h"
+#include "pmstep/pmstep_position.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -80,6 +94,10 @@ typedef enum {
     PMSTEP_CONSOLE_GET_COMMISSIONING = 0x0A,
     PMSTEP_CONSOLE_TELEMETRY = 0x0B,
     PMSTEP_CONSOLE_GET_COUNTERS = 0x0C,
+    PMSTEP_CONSOLE_MOVE_TO = 0x0D,
+    PMSTEP_CONSOLE_HOLD = 0x0E,
+    PMSTEP_CONSOLE_GET_POSITION = 0x0F,
+    PMSTEP_CONSOLE_SET_POSITION_ZERO = 0x10,
     PMSTEP_CONSOLE_SIM_ADVANCE = 0x40,
     PMSTEP_CONSOLE_SIM_FINISH = 0x41,
     PMSTEP_CONSOLE_TELEMETRY_FRAME = 0x90,
@@ -95,8 +113,28 @@ typedef enum {
     PMSTEP_CONSOLE_ERR_READ_ONLY = 5,      /**< the value is fixed by the port (period, delay) */
     PMSTEP_CONSOLE_ERR_NOT_STOPPED = 6,    /**< a configuration change while the motor runs */
     PMSTEP_CONSOLE_ERR_BUSY = 7,           /**< the previous command has not reached the core yet */
-    PMSTEP_CONSOLE_ERR_NOT_SUPPORTED = 8   /**< e.g. SIM_ADVANCE on hardware */
+    PMSTEP_CONSOLE_ERR_NOT_SUPPORTED = 8,  /**< e.g. SIM_ADVANCE on hardware */
+    PMSTEP_CONSOLE_ERR_NO_POSITION = 9     /**< a position request, no position control attached */
 } pmstep_console_error_t;
+
+/** GET_POSITION flags. */
+#define PMSTEP_CONSOLE_POSITION_TRACKED 1u
+#define PMSTEP_CONSOLE_POSITION_MODE 2u
+#define PMSTEP_CONSOLE_POSITION_MOVING 4u
+
+/** What GET_POSITION reads (mechanical rad). */
+typedef struct {
+    float position_rad;
+    float position_ref_rad;
+    float position_error_rad;
+    uint8_t flags;
+} pmstep_console_position_reading_t;
+
+/** Applies a position request to @p pos (pmstep_console_position.c, linked only by an image that
+ *  attaches position control): @p args as parsed; @p reading filled for GET_POSITION.
+ *  @return the pmstep_status_t of the core's call. */
+typedef int32_t (*pmstep_console_position_apply_t)(pmstep_position_t *pos, uint8_t cmd, const float *args,
+                                                    pmstep_console_position_reading_t *reading);
 
 /** What the console counted, since init. */
 typedef struct {
@@ -172,6 +210,10 @@ typedef struct {
     float a;
     float b;
     uint32_t u;
+    float arg[4];         /**< a position request's values */
+    /* position control (NULL: none, the position requests are refused) */
+    pmstep_position_t *position;
+    pmstep_console_position_apply_t position_apply;
     /* simulation images: periods to run (SIM_ADVANCE) */
     bool simulation;
     uint32_t advance_periods;
@@ -191,6 +233,13 @@ typedef struct {
 
 /** A console in its initial state; @p identity is the hello text (must outlive it). */
 void pmstep_console_init(pmstep_console_t *c, const char *identity, bool simulation);
+
+/**
+ * Attaches position control (@p pos, initialised with pmstep_position_init() on the instance the
+ * console drives): MOVE_TO, HOLD, GET_POSITION and SET_POSITION_ZERO then reach it at the
+ * period boundary. The application runs pmstep_position_update() after every step.
+ */
+void pmstep_console_attach_position(pmstep_console_t *c, pmstep_position_t *pos);
 
 /** Feeds received bytes (main loop). @p now_ms: a millisecond clock, for the truncation timeout. */
 void pmstep_console_receive(pmstep_console_t *c, const uint8_t *data, uint32_t n, uint32_t now_ms);

@@ -182,6 +182,36 @@ static int32_t config_by_name(const uint8_t *name, uint32_t n)
     return -1;
 }
 
+/* A position request's DATA into c->arg (absent values 0): false after an error reply. */
+static bool parse_position(pmstep_console_t *c, uint8_t type, uint8_t seq, const uint8_t *d, uint32_t n)
+{
+    uint32_t i;
+    bool length_ok;
+    if (c->position == NULL || c->position_apply == NULL) {
+        send_error(c, type, seq, PMSTEP_CONSOLE_ERR_NO_POSITION);
+        return false;
+    }
+    if (type == PMSTEP_CONSOLE_MOVE_TO) {
+        length_ok = n == 12u || n == 16u;
+    } else if (type == PMSTEP_CONSOLE_HOLD) {
+        length_ok = n == 0u || n == 4u;
+    } else {
+        length_ok = n == 0u;
+    }
+    if (!length_ok) {
+        send_error(c, type, seq, PMSTEP_CONSOLE_ERR_BAD_LENGTH);
+        return false;
+    }
+    for (i = 0; i < 4u; ++i) {
+        c->arg[i] = 4u * i < n ? get_f32(d + 4u * i) : 0.0f;
+        if (!is_finite(c->arg[i])) {
+            send_error(c, type, seq, PMSTEP_CONSOLE_ERR_BAD_VALUE);
+            return false;
+        }
+    }
+    return true;
+}
+
 /* A request with a good CRC: answered now (HELLO, GET_COUNTERS, errors), or put in the
  * mailbox for the next period boundary. */
 static void handle_frame(pmstep_console_t *c)
@@ -322,6 +352,14 @@ static void handle_frame(pmstep_console_t *c)
         }
         break;
     }
+    case PMSTEP_CONSOLE_MOVE_TO:
+    case PMSTEP_CONSOLE_HOLD:
+    case PMSTEP_CONSOLE_GET_POSITION:
+    case PMSTEP_CONSOLE_SET_POSITION_ZERO:
+        if (!parse_position(c, type, seq, d, n)) {
+            return;
+        }
+        break;
     default:
         send_error(c, type, seq, PMSTEP_CONSOLE_ERR_UNKNOWN_COMMAND);
         return;
@@ -437,6 +475,20 @@ static void send_config(pmstep_console_t *c, uint8_t seq, const pmstep_config_t 
     send(c, PMSTEP_CONSOLE_GET_CONFIG | 0x80u, seq, w.b, w.n);
 }
 
+static void send_position(pmstep_console_t *c, uint8_t seq, int32_t status, const pmstep_console_snapshot_t *s,
+                          const pmstep_console_position_reading_t *r)
+{
+    writer_t w;
+    w.n = 0;
+    put_u16(&w, (uint32_t)(uint16_t)(int16_t)status);
+    put_u32(&w, s->period);
+    put_f32(&w, r->position_rad);
+    put_f32(&w, r->position_ref_rad);
+    put_f32(&w, r->position_error_rad);
+    put_u8(&w, r->flags);
+    send(c, PMSTEP_CONSOLE_GET_POSITION | 0x80u, seq, w.b, w.n);
+}
+
 void pmstep_console_boundary(pmstep_console_t *c, pmstep_t *inst, pmstep_config_t *cfg,
                              const pmstep_console_snapshot_t *snap)
 {
@@ -468,6 +520,17 @@ void pmstep_console_boundary(pmstep_console_t *c, pmstep_t *inst, pmstep_config_
         c->decimation = c->u;
         c->next_telemetry = c->u == 0u ? 0u : (snap->period + 1u) - (snap->period + 1u) % c->u + c->u;
         break;
+    case PMSTEP_CONSOLE_MOVE_TO:
+    case PMSTEP_CONSOLE_HOLD:
+    case PMSTEP_CONSOLE_SET_POSITION_ZERO:
+        st = c->position_apply(c->position, c->cmd, c->arg, NULL); /* attached: checked at parsing */
+        break;
+    case PMSTEP_CONSOLE_GET_POSITION: {
+        pmstep_console_position_reading_t r;
+        st = c->position_apply(c->position, c->cmd, c->arg, &r);
+        send_position(c, seq, st, snap, &r);
+        return;
+    }
     case PMSTEP_CONSOLE_GET_STATUS:
         send_status(c, seq, snap);
         return;

@@ -23,6 +23,19 @@
  * k_I <= k_theta^2/4; the designer's rule k_theta = k_w/4, DESIGN.md). At standstill the
  * law's T-hat_L carries the load; k_I takes out what is left of a speed-estimate bias.
  *
+ * Rates: the turn count runs every period (it must see every crossing); the fine angle, the
+ * profile and the loop run every PMSTEP_POSITION_DECIMATION = N periods (a cascade's outer loop
+ * at a lower rate, as the turn count alone is cheap). An update after period k puts the speed
+ * reference of periods k+1 .. k+N: (w*, w*', w*'') above as the state of the speed reference
+ * filter, whose held set-point is solved for so that the filter, run on by pmstep_step() every
+ * period, ends the N periods at the w* of the next update (the profile is sampled one update
+ * ahead, the feedback moved on by its derivatives): the law keeps a smooth reference whose
+ * derivatives are its own, with no step at the updates (DESIGN.md section 11). Cost: the
+ * sample-and-hold of the error adds about (N/2) T_s of delay to the one period the loop already
+ * acts after the speed law; at the loop's bandwidth k_theta the phase lag is
+ * k_theta (N/2 + 1) T_s (paper's motor: 25 rad/s x 5 x 50 us = 6e-3 rad, 0.36 deg), and the
+ * integral z sums N T_s e per update.
+ *
  * Use: pmstep_init() the core, then pmstep_position_init() with the same instance, and call
  * pmstep_position_step() in place of pmstep_step() every period. pmstep_set_speed_target()
  * (any time) returns the drive to speed mode; pmstep_position_move_to() and
@@ -44,17 +57,24 @@ extern "C" {
  *  the float32 angle still resolves 4e-3 rad (2^-8), 1/25 of a 0.1 rad position bound. */
 #define PMSTEP_POSITION_MAX_ELECTRICAL_RAD 32768.0f
 
+/** N: the fine angle, the profile and the position loop run every N-th period (header text).
+ *  8 keeps a period with the loop on within 600 instructions on the mean (README, cost). */
+#define PMSTEP_POSITION_DECIMATION 8
+
 /** Gains of the position loop. */
 typedef struct {
     float gain_per_s;           /**< k_theta > 0, at most k_w/2 (designer: k_w/4) */
     float integral_gain_per_s2; /**< k_I >= 0, at most k_theta^2/4 (a double pole); 0 = none */
 } pmstep_position_config_t;
 
-/** What one pmstep_position_step() estimated and commanded (mechanical rad, rad/s). */
+/** What pmstep_position_step() estimated and commanded (mechanical rad). The three positions are
+ *  those of the last update (every PMSTEP_POSITION_DECIMATION periods; at RUN's first period and
+ *  the period after a move from speed mode); pmstep_get_position() and
+ *  pmstep_position_reference() give the present period's on demand. */
 typedef struct {
-    float position_rad;       /**< theta-hat (0 while not tracked) */
-    float position_ref_rad;   /**< theta* in position mode; theta-hat in speed mode */
-    float position_error_rad; /**< theta* - theta-hat in position mode; 0 in speed mode */
+    float position_rad;       /**< theta-hat of the update's period k (0 while not tracked) */
+    float position_ref_rad;   /**< position mode: theta* of period k+1 the loop tracked; else theta-hat */
+    float position_error_rad; /**< position mode: the loop's e = theta*(k+1) - (theta-hat + T_s w-hat); else 0 */
     bool tracked;             /**< RUN: the estimate is valid */
     bool position_mode;       /**< the position loop drives the speed reference */
     bool moving;              /**< the profile is still running (false: holding theta*) */
@@ -73,11 +93,17 @@ typedef struct {
     float zero_rad;           /**< electrical angle subtracted (set zero) */
     int32_t turns;            /**< electrical turns counted since RUN began */
     int32_t sin_negative;     /**< 1 if s-hat < 0 in the last period, else 0 */
-    bool tracked;             /**< in RUN since the last turn count reset */
-    bool position_mode;
-    float position_ref_rad;   /**< theta* of the period being run */
+    int32_t loop_countdown;   /**< periods to the next update (1: after the next period) */
     float error_integral_rad_s; /**< z, integral of theta* - theta-hat (rad s) */
-    pmstep_motion_t motion;   /**< theta* and its derivatives (position mode) */
+    pmstep_position_output_t out; /**< the state's flags (tracked: in RUN since the turn count's reset;
+                                       moving: the profile had not ended at the last update or command)
+                                       and the last update's positions; each period's output is a copy */
+    pmstep_motion_t motion;   /**< theta* and its derivatives (position mode), sampled every N T_s */
+    pmstep_motion_sample_t now;   /**< the profile's sample for the period after the last update */
+    pmstep_motion_sample_t ahead; /**< the sample for the period after the next update (one ahead) */
+    float hold_inv_gain;      /**< the reference filter over N periods (put_speed_reference) */
+    float hold_c23;
+    float hold_c12;
 } pmstep_position_t;
 
 /**
@@ -105,8 +131,9 @@ float pmstep_atan2_poly(float y, float x);
 pmstep_status_t pmstep_position_init(pmstep_position_t *pos, pmstep_t *inst, const pmstep_position_config_t *cfg);
 
 /**
- * One control period: pmstep_step() on the attached instance, then the position estimate and,
- * in position mode, the speed reference of the next period. Never fails; leaving RUN (stop,
+ * One control period: pmstep_step() on the attached instance, then the turn count and, every
+ * PMSTEP_POSITION_DECIMATION periods, the position estimate and, in position mode, the loop's
+ * speed reference for the next N periods. Never fails; leaving RUN (stop,
  * fault, re-alignment) loses the position (not tracked, speed mode).
  */
 void pmstep_position_step(pmstep_position_t *pos, const pmstep_meas_t *meas, pmstep_output_t *out,
@@ -123,6 +150,13 @@ void pmstep_position_update(pmstep_position_t *pos, const pmstep_output_t *out, 
  * @retval PMSTEP_ERR_BAD_MODE       not tracked (not in RUN): no estimate
  */
 pmstep_status_t pmstep_get_position(const pmstep_position_t *pos, float *position_rad);
+
+/**
+ * theta* of the period just run (position mode; theta-hat in speed mode), from the profile: for
+ * logs and a console, not needed by the loop.
+ * @retval PMSTEP_OK, PMSTEP_ERR_NULL_ARGUMENT, PMSTEP_ERR_BAD_MODE (not tracked)
+ */
+pmstep_status_t pmstep_position_reference(const pmstep_position_t *pos, float *position_ref_rad);
 
 /**
  * The present position becomes 0 (theta-hat and, in position mode, theta* and the target move with it).

@@ -16,6 +16,8 @@ static pmstep_t motor;
 static pmstep_config_t motor_config;       /* must outlive the instance */
 static pmstep_stm32g4_config_t board;      /* must outlive the port */
 static pmstep_console_t console;
+static pmstep_position_t position;         /* sensorless position control on the same instance */
+static pmstep_position_output_t position_out;
 static uint32_t uart_errors;
 static uint8_t tx[64];
 static uint32_t tx_len;
@@ -46,6 +48,13 @@ static void clock_update(void)
     clk.rem_period %= clk.cycles_per_period;
 }
 
+/* In the control interrupt, after each step: the turn count and, every N-th period, the position
+ * loop (pmstep_position.h). */
+static void after_step(const pmstep_output_t *out)
+{
+    pmstep_position_update(&position, out, &position_out);
+}
+
 static void snapshot(pmstep_console_snapshot_t *snap)
 {
     snap->period = clk.periods - 1u; /* the period that just ended (counted from the timer's start) */
@@ -68,6 +77,14 @@ int32_t pmstep_app_init(void)
     if (st != PMSTEP_OK) {
         return -100 + (int32_t)st;
     }
+    {
+        pmstep_position_config_t gains;
+        (void)pmstep_position_design(&motor_config, &gains);
+        st = pmstep_position_init(&position, &motor, &gains);
+        if (st != PMSTEP_OK) {
+            return -200 + (int32_t)st;
+        }
+    }
     port_st = pmstep_stm32g4_init(&board, &motor);
     if (port_st != PMSTEP_STM32G4_OK) {
         return (int32_t)port_st;
@@ -78,6 +95,8 @@ int32_t pmstep_app_init(void)
         return (int32_t)port_st;
     }
     pmstep_console_init(&console, "pmstep " PMSTEP_VERSION_TEXT " stm32g431", false);
+    pmstep_console_attach_position(&console, &position);
+    pmstep_stm32g4_set_after_step(after_step);
     uart_errors = 0u;
     tx_len = 0u;
     tx_pos = 0u;

@@ -14,8 +14,10 @@ extern "C" {
 
 /**
  * Clock to 170 MHz, the core (paper configuration, the port's period, one period of delay), the
- * port (bridge off, motor IDLE), the console on LPUART1, then TIM1 started.
- * @return 0, or the failing step's status: a pmstep_stm32g4_status_t, or -100 + a pmstep_status_t.
+ * port (bridge off, motor IDLE), position control (pmstep_position, updated in the control
+ * interrupt after each step, its commands on the console), the console on LPUART1, then TIM1 started.
+ * @return 0, or the failing step's status: a pmstep_stm32g4_status_t, -100 + a pmstep_status_t (pmstep_init),
+ *         or -200 + a pmstep_status_t (pmstep_position_init).
  */
 int32_t pmstep_app_init(void);
 

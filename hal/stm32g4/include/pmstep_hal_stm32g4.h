@@ -226,6 +226,13 @@ pmstep_stm32g4_status_t pmstep_stm32g4_init(const pmstep_stm32g4_config_t *cfg, 
 /** Control period (s) that TIM1 runs at: 2 ARR / f_TIM1. 0 if the configuration is invalid. */
 float pmstep_stm32g4_period_s(const pmstep_stm32g4_config_t *cfg);
 
+/** Work run in the control interrupt after each step, with its output (e.g. position control's
+ *  pmstep_position_update()). */
+typedef void (*pmstep_stm32g4_after_step_t)(const pmstep_output_t *out);
+
+/** Sets the work run after each step (NULL: none); call before pmstep_stm32g4_start(). */
+void pmstep_stm32g4_set_after_step(pmstep_stm32g4_after_step_t hook);
+
 /** Starts the TIM1 counter: from here on the ADC interrupt runs every period. */
 void pmstep_stm32g4_start(void);
 

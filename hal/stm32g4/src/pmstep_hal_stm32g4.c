@@ -20,6 +20,7 @@ static struct {
     volatile pmstep_stm32g4_fault_t fault;
     volatile bool bridge_on;
     volatile uint32_t isr_cycles_max;
+    pmstep_stm32g4_after_step_t after_step;
 } port;
 
 static bool fault_input_asserted(void)
@@ -120,6 +121,9 @@ void ADC1_2_IRQHandler(void)
     }
     pmstep_hal_control_period(port.inst, &port.out);
     stop_core_on_port_fault();
+    if (port.after_step != NULL) {
+        port.after_step(&port.out);
+    }
     cycles = STM32G4_DWT->CYCCNT - start;
     if (cycles > port.isr_cycles_max) {
         port.isr_cycles_max = cycles;
@@ -231,6 +235,11 @@ pmstep_stm32g4_status_t pmstep_stm32g4_init(const pmstep_stm32g4_config_t *cfg, 
     nvic_enable(STM32G4_IRQ_TIM1_BRK_TIM15, 0x00u);
     nvic_enable(STM32G4_IRQ_ADC1_2, 0x10u);
     return PMSTEP_STM32G4_OK;
+}
+
+void pmstep_stm32g4_set_after_step(pmstep_stm32g4_after_step_t hook)
+{
+    port.after_step = hook;
 }
 
 void pmstep_stm32g4_start(void)

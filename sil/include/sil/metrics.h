@@ -32,6 +32,9 @@ typedef struct {
     const pmstep_position_output_t *position; /**< a position scenario's position output; NULL otherwise */
     double position_rad;             /**< position scenario: true theta from the c-alignment's equilibrium (the
                                           estimate's origin) once RUN began; 0 before */
+    double position_estimate_rad;    /**< position scenario, tracked: theta-hat of this period (pmstep_get_position) */
+    double position_reference_rad;   /**< theta* of this period (pmstep_position_reference) */
+    bool position_updated;           /**< this period ran the position update (the output's values are its own) */
 } sil_sample_t;
 
 /** Position scenario (issue 13): the moves and the hold, judged on the true position (electrical rad: p times

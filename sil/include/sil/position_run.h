@@ -44,8 +44,10 @@ void sil_position_run_init(sil_position_run_t *run, const sil_scenario_t *sc);
 /** Issues the moves due at @p t_s (once the position is tracked). */
 void sil_position_run_command(sil_position_run_t *run, pmstep_position_t *pos, double t_s, sil_summary_t *s);
 
-/** One period: the true position from the origin (into the sample) and the metrics. */
-void sil_position_run_sample(sil_position_run_t *run, sil_sample_t *sample, sil_summary_t *s);
+/** One period: the true position from the origin, the estimate and theta* of the period (queried from
+ *  @p pos: the output holds the last update's) into the sample, and the metrics. */
+void sil_position_run_sample(sil_position_run_t *run, const pmstep_position_t *pos, sil_sample_t *sample,
+                             sil_summary_t *s);
 
 /** Closes the last move and the hold window. */
 void sil_position_run_finish(sil_position_run_t *run, sil_summary_t *s);

@@ -11,6 +11,9 @@
  *
  * usage (semihosting command line):
  *   pil-console [--duration S] [--substeps N] [--summary FILE] [--cost FILE]
+ * Position control (pmstep_position) is attached to the console: pmstep_position_update() runs
+ * after every step (in the main loop, after the control interrupt), and MOVE_TO, HOLD,
+ * GET_POSITION, SET_POSITION_ZERO reach it; in speed mode it changes nothing of the run.
  * --summary: the closed-loop metrics (the keys of pil-closed-loop's summary);
  * --cost: the control step's cost per mode from SysTick (with -icount shift=0), and the
  * console's counters.
@@ -39,6 +42,7 @@
 static pmstep_t motor;
 static pmstep_config_t config; /* outlives the instance, as pmstep_init() requires */
 static pmstep_console_t console;
+static pmstep_position_t position;
 static const char *const mode_names[MPS2_PIL_MODES] = {"IDLE", "S_ALIGN", "C_ALIGN", "RUN", "FAULT"};
 
 /* ---- the console's side of the main loop ---- */
@@ -114,6 +118,10 @@ static void run_period(loop_t *L, long k, pmstep_console_snapshot_t *snap)
     meas.bus_voltage_V = (float)sil_inverter_bus_voltage(&L->inv, t_s);
     meas.load_torque_Nm = (float)sample.load_Nm;
     mps2_pil_control_period(&meas, &out);
+    {
+        pmstep_position_output_t pos_out;
+        pmstep_position_update(&position, &out, &pos_out);
+    }
     sil_inverter_apply(&L->inv, &out, (double)meas.bus_voltage_V);
     sil_drive_advance(&L->plant, &L->inv, L->period_s, L->sc.substeps);
     sample.cos_ptheta = cos(L->p * sample.theta_rad);
@@ -209,6 +217,15 @@ int main(int argc, char **argv)
         fprintf(stderr, "pil-console: pmstep_init: %s\n", pmstep_status_str(st));
         return 2;
     }
+    {
+        pmstep_position_config_t gains;
+        (void)pmstep_position_design(&config, &gains);
+        st = pmstep_position_init(&position, &motor, &gains);
+        if (st != PMSTEP_OK) {
+            fprintf(stderr, "pil-console: pmstep_position_init: %s\n", pmstep_status_str(st));
+            return 2;
+        }
+    }
     L.period_s = (double)pmstep_console_config_period_s(&config);
     steps = sil_periods_in(L.sc.duration_s, L.period_s);
     sil_metrics_init(&L.metrics, &L.sc, &L.s);
@@ -228,6 +245,7 @@ int main(int argc, char **argv)
     insns_per_tick = mps2_pil_instructions_per_tick(100000u);
     cmsdk_uart_init(16u);
     pmstep_console_init(&console, "pmstep " PMSTEP_VERSION_TEXT " qemu-mps2-an386", true);
+    pmstep_console_attach_position(&console, &position);
     snap.period = UINT32_MAX; /* no step yet */
     systick_last = SYST_CVR;
 

@@ -91,7 +91,7 @@ int main(int argc, char **argv)
         pmstep_meas_t meas;
         plant.time_s = t_s;
         if (next_move < sizeof move_time_s / sizeof move_time_s[0] && t_s >= move_time_s[next_move]
-            && position.tracked) {
+            && position.out.tracked) {
             (void)pmstep_position_move_to(&position, move_target_rad[next_move], 5.0f, 50.0f, 0.0f);
             next_move++;
         }
