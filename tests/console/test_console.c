@@ -14,6 +14,7 @@
 #include <cmocka.h>
 
 #include "pmstep_console.h"
+#include "console_test_frame.h"
 
 static pmstep_console_t con;
 static pmstep_config_t cfg;
@@ -33,26 +34,11 @@ static int setup(void **state)
 
 /* ---- host side of the protocol ---- */
 
-static uint32_t frame(uint8_t *out, uint8_t type, uint8_t seq, const void *data, uint32_t n)
-{
-    uint16_t crc;
-    out[0] = PMSTEP_CONSOLE_SYNC;
-    out[1] = (uint8_t)(n + 2u);
-    out[2] = type;
-    out[3] = seq;
-    if (n > 0u) {
-        memcpy(out + 4, data, n);
-    }
-    crc = pmstep_console_crc16(0xFFFFu, out + 1, n + 3u);
-    out[4 + n] = (uint8_t)(crc & 0xFFu);
-    out[5 + n] = (uint8_t)(crc >> 8);
-    return n + 6u;
-}
 
 static void send_request(uint8_t type, uint8_t seq, const void *data, uint32_t n)
 {
     uint8_t buf[80];
-    const uint32_t len = frame(buf, type, seq, data, n);
+    const uint32_t len = console_test_frame(buf, type, seq, data, n);
     pmstep_console_receive(&con, buf, len, 0u);
 }
 
@@ -382,16 +368,16 @@ static void test_fuzz_never_reaches_core(void **state)
                 }
             }
         } else if (kind == 1u) { /* a good START with its CRC broken */
-            n = frame(buf, PMSTEP_CONSOLE_START, 1u, NULL, 0u);
+            n = console_test_frame(buf, PMSTEP_CONSOLE_START, 1u, NULL, 0u);
             buf[n - 1u - (uint32_t)rand() % 2u] ^= (uint8_t)(1u + (unsigned)rand() % 255u);
         } else if (kind == 2u) { /* length out of range */
             buf[0] = PMSTEP_CONSOLE_SYNC;
             buf[1] = (rand() % 2) != 0 ? (uint8_t)(PMSTEP_CONSOLE_MAX_PAYLOAD + 1u + (unsigned)rand() % 100u) : 1u;
             n = 2u;
         } else if (kind == 3u) { /* a frame cut short, then silence */
-            n = frame(buf, PMSTEP_CONSOLE_STOP, 1u, NULL, 0u) - 1u - (uint32_t)rand() % 4u;
+            n = console_test_frame(buf, PMSTEP_CONSOLE_STOP, 1u, NULL, 0u) - 1u - (uint32_t)rand() % 4u;
         } else { /* a STOP with one payload byte flipped (the CRC no longer matches) */
-            n = frame(buf, PMSTEP_CONSOLE_STOP, 1u, NULL, 0u);
+            n = console_test_frame(buf, PMSTEP_CONSOLE_STOP, 1u, NULL, 0u);
             buf[2] ^= 0x10u;
         }
         pmstep_console_receive(&con, buf, n, round * 100u);

@@ -15,6 +15,7 @@
 #include <cmocka.h>
 
 #include "pmstep_console.h"
+#include "console_test_frame.h"
 
 static pmstep_console_t con;
 static pmstep_config_t cfg;
@@ -39,18 +40,7 @@ static int setup(void **state)
 static void request(uint8_t type, uint8_t seq, const void *data, uint32_t n)
 {
     uint8_t buf[80];
-    uint16_t crc;
-    buf[0] = PMSTEP_CONSOLE_SYNC;
-    buf[1] = (uint8_t)(n + 2u);
-    buf[2] = type;
-    buf[3] = seq;
-    if (n > 0u) {
-        memcpy(buf + 4, data, n);
-    }
-    crc = pmstep_console_crc16(0xFFFFu, buf + 1, n + 3u);
-    buf[4 + n] = (uint8_t)(crc & 0xFFu);
-    buf[5 + n] = (uint8_t)(crc >> 8);
-    pmstep_console_receive(&con, buf, n + 6u, 0u);
+    pmstep_console_receive(&con, buf, console_test_frame(buf, type, seq, data, n), 0u);
 }
 
 typedef struct {
