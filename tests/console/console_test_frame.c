@@ -1,7 +1,12 @@
 /* Host side of the console protocol for the tests (console_test_frame.h). */
 #include "console_test_frame.h"
 
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
 #include <string.h>
+
+#include <cmocka.h>
 
 #include "pmstep_console.h"
 
@@ -19,4 +24,45 @@ uint32_t console_test_frame(uint8_t *out, uint8_t type, uint8_t seq, const void 
     out[4 + n] = (uint8_t)(crc & 0xFFu);
     out[5 + n] = (uint8_t)(crc >> 8);
     return n + 6u;
+}
+
+unsigned console_test_replies(const uint8_t *tx, uint32_t n, console_test_reply_t *r, unsigned max)
+{
+    uint32_t i = 0;
+    unsigned count = 0;
+    while (i < n) {
+        uint8_t len;
+        uint16_t crc;
+        assert_int_equal(tx[i], PMSTEP_CONSOLE_SYNC);
+        len = tx[i + 1u];
+        assert_true(i + 4u + len <= n);
+        crc = pmstep_console_crc16(0xFFFFu, &tx[i + 1u], 1u + (uint32_t)len);
+        assert_int_equal(crc, tx[i + 2u + len] | (tx[i + 3u + len] << 8));
+        if (count < max) {
+            r[count].type = tx[i + 2u];
+            r[count].seq = tx[i + 3u];
+            r[count].n = (uint32_t)len - 2u;
+            memcpy(r[count].data, &tx[i + 4u], r[count].n);
+        }
+        ++count;
+        i += 4u + len;
+    }
+    return count;
+}
+
+float console_test_f32(const uint8_t *p)
+{
+    float x;
+    memcpy(&x, p, sizeof x);
+    return x;
+}
+
+uint32_t console_test_u32(const uint8_t *p)
+{
+    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
+}
+
+int16_t console_test_i16(const uint8_t *p)
+{
+    return (int16_t)(uint16_t)(p[0] | (p[1] << 8));
 }

@@ -42,55 +42,19 @@ static void send_request(uint8_t type, uint8_t seq, const void *data, uint32_t n
     pmstep_console_receive(&con, buf, len, 0u);
 }
 
-typedef struct {
-    uint8_t type;
-    uint8_t seq;
-    uint8_t data[64];
-    uint32_t n;
-} reply_t;
+typedef console_test_reply_t reply_t;
 
 /* Decodes the frames the console transmitted; @return how many. */
 static unsigned replies(reply_t *r, unsigned max)
 {
     uint8_t tx[PMSTEP_CONSOLE_TX_BYTES];
     const uint32_t n = pmstep_console_transmit(&con, tx, sizeof tx);
-    uint32_t i = 0;
-    unsigned count = 0;
-    while (i < n) {
-        uint8_t len;
-        uint16_t crc;
-        assert_int_equal(tx[i], PMSTEP_CONSOLE_SYNC);
-        len = tx[i + 1u];
-        assert_true(i + 4u + len <= n);
-        crc = pmstep_console_crc16(0xFFFFu, &tx[i + 1u], 1u + (uint32_t)len);
-        assert_int_equal(crc, tx[i + 2u + len] | (tx[i + 3u + len] << 8));
-        if (count < max) {
-            r[count].type = tx[i + 2u];
-            r[count].seq = tx[i + 3u];
-            r[count].n = (uint32_t)len - 2u;
-            memcpy(r[count].data, &tx[i + 4u], r[count].n);
-        }
-        ++count;
-        i += 4u + len;
-    }
-    return count;
-}
-
-static float f32_at(const uint8_t *p)
-{
-    float x;
-    memcpy(&x, p, sizeof x);
-    return x;
-}
-
-static uint32_t u32_at(const uint8_t *p)
-{
-    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
+    return console_test_replies(tx, n, r, max);
 }
 
 static int16_t ack_status(const reply_t *r)
 {
-    return (int16_t)(uint16_t)(r->data[0] | (r->data[1] << 8));
+    return console_test_i16(r->data);
 }
 
 static void boundary(void)
@@ -146,7 +110,7 @@ static void test_command_at_period_boundary(void **state)
     assert_int_equal(replies(r, 2), 1u);
     assert_int_equal(r[0].type, 0x82u);
     assert_int_equal(ack_status(&r[0]), PMSTEP_OK);
-    assert_int_equal(u32_at(&r[0].data[2]), 42u); /* the step after period 41 */
+    assert_int_equal(console_test_u32(&r[0].data[2]), 42u); /* the step after period 41 */
     assert_int_equal(snap.out.mode, PMSTEP_MODE_S_ALIGN); /* the step after the boundary ran started */
     send_request(PMSTEP_CONSOLE_SPEED_TARGET, 2u, target, 8u);
     step();
@@ -245,7 +209,7 @@ static void test_config_by_name_and_id(void **state)
     step();
     assert_int_equal(replies(r, 2), 1u);
     assert_int_equal(r[0].type, 0x88u);
-    assert_float_equal(f32_at(&r[0].data[3]), 100.0f, 0.0f);
+    assert_float_equal(console_test_f32(&r[0].data[3]), 100.0f, 0.0f);
     assert_memory_equal(&r[0].data[7], "gains.speed_gain_per_s", 22u);
     /* Set by name in IDLE: validated, applied, the core re-initialised. */
     req[0] = 0xFFu;
@@ -327,15 +291,15 @@ static void test_status_and_telemetry(void **state)
     assert_int_equal(n, 3u); /* periods 4, 8, 12: the multiples of the decimation */
     for (k = 0; k < n; ++k) {
         assert_int_equal(r[k].type, PMSTEP_CONSOLE_TELEMETRY_FRAME);
-        assert_int_equal(u32_at(r[k].data), 4u + 4u * k);
+        assert_int_equal(console_test_u32(r[k].data), 4u + 4u * k);
         assert_int_equal(r[k].data[4], PMSTEP_MODE_S_ALIGN);
-        assert_float_equal(f32_at(&r[k].data[6 + 4 * 7]), 48.0f, 0.0f); /* bus */
+        assert_float_equal(console_test_f32(&r[k].data[6 + 4 * 7]), 48.0f, 0.0f); /* bus */
     }
     send_request(PMSTEP_CONSOLE_GET_STATUS, 3u, NULL, 0u);
     step();
     n = replies(r, 16);
     assert_int_equal(r[n - 1u].type, 0x87u);
-    assert_int_equal(u32_at(r[n - 1u].data), snap.period - 1u); /* the snapshot before this boundary's step */
+    assert_int_equal(console_test_u32(r[n - 1u].data), snap.period - 1u); /* the snapshot before this boundary's step */
     assert_int_equal(r[n - 1u].data[4], PMSTEP_MODE_S_ALIGN);
     send_request(PMSTEP_CONSOLE_GET_COMMISSIONING, 4u, NULL, 0u);
     step();

@@ -43,12 +43,7 @@ static void request(uint8_t type, uint8_t seq, const void *data, uint32_t n)
     pmstep_console_receive(&con, buf, console_test_frame(buf, type, seq, data, n), 0u);
 }
 
-typedef struct {
-    uint8_t type;
-    uint8_t seq;
-    uint8_t data[64];
-    uint32_t n;
-} reply_t;
+typedef console_test_reply_t reply_t;
 
 /* The one frame the console transmitted. */
 static reply_t one_reply(void)
@@ -56,27 +51,13 @@ static reply_t one_reply(void)
     uint8_t tx[PMSTEP_CONSOLE_TX_BYTES];
     const uint32_t n = pmstep_console_transmit(&con, tx, sizeof tx);
     reply_t r;
-    assert_true(n >= 6u);
-    assert_int_equal(tx[0], PMSTEP_CONSOLE_SYNC);
-    assert_int_equal(n, (uint32_t)tx[1] + 4u); /* exactly one frame */
-    assert_int_equal(pmstep_console_crc16(0xFFFFu, &tx[1], 1u + (uint32_t)tx[1]), tx[n - 2u] | (tx[n - 1u] << 8));
-    r.type = tx[2];
-    r.seq = tx[3];
-    r.n = (uint32_t)tx[1] - 2u;
-    memcpy(r.data, &tx[4], r.n);
+    assert_int_equal(console_test_replies(tx, n, &r, 1u), 1u);
     return r;
-}
-
-static float f32_at(const uint8_t *p)
-{
-    float x;
-    memcpy(&x, p, sizeof x);
-    return x;
 }
 
 static int16_t status_of(const reply_t *r)
 {
-    return (int16_t)(uint16_t)(r->data[0] | (r->data[1] << 8));
+    return console_test_i16(r->data);
 }
 
 static void expect_error(uint8_t type, uint8_t code)
@@ -182,9 +163,9 @@ static void test_requests_at_the_boundary(void **state)
     r = one_reply();
     assert_int_equal(status_of(&r), PMSTEP_OK);
     assert_int_equal(r.data[2] | (r.data[3] << 8), 102u); /* the period the values are from */
-    assert_float_equal(f32_at(&r.data[6]), (float)(angle / (double)cfg.motor.pole_pairs), 1e-5f);
-    assert_float_equal(f32_at(&r.data[10]), f32_at(&r.data[6]), 0.0f); /* speed mode: theta* = theta-hat */
-    assert_float_equal(f32_at(&r.data[14]), 0.0f, 0.0f);
+    assert_float_equal(console_test_f32(&r.data[6]), (float)(angle / (double)cfg.motor.pole_pairs), 1e-5f);
+    assert_float_equal(console_test_f32(&r.data[10]), console_test_f32(&r.data[6]), 0.0f); /* speed mode: theta* = theta-hat */
+    assert_float_equal(console_test_f32(&r.data[14]), 0.0f, 0.0f);
     assert_int_equal(r.data[18], PMSTEP_CONSOLE_POSITION_TRACKED);
 
     request(PMSTEP_CONSOLE_MOVE_TO, 4u, bad_limit, 16u); /* finite, but the core refuses it */
@@ -205,7 +186,7 @@ static void test_requests_at_the_boundary(void **state)
     assert_int_equal(status_of(&r), PMSTEP_OK);
     assert_int_equal(r.data[18], PMSTEP_CONSOLE_POSITION_TRACKED | PMSTEP_CONSOLE_POSITION_MODE
                                      | PMSTEP_CONSOLE_POSITION_MOVING);
-    assert_float_equal(f32_at(&r.data[14]), f32_at(&r.data[10]) - f32_at(&r.data[6]), 0.0f);
+    assert_float_equal(console_test_f32(&r.data[14]), console_test_f32(&r.data[10]) - console_test_f32(&r.data[6]), 0.0f);
 
     request(PMSTEP_CONSOLE_SET_POSITION_ZERO, 7u, NULL, 0u);
     pmstep_console_boundary(&con, &motor, &cfg, &snap);
@@ -215,7 +196,7 @@ static void test_requests_at_the_boundary(void **state)
     request(PMSTEP_CONSOLE_GET_POSITION, 8u, NULL, 0u);
     pmstep_console_boundary(&con, &motor, &cfg, &snap);
     r = one_reply();
-    assert_float_equal(f32_at(&r.data[6]), 0.0f, 1e-6f);
+    assert_float_equal(console_test_f32(&r.data[6]), 0.0f, 1e-6f);
     /* the target moved with it; the estimate it moved by is within the atan2 polynomial's 1.2e-5/p rad */
     assert_float_equal(position.motion.target, (float)(0.5 - angle / (double)cfg.motor.pole_pairs), 3e-6f);
 
