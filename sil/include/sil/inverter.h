@@ -21,11 +21,18 @@
  *    held open (the dead time's zero-current clamp) until a later step finds a branch.
  *  - switching model: centre-aligned carrier, valley at the period boundary (where the
  *    ADC samples). Leg A is high for (1+d)/2 T and leg B for (1-d)/2 T, both windows
- *    centred on mid-period; u = V_bus (s_A - s_B). Dead time delays a leg's turn-on edge
- *    by t_d when the current flows out of that leg, its turn-off edge when it flows in
- *    (a leg at d = +/-1 does not switch and has no dead time; a delayed edge is held
- *    inside the period). Simplification: the current's sign is taken once, at the start
- *    of the period, for all edges of that period. With the exponential integrator at one
+ *    centred on mid-period; u = V_bus (s_A - s_B). For t_d after each edge of a leg both
+ *    its switches are off and the freewheel diode of the current's direction at that edge
+ *    sets the leg: low for a current out of the leg, high for one into it, as commanded
+ *    for a zero current. So a turn-on edge is delayed by t_d when the current flows out of
+ *    that leg, a turn-off edge when it flows in (a leg at d = +/-1 does not switch and has
+ *    no dead time; a dead time is held inside the period). Each edge takes the sign of
+ *    the current at that edge: the period is integrated with the signs of its start, and
+ *    again (up to three passes) with the signs the last pass found at the edges while any
+ *    differ, so a current crossing zero within the period, or rippling across zero, loses
+ *    the dead time of each edge with its own sign. Not modelled: a current that reaches
+ *    zero inside a dead time stays there until the edge's switch turns on (the zero-current
+ *    clamp of the averaged model). With the exponential integrator at one
  *    step a period, the currents are split into the response to the period's mean voltage
  *    (one step, with the back EMF and the mechanics) and the PWM ripple, which solves
  *    r' = -(R/L) r + (u - u_mean)/L, r(0) = 0, exactly between the edges; the ripple's
