@@ -7,7 +7,7 @@
 #include "inverter_internal.h"
 
 #define EDGES_MAX 18  /* 0, T and, for each of four legs, its two edges and the ends of their dead times */
-#define SIGN_PASSES_MAX 3 /* passes over a period until the signs at its edges agree with its currents */
+#define SIGN_PASSES 3 /* passes over a period at most, until the signs at its edges agree with its currents */
 
 /* A leg's nominal window, centred on mid-period: high from on_s to off_s. A leg that does not
  * switch (width 0 or T) stays at its level all period and has no dead time. */
@@ -133,8 +133,10 @@ static double current_at(const segments_t *seg, int k, double t_s)
     return seg->i_end_A[seg->n - 1][k];
 }
 
-/* The signs at the edges from the currents a pass integrated; true if any changed. */
-static bool signs_at_edges(const segments_t *seg, edge_signs_t *signs)
+/* The signs at the edges from the currents a pass integrated; true if any changed. With
+ * @p last_pass, a sign that changed again is taken as zero: that edge's current turns with
+ * the dead time's own sign, so it sits at zero there. */
+static bool signs_at_edges(const segments_t *seg, edge_signs_t *signs, bool last_pass)
 {
     bool changed = false;
     int k, j, e;
@@ -148,7 +150,7 @@ static bool signs_at_edges(const segments_t *seg, edge_signs_t *signs)
                 const int s = sil_inv_sign_of(current_at(seg, k, e == 0 ? leg->on_s : leg->off_s));
                 const int out = j == 0 ? s : -s;
                 if (signs->out[k][j][e] != out) {
-                    signs->out[k][j][e] = out;
+                    signs->out[k][j][e] = last_pass ? 0 : out;
                     changed = true;
                 }
             }
@@ -308,7 +310,7 @@ void sil_inv_switching_period(sil_inv_period_t *p, double period_s, int substeps
         } else {
             segment_steps(p, period_s, substeps, &seg);
         }
-        if (pass == SIGN_PASSES_MAX || !signs_at_edges(&seg, &signs)) {
+        if (pass == SIGN_PASSES || !signs_at_edges(&seg, &signs, pass + 1 == SIGN_PASSES)) {
             break;
         }
         /* A current changed sign before an edge: the period again, with the signs this pass found. */

@@ -307,6 +307,49 @@ static void switching_one_step_matches_the_segments(void **state)
     assert_true(fabs(bus_one - bus_ref) < 1e-7);
 }
 
+/* Mean phase voltage over one period that starts at i0 under u_a = -0.9 V_bus (leg B on at
+ * 0.025 T, leg A on at 0.475 T and off at 0.525 T, leg B off at 0.975 T). */
+static double crossing_period_mean_V(plant_integrator_t method, int substeps, double i0_A, double *i_end_A)
+{
+    plant_t plant = rl_plant();
+    sil_inverter_t inv = make_inverter(SIL_INVERTER_SWITCHING, 1e-6, 0.0);
+    pmstep_output_t out;
+    memset(&out, 0, sizeof out);
+    out.u_a_V = (float)(-0.9 * BUS_V);
+    out.bridge_enable = true;
+    plant.integrator = method;
+    plant.x.i_a_A = i0_A;
+    sil_inverter_apply(&inv, &out, BUS_V);
+    sil_drive_advance(&plant, &inv, PERIOD_S, substeps);
+    *i_end_A = plant.x.i_a_A;
+    return inv.applied_a_V;
+}
+
+static void switching_dead_time_takes_the_sign_at_each_edge(void **state)
+{
+    /* From 0.22 A the current falls about 0.18 A in each of the two stretches at -V_bus: it is
+     * positive at B's turn-on and at A's two edges, negative at B's turn-off. Only A's turn-on
+     * loses its dead time (A stays low for t_d): -0.9 V_bus - V_bus t_d / T. B's turn-on and
+     * turn-off take their commanded levels through the diodes, A's turn-off too. Held at the
+     * start's sign every edge would lose: -0.9 V_bus - 2 V_bus t_d / T. From 2 A (positive at
+     * every edge) the full loss. */
+    const double one_edge_V = BUS_V * 1e-6 / PERIOD_S;
+    const double command_V = (double)(float)(-0.9 * BUS_V); /* as the MCU's float output carries it */
+    const double expected_V = command_V - one_edge_V;
+    double i_end_one, i_end_seg, i_end_far;
+    const double one_V = crossing_period_mean_V(PLANT_INTEGRATOR_EXPONENTIAL, 1, 0.22, &i_end_one);
+    const double seg_V = crossing_period_mean_V(PLANT_INTEGRATOR_RK4, 10, 0.22, &i_end_seg);
+    const double far_V = crossing_period_mean_V(PLANT_INTEGRATOR_EXPONENTIAL, 1, 2.0, &i_end_far);
+    (void)state;
+    print_message("crossing period: mean u %.9f V (one step), %.9f V (segments), expected %.9f V; i 0.22 -> %.4f A; "
+                  "from 2 A: %.9f V (expected %.9f V)\n", one_V, seg_V, expected_V, i_end_one, far_V,
+                  command_V - 2.0 * one_edge_V);
+    assert_true(i_end_one < -0.1 && i_end_seg < -0.1 && i_end_far > 1.0);
+    assert_true(fabs(one_V - expected_V) < 1e-9);
+    assert_true(fabs(seg_V - expected_V) < 1e-9);
+    assert_true(fabs(far_V - (command_V - 2.0 * one_edge_V)) < 1e-9);
+}
+
 static void bridge_off_freewheels_to_exactly_zero_and_holds(void **state)
 {
     /* Diodes: L di/dt = -R i - sign(i) V until i = 0, i.e. zero at tau ln(1 + R |i0| / V); then open. */
@@ -427,6 +470,7 @@ int main(void)
         cmocka_unit_test(switching_matches_averaged_and_the_rl_ripple),
         cmocka_unit_test(switching_in_one_exponential_step_keeps_the_ripple),
         cmocka_unit_test(switching_one_step_matches_the_segments),
+        cmocka_unit_test(switching_dead_time_takes_the_sign_at_each_edge),
         cmocka_unit_test(bridge_off_freewheels_to_exactly_zero_and_holds),
         cmocka_unit_test(open_phase_holds_zero_against_back_emf),
         cmocka_unit_test(bus_sags_with_the_source_resistance),
