@@ -14,7 +14,7 @@ core_sources=(firmware/src/pmstep_{core,config,control,detect,actuate,ref,angle,
 case $target in
   core) sources='firmware/src/'; harness_sources=("${core_sources[@]}"); libs=(-lm) ;;
   scenario) sources='sil/src/scenario'
-    harness_sources=(sil/src/{scenario,scenario_profile,plant,inverter,inverter_switching,sensors}.c "${core_sources[@]}")
+    harness_sources=(sil/src/{scenario_keys,scenario,scenario_load,scenario_print,scenario_profile,plant,inverter,inverter_switching,sensors}.c "${core_sources[@]}")
     libs=($(pkg-config --libs inih gsl) -lm) ;;
   *) echo "run_fuzz: unknown fuzzer '$target'" >&2; exit 2 ;;
 esac

@@ -1,6 +1,6 @@
 """The scenario keys (`section.key` of pmstep-sil) that the Python tools set or read.
 
-The one place that spells them: a key renamed in sil/src/scenario.c is renamed here, and
+The one place that spells them: a key renamed in sil/src/scenario_keys.c is renamed here, and
 every tool (monte_carlo.py and its modules, bench_sil.py) follows. Tools name a key by
 its entry, e.g. KEYS["plant_resistance"].
 """

@@ -1,0 +1,212 @@
+/*
+ * Command and telemetry interface: at a period boundary (see pmstep_console.h): the mailbox's
+ * request applied to the core and answered, the telemetry frames, the simulator's advance.
+ */
+#include "pmstep_console_internal.h"
+
+#include <stddef.h>
+
+static void send_status(pmstep_console_t *c, uint8_t seq, const pmstep_console_snapshot_t *s)
+{
+    writer_t w;
+    w.n = 0;
+    put_u32(&w, s->period);
+    put_u8(&w, (uint32_t)s->out.mode);
+    put_u8(&w, (uint32_t)s->out.fault);
+    put_u8(&w, s->port_fault);
+    put_u8(&w, (s->out.bridge_enable ? 1u : 0u) | (s->out.voltage_limited ? 2u : 0u));
+    put_u32(&w, s->out.fault_step);
+    put_f32(&w, s->out.speed_ref_rad_s);
+    put_f32(&w, s->out.speed_hat_rad_s);
+    put_f32(&w, s->out.load_hat_Nm);
+    put_f32(&w, s->out.cos_hat);
+    put_f32(&w, s->out.sin_hat);
+    put_f32(&w, s->meas.i_a_A);
+    put_f32(&w, s->meas.i_b_A);
+    put_f32(&w, s->meas.bus_voltage_V);
+    put_f32(&w, s->out.u_a_V);
+    put_f32(&w, s->out.u_b_V);
+    put_f32(&w, s->out.i_d_A);
+    put_f32(&w, s->out.i_q_A);
+    pmstep_console_send(c, PMSTEP_CONSOLE_GET_STATUS | 0x80u, seq, w.b, w.n);
+}
+
+static void send_config(pmstep_console_t *c, uint8_t seq, const pmstep_config_t *cfg, uint32_t id)
+{
+    uint32_t count;
+    const pmstep_console_config_entry_t *t = pmstep_console_config_table(&count);
+    writer_t w;
+    float value = 0.0f;
+    (void)pmstep_console_config_get(cfg, id, &value);
+    w.n = 0;
+    put_u8(&w, id);
+    put_u8(&w, t[id].type);
+    put_u8(&w, t[id].flags);
+    put_f32(&w, value);
+    put_text(&w, t[id].name, PMSTEP_CONSOLE_MAX_PAYLOAD - 2u - 7u);
+    pmstep_console_send(c, PMSTEP_CONSOLE_GET_CONFIG | 0x80u, seq, w.b, w.n);
+}
+
+static void send_position(pmstep_console_t *c, uint8_t seq, int32_t status, const pmstep_console_snapshot_t *s,
+                          const pmstep_console_position_reading_t *r)
+{
+    writer_t w;
+    w.n = 0;
+    put_u16(&w, (uint32_t)(uint16_t)(int16_t)status);
+    put_u32(&w, s->period);
+    put_f32(&w, r->position_rad);
+    put_f32(&w, r->position_ref_rad);
+    put_f32(&w, r->position_error_rad);
+    put_u8(&w, r->flags);
+    pmstep_console_send(c, PMSTEP_CONSOLE_GET_POSITION | 0x80u, seq, w.b, w.n);
+}
+
+void pmstep_console_boundary(pmstep_console_t *c, pmstep_t *inst, pmstep_config_t *cfg,
+                             const pmstep_console_snapshot_t *snap)
+{
+    const uint8_t seq = c->seq;
+    int32_t st = 0;
+    if (!c->pending) {
+        return;
+    }
+    c->pending = false;
+    c->count.commands_applied++;
+    switch (c->cmd) {
+    case PMSTEP_CONSOLE_START:
+        st = (int32_t)pmstep_start(inst);
+        break;
+    case PMSTEP_CONSOLE_STOP:
+        st = (int32_t)pmstep_stop(inst);
+        break;
+    case PMSTEP_CONSOLE_CLEAR_FAULT:
+        st = (int32_t)pmstep_clear_fault(inst);
+        break;
+    case PMSTEP_CONSOLE_SPEED_TARGET:
+        st = (int32_t)pmstep_set_speed_target(inst, c->a, c->b);
+        break;
+    case PMSTEP_CONSOLE_ID_TARGET:
+        st = (int32_t)pmstep_set_id_target(inst, c->a);
+        break;
+    case PMSTEP_CONSOLE_TELEMETRY:
+        /* Frames for the periods that are multiples of the decimation, from the next one on. */
+        c->decimation = c->u;
+        c->next_telemetry = c->u == 0u ? 0u : (snap->period + 1u) - (snap->period + 1u) % c->u + c->u;
+        break;
+    case PMSTEP_CONSOLE_MOVE_TO:
+    case PMSTEP_CONSOLE_HOLD:
+    case PMSTEP_CONSOLE_SET_POSITION_ZERO:
+        st = c->position_apply(c->position, c->cmd, c->arg, NULL); /* attached: checked at parsing */
+        break;
+    case PMSTEP_CONSOLE_GET_POSITION: {
+        pmstep_console_position_reading_t r;
+        st = c->position_apply(c->position, c->cmd, c->arg, &r);
+        send_position(c, seq, st, snap, &r);
+        return;
+    }
+    case PMSTEP_CONSOLE_GET_STATUS:
+        send_status(c, seq, snap);
+        return;
+    case PMSTEP_CONSOLE_GET_CONFIG:
+        send_config(c, seq, cfg, c->cfg_id);
+        return;
+    case PMSTEP_CONSOLE_GET_COMMISSIONING: {
+        pmstep_commissioning_t cm;
+        writer_t w;
+        pmstep_get_commissioning(inst, &cm);
+        w.n = 0;
+        put_u8(&w, cm.measured ? 1u : 0u);
+        put_u32(&w, cm.offset_samples);
+        put_u32(&w, cm.realignments);
+        put_f32(&w, cm.offset_a_A);
+        put_f32(&w, cm.offset_b_A);
+        put_f32(&w, cm.resistance_Ohm);
+        put_f32(&w, cm.phase_a_current_scale);
+        put_f32(&w, cm.inductance_H);
+        put_f32(&w, cm.torque_constant_Nm_A);
+        put_f32(&w, cm.voltage_bias_a_V);
+        put_f32(&w, cm.voltage_bias_b_V);
+        pmstep_console_send(c, PMSTEP_CONSOLE_GET_COMMISSIONING | 0x80u, seq, w.b, w.n);
+        return;
+    }
+    case PMSTEP_CONSOLE_SET_CONFIG: {
+        pmstep_config_t trial;
+        int err;
+        /* A configuration change re-initialises the core: only with the motor stopped. */
+        if (snap->out.mode != PMSTEP_MODE_IDLE) {
+            c->count.commands_applied--;
+            pmstep_console_send_error(c, PMSTEP_CONSOLE_SET_CONFIG, seq, PMSTEP_CONSOLE_ERR_NOT_STOPPED);
+            return;
+        }
+        trial = *cfg;
+        err = pmstep_console_config_set(&trial, c->cfg_id, c->a);
+        if (err != 0) {
+            c->count.commands_applied--;
+            pmstep_console_send_error(c, PMSTEP_CONSOLE_SET_CONFIG, seq, (pmstep_console_error_t)err);
+            return;
+        }
+        st = (int32_t)pmstep_validate_config(&trial);
+        if (st == (int32_t)PMSTEP_OK) {
+            *cfg = trial;
+            st = (int32_t)pmstep_init(inst, cfg);
+        }
+        break;
+    }
+    default:
+        break;
+    }
+    pmstep_console_send_ack(c, c->cmd, seq, st, snap->period + 1u);
+}
+
+void pmstep_console_telemetry(pmstep_console_t *c, const pmstep_console_snapshot_t *snap)
+{
+    writer_t w;
+    if (c->decimation == 0u || (int32_t)(snap->period - c->next_telemetry) < 0) {
+        return;
+    }
+    c->next_telemetry = snap->period - snap->period % c->decimation + c->decimation;
+    w.n = 0;
+    put_u32(&w, snap->period);
+    put_u8(&w, (uint32_t)snap->out.mode);
+    put_u8(&w, (uint32_t)snap->out.fault);
+    put_f32(&w, snap->out.speed_ref_rad_s);
+    put_f32(&w, snap->out.speed_hat_rad_s);
+    put_f32(&w, snap->out.load_hat_Nm);
+    put_f32(&w, snap->out.cos_hat);
+    put_f32(&w, snap->out.sin_hat);
+    put_f32(&w, snap->meas.i_a_A);
+    put_f32(&w, snap->meas.i_b_A);
+    put_f32(&w, snap->meas.bus_voltage_V);
+    put_f32(&w, snap->out.u_a_V);
+    put_f32(&w, snap->out.u_b_V);
+    put_f32(&w, snap->out.i_q_A);
+    c->count.telemetry_frames++;
+    pmstep_console_send(c, PMSTEP_CONSOLE_TELEMETRY_FRAME, 0u, w.b, w.n);
+}
+
+uint32_t pmstep_console_advance_request(pmstep_console_t *c)
+{
+    return c->advancing ? c->advance_periods : 0u;
+}
+
+void pmstep_console_advance_done(pmstep_console_t *c, uint32_t period)
+{
+    writer_t w;
+    if (!c->advancing) {
+        return;
+    }
+    c->advancing = false;
+    w.n = 0;
+    put_u16(&w, 0u);
+    put_u32(&w, period);
+    pmstep_console_send(c, PMSTEP_CONSOLE_SIM_ADVANCE | 0x80u, c->advance_seq, w.b, w.n);
+}
+
+bool pmstep_console_finish_requested(const pmstep_console_t *c)
+{
+    return c->finish_requested;
+}
+
+uint8_t pmstep_console_pending_command(const pmstep_console_t *c)
+{
+    return c->pending ? c->cmd : 0u;
+}
