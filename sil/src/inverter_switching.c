@@ -121,7 +121,8 @@ static void signs_at_start(plant_t *plant, edge_signs_t *signs)
     }
 }
 
-/* The current at a time that ends a segment (an edge of the period). */
+/* The current at a switching edge: every one ends a segment (it is in the sorted edge list, after
+ * 0, and the segment before it has a length), so the loop finds it. */
 static double current_at(const segments_t *seg, int k, double t_s)
 {
     int j;
@@ -299,6 +300,8 @@ void sil_inv_switching_period(sil_inv_period_t *p, double period_s, int substeps
 {
     const plant_t plant_start = *p->plant;
     const sil_inv_period_t period_start = *p;
+    /* Without dead time the signs at the edges set no level: one pass. */
+    const int passes = p->inv->cfg.dead_time_s > 0.0 ? SIGN_PASSES : 1;
     segments_t seg;
     edge_signs_t signs;
     int pass;
@@ -310,7 +313,7 @@ void sil_inv_switching_period(sil_inv_period_t *p, double period_s, int substeps
         } else {
             segment_steps(p, period_s, substeps, &seg);
         }
-        if (pass == SIGN_PASSES || !signs_at_edges(&seg, &signs, pass + 1 == SIGN_PASSES)) {
+        if (pass == passes || !signs_at_edges(&seg, &signs, pass + 1 == passes)) {
             break;
         }
         /* A current changed sign before an edge: the period again, with the signs this pass found. */
