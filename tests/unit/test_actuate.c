@@ -100,6 +100,9 @@ static void a_sign_fixed_by_the_samples_replaces_the_assumed_one(void **state)
     pmstep_actuate_coeffs_init(&coeffs, &cfg);
     pmstep_actuate_reset(&actuator);
     assert_true(pmstep_actuate(&actuator, &coeffs, &in, BUS_V, &out));
+    /* No delay: this command's compensation is the one applied. */
+    assert_float_equal(actuator.compensation_applied_a_V, DEAD_V, 1e-5f);
+    assert_float_equal(actuator.compensation_applied_b_V, DEAD_V, 1e-5f);
     pmstep_actuate_voltage_over_period(&actuator, &coeffs, &c, BUS_V, &u_a_V, &u_b_V);
     assert_float_equal(u_a_V, 4.0f + 2.0f * DEAD_V, 1e-5f);
     assert_float_equal(u_b_V, 2.0f, 1e-5f);

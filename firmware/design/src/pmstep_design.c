@@ -257,8 +257,9 @@ static void design_protection(const pmstep_design_input_t *in, pmstep_config_t *
     cfg->detection.stall_speed_error_rad_s = STALL_FRACTION_OF_TOP_SPEED * top_speed_rad_s;
     cfg->detection.speed_consistency_bound_rad_s = STALL_FRACTION_OF_TOP_SPEED * top_speed_rad_s;
     /* Plus the dead time's floor: in a period in which a current crosses zero the observer's
-     * prediction (the compensated voltage) can be off by the whole 2 (2 V_bus t_d / T), which
-     * moves that period's current by 4 V_bus t_d / L (DESIGN.md section 5). */
+     * prediction (the compensated voltage) can be off by twice the loss 2 V_bus t_d / T (the
+     * sign taken the wrong way), which moves that period's current by 4 V_bus t_d / L
+     * (DESIGN.md section 5). */
     cfg->detection.observer_residual_bound_A = RESIDUAL_PER_RATED_CURRENT * in->rated_current_A
                                                + 4.0f * in->bus_voltage_V * cfg->inverter.dead_time_s
                                                      / in->motor.inductance_H;
