@@ -59,3 +59,12 @@ void pmstep_angle_correct(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *co
     compensated_add(&angle->phi_a, &angle->phi_a_compensation, radial_step * cos_hat);
     compensated_add(&angle->phi_b, &angle->phi_b_compensation, radial_step * sin_hat);
 }
+
+void pmstep_angle_set(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs, float cos_hat, float sin_hat)
+{
+    /* pmstep_angle_estimate() solved for phi at i = i_prev */
+    angle->phi_a = (angle->i_a_prev_A - angle->i_a_start_A) - (1.0f - cos_hat) / coeffs->flux_to_angle;
+    angle->phi_b = (angle->i_b_prev_A - angle->i_b_start_A) + sin_hat / coeffs->flux_to_angle;
+    angle->phi_a_compensation = 0.0f;
+    angle->phi_b_compensation = 0.0f;
+}

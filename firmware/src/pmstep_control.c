@@ -1,5 +1,6 @@
 /* Controller (6), or (13) with a known load (Remark 1), in RUN: the control stage (angle,
- * Park, observer rates, law) and the advance stage (observer, references). */
+ * Park, observer rates, law, or a vector hold's voltage) and the advance stage (observer,
+ * references). */
 #include "pmstep_internal.h"
 
 /* Starts controller (6) at t_c: phi = 0, i-hat = i(t_c), w-hat = T_L-hat = 0, references from 0. */
@@ -33,9 +34,7 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
     float i_d;
     float i_q;
     float load_Nm;
-    float load_rate;
     float i_q_ref;
-    float i_q_ref_rate;
     pmstep_detent_t detent;
     pmstep_speed_term_t speed;
 
@@ -77,26 +76,33 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
     }
     /* The detent torque is known in form: the law supplies it, the observer expects it. */
     detent = pmstep_law_detent(&inst->law_coeffs, cos_hat, sin_hat, inst->observer.speed_hat_rad_s);
-    speed = pmstep_law_speed_term(&inst->law_coeffs, inst->observer.speed_hat_rad_s - refs.speed_ref_rad_s);
-    i_q_ref = pmstep_law_iq_ref(&inst->law_coeffs, &refs, speed.term, load_Nm - detent.torque_Nm);
-
     obs_in->i_a_A = sample->i_a_A;
     obs_in->i_b_A = sample->i_b_A;
     obs_in->cos_hat = cos_hat;
     obs_in->sin_hat = sin_hat;
     obs_in->i_d_A = i_d;
     obs_in->i_q_A = i_q;
-    obs_in->i_d_err_A = i_d - refs.i_d_ref_A;
-    obs_in->i_q_err_A = i_q - i_q_ref;
     obs_in->known_load_Nm = ref.value;
     obs_in->detent_torque_Nm = detent.torque_Nm;
+    if (inst->hold.active) { /* a vector hold: its own voltage, the law's speed loop paused */
+        i_q_ref = 0.0f;
+        pmstep_hold_voltages(inst, obs_in, out);
+    } else {
+        speed = pmstep_law_speed_term(&inst->law_coeffs, inst->observer.speed_hat_rad_s - refs.speed_ref_rad_s);
+        i_q_ref = pmstep_law_iq_ref(&inst->law_coeffs, &refs, speed.term, load_Nm - detent.torque_Nm);
+        obs_in->i_d_err_A = i_d - refs.i_d_ref_A;
+        obs_in->i_q_err_A = i_q - i_q_ref;
+    }
     scratch->mech_rates = pmstep_observer_mech_rates(&inst->observer, &inst->observer_coeffs, obs_in, known_load);
 
-    load_rate = known_load ? ref.rate : scratch->mech_rates.load_hat_rate_Nm_s;
-    i_q_ref_rate = pmstep_law_iq_ref_rate(&inst->law_coeffs, &refs, speed.slope,
-                                          scratch->mech_rates.speed_hat_rate_rad_s2, load_rate - detent.rate_Nm_s);
-    pmstep_law_voltages(&inst->law_coeffs, &refs, cos_hat, sin_hat, i_d, i_q, inst->observer.speed_hat_rad_s,
-                        i_q_ref, i_q_ref_rate, &inst->current_integral, &out->u_a_V, &out->u_b_V);
+    if (!inst->hold.active) {
+        const float load_rate = known_load ? ref.rate : scratch->mech_rates.load_hat_rate_Nm_s;
+        const float i_q_ref_rate = pmstep_law_iq_ref_rate(&inst->law_coeffs, &refs, speed.slope,
+                                                          scratch->mech_rates.speed_hat_rate_rad_s2,
+                                                          load_rate - detent.rate_Nm_s);
+        pmstep_law_voltages(&inst->law_coeffs, &refs, cos_hat, sin_hat, i_d, i_q, inst->observer.speed_hat_rad_s,
+                            i_q_ref, i_q_ref_rate, &inst->current_integral, &out->u_a_V, &out->u_b_V);
+    }
 
     out->cos_hat = cos_hat;
     out->sin_hat = sin_hat;

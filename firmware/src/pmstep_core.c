@@ -103,6 +103,7 @@ static void clear_dynamic_state(pmstep_t *inst)
 {
     inst->mode_step = 0u;
     inst->run_started = false;
+    inst->hold.active = false;
     pmstep_angle_start(&inst->angle, 0.0f, 0.0f);
     pmstep_observer_start(&inst->observer, 0.0f, 0.0f);
     pmstep_actuate_reset(&inst->actuator);
@@ -169,6 +170,7 @@ pmstep_status_t pmstep_set_speed_target(pmstep_t *inst, float target_rad_s, floa
     if (!pmstep_all_finite4(target_rad_s, ramp_rate_rad_s2, 0.0f, 0.0f) || !(ramp_rate_rad_s2 > 0.0f)) {
         return PMSTEP_ERR_BAD_COMMAND_VALUE;
     }
+    pmstep_release_vector(inst); /* a speed command ends a hold */
     pmstep_ref_set_target(&inst->speed_ref, target_rad_s, ramp_rate_rad_s2);
     return PMSTEP_OK;
 }
@@ -412,7 +414,10 @@ static pmstep_compensation_input_t compensation_input(const pmstep_t *inst, cons
     pmstep_compensation_input_t in;
     in.sign_current_a_A = sample->i_a_A;
     in.sign_current_b_A = sample->i_b_A;
-    if (inst->mode == PMSTEP_MODE_RUN) {
+    if ((inst->mode == PMSTEP_MODE_RUN) && inst->hold.active) { /* a vector hold: its own currents, not the law's */
+        in.sign_current_a_A = inst->hold.current_A * inst->hold.cos_frame;
+        in.sign_current_b_A = inst->hold.current_A * inst->hold.sin_frame;
+    } else if (inst->mode == PMSTEP_MODE_RUN) {
         reference_current_over_period(inst, out, &in);
     } else if (out->u_a_V > 0.0f) {
         in.sign_current_a_A = out->u_a_V / inst->cfg->motor.resistance_Ohm;

@@ -50,4 +50,8 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
 bool pmstep_control_advance(pmstep_t *inst, const pmstep_control_scratch_t *scratch, const pmstep_meas_t *meas,
                             const pmstep_output_t *out);
 
+/* Vector hold (pmstep_hold.c), in place of the law's voltage: the vector turned back by the
+ * damping, the PI current loop's errors in its frame into @p obs_in, the voltage into @p out. */
+void pmstep_hold_voltages(pmstep_t *inst, pmstep_observer_input_t *obs_in, pmstep_output_t *out);
+
 #endif /* PMSTEP_INTERNAL_H */

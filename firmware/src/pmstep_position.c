@@ -1,5 +1,6 @@
 /* Sensorless position control on the speed controller (pmstep_position.h). */
 #include "pmstep/pmstep_position.h"
+#include "pmstep_position_internal.h"
 
 #include <math.h> /* fabsf: one instruction, no libm call */
 #include <stddef.h>
@@ -61,6 +62,7 @@ pmstep_status_t pmstep_position_design(const pmstep_config_t *cfg, pmstep_positi
     }
     pos_cfg->gain_per_s = 0.25f * cfg->gains.speed_gain_per_s;
     pos_cfg->integral_gain_per_s2 = pos_cfg->gain_per_s * pos_cfg->gain_per_s / 8.0f;
+    pos_cfg->hold_current_A = 0.5f * cfg->limits.max_phase_current_A; /* the rated current (DESIGN.md) */
     return PMSTEP_OK;
 }
 
@@ -103,7 +105,8 @@ pmstep_status_t pmstep_position_init(pmstep_position_t *pos, pmstep_t *inst, con
         return PMSTEP_ERR_NULL_ARGUMENT;
     }
     core = inst->cfg;
-    if ((cfg->gain_per_s - cfg->gain_per_s) != 0.0f || (cfg->integral_gain_per_s2 - cfg->integral_gain_per_s2) != 0.0f) {
+    if ((cfg->gain_per_s - cfg->gain_per_s) != 0.0f || (cfg->integral_gain_per_s2 - cfg->integral_gain_per_s2) != 0.0f
+        || (cfg->hold_current_A - cfg->hold_current_A) != 0.0f) {
         return PMSTEP_ERR_NONFINITE_PARAMETER;
     }
     if (!(cfg->gain_per_s > 0.0f) || cfg->gain_per_s > 0.5f * core->gains.speed_gain_per_s) {
@@ -112,8 +115,18 @@ pmstep_status_t pmstep_position_init(pmstep_position_t *pos, pmstep_t *inst, con
     if (cfg->integral_gain_per_s2 < 0.0f || cfg->integral_gain_per_s2 > 0.25f * cfg->gain_per_s * cfg->gain_per_s) {
         return PMSTEP_ERR_POSITION_INTEGRAL_GAIN;
     }
+    if (cfg->hold_current_A < 0.0f || !(cfg->hold_current_A < core->limits.max_phase_current_A)) {
+        return PMSTEP_ERR_HOLD_CURRENT;
+    }
     pos->inst = inst;
     pos->cfg = *cfg;
+    pos->hold_stage = POSITION_HOLD_NONE;
+    pos->hold_periods = 0;
+    pos->rest_cos = 1.0f;
+    pos->rest_sin = 0.0f;
+    pos->aim_load_Nm = 0.0f;
+    pos->frozen_cos = 1.0f;
+    pos->frozen_sin = 0.0f;
     pos->inv_pole_pairs = 1.0f / (float)core->motor.pole_pairs;
     pos->period_s = core->timing.period_s;
     pos->inv_bandwidth_s = 1.0f / inst->ref_coeffs.bandwidth_rad_s;
@@ -206,6 +219,7 @@ POSITION_OUT_OF_LINE static void lose_position(pmstep_position_t *pos)
     if (pos->out.position_mode) {
         pmstep_ref_reset(&pos->inst->speed_ref, 0.0f);
     }
+    pos->hold_stage = POSITION_HOLD_NONE; /* the core ended its hold on leaving RUN */
     pos->out.tracked = false;
     pos->out.position_mode = false;
     pos->out.moving = false;
@@ -236,9 +250,17 @@ POSITION_OUT_OF_LINE static void update(pmstep_position_t *pos)
          * been ramping from the held set-point since; the loop writes nothing more. */
         pos->out.position_mode = false;
         pos->out.moving = false;
+        pos->hold_stage = POSITION_HOLD_NONE; /* the command released the core's hold */
     }
     if (pos->out.position_mode) {
-        position_loop(pos, position_rad);
+        if (pos->hold_stage == POSITION_HOLD_SETTLING || pos->hold_stage == POSITION_HOLD_ANCHORED) {
+            pmstep_position_vector_hold(pos, position_rad);
+        } else {
+            position_loop(pos, position_rad);
+            if (!pos->out.moving && pos->hold_stage != POSITION_HOLD_REFUSED && pos->cfg.hold_current_A > 0.0f) {
+                pmstep_position_wait_and_aim(pos, position_rad);
+            }
+        }
     } else {
         pos->out.position_ref_rad = position_rad;
         pos->out.position_error_rad = 0.0f;
@@ -385,6 +407,7 @@ pmstep_status_t pmstep_position_move_to(pmstep_position_t *pos, float target_rad
         || (j_max_rad_s3 - j_max_rad_s3) != 0.0f) {
         return PMSTEP_ERR_BAD_COMMAND_VALUE; /* NaN fails every compare; Inf - Inf is NaN */
     }
+    pmstep_position_release_hold(pos);
     start = profile_start(pos);
     pmstep_motion_plan(&pos->motion, start.position, start.speed, start.accel, target_rad, v_max_rad_s, a_max_rad_s2,
                        (j_max_rad_s3 > 0.0f) ? j_max_rad_s3 : (a_max_rad_s2 / pos->inv_bandwidth_s));
@@ -408,6 +431,7 @@ pmstep_status_t pmstep_position_hold(pmstep_position_t *pos, float a_max_rad_s2)
         pos->motion.a_max = a_max_rad_s2;
         pos->motion.j_max = a_max_rad_s2 / pos->inv_bandwidth_s;
     }
+    pmstep_position_release_hold(pos);
     start = profile_start(pos);
     pmstep_motion_stop(&pos->motion, &start);
     enter_position_mode(pos);

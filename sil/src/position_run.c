@@ -9,8 +9,14 @@
 pmstep_position_config_t sil_position_config(const sil_scenario_t *sc)
 {
     pmstep_position_config_t cfg = sc->position;
+    pmstep_position_config_t designed;
+    (void)pmstep_position_design(&sc->controller, &designed);
     if (cfg.gain_per_s == 0.0f) {
-        (void)pmstep_position_design(&sc->controller, &cfg);
+        cfg.gain_per_s = designed.gain_per_s;
+        cfg.integral_gain_per_s2 = designed.integral_gain_per_s2;
+    }
+    if (cfg.hold_current_A < 0.0f) {
+        cfg.hold_current_A = designed.hold_current_A;
     }
     return cfg;
 }

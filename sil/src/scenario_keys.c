@@ -102,6 +102,7 @@ const key_t_ scenario_keys[] = {
     {"position.hold_start_s", KEY_DOUBLE, OFF(hold_start_s), 0, 0, 3600, 0, "start of the hold window of the position metrics (s); 0 = none"},
     {"controller.position.gain_per_s", KEY_FLOAT, OFF(position.gain_per_s), 0, 0, BIG, 0, "k_theta (1/s); 0 = the designer's rule k_w/4 and k_theta^2/8"},
     {"controller.position.integral_gain_per_s2", KEY_FLOAT, OFF(position.integral_gain_per_s2), -BIG, 0, BIG, 0, "k_I of the position loop (1/s^2)"},
+    {"controller.position.hold_current_A", KEY_FLOAT, OFF(position.hold_current_A), -1, 0, BIG, 0, "current of the vector hold when a move ends (A); 0 = the loop holds on the estimate, -1 = the designer's (max_phase_current_A / 2)"},
 
     {"sensors.adc_bits", KEY_ADC_BITS, OFF(sensors.adc_bits), 0, 0, 16, 0, "ADC resolution: 0 = ideal (no quantisation), or 8..16 bits"},
     {"sensors.current_full_scale_A", KEY_DOUBLE, OFF(sensors.current_full_scale_A), 0, 1, 1e6, 0, "current ADC span +/- this, mid-tread, clips beyond (A)"},

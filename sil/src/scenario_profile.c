@@ -51,6 +51,7 @@ void sil_scenario_paper(sil_scenario_t *sc)
     /* No moves (a speed scenario); the limits a position scenario starts from. */
     sc->move_speed_rad_s = 5.0;
     sc->move_accel_rad_s2 = 50.0;
+    sc->position.hold_current_A = -1.0f; /* the designer's */
 }
 
 double sil_scenario_hold_end_s(const sil_scenario_t *sc)

@@ -181,8 +181,8 @@ int main(int argc, char **argv)
                (double)sc.controller.commissioning.identification_time_s,
                (double)sc.controller.commissioning.identification_min_speed_rad_s);
     }
-    printf("  position loop: k_theta %g 1/s, k_I %g 1/s^2\n", (double)sc.position.gain_per_s,
-           (double)sc.position.integral_gain_per_s2);
+    printf("  position loop: k_theta %g 1/s, k_I %g 1/s^2; vector hold at %g A\n", (double)sc.position.gain_per_s,
+           (double)sc.position.integral_gain_per_s2, (double)sc.position.hold_current_A);
     if (ini_path != NULL) {
         FILE *f = fopen(ini_path, "w");
         if (f == NULL) {

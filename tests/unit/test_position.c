@@ -61,6 +61,7 @@ static void fixture_init(fixture_t *f)
     assert_int_equal(pmstep_init(&f->inst, &f->cfg), PMSTEP_OK);
     f->pos_cfg.gain_per_s = 25.0f;
     f->pos_cfg.integral_gain_per_s2 = 0.0f;
+    f->pos_cfg.hold_current_A = 0.0f; /* the loop holds (the vector hold: closed_loop.position) */
     assert_int_equal(pmstep_position_init(&f->pos, &f->inst, &f->pos_cfg), PMSTEP_OK);
     f->updates = 0u;
 }
@@ -214,6 +215,7 @@ static void init_validates_the_gains_with_named_codes(void **state)
     fixture_init(&f); /* paper: k_w = 100 1/s */
     c.gain_per_s = 25.0f;
     c.integral_gain_per_s2 = 0.0f;
+    c.hold_current_A = 0.0f;
     assert_int_equal(pmstep_position_init(NULL, &f.inst, &c), PMSTEP_ERR_NULL_ARGUMENT);
     assert_int_equal(pmstep_position_init(&f.pos, NULL, &c), PMSTEP_ERR_NULL_ARGUMENT);
     assert_int_equal(pmstep_position_init(&f.pos, &f.inst, NULL), PMSTEP_ERR_NULL_ARGUMENT);
@@ -236,10 +238,20 @@ static void init_validates_the_gains_with_named_codes(void **state)
     assert_int_equal(pmstep_position_init(&f.pos, &f.inst, &c), PMSTEP_ERR_POSITION_INTEGRAL_GAIN);
     c.integral_gain_per_s2 = 625.0f;
     assert_int_equal(pmstep_position_init(&f.pos, &f.inst, &c), PMSTEP_OK);
+    /* the hold current: finite, >= 0 (0: no vector hold), below the current trip (15 A) */
+    c.hold_current_A = NAN;
+    assert_int_equal(pmstep_position_init(&f.pos, &f.inst, &c), PMSTEP_ERR_NONFINITE_PARAMETER);
+    c.hold_current_A = -0.1f;
+    assert_int_equal(pmstep_position_init(&f.pos, &f.inst, &c), PMSTEP_ERR_HOLD_CURRENT);
+    c.hold_current_A = 15.0f;
+    assert_int_equal(pmstep_position_init(&f.pos, &f.inst, &c), PMSTEP_ERR_HOLD_CURRENT);
+    c.hold_current_A = 14.9f;
+    assert_int_equal(pmstep_position_init(&f.pos, &f.inst, &c), PMSTEP_OK);
     /* the designer's rule passes validation */
     assert_int_equal(pmstep_position_design(&f.cfg, &c), PMSTEP_OK);
     assert_float_equal(c.gain_per_s, 25.0f, 0.0f);
     assert_float_equal(c.integral_gain_per_s2, 25.0f * 25.0f / 8.0f, 1e-4f);
+    assert_float_equal(c.hold_current_A, 7.5f, 0.0f);
     assert_int_equal(pmstep_position_init(&f.pos, &f.inst, &c), PMSTEP_OK);
     assert_int_equal(pmstep_position_design(NULL, &c), PMSTEP_ERR_NULL_ARGUMENT);
 }

@@ -85,6 +85,32 @@ pmstep_status_t pmstep_set_speed_target(pmstep_t *inst, float target_rad_s, floa
  */
 pmstep_status_t pmstep_set_id_target(pmstep_t *inst, float target_A);
 
+/**
+ * Holds the rotor at rest at the electrical angle (@p cos_rest, @p sin_rest) by a current
+ * vector of @p current_A fixed in the stator frame, aimed ahead of the rest by the load angle
+ * of @p load_Nm (pmstep_hold.h). The law's speed loop pauses; the observer runs on. In force
+ * until pmstep_release_vector(), a speed command, or leaving RUN. A new call re-aims.
+ * @retval PMSTEP_OK                    holding
+ * @retval PMSTEP_ERR_NULL_ARGUMENT     @p inst is NULL
+ * @retval PMSTEP_ERR_BAD_MODE          not in RUN, or the known-load mode (Remark 1)
+ * @retval PMSTEP_ERR_BAD_COMMAND_VALUE a value not finite, or (cos, sin) not within 1 % of unit length
+ * @retval PMSTEP_ERR_HOLD_CURRENT      @p current_A not in (0, max_phase_current_A), or
+ *                                      |load - detent| above PMSTEP_HOLD_MAX_TORQUE_FRACTION k_M I
+ */
+pmstep_status_t pmstep_hold_vector(pmstep_t *inst, float cos_rest, float sin_rest, float current_A, float load_Nm);
+
+/** Ends a vector hold: the law's speed loop takes over from the next period (its current
+ *  integrals restart at 0). No effect without a hold. */
+void pmstep_release_vector(pmstep_t *inst);
+
+/**
+ * Sets the angle estimate to (@p cos_hat, @p sin_hat): the flux integrals are moved so that
+ * the present currents give it. For a rotor known to be at that angle (at rest in a hold).
+ * @retval PMSTEP_OK, PMSTEP_ERR_NULL_ARGUMENT, PMSTEP_ERR_BAD_MODE (not in RUN),
+ *         PMSTEP_ERR_BAD_COMMAND_VALUE (a value not finite)
+ */
+pmstep_status_t pmstep_set_angle_estimate(pmstep_t *inst, float cos_hat, float sin_hat);
+
 /** Runs one control period. Never fails; see pmstep_output_t. */
 void pmstep_step(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out);
 

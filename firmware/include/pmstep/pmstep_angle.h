@@ -68,6 +68,10 @@ void pmstep_angle_estimate(const pmstep_angle_t *angle, const pmstep_angle_coeff
  */
 void pmstep_angle_correct(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs, float cos_hat, float sin_hat);
 
+/** Moves phi1, phi2 (compensations cleared) so that the estimate for the last sampled currents
+ *  (those of the last update) is (@p cos_hat, @p sin_hat). */
+void pmstep_angle_set(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs, float cos_hat, float sin_hat);
+
 #ifdef __cplusplus
 }
 #endif

@@ -16,6 +16,7 @@
 #include "pmstep/pmstep_identify.h"
 #include "pmstep/pmstep_detect.h"
 #include "pmstep/pmstep_actuate.h"
+#include "pmstep/pmstep_hold.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -61,6 +62,8 @@ typedef struct {
             pmstep_identify_sums_t identify; /**< J and F fit, while the identification window is open */
         } run;                            /**< from t_c */
     } scratch;
+
+    pmstep_vector_hold_t hold;            /**< standstill hold by a stator-frame vector (pmstep_hold.h) */
 } pmstep_t;
 
 #ifdef __cplusplus

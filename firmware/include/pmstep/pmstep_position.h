@@ -23,6 +23,17 @@
  * k_I <= k_theta^2/4; the designer's rule k_theta = k_w/4, DESIGN.md). At standstill the
  * law's T-hat_L carries the load; k_I takes out what is left of a speed-estimate bias.
  *
+ * Vector hold (hold_current_A > 0): when a move's profile has ended, the rotor is held at the
+ * target by a current vector fixed in the stator frame (pmstep_hold_vector(), pmstep_hold.h),
+ * aimed at the target's electrical direction (the estimate turned by p (theta* - theta-hat))
+ * ahead by the load angle of T_L-hat (read 2/k_theta after the profile ends, while the loop
+ * still holds): no estimate drift moves it. Once the rotor has been at rest (|w-hat - w-bar|
+ * within the quiet band) for the held rotor's settling time, the estimate is kept where it was
+ * then, so it does not drift, and it follows the flux integrals while the rotor moves (a load
+ * step). After POSITION_REAIM_PERIODS at rest more than 0.05 electrical rad from the target,
+ * the aim is turned by that displacement (the load angle off, or the load changed), and so on
+ * until the rotor rests within 0.05. A move, a stop or a speed command releases it.
+ *
  * Rates: the turn count runs every period (it must see every crossing); the fine angle, the
  * profile and the loop run every PMSTEP_POSITION_DECIMATION = N periods (a cascade's outer loop
  * at a lower rate, as the turn count alone is cheap). An update after period k puts the speed
@@ -65,6 +76,9 @@ extern "C" {
 typedef struct {
     float gain_per_s;           /**< k_theta > 0, at most k_w/2 (designer: k_w/4) */
     float integral_gain_per_s2; /**< k_I >= 0, at most k_theta^2/4 (a double pole); 0 = none */
+    float hold_current_A;       /**< I of the vector hold when a move ends (pmstep_hold.h), below
+                                     max_phase_current_A; 0 = the loop holds on the estimate
+                                     (designer: max_phase_current_A / 2) */
 } pmstep_position_config_t;
 
 /** What pmstep_position_step() estimated and commanded (mechanical rad). The three positions are
@@ -104,6 +118,15 @@ typedef struct {
     float hold_inv_gain;      /**< the reference filter over N periods (put_speed_reference) */
     float hold_c23;
     float hold_c12;
+    /* Vector hold when a move ends (hold_current_A > 0; pmstep_position.c, "Vector hold") */
+    float rest_cos;           /**< the vector's aim before its load angle (stator frame): the target's
+                                   electrical direction, corrected by the displacements at rest */
+    float rest_sin;
+    float aim_load_Nm;        /**< the load the aim's load angle is for (T_L-hat when the move ended) */
+    float frozen_cos;         /**< the estimate kept while the held rotor is at rest */
+    float frozen_sin;
+    int32_t hold_stage;       /**< none, settling, anchored, refused (until the next move) */
+    int32_t hold_periods;     /**< waiting, settling: periods left; anchored: periods at rest */
 } pmstep_position_t;
 
 /**

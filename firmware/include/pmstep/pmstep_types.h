@@ -94,8 +94,10 @@ typedef enum {
     PMSTEP_ERR_MECHANICS_UNIDENTIFIED = -122, /**< identified J and F used without an identification window */
     /* position control (pmstep_position.h) */
     PMSTEP_ERR_POSITION_GAIN = -130,        /**< position gain k_theta <= 0, or above k_w/2 (the speed loop's) */
-    PMSTEP_ERR_POSITION_INTEGRAL_GAIN = -131 /**< position integral gain k_I < 0, or above k_theta^2/4 (the loop's
+    PMSTEP_ERR_POSITION_INTEGRAL_GAIN = -131, /**< position integral gain k_I < 0, or above k_theta^2/4 (the loop's
                                                  poles would turn complex) */
+    PMSTEP_ERR_HOLD_CURRENT = -132          /**< hold current <= 0 or not below max_phase_current_A, or too small
+                                                 for the load: |T_L - T_detent| above 0.9 k_M I (pmstep_hold.h) */
 } pmstep_status_t;
 
 /** Shortest and longest control period accepted (s): 1 MHz down to 100 Hz. */

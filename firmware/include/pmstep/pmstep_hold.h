@@ -1,0 +1,62 @@
+/**
+ * @file pmstep_hold.h
+ * @brief Standstill hold by a current vector fixed in the stator frame (for position control).
+ *
+ * At zero speed nothing observes the phase of the flux estimate: an estimate hold drifts with
+ * the sum of every small voltage error (offsets, R, dead time). A vector hold does not need the
+ * estimate: the stator current i = I (cos v, sin v) pulls the rotor to the electrical angle
+ * x with k_M I sin(v - x) = T_L - T_detent(x), so a vector aimed at
+ *   v = x_rest + delta,   sin delta = (T_L-hat - T_detent(x_rest)) / (k_M I)
+ * holds the rotor at x_rest under the estimated load. Linearised about the rest the rotor is a
+ * spring, J theta'' = -p k_M I cos(delta) theta, of natural frequency
+ *   w_n = sqrt(p k_M I cos(delta) / J);
+ * turning the vector back by g (w-hat - w-bar), g = 2 zeta p / w_n, adds the damping 2 zeta w_n.
+ * w-bar is w-hat low-passed at w_n / PMSTEP_HOLD_BIAS_CORNER_RATIO: the speed estimate's bias
+ * at rest, which would otherwise turn the vector off the rest for good (g times the bias).
+ * The law's PI current loop (pmstep_law_voltages' at zero speed, written out in pmstep_hold.c)
+ * runs in the vector's frame: i_d* = I, i_q* = 0, its integrals on those errors. The observer, the angle integrals
+ * and the detection run on as in RUN.
+ */
+#ifndef PMSTEP_HOLD_H
+#define PMSTEP_HOLD_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** zeta of the held rotor (the vector's lag g = 2 zeta p / w_n). */
+#define PMSTEP_HOLD_DAMPING_RATIO 0.7f
+/** |w-hat - w-bar| below this fraction of w_n / p counts as at rest (the position library's test). */
+#define PMSTEP_HOLD_QUIET_FRACTION 0.05f
+/** Settling time of the held rotor, in time constants 1/(zeta w_n). */
+#define PMSTEP_HOLD_SETTLE_TIME_CONSTANTS 6.0f
+/** w-bar follows w-hat with the corner frequency w_n divided by this. */
+#define PMSTEP_HOLD_BIAS_CORNER_RATIO 20.0f
+/** Largest |sin delta| a hold accepts: beyond, the load is too near the vector's pull-out torque. */
+#define PMSTEP_HOLD_MAX_TORQUE_FRACTION 0.9f
+/** Largest turn of the vector by the damping term (electrical rad). */
+#define PMSTEP_HOLD_MAX_DAMPING_TURN 0.5f
+
+/** State of a vector hold (part of pmstep_t). */
+typedef struct {
+    float cos_vector;          /**< cos v of the aimed vector (stator frame) */
+    float sin_vector;          /**< sin v */
+    float current_A;           /**< I */
+    float damping_s;           /**< g = 2 zeta p / w_n, electrical rad per rad/s */
+    float speed_bias_rad_s;    /**< w-bar, the speed estimate at rest (w-hat low-passed) */
+    float bias_gain;           /**< w_n T_s / PMSTEP_HOLD_BIAS_CORNER_RATIO, w-bar's filter per period */
+    float quiet_band_rad_s;    /**< PMSTEP_HOLD_QUIET_FRACTION w_n / p */
+    float cos_frame;           /**< the period's frame: the vector turned by the damping */
+    float sin_frame;
+    uint32_t settle_periods;      /**< PMSTEP_HOLD_SETTLE_TIME_CONSTANTS / (zeta w_n), in periods */
+    bool active;
+} pmstep_vector_hold_t;
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PMSTEP_HOLD_H */

@@ -1,0 +1,126 @@
+/* Standstill hold by a current vector fixed in the stator frame (pmstep_hold.h). */
+#include "pmstep_internal.h"
+
+#include <stddef.h>
+
+/* Longest settling time counted, in periods (a weak hold of a heavy rotor): far below the
+ * float-to-integer range. */
+#define HOLD_MAX_SETTLE_PERIODS 1.0e6f
+
+pmstep_status_t pmstep_hold_vector(pmstep_t *inst, float cos_rest, float sin_rest, float current_A, float load_Nm)
+{
+    const pmstep_law_coeffs_t *law;
+    pmstep_vector_hold_t *hold;
+    pmstep_detent_t detent;
+    float sin_delta;
+    float cos_delta;
+    float natural_rad_s;
+    float settle_periods;
+    if (inst == NULL) {
+        return PMSTEP_ERR_NULL_ARGUMENT;
+    }
+    if (inst->mode != PMSTEP_MODE_RUN || !inst->run_started || inst->cfg->known_load_mode) {
+        return PMSTEP_ERR_BAD_MODE;
+    }
+    if (!pmstep_all_finite4(cos_rest, sin_rest, current_A, load_Nm)
+        || !(pmstep_abs(cos_rest * cos_rest + sin_rest * sin_rest - 1.0f) <= 0.02f)) {
+        return PMSTEP_ERR_BAD_COMMAND_VALUE;
+    }
+    if (!(current_A > 0.0f && current_A < inst->cfg->limits.max_phase_current_A)) {
+        return PMSTEP_ERR_HOLD_CURRENT;
+    }
+    law = &inst->law_coeffs;
+    detent = pmstep_law_detent(law, cos_rest, sin_rest, 0.0f);
+    /* k_M I sin(delta) = T_L - T_detent(rest), k_M from the commissioned model */
+    sin_delta = (load_Nm - detent.torque_Nm) / (law->km_over_l * law->inductance_H * current_A);
+    if (!(pmstep_abs(sin_delta) <= PMSTEP_HOLD_MAX_TORQUE_FRACTION)) {
+        return PMSTEP_ERR_HOLD_CURRENT;
+    }
+    hold = &inst->hold;
+    cos_delta = sqrtf(1.0f - sin_delta * sin_delta);
+    pmstep_turn(cos_rest, sin_rest, cos_delta, sin_delta, &hold->cos_vector, &hold->sin_vector);
+    natural_rad_s = sqrtf(law->pole_pairs * current_A * cos_delta / law->j_over_km); /* sqrt(p k_M I cos d / J) */
+    hold->current_A = current_A;
+    hold->damping_s = 2.0f * PMSTEP_HOLD_DAMPING_RATIO * law->pole_pairs / natural_rad_s;
+    hold->quiet_band_rad_s = PMSTEP_HOLD_QUIET_FRACTION * natural_rad_s / law->pole_pairs;
+    hold->bias_gain = natural_rad_s * inst->cfg->timing.period_s / PMSTEP_HOLD_BIAS_CORNER_RATIO;
+    settle_periods = PMSTEP_HOLD_SETTLE_TIME_CONSTANTS
+                     / (PMSTEP_HOLD_DAMPING_RATIO * natural_rad_s * inst->cfg->timing.period_s);
+    hold->settle_periods = (uint32_t)(settle_periods < HOLD_MAX_SETTLE_PERIODS ? settle_periods
+                                                                               : HOLD_MAX_SETTLE_PERIODS);
+    hold->cos_frame = hold->cos_vector;
+    hold->sin_frame = hold->sin_vector;
+    if (!hold->active) { /* from the law: its integrals were of other errors */
+        inst->current_integral.i_d_error_integral_As = 0.0f;
+        inst->current_integral.i_q_error_integral_As = 0.0f;
+        hold->speed_bias_rad_s = 0.0f;
+        hold->active = true;
+    }
+    return PMSTEP_OK;
+}
+
+void pmstep_release_vector(pmstep_t *inst)
+{
+    if (inst != NULL && inst->hold.active) {
+        inst->hold.active = false;
+        inst->current_integral.i_d_error_integral_As = 0.0f;
+        inst->current_integral.i_q_error_integral_As = 0.0f;
+    }
+}
+
+pmstep_status_t pmstep_set_angle_estimate(pmstep_t *inst, float cos_hat, float sin_hat)
+{
+    if (inst == NULL) {
+        return PMSTEP_ERR_NULL_ARGUMENT;
+    }
+    if (inst->mode != PMSTEP_MODE_RUN || !inst->run_started) {
+        return PMSTEP_ERR_BAD_MODE;
+    }
+    if (!pmstep_all_finite4(cos_hat, sin_hat, 0.0f, 0.0f)) {
+        return PMSTEP_ERR_BAD_COMMAND_VALUE;
+    }
+    pmstep_angle_set(&inst->angle, &inst->angle_coeffs, cos_hat, sin_hat);
+    return PMSTEP_OK;
+}
+
+/* The hold's arithmetic is written out here, not through pmstep_park(), pmstep_law_voltages()
+ * or pmstep_small_rotation(): a second caller makes -Os keep those out of line, and the RUN
+ * step then pays their calls every period (LTO image: about 40 instructions a period). */
+void pmstep_hold_voltages(pmstep_t *inst, pmstep_observer_input_t *obs_in, pmstep_output_t *out)
+{
+    pmstep_vector_hold_t *hold = &inst->hold;
+    const pmstep_law_coeffs_t *law = &inst->law_coeffs;
+    const float speed_change = inst->observer.speed_hat_rad_s - hold->speed_bias_rad_s;
+    float turn = -hold->damping_s * speed_change;
+    float c;
+    float s;
+    float i_d_err;
+    float i_q_err;
+    float u_d;
+    float u_q;
+    if (pmstep_abs(turn) > PMSTEP_HOLD_MAX_DAMPING_TURN) {
+        turn = turn > 0.0f ? PMSTEP_HOLD_MAX_DAMPING_TURN : -PMSTEP_HOLD_MAX_DAMPING_TURN;
+    }
+    hold->speed_bias_rad_s += hold->bias_gain * speed_change; /* w-bar: w-hat low-passed at w_n / 20 */
+    {
+        /* the vector turned by the damping, (cos t, sin t) to second order: |t| <= 0.5, and the
+         * frame needs no more than a damping term's accuracy */
+        const float cos_turn = 1.0f - 0.5f * turn * turn;
+        c = hold->cos_vector * cos_turn - hold->sin_vector * turn;
+        s = hold->sin_vector * cos_turn + hold->cos_vector * turn;
+    }
+    hold->cos_frame = c;
+    hold->sin_frame = s;
+    /* the currents in the frame (Park), their errors from i_d* = I, i_q* = 0 */
+    i_d_err = c * obs_in->i_a_A + s * obs_in->i_b_A - hold->current_A;
+    i_q_err = c * obs_in->i_b_A - s * obs_in->i_a_A;
+    obs_in->i_d_err_A = i_d_err; /* the PI integral's errors (the observer of (6) reads none) */
+    obs_in->i_q_err_A = i_q_err;
+    /* the law's current loop (pmstep_law_voltages) at zero speed: u = L [(R/L) i* - K_i e - K_I z] */
+    u_d = law->inductance_H * (law->r_over_l_per_s * hold->current_A - law->current_gain_per_s * i_d_err
+                               - law->current_integral_gain_per_s2 * inst->current_integral.i_d_error_integral_As);
+    u_q = law->inductance_H * (-law->current_gain_per_s * i_q_err
+                               - law->current_integral_gain_per_s2 * inst->current_integral.i_q_error_integral_As);
+    out->u_a_V = c * u_d - s * u_q;
+    out->u_b_V = s * u_d + c * u_q;
+}

@@ -1,0 +1,128 @@
+/* Vector hold at the end of a move (pmstep_position.h, "Vector hold"; the core's side in
+ * pmstep_hold.h). */
+#include "pmstep_position_internal.h"
+
+#include <math.h> /* fabsf, sqrtf: one instruction each, no libm call */
+
+/* The periods at rest before a re-aim, the error (electrical rad) that makes one, and the
+ * largest error a move may end with to aim at all. */
+#define POSITION_REAIM_PERIODS ((int32_t)200)
+#define POSITION_REAIM_ERROR_RAD 0.05f
+#define POSITION_AIM_MAX_ERROR_RAD 1.0f
+/* The wait before aiming, in time constants 1/k_theta of the position loop: the load estimate
+ * settles after the deceleration (its transient would aim the vector off; the paper motor's
+ * T_L-hat is 2e-3 N m at a move's end, 1e-4 N m 90 ms later). */
+#define POSITION_AIM_WAIT_TIME_CONSTANTS 2.0f
+
+/* Vector hold: aims the core's vector at (pos->rest_cos, rest_sin) ahead by the load angle of
+ * pos->aim_load_Nm; the speed reference at rest, the loop's integral cleared (the vector carries
+ * the load). */
+static void hold_at_rest(pmstep_position_t *pos)
+{
+    pmstep_t *inst = pos->inst;
+    if (pmstep_hold_vector(inst, pos->rest_cos, pos->rest_sin, pos->cfg.hold_current_A, pos->aim_load_Nm)
+        != PMSTEP_OK) {
+        pmstep_release_vector(inst); /* a load beyond the vector's pull: the loop holds on */
+        pos->hold_stage = POSITION_HOLD_REFUSED;
+        return;
+    }
+    pmstep_ref_reset(&inst->speed_ref, 0.0f);
+    pos->error_integral_rad_s = 0.0f;
+    pos->hold_stage = POSITION_HOLD_SETTLING;
+    pos->hold_periods = (int32_t)inst->hold.settle_periods;
+}
+
+/* The target's direction is the estimate's turned by the error left, p (theta* - theta-hat)
+ * (within POSITION_AIM_MAX_ERROR_RAD, else the loop holds on). */
+static void aim_vector(pmstep_position_t *pos, float position_rad)
+{
+    const float error = (pos->now.position - position_rad) / pos->inv_pole_pairs;
+    const float length = sqrtf(pos->cos_hat * pos->cos_hat + pos->sin_hat * pos->sin_hat);
+    float cos_error;
+    float sin_error;
+    if (!(fabsf(error) <= POSITION_AIM_MAX_ERROR_RAD && length > 0.0f)) {
+        pos->hold_stage = POSITION_HOLD_REFUSED;
+        return;
+    }
+    pmstep_small_rotation(error, &cos_error, &sin_error);
+    pmstep_turn(pos->cos_hat / length, pos->sin_hat / length, cos_error, sin_error, &pos->rest_cos, &pos->rest_sin);
+    pos->aim_load_Nm = pos->inst->observer.load_hat_Nm;
+    hold_at_rest(pos);
+}
+
+void pmstep_position_wait_and_aim(pmstep_position_t *pos, float position_rad)
+{
+    if (pos->hold_stage == POSITION_HOLD_NONE) {
+        pos->hold_stage = POSITION_HOLD_WAITING;
+        pos->hold_periods = (int32_t)(POSITION_AIM_WAIT_TIME_CONSTANTS / (pos->cfg.gain_per_s * pos->period_s));
+    }
+    pos->hold_periods -= PMSTEP_POSITION_DECIMATION;
+    if (pos->hold_periods <= 0) {
+        aim_vector(pos, position_rad);
+    }
+}
+
+/* The rotor rests p (theta* - theta-hat) from the target: the vector's aim is turned by that
+ * displacement (at most POSITION_AIM_MAX_ERROR_RAD a time), its load angle kept. The estimate
+ * over the short rest measures what T_L-hat cannot: held, the observer sees the vector's own
+ * torque and T_L-hat only confirms the aim. */
+static void correct_aim(pmstep_position_t *pos)
+{
+    float error = pos->out.position_error_rad / pos->inv_pole_pairs;
+    float cos_error;
+    float sin_error;
+    float c;
+    if (fabsf(error) > POSITION_AIM_MAX_ERROR_RAD) {
+        error = error > 0.0f ? POSITION_AIM_MAX_ERROR_RAD : -POSITION_AIM_MAX_ERROR_RAD;
+    }
+    pmstep_small_rotation(error, &cos_error, &sin_error);
+    c = pos->rest_cos;
+    pmstep_turn(c, pos->rest_sin, cos_error, sin_error, &pos->rest_cos, &pos->rest_sin);
+    hold_at_rest(pos);
+}
+
+/* An update in a vector hold: settling, then the estimate kept while the rotor is at rest (it
+ * would drift: nothing observes its phase at zero speed) and followed while the rotor moves;
+ * after POSITION_REAIM_PERIODS more at rest more than POSITION_REAIM_ERROR_RAD from the target
+ * (the aim's load angle off, or the load changed), the aim is corrected (pmstep_position.h). */
+void pmstep_position_vector_hold(pmstep_position_t *pos, float position_rad)
+{
+    pmstep_t *inst = pos->inst;
+    pos->out.moving = false;
+    pos->out.position_ref_rad = pos->now.position;
+    pos->out.position_error_rad = pos->now.position - position_rad;
+    if (pos->hold_stage == POSITION_HOLD_SETTLING) {
+        pos->hold_periods -= PMSTEP_POSITION_DECIMATION;
+        if (pos->hold_periods <= 0) { /* settled: the rest is counted from here */
+            pos->hold_periods = 0;
+            pos->hold_stage = POSITION_HOLD_ANCHORED;
+        }
+    } else if (fabsf(pos->speed_hat_rad_s - inst->hold.speed_bias_rad_s) < inst->hold.quiet_band_rad_s) {
+        /* at rest for one more update; after a settling time of it, the estimate is kept (taken
+         * then, not when the rest began: the ring-down's last motion would be lost) */
+        const int32_t keep_after = (int32_t)inst->hold.settle_periods;
+        pos->hold_periods += PMSTEP_POSITION_DECIMATION;
+        if (pos->hold_periods - PMSTEP_POSITION_DECIMATION < keep_after) {
+            pos->frozen_cos = pos->cos_hat;
+            pos->frozen_sin = pos->sin_hat;
+        } else {
+            (void)pmstep_set_angle_estimate(inst, pos->frozen_cos, pos->frozen_sin);
+        }
+        if (pos->hold_periods >= keep_after + POSITION_REAIM_PERIODS
+            && fabsf(pos->out.position_error_rad) / pos->inv_pole_pairs > POSITION_REAIM_ERROR_RAD) {
+            correct_aim(pos);
+        }
+    } else {
+        pos->hold_periods = 0; /* moving: the estimate follows the flux integrals */
+    }
+}
+
+/* Ends a vector hold (a move, a stop). */
+void pmstep_position_release_hold(pmstep_position_t *pos)
+{
+    if (pos->hold_stage != POSITION_HOLD_NONE) {
+        pmstep_release_vector(pos->inst);
+        pos->hold_stage = POSITION_HOLD_NONE;
+    }
+}
+

@@ -1,0 +1,26 @@
+/* Private to the position library's sources: the vector hold at the end of a move
+ * (pmstep_position_hold.c), called from the loop's updates (pmstep_position.c). */
+#ifndef PMSTEP_POSITION_INTERNAL_H
+#define PMSTEP_POSITION_INTERNAL_H
+
+#include "pmstep/pmstep_position.h"
+
+/* pmstep_position_t.hold_stage */
+#define POSITION_HOLD_NONE ((int32_t)0)
+#define POSITION_HOLD_WAITING ((int32_t)4) /* the move has ended; the loop holds while T_L-hat settles */
+#define POSITION_HOLD_SETTLING ((int32_t)1)
+#define POSITION_HOLD_ANCHORED ((int32_t)2)
+#define POSITION_HOLD_REFUSED ((int32_t)3) /* until the next move: the loop holds on the estimate */
+
+/* An update in position mode with the profile ended and no vector yet: the loop holds
+ * POSITION_AIM_WAIT_TIME_CONSTANTS / k_theta, then aims the core's vector at the target (or the
+ * stage becomes refused). */
+void pmstep_position_wait_and_aim(pmstep_position_t *pos, float position_rad);
+
+/* An update while the vector holds (settling or anchored). */
+void pmstep_position_vector_hold(pmstep_position_t *pos, float position_rad);
+
+/* Ends a vector hold (a move, a stop); the stage returns to none. */
+void pmstep_position_release_hold(pmstep_position_t *pos);
+
+#endif /* PMSTEP_POSITION_INTERNAL_H */

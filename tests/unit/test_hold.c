@@ -1,0 +1,168 @@
+/* The core's vector hold (pmstep_hold.h) against the real module on a paper-configured
+ * instance put in RUN: the command's refusals, the vector, spring and damping it derives, the
+ * period's voltage (the law's current loop in the vector's frame), the release, and the angle
+ * estimate's set. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+
+#include "pmstep/pmstep.h"
+#include "pmstep/pmstep_text.h"
+#include "../../firmware/src/pmstep_internal.h" /* pmstep_hold_voltages, the period's part */
+
+/* Paper: k_M = 2 N m/A, J = 0.01 kg m^2, p = 6, R = 3 Ohm, current trip 15 A, 20 kHz. */
+typedef struct {
+    pmstep_config_t cfg;
+    pmstep_t inst;
+} fixture_t;
+
+static void fixture_in_run(fixture_t *f)
+{
+    f->cfg = pmstep_paper_config();
+    assert_int_equal(pmstep_init(&f->inst, &f->cfg), PMSTEP_OK);
+    f->inst.mode = PMSTEP_MODE_RUN; /* as at t_c, without the alignments */
+    f->inst.run_started = true;
+    pmstep_angle_start(&f->inst.angle, 0.0f, 0.0f);
+}
+
+static void hold_refuses_with_named_codes(void **state)
+{
+    fixture_t f;
+    pmstep_t idle;
+    (void)state;
+    fixture_in_run(&f);
+    idle = f.inst;
+    idle.mode = PMSTEP_MODE_IDLE;
+    assert_int_equal(pmstep_hold_vector(NULL, 1.0f, 0.0f, 7.5f, 0.0f), PMSTEP_ERR_NULL_ARGUMENT);
+    assert_int_equal(pmstep_hold_vector(&idle, 1.0f, 0.0f, 7.5f, 0.0f), PMSTEP_ERR_BAD_MODE);
+    assert_int_equal(pmstep_hold_vector(&f.inst, NAN, 0.0f, 7.5f, 0.0f), PMSTEP_ERR_BAD_COMMAND_VALUE);
+    assert_int_equal(pmstep_hold_vector(&f.inst, 1.0f, 0.0f, 7.5f, INFINITY), PMSTEP_ERR_BAD_COMMAND_VALUE);
+    assert_int_equal(pmstep_hold_vector(&f.inst, 0.97f, 0.0f, 7.5f, 0.0f), PMSTEP_ERR_BAD_COMMAND_VALUE);
+    assert_int_equal(pmstep_hold_vector(&f.inst, 0.0f, 0.0f, 7.5f, 0.0f), PMSTEP_ERR_BAD_COMMAND_VALUE);
+    assert_int_equal(pmstep_hold_vector(&f.inst, 1.0f, 0.0f, 0.0f, 0.0f), PMSTEP_ERR_HOLD_CURRENT);
+    assert_int_equal(pmstep_hold_vector(&f.inst, 1.0f, 0.0f, 15.0f, 0.0f), PMSTEP_ERR_HOLD_CURRENT); /* the trip */
+    /* the load beyond 0.9 k_M I = 13.5 N m, either way */
+    assert_int_equal(pmstep_hold_vector(&f.inst, 1.0f, 0.0f, 7.5f, 13.6f), PMSTEP_ERR_HOLD_CURRENT);
+    assert_int_equal(pmstep_hold_vector(&f.inst, 1.0f, 0.0f, 7.5f, -13.6f), PMSTEP_ERR_HOLD_CURRENT);
+    assert_false(f.inst.hold.active);
+    assert_int_equal(pmstep_hold_vector(&f.inst, 1.0f, 0.0f, 7.5f, 13.4f), PMSTEP_OK);
+    assert_true(f.inst.hold.active);
+    f.cfg.known_load_mode = true; /* Remark 1: the law has the load, no hold */
+    assert_int_equal(pmstep_hold_vector(&f.inst, 1.0f, 0.0f, 7.5f, 0.0f), PMSTEP_ERR_BAD_MODE);
+    assert_string_equal(pmstep_status_str(PMSTEP_ERR_HOLD_CURRENT),
+                        "need 0 < hold current < max_phase_current_A and |T_L - T_detent| <= 0.9 k_M I");
+}
+
+static void hold_derives_vector_spring_and_damping(void **state)
+{
+    fixture_t f;
+    const double rest = 2.0; /* electrical rad */
+    const double delta = asin(4.8 / (2.0 * 7.5));
+    const double w_n = sqrt(6.0 * 2.0 * 7.5 * cos(delta) / 0.01);
+    (void)state;
+    fixture_in_run(&f);
+    f.inst.current_integral.i_d_error_integral_As = 0.1f;
+    f.inst.current_integral.i_q_error_integral_As = -0.1f;
+    assert_int_equal(pmstep_hold_vector(&f.inst, (float)cos(rest), (float)sin(rest), 7.5f, 4.8f), PMSTEP_OK);
+    assert_float_equal(f.inst.hold.cos_vector, cos(rest + delta), 2e-6);
+    assert_float_equal(f.inst.hold.sin_vector, sin(rest + delta), 2e-6);
+    assert_float_equal(f.inst.hold.current_A, 7.5f, 0.0f);
+    assert_float_equal(f.inst.hold.damping_s, 2.0 * 0.7 * 6.0 / w_n, 1e-6 * 2.0 * 0.7 * 6.0 / w_n);
+    assert_float_equal(f.inst.hold.quiet_band_rad_s, 0.05 * w_n / 6.0, 1e-6 * w_n);
+    assert_float_equal(f.inst.hold.bias_gain, w_n * 5e-5 / 20.0, 1e-6 * w_n * 5e-5);
+    assert_int_equal(f.inst.hold.settle_periods, (uint32_t)(6.0 / (0.7 * w_n * 5e-5)));
+    assert_float_equal(f.inst.current_integral.i_d_error_integral_As, 0.0f, 0.0f); /* restarted */
+    assert_float_equal(f.inst.current_integral.i_q_error_integral_As, 0.0f, 0.0f);
+    print_message("paper motor, 7.5 A, 4.8 N m: load angle %.4f rad, w_n %.2f rad/s, settling %u periods\n",
+                  delta, w_n, (unsigned)f.inst.hold.settle_periods);
+}
+
+static void hold_voltage_is_the_current_loop_in_the_vector_frame(void **state)
+{
+    fixture_t f;
+    pmstep_observer_input_t obs_in;
+    pmstep_output_t out;
+    const double v = 0.7; /* the vector's angle (no load) */
+    (void)state;
+    fixture_in_run(&f);
+    assert_int_equal(pmstep_hold_vector(&f.inst, (float)cos(v), (float)sin(v), 7.5f, 0.0f), PMSTEP_OK);
+    /* at rest, the current on the vector: u = R I along it (K_I = 0 in the paper's law) */
+    f.inst.observer.speed_hat_rad_s = 0.0f;
+    obs_in.i_a_A = (float)(7.5 * cos(v));
+    obs_in.i_b_A = (float)(7.5 * sin(v));
+    pmstep_hold_voltages(&f.inst, &obs_in, &out);
+    assert_float_equal(out.u_a_V, 3.0 * 7.5 * cos(v), 2e-4);
+    assert_float_equal(out.u_b_V, 3.0 * 7.5 * sin(v), 2e-4);
+    assert_float_equal(obs_in.i_d_err_A, 0.0f, 2e-6);
+    assert_float_equal(obs_in.i_q_err_A, 0.0f, 2e-6);
+    /* 1 A short along the vector: u_d = L (R/L I - K_i e) = 22.5 + L K_i, K_i = 20 1/s, L = 6e-3 H */
+    obs_in.i_a_A = (float)(6.5 * cos(v));
+    obs_in.i_b_A = (float)(6.5 * sin(v));
+    pmstep_hold_voltages(&f.inst, &obs_in, &out);
+    assert_float_equal(obs_in.i_d_err_A, -1.0f, 2e-6);
+    assert_float_equal(out.u_a_V * cos(v) + out.u_b_V * sin(v), 22.5 + 6e-3 * 20.0, 2e-4);
+    /* the rotor moving forward: the frame turns back by the damping, g w-hat (w-bar still 0) */
+    f.inst.observer.speed_hat_rad_s = 1.0f;
+    pmstep_hold_voltages(&f.inst, &obs_in, &out);
+    assert_float_equal(atan2(f.inst.hold.sin_frame, f.inst.hold.cos_frame), v - f.inst.hold.damping_s,
+                       0.01 * f.inst.hold.damping_s);
+    /* w-bar follows w-hat by the filter's gain each period */
+    assert_float_equal(f.inst.hold.speed_bias_rad_s, f.inst.hold.bias_gain, 1e-7);
+}
+
+static void release_and_speed_command_end_the_hold(void **state)
+{
+    fixture_t f;
+    (void)state;
+    fixture_in_run(&f);
+    pmstep_release_vector(&f.inst); /* none in force: nothing */
+    pmstep_release_vector(NULL);
+    assert_false(f.inst.hold.active);
+    assert_int_equal(pmstep_hold_vector(&f.inst, 1.0f, 0.0f, 7.5f, 0.0f), PMSTEP_OK);
+    f.inst.current_integral.i_d_error_integral_As = 0.1f;
+    pmstep_release_vector(&f.inst);
+    assert_false(f.inst.hold.active);
+    assert_float_equal(f.inst.current_integral.i_d_error_integral_As, 0.0f, 0.0f);
+    assert_int_equal(pmstep_hold_vector(&f.inst, 1.0f, 0.0f, 7.5f, 0.0f), PMSTEP_OK);
+    assert_int_equal(pmstep_set_speed_target(&f.inst, 1.0f, 10.0f), PMSTEP_OK);
+    assert_false(f.inst.hold.active);
+    assert_int_equal(pmstep_hold_vector(&f.inst, 1.0f, 0.0f, 7.5f, 0.0f), PMSTEP_OK);
+    assert_int_equal(pmstep_stop(&f.inst), PMSTEP_OK); /* leaving RUN */
+    assert_false(f.inst.hold.active);
+}
+
+static void angle_estimate_set_gives_that_estimate(void **state)
+{
+    fixture_t f;
+    float c;
+    float s;
+    pmstep_t idle;
+    (void)state;
+    fixture_in_run(&f);
+    pmstep_angle_update(&f.inst.angle, &f.inst.angle_coeffs, 1.5f, -0.5f, 10.0f, 3.0f); /* some history */
+    assert_int_equal(pmstep_set_angle_estimate(&f.inst, 0.6f, -0.8f), PMSTEP_OK);
+    pmstep_angle_estimate(&f.inst.angle, &f.inst.angle_coeffs, 1.5f, -0.5f, &c, &s);
+    assert_float_equal(c, 0.6f, 1e-6f);
+    assert_float_equal(s, -0.8f, 1e-6f);
+    assert_int_equal(pmstep_set_angle_estimate(NULL, 1.0f, 0.0f), PMSTEP_ERR_NULL_ARGUMENT);
+    assert_int_equal(pmstep_set_angle_estimate(&f.inst, NAN, 0.0f), PMSTEP_ERR_BAD_COMMAND_VALUE);
+    idle = f.inst;
+    idle.mode = PMSTEP_MODE_IDLE;
+    assert_int_equal(pmstep_set_angle_estimate(&idle, 1.0f, 0.0f), PMSTEP_ERR_BAD_MODE);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(hold_refuses_with_named_codes),
+        cmocka_unit_test(hold_derives_vector_spring_and_damping),
+        cmocka_unit_test(hold_voltage_is_the_current_loop_in_the_vector_frame),
+        cmocka_unit_test(release_and_speed_command_end_the_hold),
+        cmocka_unit_test(angle_estimate_set_gives_that_estimate),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
