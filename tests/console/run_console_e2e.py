@@ -57,9 +57,9 @@ TOLERANCE = {"speed_hat_rad_s": ("omega_hat_rad_s", 1e-5), "load_hat_Nm": ("load
 # The position run's move and its bound: the issue's final-error criterion, 0.1 electrical rad
 # (0.1/p mechanical, p = 6). The host SIL's run of the same move (pmstep-sil --set
 # run.duration_s=0.9 --set run.substeps=10 --set position.points=0.605:0.5 --set speed.points=0:0)
-# ends 0.0102 electrical rad from the target (its 2 N m load step at 0.63 s comes during the move)
-# with the estimate within 2.3e-5 of the truth: the
-# read-back theta-hat is then within 0.0103 electrical rad, 1.7e-3 mechanical, a factor 10 inside.
+# ends 0.0080 electrical rad from the target (its 2 N m load step at 0.63 s comes during the move)
+# with the estimate within 1.4e-5 of the truth: the
+# read-back theta-hat is then within 0.0079 electrical rad, 1.3e-3 mechanical, a factor 12 inside.
 POSITION_TARGET_RAD = 0.5
 POSITION_BOUND_RAD = 0.1 / 6.0
 
@@ -115,11 +115,26 @@ class Fuzzer(threading.Thread):
                 data = b"".join(pc.encode(pc.HELLO, 0xEE) for _ in range(50))
             self.link.write(data)
             time.sleep(0.002)
-        # Last, a frame cut short and then silence: the image drops it after 20 ms of its own
-        # time without a byte (under -icount shift=0 that is far more than 20 ms of real time).
+
+    def cut_frame_then_silence(self, con):
+        """Last, a frame cut short and then silence: the image drops it after 20 ms of its own time
+        without a byte (under -icount shift=0 that is far more than 20 ms of real time). First the
+        host waits until the image has read all the bad input: QEMU hands the guest the socket's
+        bytes one at a time, and on a loaded machine it can still be reading them seconds after the
+        writer stopped; a request sent then would land in the middle of a cut frame and be lost.
+        A HELLO answered proves everything before it read; one that a cut frame swallowed goes
+        unanswered, and the next one is sent."""
+        for _ in range(30):
+            try:
+                con.request(pc.HELLO, timeout=2.0)
+                break
+            except TimeoutError:
+                continue
+        else:
+            raise TimeoutError("the image answered none of 30 HELLOs after the bad input")
         self.sent["truncated"] += 1
         self.link.write(pc.encode(pc.START, 0xEE)[:3])
-        time.sleep(3.0)
+        con.pump(3.0)
 
 
 def step_addresses(elf):
@@ -193,8 +208,8 @@ def run_target(a, out, mode, period_s, k_speed, steps):
             assert status == 0 and period == stop_at, (status, period)
             if fz:
                 fz.join()
-                con.pump(0.2)  # the replies to the bad requests
-                con.pending.clear()
+                fz.cut_frame_then_silence(con)
+                con.pending.clear()  # the replies to the bad requests
             if stop_at == k_speed:
                 assert con.speed(10.0, 50.0) == k_speed  # as the SIL's scenario: before period k_speed
         status = con.status()
@@ -336,8 +351,13 @@ def main():
             failures.append(f"fuzz run counted no {k}")
     for m, v in clean["cost"]["modes"].items():
         fv = fuzz["cost"]["modes"].get(m)
-        # SysTick counts every 40 instructions; the mean of thousands of steps carries well under one.
-        if fv is None or fv["steps"] != v["steps"] or abs(fv["instructions_mean"] - v["instructions_mean"]) > 1.0:
+        if fv is None or fv["steps"] != v["steps"]:
+            failures.append(f"control step count of {m}: clean {v} vs fuzz {fv}")
+        # SysTick counts every 40 instructions, and where a step starts against that grid depends on
+        # the console's I/O, which QEMU times from the host: three clean runs of the same image gave
+        # C_ALIGN means of 254.83, 254.94 and 255.84 (exactly 254 each step, plugin). With the plugin
+        # the exact counts are compared step by step below; without it, these means within 1.0.
+        elif not a.plugin and abs(fv["instructions_mean"] - v["instructions_mean"]) > 1.0:
             failures.append(f"control step cost of {m}: clean {v} vs fuzz {fv}")
     if a.plugin:
         ca, fa = clean["insns"], fuzz["insns"]
