@@ -1,0 +1,154 @@
+/* The position library's vector hold at the end of a move (pmstep_position_hold.c) against the
+ * real modules on a paper-configured instance put in RUN: the aim (the estimate turned by
+ * p (theta* - theta-hat), ahead by the load angle of T_L-hat), and the two refusals that leave
+ * the position loop holding - a load beyond the vector's pull, a move ending more than 1
+ * electrical rad off - until the next move. The rotor is held still by the test (the estimate
+ * stays where the test puts it), so the error a move ends with is chosen exactly. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+
+#include "pmstep/pmstep.h"
+#include "pmstep/pmstep_position.h"
+#include "../../firmware/src/pmstep_position_internal.h" /* the hold's stages */
+
+/* Paper: k_M = 2 N m/A, p = 6; hold current 7.5 A: the vector pulls at most 0.9 k_M I = 13.5 N m. */
+#define HOLD_CURRENT_A 7.5f
+#define REST_ELECTRICAL_RAD 0.3
+
+typedef struct {
+    pmstep_config_t cfg;
+    pmstep_t inst;
+    pmstep_position_t pos;
+    pmstep_position_config_t pos_cfg;
+} fixture_t;
+
+static void fixture_in_run(fixture_t *f)
+{
+    f->cfg = pmstep_paper_config();
+    assert_int_equal(pmstep_init(&f->inst, &f->cfg), PMSTEP_OK);
+    f->inst.mode = PMSTEP_MODE_RUN; /* as at t_c, without the alignments */
+    f->inst.run_started = true;
+    pmstep_angle_start(&f->inst.angle, 0.0f, 0.0f);
+    f->pos_cfg.gain_per_s = 25.0f;
+    f->pos_cfg.integral_gain_per_s2 = 0.0f;
+    f->pos_cfg.hold_current_A = HOLD_CURRENT_A;
+    assert_int_equal(pmstep_position_init(&f->pos, &f->inst, &f->pos_cfg), PMSTEP_OK);
+}
+
+/* @p periods of RUN with the rotor and its estimate at rest at @p electrical_rad. */
+static void rest_at(fixture_t *f, double electrical_rad, long periods)
+{
+    pmstep_output_t out = {0};
+    pmstep_position_output_t pos_out;
+    long n;
+    out.mode = PMSTEP_MODE_RUN;
+    out.cos_hat = (float)cos(electrical_rad);
+    out.sin_hat = (float)sin(electrical_rad);
+    for (n = 0; n < periods; ++n) {
+        pmstep_position_update(&f->pos, &out, &pos_out);
+    }
+}
+
+/* A move from the rest angle to @p error_electrical_rad beyond it, the rotor left where it was:
+ * the move ends that far off. Runs until the library has aimed or refused (the profile takes
+ * 0.1 s, the wait 2/k_theta 0.08 s), at most 1 s. */
+static void move_and_stay(fixture_t *f, double error_electrical_rad, float load_hat_Nm)
+{
+    const float target_rad = (float)((REST_ELECTRICAL_RAD + error_electrical_rad) / 6.0);
+    long n;
+    f->inst.observer.load_hat_Nm = load_hat_Nm;
+    assert_int_equal(pmstep_position_move_to(&f->pos, target_rad, 1.0f, 10.0f, 0.0f), PMSTEP_OK);
+    assert_int_equal(f->pos.hold_stage, POSITION_HOLD_NONE);
+    for (n = 0; n < 20000 && (f->pos.hold_stage == POSITION_HOLD_NONE || f->pos.hold_stage == POSITION_HOLD_WAITING);
+         ++n) {
+        rest_at(f, REST_ELECTRICAL_RAD, 1);
+    }
+    print_message("move ending %.2f electrical rad off, T_L-hat %.1f N m: aimed or refused after %.3f s\n",
+                  error_electrical_rad, (double)load_hat_Nm, (double)n * 5e-5);
+    assert_true(n < 20000);
+}
+
+static double vector_angle(const fixture_t *f)
+{
+    return atan2((double)f->inst.hold.sin_vector, (double)f->inst.hold.cos_vector);
+}
+
+static void move_end_aims_at_the_target_ahead_by_the_load_angle(void **state)
+{
+    fixture_t f;
+    const double delta = asin(4.8 / (2.0 * (double)HOLD_CURRENT_A));
+    (void)state;
+    fixture_in_run(&f);
+    rest_at(&f, REST_ELECTRICAL_RAD, 10);
+    move_and_stay(&f, 0.4, 4.8f);
+    assert_int_equal(f.pos.hold_stage, POSITION_HOLD_SETTLING);
+    assert_true(f.inst.hold.active);
+    assert_float_equal(f.inst.hold.current_A, HOLD_CURRENT_A, 0.0f);
+    /* the target's direction, 0.3 + 0.4 electrical rad, and the load angle ahead of it */
+    assert_float_equal(atan2((double)f.pos.rest_sin, (double)f.pos.rest_cos), REST_ELECTRICAL_RAD + 0.4, 2e-5);
+    assert_float_equal(vector_angle(&f), REST_ELECTRICAL_RAD + 0.4 + delta, 2e-5);
+    print_message("aim at 0.7 electrical rad with T_L-hat 4.8 N m: vector at %.5f (0.7 + load angle %.5f)\n",
+                  vector_angle(&f), delta);
+}
+
+static void load_beyond_the_vectors_pull_leaves_the_loop_holding(void **state)
+{
+    fixture_t f;
+    (void)state;
+    fixture_in_run(&f);
+    rest_at(&f, REST_ELECTRICAL_RAD, 10);
+    move_and_stay(&f, 0.4, 13.6f); /* 0.9 k_M I = 13.5 N m */
+    assert_int_equal(f.pos.hold_stage, POSITION_HOLD_REFUSED);
+    assert_false(f.inst.hold.active);
+    assert_true(f.pos.out.position_mode); /* the position loop holds on the estimate */
+    assert_false(f.pos.out.moving);
+    assert_float_equal(f.pos.out.position_error_rad, 0.4f / 6.0f, 1e-6f); /* theta* - theta-hat */
+    /* the loop drives the speed reference towards the target: k_theta (theta* - theta-hat) */
+    assert_float_equal(f.inst.speed_ref.value, 25.0f * 0.4f / 6.0f, 1e-4f);
+    /* the same load the other way */
+    fixture_in_run(&f);
+    rest_at(&f, REST_ELECTRICAL_RAD, 10);
+    move_and_stay(&f, 0.4, -13.6f);
+    assert_int_equal(f.pos.hold_stage, POSITION_HOLD_REFUSED);
+    assert_false(f.inst.hold.active);
+    /* the next move tries again: within the pull it is held */
+    move_and_stay(&f, 0.2, 13.4f);
+    assert_int_equal(f.pos.hold_stage, POSITION_HOLD_SETTLING);
+    assert_true(f.inst.hold.active);
+}
+
+static void move_ending_more_than_a_radian_off_is_not_aimed(void **state)
+{
+    fixture_t f;
+    (void)state;
+    fixture_in_run(&f);
+    rest_at(&f, REST_ELECTRICAL_RAD, 10);
+    move_and_stay(&f, 1.05, 0.0f); /* 1 electrical rad is the bound */
+    assert_int_equal(f.pos.hold_stage, POSITION_HOLD_REFUSED);
+    assert_false(f.inst.hold.active);
+    assert_true(f.pos.out.position_mode);
+    assert_float_equal(f.pos.out.position_error_rad, 1.05f / 6.0f, 1e-6f);
+    move_and_stay(&f, -1.05, 0.0f);
+    assert_int_equal(f.pos.hold_stage, POSITION_HOLD_REFUSED);
+    assert_false(f.inst.hold.active);
+    move_and_stay(&f, 0.95, 0.0f); /* within the bound: aimed */
+    assert_int_equal(f.pos.hold_stage, POSITION_HOLD_SETTLING);
+    /* the turn's Taylor polynomials (pmstep_rotation.h) err by below 0.95^6/720 + 0.95^7/5040 */
+    assert_float_equal(atan2((double)f.pos.rest_sin, (double)f.pos.rest_cos), REST_ELECTRICAL_RAD + 0.95,
+                       pow(0.95, 6) / 720.0 + pow(0.95, 7) / 5040.0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(move_end_aims_at_the_target_ahead_by_the_load_angle),
+        cmocka_unit_test(load_beyond_the_vectors_pull_leaves_the_loop_holding),
+        cmocka_unit_test(move_ending_more_than_a_radian_off_is_not_aimed),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
