@@ -171,13 +171,15 @@ pmstep_fault_t pmstep_commission_finish(const pmstep_commission_sums_t *sums, co
                                                   plan->inductance_steps, offset_b, period_s);
         const float volt_seconds = period_s * (sums->rise_voltage_sum_V
                                                - (float)plan->inductance_steps * result->voltage_bias_b_V);
-        inductance_H = (volt_seconds - r_b * charge_a_s) / (sums->rise_end_A - sums->rise_start_A);
-        result->inductance_H = inductance_H;
+        result->inductance_H = (volt_seconds - r_b * charge_a_s) / (sums->rise_end_A - sums->rise_start_A);
+        if (cfg->commissioning.use_measured_inductance) {
+            inductance_H = result->inductance_H;
+        }
     }
     if (windows) {
         /* Flux swing of c-alignment (see the header), samples t_s .. t_c, on the driven phase a:
          * its current is far from zero throughout, so its voltage is known (bias included). Its
-         * apparent L is phase b's on phase a's sensor scale. */
+         * apparent L is phase b's on phase a's sensor scale; the L is the one RUN takes. */
         const uint32_t periods = plan->c_align_end_step - plan->s_align_steps;
         const float flux_a = swing_flux(sums->swing_voltage_a_V + u_a_V - (float)periods * result->voltage_bias_a_V,
                                         sums->swing_current_a_A, sums->swing_start_a_A, i_a_A, periods, offset_a, r_a,
@@ -186,7 +188,7 @@ pmstep_fault_t pmstep_commission_finish(const pmstep_commission_sums_t *sums, co
     }
     if ((windows && !(plausible(r_a, cfg->motor.resistance_Ohm) && plausible(r_b, cfg->motor.resistance_Ohm)
                       && plausible(result->torque_constant_Nm_A, cfg->motor.torque_constant_Nm_A)))
-        || (plan->inductance_steps > 0u && !plausible(inductance_H, cfg->motor.inductance_H))) {
+        || (cfg->commissioning.use_measured_inductance && !plausible(inductance_H, cfg->motor.inductance_H))) {
         return PMSTEP_FAULT_COMMISSIONING;
     }
     return PMSTEP_FAULT_NONE;

@@ -78,9 +78,12 @@ void pmstep_commission_add_alignment(pmstep_commission_sums_t *sums, const pmste
 /**
  * At t_c: offsets, R, L and k_M (and the voltage biases) from the sums and the sample
  * i_a at t_c; values not measured are left 0 in @p result. The voltage of phase a over
- * the last period before t_c is @p u_a_V.
- * @return PMSTEP_FAULT_NONE, or PMSTEP_FAULT_COMMISSIONING when a measured value is not
- *         finite or outside [1/2, 2] x the configured one.
+ * the last period before t_c is @p u_a_V. k_M's flux swing takes the L that RUN will use:
+ * the measured one with use_measured_inductance, else the configured one (a rise during which
+ * the rotor turns - hybrid steppers - measures back EMF too; the designer then keeps the
+ * datasheet's L, and its measurement is only reported).
+ * @return PMSTEP_FAULT_NONE, or PMSTEP_FAULT_COMMISSIONING when R or k_M, or L where RUN takes
+ *         it, is not finite or outside [1/2, 2] x the configured one.
  */
 pmstep_fault_t pmstep_commission_finish(const pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
                                         const pmstep_config_t *cfg, float i_a_A, float u_a_V,

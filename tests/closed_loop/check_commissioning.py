@@ -1,0 +1,39 @@
+"""Checks a SIL run's commissioning in summary.json: no fault latched, the measured L at least
+--min-inductance-ratio x the motor's (the current rise saw the rotor turn), and k_M within
+--max-torque-constant-error of the motor's.
+
+usage: check_commissioning.py SUMMARY --motor-inductance H --motor-torque-constant K
+                              --min-inductance-ratio R --max-torque-constant-error E"""
+import argparse
+import json
+import sys
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("summary")
+    for k in ("motor-inductance", "motor-torque-constant", "min-inductance-ratio", "max-torque-constant-error"):
+        ap.add_argument(f"--{k}", type=float, required=True)
+    a = ap.parse_args()
+    with open(a.summary) as f:
+        s = json.load(f)
+    c = s["commissioning"]
+    l_ratio = c["inductance_H"] / a.motor_inductance
+    k_error = c["torque_constant_Nm_A"] / a.motor_torque_constant - 1.0
+    print(f"fault {s['fault']['name']}; measured L {c['inductance_H']:.6g} H ({l_ratio:.3f} x the motor's), "
+          f"k_M {c['torque_constant_Nm_A']:.6g} N m/A ({100 * k_error:+.2f} %), R {c['resistance_Ohm']:.6g} Ohm")
+    failures = []
+    if s["fault"]["name"] != "NONE":
+        failures.append(f"fault {s['fault']['name']} latched")
+    if not l_ratio >= a.min_inductance_ratio:
+        failures.append(f"the rise measured L {l_ratio:.3f} x the motor's, expected at least {a.min_inductance_ratio}")
+    if not abs(k_error) <= a.max_torque_constant_error:
+        failures.append(f"k_M {100 * k_error:+.2f} % off, bound {100 * a.max_torque_constant_error:.1f} %")
+    for f in failures:
+        print("FAIL:", f)
+    print(f"{3 - len(failures)} passed, {len(failures)} failed")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
