@@ -49,6 +49,7 @@ void sil_metrics_init(sil_metrics_t *m, const sil_scenario_t *sc, sil_summary_t 
     m->settle_step = m->transient_end_step;
     m->loss_speed_error_rad_s = sc->loss_speed_error_rad_s;
     m->loss_angle_error_rad = sc->loss_angle_error_rad;
+    m->loss_position_error_rad = sc->loss_position_error_rad;
     s->run_start_time_s = (double)m->tc_step * period_s;
     s->settle_time_s = (double)m->settle_step * period_s;
     s->loss_of_control_time_s = -1.0;
@@ -119,6 +120,18 @@ static void add_load_angle(sil_metrics_t *m, const sil_sample_t *x, sil_summary_
     }
 }
 
+/* Off course: in a position scenario's position mode, the true position more than
+ * loss_position_error_rad (electrical) from theta* - a positioning drive's loss of control is
+ * a lost step; its speed may leave omega* by more (a held rotor swings onto a load step's load
+ * angle) without losing anything. Otherwise the speed error above loss_speed_error_rad_s. */
+static bool off_course(const sil_metrics_t *m, const sil_sample_t *x, double speed_error)
+{
+    if (x->position != NULL && x->position->position_mode) {
+        return fabs(x->position_reference_rad - x->position_rad) * m->pole_pairs > m->loss_position_error_rad;
+    }
+    return speed_error > m->loss_speed_error_rad_s;
+}
+
 void sil_metrics_add(sil_metrics_t *m, const sil_sample_t *x, sil_summary_t *s)
 {
     const pmstep_output_t *out = x->out;
@@ -186,7 +199,7 @@ void sil_metrics_add(sil_metrics_t *m, const sil_sample_t *x, sil_summary_t *s)
                 s->max_speed_error_after_settle_rad_s = max_of(s->max_speed_error_after_settle_rad_s, speed_error);
             }
             angle_lost = m->loss_angle_reachable && ey * m->loss_angle_cos - ex * m->loss_angle_sin > 0.0;
-            if (s->loss_of_control_time_s < 0.0 && (speed_error > m->loss_speed_error_rad_s || angle_lost)) {
+            if (s->loss_of_control_time_s < 0.0 && (off_course(m, x, speed_error) || angle_lost)) {
                 s->loss_of_control_time_s = x->t_s;
             }
             if (angle_lost && !s->loss_of_synchronism) {

@@ -83,6 +83,7 @@ const key_t_ scenario_keys[] = {
     {"run.loss_speed_error_rad_s", KEY_DOUBLE, OFF(loss_speed_error_rad_s), 0, 1, BIG, 0, "|omega - omega*| above this in RUN counts as loss of control (rad/s)"},
     {"run.max_csv_MB", KEY_DOUBLE, OFF(max_csv_MB), 0, 1, 1e6, 0, "refuse to start a run whose run.csv would exceed this (MB)"},
     {"run.loss_angle_error_rad", KEY_DOUBLE, OFF(loss_angle_error_rad), 0, 1, BIG, 0, "angle-estimate error above this in RUN counts as loss of control (rad)"},
+    {"run.loss_position_error_rad", KEY_DOUBLE, OFF(loss_position_error_rad), 0, 1, BIG, 0, "position scenario, in position mode: |theta* - theta| p above this counts as loss of control in place of the speed error (electrical rad; default pi/2, a full step)"},
     {"run.controller", KEY_DRIVE, OFF(drive), 0, 0, 0, 0, "pmstep (the firmware) | microstep (open-loop microstepping at datasheet.rated_current_A, the baseline)"},
     {"run.metrics_start_s", KEY_DOUBLE, OFF(metrics_start_s), -1, 0, 3600, 0, "start of the RMS-current and load-angle window (s); < 0: start of RUN (t_c) or end of the microstep hold"},
 

@@ -40,6 +40,7 @@ void sil_scenario_paper(sil_scenario_t *sc)
     sc->id_target_A = 0.0;
     sc->loss_speed_error_rad_s = 2.0;
     sc->loss_angle_error_rad = 0.5;
+    sc->loss_position_error_rad = 0.5 * PI; /* a full step of a two-phase motor */
     sc->max_csv_MB = 1000.0;
     /* Measurement chain, inverter and bus: all ideal. */
     sc->seed = 1u;

@@ -100,6 +100,7 @@ static void hold_under_load_keeps_the_position(void **state)
     assert_int_equal(sil_scenario_set_assignment(&sc, "load.step_time_s=7", err, sizeof err), 0);
     assert_int_equal(sil_scenario_set_assignment(&sc, "position.hold_start_s=7", err, sizeof err), 0);
     assert_int_equal(sil_scenario_set_assignment(&sc, "run.duration_s=12", err, sizeof err), 0);
+    assert_int_equal(sil_scenario_set_assignment(&sc, "run.loss_speed_error_rad_s=1", err, sizeof err), 0);
     assert_int_equal(sil_run(&sc, NULL, NULL, false, &s), 0);
     print_message("hold 5 s under 4.8 Nm: max error %.3g electrical rad, drift %.3g electrical rad/s\n",
                   p->hold_max_error_rad, p->hold_drift_rad_s);
@@ -108,6 +109,25 @@ static void hold_under_load_keeps_the_position(void **state)
     /* The vector hold (7.5 A, the designer's) gives way by the load angle asin(4.8/(2 x 7.5)) = 0.326
      * electrical rad, plus the damped rotor's overshoot (zeta 0.7): measured 0.337 at the step. */
     assert_true(p->hold_max_error_rad < 0.35);
+    /* Loss of control in a position scenario is a lost step, |theta* - theta| p > pi/2
+     * (run.loss_position_error_rad), not the speed error: swinging onto the load angle the rotor
+     * leaves w* = 0 by 1.85 rad/s here (up to 5 rad/s in the Monte Carlo's cases of lower J)
+     * without losing anything; run.loss_speed_error_rad_s is set to 1 rad/s below it. */
+    print_message("largest |w - w*| after settling %.3g rad/s; loss of control at %.3g s\n",
+                  s.max_speed_error_after_settle_rad_s, s.loss_of_control_time_s);
+    assert_true(s.max_speed_error_after_settle_rad_s > sc.loss_speed_error_rad_s);
+    assert_true(s.loss_of_control_time_s < 0.0);
+    {
+        /* With the bound below the give-way the step is a loss of control, within the hold's
+         * settling time 6/(zeta w_n) = 0.093 s of the step (w_n = 92.3 rad/s, zeta = 0.7). */
+        static sil_scenario_t tight;
+        sil_summary_t t;
+        tight = sc;
+        assert_int_equal(sil_scenario_set_assignment(&tight, "run.loss_position_error_rad=0.3", err, sizeof err), 0);
+        assert_int_equal(sil_run(&tight, NULL, NULL, false, &t), 0);
+        print_message("bound 0.3 electrical rad: loss of control at %.6f s\n", t.loss_of_control_time_s);
+        assert_true(t.loss_of_control_time_s >= 7.0 && t.loss_of_control_time_s < 7.093);
+    }
     /* From 0.5 s after the step: the aim corrected by the displacement (re-aimed while more than
      * 0.05 electrical rad off); measured 4.5e-3 at most, drift -1.4e-4 electrical rad/s. */
     assert_int_equal(sil_scenario_set_assignment(&sc, "position.hold_start_s=7.5", err, sizeof err), 0);

@@ -112,6 +112,7 @@ typedef struct {
     double s_align_current_A, c_align_current_A; /**< u_cs/R, u_cc/R with the plant's R */
     long settle_step;                          /**< first sample counted "after transients" */
     double loss_speed_error_rad_s, loss_angle_error_rad; /**< the scenario's loss-of-control bounds */
+    double loss_position_error_rad;            /**< in a position scenario's position mode, for the speed's */
     double transient_sq, tracking_sq;
     long transient_n, tracking_n;
     /* The angle error without an atan2 per period: the error of (x, y) = (cos, sin) of

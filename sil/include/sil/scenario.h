@@ -65,6 +65,9 @@ typedef struct {
     double id_target_A;              /**< speed.id_target_A */
     double loss_speed_error_rad_s;   /**< run.loss_speed_error_rad_s: |omega - omega*| above -> loss of control */
     double loss_angle_error_rad;     /**< run.loss_angle_error_rad: angle-estimate error above -> loss of control */
+    double loss_position_error_rad;  /**< run.loss_position_error_rad: a position scenario in position mode,
+                                          |theta* - theta| p above -> loss of control (in place of the speed
+                                          error) */
     uint32_t seed;                   /**< run.seed: of every random draw of the run (measurement noise) */
     double max_csv_MB;               /**< run.max_csv_MB: largest run.csv a run may write (MB) */
     sil_sensor_config_t sensors;     /**< [sensors]: measurement chain (ideal by default) */
