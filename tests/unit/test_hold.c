@@ -13,6 +13,7 @@
 #include "pmstep/pmstep.h"
 #include "pmstep/pmstep_text.h"
 #include "../../firmware/src/pmstep_internal.h" /* pmstep_hold_voltages, the period's part */
+#include "paper_in_run.h"
 
 /* Paper: k_M = 2 N m/A, J = 0.01 kg m^2, p = 6, R = 3 Ohm, current trip 15 A, 20 kHz. */
 typedef struct {
@@ -22,11 +23,7 @@ typedef struct {
 
 static void fixture_in_run(fixture_t *f)
 {
-    f->cfg = pmstep_paper_config();
-    assert_int_equal(pmstep_init(&f->inst, &f->cfg), PMSTEP_OK);
-    f->inst.mode = PMSTEP_MODE_RUN; /* as at t_c, without the alignments */
-    f->inst.run_started = true;
-    pmstep_angle_start(&f->inst.angle, 0.0f, 0.0f);
+    assert_int_equal(paper_instance_in_run(&f->cfg, &f->inst), PMSTEP_OK);
 }
 
 static void hold_refuses_with_named_codes(void **state)

@@ -15,6 +15,7 @@
 #include "pmstep/pmstep.h"
 #include "pmstep/pmstep_position.h"
 #include "../../firmware/src/pmstep_position_internal.h" /* the hold's stages */
+#include "paper_in_run.h"
 
 /* Paper: k_M = 2 N m/A, p = 6; hold current 7.5 A: the vector pulls at most 0.9 k_M I = 13.5 N m. */
 #define HOLD_CURRENT_A 7.5f
@@ -29,11 +30,7 @@ typedef struct {
 
 static void fixture_in_run(fixture_t *f)
 {
-    f->cfg = pmstep_paper_config();
-    assert_int_equal(pmstep_init(&f->inst, &f->cfg), PMSTEP_OK);
-    f->inst.mode = PMSTEP_MODE_RUN; /* as at t_c, without the alignments */
-    f->inst.run_started = true;
-    pmstep_angle_start(&f->inst.angle, 0.0f, 0.0f);
+    assert_int_equal(paper_instance_in_run(&f->cfg, &f->inst), PMSTEP_OK);
     f->pos_cfg.gain_per_s = 25.0f;
     f->pos_cfg.integral_gain_per_s2 = 0.0f;
     f->pos_cfg.hold_current_A = HOLD_CURRENT_A;
