@@ -181,6 +181,16 @@ def extract_metrics(summary, params, base):
         "realignments": number_or_none(com.get("realignments")),
         "final_mode": str(summary.get("final_mode", "")),
     }
+    # A position scenario (issue 13): its moves and hold, electrical rad, on the true position.
+    pos = summary.get("position") if isinstance(summary.get("position"), dict) else {}
+    moved = (number_or_none(pos.get("moves")) or 0) > 0
+    held = moved and (number_or_none(pos.get("hold_duration_s")) or 0.0) > 0.0
+    drift = number_or_none(pos.get("hold_drift_electrical_rad_s")) if held else None
+    metrics["position_max_final_error_rad"] = number_or_none(pos.get("max_final_error_electrical_rad")) if moved else None
+    metrics["position_max_tracking_error_rad"] = (number_or_none(pos.get("max_tracking_error_electrical_rad"))
+                                                  if moved else None)
+    metrics["position_hold_max_error_rad"] = number_or_none(pos.get("hold_max_error_electrical_rad")) if held else None
+    metrics["position_abs_hold_drift_rad_s"] = abs(drift) if drift is not None else None
     # The "after settling" maxima mean nothing when a fault stopped the run before settling.
     settle_s, fault_s = metrics["settle_time_s"], metrics["fault_time_s"]
     metrics["past_settle"] = not (fault.get("code") and settle_s is not None and fault_s is not None

@@ -89,6 +89,8 @@ def aggregate(records, args):
         "commissioning_abs_offset_a_error_A": stats("offset_a_error_A", abs),
         "commissioning_abs_offset_b_error_A": stats("offset_b_error_A", abs),
     }
+    for name in POSITION_METRICS:
+        distributions[name] = stats(name)
     for name in ("r_rel_error", "l_rel_error", "k_rel_error"):
         values = [r["metrics"][name] for r in records if r["metrics"].get(name) is not None]
         distributions[f"commissioning_abs_{name}"]["mean_signed"] = statistics.fmean(values) if values else None
@@ -239,7 +241,8 @@ def write_report(path, records, agg, args, scenario, version, plots, started_utc
 
     lines += ["## Distributions", "",
               "Over the cases that produced the value: the errors after settling over the cases not stopped by "
-              "a fault before settling, the commissioning errors where the core measured.", "",
+              "a fault before settling, the commissioning errors where the core measured, a position "
+              "scenario's moves and hold on the true position.", "",
               "| quantity | n | p50 | p90 | p99 | max |", "|---|---|---|---|---|---|"]
     titles = (("max_speed_error_rad_s", "max speed error after settling (rad/s)"),
               ("max_angle_error_rad", "max angle error after settling (rad)"),
@@ -248,6 +251,8 @@ def write_report(path, records, agg, args, scenario, version, plots, started_utc
               ("commissioning_abs_k_rel_error", "\\|k_M commissioned / k_M plant - 1\\|"),
               ("commissioning_abs_offset_a_error_A", "\\|offset a commissioned - true\\| (A)"),
               ("commissioning_abs_offset_b_error_A", "\\|offset b commissioned - true\\| (A)"))
+    titles += tuple((name, title) for name, title in zip(POSITION_METRICS, POSITION_TITLES)
+                    if agg["distributions"][name]["n"])  # a position scenario's
     for name, title in titles:
         d = agg["distributions"][name]
         lines.append(f"| {title} | {d['n']} | {fmt(d['p50'])} | {fmt(d['p90'])} | {fmt(d['p99'])} | {fmt(d['max'])} |")
@@ -302,10 +307,18 @@ def write_report(path, records, agg, args, scenario, version, plots, started_utc
         f.write("\n".join(lines))
 
 
+# A position scenario's figures (electrical rad; none for a speed scenario).
+POSITION_METRICS = ("position_max_final_error_rad", "position_max_tracking_error_rad",
+                    "position_hold_max_error_rad", "position_abs_hold_drift_rad_s")
+POSITION_TITLES = ("largest final error of a move (electrical rad)",
+                   "largest \\|theta* - theta\\| in position mode (electrical rad)",
+                   "largest hold error (electrical rad)",
+                   "\\|hold drift\\| (electrical rad/s)")
+
 CSV_METRICS = ("max_speed_error_rad_s", "max_angle_error_rad", "settle_time_s", "loss_of_control_time_s",
                "detection_latency_s", "fault_time_s", "nonfinite_seen", "tracking_max_abs_error_rad_s",
                "commissioning_measured", "r_rel_error", "l_rel_error", "k_rel_error", "offset_a_error_A",
-               "offset_b_error_A", "realignments", "final_mode", "past_settle", "wall_s")
+               "offset_b_error_A", "realignments", "final_mode", "past_settle", "wall_s") + POSITION_METRICS
 
 
 def write_cases_csv(path, records):

@@ -221,6 +221,26 @@ class Metrics(unittest.TestCase):
         s["commissioning"]["measured"] = False
         self.assertIsNone(mc.extract_metrics(s, params, {})["r_rel_error"])
 
+    def test_position_figures(self):
+        """Issue 13: a position scenario's moves and hold, electrical rad; none for a speed scenario."""
+        s = summary()
+        m = mc.extract_metrics(s, {}, {})
+        self.assertIsNone(m["position_max_final_error_rad"])
+        self.assertIsNone(m["position_abs_hold_drift_rad_s"])
+        s["position"] = {"moves": 50, "max_final_error_electrical_rad": 0.131, "max_tracking_error_electrical_rad": 0.366,
+                         "hold_duration_s": 60.0, "hold_max_error_electrical_rad": 0.35,
+                         "hold_drift_electrical_rad_s": -3.2e-4}
+        m = mc.extract_metrics(s, {}, {})
+        self.assertEqual(m["position_max_final_error_rad"], 0.131)
+        self.assertEqual(m["position_max_tracking_error_rad"], 0.366)
+        self.assertEqual(m["position_hold_max_error_rad"], 0.35)
+        self.assertEqual(m["position_abs_hold_drift_rad_s"], 3.2e-4)
+        s["position"]["hold_duration_s"] = 0.0           # no hold window: no hold figures
+        m = mc.extract_metrics(s, {}, {})
+        self.assertIsNone(m["position_hold_max_error_rad"])
+        self.assertIsNone(m["position_abs_hold_drift_rad_s"])
+        self.assertEqual(m["position_max_final_error_rad"], 0.131)
+
     def test_fault_before_settling(self):
         m = mc.extract_metrics(summary(fault_code=6, fault_time_s=0.7), {}, {})   # settle_time_s = 0.8
         self.assertFalse(m["past_settle"])
