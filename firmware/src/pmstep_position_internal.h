@@ -7,10 +7,10 @@
 
 /* pmstep_position_t.hold_stage */
 #define POSITION_HOLD_NONE ((int32_t)0)
-#define POSITION_HOLD_WAITING ((int32_t)4) /* the move has ended; the loop holds while T_L-hat settles */
-#define POSITION_HOLD_SETTLING ((int32_t)1)
-#define POSITION_HOLD_ANCHORED ((int32_t)2)
-#define POSITION_HOLD_REFUSED ((int32_t)3) /* until the next move: the loop holds on the estimate */
+#define POSITION_HOLD_WAITING ((int32_t)1) /* the move has ended; the loop holds while T_L-hat settles */
+#define POSITION_HOLD_SETTLING ((int32_t)2)
+#define POSITION_HOLD_ANCHORED ((int32_t)3)
+#define POSITION_HOLD_REFUSED ((int32_t)4) /* until the next move: the loop holds on the estimate */
 
 /* An update in position mode with the profile ended and no vector yet: the loop holds
  * POSITION_AIM_WAIT_TIME_CONSTANTS / k_theta, then aims the core's vector at the target (or the

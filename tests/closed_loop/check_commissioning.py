@@ -1,10 +1,10 @@
-"""Checks a SIL run's commissioning in summary.json: no fault latched, the measured L at least
---min-inductance-ratio x the motor's (the current rise saw the rotor turn), and k_M within
---max-torque-constant-error of the motor's.
+"""Checks a SIL run's commissioning in summary.json against the plant's motor in the scenario
+file it ran: no fault latched, the measured L at least --min-inductance-ratio x the motor's (the
+current rise saw the rotor turn), and k_M within --max-torque-constant-error of the motor's.
 
-usage: check_commissioning.py SUMMARY --motor-inductance H --motor-torque-constant K
-                              --min-inductance-ratio R --max-torque-constant-error E"""
+usage: check_commissioning.py SUMMARY SCENARIO --min-inductance-ratio R --max-torque-constant-error E"""
 import argparse
+import configparser
 import json
 import sys
 
@@ -12,14 +12,20 @@ import sys
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("summary")
-    for k in ("motor-inductance", "motor-torque-constant", "min-inductance-ratio", "max-torque-constant-error"):
+    ap.add_argument("scenario")
+    for k in ("min-inductance-ratio", "max-torque-constant-error"):
         ap.add_argument(f"--{k}", type=float, required=True)
     a = ap.parse_args()
     with open(a.summary) as f:
         s = json.load(f)
+    scenario = configparser.ConfigParser(inline_comment_prefixes=(";", "#"))
+    if not scenario.read(a.scenario):
+        sys.exit(f"check_commissioning: cannot read {a.scenario}")
+    motor_inductance_H = float(scenario["motor"]["inductance_H"])
+    motor_torque_constant = float(scenario["motor"]["torque_constant_Nm_A"])
     c = s["commissioning"]
-    l_ratio = c["inductance_H"] / a.motor_inductance
-    k_error = c["torque_constant_Nm_A"] / a.motor_torque_constant - 1.0
+    l_ratio = c["inductance_H"] / motor_inductance_H
+    k_error = c["torque_constant_Nm_A"] / motor_torque_constant - 1.0
     print(f"fault {s['fault']['name']}; measured L {c['inductance_H']:.6g} H ({l_ratio:.3f} x the motor's), "
           f"k_M {c['torque_constant_Nm_A']:.6g} N m/A ({100 * k_error:+.2f} %), R {c['resistance_Ohm']:.6g} Ohm")
     failures = []

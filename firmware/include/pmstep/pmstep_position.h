@@ -118,14 +118,14 @@ typedef struct {
     float hold_inv_gain;      /**< the reference filter over N periods (put_speed_reference) */
     float hold_c23;
     float hold_c12;
-    /* Vector hold when a move ends (hold_current_A > 0; pmstep_position.c, "Vector hold") */
+    /* Vector hold when a move ends (hold_current_A > 0; "Vector hold" above, pmstep_position_hold.c) */
     float rest_cos;           /**< the vector's aim before its load angle (stator frame): the target's
                                    electrical direction, corrected by the displacements at rest */
     float rest_sin;
     float aim_load_Nm;        /**< the load the aim's load angle is for (T_L-hat when the move ended) */
     float frozen_cos;         /**< the estimate kept while the held rotor is at rest */
     float frozen_sin;
-    int32_t hold_stage;       /**< none, settling, anchored, refused (until the next move) */
+    int32_t hold_stage;       /**< none, waiting, settling, anchored, refused (until the next move) */
     int32_t hold_periods;     /**< waiting, settling: periods left; anchored: periods at rest */
 } pmstep_position_t;
 
