@@ -7,6 +7,7 @@ void pmstep_actuate_coeffs_init(pmstep_actuate_coeffs_t *coeffs, const pmstep_co
 {
     coeffs->compensate = cfg->inverter.dead_time_s > 0.0f || cfg->commissioning.voltage_bias_level_fraction > 0.0f;
     coeffs->delayed = cfg->timing.computational_delay_periods != 0u;
+    coeffs->sensed = cfg->inverter.phase_voltage_sensing;
     coeffs->dead_time_duty = 2.0f * cfg->inverter.dead_time_s / cfg->timing.period_s;
     coeffs->inv_band_per_A = coeffs->compensate ? 1.0f / cfg->inverter.dead_time_current_band_A : 0.0f;
     /* PWM ripple's half amplitude at its largest (d = 1/2): V_bus T / (16 L), plus 3 bands (noise). */

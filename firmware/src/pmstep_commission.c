@@ -9,10 +9,13 @@ void pmstep_commission_clear(pmstep_commission_sums_t *sums)
     memset(sums, 0, sizeof *sums);
 }
 
-void pmstep_commission_add_bridge_off(pmstep_commission_sums_t *sums, float i_a_A, float i_b_A)
+void pmstep_commission_add_bridge_off(pmstep_commission_sums_t *sums, float i_a_A, float i_b_A, float u_a_V,
+                                      float u_b_V)
 {
     sums->zero_sum_a_A += i_a_A;
     sums->zero_sum_b_A += i_b_A;
+    sums->zero_voltage_sum_a_V += u_a_V;
+    sums->zero_voltage_sum_b_V += u_b_V;
     sums->zero_count_a++;
     sums->zero_count_b++;
 }

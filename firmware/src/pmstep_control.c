@@ -22,6 +22,18 @@ static void start_run(pmstep_t *inst, const pmstep_meas_t *sample)
     inst->run_started = true;
 }
 
+/* With phase-voltage sensing: the voltage of the period just ended as measured (offsets off), for
+ * the flux integrals; the observer's prediction of this sample is redone with it (its current
+ * step is linear in u). */
+static void sensed_period_voltage(pmstep_t *inst, const pmstep_meas_t *sample, float *u_a_V, float *u_b_V)
+{
+    const float input_gain = inst->observer_coeffs.current_step_s * inst->observer_coeffs.inv_l_per_H;
+    *u_a_V = sample->phase_voltage_a_V - inst->commissioning.phase_voltage_offset_a_V;
+    *u_b_V = sample->phase_voltage_b_V - inst->commissioning.phase_voltage_offset_b_V;
+    inst->observer.i_a_hat_A += input_gain * (*u_a_V - inst->actuator.u_applied_a_V);
+    inst->observer.i_b_hat_A += input_gain * (*u_b_V - inst->actuator.u_applied_b_V);
+}
+
 void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_output_t *out,
                             pmstep_control_scratch_t *scratch)
 {
@@ -43,7 +55,9 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
     } else {
         float u_a_V = inst->actuator.u_applied_a_V;
         float u_b_V = inst->actuator.u_applied_b_V;
-        if (inst->actuate_coeffs.compensate) { /* the dead time's loss, where the samples fix it */
+        if (inst->actuate_coeffs.sensed) {
+            sensed_period_voltage(inst, sample, &u_a_V, &u_b_V);
+        } else if (inst->actuate_coeffs.compensate) { /* the dead time's loss, where the samples fix it */
             pmstep_period_currents_t currents;
             currents.i_start_a_A = inst->angle.i_a_prev_A;
             currents.i_start_b_A = inst->angle.i_b_prev_A;

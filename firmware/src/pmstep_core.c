@@ -214,6 +214,20 @@ static void realign(pmstep_t *inst)
     inst->mode = PMSTEP_MODE_S_ALIGN;
 }
 
+/* With phase-voltage sensing: a sensed voltage non-finite, or above the bus by more than the
+ * sensors' margin (a mean phase voltage cannot exceed the bus). */
+static pmstep_fault_t check_phase_voltages(const pmstep_meas_t *meas)
+{
+    const float limit_V = PMSTEP_PHASE_VOLTAGE_RANGE_FACTOR * meas->bus_voltage_V;
+    if (!pmstep_all_finite4(meas->phase_voltage_a_V, meas->phase_voltage_b_V, 0.0f, 0.0f)) {
+        return PMSTEP_FAULT_MEASUREMENT_NONFINITE;
+    }
+    if (pmstep_abs(meas->phase_voltage_a_V) > limit_V || pmstep_abs(meas->phase_voltage_b_V) > limit_V) {
+        return PMSTEP_FAULT_PHASE_VOLTAGE_RANGE;
+    }
+    return PMSTEP_FAULT_NONE;
+}
+
 /* Check stage: the protections, while the bridge may be on. */
 static pmstep_fault_t check_measurements(const pmstep_config_t *cfg, const pmstep_meas_t *meas)
 {
@@ -231,20 +245,26 @@ static pmstep_fault_t check_measurements(const pmstep_config_t *cfg, const pmste
     if (meas->bus_voltage_V > cfg->limits.max_bus_voltage_V) {
         return PMSTEP_FAULT_BUS_OVERVOLTAGE;
     }
-    return PMSTEP_FAULT_NONE;
+    return cfg->inverter.phase_voltage_sensing ? check_phase_voltages(meas) : PMSTEP_FAULT_NONE;
 }
 
 /* Bridge off and the mode of this period; the offset calibration's samples. */
 static void offset_calibration_stage(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out)
 {
+    const bool sensing = inst->cfg->inverter.phase_voltage_sensing;
     output_off(out, inst);
-    pmstep_commission_add_bridge_off(&inst->scratch.sums, meas->i_a_A, meas->i_b_A);
+    pmstep_commission_add_bridge_off(&inst->scratch.sums, meas->i_a_A, meas->i_b_A,
+                                     sensing ? meas->phase_voltage_a_V : 0.0f,
+                                     sensing ? meas->phase_voltage_b_V : 0.0f);
     if (++inst->mode_step >= inst->offset_cal_steps) {
         /* Provisional offsets for the alignment (the dead-time compensation needs the sign of
-         * small currents); t_c refines them with the alignment steady states. */
+         * small currents); t_c refines them with the alignment steady states. The phase-voltage
+         * offsets are final (the sums hold 0 without sensing). */
         const pmstep_commission_sums_t *sums = &inst->scratch.sums;
         inst->commissioning.offset_a_A = sums->zero_sum_a_A / (float)sums->zero_count_a;
         inst->commissioning.offset_b_A = sums->zero_sum_b_A / (float)sums->zero_count_b;
+        inst->commissioning.phase_voltage_offset_a_V = sums->zero_voltage_sum_a_V / (float)sums->zero_count_a;
+        inst->commissioning.phase_voltage_offset_b_V = sums->zero_voltage_sum_b_V / (float)sums->zero_count_b;
         inst->mode = PMSTEP_MODE_S_ALIGN;
         inst->mode_step = 0u;
     }
@@ -322,8 +342,11 @@ static pmstep_fault_t commission_stage(pmstep_t *inst, const pmstep_meas_t *meas
         return PMSTEP_FAULT_NONE;
     }
     if (inst->mode != PMSTEP_MODE_RUN) {
-        pmstep_commission_add_alignment(&inst->scratch.sums, plan, inst->mode_step, meas->i_a_A, meas->i_b_A,
-                                        inst->actuator.u_applied_a_V, inst->actuator.u_applied_b_V);
+        const bool sensing = inst->cfg->inverter.phase_voltage_sensing;
+        pmstep_commission_add_alignment(
+            &inst->scratch.sums, plan, inst->mode_step, meas->i_a_A, meas->i_b_A,
+            sensing ? meas->phase_voltage_a_V - inst->commissioning.phase_voltage_offset_a_V : inst->actuator.u_applied_a_V,
+            sensing ? meas->phase_voltage_b_V - inst->commissioning.phase_voltage_offset_b_V : inst->actuator.u_applied_b_V);
         return PMSTEP_FAULT_NONE;
     }
     return finish_commissioning(inst, meas);
@@ -336,7 +359,7 @@ static pmstep_meas_t calibrated_sample(const pmstep_t *inst, const pmstep_meas_t
     pmstep_meas_t sample = *meas;
     sample.i_a_A = (sample.i_a_A - inst->commissioning.offset_a_A) * inst->commissioning.phase_a_current_scale;
     sample.i_b_A -= inst->commissioning.offset_b_A;
-    return sample;
+    return sample; /* the phase-voltage offsets come off where the voltages are used (with sensing only) */
 }
 
 /* Control stage of the alignments: (3) or (5), the last window at the lower level with the

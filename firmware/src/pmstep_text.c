@@ -83,6 +83,7 @@ const char *pmstep_fault_str(pmstep_fault_t fault)
     case PMSTEP_FAULT_STALL: return "STALL";
     case PMSTEP_FAULT_COMMISSIONING: return "COMMISSIONING";
     case PMSTEP_FAULT_OBSERVER_RESIDUAL: return "OBSERVER_RESIDUAL";
+    case PMSTEP_FAULT_PHASE_VOLTAGE_RANGE: return "PHASE_VOLTAGE_RANGE";
     }
     return "UNKNOWN";
 }

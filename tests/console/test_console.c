@@ -65,7 +65,7 @@ static void boundary(void)
 /* One control period of the core with zero currents on a 48 V bus. */
 static void step(void)
 {
-    const pmstep_meas_t m = {0.0f, 0.0f, 48.0f, 0.0f};
+    const pmstep_meas_t m = {0.0f, 0.0f, 48.0f, 0.0f, 0.0f, 0.0f};
     boundary();
     pmstep_step(&motor, &m, &snap.out);
     snap.meas = m;

@@ -66,6 +66,8 @@ int main(void)
             meas.i_b_A = any_float();
             meas.bus_voltage_V = any_float();
             meas.load_torque_Nm = any_float();
+            meas.phase_voltage_a_V = any_float();
+            meas.phase_voltage_b_V = any_float();
             pmstep_step(&inst, &meas, &out);
             /*@ assert bridge_off_zero: !out.bridge_enable ==> out.u_a_V == 0.0 && out.u_b_V == 0.0; */
             /*@ assert bridge_on_finite: out.bridge_enable ==> \is_finite(out.u_a_V) && \is_finite(out.u_b_V); */

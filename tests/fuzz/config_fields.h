@@ -21,6 +21,7 @@ static const size_t fuzz_bool_fields[] = {
     offsetof(pmstep_config_t, commissioning.use_measured_inductance),
     offsetof(pmstep_config_t, commissioning.use_measured_torque_constant),
     offsetof(pmstep_config_t, commissioning.use_identified_mechanics),
+    offsetof(pmstep_config_t, inverter.phase_voltage_sensing),
 };
 #define FUZZ_BOOL_FIELDS (sizeof fuzz_bool_fields / sizeof fuzz_bool_fields[0])
 
@@ -28,7 +29,8 @@ static const size_t fuzz_bool_fields[] = {
  * (offset calibration, alignment windows with the voltage bias, inductance window, commissioned
  * R, L, k_M used, dead-time compensation, drift-free angle, detent compensation, PI current loop, all
  * detectors, re-alignments).
- * 2: as 1 in known-load mode. 3: the paper's with short alignments (RUN after 400 periods). */
+ * 2: as 1 in known-load mode. 3: the paper's with short alignments (RUN after 400 periods) and
+ * phase-voltage sensing. */
 #define FUZZ_BASE_CONFIGS 4u
 static inline pmstep_config_t fuzz_base_config(unsigned which)
 {
@@ -39,6 +41,7 @@ static inline pmstep_config_t fuzz_base_config(unsigned which)
     } else if (which == 3u) {
         cfg.alignment.s_align_time_s = 0.01f;
         cfg.alignment.c_align_time_s = 0.02f;
+        cfg.inverter.phase_voltage_sensing = true;
     }
     return cfg;
 }

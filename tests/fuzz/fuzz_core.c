@@ -152,7 +152,7 @@ static void check_output(state_t *st, const pmstep_meas_t *meas)
         CHECK(fuzz_finite(floats[n]), "an output is not finite");
     }
     CHECK((unsigned)o->mode <= (unsigned)PMSTEP_MODE_OFFSET_CAL, "mode out of range");
-    CHECK((unsigned)o->fault <= (unsigned)PMSTEP_FAULT_OBSERVER_RESIDUAL, "fault out of range");
+    CHECK((unsigned)o->fault <= (unsigned)PMSTEP_FAULT_PHASE_VOLTAGE_RANGE, "fault out of range");
     CHECK((o->mode == PMSTEP_MODE_FAULT) == (o->fault != PMSTEP_FAULT_NONE), "mode FAULT and fault code disagree");
     if (o->bridge_enable) {
         CHECK(o->mode == PMSTEP_MODE_S_ALIGN || o->mode == PMSTEP_MODE_C_ALIGN || o->mode == PMSTEP_MODE_RUN,
@@ -227,6 +227,9 @@ static void run_plant(state_t *st, reader_t *r, unsigned n)
         meas.i_b_A = (float)(st->i_b - offset + noise * uniform(st));
         meas.bus_voltage_V = (float)(bus + ripple * uniform(st));
         meas.load_torque_Nm = (float)load;
+        /* the sensed mean voltage of the period just ended: what the model applied */
+        meas.phase_voltage_a_V = (float)(st->u_a + 10.0 * offset + 10.0 * noise * uniform(st));
+        meas.phase_voltage_b_V = (float)(st->u_b - 10.0 * offset + 10.0 * noise * uniform(st));
         step(st, &meas);
         st->u_a = st->out.bridge_enable ? (double)st->out.u_a_V : 0.0;
         st->u_b = st->out.bridge_enable ? (double)st->out.u_b_V : 0.0;
@@ -340,6 +343,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             meas.i_b_A = read_f32(&r);
             meas.bus_voltage_V = read_f32(&r);
             meas.load_torque_Nm = read_f32(&r);
+            meas.phase_voltage_a_V = read_f32(&r);
+            meas.phase_voltage_b_V = read_f32(&r);
             step(st, &meas);
             break;
         }
@@ -352,11 +357,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             meas.i_b_A = (float)st->i_b;
             meas.bus_voltage_V = 48.0f;
             meas.load_torque_Nm = 0.0f;
-            switch (which % 5u) {
+            meas.phase_voltage_a_V = (float)st->u_a;
+            meas.phase_voltage_b_V = (float)st->u_b;
+            switch (which % 7u) {
             case 0: meas.i_a_A = special_value(kind, meas.i_a_A, fuzz_current_limit_a(&st->cfg)); break;
             case 1: meas.i_b_A = special_value(kind, meas.i_b_A, fuzz_current_limit_a(&st->cfg)); break;
             case 2: meas.bus_voltage_V = special_value(kind, meas.bus_voltage_V, fuzz_max_bus_v(&st->cfg)); break;
             case 3: meas.bus_voltage_V = special_value(kind, meas.bus_voltage_V, fuzz_min_bus_v(&st->cfg)); break;
+            case 4: meas.phase_voltage_a_V = special_value(kind, meas.phase_voltage_a_V, 60.0f); break;
+            case 5: meas.phase_voltage_b_V = special_value(kind, meas.phase_voltage_b_V, 60.0f); break;
             default: meas.load_torque_Nm = special_value(kind, 1.0f, 1.0f); break;
             }
             step(st, &meas);

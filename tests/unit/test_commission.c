@@ -38,6 +38,8 @@ static pmstep_meas_t rl_sample(const rl_plant_t *p)
     m.i_b_A = (float)(p->i_b_A + p->offset_b_A);
     m.bus_voltage_V = 48.0f;
     m.load_torque_Nm = 0.0f;
+    m.phase_voltage_a_V = 0.0f;
+    m.phase_voltage_b_V = 0.0f;
     return m;
 }
 
@@ -212,12 +214,58 @@ static void two_levels_give_r_and_the_voltage_bias(void **state)
     assert_true(fabsf(result.voltage_bias_b_V - 0.3f) < 1e-3f);
 }
 
+/* With phase-voltage sensing, R comes from the sensed voltages: the same two levels as above,
+ * with a bridge 0.3 V short at positive current and a voltage sensor that reads 1 % high, give
+ * R as that sensor sees it, 1.01 x 3.6 Ohm (so u - R i vanishes at standstill in the flux
+ * integrals, which use the same sensor), and no voltage bias (nothing is short of the sensed
+ * voltage). */
+static void sensed_voltages_give_r_as_the_sensor_sees_it(void **state)
+{
+    const double sensor_gain = 1.01;
+    pmstep_config_t cfg = short_config();
+    rl_plant_t plant = {3.6, 0.0066, 0.0, 0.0, 0.02, -0.01, 0.3};
+    pmstep_t inst;
+    pmstep_output_t out;
+    pmstep_commissioning_t result;
+    double applied_a_V = 0.0;
+    double applied_b_V = 0.0;
+    uint32_t k;
+    (void)state;
+    cfg.alignment.s_align_time_s = 0.16f;
+    cfg.alignment.c_align_time_s = 0.32f;
+    cfg.commissioning.steady_state_window_s = 0.04f;
+    cfg.commissioning.voltage_bias_level_fraction = 0.5f;
+    cfg.inverter.dead_time_current_band_A = 0.05f;
+    cfg.inverter.phase_voltage_sensing = true;
+    assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
+    assert_int_equal(pmstep_start(&inst), PMSTEP_OK);
+    for (k = 0; k < 7000u; ++k) { /* t_c = 6400 periods */
+        pmstep_meas_t m = rl_sample(&plant);
+        m.phase_voltage_a_V = (float)(sensor_gain * applied_a_V);
+        m.phase_voltage_b_V = (float)(sensor_gain * applied_b_V);
+        pmstep_step(&inst, &m, &out);
+        if (out.mode == PMSTEP_MODE_RUN || out.mode == PMSTEP_MODE_FAULT) {
+            break;
+        }
+        applied_a_V = out.bridge_enable ? (double)out.u_a_V - (plant.i_a_A > 0.0 ? plant.bias_V : 0.0) : 0.0;
+        applied_b_V = out.bridge_enable ? (double)out.u_b_V - (plant.i_b_A > 0.0 ? plant.bias_V : 0.0) : 0.0;
+        rl_advance(&plant, &out, 50e-6);
+    }
+    pmstep_get_commissioning(&inst, &result);
+    assert_true(result.measured); /* t_c reached (the locked rotor's k_M may fault, as above) */
+    print_message("R %.6f bias %.6f %.6f V\n", (double)result.resistance_Ohm, (double)result.voltage_bias_a_V,
+                  (double)result.voltage_bias_b_V);
+    assert_true(fabsf(result.resistance_Ohm - 1.01f * 3.6f) < 3.6f * 1e-4f);
+    assert_true(fabsf(result.voltage_bias_a_V) < 1e-3f);
+    assert_true(fabsf(result.voltage_bias_b_V) < 1e-3f);
+}
+
 static void dead_time_is_compensated_on_the_driven_phase(void **state)
 {
     pmstep_config_t cfg = short_config();
     pmstep_t inst;
     pmstep_output_t out;
-    pmstep_meas_t m = {0.0f, 0.0f, 48.0f, 0.0f};
+    pmstep_meas_t m = {0.0f, 0.0f, 48.0f, 0.0f, 0.0f, 0.0f};
     (void)state;
     cfg.inverter.dead_time_s = 1e-6f;
     cfg.inverter.dead_time_current_band_A = 0.1f;
@@ -243,7 +291,7 @@ static void dead_time_is_compensated_on_the_driven_phase(void **state)
 /* Holds the c-aligned state (i_a = 8 A, rotor still) into RUN. */
 static void hold_to_run(pmstep_t *inst, pmstep_output_t *out)
 {
-    const pmstep_meas_t m = {8.0f, 0.0f, 48.0f, 0.0f};
+    const pmstep_meas_t m = {8.0f, 0.0f, 48.0f, 0.0f, 0.0f, 0.0f};
     uint32_t k;
     assert_int_equal(pmstep_start(inst), PMSTEP_OK);
     for (k = 0; k <= inst->commission_plan.c_align_end_step; ++k) {
@@ -255,7 +303,7 @@ static void hold_to_run(pmstep_t *inst, pmstep_output_t *out)
 static void lost_angle_faults_or_realigns_after_the_detection_time(void **state)
 {
     pmstep_config_t cfg = pmstep_paper_config();
-    const pmstep_meas_t m = {8.0f, 0.0f, 48.0f, 0.0f};
+    const pmstep_meas_t m = {8.0f, 0.0f, 48.0f, 0.0f, 0.0f, 0.0f};
     pmstep_t inst;
     pmstep_output_t out;
     uint32_t k;
@@ -306,6 +354,7 @@ int main(void)
         cmocka_unit_test(bridge_off_calibration_measures_the_offsets),
         cmocka_unit_test(locked_rotor_gives_r_and_l_and_fails_the_torque_constant),
         cmocka_unit_test(two_levels_give_r_and_the_voltage_bias),
+        cmocka_unit_test(sensed_voltages_give_r_as_the_sensor_sees_it),
         cmocka_unit_test(dead_time_is_compensated_on_the_driven_phase),
         cmocka_unit_test(lost_angle_faults_or_realigns_after_the_detection_time),
     };

@@ -19,6 +19,8 @@ static pmstep_meas_t nominal_meas(void)
     m.i_b_A = 0.0f;
     m.bus_voltage_V = 48.0f;
     m.load_torque_Nm = 0.0f;
+    m.phase_voltage_a_V = 0.0f;
+    m.phase_voltage_b_V = 0.0f;
     return m;
 }
 
@@ -155,6 +157,73 @@ static void nonfinite_known_load_faults_only_in_known_load_mode(void **state)
     assert_int_equal(out.fault, PMSTEP_FAULT_MEASUREMENT_NONFINITE);
 }
 
+/* With phase-voltage sensing the sensed voltages are inputs like the currents: a non-finite one
+ * latches MEASUREMENT_NONFINITE, one beyond 1.25 x the measured bus PHASE_VOLTAGE_RANGE. Without
+ * sensing they are never read. */
+static void phase_voltages_checked_only_with_sensing(void **state)
+{
+    static const struct {
+        float u_a_V;
+        float u_b_V;
+        bool sensing;
+        pmstep_fault_t expected;
+    } cases[] = {
+        {NAN, 0.0f, false, PMSTEP_FAULT_NONE},
+        {1e9f, -INFINITY, false, PMSTEP_FAULT_NONE},
+        {NAN, 0.0f, true, PMSTEP_FAULT_MEASUREMENT_NONFINITE},
+        {0.0f, -INFINITY, true, PMSTEP_FAULT_MEASUREMENT_NONFINITE},
+        {60.0f, -60.0f, true, PMSTEP_FAULT_NONE},             /* 1.25 x 48 V: the edge passes */
+        {0.0f, -60.01f, true, PMSTEP_FAULT_PHASE_VOLTAGE_RANGE},
+        {60.01f, 0.0f, true, PMSTEP_FAULT_PHASE_VOLTAGE_RANGE},
+    };
+    size_t n;
+    (void)state;
+    for (n = 0; n < sizeof cases / sizeof cases[0]; ++n) {
+        pmstep_config_t cfg = pmstep_paper_config();
+        pmstep_t inst;
+        pmstep_output_t out;
+        pmstep_meas_t meas = nominal_meas();
+        cfg.inverter.phase_voltage_sensing = cases[n].sensing;
+        assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
+        assert_int_equal(pmstep_start(&inst), PMSTEP_OK);
+        meas.phase_voltage_a_V = cases[n].u_a_V;
+        meas.phase_voltage_b_V = cases[n].u_b_V;
+        pmstep_step(&inst, &meas, &out);
+        assert_int_equal(out.fault, cases[n].expected);
+        assert_int_equal(out.bridge_enable, cases[n].expected == PMSTEP_FAULT_NONE);
+    }
+    assert_string_equal(pmstep_fault_str(PMSTEP_FAULT_PHASE_VOLTAGE_RANGE), "PHASE_VOLTAGE_RANGE");
+}
+
+/* The offset calibration (bridge off) averages the sensed phase voltages as the sensors' offsets;
+ * without sensing they stay 0 whatever the fields hold. */
+static void phase_voltage_offsets_from_the_offset_calibration(void **state)
+{
+    int sensing;
+    (void)state;
+    for (sensing = 0; sensing <= 1; ++sensing) {
+        pmstep_config_t cfg = pmstep_paper_config();
+        pmstep_t inst;
+        pmstep_output_t out;
+        pmstep_commissioning_t result;
+        uint32_t k;
+        cfg.commissioning.offset_calibration_time_s = 0.01f; /* 200 periods */
+        cfg.inverter.phase_voltage_sensing = sensing != 0;
+        assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
+        assert_int_equal(pmstep_start(&inst), PMSTEP_OK);
+        for (k = 0; k < 200u; ++k) {
+            pmstep_meas_t meas = nominal_meas();
+            meas.phase_voltage_a_V = (k % 2u) != 0u ? 0.06f : 0.04f; /* mean 0.05 V */
+            meas.phase_voltage_b_V = -0.03f;
+            pmstep_step(&inst, &meas, &out);
+            assert_false(out.bridge_enable);
+        }
+        pmstep_get_commissioning(&inst, &result);
+        assert_float_equal(result.phase_voltage_offset_a_V, sensing != 0 ? 0.05f : 0.0f, 1e-6f);
+        assert_float_equal(result.phase_voltage_offset_b_V, sensing != 0 ? -0.03f : 0.0f, 1e-6f);
+    }
+}
+
 /* Steps to RUN with the rotor "held" at cos p theta = 1 (currents of the c-aligned state). */
 static void step_to_run(pmstep_t *inst, pmstep_output_t *out, float bus_V)
 {
@@ -167,6 +236,55 @@ static void step_to_run(pmstep_t *inst, pmstep_output_t *out, float bus_V)
         pmstep_step(inst, &meas, out);
     }
     assert_int_equal(out->mode, PMSTEP_MODE_RUN);
+}
+
+/* In RUN the flux integrals take the sensed mean voltage of the period just ended, and the
+ * observer's prediction of this sample is redone with it: two instances in the same state, whose
+ * sensed u_a differs by delta_V over one period, differ at that sample by p T delta / k_M in
+ * c-hat (phi_a grows by T u / L, c-hat = 1 - (L p / k_M)(i_a - i_a0 - phi_a)) and by
+ * T / (1 + R T / (2 L)) delta / L in i_a-hat (the observer's trapezoid step). Without sensing the
+ * field changes nothing. */
+static void sensed_phase_voltage_drives_flux_integrals_and_observer(void **state)
+{
+    const float delta_V = 2.0f;
+    int sensing;
+    (void)state;
+    for (sensing = 0; sensing <= 1; ++sensing) {
+        pmstep_config_t cfg = pmstep_paper_config();
+        pmstep_t base;
+        pmstep_t other;
+        pmstep_output_t out_base;
+        pmstep_output_t out_other;
+        pmstep_meas_t meas = nominal_meas();
+        const float p = (float)cfg.motor.pole_pairs;
+        const float t_s = cfg.timing.period_s;
+        const float r = cfg.motor.resistance_Ohm;
+        const float l = cfg.motor.inductance_H;
+        cfg.inverter.phase_voltage_sensing = sensing != 0;
+        assert_int_equal(pmstep_init(&base, &cfg), PMSTEP_OK);
+        assert_int_equal(pmstep_init(&other, &cfg), PMSTEP_OK);
+        step_to_run(&base, &out_base, 48.0f);
+        step_to_run(&other, &out_other, 48.0f);
+        meas.i_a_A = 8.0f;
+        meas.phase_voltage_a_V = 24.0f; /* the c-alignment's steady state: R i_a */
+        pmstep_step(&base, &meas, &out_base);
+        pmstep_step(&other, &meas, &out_other);
+        assert_true(out_base.cos_hat == out_other.cos_hat && out_base.i_a_hat_A == out_other.i_a_hat_A);
+        pmstep_step(&base, &meas, &out_base);
+        meas.phase_voltage_a_V += delta_V;
+        pmstep_step(&other, &meas, &out_other);
+        assert_int_equal(out_other.fault, PMSTEP_FAULT_NONE);
+        if (sensing != 0) {
+            assert_float_equal(out_other.cos_hat - out_base.cos_hat, p * t_s * delta_V / cfg.motor.torque_constant_Nm_A,
+                               2e-6f);
+            assert_float_equal(out_other.i_a_hat_A - out_base.i_a_hat_A,
+                               t_s / (1.0f + 0.5f * r * t_s / l) * delta_V / l, 2e-5f);
+            assert_true(out_other.sin_hat == out_base.sin_hat && out_other.i_b_hat_A == out_base.i_b_hat_A);
+        } else {
+            assert_true(out_other.cos_hat == out_base.cos_hat && out_other.i_a_hat_A == out_base.i_a_hat_A
+                        && out_other.u_a_V == out_base.u_a_V && out_other.u_b_V == out_base.u_b_V);
+        }
+    }
 }
 
 static void voltage_limited_to_bus_keeping_direction(void **state)
@@ -290,6 +408,9 @@ int main(void)
         cmocka_unit_test(commands_validate_their_values),
         cmocka_unit_test(each_fault_latches_with_zero_output),
         cmocka_unit_test(nonfinite_known_load_faults_only_in_known_load_mode),
+        cmocka_unit_test(phase_voltages_checked_only_with_sensing),
+        cmocka_unit_test(phase_voltage_offsets_from_the_offset_calibration),
+        cmocka_unit_test(sensed_phase_voltage_drives_flux_integrals_and_observer),
         cmocka_unit_test(voltage_limited_to_bus_keeping_direction),
         cmocka_unit_test(delay_one_period_integrates_the_applied_voltage),
         cmocka_unit_test(nonfinite_voltage_never_leaves_with_the_bridge_on),

@@ -43,6 +43,7 @@ static pmstep_design_input_t input_of(const motor_data_t *m, bool robust)
     in.self_commissioning = robust;
     in.dead_time_s = robust ? 1e-6f : 0.0f;
     in.current_resolution_A = robust ? 0.005f : 0.0f;
+    in.phase_voltage_sensing = false;
     return in;
 }
 
@@ -205,6 +206,24 @@ static void bad_motor_data_gets_a_named_error(void **state)
     }
 }
 
+/* Phase-voltage sensing is the drive's: the design passes it on and designs the same gains. */
+static void phase_voltage_sensing_is_passed_on(void **state)
+{
+    pmstep_design_input_t in = input_of(&presets[1], true);
+    pmstep_config_t without;
+    pmstep_config_t with;
+    pmstep_design_report_t report;
+    (void)state;
+    assert_int_equal(pmstep_design(&in, &without, &report), PMSTEP_OK);
+    in.phase_voltage_sensing = true;
+    assert_int_equal(pmstep_design(&in, &with, &report), PMSTEP_OK);
+    assert_false(without.inverter.phase_voltage_sensing);
+    assert_true(with.inverter.phase_voltage_sensing);
+    with.inverter.phase_voltage_sensing = false;
+    assert_memory_equal(&with.gains, &without.gains, sizeof with.gains);
+    assert_int_equal(pmstep_validate_config(&with), PMSTEP_OK);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -212,6 +231,7 @@ int main(void)
         cmocka_unit_test(residual_bound_has_the_dead_time_floor),
         cmocka_unit_test(observer_poles_are_placed),
         cmocka_unit_test(bad_motor_data_gets_a_named_error),
+        cmocka_unit_test(phase_voltage_sensing_is_passed_on),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

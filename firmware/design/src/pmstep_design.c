@@ -245,6 +245,7 @@ static void design_commissioning(const pmstep_design_input_t *in, float window_s
     cfg->inverter.dead_time_s = robust ? in->dead_time_s : 0.0f;
     /* The band of the compensation, which the voltage bias uses too. */
     cfg->inverter.dead_time_current_band_A = robust ? max2(in->current_resolution_A, MIN_DEAD_TIME_BAND_A) : 0.0f;
+    cfg->inverter.phase_voltage_sensing = in->phase_voltage_sensing; /* the drive's, not the design's */
     report->magnetising_current_A = robust ? MAGNETISING_PER_RATED_CURRENT * in->rated_current_A : 0.0f;
 }
 

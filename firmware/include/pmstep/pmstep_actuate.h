@@ -43,6 +43,7 @@ typedef struct {
     float sign_threshold_A_per_V; /**< a current's sign is known beyond this x V_bus + sign_threshold_A */
     float sign_threshold_A;
     bool compensate;            /**< dead time configured or voltage bias estimated */
+    bool sensed;                /**< the phase voltages are sensed: the period's voltage is measured, not estimated */
     bool delayed;               /**< one period of computational delay */
 } pmstep_actuate_coeffs_t;
 

@@ -52,6 +52,7 @@ typedef struct {
 typedef struct {
     float zero_sum_a_A, zero_sum_b_A;       /**< samples of a phase whose true current is 0 */
     uint32_t zero_count_a, zero_count_b;
+    float zero_voltage_sum_a_V, zero_voltage_sum_b_V; /**< sensed phase voltages with the bridge off (true 0) */
     float rise_voltage_sum_V, rise_current_sum_A, rise_start_A, rise_end_A; /**< L, phase b */
     float s_current_sum_A, s_voltage_sum_V; /**< end of s-alignment, phase b */
     float c_current_sum_A, c_voltage_sum_V; /**< end of c-alignment, phase a */
@@ -65,8 +66,10 @@ void pmstep_commission_clear(pmstep_commission_sums_t *sums);
 /** True from the sample where an alignment ending at sample @p end runs at its lower level. */
 bool pmstep_commission_low_level(const pmstep_commission_plan_t *plan, uint32_t sample, uint32_t end);
 
-/** A sample with the bridge off (true currents zero). */
-void pmstep_commission_add_bridge_off(pmstep_commission_sums_t *sums, float i_a_A, float i_b_A);
+/** A sample with the bridge off, the motor at rest (true currents and phase voltages zero); the
+ *  voltages are the sensed ones (0 without phase-voltage sensing). */
+void pmstep_commission_add_bridge_off(pmstep_commission_sums_t *sums, float i_a_A, float i_b_A, float u_a_V,
+                                      float u_b_V);
 
 /**
  * Sample @p sample (< c_align_end_step) of the alignment.

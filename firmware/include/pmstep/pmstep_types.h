@@ -132,7 +132,8 @@ typedef enum {
 /** Fault causes latched by pmstep_step(). */
 typedef enum {
     PMSTEP_FAULT_NONE = 0,
-    PMSTEP_FAULT_MEASUREMENT_NONFINITE = 1, /**< NaN or Inf in a current, bus or load input */
+    PMSTEP_FAULT_MEASUREMENT_NONFINITE = 1, /**< NaN or Inf in a current, bus or load input, or in a sensed
+                                                 phase voltage (with phase-voltage sensing) */
     PMSTEP_FAULT_OVERCURRENT = 2,           /**< |i_a| or |i_b| above max_phase_current_A */
     PMSTEP_FAULT_BUS_UNDERVOLTAGE = 3,      /**< bus below min_bus_voltage_V */
     PMSTEP_FAULT_BUS_OVERVOLTAGE = 4,       /**< bus above max_bus_voltage_V */
@@ -141,9 +142,17 @@ typedef enum {
     PMSTEP_FAULT_SPEED_INCONSISTENT = 7,    /**< speed from the angle estimate's rotation and w-hat disagree */
     PMSTEP_FAULT_STALL = 8,                 /**< |w-hat - w*| above stall_speed_error_rad_s: motor not following */
     PMSTEP_FAULT_COMMISSIONING = 9,         /**< measured R, L or k_M outside [1/2, 2] x the configured value */
-    PMSTEP_FAULT_OBSERVER_RESIDUAL = 10     /**< |i_a - i_a-hat| + |i_b - i_b-hat| low-passed above its bound: the
+    PMSTEP_FAULT_OBSERVER_RESIDUAL = 10,    /**< |i_a - i_a-hat| + |i_b - i_b-hat| low-passed above its bound: the
                                                  observer's model no longer explains the currents */
+    PMSTEP_FAULT_PHASE_VOLTAGE_RANGE = 11   /**< with phase-voltage sensing: a sensed mean phase voltage beyond
+                                                 PMSTEP_PHASE_VOLTAGE_RANGE_FACTOR x the measured bus (a mean
+                                                 phase voltage cannot exceed the bus: a sensor fault) */
 } pmstep_fault_t;
+
+/** A sensed mean phase voltage above this many times the measured bus latches
+ *  PMSTEP_FAULT_PHASE_VOLTAGE_RANGE: the bus bounds the true value, the margin covers the
+ *  two sensors' gain errors and noise. */
+#define PMSTEP_PHASE_VOLTAGE_RANGE_FACTOR 1.25f
 
 /** Motor model (1), as known to the controller. */
 typedef struct {
@@ -222,6 +231,13 @@ typedef struct {
 typedef struct {
     float dead_time_s;              /**< dead time of each half-bridge to compensate (2 per phase); 0 = none */
     float dead_time_current_band_A; /**< compensation is linear in i within +/- this band, full outside */
+    bool phase_voltage_sensing;     /**< the drive measures each phase's mean voltage over every period
+                                         (pmstep_meas_t phase_voltage_a_V, _b_V): RUN's flux integrals take it
+                                         in place of the command less the dead time's estimated loss, it
+                                         corrects the observer's last current prediction, and the Remark 2
+                                         steady states take it for R (so R is as that sensor sees it, and the
+                                         voltage bias only what it leaves unexplained); its offsets come from
+                                         the offset calibration. false = not measured (fields unread) */
 } pmstep_inverter_config_t;
 
 /** Detection in RUN, every PMSTEP_DETECTION_DECIMATION periods; a bound of 0 switches its detector off.
@@ -277,6 +293,9 @@ typedef struct {
     float i_b_A;         /**< phase b current */
     float bus_voltage_V; /**< DC bus voltage */
     float load_torque_Nm;/**< known load T_L (used only in known_load_mode) */
+    float phase_voltage_a_V; /**< mean voltage across phase a over the period that ends at this sample
+                                  (used only with inverter.phase_voltage_sensing) */
+    float phase_voltage_b_V; /**< same for phase b */
 } pmstep_meas_t;
 
 /** What one step commands, and what it estimated. */
@@ -329,6 +348,9 @@ typedef struct {
     float torque_constant_Nm_A; /**< k_M from the flux swing of c-alignment (0: not measured) */
     float voltage_bias_a_V;         /**< voltage phase a falls short by at positive current (0: not measured) */
     float voltage_bias_b_V;         /**< same for phase b */
+    float phase_voltage_offset_a_V; /**< phase-voltage sensor offset subtracted from every sample of phase a, from
+                                         the offset calibration (0: not measured or no sensing) */
+    float phase_voltage_offset_b_V; /**< same for phase b */
     float inertia_kgm2;             /**< J identified in RUN (0: not identified; see identification) */
     float friction_Nms_rad;         /**< F identified in RUN (may be < 0: see identification) */
     pmstep_identification_t identification; /**< state and outcome of the identification of J and F */

@@ -27,6 +27,8 @@ typedef struct {
     bool self_commissioning;              /**< robust mode: Remark 2 offsets and voltage bias, R/L/k_M measured
                                                at t_c, drift-free angle, dead-time compensation */
     float dead_time_s;                    /**< the bridge's dead time (robust mode; 0 = none) */
+    bool phase_voltage_sensing;           /**< the drive senses the phase voltages: passed on to
+                                               inverter.phase_voltage_sensing (the gains are the same) */
     float current_resolution_A;           /**< current measurement resolution (ADC step or noise, whichever is
                                                larger): the dead-time compensation's band (robust mode) */
 } pmstep_design_input_t;
