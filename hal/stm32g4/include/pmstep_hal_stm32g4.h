@@ -47,7 +47,10 @@ typedef enum {
     PMSTEP_STM32G4_ERR_PIN = -9,            /**< a pin's port, number or alternate function out of range */
     PMSTEP_STM32G4_ERR_PIN_CONFLICT = -10,  /**< two functions on one pin */
     PMSTEP_STM32G4_ERR_PIN_RESERVED = -11,  /**< a pin the board itself uses (VCP, SWD, crystal..) given another function */
-    PMSTEP_STM32G4_ERR_UART_CONFIG = -12    /**< console baud rate outside what LPUART1 can make from its clock */
+    PMSTEP_STM32G4_ERR_UART_CONFIG = -12,   /**< console baud rate outside what LPUART1 can make from its clock */
+    PMSTEP_STM32G4_ERR_UNMEASURED_INPUT = -13 /**< the core's configuration reads an input this board does not
+                                                   measure: phase voltages (inverter.phase_voltage_sensing) or
+                                                   the load torque (known_load_mode) */
 } pmstep_stm32g4_status_t;
 
 /** Why the port holds the bridge off, independently of the core. */
@@ -217,8 +220,10 @@ pmstep_stm32g4_status_t pmstep_stm32g4_pwm_init(const pmstep_stm32g4_config_t *c
 pmstep_stm32g4_status_t pmstep_stm32g4_adc_init(const pmstep_stm32g4_config_t *cfg);
 
 /**
- * The whole port for @p inst (whose configuration must use computational_delay_periods = 1
- * and period_s = pmstep_stm32g4_period_s()): GPIO, TIM1, ADC, interrupts; bridge off.
+ * The whole port for @p inst (initialised; its configuration must use computational_delay_periods = 1
+ * and period_s = pmstep_stm32g4_period_s(), and read neither phase voltages nor a load torque:
+ * PMSTEP_STM32G4_ERR_UNMEASURED_INPUT, before any register is touched): GPIO, TIM1, ADC,
+ * interrupts; bridge off.
  * Call after pmstep_stm32g4_clock_init() with the same @p cfg, which must outlive the port.
  */
 pmstep_stm32g4_status_t pmstep_stm32g4_init(const pmstep_stm32g4_config_t *cfg, pmstep_t *inst);

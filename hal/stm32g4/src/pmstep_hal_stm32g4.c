@@ -72,7 +72,9 @@ void pmstep_hal_read_measurements(pmstep_meas_t *meas)
     meas->bus_voltage_V = pmstep_stm32g4_counts_to_si(STM32G4_ADC1->JDR[1], cfg->bus_offset_counts,
                                                       cfg->bus_gain_v_per_count);
     meas->i_b_A = pmstep_stm32g4_counts_to_si(STM32G4_ADC2->JDR[0], cfg->i_b_offset_counts, cfg->i_b_gain_a_per_count);
-    meas->load_torque_Nm = 0.0f; /* no torque sensor on this board (known_load_mode unsupported) */
+    meas->load_torque_Nm = 0.0f; /* no torque sensor on this board (known_load_mode refused at init) */
+    meas->phase_voltage_a_V = 0.0f; /* no phase-voltage sensing (refused at init) */
+    meas->phase_voltage_b_V = 0.0f;
     port.bus_voltage_V = meas->bus_voltage_V;
     if (fault_input_asserted()) {
         latch_fault(PMSTEP_STM32G4_FAULT_INPUT);
@@ -198,8 +200,11 @@ pmstep_stm32g4_status_t pmstep_stm32g4_init(const pmstep_stm32g4_config_t *cfg, 
 {
     uint32_t sysclk_Hz;
     pmstep_stm32g4_status_t st;
-    if (cfg == NULL || inst == NULL) {
+    if (cfg == NULL || inst == NULL || inst->cfg == NULL) {
         return PMSTEP_STM32G4_ERR_NULL_ARGUMENT;
+    }
+    if (inst->cfg->inverter.phase_voltage_sensing || inst->cfg->known_load_mode) {
+        return PMSTEP_STM32G4_ERR_UNMEASURED_INPUT;
     }
     sysclk_Hz = pmstep_stm32g4_sysclk_Hz(&cfg->clock);
     if (sysclk_Hz == 0u) {
@@ -268,7 +273,7 @@ void pmstep_stm32g4_last_period(pmstep_output_t *out, pmstep_meas_t *meas, uint8
     *out = port.out;
     *port_fault = (uint8_t)port.fault;
     if (cfg == NULL) {
-        const pmstep_meas_t zero = {0.0f, 0.0f, 0.0f, 0.0f};
+        const pmstep_meas_t zero = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
         *meas = zero;
         return;
     }
@@ -278,4 +283,6 @@ void pmstep_stm32g4_last_period(pmstep_output_t *out, pmstep_meas_t *meas, uint8
                                                       cfg->bus_gain_v_per_count);
     meas->i_b_A = pmstep_stm32g4_counts_to_si(STM32G4_ADC2->JDR[0], cfg->i_b_offset_counts, cfg->i_b_gain_a_per_count);
     meas->load_torque_Nm = 0.0f;
+    meas->phase_voltage_a_V = 0.0f;
+    meas->phase_voltage_b_V = 0.0f;
 }

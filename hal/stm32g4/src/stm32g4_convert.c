@@ -149,6 +149,8 @@ const char *pmstep_stm32g4_status_str(pmstep_stm32g4_status_t status)
         return "a pin the board itself uses is given another function";
     case PMSTEP_STM32G4_ERR_UART_CONFIG:
         return "console baud rate out of LPUART1's range";
+    case PMSTEP_STM32G4_ERR_UNMEASURED_INPUT:
+        return "the core reads phase voltages or a load torque, which this board does not measure";
     }
     return "unknown status";
 }

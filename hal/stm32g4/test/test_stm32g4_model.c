@@ -610,6 +610,8 @@ static void test_port_duties_follow_commanded_voltages(void **state)
         meas.bus_voltage_V = pmstep_stm32g4_counts_to_si(M.analog_counts[0][board.adc1_channel_bus],
                                                          board.bus_offset_counts, board.bus_gain_v_per_count);
         meas.load_torque_Nm = 0.0f;
+        meas.phase_voltage_a_V = 0.0f; /* not sensed on this board */
+        meas.phase_voltage_b_V = 0.0f;
         pmstep_step(&twin, &meas, &out);
         /* This period carries the duties of sample k - 1 (loaded at its update event); the
          * interrupt of sample k writes the next ones during it. */

@@ -484,7 +484,7 @@ static void test_fault_input_turns_bridge_off(void **state)
     assert_int_equal(stm32g4_fake.tim1.CCR3, ARR_20KHZ / 2u);
     {
         pmstep_output_t out;
-        const pmstep_meas_t m = {0.0f, 0.0f, 48.0f, 0.0f};
+        const pmstep_meas_t m = {0.0f, 0.0f, 48.0f, 0.0f, 0.0f, 0.0f};
         pmstep_step(&motor, &m, &out);
         assert_int_equal(out.mode, PMSTEP_MODE_IDLE); /* the core was stopped */
     }
@@ -656,6 +656,31 @@ static void test_pin_map_conflicts_refused(void **state)
     assert_int_equal(stm32g4_fake.rcc.AHB2ENR, 0u);
 }
 
+/* A core that reads an input this board has no sensor for is refused before any register is
+ * touched: phase-voltage sensing and known-load mode each. */
+static void test_unmeasured_inputs_refused(void **state)
+{
+    pmstep_config_t cfg = motor_config;
+    pmstep_t inst;
+    (void)state;
+    fault_input(false);
+    cfg.inverter.phase_voltage_sensing = true;
+    assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
+    assert_int_equal(pmstep_stm32g4_init(&board, &inst), PMSTEP_STM32G4_ERR_UNMEASURED_INPUT);
+    cfg.inverter.phase_voltage_sensing = false;
+    cfg.known_load_mode = true;
+    assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
+    assert_int_equal(pmstep_stm32g4_init(&board, &inst), PMSTEP_STM32G4_ERR_UNMEASURED_INPUT);
+    assert_int_equal(stm32g4_fake.rcc.AHB2ENR, 0u);
+    assert_int_equal(stm32g4_fake.tim1.BDTR & TIM_BDTR_MOE, 0u);
+    assert_string_equal(pmstep_stm32g4_status_str(PMSTEP_STM32G4_ERR_UNMEASURED_INPUT),
+                        "the core reads phase voltages or a load torque, which this board does not measure");
+    /* The same configuration without them starts. */
+    cfg.known_load_mode = false;
+    assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
+    assert_int_equal(pmstep_stm32g4_init(&board, &inst), PMSTEP_STM32G4_OK);
+}
+
 /* ---- console UART (LPUART1) and the main loop's access to the last period ---- */
 
 static void test_lpuart(void **state)
@@ -736,6 +761,7 @@ int main(void)
         cmocka_unit_test_setup(test_measurements_in_si, setup),
         cmocka_unit_test_setup(test_pin_map_default_board, setup),
         cmocka_unit_test_setup(test_pin_map_conflicts_refused, setup),
+        cmocka_unit_test_setup(test_unmeasured_inputs_refused, setup),
         cmocka_unit_test_setup(test_lpuart, setup),
         cmocka_unit_test_setup(test_hold_and_last_period, setup),
     };
