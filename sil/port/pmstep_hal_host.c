@@ -12,6 +12,8 @@ int pmstep_hal_host_bind(plant_t *plant, const pmstep_hal_host_setup_t *setup)
     port.meas.i_b_A = 0.0f;
     port.meas.bus_voltage_V = (float)setup->bus_voltage_V;
     port.meas.load_torque_Nm = 0.0f;
+    port.meas.phase_voltage_a_V = 0.0f;
+    port.meas.phase_voltage_b_V = 0.0f;
     port.bus_V = setup->bus_voltage_V;
     return sil_sensors_init(&port.sensors, &setup->sensors, setup->seed);
 }
@@ -31,17 +33,21 @@ sil_inverter_t *pmstep_hal_host_inverter(void)
     return &port.inverter;
 }
 
-/* Sampled at the period boundary: the carrier's valley, where every phase sees zero volts. */
+/* Sampled at the period boundary: the carrier's valley, where every phase sees zero volts; the
+ * phase voltages are the means over the period just ended (what the plant received). */
 void pmstep_hal_read_measurements(pmstep_meas_t *meas)
 {
     const plant_t *plant = port.plant;
-    double i_a_A, i_b_A;
+    double i_a_A, i_b_A, u_a_V, u_b_V;
     port.bus_V = sil_inverter_bus_voltage(&port.inverter, plant->time_s);
     sil_sensors_currents(&port.sensors, plant->x.i_a_A, plant->x.i_b_A, &i_a_A, &i_b_A);
     meas->i_a_A = (float)i_a_A;
     meas->i_b_A = (float)i_b_A;
     meas->bus_voltage_V = (float)sil_sensors_bus(&port.sensors, port.bus_V);
     meas->load_torque_Nm = (float)plant_load_torque(&plant->load, plant->time_s, plant->x.omega_rad_s);
+    sil_sensors_phase_voltages(&port.sensors, port.inverter.applied_a_V, port.inverter.applied_b_V, &u_a_V, &u_b_V);
+    meas->phase_voltage_a_V = (float)u_a_V;
+    meas->phase_voltage_b_V = (float)u_b_V;
     port.meas = *meas;
 }
 

@@ -96,6 +96,14 @@ static cJSON *measurement_chain_json(const sil_scenario_t *sc)
     cJSON_AddNumberToObject(sensors, "noise_rms_A", sc->sensors.noise_rms_A);
     cJSON_AddNumberToObject(sensors, "bus_full_scale_V", sc->sensors.bus_full_scale_V);
     cJSON_AddNumberToObject(sensors, "bus_noise_rms_V", sc->sensors.bus_noise_rms_V);
+    cJSON_AddNumberToObject(sensors, "phase_voltage_bits", sc->sensors.phase_voltage_bits);
+    cJSON_AddNumberToObject(sensors, "phase_voltage_full_scale_V", sc->sensors.phase_voltage_full_scale_V);
+    cJSON_AddNumberToObject(sensors, "phase_voltage_offset_a_V", sc->sensors.phase_voltage_offset_a_V);
+    cJSON_AddNumberToObject(sensors, "phase_voltage_offset_b_V", sc->sensors.phase_voltage_offset_b_V);
+    cJSON_AddNumberToObject(sensors, "phase_voltage_gain_error_a", sc->sensors.phase_voltage_gain_error_a);
+    cJSON_AddNumberToObject(sensors, "phase_voltage_gain_error_b", sc->sensors.phase_voltage_gain_error_b);
+    cJSON_AddNumberToObject(sensors, "phase_voltage_noise_rms_V", sc->sensors.phase_voltage_noise_rms_V);
+    cJSON_AddBoolToObject(sensors, "phase_voltage_sensing", sc->controller.inverter.phase_voltage_sensing);
     cJSON_AddItemToObject(chain, "sensors", sensors);
     cJSON_AddStringToObject(inverter, "model", sc->inverter.model == SIL_INVERTER_SWITCHING ? "switching" : "averaged");
     cJSON_AddNumberToObject(inverter, "dead_time_s", sc->inverter.dead_time_s);
@@ -108,6 +116,7 @@ static cJSON *measurement_chain_json(const sil_scenario_t *sc)
     /* Phase samples (two per period) and bus samples at an end code of the ADC. */
     cJSON_AddNumberToObject(chain, "adc_clipped_current_samples", (double)port->sensors.clipped_current_samples);
     cJSON_AddNumberToObject(chain, "adc_clipped_bus_samples", (double)port->sensors.clipped_bus_samples);
+    cJSON_AddNumberToObject(chain, "adc_clipped_phase_voltage_samples", (double)port->sensors.clipped_voltage_samples);
     return chain;
 }
 

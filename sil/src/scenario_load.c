@@ -218,6 +218,13 @@ int sil_scenario_check(const sil_scenario_t *sc, char *err, size_t err_size)
                     "before the overvoltage trip",
                     sc->sensors.bus_full_scale_V, (double)sc->controller.limits.max_bus_voltage_V);
     }
+    if (sc->controller.inverter.phase_voltage_sensing && sc->sensors.phase_voltage_bits > 0u
+        && sc->sensors.phase_voltage_full_scale_V < (double)sc->controller.limits.max_bus_voltage_V) {
+        return fail(err, err_size,
+                    "sensors.phase_voltage_full_scale_V = %g is below controller.limits.max_bus_voltage_V = %g: the "
+                    "phase-voltage ADC would clip a voltage the bridge can apply",
+                    sc->sensors.phase_voltage_full_scale_V, (double)sc->controller.limits.max_bus_voltage_V);
+    }
     if (sc->drive == SIL_DRIVE_MICROSTEP
         && !(sc->controller.motor.resistance_Ohm >= 0.0f && sc->controller.motor.inductance_H > 0.0f
              && sc->controller.motor.pole_pairs >= 1)) {

@@ -14,6 +14,7 @@ int sil_sensors_init(sil_sensors_t *s, const sil_sensor_config_t *cfg, unsigned 
     s->rng = rng;
     s->clipped_current_samples = 0;
     s->clipped_bus_samples = 0;
+    s->clipped_voltage_samples = 0;
     if (rng == NULL) {
         return -1;
     }
@@ -46,32 +47,54 @@ double sil_adc_quantise(double x, double low, double high, unsigned bits, int *c
     return isnan(x) ? x : low + k * q;
 }
 
-/* One phase: gain, offset, noise, ADC; each stage only when it is on. */
-static double current_sample(sil_sensors_t *s, double i_a, double gain_error, double offset_a)
+/* A bipolar channel of one phase (current or voltage): gain, offset, noise, ADC over
+ * +/- full_scale; each stage only when it is on. */
+typedef struct {
+    double gain_error;
+    double offset;
+    double noise_rms;
+    double full_scale;
+    unsigned bits;
+} phase_channel_t;
+
+static double phase_sample(sil_sensors_t *s, double x, const phase_channel_t *ch, unsigned long *clipped_count)
 {
-    const sil_sensor_config_t *c = &s->cfg;
-    double x = i_a;
-    if (gain_error != 0.0) {
-        x *= 1.0 + gain_error;
+    if (ch->gain_error != 0.0) {
+        x *= 1.0 + ch->gain_error;
     }
-    if (offset_a != 0.0) {
-        x += offset_a;
+    if (ch->offset != 0.0) {
+        x += ch->offset;
     }
-    if (c->noise_rms_A > 0.0) {
-        x += gsl_ran_gaussian_ziggurat((gsl_rng *)s->rng, c->noise_rms_A);
+    if (ch->noise_rms > 0.0) {
+        x += gsl_ran_gaussian_ziggurat((gsl_rng *)s->rng, ch->noise_rms);
     }
-    if (c->adc_bits > 0u) {
+    if (ch->bits > 0u) {
         int clipped;
-        x = sil_adc_quantise(x, -c->current_full_scale_A, c->current_full_scale_A, c->adc_bits, &clipped);
-        s->clipped_current_samples += (unsigned long)clipped;
+        x = sil_adc_quantise(x, -ch->full_scale, ch->full_scale, ch->bits, &clipped);
+        *clipped_count += (unsigned long)clipped;
     }
     return x;
 }
 
 void sil_sensors_currents(sil_sensors_t *s, double i_a_A, double i_b_A, double *i_a_meas_A, double *i_b_meas_A)
 {
-    *i_a_meas_A = current_sample(s, i_a_A, s->cfg.gain_error_a, s->cfg.offset_a_A);
-    *i_b_meas_A = current_sample(s, i_b_A, s->cfg.gain_error_b, s->cfg.offset_b_A);
+    const sil_sensor_config_t *c = &s->cfg;
+    const phase_channel_t a = {c->gain_error_a, c->offset_a_A, c->noise_rms_A, c->current_full_scale_A, c->adc_bits};
+    const phase_channel_t b = {c->gain_error_b, c->offset_b_A, c->noise_rms_A, c->current_full_scale_A, c->adc_bits};
+    *i_a_meas_A = phase_sample(s, i_a_A, &a, &s->clipped_current_samples);
+    *i_b_meas_A = phase_sample(s, i_b_A, &b, &s->clipped_current_samples);
+}
+
+void sil_sensors_phase_voltages(sil_sensors_t *s, double u_a_V, double u_b_V, double *u_a_meas_V,
+                                double *u_b_meas_V)
+{
+    const sil_sensor_config_t *c = &s->cfg;
+    const phase_channel_t a = {c->phase_voltage_gain_error_a, c->phase_voltage_offset_a_V,
+                               c->phase_voltage_noise_rms_V, c->phase_voltage_full_scale_V, c->phase_voltage_bits};
+    const phase_channel_t b = {c->phase_voltage_gain_error_b, c->phase_voltage_offset_b_V,
+                               c->phase_voltage_noise_rms_V, c->phase_voltage_full_scale_V, c->phase_voltage_bits};
+    *u_a_meas_V = phase_sample(s, u_a_V, &a, &s->clipped_voltage_samples);
+    *u_b_meas_V = phase_sample(s, u_b_V, &b, &s->clipped_voltage_samples);
 }
 
 double sil_sensors_bus(sil_sensors_t *s, double bus_V)

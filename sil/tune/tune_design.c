@@ -23,6 +23,7 @@ void design_input(const sil_scenario_t *sc, bool robust, pmstep_design_input_t *
     in->computational_delay_periods = sc->controller.timing.computational_delay_periods;
     in->self_commissioning = robust;
     in->dead_time_s = (float)sc->inverter.dead_time_s;
+    in->phase_voltage_sensing = sc->controller.inverter.phase_voltage_sensing;
     {
         const double step_A = sc->sensors.adc_bits > 0 ? 2.0 * sc->sensors.current_full_scale_A
                                                              / (double)(1L << sc->sensors.adc_bits)
@@ -118,8 +119,9 @@ int write_c(const char *path, const sil_scenario_t *sc)
             (double)c->commissioning.voltage_bias_level_fraction, (double)c->commissioning.identification_time_s,
             (double)c->commissioning.identification_min_speed_rad_s,
             c->commissioning.use_identified_mechanics ? "true" : "false");
-    fprintf(f, "    .inverter = {.dead_time_s = %.9gf, .dead_time_current_band_A = %.9gf},\n",
-            (double)c->inverter.dead_time_s, (double)c->inverter.dead_time_current_band_A);
+    fprintf(f, "    .inverter = {.dead_time_s = %.9gf, .dead_time_current_band_A = %.9gf, .phase_voltage_sensing = %s},\n",
+            (double)c->inverter.dead_time_s, (double)c->inverter.dead_time_current_band_A,
+            c->inverter.phase_voltage_sensing ? "true" : "false");
     fprintf(f, "    .detection = {.angle_magnitude_bound = %.9gf, .speed_consistency_bound_rad_s = %.9gf,\n"
                "                  .stall_speed_error_rad_s = %.9gf, .observer_residual_bound_A = %.9gf,\n"
                "                  .persistence_s = %.9gf, .max_realignments = %uu},\n",

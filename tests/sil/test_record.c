@@ -37,6 +37,7 @@ static void config_round_trips_through_the_words(void **state)
     in.commissioning.identification_time_s = 0.4f;
     in.commissioning.identification_min_speed_rad_s = 12.5f;
     in.commissioning.use_identified_mechanics = true;
+    in.inverter.phase_voltage_sensing = true;
     sil_record_config_to_words(&in, w);
     sil_record_config_from_words(w, &out);
     assert_memory_equal(&in.motor.resistance_Ohm, &out.motor.resistance_Ohm, sizeof(float));
@@ -57,14 +58,29 @@ static void config_round_trips_through_the_words(void **state)
     assert_true(out.commissioning.identification_time_s == in.commissioning.identification_time_s
                 && out.commissioning.identification_min_speed_rad_s == in.commissioning.identification_min_speed_rad_s
                 && out.commissioning.use_identified_mechanics);
+    assert_true(out.inverter.phase_voltage_sensing);
     /* The last word is the last field. */
     assert_true(w[SIL_RECORD_CONFIG_WORDS - 1u] == 1u);
+}
+
+/* A period's input, the sensed phase voltages included, comes back bit for bit. */
+static void measurement_round_trips_through_the_words(void **state)
+{
+    uint32_t w[SIL_RECORD_IN_WORDS];
+    const pmstep_meas_t in = {0.25f, -1.5f, 47.9f, 0.125f, 3.75f, -0.0625f};
+    pmstep_meas_t out;
+    (void)state;
+    sil_record_meas_to_words(&in, w);
+    sil_record_meas_from_words(w, &out);
+    assert_memory_equal(&in, &out, sizeof in);
+    assert_int_equal(SIL_RECORD_IN_WORDS, 6);
 }
 
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(config_round_trips_through_the_words),
+        cmocka_unit_test(measurement_round_trips_through_the_words),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

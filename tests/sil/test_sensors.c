@@ -80,6 +80,34 @@ static void offset_and_gain_are_applied(void **state)
     sil_sensors_release(&s);
 }
 
+/* The phase-voltage channel: its own gain, offset, resolution and span, independent of the
+ * current ADC's bits; clipped samples counted apart. */
+static void phase_voltage_channel(void **state)
+{
+    sil_sensors_t s;
+    sil_sensor_config_t cfg = sil_sensors_ideal();
+    double a, b;
+    (void)state;
+    cfg.adc_bits = 8; /* the current ADC's resolution does not touch the voltages */
+    cfg.phase_voltage_offset_a_V = 0.05;
+    cfg.phase_voltage_offset_b_V = -0.05;
+    cfg.phase_voltage_gain_error_a = 0.005;
+    cfg.phase_voltage_gain_error_b = -0.005;
+    assert_int_equal(sil_sensors_init(&s, &cfg, 1u), 0);
+    sil_sensors_phase_voltages(&s, 12.0, -3.0, &a, &b);
+    assert_true(fabs(a - (12.0 * 1.005 + 0.05)) < 1e-14 && fabs(b - (-3.0 * 0.995 - 0.05)) < 1e-14);
+    sil_sensors_release(&s);
+    /* 14 bits over +-36 V: q = 72/16384 V; 1.0 V = 227.56 q above -36 V's code -> nearest code. */
+    cfg = sil_sensors_ideal();
+    cfg.phase_voltage_bits = 14;
+    cfg.phase_voltage_full_scale_V = 36.0;
+    assert_int_equal(sil_sensors_init(&s, &cfg, 1u), 0);
+    sil_sensors_phase_voltages(&s, 1.0, 40.0, &a, &b);
+    assert_true(fabs(a - 1.0) <= 0.5 * 72.0 / 16384.0 && a != 1.0);
+    assert_true(b == 36.0 - 72.0 / 16384.0 && s.clipped_voltage_samples == 1u && s.clipped_current_samples == 0u);
+    sil_sensors_release(&s);
+}
+
 static void ideal_chain_is_the_identity_and_draws_nothing(void **state)
 {
     /* No noise: the RNG is never called, so switching noise on later gives the first draw of the seed. */
@@ -195,6 +223,7 @@ int main(void)
         cmocka_unit_test(quantisation_step_and_clipping),
         cmocka_unit_test(chain_counts_clipped_samples),
         cmocka_unit_test(offset_and_gain_are_applied),
+        cmocka_unit_test(phase_voltage_channel),
         cmocka_unit_test(ideal_chain_is_the_identity_and_draws_nothing),
         cmocka_unit_test(noise_mean_and_std),
         cmocka_unit_test(seed_fixes_the_sequence),

@@ -40,9 +40,9 @@ extern "C" {
  * then the entries in order.
  */
 #define SIL_RECORD_MAGIC 0x52534D50u /* "PMSR" */
-#define SIL_RECORD_VERSION 5u /* 2: calibration, commissioning, angle, detection; 3: voltage bias; 4: residual;
-                                 5: identification of J and F */
-#define SIL_RECORD_CONFIG_WORDS 44u
+#define SIL_RECORD_VERSION 6u /* 2: calibration, commissioning, angle, detection; 3: voltage bias; 4: residual;
+                                 5: identification of J and F; 6: phase-voltage sensing */
+#define SIL_RECORD_CONFIG_WORDS 45u
 #define SIL_RECORD_TAG_SPEED_TARGET 1u
 #define SIL_RECORD_TAG_PERIOD 2u
 #define SIL_RECORD_TAG_END 3u
@@ -50,6 +50,7 @@ extern "C" {
 /** Word order of a period's input (pmstep_meas_t). */
 enum {
     SIL_RECORD_IN_I_A = 0, SIL_RECORD_IN_I_B, SIL_RECORD_IN_BUS, SIL_RECORD_IN_LOAD,
+    SIL_RECORD_IN_U_A, SIL_RECORD_IN_U_B,
     SIL_RECORD_IN_WORDS
 };
 
@@ -152,6 +153,7 @@ static inline void sil_record_config_from_words(const uint32_t *w, pmstep_config
     c->commissioning.identification_time_s = sil_record_float(w[41]);
     c->commissioning.identification_min_speed_rad_s = sil_record_float(w[42]);
     c->commissioning.use_identified_mechanics = w[43] != 0u;
+    c->inverter.phase_voltage_sensing = w[44] != 0u;
 }
 
 static inline void sil_record_meas_from_words(const uint32_t *w, pmstep_meas_t *m)
@@ -160,6 +162,8 @@ static inline void sil_record_meas_from_words(const uint32_t *w, pmstep_meas_t *
     m->i_b_A = sil_record_float(w[SIL_RECORD_IN_I_B]);
     m->bus_voltage_V = sil_record_float(w[SIL_RECORD_IN_BUS]);
     m->load_torque_Nm = sil_record_float(w[SIL_RECORD_IN_LOAD]);
+    m->phase_voltage_a_V = sil_record_float(w[SIL_RECORD_IN_U_A]);
+    m->phase_voltage_b_V = sil_record_float(w[SIL_RECORD_IN_U_B]);
 }
 
 static inline void sil_record_output_to_words(const pmstep_output_t *o, uint32_t *w)
@@ -232,6 +236,7 @@ static inline void sil_record_config_to_words(const pmstep_config_t *c, uint32_t
     w[41] = sil_record_bits(c->commissioning.identification_time_s);
     w[42] = sil_record_bits(c->commissioning.identification_min_speed_rad_s);
     w[43] = c->commissioning.use_identified_mechanics ? 1u : 0u;
+    w[44] = c->inverter.phase_voltage_sensing ? 1u : 0u;
 }
 
 static inline void sil_record_meas_to_words(const pmstep_meas_t *m, uint32_t *w)
@@ -240,6 +245,8 @@ static inline void sil_record_meas_to_words(const pmstep_meas_t *m, uint32_t *w)
     w[SIL_RECORD_IN_I_B] = sil_record_bits(m->i_b_A);
     w[SIL_RECORD_IN_BUS] = sil_record_bits(m->bus_voltage_V);
     w[SIL_RECORD_IN_LOAD] = sil_record_bits(m->load_torque_Nm);
+    w[SIL_RECORD_IN_U_A] = sil_record_bits(m->phase_voltage_a_V);
+    w[SIL_RECORD_IN_U_B] = sil_record_bits(m->phase_voltage_b_V);
 }
 
 /** Reads @p n (<= SIL_RECORD_MAX_WORDS) little-endian words. @return 0, or -1 on a short read. */

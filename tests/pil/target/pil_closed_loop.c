@@ -117,6 +117,8 @@ int main(int argc, char **argv)
         meas.i_b_A = (float)sample.i_b_A;
         meas.bus_voltage_V = (float)sil_inverter_bus_voltage(&inv, t_s);
         meas.load_torque_Nm = (float)sample.load_Nm;
+        meas.phase_voltage_a_V = (float)inv.applied_a_V; /* the mean voltage of the period just ended */
+        meas.phase_voltage_b_V = (float)inv.applied_b_V;
         mps2_pil_control_period(&meas, &out);
         sil_inverter_apply(&inv, &out, (double)meas.bus_voltage_V);
         sil_drive_advance(&plant, &inv, period_s, substeps);

@@ -117,6 +117,8 @@ static void run_period(loop_t *L, long k, pmstep_console_snapshot_t *snap)
     meas.i_b_A = (float)sample.i_b_A;
     meas.bus_voltage_V = (float)sil_inverter_bus_voltage(&L->inv, t_s);
     meas.load_torque_Nm = (float)sample.load_Nm;
+    meas.phase_voltage_a_V = (float)L->inv.applied_a_V; /* the mean voltage of the period just ended */
+    meas.phase_voltage_b_V = (float)L->inv.applied_b_V;
     mps2_pil_control_period(&meas, &out);
     {
         pmstep_position_output_t pos_out;

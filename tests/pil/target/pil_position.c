@@ -99,6 +99,8 @@ int main(int argc, char **argv)
         meas.i_b_A = (float)plant.x.i_b_A;
         meas.bus_voltage_V = (float)sil_inverter_bus_voltage(&inv, t_s);
         meas.load_torque_Nm = 0.0f;
+        meas.phase_voltage_a_V = (float)inv.applied_a_V; /* the mean voltage of the period just ended */
+        meas.phase_voltage_b_V = (float)inv.applied_b_V;
         mps2_pil_control_period(&meas, &out);      /* pmstep_step() in the control interrupt */
         pmstep_position_update(&position, &out, &pos_out);
         sil_inverter_apply(&inv, &out, (double)meas.bus_voltage_V);
