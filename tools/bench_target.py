@@ -55,6 +55,7 @@ PLUGIN_SRC = ROOT / "hal" / "qemu_mps2" / "tools" / "pil_insn_plugin.c"
 MODES = ["IDLE", "S_ALIGN", "C_ALIGN", "RUN", "FAULT"]
 CPU_HZ = 170e6
 CONTROL_HZ = 20e3
+IN_WORDS = 6    # SIL_RECORD_IN_WORDS
 OUT_WORDS = 19  # SIL_RECORD_OUT_WORDS
 OUT_MODE = 4    # SIL_RECORD_OUT_MODE
 
@@ -95,16 +96,17 @@ def record_outputs(path):
     w = struct.unpack("<%dI" % (os.path.getsize(path) // 4), Path(path).read_bytes())
     # header: magic, version, config words, input words, output words, config, i_d* (sil/include/sil/record.h)
     config_words, in_words, out_words = w[2], w[3], w[4]
-    if (in_words, out_words) != (4, OUT_WORDS):
-        sys.exit("bench_target: record layout %d/%d words, expected 4/%d" % (in_words, out_words, OUT_WORDS))
+    if (in_words, out_words) != (IN_WORDS, OUT_WORDS):
+        sys.exit("bench_target: record layout %d/%d words, expected %d/%d" % (in_words, out_words, IN_WORDS,
+                                                                               OUT_WORDS))
     i, outs = 5 + config_words + 1, []
     while True:
         tag = w[i]
         if tag == 1:
             i += 3
         elif tag == 2:
-            outs.append(w[i + 5:i + 5 + OUT_WORDS])
-            i += 5 + OUT_WORDS
+            outs.append(w[i + 1 + IN_WORDS:i + 1 + IN_WORDS + OUT_WORDS])
+            i += 1 + IN_WORDS + OUT_WORDS
         elif tag == 3:
             return outs
         else:

@@ -3,7 +3,8 @@
 microstepping at rated current (issue 11). A benchmark that prints and writes figures; not a test.
 
 For each preset (sil/scenarios/motors/) and chain (ideal; realistic = sil/scenarios/robust.ini's
-measurement chain with the robust mode), it designs the gains with pmstep-tune (no hand tuning),
+measurement chain with the robust mode; sensed = realistic on a drive that also senses each
+phase's mean voltage per period, tools/mc_preset.py's PHASE_VOLTAGE_SENSING), it designs the gains with pmstep-tune (no hand tuning),
 then runs pmstep-sil:
   ramps     RUN of --duration s: ramps to +-80 % and +-5 % of the top speed and holds, repeated;
             fault, max |w - w*| after the transients (% of top), max angle-estimate error
@@ -17,7 +18,6 @@ then runs pmstep-sil:
       --out out/envelope
 """
 import argparse
-import configparser
 import csv
 import json
 import os
@@ -27,11 +27,11 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
+sys.path.insert(0, HERE)
+from mc_preset import chain_sets, read_preset as read_preset_file  # noqa: E402
+
 PRESETS = ("paper", "17hs4401", "bj42d29", "as1050")
-# sil/scenarios/robust.ini's measurement chain; the ADC span is sized to the motor (3 x rated).
-REALISTIC = ("sensors.adc_bits=12", "sensors.offset_a_A=0.02", "sensors.offset_b_A=-0.02",
-             "sensors.noise_rms_A=0.005", "inverter.model=switching", "inverter.dead_time_s=1e-6",
-             "run.delay_periods=1")
+ROBUST_CHAINS = ("realistic", "sensed")  # designed with --robust, behind mc_preset.py's chain
 HOLD_S = 1.0
 SETTLE_S = 0.1  # after each ramp, before the tracking error counts ("after transients")
 BISECTION_STEPS = 6
@@ -49,26 +49,22 @@ def sets(pairs):
 
 
 def read_preset(name):
-    ini = configparser.ConfigParser(inline_comment_prefixes=(";",))
-    ini.read(os.path.join(ROOT, "sil", "scenarios", "motors", name + ".ini"))
-    return {"rated_current_A": ini.getfloat("datasheet", "rated_current_A"),
-            "holding_torque_Nm": ini.getfloat("datasheet", "holding_torque_Nm")}
+    return read_preset_file(os.path.join(ROOT, "sil", "scenarios", "motors", name + ".ini"))
 
 
 def design(args, name, chain, out_dir):
     preset = read_preset(name)
-    chain_sets = []
-    if chain == "realistic":
-        chain_sets = list(REALISTIC) + ["sensors.current_full_scale_A=%g" % (3.0 * preset["rated_current_A"])]
+    robust = chain in ROBUST_CHAINS
+    chain_items = chain_sets(preset, chain == "sensed") if robust else []
     ini = os.path.join(out_dir, "design.ini")
     cmd = [args.tune, "--motor", os.path.join(ROOT, "sil", "scenarios", "motors", name + ".ini"),
-           "--write-ini", ini] + (["--robust"] if chain == "realistic" else []) + sets(chain_sets)
+           "--write-ini", ini] + (["--robust"] if robust else []) + sets(chain_items)
     r = run(cmd)
     if r.returncode != 0:
         raise SystemExit("pmstep-tune failed: %s\n%s" % (" ".join(cmd), r.stderr))
     top = float(re.search(r"V\): ([0-9.]+) rad/s", r.stdout).group(1))
     t_c = float(re.search(r"t_c ([0-9.]+) s", r.stdout).group(1))
-    start = t_c + (0.05 if chain == "realistic" else 0.0) + 0.1
+    start = t_c + (0.05 if robust else 0.0) + 0.1
     return ini, top, start, preset
 
 
@@ -255,12 +251,16 @@ def main():
     ap.add_argument("--tune", required=True)
     ap.add_argument("--out", required=True)
     ap.add_argument("--presets", default=",".join(PRESETS))
-    ap.add_argument("--chains", default="ideal,realistic")
+    ap.add_argument("--chains", default="ideal,realistic",
+                    help="comma-separated: ideal, realistic, sensed (realistic with phase-voltage sensing)")
     ap.add_argument("--duration", type=float, default=20.0, help="RUN time of the ramps run (s)")
     ap.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
                     help="a pmstep-sil --set applied to every run after the design (e.g. one impairment "
                          "of the chain removed: --set inverter.dead_time_s=0 --set controller.inverter.dead_time_s=0)")
     args = ap.parse_args()
+    unknown = [c for c in args.chains.split(",") if c not in ("ideal",) + ROBUST_CHAINS]
+    if unknown:
+        ap.error("unknown chain %s (ideal, %s)" % (", ".join(unknown), ", ".join(ROBUST_CHAINS)))
     rows = []
     for name in args.presets.split(","):
         for chain in args.chains.split(","):

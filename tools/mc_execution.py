@@ -120,6 +120,8 @@ def rerun_command(args, seed):
     """The command that re-runs one case with this tool (same bounds, same output folder)."""
     if getattr(args, "preset", None):
         cmd = ["python3", args.script, "--sil", args.sil, "--preset", args.preset, "--tune", args.tune, "--out", args.out]
+        if getattr(args, "phase_voltage_sensing", False):
+            cmd += ["--phase-voltage-sensing"]
     else:
         cmd = ["python3", args.script, "--sil", args.sil, "--scenario", args.scenario, "--out", args.out]
     if args.duration is not None:

@@ -18,7 +18,11 @@ values that mean nothing for a NEMA 17. For a preset (sil/scenarios/motors/*.ini
   fraction of the holding torque; the ripple as a fraction of the bus voltage (2 V of 48 V);
   the source resistance as a fraction of the winding resistance (0.2 Ohm of 3 Ohm);
 - the measurement chain's rows (offsets, gain errors, noise, dead time and the firmware's
-  programmed dead time) and the initial angle are the paper table's, unchanged.
+  programmed dead time) and the initial angle are the paper table's, unchanged;
+- with --phase-voltage-sensing, the drive also senses each phase's mean voltage per period
+  (PHASE_VOLTAGE_SENSING) and the cases draw that sensor's offsets, gain errors and noise
+  (PHASE_VOLTAGE_DISTRIBUTIONS, after the other rows: the same seed draws the same case
+  otherwise, a paired comparison with the campaign without it).
 
 The speed thresholds scale with the top speed the designer gives (rated current at 90 % of
 the bus): the paper campaign's are 0.5 rad/s (success) and 2 rad/s (loss of control) on the
@@ -52,6 +56,26 @@ REALISTIC_CHAIN = ("sensors.adc_bits=12", "sensors.offset_a_A=0.02", "sensors.of
                    "sensors.noise_rms_A=0.005", "inverter.model=switching", "inverter.dead_time_s=1e-6",
                    "run.delay_periods=1")
 ADC_SPAN_RATED = 3.0
+# A drive that senses each phase's mean voltage over every period (the paper's premise: stator
+# voltages measured; controller.inverter.phase_voltage_sensing): the realistic chain plus that
+# sensor, 14 bits over +-1.5 x the bus (4.4 mV on a 24 V bus: a capture timer at 170 MHz times the
+# bridge's edges to 5.9 ns, 2.8 mV of a 24 V, 50 us period), with offsets of +-50 mV (the
+# firmware's offset calibration takes them off), gain errors of +-0.5 % (divider and bus
+# measurement) and 5 mV rms of noise.
+PHASE_VOLTAGE_SPAN_BUS = 1.5
+PHASE_VOLTAGE_SENSING = (f"{KEYS['phase_voltage_sensing']}=true", f"{KEYS['phase_voltage_bits']}=14",
+                         f"{KEYS['phase_voltage_offset_a']}=0.05",
+                         f"{KEYS['phase_voltage_offset_b']}=-0.05", f"{KEYS['phase_voltage_gain_error_a']}=0.005",
+                         f"{KEYS['phase_voltage_gain_error_b']}=-0.005", f"{KEYS['phase_voltage_noise']}=0.005")
+# The Monte Carlo draws that sensor's errors too; the rows follow DISTRIBUTIONS' rows, so a case
+# draws the same plant, current sensors, inverter and load as with the realistic chain (paired).
+PHASE_VOLTAGE_DISTRIBUTIONS = [
+    (KEYS["phase_voltage_offset_a"], "uniform", -0.05, 0.05),
+    (KEYS["phase_voltage_offset_b"], "uniform", -0.05, 0.05),
+    (KEYS["phase_voltage_gain_error_a"], "uniform", -0.005, 0.005),
+    (KEYS["phase_voltage_gain_error_b"], "uniform", -0.005, 0.005),
+    (KEYS["phase_voltage_noise"], "uniform", 0.0025, 0.0075),
+]
 LOAD_STEP_AFTER_RUN_S = 0.03     # robust.ini's: 30 ms after RUN starts (0.68 s)
 PAPER_SPEED_BOUND_RAD_S = 0.5    # the paper campaign's success bound (monte_carlo.py --speed-bound)
 PAPER_LOSS_SPEED_RAD_S = 2.0     # robust.ini's run.loss_speed_error_rad_s
@@ -88,9 +112,20 @@ def paper_holding_torque():
     return read_preset(PAPER_PRESET)["holding_torque_Nm"]
 
 
-def preset_distributions(preset, peak_speed_rad_s, paper_holding_Nm):
-    """The distribution table for a preset (same rows, keys and order as DISTRIBUTIONS, so a
-    case draws as many numbers in the same order); see the module docstring."""
+def chain_sets(preset, phase_voltage_sensing=False):
+    """pmstep-tune/pmstep-sil --set items of the realistic chain for @p preset (the ADC span sized
+    to its rated current), with the phase-voltage sensor when @p phase_voltage_sensing."""
+    sets = list(REALISTIC_CHAIN) + [f"sensors.current_full_scale_A={ADC_SPAN_RATED * preset['rated_current_A']:g}"]
+    if phase_voltage_sensing:
+        sets += list(PHASE_VOLTAGE_SENSING) + [
+            f"{KEYS['phase_voltage_span']}={PHASE_VOLTAGE_SPAN_BUS * preset['bus_voltage_V']:g}"]
+    return sets
+
+
+def preset_distributions(preset, peak_speed_rad_s, paper_holding_Nm, phase_voltage_sensing=False):
+    """The distribution table for a preset (the rows, keys and order of DISTRIBUTIONS, so a
+    case draws as many numbers in the same order, then PHASE_VOLTAGE_DISTRIBUTIONS' with
+    @p phase_voltage_sensing); see the module docstring."""
     if not peak_speed_rad_s > 0.0:
         raise ToolError(f"the preset's profile peak speed {peak_speed_rad_s:g} rad/s is not positive")
     torque_ratio = preset["holding_torque_Nm"] / paper_holding_Nm
@@ -107,7 +142,8 @@ def preset_distributions(preset, peak_speed_rad_s, paper_holding_Nm):
                                         / PAPER_RESISTANCE_OHM),
         KEYS["load_torque"]: ("scale", 0.0, 1.0),  # of the scenario's load: PAPER_LOAD_NM x torque_ratio
     }
-    return [(key,) + replace[key] if key in replace else (key, kind, a, b) for key, kind, a, b in DISTRIBUTIONS]
+    table = [(key,) + replace[key] if key in replace else (key, kind, a, b) for key, kind, a, b in DISTRIBUTIONS]
+    return table + (PHASE_VOLTAGE_DISTRIBUTIONS if phase_voltage_sensing else [])
 
 
 def _design(tune, preset_path, chain_sets):
@@ -137,13 +173,13 @@ def _points_lines(points):
     return ",\n    ".join(rows)
 
 
-def design_scenario(tune, preset_path, out_dir):
+def design_scenario(tune, preset_path, out_dir, phase_voltage_sensing=False):
     """Designs the preset with pmstep-tune (robust mode, realistic chain) and writes the
     campaign's scenario to out_dir/preset_scenario.ini. Returns (its path, info) with info =
     {"preset", "top_speed_rad_s", "run_start_s", "peak_speed_rad_s", "load_Nm", "tune_command", ...}."""
     preset = read_preset(preset_path)
     paper_holding = paper_holding_torque()
-    chain = list(REALISTIC_CHAIN) + [f"sensors.current_full_scale_A={ADC_SPAN_RATED * preset['rated_current_A']:g}"]
+    chain = chain_sets(preset, phase_voltage_sensing)
     os.makedirs(out_dir, exist_ok=True)
     design_path = os.path.join(out_dir, "preset_design.ini")
     cmd = _design(tune, preset_path, chain) + ["--write-ini", design_path]

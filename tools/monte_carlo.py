@@ -111,6 +111,9 @@ def parse_args(argv):
                              "the realistic chain, distributions scaled to the motor (mc_preset.py)")
     parser.add_argument("--tune", default=None, metavar="PATH",
                         help="pmstep-tune for --preset (default: the one next to --sil)")
+    parser.add_argument("--phase-voltage-sensing", action="store_true",
+                        help="with --preset: the drive also senses each phase's mean voltage per period, and the "
+                             "cases draw that sensor's errors (mc_preset.py)")
     parser.add_argument("--out", required=True, help="output folder")
     parser.add_argument("--cases", type=int, default=100, help="number of cases N (default 100)")
     parser.add_argument("--seed", type=int, default=1, help="base seed S: case k has seed S*100000+k (default 1)")
@@ -149,6 +152,8 @@ def parse_args(argv):
         parser.error("give one of --scenario and --preset")
     if args.tune is not None and args.preset is None:
         parser.error("--tune is for --preset")
+    if args.phase_voltage_sensing and args.preset is None:
+        parser.error("--phase-voltage-sensing is for --preset (a scenario file sets the sensor itself)")
     if args.preset is not None and args.tune is None:
         args.tune = os.path.join(os.path.dirname(args.sil) or ".", "pmstep-tune")
     if args.case is None and not 1 <= args.cases <= SEED_STRIDE:
@@ -202,9 +207,10 @@ def use_preset(args):
     if not (os.path.isfile(args.tune) and os.access(args.tune, os.X_OK)):
         raise ToolError(f"{args.tune} is not an executable file (pmstep-tune, built beside pmstep-sil; or give --tune)")
     read_preset(args.preset)  # a clear error for a bad preset before the designer runs
-    args.scenario, info = design_scenario(args.tune, args.preset, args.out)
+    args.scenario, info = design_scenario(args.tune, args.preset, args.out, args.phase_voltage_sensing)
     # In place, so every function's default table (the same list object) sees it.
-    DISTRIBUTIONS[:] = preset_distributions(info["figures"], info["peak_speed_rad_s"], info["paper_holding_torque_Nm"])
+    DISTRIBUTIONS[:] = preset_distributions(info["figures"], info["peak_speed_rad_s"], info["paper_holding_torque_Nm"],
+                                            args.phase_voltage_sensing)
     if args.speed_bound is None:
         args.speed_bound = info["speed_bound_rad_s"]
     print(f"monte_carlo: preset {info['preset']}: top speed {info['top_speed_rad_s']:g} rad/s, profile peak "

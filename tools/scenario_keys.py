@@ -18,6 +18,13 @@ KEYS = {
     "sensor_gain_error_a": "sensors.gain_error_a",
     "sensor_gain_error_b": "sensors.gain_error_b",
     "sensor_noise": "sensors.noise_rms_A",
+    "phase_voltage_bits": "sensors.phase_voltage_bits",
+    "phase_voltage_span": "sensors.phase_voltage_full_scale_V",
+    "phase_voltage_offset_a": "sensors.phase_voltage_offset_a_V",
+    "phase_voltage_offset_b": "sensors.phase_voltage_offset_b_V",
+    "phase_voltage_gain_error_a": "sensors.phase_voltage_gain_error_a",
+    "phase_voltage_gain_error_b": "sensors.phase_voltage_gain_error_b",
+    "phase_voltage_noise": "sensors.phase_voltage_noise_rms_V",
     # [inverter] and [bus]
     "inverter_model": "inverter.model",
     "inverter_dead_time": "inverter.dead_time_s",
@@ -25,6 +32,7 @@ KEYS = {
     "bus_source_resistance": "bus.source_resistance_Ohm",
     # [controller]: what the firmware is told
     "firmware_dead_time": "controller.inverter.dead_time_s",
+    "phase_voltage_sensing": "controller.inverter.phase_voltage_sensing",
     # [run] and [load]
     "seed": "run.seed",
     "duration": "run.duration_s",
