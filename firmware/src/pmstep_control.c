@@ -23,15 +23,13 @@ static void start_run(pmstep_t *inst, const pmstep_meas_t *sample)
 }
 
 /* With phase-voltage sensing: the voltage of the period just ended as measured (offsets off), for
- * the flux integrals; the observer's prediction of this sample is redone with it (its current
- * step is linear in u). */
+ * the flux integrals; the observer's prediction of this sample is redone with it. */
 static void sensed_period_voltage(pmstep_t *inst, const pmstep_meas_t *sample, float *u_a_V, float *u_b_V)
 {
-    const float input_gain = inst->observer_coeffs.current_step_s * inst->observer_coeffs.inv_l_per_H;
     *u_a_V = sample->phase_voltage_a_V - inst->commissioning.phase_voltage_offset_a_V;
     *u_b_V = sample->phase_voltage_b_V - inst->commissioning.phase_voltage_offset_b_V;
-    inst->observer.i_a_hat_A += input_gain * (*u_a_V - inst->actuator.u_applied_a_V);
-    inst->observer.i_b_hat_A += input_gain * (*u_b_V - inst->actuator.u_applied_b_V);
+    pmstep_observer_correct_voltage(&inst->observer, &inst->observer_coeffs, *u_a_V - inst->actuator.u_applied_a_V,
+                                    *u_b_V - inst->actuator.u_applied_b_V);
 }
 
 void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_output_t *out,

@@ -72,6 +72,14 @@ pmstep_observer_mech_rates_t pmstep_observer_mech_rates(const pmstep_observer_t 
     return rates;
 }
 
+void pmstep_observer_correct_voltage(pmstep_observer_t *obs, const pmstep_observer_coeffs_t *coeffs,
+                                     float du_a_V, float du_b_V)
+{
+    const float input_gain = coeffs->current_step_s * coeffs->inv_l_per_H;
+    obs->i_a_hat_A += input_gain * du_a_V;
+    obs->i_b_hat_A += input_gain * du_b_V;
+}
+
 void pmstep_observer_advance(pmstep_observer_t *obs, const pmstep_observer_coeffs_t *coeffs,
                              const pmstep_observer_input_t *in,
                              const pmstep_observer_mech_rates_t *mech,

@@ -79,11 +79,48 @@ static void injection_gains_reduce_to_paper_values_without_friction(void **state
     assert_true(fabs(coeffs.load_injection_gain - 9.0) < 1e-4);
 }
 
+/* An advance with the assumed voltage, corrected by the difference, equals the advance with the
+ * actual voltage (to float rounding); the mechanical states do not depend on u in one step. */
+static void voltage_correction_redoes_the_advance(void **state)
+{
+    const pmstep_config_t cfg = pmstep_paper_config();
+    const pmstep_electrical_t model = pmstep_configured_electrical(&cfg);
+    pmstep_observer_coeffs_t coeffs;
+    pmstep_observer_t assumed;
+    pmstep_observer_t actual;
+    pmstep_observer_input_t in;
+    pmstep_observer_mech_rates_t mech;
+    (void)state;
+    pmstep_observer_coeffs_init(&coeffs, &cfg, &model);
+    pmstep_observer_start(&assumed, 0.3f, 0.9f);
+    assumed.speed_hat_rad_s = 8.0f;
+    assumed.load_hat_Nm = 1.0f;
+    actual = assumed;
+    in.i_a_A = 0.35f;
+    in.i_b_A = 0.85f;
+    in.cos_hat = 0.6f;
+    in.sin_hat = 0.8f;
+    pmstep_park(in.cos_hat, in.sin_hat, in.i_a_A, in.i_b_A, &in.i_d_A, &in.i_q_A);
+    in.i_d_err_A = 0.0f;
+    in.i_q_err_A = 0.0f;
+    in.known_load_Nm = 0.0f;
+    in.detent_torque_Nm = 0.0f;
+    mech = pmstep_observer_mech_rates(&assumed, &coeffs, &in, false);
+    pmstep_observer_advance(&assumed, &coeffs, &in, &mech, 12.0f, -5.0f, cfg.timing.period_s);
+    pmstep_observer_advance(&actual, &coeffs, &in, &mech, 12.4f, -5.3f, cfg.timing.period_s);
+    assert_true(assumed.i_a_hat_A != actual.i_a_hat_A); /* the voltages make a difference ... */
+    pmstep_observer_correct_voltage(&assumed, &coeffs, 0.4f, -0.3f);
+    assert_float_equal(assumed.i_a_hat_A, actual.i_a_hat_A, 1e-6f); /* ... which the correction removes */
+    assert_float_equal(assumed.i_b_hat_A, actual.i_b_hat_A, 1e-6f);
+    assert_true(assumed.speed_hat_rad_s == actual.speed_hat_rad_s && assumed.load_hat_Nm == actual.load_hat_Nm);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(injection_gains_reduce_to_paper_values_without_friction),
         cmocka_unit_test(observer_converges_on_exact_samples),
+        cmocka_unit_test(voltage_correction_redoes_the_advance),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

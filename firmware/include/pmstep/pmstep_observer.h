@@ -83,6 +83,11 @@ pmstep_observer_mech_rates_t pmstep_observer_mech_rates(const pmstep_observer_t 
                                                         const pmstep_observer_input_t *in,
                                                         bool known_load);
 
+/** The last advance redone for the voltage the period really had: the current step is linear
+ *  in u, so the estimates move by T/(1 + R T/(2L)) (u_actual - u_assumed)/L. */
+void pmstep_observer_correct_voltage(pmstep_observer_t *obs, const pmstep_observer_coeffs_t *coeffs,
+                                     float du_a_V, float du_b_V);
+
 /** Step of all four states over the next period (see the discretisation above), with the
  *  voltage applied over that period. */
 void pmstep_observer_advance(pmstep_observer_t *obs, const pmstep_observer_coeffs_t *coeffs,
