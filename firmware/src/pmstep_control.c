@@ -151,7 +151,6 @@ bool pmstep_control_advance(pmstep_t *inst, const pmstep_control_scratch_t *scra
         pmstep_ref_advance(&inst->ref_coeffs, &inst->scratch.run.known_load_filter, period_s);
     }
     /* The current integrals need no check here: they enter the next voltage, which actuate checks. */
-    return pmstep_all_finite4(inst->observer.speed_hat_rad_s, inst->observer.load_hat_Nm, inst->observer.i_a_hat_A,
-                              inst->observer.i_b_hat_A)
-           && pmstep_all_finite4(inst->angle.phi_a, inst->angle.phi_b, 0.0f, 0.0f);
+    return pmstep_all_finite6(inst->observer.speed_hat_rad_s, inst->observer.load_hat_Nm, inst->observer.i_a_hat_A,
+                              inst->observer.i_b_hat_A, inst->angle.phi_a, inst->angle.phi_b);
 }

@@ -43,6 +43,7 @@ static void derive(pmstep_t *inst, const pmstep_config_t *cfg)
     plan->bias_estimation = cfg->commissioning.voltage_bias_level_fraction > 0.0f;
     plan->identification_steps = pmstep_periods_in(cfg->commissioning.identification_time_s, period_s);
     inst->offset_cal_steps = pmstep_periods_in(cfg->commissioning.offset_calibration_time_s, period_s);
+    inst->optional_inputs = cfg->known_load_mode || cfg->inverter.phase_voltage_sensing;
     pmstep_detect_coeffs_init(&inst->detect_coeffs, cfg);
     pmstep_actuate_coeffs_init(&inst->actuate_coeffs, cfg);
 }
@@ -214,25 +215,31 @@ static void realign(pmstep_t *inst)
     inst->mode = PMSTEP_MODE_S_ALIGN;
 }
 
-/* With phase-voltage sensing: a sensed voltage non-finite, or above the bus by more than the
- * sensors' margin (a mean phase voltage cannot exceed the bus). */
-static pmstep_fault_t check_phase_voltages(const pmstep_meas_t *meas)
+/* The inputs a configuration adds: the load torque of known-load mode non-finite; with
+ * phase-voltage sensing, a sensed voltage non-finite, or above the bus by more than the sensors'
+ * margin (a mean phase voltage cannot exceed the bus). */
+static pmstep_fault_t check_optional_inputs(const pmstep_config_t *cfg, const pmstep_meas_t *meas)
 {
-    const float limit_V = PMSTEP_PHASE_VOLTAGE_RANGE_FACTOR * meas->bus_voltage_V;
-    if (!pmstep_all_finite4(meas->phase_voltage_a_V, meas->phase_voltage_b_V, 0.0f, 0.0f)) {
+    if (cfg->known_load_mode && !pmstep_all_finite4(meas->load_torque_Nm, 0.0f, 0.0f, 0.0f)) {
         return PMSTEP_FAULT_MEASUREMENT_NONFINITE;
     }
-    if (pmstep_abs(meas->phase_voltage_a_V) > limit_V || pmstep_abs(meas->phase_voltage_b_V) > limit_V) {
-        return PMSTEP_FAULT_PHASE_VOLTAGE_RANGE;
+    if (cfg->inverter.phase_voltage_sensing) {
+        const float limit_V = PMSTEP_PHASE_VOLTAGE_RANGE_FACTOR * meas->bus_voltage_V;
+        if (!pmstep_all_finite4(meas->phase_voltage_a_V, meas->phase_voltage_b_V, 0.0f, 0.0f)) {
+            return PMSTEP_FAULT_MEASUREMENT_NONFINITE;
+        }
+        if (pmstep_abs(meas->phase_voltage_a_V) > limit_V || pmstep_abs(meas->phase_voltage_b_V) > limit_V) {
+            return PMSTEP_FAULT_PHASE_VOLTAGE_RANGE;
+        }
     }
     return PMSTEP_FAULT_NONE;
 }
 
 /* Check stage: the protections, while the bridge may be on. */
-static pmstep_fault_t check_measurements(const pmstep_config_t *cfg, const pmstep_meas_t *meas)
+static pmstep_fault_t check_measurements(const pmstep_t *inst, const pmstep_meas_t *meas)
 {
-    if (!pmstep_all_finite4(meas->i_a_A, meas->i_b_A, meas->bus_voltage_V,
-                            cfg->known_load_mode ? meas->load_torque_Nm : 0.0f)) {
+    const pmstep_config_t *cfg = inst->cfg;
+    if (!pmstep_all_finite4(meas->i_a_A, meas->i_b_A, meas->bus_voltage_V, 0.0f)) {
         return PMSTEP_FAULT_MEASUREMENT_NONFINITE;
     }
     if (pmstep_abs(meas->i_a_A) > cfg->limits.max_phase_current_A
@@ -245,7 +252,7 @@ static pmstep_fault_t check_measurements(const pmstep_config_t *cfg, const pmste
     if (meas->bus_voltage_V > cfg->limits.max_bus_voltage_V) {
         return PMSTEP_FAULT_BUS_OVERVOLTAGE;
     }
-    return cfg->inverter.phase_voltage_sensing ? check_phase_voltages(meas) : PMSTEP_FAULT_NONE;
+    return inst->optional_inputs ? check_optional_inputs(cfg, meas) : PMSTEP_FAULT_NONE;
 }
 
 /* Bridge off and the mode of this period; the offset calibration's samples. */
@@ -505,7 +512,7 @@ void pmstep_step(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out
         output_off(out, inst);
         return;
     }
-    fault = check_measurements(inst->cfg, meas);
+    fault = check_measurements(inst, meas);
     if (fault == PMSTEP_FAULT_NONE && inst->mode == PMSTEP_MODE_OFFSET_CAL) {
         offset_calibration_stage(inst, meas, out);
         return;

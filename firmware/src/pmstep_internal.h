@@ -19,6 +19,12 @@ static inline bool pmstep_all_finite4(float a, float b, float c, float d)
     return ((a - a) + (b - b)) + ((c - c) + (d - d)) == 0.0f;
 }
 
+/* The same for six values, in one compare. */
+static inline bool pmstep_all_finite6(float a, float b, float c, float d, float e, float f)
+{
+    return (((a - a) + (b - b)) + ((c - c) + (d - d))) + ((e - e) + (f - f)) == 0.0f;
+}
+
 /* Whole periods in @p duration_s, rounded; defined for the durations validation accepts
  * (at most PMSTEP_MAX_DURATION_PERIODS periods). */
 static inline uint32_t pmstep_periods_in(float duration_s, float period_s)

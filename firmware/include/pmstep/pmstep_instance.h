@@ -30,6 +30,7 @@ typedef struct {
      * at t_c, for the commissioned model); init checks every float of them finite. */
     pmstep_commission_plan_t commission_plan; /**< alignment timing (t_s, t_c in periods) and windows */
     uint32_t offset_cal_steps;                /**< periods of bridge-off offset calibration */
+    bool optional_inputs;                     /**< a load torque or phase voltages to check each period */
     pmstep_detect_coeffs_t detect_coeffs;
     pmstep_actuate_coeffs_t actuate_coeffs;
     pmstep_ref_coeffs_t ref_coeffs;
