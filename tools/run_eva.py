@@ -34,8 +34,9 @@ HARNESSES = {
     "init": ("eva_init.c", None),
     "paper": ("eva_step.c", "eva_paper_config"),
     "features": ("eva_step.c", "eva_features_config"),
+    "sensed": ("eva_step.c", "eva_sensed_config"),
     "known_load": ("eva_step.c", "eva_known_load_config"),
-    "step": ("eva_step.c", None),   # the three configurations in one analysis: the union of what they reach
+    "step": ("eva_step.c", None),   # the four configurations in one analysis: the union of what they reach
 }
 # The functions of the step (pmstep_step and what it calls) for the statement figure.
 STEP_FUNCTIONS = None
@@ -94,8 +95,10 @@ def main():
     reached = re.search(r"(\d+) statements reached \(out of (\d+)\)", log)
     per_function = dict((f, (int(a), int(b))) for f, a, b in
                         re.findall(r"^  (\w+): (\d+) stmts out of (\d+)", log, re.M))
-    step = ["pmstep_step", "run_controller", "start_run", "finish_commissioning", "check_measurements", "detect",
-            "limit_to_bus", "trip", "output_off", "realign", "offset_calibration_step", "dead_time_voltage"]
+    step = ["pmstep_step", "output_off", "trip", "realign", "clear_dynamic_state", "check_measurements",
+            "check_optional_inputs", "offset_calibration_stage", "commission_stage", "commissioned_model",
+            "finish_commissioning", "identify_stage", "calibrated_sample", "alignment_stage", "supervise_stage",
+            "reference_current_over_period", "compensation_input", "bridge_on_stages"]
     step_reached = sum(per_function.get(f, (0, 0))[0] for f in step)
     step_total = sum(per_function.get(f, (0, 0))[1] for f in step)
     unreached = re.search(r"Unreached functions \(\d+\) =\n((?:    .*\n)+)", log)

@@ -46,8 +46,14 @@ pmstep_status_t pmstep_hold_vector(pmstep_t *inst, float cos_rest, float sin_res
     hold->bias_gain = natural_rad_s * inst->cfg->timing.period_s / PMSTEP_HOLD_BIAS_CORNER_RATIO;
     settle_periods = PMSTEP_HOLD_SETTLE_TIME_CONSTANTS
                      / (PMSTEP_HOLD_DAMPING_RATIO * natural_rad_s * inst->cfg->timing.period_s);
-    hold->settle_periods = (uint32_t)(settle_periods < HOLD_MAX_SETTLE_PERIODS ? settle_periods
-                                                                               : HOLD_MAX_SETTLE_PERIODS);
+    /* NaN and anything outside [0, max) count as the longest: a model with k_M and J positive gives
+     * neither, the test keeps the conversion defined whatever the model. NaN is tested apart as
+     * well, for Frama-C EVA, which does not take it out through an ordered compare (eva.step). */
+    if (settle_periods != settle_periods /* NaN */
+        || !(settle_periods >= 0.0f && settle_periods < HOLD_MAX_SETTLE_PERIODS)) {
+        settle_periods = HOLD_MAX_SETTLE_PERIODS;
+    }
+    hold->settle_periods = (uint32_t)settle_periods;
     hold->cos_frame = hold->cos_vector;
     hold->sin_frame = hold->sin_vector;
     if (!hold->active) { /* from the law: its integrals were of other errors */

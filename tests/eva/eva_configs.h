@@ -34,6 +34,15 @@ static pmstep_config_t eva_known_load_config(void)
     return cfg;
 }
 
+/* As eva_features_config with phase-voltage sensing: the sensed voltages in the flux integrals,
+ * the observer and the Remark 2 steady states, their offsets from the offset calibration. */
+static pmstep_config_t eva_sensed_config(void)
+{
+    pmstep_config_t cfg = eva_features_config();
+    cfg.inverter.phase_voltage_sensing = true;
+    return cfg;
+}
+
 /* Any finite float. */
 static float eva_any_finite(void)
 {
@@ -78,6 +87,7 @@ static void eva_any_config(pmstep_config_t *cfg)
     cfg->commissioning.voltage_bias_level_fraction = eva_any_finite();
     cfg->inverter.dead_time_s = eva_any_finite();
     cfg->inverter.dead_time_current_band_A = eva_any_finite();
+    cfg->inverter.phase_voltage_sensing = Frama_C_nondet(0, 1) != 0;
     cfg->gains.angle_correction_gain_per_s = eva_any_finite();
     cfg->gains.current_integral_gain_per_s2 = eva_any_finite();
     cfg->motor.detent_torque_Nm = eva_any_finite();

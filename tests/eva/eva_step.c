@@ -1,23 +1,25 @@
 /* Frama-C EVA harness: pmstep_step in every mode, reached the way an application reaches it:
  * init with the configuration EVA_CONFIG (eva_configs.h), then any number of periods, each
- * with any command (start, stop, clear_fault, reset, set-points, any float included) and a step
+ * with any command (start, stop, clear_fault, reset, set-points, a vector hold and its release,
+ * an angle estimate set, any float included) and a step
  * with any measurement: each field any finite value, or NaN, or +/-Inf. The output invariant is
  * asserted after every step. */
 #include <math.h>
 
 #include "eva_configs.h"
 
-/* EVA_CONFIG: one configuration of eva_configs.h; unset, all three, each analysed apart (split). */
+/* EVA_CONFIG: one configuration of eva_configs.h; unset, all four, each analysed apart (split). */
 static pmstep_config_t any_config(void)
 {
 #ifdef EVA_CONFIG
     return EVA_CONFIG();
 #else
-    int which = Frama_C_interval(0, 2);
+    int which = Frama_C_interval(0, 3);
     /*@ split which; */
     switch (which) {
     case 0: return eva_paper_config();
     case 1: return eva_features_config();
+    case 2: return eva_sensed_config();
     default: return eva_known_load_config();
     }
 #endif
@@ -45,8 +47,8 @@ int main(void)
         return 1;
     }
     while (Frama_C_nondet(0, 1)) {
-        switch (Frama_C_interval(0, 7)) {
-        case 7:
+        switch (Frama_C_interval(0, 9)) {
+        case 9:
             /* every command refuses a missing instance */
             (void)pmstep_init(NULL, &cfg);
             (void)pmstep_start(NULL);
@@ -54,6 +56,8 @@ int main(void)
             (void)pmstep_clear_fault(NULL);
             (void)pmstep_set_speed_target(NULL, 0.0f, 1.0f);
             (void)pmstep_set_id_target(NULL, 0.0f);
+            (void)pmstep_hold_vector(NULL, 1.0f, 0.0f, 0.0f, 0.0f);
+            (void)pmstep_set_angle_estimate(NULL, 1.0f, 0.0f);
             break;
         case 0: (void)pmstep_start(&inst); break;
         case 1: (void)pmstep_stop(&inst); break;
@@ -61,6 +65,13 @@ int main(void)
         case 3: pmstep_reset(&inst); break;
         case 4: (void)pmstep_set_speed_target(&inst, any_float(), any_float()); break;
         case 5: (void)pmstep_set_id_target(&inst, any_float()); break;
+        case 7:
+            (void)pmstep_hold_vector(&inst, any_float(), any_float(), any_float(), any_float());
+            if (Frama_C_nondet(0, 1)) {
+                pmstep_release_vector(&inst);
+            }
+            break;
+        case 8: (void)pmstep_set_angle_estimate(&inst, any_float(), any_float()); break;
         default:
             meas.i_a_A = any_float();
             meas.i_b_A = any_float();

@@ -152,6 +152,24 @@ static void angle_estimate_set_gives_that_estimate(void **state)
     assert_int_equal(pmstep_set_angle_estimate(&idle, 1.0f, 0.0f), PMSTEP_ERR_BAD_MODE);
 }
 
+/* The settling count is the longest (10^6 periods) where the model gives no finite, non-negative
+ * time below that: J/k_M negative (a NaN natural frequency), +Inf (zero), -Inf (-0: a time of
+ * -Inf), huge (a time beyond the count); never an undefined float-to-integer conversion. The
+ * validated model cannot give these; the instance is set by hand. */
+static void hold_settling_count_defined_for_any_model(void **state)
+{
+    static const float j_over_km[] = {-0.005f, INFINITY, -INFINITY, 1e30f};
+    size_t n;
+    (void)state;
+    for (n = 0; n < sizeof j_over_km / sizeof j_over_km[0]; ++n) {
+        fixture_t f;
+        fixture_in_run(&f);
+        f.inst.law_coeffs.j_over_km = j_over_km[n];
+        assert_int_equal(pmstep_hold_vector(&f.inst, 1.0f, 0.0f, 7.5f, 0.0f), PMSTEP_OK);
+        assert_int_equal(f.inst.hold.settle_periods, 1000000u);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -160,6 +178,7 @@ int main(void)
         cmocka_unit_test(hold_voltage_is_the_current_loop_in_the_vector_frame),
         cmocka_unit_test(release_and_speed_command_end_the_hold),
         cmocka_unit_test(angle_estimate_set_gives_that_estimate),
+        cmocka_unit_test(hold_settling_count_defined_for_any_model),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
