@@ -37,6 +37,23 @@ static uint32_t high_window_end(const pmstep_commission_plan_t *plan, uint32_t e
     return plan->bias_estimation ? end - plan->window_steps : end;
 }
 
+/* The drop to the lower level of an alignment ending at @p end: samples end - W - 1 (the last of
+ * the full-level window) .. end - 1, voltages over the W periods between them. */
+static void add_drop(const pmstep_commission_plan_t *plan, uint32_t sample, uint32_t end, float current_A,
+                     float voltage_V, float *voltage_sum_V, float *current_sum_A, float *start_A, float *end_A)
+{
+    if (sample + plan->window_steps + 1u == end) {
+        *start_A = current_A;
+        *current_sum_A = current_A;
+    } else if (sample + plan->window_steps + 1u > end) {
+        *voltage_sum_V += voltage_V;
+        *current_sum_A += current_A;
+        *end_A = current_A;
+    } else {
+        /* before the drop */
+    }
+}
+
 void pmstep_commission_add_alignment(pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
                                      uint32_t sample, float i_a_A, float i_b_A, float u_a_V, float u_b_V)
 {
@@ -63,6 +80,10 @@ void pmstep_commission_add_alignment(pmstep_commission_sums_t *sums, const pmste
             sums->s_low_current_sum_A += i_b_A;
             sums->s_low_voltage_sum_V += u_b_V;
         }
+        if (plan->bias_estimation) {
+            add_drop(plan, sample, plan->s_align_steps, i_b_A, u_b_V, &sums->s_drop_voltage_sum_V,
+                     &sums->s_drop_current_sum_A, &sums->s_drop_start_A, &sums->s_drop_end_A);
+        }
         return;
     }
     if (sample == plan->s_align_steps) {
@@ -74,6 +95,10 @@ void pmstep_commission_add_alignment(pmstep_commission_sums_t *sums, const pmste
     if (plan->bias_estimation && in_window(sample, plan->c_align_end_step, plan->window_steps / 2u)) {
         sums->c_low_current_sum_A += i_a_A;
         sums->c_low_voltage_sum_V += u_a_V;
+    }
+    if (plan->bias_estimation) {
+        add_drop(plan, sample, plan->c_align_end_step, i_a_A, u_a_V, &sums->c_drop_voltage_sum_V,
+                 &sums->c_drop_current_sum_A, &sums->c_drop_start_A, &sums->c_drop_end_A);
     }
     if (in_window(sample, high_window_end(plan, plan->c_align_end_step), plan->window_steps)) {
         sums->c_current_sum_A += i_a_A;
@@ -124,6 +149,15 @@ static float swing_flux(float voltage_sum_V, float current_sum_A, float start_a,
     return period_s * voltage_sum_V - resistance_Ohm * charge_a_s - inductance_H * (end_a - start_a);
 }
 
+/* L from the drop to the lower level (see the header): integral(u - bias - R i) over the W periods
+ * of the drop, over the step between the two steady states' mean currents. */
+static float drop_inductance(float voltage_sum_V, float current_sum_A, float start_A, float end_A, uint32_t periods,
+                             float offset_A, float resistance_Ohm, float bias_V, float step_A, float period_s)
+{
+    const float charge_A_s = current_integral(current_sum_A, start_A, end_A, periods, offset_A, period_s);
+    return (period_s * (voltage_sum_V - (float)periods * bias_V) - resistance_Ohm * charge_A_s) / step_A;
+}
+
 pmstep_fault_t pmstep_commission_finish(const pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
                                         const pmstep_config_t *cfg, float i_a_A, float u_a_V,
                                         pmstep_commissioning_t *result)
@@ -158,6 +192,21 @@ pmstep_fault_t pmstep_commission_finish(const pmstep_commission_sums_t *sums, co
         r_a = two_level_resistance(sums->c_voltage_sum_V / n_1, sums->c_current_sum_A / n_1 - offset_a,
                                    sums->c_low_voltage_sum_V / n_2, sums->c_low_current_sum_A / n_2 - offset_a,
                                    &result->voltage_bias_a_V);
+        if (plan->inductance_steps == 0u) {
+            /* L from the drops: phase b's, and phase a's on phase b's scale (a's current is scaled by
+             * r_a / r_b in RUN, so its apparent L is divided by that). */
+            const float l_b = drop_inductance(sums->s_drop_voltage_sum_V, sums->s_drop_current_sum_A,
+                                              sums->s_drop_start_A, sums->s_drop_end_A, plan->window_steps, offset_b,
+                                              r_b, result->voltage_bias_b_V,
+                                              (sums->s_low_current_sum_A / n_2) - (sums->s_current_sum_A / n_1),
+                                              period_s);
+            const float l_a = drop_inductance(sums->c_drop_voltage_sum_V, sums->c_drop_current_sum_A,
+                                              sums->c_drop_start_A, sums->c_drop_end_A, plan->window_steps, offset_a,
+                                              r_a, result->voltage_bias_a_V,
+                                              (sums->c_low_current_sum_A / n_2) - (sums->c_current_sum_A / n_1),
+                                              period_s);
+            result->inductance_H = 0.5f * (l_b + l_a * (r_b / r_a));
+        }
     } else if (windows) {
         /* Steady states of (3) and (5): R = u/i on each phase. */
         r_b = window_resistance(sums->s_voltage_sum_V, sums->s_current_sum_A, plan->window_steps, offset_b);
@@ -175,9 +224,9 @@ pmstep_fault_t pmstep_commission_finish(const pmstep_commission_sums_t *sums, co
         const float volt_seconds = period_s * (sums->rise_voltage_sum_V
                                                - (float)plan->inductance_steps * result->voltage_bias_b_V);
         result->inductance_H = (volt_seconds - r_b * charge_a_s) / (sums->rise_end_A - sums->rise_start_A);
-        if (cfg->commissioning.use_measured_inductance) {
-            inductance_H = result->inductance_H;
-        }
+    }
+    if (cfg->commissioning.use_measured_inductance) {
+        inductance_H = result->inductance_H;
     }
     if (windows) {
         /* Flux swing of c-alignment (see the header), samples t_s .. t_c, on the driven phase a:

@@ -186,14 +186,16 @@ static pmstep_status_t validate_commissioning(const pmstep_config_t *cfg)
     if (comm->inductance_window_s > 0.5f * s_align_s) {
         return PMSTEP_ERR_INDUCTANCE_WINDOW;
     }
-    /* What is used must be measured: offsets, R and k_M need the windows, L its rise window. */
+    /* What is used must be measured: offsets, R and k_M need the windows, L its rise window or the
+     * level drops of the voltage-bias option. */
     if (comm->alignment_offset_calibration && !window) {
         return PMSTEP_ERR_ALIGNMENT_OFFSETS_UNMEASURED;
     }
     if (comm->use_measured_resistance && !window) {
         return PMSTEP_ERR_RESISTANCE_UNMEASURED;
     }
-    if (comm->use_measured_inductance && !(comm->inductance_window_s > 0.0f)) {
+    if (comm->use_measured_inductance && !(comm->inductance_window_s > 0.0f)
+        && !(window && comm->voltage_bias_level_fraction > 0.0f)) {
         return PMSTEP_ERR_INDUCTANCE_UNMEASURED;
     }
     if (comm->use_measured_torque_constant && !window) {

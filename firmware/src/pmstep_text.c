@@ -47,7 +47,7 @@ const char *pmstep_status_str(pmstep_status_t status)
     case PMSTEP_ERR_INDUCTANCE_WINDOW: return "L window < 0 or over half of t_s";
     case PMSTEP_ERR_ALIGNMENT_OFFSETS_UNMEASURED: return "alignment offsets need a window";
     case PMSTEP_ERR_RESISTANCE_UNMEASURED: return "measured R needs a window";
-    case PMSTEP_ERR_INDUCTANCE_UNMEASURED: return "measured L needs an L window";
+    case PMSTEP_ERR_INDUCTANCE_UNMEASURED: return "measured L needs an L window or the voltage-bias level";
     case PMSTEP_ERR_TORQUE_CONSTANT_UNMEASURED: return "measured k_M needs a window";
     case PMSTEP_ERR_VOLTAGE_BIAS_FRACTION: return "need 0 <= bias fraction < 1";
     case PMSTEP_ERR_VOLTAGE_BIAS_WINDOW: return "bias needs a window <= 1/4 alignment";

@@ -214,6 +214,38 @@ static void two_levels_give_r_and_the_voltage_bias(void **state)
     assert_true(fabsf(result.voltage_bias_b_V - 0.3f) < 1e-3f);
 }
 
+/* Without a rise window, L comes from the drops to the lower level: the same two levels as above
+ * (bridge 0.3 V short, offsets), L 10 % above the configured 6 mH. Over each drop the integrand
+ * u - bias - R i vanishes in both steady states, so L (i_2 - i_1) is the integral over the decay:
+ * trapezoid error (T/tau)^2/12 ~ 6e-5, the lower level settled to e^-11. The rotor is locked, so
+ * k_M fails as in the locked-rotor test above; L is still reported. */
+static void level_drops_give_l_without_a_rise_window(void **state)
+{
+    pmstep_config_t cfg = short_config();
+    rl_plant_t plant = {3.6, 0.0066, 0.0, 0.0, 0.02, -0.01, 0.3};
+    pmstep_t inst;
+    pmstep_output_t out;
+    pmstep_commissioning_t result;
+    (void)state;
+    cfg.alignment.s_align_time_s = 0.16f;
+    cfg.alignment.c_align_time_s = 0.32f;
+    cfg.commissioning.steady_state_window_s = 0.04f;
+    cfg.commissioning.voltage_bias_level_fraction = 0.5f;
+    cfg.commissioning.inductance_window_s = 0.0f;
+    cfg.commissioning.use_measured_inductance = true;
+    cfg.inverter.dead_time_current_band_A = 0.05f;
+    assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
+    assert_int_equal(pmstep_start(&inst), PMSTEP_OK);
+    run_rl(&inst, &plant, &out, 8000u);
+    pmstep_get_commissioning(&inst, &result);
+    print_message("L %.7f H (true 0.0066), R %.6f\n", (double)result.inductance_H, (double)result.resistance_Ohm);
+    assert_true(fabsf(result.inductance_H - 0.0066f) < 0.0066f * 1e-3f);
+    assert_int_equal(out.fault, PMSTEP_FAULT_COMMISSIONING); /* k_M: the locked rotor never swings */
+    /* Without the voltage-bias level there are no drops: a measured L needs the rise window. */
+    cfg.commissioning.voltage_bias_level_fraction = 0.0f;
+    assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_ERR_INDUCTANCE_UNMEASURED);
+}
+
 /* With phase-voltage sensing, R comes from the sensed voltages: the same two levels as above,
  * with a bridge 0.3 V short at positive current and a voltage sensor that reads 1 % high, give
  * R as that sensor sees it, 1.01 x 3.6 Ohm (so u - R i vanishes at standstill in the flux
@@ -354,6 +386,7 @@ int main(void)
         cmocka_unit_test(bridge_off_calibration_measures_the_offsets),
         cmocka_unit_test(locked_rotor_gives_r_and_l_and_fails_the_torque_constant),
         cmocka_unit_test(two_levels_give_r_and_the_voltage_bias),
+        cmocka_unit_test(level_drops_give_l_without_a_rise_window),
         cmocka_unit_test(sensed_voltages_give_r_as_the_sensor_sees_it),
         cmocka_unit_test(dead_time_is_compensated_on_the_driven_phase),
         cmocka_unit_test(lost_angle_faults_or_realigns_after_the_detection_time),

@@ -103,13 +103,15 @@ static void every_preset_gets_a_valid_design(void **state)
                 const float k = in.motor.resistance_Ohm / in.motor.inductance_H + cfg.gains.current_gain_per_s;
                 assert_float_equal(cfg.gains.current_integral_gain_per_s2, 0.125f * k * k, 1e-3f * k * k);
             }
-            /* RUN takes the measured L and k_M only where the rotor stays still over the L window:
-             * the paper's motor (w_n T_L ~ 0.05), not the hybrids (~0.45-0.75). */
-            assert_true(cfg.commissioning.use_measured_inductance
-                        == (robust != 0 && report.alignment_frequency_rad_s * cfg.commissioning.inductance_window_s < 0.1f));
-            assert_true(cfg.commissioning.use_measured_inductance == cfg.commissioning.use_measured_torque_constant);
+            /* Robust: RUN takes the measured L and k_M. L from the current rise where the rotor stays
+             * still over its window (the paper's motor, w_n T_L ~ 0.05), else from the level drops:
+             * no rise window for the hybrids (~0.45-0.75), the voltage-bias level on. */
+            assert_true(cfg.commissioning.use_measured_inductance == (robust != 0));
+            assert_true(cfg.commissioning.use_measured_torque_constant == (robust != 0));
             if (robust != 0) {
-                assert_true(cfg.commissioning.use_measured_inductance == (n == 0));
+                assert_true((cfg.commissioning.inductance_window_s > 0.0f) == (n == 0));
+                assert_true(report.alignment_frequency_rad_s * cfg.commissioning.inductance_window_s < 0.1f);
+                assert_true(cfg.commissioning.voltage_bias_level_fraction > 0.0f);
             }
             /* Top speed: the bus takes (R I + k_M w)^2 + (p w L I)^2 = (0.9 V)^2 there. */
             {

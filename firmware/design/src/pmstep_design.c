@@ -230,13 +230,16 @@ static void design_commissioning(const pmstep_design_input_t *in, float window_s
                                     : 0.0f;
     /* L comes from the first current rise of s-alignment, with the rotor taken as still; where
      * the alignment swing's natural frequency turns the rotor within that window (hybrid
-     * steppers: w_n ~ 1000 rad/s), its back EMF enters the measurement, and k_M's measurement
-     * uses that L: RUN then keeps the datasheet's L and k_M (they are still measured and
-     * reported). */
+     * steppers: w_n ~ 1000 rad/s), its back EMF would enter the measurement: there L comes
+     * from the drops to the voltage-bias level instead, where the rotor stays at its
+     * equilibrium (no rise window). k_M's flux swing uses that L. */
     rotor_still = report->alignment_frequency_rad_s * c->inductance_window_s < STILL_ROTOR_SWING_PHASE;
+    if (!rotor_still) {
+        c->inductance_window_s = 0.0f;
+    }
     c->use_measured_resistance = robust;
-    c->use_measured_inductance = robust && rotor_still;
-    c->use_measured_torque_constant = robust && rotor_still;
+    c->use_measured_inductance = robust;
+    c->use_measured_torque_constant = robust;
     c->voltage_bias_level_fraction = robust ? VOLTAGE_BIAS_LEVEL : 0.0f;
     /* The window is the application's: it must hold the speed commands that excite the motor. */
     c->identification_time_s = 0.0f;

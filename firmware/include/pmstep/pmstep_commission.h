@@ -17,7 +17,16 @@
  *  - L: the rise of i_b over N periods early in s-alignment, when the rotor has
  *    hardly moved: L (i_b(m0 + N) - i_b(m0)) = integral of (u_b - R i_b). The window
  *    starts at m0 = 2 + delay, once the current is clear of zero and the dead-time
- *    compensation acts in full;
+ *    compensation acts in full. Without that window (N = 0) and with the voltage-bias
+ *    option, from each alignment's drop to its lower level instead: the rotor stays at
+ *    its equilibrium (the torque keeps its direction), so over the W periods from the last
+ *    sample of the full-level window to the end of the alignment
+ *      L (i_2 - i_1) = integral of (u - bias - R i)
+ *    with i_1, i_2 the two steady states' means and R, bias their fit (the integrand is 0
+ *    in both steady states: an error of R weighs only on the decay, L dR/R). Phase b at
+ *    the end of s-alignment, phase a (on phase b's sensor scale) at the end of
+ *    c-alignment, averaged. The rise needs a rotor that stays put for N periods, which a
+ *    hybrid stepper's alignment swing (w_n ~ 1000 rad/s) does not; the drop does not;
  *  - k_M: the flux swing of c-alignment, the rotor turning from sin p theta = 1 to
  *    cos p theta = 1. With x = L i + (k_M/p)(cos p theta, sin p theta) and x' = u - R i
  *    (model (1)), over [t_s, t_c] on the driven phase a (cos: 0 -> 1):
@@ -41,7 +50,7 @@ typedef struct {
     uint32_t s_align_steps;     /**< first sample of c-alignment (t_s) */
     uint32_t c_align_end_step;  /**< sample at t_c */
     uint32_t window_steps;      /**< W: steady-state window at the end of each alignment (0 = none) */
-    uint32_t inductance_steps;  /**< N: current-rise window (0 = L not measured) */
+    uint32_t inductance_steps;  /**< N: current-rise window (0 = L from the level drops, with bias_estimation) */
     uint32_t inductance_start_step; /**< m0: first sample of the current-rise window */
     bool offsets_from_alignment;/**< take offsets from the alignment steady states too */
     bool bias_estimation;       /**< second, lower steady state at the end of each alignment */
@@ -59,6 +68,8 @@ typedef struct {
     float s_low_current_sum_A, s_low_voltage_sum_V; /**< lower steady state of s-alignment (bias option) */
     float c_low_current_sum_A, c_low_voltage_sum_V; /**< lower steady state of c-alignment */
     float swing_voltage_a_V, swing_current_a_A, swing_start_a_A; /**< c-alignment, k_M */
+    float s_drop_voltage_sum_V, s_drop_current_sum_A, s_drop_start_A, s_drop_end_A; /**< L, phase b */
+    float c_drop_voltage_sum_V, c_drop_current_sum_A, c_drop_start_A, c_drop_end_A; /**< L, phase a */
 } pmstep_commission_sums_t;
 
 void pmstep_commission_clear(pmstep_commission_sums_t *sums);

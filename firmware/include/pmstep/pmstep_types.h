@@ -69,7 +69,7 @@ typedef enum {
     PMSTEP_ERR_INDUCTANCE_WINDOW = -82,     /**< current-rise window < 0 or longer than half of s-alignment */
     PMSTEP_ERR_ALIGNMENT_OFFSETS_UNMEASURED = -83, /**< offsets from the alignments without a steady-state window */
     PMSTEP_ERR_RESISTANCE_UNMEASURED = -84, /**< measured R used without a steady-state window */
-    PMSTEP_ERR_INDUCTANCE_UNMEASURED = -85, /**< measured L used without a current-rise window */
+    PMSTEP_ERR_INDUCTANCE_UNMEASURED = -85, /**< measured L used without a current-rise window or level drops */
     PMSTEP_ERR_TORQUE_CONSTANT_UNMEASURED = -86, /**< measured k_M used without a steady-state window */
     PMSTEP_ERR_VOLTAGE_BIAS_FRACTION = -87, /**< voltage-bias level fraction outside [0, 1) */
     PMSTEP_ERR_VOLTAGE_BIAS_WINDOW = -88,   /**< voltage bias without a window, or a window over a quarter alignment */
