@@ -4,6 +4,14 @@
 #include <math.h> /* isfinite: a classification macro, no libm call */
 #include <string.h>
 
+/* The alignments' sums and t_c's one-off out of line (GCC, Clang): inlined into pmstep_step() by
+ * link-time optimisation, their registers weigh on RUN's code as well. */
+#if defined(__GNUC__)
+#define COMMISSION_OUT_OF_LINE __attribute__((noinline))
+#else
+#define COMMISSION_OUT_OF_LINE
+#endif
+
 void pmstep_commission_clear(pmstep_commission_sums_t *sums)
 {
     memset(sums, 0, sizeof *sums);
@@ -37,35 +45,35 @@ static uint32_t high_window_end(const pmstep_commission_plan_t *plan, uint32_t e
     return plan->bias_estimation ? end - plan->window_steps : end;
 }
 
+/* A sample into a flux integral's sums; @p first: the integral's first sample (its voltage,
+ * of the period before it, is not part of the integral). */
+static void add_flux_sample(pmstep_flux_sums_t *flux, bool first, float current_A, float voltage_V)
+{
+    if (first) {
+        flux->start_A = current_A;
+    } else {
+        flux->voltage_sum_V += voltage_V;
+    }
+    flux->current_sum_A += current_A;
+    flux->end_A = current_A;
+}
+
 /* The drop to the lower level of an alignment ending at @p end: samples end - W - 1 (the last of
  * the full-level window) .. end - 1, voltages over the W periods between them. */
-static void add_drop(const pmstep_commission_plan_t *plan, uint32_t sample, uint32_t end, float current_A,
-                     float voltage_V, float *voltage_sum_V, float *current_sum_A, float *start_A, float *end_A)
+static void add_drop_sample(pmstep_flux_sums_t *drop, const pmstep_commission_plan_t *plan, uint32_t sample,
+                            uint32_t end, float current_A, float voltage_V)
 {
-    if (sample + plan->window_steps + 1u == end) {
-        *start_A = current_A;
-        *current_sum_A = current_A;
-    } else if (sample + plan->window_steps + 1u > end) {
-        *voltage_sum_V += voltage_V;
-        *current_sum_A += current_A;
-        *end_A = current_A;
-    } else {
-        /* before the drop */
+    if (plan->bias_estimation && sample + plan->window_steps + 1u >= end) {
+        add_flux_sample(drop, sample + plan->window_steps + 1u == end, current_A, voltage_V);
     }
 }
 
-void pmstep_commission_add_alignment(pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
+COMMISSION_OUT_OF_LINE void pmstep_commission_add_alignment(pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
                                      uint32_t sample, float i_a_A, float i_b_A, float u_a_V, float u_b_V)
 {
     if (sample >= plan->inductance_start_step && sample - plan->inductance_start_step <= plan->inductance_steps) {
         /* Samples m0..m0+N of the rise, voltages over the N periods between them. */
-        if (sample == plan->inductance_start_step) {
-            sums->rise_start_A = i_b_A;
-        } else {
-            sums->rise_voltage_sum_V += u_b_V;
-        }
-        sums->rise_current_sum_A += i_b_A;
-        sums->rise_end_A = i_b_A;
+        add_flux_sample(&sums->rise, sample == plan->inductance_start_step, i_b_A, u_b_V);
     }
     if (sample < plan->s_align_steps) {
         if (in_window(sample, high_window_end(plan, plan->s_align_steps), plan->window_steps)) {
@@ -80,26 +88,15 @@ void pmstep_commission_add_alignment(pmstep_commission_sums_t *sums, const pmste
             sums->s_low_current_sum_A += i_b_A;
             sums->s_low_voltage_sum_V += u_b_V;
         }
-        if (plan->bias_estimation) {
-            add_drop(plan, sample, plan->s_align_steps, i_b_A, u_b_V, &sums->s_drop_voltage_sum_V,
-                     &sums->s_drop_current_sum_A, &sums->s_drop_start_A, &sums->s_drop_end_A);
-        }
+        add_drop_sample(&sums->s_drop, plan, sample, plan->s_align_steps, i_b_A, u_b_V);
         return;
     }
-    if (sample == plan->s_align_steps) {
-        sums->swing_start_a_A = i_a_A;
-    } else {
-        sums->swing_voltage_a_V += u_a_V;
-    }
-    sums->swing_current_a_A += i_a_A;
+    add_flux_sample(&sums->swing, sample == plan->s_align_steps, i_a_A, u_a_V);
     if (plan->bias_estimation && in_window(sample, plan->c_align_end_step, plan->window_steps / 2u)) {
         sums->c_low_current_sum_A += i_a_A;
         sums->c_low_voltage_sum_V += u_a_V;
     }
-    if (plan->bias_estimation) {
-        add_drop(plan, sample, plan->c_align_end_step, i_a_A, u_a_V, &sums->c_drop_voltage_sum_V,
-                 &sums->c_drop_current_sum_A, &sums->c_drop_start_A, &sums->c_drop_end_A);
-    }
+    add_drop_sample(&sums->c_drop, plan, sample, plan->c_align_end_step, i_a_A, u_a_V);
     if (in_window(sample, high_window_end(plan, plan->c_align_end_step), plan->window_steps)) {
         sums->c_current_sum_A += i_a_A;
         sums->c_voltage_sum_V += u_a_V;
@@ -141,24 +138,16 @@ static float two_level_resistance(float u_1, float i_1, float u_2, float i_2, fl
     return resistance_Ohm;
 }
 
-/* integral(u - R i) - L delta i over the c-alignment swing of one phase (V s). */
-static float swing_flux(float voltage_sum_V, float current_sum_A, float start_a, float end_a, uint32_t periods,
-                        float offset_a, float resistance_Ohm, float inductance_H, float period_s)
+/* integral(u - bias - R i) (V s) over the @p periods of @p flux, the currents less @p offset_A. */
+static float window_flux(const pmstep_flux_sums_t *flux, uint32_t periods, float offset_A, float resistance_Ohm,
+                         float bias_V, float period_s)
 {
-    const float charge_a_s = current_integral(current_sum_A + end_a, start_a, end_a, periods, offset_a, period_s);
-    return period_s * voltage_sum_V - resistance_Ohm * charge_a_s - inductance_H * (end_a - start_a);
+    const float charge_A_s = current_integral(flux->current_sum_A, flux->start_A, flux->end_A, periods, offset_A,
+                                              period_s);
+    return period_s * (flux->voltage_sum_V - (float)periods * bias_V) - resistance_Ohm * charge_A_s;
 }
 
-/* L from the drop to the lower level (see the header): integral(u - bias - R i) over the W periods
- * of the drop, over the step between the two steady states' mean currents. */
-static float drop_inductance(float voltage_sum_V, float current_sum_A, float start_A, float end_A, uint32_t periods,
-                             float offset_A, float resistance_Ohm, float bias_V, float step_A, float period_s)
-{
-    const float charge_A_s = current_integral(current_sum_A, start_A, end_A, periods, offset_A, period_s);
-    return (period_s * (voltage_sum_V - (float)periods * bias_V) - resistance_Ohm * charge_A_s) / step_A;
-}
-
-pmstep_fault_t pmstep_commission_finish(const pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
+COMMISSION_OUT_OF_LINE pmstep_fault_t pmstep_commission_finish(const pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
                                         const pmstep_config_t *cfg, float i_a_A, float u_a_V,
                                         pmstep_commissioning_t *result)
 {
@@ -193,18 +182,15 @@ pmstep_fault_t pmstep_commission_finish(const pmstep_commission_sums_t *sums, co
                                    sums->c_low_voltage_sum_V / n_2, sums->c_low_current_sum_A / n_2 - offset_a,
                                    &result->voltage_bias_a_V);
         if (plan->inductance_steps == 0u) {
-            /* L from the drops: phase b's, and phase a's on phase b's scale (a's current is scaled by
-             * r_a / r_b in RUN, so its apparent L is divided by that). */
-            const float l_b = drop_inductance(sums->s_drop_voltage_sum_V, sums->s_drop_current_sum_A,
-                                              sums->s_drop_start_A, sums->s_drop_end_A, plan->window_steps, offset_b,
-                                              r_b, result->voltage_bias_b_V,
-                                              (sums->s_low_current_sum_A / n_2) - (sums->s_current_sum_A / n_1),
-                                              period_s);
-            const float l_a = drop_inductance(sums->c_drop_voltage_sum_V, sums->c_drop_current_sum_A,
-                                              sums->c_drop_start_A, sums->c_drop_end_A, plan->window_steps, offset_a,
-                                              r_a, result->voltage_bias_a_V,
-                                              (sums->c_low_current_sum_A / n_2) - (sums->c_current_sum_A / n_1),
-                                              period_s);
+            /* L from the drops (see the header), over the step between the steady states' means:
+             * phase b's, and phase a's on phase b's scale (a's current is scaled by r_a / r_b in
+             * RUN, so its apparent L is divided by that). */
+            const float l_b = window_flux(&sums->s_drop, plan->window_steps, offset_b, r_b, result->voltage_bias_b_V,
+                                          period_s)
+                              / ((sums->s_low_current_sum_A / n_2) - (sums->s_current_sum_A / n_1));
+            const float l_a = window_flux(&sums->c_drop, plan->window_steps, offset_a, r_a, result->voltage_bias_a_V,
+                                          period_s)
+                              / ((sums->c_low_current_sum_A / n_2) - (sums->c_current_sum_A / n_1));
             result->inductance_H = 0.5f * (l_b + l_a * (r_b / r_a));
         }
     } else if (windows) {
@@ -219,11 +205,9 @@ pmstep_fault_t pmstep_commission_finish(const pmstep_commission_sums_t *sums, co
     }
     if (plan->inductance_steps > 0u) {
         /* L delta i = integral(u - R i) over the rise; the rotor has not moved yet. */
-        const float charge_a_s = current_integral(sums->rise_current_sum_A, sums->rise_start_A, sums->rise_end_A,
-                                                  plan->inductance_steps, offset_b, period_s);
-        const float volt_seconds = period_s * (sums->rise_voltage_sum_V
-                                               - (float)plan->inductance_steps * result->voltage_bias_b_V);
-        result->inductance_H = (volt_seconds - r_b * charge_a_s) / (sums->rise_end_A - sums->rise_start_A);
+        result->inductance_H = window_flux(&sums->rise, plan->inductance_steps, offset_b, r_b,
+                                           result->voltage_bias_b_V, period_s)
+                               / (sums->rise.end_A - sums->rise.start_A);
     }
     if (cfg->commissioning.use_measured_inductance) {
         inductance_H = result->inductance_H;
@@ -232,10 +216,12 @@ pmstep_fault_t pmstep_commission_finish(const pmstep_commission_sums_t *sums, co
         /* Flux swing of c-alignment (see the header), samples t_s .. t_c, on the driven phase a:
          * its current is far from zero throughout, so its voltage is known (bias included). Its
          * apparent L is phase b's on phase a's sensor scale; the L is the one RUN takes. */
-        const uint32_t periods = plan->c_align_end_step - plan->s_align_steps;
-        const float flux_a = swing_flux(sums->swing_voltage_a_V + u_a_V - (float)periods * result->voltage_bias_a_V,
-                                        sums->swing_current_a_A, sums->swing_start_a_A, i_a_A, periods, offset_a, r_a,
-                                        inductance_H * result->phase_a_current_scale, period_s);
+        pmstep_flux_sums_t swing = sums->swing;
+        float flux_a;
+        add_flux_sample(&swing, false, i_a_A, u_a_V); /* t_c's sample closes it */
+        flux_a = window_flux(&swing, plan->c_align_end_step - plan->s_align_steps, offset_a, r_a,
+                             result->voltage_bias_a_V, period_s)
+                 - inductance_H * result->phase_a_current_scale * (swing.end_A - swing.start_A);
         result->torque_constant_Nm_A = flux_a * (float)cfg->motor.pole_pairs;
     }
     if ((windows && !(plausible(r_a, cfg->motor.resistance_Ohm) && plausible(r_b, cfg->motor.resistance_Ohm)

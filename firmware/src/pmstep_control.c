@@ -26,8 +26,7 @@ static void start_run(pmstep_t *inst, const pmstep_meas_t *sample)
  * the flux integrals; the observer's prediction of this sample is redone with it. */
 static void sensed_period_voltage(pmstep_t *inst, const pmstep_meas_t *sample, float *u_a_V, float *u_b_V)
 {
-    *u_a_V = sample->phase_voltage_a_V - inst->commissioning.phase_voltage_offset_a_V;
-    *u_b_V = sample->phase_voltage_b_V - inst->commissioning.phase_voltage_offset_b_V;
+    pmstep_sensed_voltages(inst, sample, u_a_V, u_b_V);
     pmstep_observer_correct_voltage(&inst->observer, &inst->observer_coeffs, *u_a_V - inst->actuator.u_applied_a_V,
                                     *u_b_V - inst->actuator.u_applied_b_V);
 }

@@ -349,11 +349,13 @@ static pmstep_fault_t commission_stage(pmstep_t *inst, const pmstep_meas_t *meas
         return PMSTEP_FAULT_NONE;
     }
     if (inst->mode != PMSTEP_MODE_RUN) {
-        const bool sensing = inst->cfg->inverter.phase_voltage_sensing;
-        pmstep_commission_add_alignment(
-            &inst->scratch.sums, plan, inst->mode_step, meas->i_a_A, meas->i_b_A,
-            sensing ? meas->phase_voltage_a_V - inst->commissioning.phase_voltage_offset_a_V : inst->actuator.u_applied_a_V,
-            sensing ? meas->phase_voltage_b_V - inst->commissioning.phase_voltage_offset_b_V : inst->actuator.u_applied_b_V);
+        float u_a_V = inst->actuator.u_applied_a_V;
+        float u_b_V = inst->actuator.u_applied_b_V;
+        if (inst->cfg->inverter.phase_voltage_sensing) {
+            pmstep_sensed_voltages(inst, meas, &u_a_V, &u_b_V);
+        }
+        pmstep_commission_add_alignment(&inst->scratch.sums, plan, inst->mode_step, meas->i_a_A, meas->i_b_A,
+                                        u_a_V, u_b_V);
         return PMSTEP_FAULT_NONE;
     }
     return finish_commissioning(inst, meas);

@@ -25,6 +25,15 @@ static inline bool pmstep_all_finite6(float a, float b, float c, float d, float 
     return (((a - a) + (b - b)) + ((c - c) + (d - d))) + ((e - e) + (f - f)) == 0.0f;
 }
 
+/* With phase-voltage sensing: the sensed mean voltages of the period that ends at @p meas, their
+ * bridge-off offsets taken off. */
+static inline void pmstep_sensed_voltages(const pmstep_t *inst, const pmstep_meas_t *meas, float *u_a_V,
+                                          float *u_b_V)
+{
+    *u_a_V = meas->phase_voltage_a_V - inst->commissioning.phase_voltage_offset_a_V;
+    *u_b_V = meas->phase_voltage_b_V - inst->commissioning.phase_voltage_offset_b_V;
+}
+
 /* Whole periods in @p duration_s, rounded; defined for the durations validation accepts
  * (at most PMSTEP_MAX_DURATION_PERIODS periods). */
 static inline uint32_t pmstep_periods_in(float duration_s, float period_s)

@@ -57,19 +57,28 @@ typedef struct {
     uint32_t identification_steps; /**< RUN periods of the J and F identification window from t_c (0 = none) */
 } pmstep_commission_plan_t;
 
+/** An integral of u - R i over consecutive samples of one phase (raw samples): the first sample's
+ *  current, then each later sample's current and the voltage over the period that ends at it. */
+typedef struct {
+    float voltage_sum_V; /**< the voltages of the periods after the first sample */
+    float current_sum_A; /**< every sample's current, the first included */
+    float start_A;       /**< the first sample's current */
+    float end_A;         /**< the last sample's current */
+} pmstep_flux_sums_t;
+
 /** Running sums (raw samples; offsets are removed at the end). */
 typedef struct {
     float zero_sum_a_A, zero_sum_b_A;       /**< samples of a phase whose true current is 0 */
     uint32_t zero_count_a, zero_count_b;
     float zero_voltage_sum_a_V, zero_voltage_sum_b_V; /**< sensed phase voltages with the bridge off (true 0) */
-    float rise_voltage_sum_V, rise_current_sum_A, rise_start_A, rise_end_A; /**< L, phase b */
+    pmstep_flux_sums_t rise;                /**< L from the current rise, phase b */
     float s_current_sum_A, s_voltage_sum_V; /**< end of s-alignment, phase b */
     float c_current_sum_A, c_voltage_sum_V; /**< end of c-alignment, phase a */
     float s_low_current_sum_A, s_low_voltage_sum_V; /**< lower steady state of s-alignment (bias option) */
     float c_low_current_sum_A, c_low_voltage_sum_V; /**< lower steady state of c-alignment */
-    float swing_voltage_a_V, swing_current_a_A, swing_start_a_A; /**< c-alignment, k_M */
-    float s_drop_voltage_sum_V, s_drop_current_sum_A, s_drop_start_A, s_drop_end_A; /**< L, phase b */
-    float c_drop_voltage_sum_V, c_drop_current_sum_A, c_drop_start_A, c_drop_end_A; /**< L, phase a */
+    pmstep_flux_sums_t swing;               /**< c-alignment from t_s, phase a: k_M (t_c's sample added at the end) */
+    pmstep_flux_sums_t s_drop;              /**< L from s-alignment's level drop, phase b */
+    pmstep_flux_sums_t c_drop;              /**< L from c-alignment's level drop, phase a */
 } pmstep_commission_sums_t;
 
 void pmstep_commission_clear(pmstep_commission_sums_t *sums);
