@@ -24,6 +24,19 @@ static pmstep_config_t short_config(void)
     return cfg;
 }
 
+/* The voltage-bias option on short_config(): each alignment 4 x longer, its last 40 ms at half
+ * voltage (the lower level settles for 20 ms, 11 L/R), a compensation band for the bias. */
+static pmstep_config_t two_level_config(void)
+{
+    pmstep_config_t cfg = short_config();
+    cfg.alignment.s_align_time_s = 0.16f;
+    cfg.alignment.c_align_time_s = 0.32f;
+    cfg.commissioning.steady_state_window_s = 0.04f;
+    cfg.commissioning.voltage_bias_level_fraction = 0.5f;
+    cfg.inverter.dead_time_current_band_A = 0.05f;
+    return cfg;
+}
+
 /* Both phases as R, L with the rotor locked (no back-EMF), exact for held voltages;
  * the sensors add an offset. */
 typedef struct {
@@ -185,18 +198,13 @@ static void two_levels_give_r_and_the_voltage_bias(void **state)
 {
     /* The bridge falls short by 0.3 V at positive current: one level would read R 0.3 V / 6.7 A
      * (4.5 %) high; the second level at half voltage separates R from the bias. */
-    pmstep_config_t cfg = short_config();
+    pmstep_config_t cfg = two_level_config();
     rl_plant_t plant = {3.6, 0.0066, 0.0, 0.0, 0.02, -0.01, 0.3};
     pmstep_t inst;
     pmstep_output_t out;
     pmstep_commissioning_t result;
     uint32_t k;
     (void)state;
-    cfg.alignment.s_align_time_s = 0.16f;
-    cfg.alignment.c_align_time_s = 0.32f;
-    cfg.commissioning.steady_state_window_s = 0.04f; /* the lower level settles for 20 ms, 11 L/R */
-    cfg.commissioning.voltage_bias_level_fraction = 0.5f;
-    cfg.inverter.dead_time_current_band_A = 0.05f;
     assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
     assert_int_equal(pmstep_start(&inst), PMSTEP_OK);
     for (k = 0; k < 3200u; ++k) { /* s-alignment: the last 800 periods at half voltage */
@@ -221,19 +229,14 @@ static void two_levels_give_r_and_the_voltage_bias(void **state)
  * k_M fails as in the locked-rotor test above; L is still reported. */
 static void level_drops_give_l_without_a_rise_window(void **state)
 {
-    pmstep_config_t cfg = short_config();
+    pmstep_config_t cfg = two_level_config();
     rl_plant_t plant = {3.6, 0.0066, 0.0, 0.0, 0.02, -0.01, 0.3};
     pmstep_t inst;
     pmstep_output_t out;
     pmstep_commissioning_t result;
     (void)state;
-    cfg.alignment.s_align_time_s = 0.16f;
-    cfg.alignment.c_align_time_s = 0.32f;
-    cfg.commissioning.steady_state_window_s = 0.04f;
-    cfg.commissioning.voltage_bias_level_fraction = 0.5f;
     cfg.commissioning.inductance_window_s = 0.0f;
     cfg.commissioning.use_measured_inductance = true;
-    cfg.inverter.dead_time_current_band_A = 0.05f;
     assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
     assert_int_equal(pmstep_start(&inst), PMSTEP_OK);
     run_rl(&inst, &plant, &out, 8000u);
@@ -254,7 +257,7 @@ static void level_drops_give_l_without_a_rise_window(void **state)
 static void sensed_voltages_give_r_as_the_sensor_sees_it(void **state)
 {
     const double sensor_gain = 1.01;
-    pmstep_config_t cfg = short_config();
+    pmstep_config_t cfg = two_level_config();
     rl_plant_t plant = {3.6, 0.0066, 0.0, 0.0, 0.02, -0.01, 0.3};
     pmstep_t inst;
     pmstep_output_t out;
@@ -263,11 +266,6 @@ static void sensed_voltages_give_r_as_the_sensor_sees_it(void **state)
     double applied_b_V = 0.0;
     uint32_t k;
     (void)state;
-    cfg.alignment.s_align_time_s = 0.16f;
-    cfg.alignment.c_align_time_s = 0.32f;
-    cfg.commissioning.steady_state_window_s = 0.04f;
-    cfg.commissioning.voltage_bias_level_fraction = 0.5f;
-    cfg.inverter.dead_time_current_band_A = 0.05f;
     cfg.inverter.phase_voltage_sensing = true;
     assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
     assert_int_equal(pmstep_start(&inst), PMSTEP_OK);
