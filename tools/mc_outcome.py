@@ -208,4 +208,11 @@ def extract_metrics(summary, params, base):
         measured = number_or_none(com.get(field))
         ok = metrics["commissioning_measured"] and measured is not None and key in params
         metrics[name] = measured - params[key] if ok else None
+    # Where commissioning put the rotor at t_c (its start angle) against where the plant's rotor was.
+    align = summary.get("alignment") if isinstance(summary.get("alignment"), dict) else {}
+    rest = [number_or_none(v) for v in (com.get("equilibrium_cos"), com.get("equilibrium_sin"),
+                                         align.get("cos_ptheta_at_tc"), align.get("sin_ptheta_at_tc"))]
+    ok = metrics["commissioning_measured"] and all(v is not None for v in rest)
+    metrics["rest_angle_error_rad"] = (math.atan2(rest[1] * rest[2] - rest[0] * rest[3],
+                                                  rest[0] * rest[2] + rest[1] * rest[3]) if ok else None)
     return metrics

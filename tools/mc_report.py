@@ -88,6 +88,7 @@ def aggregate(records, args):
         "commissioning_abs_k_rel_error": stats("k_rel_error", abs),
         "commissioning_abs_offset_a_error_A": stats("offset_a_error_A", abs),
         "commissioning_abs_offset_b_error_A": stats("offset_b_error_A", abs),
+        "commissioning_abs_rest_angle_error_rad": stats("rest_angle_error_rad", abs),
     }
     for name in POSITION_METRICS:
         distributions[name] = stats(name)
@@ -250,7 +251,8 @@ def write_report(path, records, agg, args, scenario, version, plots, started_utc
               ("commissioning_abs_l_rel_error", "\\|L commissioned / L plant - 1\\|"),
               ("commissioning_abs_k_rel_error", "\\|k_M commissioned / k_M plant - 1\\|"),
               ("commissioning_abs_offset_a_error_A", "\\|offset a commissioned - true\\| (A)"),
-              ("commissioning_abs_offset_b_error_A", "\\|offset b commissioned - true\\| (A)"))
+              ("commissioning_abs_offset_b_error_A", "\\|offset b commissioned - true\\| (A)"),
+              ("commissioning_abs_rest_angle_error_rad", "\\|rotor's rest at t_c commissioned - true\\| (electrical rad)"))
     titles += tuple((name, title) for name, title in zip(POSITION_METRICS, POSITION_TITLES)
                     if agg["distributions"][name]["n"])  # a position scenario's
     for name, title in titles:
@@ -318,7 +320,7 @@ POSITION_TITLES = ("largest final error of a move (electrical rad)",
 CSV_METRICS = ("max_speed_error_rad_s", "max_angle_error_rad", "settle_time_s", "loss_of_control_time_s",
                "detection_latency_s", "fault_time_s", "nonfinite_seen", "tracking_max_abs_error_rad_s",
                "commissioning_measured", "r_rel_error", "l_rel_error", "k_rel_error", "offset_a_error_A",
-               "offset_b_error_A", "realignments", "final_mode", "past_settle", "wall_s") + POSITION_METRICS
+               "offset_b_error_A", "rest_angle_error_rad", "realignments", "final_mode", "past_settle", "wall_s") + POSITION_METRICS
 
 
 def write_cases_csv(path, records):

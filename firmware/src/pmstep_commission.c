@@ -79,6 +79,7 @@ COMMISSION_OUT_OF_LINE void pmstep_commission_add_alignment(pmstep_commission_su
         if (in_window(sample, high_window_end(plan, plan->s_align_steps), plan->window_steps)) {
             sums->s_current_sum_A += i_b_A;
             sums->s_voltage_sum_V += u_b_V;
+            sums->s_undriven_sum_A += i_a_A;
             if (plan->offsets_from_alignment) {
                 sums->zero_sum_a_A += i_a_A; /* u_a = 0: i_a -> 0 */
                 sums->zero_count_a++;
@@ -87,6 +88,7 @@ COMMISSION_OUT_OF_LINE void pmstep_commission_add_alignment(pmstep_commission_su
         if (plan->bias_estimation && in_window(sample, plan->s_align_steps, plan->window_steps / 2u)) {
             sums->s_low_current_sum_A += i_b_A;
             sums->s_low_voltage_sum_V += u_b_V;
+            sums->s_low_undriven_sum_A += i_a_A;
         }
         add_drop_sample(&sums->s_drop, plan, sample, plan->s_align_steps, i_b_A, u_b_V);
         return;
@@ -95,11 +97,13 @@ COMMISSION_OUT_OF_LINE void pmstep_commission_add_alignment(pmstep_commission_su
     if (plan->bias_estimation && in_window(sample, plan->c_align_end_step, plan->window_steps / 2u)) {
         sums->c_low_current_sum_A += i_a_A;
         sums->c_low_voltage_sum_V += u_a_V;
+        sums->c_low_undriven_sum_A += i_b_A;
     }
     add_drop_sample(&sums->c_drop, plan, sample, plan->c_align_end_step, i_a_A, u_a_V);
     if (in_window(sample, high_window_end(plan, plan->c_align_end_step), plan->window_steps)) {
         sums->c_current_sum_A += i_a_A;
         sums->c_voltage_sum_V += u_a_V;
+        sums->c_undriven_sum_A += i_b_A;
         if (plan->offsets_from_alignment) {
             sums->zero_sum_b_A += i_b_A; /* u_b = 0: i_b -> 0 */
             sums->zero_count_b++;
@@ -147,6 +151,62 @@ static float window_flux(const pmstep_flux_sums_t *flux, uint32_t periods, float
     return period_s * (flux->voltage_sum_V - (float)periods * bias_V) - resistance_Ohm * charge_A_s;
 }
 
+/* Newton steps on the rotor's rest angle under the currents (i_a, i_b), from (cos, sin) of p theta
+ * near it: (1)'s torque k_M (i_b cos - i_a sin) against the model's detent torque
+ * -T_d sin(4 p theta), with the configured k_M (the detent's share is a correction). Each step
+ * turns (cos, sin) by torque / stiffness to third order, which keeps its length within 1e-4 of 1
+ * for a turn of 0.2 rad. */
+#define REST_ANGLE_NEWTON_STEPS 3u
+static void rest_angle(float i_a_A, float i_b_A, const pmstep_motor_config_t *motor, float *cos_io, float *sin_io)
+{
+    uint32_t step;
+    for (step = 0u; step < REST_ANGLE_NEWTON_STEPS; step++) {
+        const float c = *cos_io;
+        const float s = *sin_io;
+        const float cos_2 = c * c - s * s;
+        const float sin_2 = 2.0f * c * s;
+        const float torque_Nm = motor->torque_constant_Nm_A * (i_b_A * c - i_a_A * s)
+                                - motor->detent_torque_Nm * 2.0f * sin_2 * cos_2;
+        const float stiffness_Nm = motor->torque_constant_Nm_A * (i_a_A * c + i_b_A * s)
+                                   + 4.0f * motor->detent_torque_Nm * (cos_2 * cos_2 - sin_2 * sin_2);
+        const float turn = torque_Nm / stiffness_Nm;
+        const float cos_turn = 1.0f - 0.5f * turn * turn;
+        const float sin_turn = turn * (1.0f - turn * turn / 6.0f);
+        *cos_io = c * cos_turn - s * sin_turn;
+        *sin_io = s * cos_turn + c * sin_turn;
+    }
+}
+
+/* Where the rotor rests in an alignment: (cos, sin) of p theta at its full level and at its end
+ * (the lower level with the voltage bias, else the same). */
+typedef struct {
+    float cos_full, sin_full;
+    float cos_end, sin_end;
+} pmstep_rest_t;
+
+/* The mean currents of an alignment's windows less their offsets, phase a's on phase b's scale. */
+typedef struct {
+    float full_a_A, full_b_A;
+    float low_a_A, low_b_A;
+} pmstep_window_currents_t;
+
+/* An alignment's rests from its nominal equilibrium (cos, sin): under the full window's
+ * currents, then under the lower level's from there (the rotor follows its equilibrium down). */
+static pmstep_rest_t alignment_rest(const pmstep_window_currents_t *currents, bool low_level,
+                                    const pmstep_motor_config_t *motor, float cos_nominal, float sin_nominal)
+{
+    pmstep_rest_t rest;
+    rest.cos_full = cos_nominal;
+    rest.sin_full = sin_nominal;
+    rest_angle(currents->full_a_A, currents->full_b_A, motor, &rest.cos_full, &rest.sin_full);
+    rest.cos_end = rest.cos_full;
+    rest.sin_end = rest.sin_full;
+    if (low_level) {
+        rest_angle(currents->low_a_A, currents->low_b_A, motor, &rest.cos_end, &rest.sin_end);
+    }
+    return rest;
+}
+
 COMMISSION_OUT_OF_LINE pmstep_fault_t pmstep_commission_finish(const pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
                                         const pmstep_config_t *cfg, float i_a_A, float u_a_V,
                                         pmstep_commissioning_t *result)
@@ -160,6 +220,11 @@ COMMISSION_OUT_OF_LINE pmstep_fault_t pmstep_commission_finish(const pmstep_comm
     float r_a = cfg->motor.resistance_Ohm;
     float r_b = cfg->motor.resistance_Ohm;
     float inductance_H = cfg->motor.inductance_H;
+    const float n_full = (float)plan->window_steps;
+    const float n_low = (float)(plan->window_steps / 2u);
+    pmstep_rest_t s_rest = {0.0f, 1.0f, 0.0f, 1.0f};
+    pmstep_rest_t c_rest = {1.0f, 0.0f, 1.0f, 0.0f};
+    float drop_turn_per_A = 0.0f; /* m of the drops' L (0: L not from the drops) */
 
     result->offset_a_A = offset_a;
     result->offset_b_A = offset_b;
@@ -168,40 +233,56 @@ COMMISSION_OUT_OF_LINE pmstep_fault_t pmstep_commission_finish(const pmstep_comm
     result->phase_a_current_scale = 1.0f;
     result->inductance_H = 0.0f;
     result->torque_constant_Nm_A = 0.0f;
+    result->equilibrium_cos = 1.0f;
+    result->equilibrium_sin = 0.0f;
     result->voltage_bias_a_V = 0.0f;
     result->voltage_bias_b_V = 0.0f;
     result->measured = true;
     if (windows && plan->bias_estimation) {
         /* Two steady states per phase: R and the voltage bias. */
-        const float n_1 = (float)plan->window_steps;
-        const float n_2 = (float)(plan->window_steps / 2u);
-        r_b = two_level_resistance(sums->s_voltage_sum_V / n_1, sums->s_current_sum_A / n_1 - offset_b,
-                                   sums->s_low_voltage_sum_V / n_2, sums->s_low_current_sum_A / n_2 - offset_b,
+        r_b = two_level_resistance(sums->s_voltage_sum_V / n_full, sums->s_current_sum_A / n_full - offset_b,
+                                   sums->s_low_voltage_sum_V / n_low, sums->s_low_current_sum_A / n_low - offset_b,
                                    &result->voltage_bias_b_V);
-        r_a = two_level_resistance(sums->c_voltage_sum_V / n_1, sums->c_current_sum_A / n_1 - offset_a,
-                                   sums->c_low_voltage_sum_V / n_2, sums->c_low_current_sum_A / n_2 - offset_a,
+        r_a = two_level_resistance(sums->c_voltage_sum_V / n_full, sums->c_current_sum_A / n_full - offset_a,
+                                   sums->c_low_voltage_sum_V / n_low, sums->c_low_current_sum_A / n_low - offset_a,
                                    &result->voltage_bias_a_V);
-        if (plan->inductance_steps == 0u) {
-            /* L from the drops (see the header), over the step between the steady states' means:
-             * phase b's, and phase a's on phase b's scale (a's current is scaled by r_a / r_b in
-             * RUN, so its apparent L is divided by that). */
-            const float l_b = window_flux(&sums->s_drop, plan->window_steps, offset_b, r_b, result->voltage_bias_b_V,
-                                          period_s)
-                              / ((sums->s_low_current_sum_A / n_2) - (sums->s_current_sum_A / n_1));
-            const float l_a = window_flux(&sums->c_drop, plan->window_steps, offset_a, r_a, result->voltage_bias_a_V,
-                                          period_s)
-                              / ((sums->c_low_current_sum_A / n_2) - (sums->c_current_sum_A / n_1));
-            result->inductance_H = 0.5f * (l_b + l_a * (r_b / r_a));
-        }
     } else if (windows) {
         /* Steady states of (3) and (5): R = u/i on each phase. */
         r_b = window_resistance(sums->s_voltage_sum_V, sums->s_current_sum_A, plan->window_steps, offset_b);
         r_a = window_resistance(sums->c_voltage_sum_V, sums->c_current_sum_A, plan->window_steps, offset_a);
     }
     if (windows) {
-        /* The phases' apparent R differ by their sensors' gains: phase b is the reference. */
+        /* The phases' apparent R differ by their sensors' gains: phase b is the reference. Then
+         * where the rotor rests in each alignment. */
+        const float scale_a = r_a / r_b;
+        const pmstep_window_currents_t s_currents = {
+            (sums->s_undriven_sum_A / n_full - offset_a) * scale_a, sums->s_current_sum_A / n_full - offset_b,
+            (sums->s_low_undriven_sum_A / n_low - offset_a) * scale_a, sums->s_low_current_sum_A / n_low - offset_b};
+        const pmstep_window_currents_t c_currents = {
+            (sums->c_current_sum_A / n_full - offset_a) * scale_a, sums->c_undriven_sum_A / n_full - offset_b,
+            (sums->c_low_current_sum_A / n_low - offset_a) * scale_a, sums->c_low_undriven_sum_A / n_low - offset_b};
         result->resistance_Ohm = r_b;
-        result->phase_a_current_scale = r_a / r_b;
+        result->phase_a_current_scale = scale_a;
+        s_rest = alignment_rest(&s_currents, plan->bias_estimation, &cfg->motor, 0.0f, 1.0f);
+        c_rest = alignment_rest(&c_currents, plan->bias_estimation, &cfg->motor, 1.0f, 0.0f);
+        result->equilibrium_cos = c_rest.cos_end;
+        result->equilibrium_sin = c_rest.sin_end;
+    }
+    if (windows && plan->bias_estimation && plan->inductance_steps == 0u) {
+        /* L from the drops (see the header), over the step between the steady states' means:
+         * phase b's, and phase a's on phase b's scale (a's current is scaled by r_a / r_b in RUN,
+         * so its apparent L is divided by that). The rotor follows its equilibrium down, so each
+         * drop's flux also holds k_M / p times the change of the driven phase's flux direction
+         * (sin on b, cos on a): L = L_0 - (k_M / p) m, L_0 here, m's share once k_M is known. */
+        const float step_b_A = sums->s_low_current_sum_A / n_low - sums->s_current_sum_A / n_full;
+        const float step_a_A = (sums->c_low_current_sum_A / n_low - sums->c_current_sum_A / n_full)
+                               * result->phase_a_current_scale;
+        result->inductance_H = 0.5f * (window_flux(&sums->s_drop, plan->window_steps, offset_b, r_b,
+                                                   result->voltage_bias_b_V, period_s) / step_b_A
+                                       + window_flux(&sums->c_drop, plan->window_steps, offset_a, r_a,
+                                                     result->voltage_bias_a_V, period_s) / step_a_A);
+        drop_turn_per_A = 0.5f * ((s_rest.sin_end - s_rest.sin_full) / step_b_A
+                                  + (c_rest.cos_end - c_rest.cos_full) / step_a_A);
     }
     if (plan->inductance_steps > 0u) {
         /* L delta i = integral(u - R i) over the rise; the rotor has not moved yet. */
@@ -214,15 +295,23 @@ COMMISSION_OUT_OF_LINE pmstep_fault_t pmstep_commission_finish(const pmstep_comm
     }
     if (windows) {
         /* Flux swing of c-alignment (see the header), samples t_s .. t_c, on the driven phase a:
-         * its current is far from zero throughout, so its voltage is known (bias included). Its
-         * apparent L is phase b's on phase a's sensor scale; the L is the one RUN takes. */
+         * its current is far from zero throughout, so its voltage is known (bias included). The
+         * rotor turns from its rest at t_s to its rest at t_c:
+         * F = L delta i_a + (k_M / p) (cos(p theta_c) - cos(p theta_s)), delta i_a on phase b's
+         * scale, L the one RUN takes (the drops' L_0 - (k_M / p) m: solved with k_M). */
+        const float run_turn_per_A = cfg->commissioning.use_measured_inductance ? drop_turn_per_A : 0.0f;
         pmstep_flux_sums_t swing = sums->swing;
-        float flux_a;
+        float step_a_A;
+        float flux_per_pole_pair;
         add_flux_sample(&swing, false, i_a_A, u_a_V); /* t_c's sample closes it */
-        flux_a = window_flux(&swing, plan->c_align_end_step - plan->s_align_steps, offset_a, r_a,
-                             result->voltage_bias_a_V, period_s)
-                 - inductance_H * result->phase_a_current_scale * (swing.end_A - swing.start_A);
-        result->torque_constant_Nm_A = flux_a * (float)cfg->motor.pole_pairs;
+        step_a_A = result->phase_a_current_scale * (swing.end_A - swing.start_A);
+        flux_per_pole_pair = (window_flux(&swing, plan->c_align_end_step - plan->s_align_steps, offset_a, r_a,
+                                          result->voltage_bias_a_V, period_s)
+                              - inductance_H * step_a_A)
+                             / (c_rest.cos_end - s_rest.cos_end - run_turn_per_A * step_a_A);
+        result->torque_constant_Nm_A = flux_per_pole_pair * (float)cfg->motor.pole_pairs;
+        result->inductance_H -= flux_per_pole_pair * drop_turn_per_A;
+        inductance_H -= flux_per_pole_pair * run_turn_per_A;
     }
     if ((windows && !(plausible(r_a, cfg->motor.resistance_Ohm) && plausible(r_b, cfg->motor.resistance_Ohm)
                       && plausible(result->torque_constant_Nm_A, cfg->motor.torque_constant_Nm_A)))

@@ -3,12 +3,14 @@
  * references). */
 #include "pmstep_internal.h"
 
-/* Starts controller (6) at t_c: phi = 0, i-hat = i(t_c), w-hat = T_L-hat = 0, references from 0. */
+/* Starts controller (6) at t_c: phi at the equilibrium, i-hat = i(t_c), w-hat = T_L-hat = 0, references from 0. */
 static void start_run(pmstep_t *inst, const pmstep_meas_t *sample)
 {
     const pmstep_ref_t speed_cmd = inst->speed_ref;
     const pmstep_ref_t i_d_cmd = inst->i_d_ref;
     pmstep_angle_start(&inst->angle, sample->i_a_A, sample->i_b_A);
+    pmstep_angle_set(&inst->angle, &inst->angle_coeffs, inst->commissioning.equilibrium_cos,
+                     inst->commissioning.equilibrium_sin); /* c-alignment's equilibrium (1, 0 unless measured) */
     pmstep_observer_start(&inst->observer, sample->i_a_A, sample->i_b_A);
     inst->current_integral.i_d_error_integral_As = 0.0f;
     inst->current_integral.i_q_error_integral_As = 0.0f;

@@ -95,6 +95,7 @@ static void clear_commissioning(pmstep_t *inst)
     const pmstep_electrical_t configured = pmstep_configured_electrical(inst->cfg);
     memset(&inst->commissioning, 0, sizeof inst->commissioning);
     inst->commissioning.phase_a_current_scale = 1.0f;
+    inst->commissioning.equilibrium_cos = 1.0f;
     pmstep_commission_clear(&inst->scratch.sums);
     apply_model(inst, &configured);
 }

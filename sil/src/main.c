@@ -145,6 +145,8 @@ static void add_robustness_json(cJSON *root, const sil_summary_t *s)
     cJSON_AddNumberToObject(comm, "resistance_Ohm", (double)c->resistance_Ohm);
     cJSON_AddNumberToObject(comm, "inductance_H", (double)c->inductance_H);
     cJSON_AddNumberToObject(comm, "torque_constant_Nm_A", (double)c->torque_constant_Nm_A);
+    cJSON_AddNumberToObject(comm, "equilibrium_cos", (double)c->equilibrium_cos);
+    cJSON_AddNumberToObject(comm, "equilibrium_sin", (double)c->equilibrium_sin);
     cJSON_AddNumberToObject(comm, "voltage_bias_a_V", (double)c->voltage_bias_a_V);
     cJSON_AddNumberToObject(comm, "voltage_bias_b_V", (double)c->voltage_bias_b_V);
     cJSON_AddNumberToObject(comm, "inertia_kgm2", (double)c->inertia_kgm2);

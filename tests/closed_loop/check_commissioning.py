@@ -1,11 +1,14 @@
 """Checks a SIL run's commissioning in summary.json against the plant's motor in the scenario
-file it ran: no fault latched, the measured L within --max-inductance-error of the motor's, and
-k_M within --max-torque-constant-error of the motor's.
+file it ran: no fault latched, the measured L within --max-inductance-error of the motor's,
+k_M within --max-torque-constant-error of the motor's, and (with --max-rest-angle-error) the
+rotor's rest at t_c that RUN starts from within that many electrical rad of the plant's p theta.
 
-usage: check_commissioning.py SUMMARY SCENARIO --max-inductance-error E --max-torque-constant-error E"""
+usage: check_commissioning.py SUMMARY SCENARIO --max-inductance-error E --max-torque-constant-error E
+                              [--max-rest-angle-error RAD]"""
 import argparse
 import configparser
 import json
+import math
 import sys
 
 
@@ -15,6 +18,7 @@ def main():
     ap.add_argument("scenario")
     for k in ("max-inductance-error", "max-torque-constant-error"):
         ap.add_argument(f"--{k}", type=float, required=True)
+    ap.add_argument("--max-rest-angle-error", type=float)
     a = ap.parse_args()
     with open(a.summary) as f:
         s = json.load(f)
@@ -35,9 +39,19 @@ def main():
         failures.append(f"L {l_ratio:.3f} x the motor's, bound {100 * a.max_inductance_error:.1f} %")
     if not abs(k_error) <= a.max_torque_constant_error:
         failures.append(f"k_M {100 * k_error:+.2f} % off, bound {100 * a.max_torque_constant_error:.1f} %")
+    checks = 3
+    if a.max_rest_angle_error is not None:
+        checks += 1
+        t = s["alignment"]
+        rest_error = math.atan2(c["equilibrium_sin"] * t["cos_ptheta_at_tc"] - c["equilibrium_cos"] * t["sin_ptheta_at_tc"],
+                                c["equilibrium_cos"] * t["cos_ptheta_at_tc"] + c["equilibrium_sin"] * t["sin_ptheta_at_tc"])
+        print(f"rest at t_c {math.atan2(c['equilibrium_sin'], c['equilibrium_cos']):+.4f} electrical rad, "
+              f"plant {math.atan2(t['sin_ptheta_at_tc'], t['cos_ptheta_at_tc']):+.4f} ({rest_error:+.4f} off)")
+        if not abs(rest_error) <= a.max_rest_angle_error:
+            failures.append(f"rest at t_c {rest_error:+.4f} rad off, bound {a.max_rest_angle_error} rad")
     for f in failures:
         print("FAIL:", f)
-    print(f"{3 - len(failures)} passed, {len(failures)} failed")
+    print(f"{checks - len(failures)} passed, {len(failures)} failed")
     return 1 if failures else 0
 
 

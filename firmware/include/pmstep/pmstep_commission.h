@@ -26,14 +26,24 @@
  *    in both steady states: an error of R weighs only on the decay, L dR/R). Phase b at
  *    the end of s-alignment, phase a (on phase b's sensor scale) at the end of
  *    c-alignment, averaged. The rise needs a rotor that stays put for N periods, which a
- *    hybrid stepper's alignment swing (w_n ~ 1000 rad/s) does not; the drop does not;
- *  - k_M: the flux swing of c-alignment, the rotor turning from sin p theta = 1 to
- *    cos p theta = 1. With x = L i + (k_M/p)(cos p theta, sin p theta) and x' = u - R i
- *    (model (1)), over [t_s, t_c] on the driven phase a (cos: 0 -> 1):
- *      k_M/p = integral(u_a - R i_a) - L delta i_a
+ *    hybrid stepper's alignment swing (w_n ~ 1000 rad/s) does not; the drop does not
+ *    (where the rotor follows a moving equilibrium down, below, its flux is taken off);
+ *  - where the rotor rests: at the direction of the current vector, shifted by the
+ *    model's detent torque (Newton steps on the torque balance, configured k_M and T_d),
+ *    from each window's mean currents, the undriven phase's included: where the
+ *    dead-time compensation exceeds the bridge's dead time, the undriven phase carries
+ *    current (0.6 A on a 5 A motor at +10 %) and the rest is 0.2 rad off the phase axis.
+ *    RUN starts its angle from c-alignment's rest (pmstep_commissioning_t.equilibrium_*);
+ *  - k_M: the flux swing of c-alignment, the rotor turning from its rest at t_s
+ *    (sin p theta ~ 1) to its rest at t_c (cos p theta ~ 1). With
+ *    x = L i + (k_M/p)(cos p theta, sin p theta) and x' = u - R i (model (1)), over
+ *    [t_s, t_c] on the driven phase a:
+ *      (k_M/p) (cos p theta_c - cos p theta_s) = integral(u_a - R i_a) - L delta i_a
  *    with phase a's own R, so a current offset cancels, and its voltage bias taken off.
  *    (Phase b's swing is not used: its current passes through zero, where the
- *    dead time makes its voltage unknown.)
+ *    dead time makes its voltage unknown.) With L from the drops, each drop's flux
+ *    holds (k_M/p) times the change of its rest's sin (phase b) or cos (phase a) too:
+ *    L and k_M are solved together.
  * Currents are integrated by the trapezoid rule, held voltages exactly.
  */
 #ifndef PMSTEP_COMMISSION_H
@@ -76,6 +86,8 @@ typedef struct {
     float c_current_sum_A, c_voltage_sum_V; /**< end of c-alignment, phase a */
     float s_low_current_sum_A, s_low_voltage_sum_V; /**< lower steady state of s-alignment (bias option) */
     float c_low_current_sum_A, c_low_voltage_sum_V; /**< lower steady state of c-alignment */
+    float s_undriven_sum_A, s_low_undriven_sum_A; /**< the undriven phase a over s-alignment's windows */
+    float c_undriven_sum_A, c_low_undriven_sum_A; /**< the undriven phase b over c-alignment's windows */
     pmstep_flux_sums_t swing;               /**< c-alignment from t_s, phase a: k_M (t_c's sample added at the end) */
     pmstep_flux_sums_t s_drop;              /**< L from s-alignment's level drop, phase b */
     pmstep_flux_sums_t c_drop;              /**< L from c-alignment's level drop, phase a */

@@ -346,6 +346,10 @@ typedef struct {
                                          phase b's scale (a sensor gain mismatch); 1 until measured */
     float inductance_H;             /**< L from the current rise at the start of s-alignment (0: not measured) */
     float torque_constant_Nm_A; /**< k_M from the flux swing of c-alignment (0: not measured) */
+    float equilibrium_cos;          /**< c-alignment's equilibrium, cos(p theta) at t_c: the direction of the current
+                                         vector over its last window (the undriven phase carries current where the
+                                         dead-time compensation does not match the bridge); 1 until measured */
+    float equilibrium_sin;          /**< sin(p theta) at t_c; 0 until measured */
     float voltage_bias_a_V;         /**< voltage phase a falls short by at positive current (0: not measured) */
     float voltage_bias_b_V;         /**< same for phase b */
     float phase_voltage_offset_a_V; /**< phase-voltage sensor offset subtracted from every sample of phase a, from
