@@ -254,6 +254,79 @@ static void level_drops_give_l_without_a_rise_window(void **state)
  * R as that sensor sees it, 1.01 x 3.6 Ohm (so u - R i vanishes at standstill in the flux
  * integrals, which use the same sensor), and no voltage bias (nothing is short of the sensed
  * voltage). */
+/* The rest of p theta under (i_a, i_b) against the detent torque, by bisection in double on
+ * k_M (i_b cos x - i_a sin x) = T_d sin 4x within 0.3 rad of the current vector's angle. */
+static double rest_by_bisection(double i_a_A, double i_b_A, double k_Nm_A, double detent_Nm)
+{
+    const double psi = atan2(i_b_A, i_a_A);
+    double lo = psi - 0.3;
+    double hi = psi + 0.3;
+    int k;
+    for (k = 0; k < 60; k++) {
+        const double mid = 0.5 * (lo + hi);
+        const double torque = k_Nm_A * (i_b_A * cos(mid) - i_a_A * sin(mid)) - detent_Nm * sin(4.0 * mid);
+        if (torque > 0.0) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    return 0.5 * (lo + hi);
+}
+
+/* The windows' sums of a rotor resting where an undriven phase's current of 0.2 x the driven one
+ * (a dead-time compensation above the bridge's) and the detent torque put it, and the swing's flux
+ * (k_M / p)(cos p theta_c - cos p theta_s) between the rests at a held current: k_M and the rest
+ * at t_c come out as the plant's, not as for a rotor on the phase axes (k_M 0.78 x). */
+static void rest_comes_from_both_phases_currents(void **state)
+{
+    const double driven_A = 2.0;
+    const double undriven_A = 0.4;
+    const float k_Nm_A = 2.0f;
+    const uint32_t window = 100u;
+    const uint32_t swing_periods = 800u;
+    pmstep_config_t cfg = short_config();
+    pmstep_commission_plan_t plan;
+    pmstep_commission_sums_t sums;
+    pmstep_commissioning_t result;
+    double detent_Nm;
+    (void)state;
+    for (detent_Nm = 0.0; detent_Nm < 0.5; detent_Nm += 0.4) {
+        const double rest_s = rest_by_bisection(undriven_A, driven_A, k_Nm_A, detent_Nm);
+        const double rest_c = rest_by_bisection(driven_A, undriven_A, k_Nm_A, detent_Nm);
+        const double flux_Wb = (double)k_Nm_A / (double)cfg.motor.pole_pairs * (cos(rest_c) - cos(rest_s));
+        const double r_Ohm = (double)cfg.motor.resistance_Ohm;
+        cfg.motor.detent_torque_Nm = (float)detent_Nm;
+        cfg.motor.torque_constant_Nm_A = k_Nm_A;
+        memset(&plan, 0, sizeof plan);
+        plan.window_steps = window;
+        plan.s_align_steps = 1000u;
+        plan.c_align_end_step = plan.s_align_steps + swing_periods;
+        pmstep_commission_clear(&sums);
+        sums.s_current_sum_A = (float)(window * driven_A);
+        sums.s_voltage_sum_V = (float)(window * r_Ohm * driven_A);
+        sums.s_undriven_sum_A = (float)(window * undriven_A);
+        sums.c_current_sum_A = (float)(window * driven_A);
+        sums.c_voltage_sum_V = (float)(window * r_Ohm * driven_A);
+        sums.c_undriven_sum_A = (float)(window * undriven_A);
+        /* Phase a held at the driven current over the swing (the last sample added by finish). */
+        sums.swing.start_A = (float)driven_A;
+        sums.swing.end_A = (float)driven_A;
+        sums.swing.current_sum_A = (float)(swing_periods * driven_A);
+        sums.swing.voltage_sum_V = (float)((swing_periods - 1u) * r_Ohm * driven_A);
+        assert_int_equal(pmstep_commission_finish(&sums, &plan, &cfg, (float)driven_A,
+                                                  (float)(r_Ohm * driven_A + flux_Wb / (double)cfg.timing.period_s),
+                                                  &result),
+                         PMSTEP_FAULT_NONE);
+        print_message("  T_d %.1f N m: rests %.4f and %.4f rad, k_M %.5f N m/A, rest at t_c (%.5f, %.5f)\n", detent_Nm,
+                      rest_s, rest_c, (double)result.torque_constant_Nm_A, (double)result.equilibrium_cos,
+                      (double)result.equilibrium_sin);
+        assert_float_equal(result.torque_constant_Nm_A, k_Nm_A, 2e-3);
+        assert_float_equal(result.equilibrium_cos, cos(rest_c), 1e-4);
+        assert_float_equal(result.equilibrium_sin, sin(rest_c), 1e-4);
+    }
+}
+
 static void sensed_voltages_give_r_as_the_sensor_sees_it(void **state)
 {
     const double sensor_gain = 1.01;
@@ -385,6 +458,7 @@ int main(void)
         cmocka_unit_test(locked_rotor_gives_r_and_l_and_fails_the_torque_constant),
         cmocka_unit_test(two_levels_give_r_and_the_voltage_bias),
         cmocka_unit_test(level_drops_give_l_without_a_rise_window),
+        cmocka_unit_test(rest_comes_from_both_phases_currents),
         cmocka_unit_test(sensed_voltages_give_r_as_the_sensor_sees_it),
         cmocka_unit_test(dead_time_is_compensated_on_the_driven_phase),
         cmocka_unit_test(lost_angle_faults_or_realigns_after_the_detection_time),
