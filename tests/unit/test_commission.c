@@ -249,11 +249,6 @@ static void level_drops_give_l_without_a_rise_window(void **state)
     assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_ERR_INDUCTANCE_UNMEASURED);
 }
 
-/* With phase-voltage sensing, R comes from the sensed voltages: the same two levels as above,
- * with a bridge 0.3 V short at positive current and a voltage sensor that reads 1 % high, give
- * R as that sensor sees it, 1.01 x 3.6 Ohm (so u - R i vanishes at standstill in the flux
- * integrals, which use the same sensor), and no voltage bias (nothing is short of the sensed
- * voltage). */
 /* The rest of p theta under (i_a, i_b) against the detent torque, by bisection in double on
  * k_M (i_b cos x - i_a sin x) = T_d sin 4x within 0.3 rad of the current vector's angle. */
 static double rest_by_bisection(double i_a_A, double i_b_A, double k_Nm_A, double detent_Nm)
@@ -327,6 +322,11 @@ static void rest_comes_from_both_phases_currents(void **state)
     }
 }
 
+/* With phase-voltage sensing, R comes from the sensed voltages: the same two levels as above,
+ * with a bridge 0.3 V short at positive current and a voltage sensor that reads 1 % high, give
+ * R as that sensor sees it, 1.01 x 3.6 Ohm (so u - R i vanishes at standstill in the flux
+ * integrals, which use the same sensor), and no voltage bias (nothing is short of the sensed
+ * voltage). */
 static void sensed_voltages_give_r_as_the_sensor_sees_it(void **state)
 {
     const double sensor_gain = 1.01;
