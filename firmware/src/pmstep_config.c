@@ -77,6 +77,7 @@ static pmstep_status_t validate_signs(const pmstep_config_t *cfg)
         SIGN_RULE(alignment.s_align_time_s, SIGN_ANY, PMSTEP_OK),
         SIGN_RULE(alignment.c_align_time_s, SIGN_ANY, PMSTEP_OK),
         SIGN_RULE(limits.max_bus_voltage_V, SIGN_ANY, PMSTEP_OK),
+        SIGN_RULE(standstill.hold_current_A, SIGN_ANY, PMSTEP_OK), /* its code is below a signed char's range */
     };
     size_t n;
     for (n = 0; n < sizeof sign_rules / sizeof sign_rules[0]; ++n) {
@@ -255,6 +256,17 @@ static pmstep_status_t validate_detection(const pmstep_config_t *cfg)
     return PMSTEP_OK;
 }
 
+/* The standstill hold of speed mode (pmstep_hold.h): below the trip current, and a vector hold
+ * needs controller (6). */
+static pmstep_status_t validate_standstill(const pmstep_config_t *cfg)
+{
+    const float current_A = cfg->standstill.hold_current_A;
+    if (current_A < 0.0f || (current_A > 0.0f && !(current_A < cfg->limits.max_phase_current_A))) {
+        return PMSTEP_ERR_HOLD_CURRENT;
+    }
+    return (current_A > 0.0f && cfg->known_load_mode) ? PMSTEP_ERR_STANDSTILL_KNOWN_LOAD : PMSTEP_OK;
+}
+
 pmstep_status_t pmstep_validate_config(const pmstep_config_t *cfg)
 {
     pmstep_status_t status;
@@ -284,6 +296,9 @@ pmstep_status_t pmstep_validate_config(const pmstep_config_t *cfg)
     }
     if (status == PMSTEP_OK) {
         status = validate_detection(cfg);
+    }
+    if (status == PMSTEP_OK) {
+        status = validate_standstill(cfg);
     }
     if (status == PMSTEP_OK && !pmstep_derived_coefficients_finite(cfg)) {
         status = PMSTEP_ERR_DERIVED_NONFINITE;

@@ -21,6 +21,7 @@ static void start_run(pmstep_t *inst, const pmstep_meas_t *sample)
     pmstep_ref_reset(&inst->scratch.run.known_load_filter, inst->cfg->known_load_mode ? sample->load_torque_Nm : 0.0f);
     pmstep_detect_start(&inst->scratch.run.detector); /* the sums are spent */
     pmstep_identify_clear(&inst->scratch.run.identify); /* a re-alignment reopens the window */
+    pmstep_standstill_start(inst);
     inst->run_started = true;
 }
 
@@ -147,6 +148,9 @@ bool pmstep_control_advance(pmstep_t *inst, const pmstep_control_scratch_t *scra
     }
     pmstep_ref_advance(&inst->ref_coeffs, &inst->speed_ref, period_s);
     pmstep_ref_advance(&inst->ref_coeffs, &inst->i_d_ref, period_s);
+    if (inst->scratch.run.standstill.speed_mode) {
+        pmstep_standstill_advance(inst, out);
+    }
     if (cfg->known_load_mode) {
         pmstep_ref_set_target(&inst->scratch.run.known_load_filter, meas->load_torque_Nm, 0.0f);
         pmstep_ref_advance(&inst->ref_coeffs, &inst->scratch.run.known_load_filter, period_s);

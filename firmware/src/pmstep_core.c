@@ -172,7 +172,16 @@ pmstep_status_t pmstep_set_speed_target(pmstep_t *inst, float target_rad_s, floa
     if (!pmstep_all_finite4(target_rad_s, ramp_rate_rad_s2, 0.0f, 0.0f) || !(ramp_rate_rad_s2 > 0.0f)) {
         return PMSTEP_ERR_BAD_COMMAND_VALUE;
     }
-    pmstep_release_vector(inst); /* a speed command ends a hold */
+    if (inst->mode == PMSTEP_MODE_RUN && inst->run_started) {
+        pmstep_standstill_t *standstill = &inst->scratch.run.standstill;
+        if (!(standstill->engaged && !(pmstep_abs(target_rad_s) > 0.0f))) {
+            pmstep_release_vector(inst); /* a speed command ends a hold; a zero one keeps the standstill's */
+            standstill->engaged = false;
+        }
+        standstill->speed_mode = inst->cfg->standstill.hold_current_A > 0.0f;
+    } else {
+        pmstep_release_vector(inst);
+    }
     pmstep_ref_set_target(&inst->speed_ref, target_rad_s, ramp_rate_rad_s2);
     return PMSTEP_OK;
 }

@@ -130,3 +130,96 @@ void pmstep_hold_voltages(pmstep_t *inst, pmstep_observer_input_t *obs_in, pmste
     out->u_a_V = c * u_d - s * u_q;
     out->u_b_V = s * u_d + c * u_q;
 }
+
+void pmstep_standstill_start(pmstep_t *inst)
+{
+    pmstep_standstill_t *standstill = &inst->scratch.run.standstill;
+    const float current_A = inst->cfg->standstill.hold_current_A;
+    standstill->engaged = false;
+    standstill->settled = false;
+    standstill->rest_periods = 0u;
+    standstill->keep_cos = 1.0f;
+    standstill->keep_sin = 0.0f;
+    standstill->speed_mode = current_A > 0.0f;
+    standstill->quiet_band_rad_s = 0.0f;
+    standstill->engage_periods = 0u;
+    if (standstill->speed_mode) {
+        const pmstep_law_coeffs_t *law = &inst->law_coeffs;
+        const float natural_rad_s = sqrtf(law->pole_pairs * current_A / law->j_over_km); /* sqrt(p k_M I / J) */
+        standstill->quiet_band_rad_s = PMSTEP_HOLD_QUIET_FRACTION * natural_rad_s / law->pole_pairs;
+        float engage_periods = PMSTEP_STANDSTILL_ENGAGE_TIME_CONSTANTS
+                               / (inst->cfg->gains.speed_gain_per_s * inst->cfg->timing.period_s);
+        if (!(engage_periods < HOLD_MAX_SETTLE_PERIODS)) { /* a slow speed loop: the longest counted */
+            engage_periods = HOLD_MAX_SETTLE_PERIODS;
+        }
+        standstill->engage_periods = (uint32_t)engage_periods;
+    }
+}
+
+/* Not yet holding: the hold once the zero command is reached and the rotor has been at rest for
+ * engage_periods, aimed at the estimate (normalised) ahead by T_L-hat's load angle. */
+static void standstill_engage(pmstep_t *inst, pmstep_standstill_t *standstill, const pmstep_output_t *out)
+{
+    const pmstep_ref_t *ref = &inst->speed_ref;
+    const bool at_rest = !(pmstep_abs(ref->target) > 0.0f) && !(pmstep_abs(ref->setpoint) > 0.0f)
+                         && pmstep_abs(out->speed_ref_rad_s)
+                                < PMSTEP_STANDSTILL_REFERENCE_FRACTION * standstill->quiet_band_rad_s
+                         && pmstep_abs(out->speed_hat_rad_s) < standstill->quiet_band_rad_s;
+    standstill->engaged = false;
+    if (!at_rest) {
+        standstill->rest_periods = 0u;
+        return;
+    }
+    standstill->rest_periods++;
+    if (standstill->rest_periods >= standstill->engage_periods) {
+        const float length = sqrtf(out->cos_hat * out->cos_hat + out->sin_hat * out->sin_hat);
+        standstill->rest_periods = 0u;
+        standstill->settled = false;
+        /* refused (a load beyond the vector's pull, an estimate at the origin): the law holds on */
+        standstill->engaged = length > 0.0f
+                              && pmstep_hold_vector(inst, out->cos_hat / length, out->sin_hat / length,
+                                                    inst->cfg->standstill.hold_current_A, inst->observer.load_hat_Nm)
+                                     == PMSTEP_OK;
+    }
+}
+
+void pmstep_standstill_advance(pmstep_t *inst, const pmstep_output_t *out)
+{
+    pmstep_standstill_t *standstill = &inst->scratch.run.standstill;
+    if (!inst->hold.active) {
+        standstill_engage(inst, standstill, out);
+        return;
+    }
+    if (!standstill->engaged) {
+        return; /* a hold of the application's own (pmstep_hold_vector) */
+    }
+    standstill->rest_periods++;
+    if (!standstill->settled) {
+        if (standstill->rest_periods >= inst->hold.settle_periods) {
+            standstill->settled = true;
+            standstill->rest_periods = 0u;
+        }
+    } else if (pmstep_abs(inst->observer.speed_hat_rad_s - inst->hold.speed_bias_rad_s) < inst->hold.quiet_band_rad_s) {
+        if (standstill->rest_periods <= inst->hold.settle_periods) {
+            standstill->keep_cos = out->cos_hat; /* the rest's first settling time: taken */
+            standstill->keep_sin = out->sin_hat;
+        } else {
+            pmstep_angle_set(&inst->angle, &inst->angle_coeffs, standstill->keep_cos, standstill->keep_sin);
+        }
+    } else {
+        standstill->rest_periods = 0u; /* moving: the estimate follows the flux integrals */
+    }
+}
+
+void pmstep_leave_speed_mode(pmstep_t *inst)
+{
+    if (inst != NULL && inst->mode == PMSTEP_MODE_RUN && inst->run_started) {
+        pmstep_standstill_t *standstill = &inst->scratch.run.standstill;
+        if (standstill->engaged) {
+            pmstep_release_vector(inst);
+            standstill->engaged = false;
+        }
+        standstill->speed_mode = false;
+        standstill->rest_periods = 0u;
+    }
+}

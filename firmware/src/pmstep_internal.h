@@ -69,4 +69,8 @@ bool pmstep_control_advance(pmstep_t *inst, const pmstep_control_scratch_t *scra
  * damping, the PI current loop's errors in its frame into @p obs_in, the voltage into @p out. */
 void pmstep_hold_voltages(pmstep_t *inst, pmstep_observer_input_t *obs_in, pmstep_output_t *out);
 
+/* Standstill hold in speed mode (pmstep_hold.h): armed at RUN's start, run after each period. */
+void pmstep_standstill_start(pmstep_t *inst);
+void pmstep_standstill_advance(pmstep_t *inst, const pmstep_output_t *out);
+
 #endif /* PMSTEP_INTERNAL_H */

@@ -373,6 +373,7 @@ static pmstep_motion_sample_t profile_start(const pmstep_position_t *pos)
 static void enter_position_mode(pmstep_position_t *pos)
 {
     const bool was_position_mode = pos->out.position_mode;
+    pmstep_leave_speed_mode(pos->inst); /* the loop's reference from now: no standstill hold of speed mode */
     if (!was_position_mode) {
         const pmstep_ref_out_t ref = pmstep_ref_output(&pos->inst->ref_coeffs, &pos->inst->speed_ref);
         const float step_s = pos->motion.period_s;

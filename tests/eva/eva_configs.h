@@ -100,6 +100,7 @@ static void eva_any_config(pmstep_config_t *cfg)
     cfg->commissioning.identification_time_s = eva_any_finite();
     cfg->commissioning.identification_min_speed_rad_s = eva_any_finite();
     cfg->commissioning.use_identified_mechanics = Frama_C_nondet(0, 1) != 0;
+    cfg->standstill.hold_current_A = eva_any_finite();
 }
 
 #endif /* PMSTEP_EVA_CONFIGS_H */

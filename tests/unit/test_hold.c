@@ -1,7 +1,7 @@
 /* The core's vector hold (pmstep_hold.h) against the real module on a paper-configured
  * instance put in RUN: the command's refusals, the vector, spring and damping it derives, the
- * period's voltage (the law's current loop in the vector's frame), the release, and the angle
- * estimate's set. */
+ * period's voltage (the law's current loop in the vector's frame), the release, the angle
+ * estimate's set, and the standstill hold of speed mode. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -170,6 +170,176 @@ static void hold_settling_count_defined_for_any_model(void **state)
     }
 }
 
+/* Standstill hold in speed mode (pmstep_hold.h): the paper instance in RUN with a hold current of
+ * 7.5 A, pmstep_standstill_advance() driven with hand-made period outputs. */
+static void fixture_with_standstill(fixture_t *f)
+{
+    fixture_in_run(f);
+    f->cfg.standstill.hold_current_A = 7.5f;
+    pmstep_standstill_start(&f->inst);
+}
+
+static pmstep_output_t at_rest_output(float cos_hat, float sin_hat)
+{
+    pmstep_output_t out = {0};
+    out.cos_hat = cos_hat;
+    out.sin_hat = sin_hat;
+    return out;
+}
+
+static void standstill_engages_after_the_engage_time_at_rest(void **state)
+{
+    fixture_t f;
+    const double w_n = sqrt(6.0 * 2.0 * 7.5 / 0.01);
+    pmstep_output_t out = at_rest_output(0.6f, 0.8f);
+    uint32_t engage;
+    uint32_t n;
+    (void)state;
+    fixture_with_standstill(&f);
+    engage = f.inst.scratch.run.standstill.engage_periods;
+    assert_true(f.inst.scratch.run.standstill.speed_mode);
+    assert_int_equal(engage, (uint32_t)(2.0f / (f.cfg.gains.speed_gain_per_s * f.cfg.timing.period_s)));
+    assert_float_equal(f.inst.scratch.run.standstill.quiet_band_rad_s, 0.05 * w_n / 6.0, 1e-6 * w_n);
+    /* a rotor not at rest (|w-hat| over the band) restarts the count */
+    for (n = 1; n < engage; ++n) {
+        pmstep_standstill_advance(&f.inst, &out);
+    }
+    out.speed_hat_rad_s = 1.1f * f.inst.scratch.run.standstill.quiet_band_rad_s;
+    pmstep_standstill_advance(&f.inst, &out);
+    assert_false(f.inst.hold.active);
+    out.speed_hat_rad_s = 0.0f;
+    for (n = 1; n < engage; ++n) {
+        pmstep_standstill_advance(&f.inst, &out);
+    }
+    assert_false(f.inst.hold.active);
+    pmstep_standstill_advance(&f.inst, &out);
+    assert_true(f.inst.hold.active && f.inst.scratch.run.standstill.engaged);
+    /* aimed at the estimate's direction (T_L-hat 0, no detent torque), at the hold's current */
+    assert_float_equal(f.inst.hold.cos_vector, 0.6f, 1e-6f);
+    assert_float_equal(f.inst.hold.sin_vector, 0.8f, 1e-6f);
+    assert_float_equal(f.inst.hold.current_A, 7.5f, 0.0f);
+}
+
+static void standstill_waits_for_the_zero_command_reached(void **state)
+{
+    fixture_t f;
+    pmstep_output_t out = at_rest_output(1.0f, 0.0f);
+    uint32_t n;
+    (void)state;
+    fixture_with_standstill(&f);
+    assert_int_equal(pmstep_set_speed_target(&f.inst, 5.0f, 100.0f), PMSTEP_OK);
+    for (n = 0; n < 4u * f.inst.scratch.run.standstill.engage_periods; ++n) {
+        pmstep_standstill_advance(&f.inst, &out); /* a non-zero command */
+    }
+    assert_false(f.inst.hold.active);
+    assert_int_equal(pmstep_set_speed_target(&f.inst, 0.0f, 100.0f), PMSTEP_OK);
+    out.speed_ref_rad_s = 0.02f * f.inst.scratch.run.standstill.quiet_band_rad_s; /* w* still on its way */
+    for (n = 0; n < 4u * f.inst.scratch.run.standstill.engage_periods; ++n) {
+        pmstep_standstill_advance(&f.inst, &out);
+    }
+    assert_false(f.inst.hold.active);
+}
+
+/* Settling, then the estimate taken over the rest's first settling time and put back every
+ * period after it (a drift moves it no more); while the rotor moves it follows the integrals. */
+static void standstill_keeps_the_estimate_while_the_rotor_rests(void **state)
+{
+    fixture_t f;
+    pmstep_output_t out = at_rest_output(1.0f, 0.0f);
+    uint32_t settle;
+    uint32_t n;
+    float c;
+    float s;
+    (void)state;
+    fixture_with_standstill(&f);
+    while (!f.inst.hold.active) {
+        pmstep_standstill_advance(&f.inst, &out);
+    }
+    settle = f.inst.hold.settle_periods;
+    for (n = 0; n < settle; ++n) {
+        pmstep_standstill_advance(&f.inst, &out);
+    }
+    assert_true(f.inst.scratch.run.standstill.settled);
+    for (n = 0; n < settle; ++n) { /* the rest's first settling time: taken, not put back */
+        out = at_rest_output(cosf(0.001f * (float)n), sinf(0.001f * (float)n));
+        pmstep_standstill_advance(&f.inst, &out);
+    }
+    assert_float_equal(f.inst.scratch.run.standstill.keep_sin, sinf(0.001f * (float)(settle - 1u)), 1e-7f);
+    out = at_rest_output(0.8f, 0.6f); /* a drifted estimate, the rotor at rest */
+    pmstep_standstill_advance(&f.inst, &out);
+    pmstep_angle_estimate(&f.inst.angle, &f.inst.angle_coeffs, f.inst.angle.i_a_prev_A, f.inst.angle.i_b_prev_A, &c,
+                          &s);
+    assert_float_equal(c, f.inst.scratch.run.standstill.keep_cos, 1e-6f);
+    assert_float_equal(s, f.inst.scratch.run.standstill.keep_sin, 1e-6f);
+    /* moving (|w-hat - w-bar| over the hold's band): the estimate is left to the integrals */
+    pmstep_angle_set(&f.inst.angle, &f.inst.angle_coeffs, 0.8f, 0.6f);
+    f.inst.observer.speed_hat_rad_s = 2.0f * f.inst.hold.quiet_band_rad_s; /* the observer's, after the period */
+    pmstep_standstill_advance(&f.inst, &out);
+    pmstep_angle_estimate(&f.inst.angle, &f.inst.angle_coeffs, f.inst.angle.i_a_prev_A, f.inst.angle.i_b_prev_A, &c,
+                          &s);
+    assert_float_equal(c, 0.8f, 1e-6f);
+    assert_float_equal(s, 0.6f, 1e-6f);
+    assert_int_equal(f.inst.scratch.run.standstill.rest_periods, 0u);
+}
+
+static void standstill_zero_command_keeps_it_other_commands_end_it(void **state)
+{
+    fixture_t f;
+    pmstep_output_t out = at_rest_output(1.0f, 0.0f);
+    (void)state;
+    fixture_with_standstill(&f);
+    while (!f.inst.hold.active) {
+        pmstep_standstill_advance(&f.inst, &out);
+    }
+    assert_int_equal(pmstep_set_speed_target(&f.inst, 0.0f, 50.0f), PMSTEP_OK);
+    assert_true(f.inst.hold.active); /* a repeated zero: held on */
+    assert_int_equal(pmstep_set_speed_target(&f.inst, -2.0f, 50.0f), PMSTEP_OK);
+    assert_false(f.inst.hold.active || f.inst.scratch.run.standstill.engaged);
+    assert_true(f.inst.scratch.run.standstill.speed_mode); /* armed for the next zero */
+    /* the position library takes the reference: released, and off until a speed command */
+    assert_int_equal(pmstep_set_speed_target(&f.inst, 0.0f, 50.0f), PMSTEP_OK);
+    while (!f.inst.hold.active) {
+        pmstep_standstill_advance(&f.inst, &out);
+    }
+    pmstep_leave_speed_mode(&f.inst);
+    pmstep_leave_speed_mode(NULL);
+    assert_false(f.inst.hold.active || f.inst.scratch.run.standstill.speed_mode);
+    assert_int_equal(pmstep_set_speed_target(&f.inst, 0.0f, 50.0f), PMSTEP_OK);
+    assert_true(f.inst.scratch.run.standstill.speed_mode);
+    /* an application's own hold is not the standstill's: a zero command ends it */
+    assert_int_equal(pmstep_hold_vector(&f.inst, 1.0f, 0.0f, 7.5f, 0.0f), PMSTEP_OK);
+    pmstep_standstill_advance(&f.inst, &out);
+    assert_false(f.inst.scratch.run.standstill.engaged);
+    assert_int_equal(pmstep_set_speed_target(&f.inst, 0.0f, 50.0f), PMSTEP_OK);
+    assert_false(f.inst.hold.active);
+}
+
+static void standstill_off_without_a_current_and_validated(void **state)
+{
+    fixture_t f;
+    pmstep_config_t cfg = pmstep_paper_config();
+    pmstep_t inst;
+    (void)state;
+    fixture_in_run(&f);
+    pmstep_standstill_start(&f.inst); /* paper: hold current 0 */
+    assert_false(f.inst.scratch.run.standstill.speed_mode);
+    assert_int_equal(pmstep_set_speed_target(&f.inst, 0.0f, 50.0f), PMSTEP_OK);
+    assert_false(f.inst.scratch.run.standstill.speed_mode);
+    cfg.standstill.hold_current_A = -0.1f;
+    assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_ERR_HOLD_CURRENT);
+    cfg.standstill.hold_current_A = cfg.limits.max_phase_current_A; /* the trip itself */
+    assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_ERR_HOLD_CURRENT);
+    cfg.standstill.hold_current_A = NAN;
+    assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_ERR_NONFINITE_PARAMETER);
+    cfg.standstill.hold_current_A = 7.5f;
+    assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
+    cfg.known_load_mode = true;
+    assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_ERR_STANDSTILL_KNOWN_LOAD);
+    assert_string_equal(pmstep_status_str(PMSTEP_ERR_STANDSTILL_KNOWN_LOAD), "standstill hold not with known_load_mode");
+    cfg.standstill.hold_current_A = 0.0f;
+    assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -179,6 +349,11 @@ int main(void)
         cmocka_unit_test(release_and_speed_command_end_the_hold),
         cmocka_unit_test(angle_estimate_set_gives_that_estimate),
         cmocka_unit_test(hold_settling_count_defined_for_any_model),
+        cmocka_unit_test(standstill_engages_after_the_engage_time_at_rest),
+        cmocka_unit_test(standstill_waits_for_the_zero_command_reached),
+        cmocka_unit_test(standstill_keeps_the_estimate_while_the_rotor_rests),
+        cmocka_unit_test(standstill_zero_command_keeps_it_other_commands_end_it),
+        cmocka_unit_test(standstill_off_without_a_current_and_validated),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -65,6 +65,7 @@ static const pmstep_console_config_entry_t table[] = {
     F32(commissioning.identification_min_speed_rad_s),
     BOOL(commissioning.use_identified_mechanics),
     BOOL(inverter.phase_voltage_sensing),
+    F32(standstill.hold_current_A),
 };
 
 const pmstep_console_config_entry_t *pmstep_console_config_table(uint32_t *count)

@@ -250,6 +250,9 @@ static void design_commissioning(const pmstep_design_input_t *in, float window_s
     cfg->inverter.dead_time_current_band_A = robust ? max2(in->current_resolution_A, MIN_DEAD_TIME_BAND_A) : 0.0f;
     cfg->inverter.phase_voltage_sensing = in->phase_voltage_sensing; /* the drive's, not the design's */
     report->magnetising_current_A = robust ? MAGNETISING_PER_RATED_CURRENT * in->rated_current_A : 0.0f;
+    /* Robust mode holds a zero speed command with a vector at rated current (pmstep_hold.h): the
+     * estimate would drift there with what is left of the voltage errors. */
+    cfg->standstill.hold_current_A = robust ? in->rated_current_A : 0.0f;
 }
 
 static void design_protection(const pmstep_design_input_t *in, pmstep_config_t *cfg, float top_speed_rad_s)

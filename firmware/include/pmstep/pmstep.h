@@ -103,6 +103,11 @@ pmstep_status_t pmstep_hold_vector(pmstep_t *inst, float cos_rest, float sin_res
  *  integrals restart at 0). No effect without a hold. */
 void pmstep_release_vector(pmstep_t *inst);
 
+/** The speed reference is taken over by another loop (the position library): the standstill
+ *  hold of speed mode (pmstep_standstill_config_t, pmstep_hold.h) ends and stays off until the
+ *  next pmstep_set_speed_target(). No effect outside RUN or with a NULL @p inst. */
+void pmstep_leave_speed_mode(pmstep_t *inst);
+
 /**
  * Sets the angle estimate to (@p cos_hat, @p sin_hat): the flux integrals are moved so that
  * the present currents give it. For a rotor known to be at that angle (at rest in a hold).

@@ -16,6 +16,20 @@
  * The law's PI current loop (pmstep_law_voltages' at zero speed, written out in pmstep_hold.c)
  * runs in the vector's frame: i_d* = I, i_q* = 0, its integrals on those errors. The observer, the angle integrals
  * and the detection run on as in RUN.
+ *
+ * Standstill hold in speed mode (cfg->standstill.hold_current_A > 0): when the speed command is
+ * 0, the reference has reached it (|w*| below 1 % of the quiet band) and |w-hat| has stayed
+ * within the quiet band PMSTEP_HOLD_QUIET_FRACTION w_n / p for PMSTEP_STANDSTILL_ENGAGE_TIME_CONSTANTS
+ * of the speed loop (1/k_w), the core holds the rotor with the vector aimed at the estimate,
+ * ahead by the load angle of T_L-hat. After the held rotor's settling time, the estimate is
+ * kept while the rotor rests (|w-hat - w-bar| within the quiet band; it is taken during the
+ * first settling time of each rest and put back every period after) and follows the flux
+ * integrals while it moves: the same rule as the position library's hold (pmstep_position.h).
+ * A non-zero speed command releases it (a zero one keeps it), as do leaving RUN and
+ * pmstep_leave_speed_mode(), by which the position library takes the reference over.
+ * Known limit: a load step on the held rotor moves it at w_n, above the observer's speed
+ * bandwidth on a hybrid stepper; w-hat misses that motion, the kept estimate stays where the
+ * rotor was, and T_L-hat with it (README, Monte Carlo).
  */
 #ifndef PMSTEP_HOLD_H
 #define PMSTEP_HOLD_H
@@ -39,6 +53,10 @@ extern "C" {
 #define PMSTEP_HOLD_MAX_TORQUE_FRACTION 0.9f
 /** Largest turn of the vector by the damping term (electrical rad). */
 #define PMSTEP_HOLD_MAX_DAMPING_TURN 0.5f
+/** Time at rest before the standstill hold, in time constants 1/k_w of the speed loop. */
+#define PMSTEP_STANDSTILL_ENGAGE_TIME_CONSTANTS 2.0f
+/** |w*| below this fraction of the quiet band counts as the zero command reached. */
+#define PMSTEP_STANDSTILL_REFERENCE_FRACTION 0.01f
 
 /** State of a vector hold (part of pmstep_t). */
 typedef struct {
@@ -54,6 +72,18 @@ typedef struct {
     uint32_t settle_periods;      /**< PMSTEP_HOLD_SETTLE_TIME_CONSTANTS / (zeta w_n), in periods */
     bool active;
 } pmstep_vector_hold_t;
+
+/** State of the standstill hold in speed mode (part of pmstep_t's RUN scratch). */
+typedef struct {
+    float quiet_band_rad_s;  /**< PMSTEP_HOLD_QUIET_FRACTION w_n / p for the hold's current: at rest below */
+    float keep_cos;          /**< the estimate kept while the held rotor rests */
+    float keep_sin;
+    uint32_t engage_periods; /**< PMSTEP_STANDSTILL_ENGAGE_TIME_CONSTANTS / k_w, in periods */
+    uint32_t rest_periods;   /**< periods at rest: before the hold, to engage it; in it, since the settling */
+    bool speed_mode;         /**< armed: RUN with a hold current, in speed mode (not the position library's) */
+    bool engaged;            /**< the core's vector hold is this one's */
+    bool settled;            /**< the held rotor's settling time has passed */
+} pmstep_standstill_t;
 
 #ifdef __cplusplus
 }

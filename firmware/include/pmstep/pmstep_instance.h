@@ -61,6 +61,7 @@ typedef struct {
             pmstep_detector_t detector;
             pmstep_ref_t known_load_filter; /**< T_L* of Remark 1 */
             pmstep_identify_sums_t identify; /**< J and F fit, while the identification window is open */
+            pmstep_standstill_t standstill;  /**< standstill hold in speed mode (pmstep_hold.h) */
         } run;                            /**< from t_c */
     } scratch;
 

@@ -96,8 +96,10 @@ typedef enum {
     PMSTEP_ERR_POSITION_GAIN = -130,        /**< position gain k_theta <= 0, or above k_w/2 (the speed loop's) */
     PMSTEP_ERR_POSITION_INTEGRAL_GAIN = -131, /**< position integral gain k_I < 0, or above k_theta^2/4 (the loop's
                                                  poles would turn complex) */
-    PMSTEP_ERR_HOLD_CURRENT = -132          /**< hold current <= 0 or not below max_phase_current_A, or too small
-                                                 for the load: |T_L - T_detent| above 0.9 k_M I (pmstep_hold.h) */
+    PMSTEP_ERR_HOLD_CURRENT = -132,         /**< hold current <= 0 or not below max_phase_current_A, or too small
+                                                 for the load: |T_L - T_detent| above 0.9 k_M I (pmstep_hold.h);
+                                                 the standstill hold's current < 0 or not below max_phase_current_A */
+    PMSTEP_ERR_STANDSTILL_KNOWN_LOAD = -133  /**< a standstill hold with known_load_mode (a vector hold needs (6)) */
 } pmstep_status_t;
 
 /** Shortest and longest control period accepted (s): 1 MHz down to 100 Hz. */
@@ -252,6 +254,14 @@ typedef struct {
     uint32_t max_realignments;           /**< 0: a detection latches its fault; N: re-align (bridge on) up to N times */
 } pmstep_detection_config_t;
 
+/** Standstill hold in speed mode (pmstep_hold.h): a zero speed command, once reached with the
+ *  rotor at rest, is held by a current vector fixed in the stator frame and the angle estimate
+ *  is kept, so that it does not drift with the voltage errors nothing observes at zero speed. */
+typedef struct {
+    float hold_current_A; /**< I of the hold, 0 < I < max_phase_current_A; 0 = off (the law holds on the
+                               estimate, which drifts). Not with known_load_mode. */
+} pmstep_standstill_config_t;
+
 /** Constant configuration (may live in flash; must outlive the instance). */
 typedef struct {
     pmstep_motor_config_t motor;
@@ -262,6 +272,7 @@ typedef struct {
     pmstep_commissioning_config_t commissioning;
     pmstep_inverter_config_t inverter;
     pmstep_detection_config_t detection;
+    pmstep_standstill_config_t standstill;
     bool known_load_mode; /**< Remark 1: load torque known, given each period in pmstep_meas_t */
 } pmstep_config_t;
 
