@@ -148,7 +148,7 @@ bool pmstep_control_advance(pmstep_t *inst, const pmstep_control_scratch_t *scra
     }
     pmstep_ref_advance(&inst->ref_coeffs, &inst->speed_ref, period_s);
     pmstep_ref_advance(&inst->ref_coeffs, &inst->i_d_ref, period_s);
-    if (inst->scratch.run.standstill.speed_mode) {
+    if (inst->hold.standstill_armed) {
         pmstep_standstill_advance(inst, out);
     }
     if (cfg->known_load_mode) {

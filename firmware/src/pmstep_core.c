@@ -106,6 +106,9 @@ static void clear_dynamic_state(pmstep_t *inst)
     inst->mode_step = 0u;
     inst->run_started = false;
     inst->hold.active = false;
+    inst->hold.standstill_armed = false;
+    inst->hold.standstill_engaged = false;
+    inst->hold.standstill_settled = false;
     pmstep_angle_start(&inst->angle, 0.0f, 0.0f);
     pmstep_observer_start(&inst->observer, 0.0f, 0.0f);
     pmstep_actuate_reset(&inst->actuator);
@@ -173,12 +176,11 @@ pmstep_status_t pmstep_set_speed_target(pmstep_t *inst, float target_rad_s, floa
         return PMSTEP_ERR_BAD_COMMAND_VALUE;
     }
     if (inst->mode == PMSTEP_MODE_RUN && inst->run_started) {
-        pmstep_standstill_t *standstill = &inst->scratch.run.standstill;
-        if (!(standstill->engaged && !(pmstep_abs(target_rad_s) > 0.0f))) {
+        if (!(inst->hold.standstill_engaged && !(pmstep_abs(target_rad_s) > 0.0f))) {
             pmstep_release_vector(inst); /* a speed command ends a hold; a zero one keeps the standstill's */
-            standstill->engaged = false;
+            inst->hold.standstill_engaged = false;
         }
-        standstill->speed_mode = inst->cfg->standstill.hold_current_A > 0.0f;
+        inst->hold.standstill_armed = inst->cfg->standstill.hold_current_A > 0.0f;
     } else {
         pmstep_release_vector(inst);
     }

@@ -135,15 +135,15 @@ void pmstep_standstill_start(pmstep_t *inst)
 {
     pmstep_standstill_t *standstill = &inst->scratch.run.standstill;
     const float current_A = inst->cfg->standstill.hold_current_A;
-    standstill->engaged = false;
-    standstill->settled = false;
+    inst->hold.standstill_engaged = false;
+    inst->hold.standstill_settled = false;
     standstill->rest_periods = 0u;
     standstill->keep_cos = 1.0f;
     standstill->keep_sin = 0.0f;
-    standstill->speed_mode = current_A > 0.0f;
+    inst->hold.standstill_armed = current_A > 0.0f;
     standstill->quiet_band_rad_s = 0.0f;
     standstill->engage_periods = 0u;
-    if (standstill->speed_mode) {
+    if (inst->hold.standstill_armed) {
         const pmstep_law_coeffs_t *law = &inst->law_coeffs;
         const float natural_rad_s = sqrtf(law->pole_pairs * current_A / law->j_over_km); /* sqrt(p k_M I / J) */
         standstill->quiet_band_rad_s = PMSTEP_HOLD_QUIET_FRACTION * natural_rad_s / law->pole_pairs;
@@ -165,7 +165,7 @@ static void standstill_engage(pmstep_t *inst, pmstep_standstill_t *standstill, c
                          && pmstep_abs(out->speed_ref_rad_s)
                                 < PMSTEP_STANDSTILL_REFERENCE_FRACTION * standstill->quiet_band_rad_s
                          && pmstep_abs(out->speed_hat_rad_s) < standstill->quiet_band_rad_s;
-    standstill->engaged = false;
+    inst->hold.standstill_engaged = false;
     if (!at_rest) {
         standstill->rest_periods = 0u;
         return;
@@ -174,9 +174,9 @@ static void standstill_engage(pmstep_t *inst, pmstep_standstill_t *standstill, c
     if (standstill->rest_periods >= standstill->engage_periods) {
         const float length = sqrtf(out->cos_hat * out->cos_hat + out->sin_hat * out->sin_hat);
         standstill->rest_periods = 0u;
-        standstill->settled = false;
+        inst->hold.standstill_settled = false;
         /* refused (a load beyond the vector's pull, an estimate at the origin): the law holds on */
-        standstill->engaged = length > 0.0f
+        inst->hold.standstill_engaged = length > 0.0f
                               && pmstep_hold_vector(inst, out->cos_hat / length, out->sin_hat / length,
                                                     inst->cfg->standstill.hold_current_A, inst->observer.load_hat_Nm)
                                      == PMSTEP_OK;
@@ -190,13 +190,13 @@ void pmstep_standstill_advance(pmstep_t *inst, const pmstep_output_t *out)
         standstill_engage(inst, standstill, out);
         return;
     }
-    if (!standstill->engaged) {
+    if (!inst->hold.standstill_engaged) {
         return; /* a hold of the application's own (pmstep_hold_vector) */
     }
     standstill->rest_periods++;
-    if (!standstill->settled) {
+    if (!inst->hold.standstill_settled) {
         if (standstill->rest_periods >= inst->hold.settle_periods) {
-            standstill->settled = true;
+            inst->hold.standstill_settled = true;
             standstill->rest_periods = 0u;
         }
     } else if (pmstep_abs(inst->observer.speed_hat_rad_s - inst->hold.speed_bias_rad_s) < inst->hold.quiet_band_rad_s) {
@@ -215,11 +215,11 @@ void pmstep_leave_speed_mode(pmstep_t *inst)
 {
     if (inst != NULL && inst->mode == PMSTEP_MODE_RUN && inst->run_started) {
         pmstep_standstill_t *standstill = &inst->scratch.run.standstill;
-        if (standstill->engaged) {
+        if (inst->hold.standstill_engaged) {
             pmstep_release_vector(inst);
-            standstill->engaged = false;
+            inst->hold.standstill_engaged = false;
         }
-        standstill->speed_mode = false;
+        inst->hold.standstill_armed = false;
         standstill->rest_periods = 0u;
     }
 }

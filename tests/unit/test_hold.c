@@ -197,7 +197,7 @@ static void standstill_engages_after_the_engage_time_at_rest(void **state)
     (void)state;
     fixture_with_standstill(&f);
     engage = f.inst.scratch.run.standstill.engage_periods;
-    assert_true(f.inst.scratch.run.standstill.speed_mode);
+    assert_true(f.inst.hold.standstill_armed);
     assert_int_equal(engage, (uint32_t)(2.0f / (f.cfg.gains.speed_gain_per_s * f.cfg.timing.period_s)));
     assert_float_equal(f.inst.scratch.run.standstill.quiet_band_rad_s, 0.05 * w_n / 6.0, 1e-6 * w_n);
     /* a rotor not at rest (|w-hat| over the band) restarts the count */
@@ -213,7 +213,7 @@ static void standstill_engages_after_the_engage_time_at_rest(void **state)
     }
     assert_false(f.inst.hold.active);
     pmstep_standstill_advance(&f.inst, &out);
-    assert_true(f.inst.hold.active && f.inst.scratch.run.standstill.engaged);
+    assert_true(f.inst.hold.active && f.inst.hold.standstill_engaged);
     /* aimed at the estimate's direction (T_L-hat 0, no detent torque), at the hold's current */
     assert_float_equal(f.inst.hold.cos_vector, 0.6f, 1e-6f);
     assert_float_equal(f.inst.hold.sin_vector, 0.8f, 1e-6f);
@@ -259,7 +259,7 @@ static void standstill_keeps_the_estimate_while_the_rotor_rests(void **state)
     for (n = 0; n < settle; ++n) {
         pmstep_standstill_advance(&f.inst, &out);
     }
-    assert_true(f.inst.scratch.run.standstill.settled);
+    assert_true(f.inst.hold.standstill_settled);
     for (n = 0; n < settle; ++n) { /* the rest's first settling time: taken, not put back */
         out = at_rest_output(cosf(0.001f * (float)n), sinf(0.001f * (float)n));
         pmstep_standstill_advance(&f.inst, &out);
@@ -294,8 +294,8 @@ static void standstill_zero_command_keeps_it_other_commands_end_it(void **state)
     assert_int_equal(pmstep_set_speed_target(&f.inst, 0.0f, 50.0f), PMSTEP_OK);
     assert_true(f.inst.hold.active); /* a repeated zero: held on */
     assert_int_equal(pmstep_set_speed_target(&f.inst, -2.0f, 50.0f), PMSTEP_OK);
-    assert_false(f.inst.hold.active || f.inst.scratch.run.standstill.engaged);
-    assert_true(f.inst.scratch.run.standstill.speed_mode); /* armed for the next zero */
+    assert_false(f.inst.hold.active || f.inst.hold.standstill_engaged);
+    assert_true(f.inst.hold.standstill_armed); /* armed for the next zero */
     /* the position library takes the reference: released, and off until a speed command */
     assert_int_equal(pmstep_set_speed_target(&f.inst, 0.0f, 50.0f), PMSTEP_OK);
     while (!f.inst.hold.active) {
@@ -303,13 +303,13 @@ static void standstill_zero_command_keeps_it_other_commands_end_it(void **state)
     }
     pmstep_leave_speed_mode(&f.inst);
     pmstep_leave_speed_mode(NULL);
-    assert_false(f.inst.hold.active || f.inst.scratch.run.standstill.speed_mode);
+    assert_false(f.inst.hold.active || f.inst.hold.standstill_armed);
     assert_int_equal(pmstep_set_speed_target(&f.inst, 0.0f, 50.0f), PMSTEP_OK);
-    assert_true(f.inst.scratch.run.standstill.speed_mode);
+    assert_true(f.inst.hold.standstill_armed);
     /* an application's own hold is not the standstill's: a zero command ends it */
     assert_int_equal(pmstep_hold_vector(&f.inst, 1.0f, 0.0f, 7.5f, 0.0f), PMSTEP_OK);
     pmstep_standstill_advance(&f.inst, &out);
-    assert_false(f.inst.scratch.run.standstill.engaged);
+    assert_false(f.inst.hold.standstill_engaged);
     assert_int_equal(pmstep_set_speed_target(&f.inst, 0.0f, 50.0f), PMSTEP_OK);
     assert_false(f.inst.hold.active);
 }
@@ -322,9 +322,9 @@ static void standstill_off_without_a_current_and_validated(void **state)
     (void)state;
     fixture_in_run(&f);
     pmstep_standstill_start(&f.inst); /* paper: hold current 0 */
-    assert_false(f.inst.scratch.run.standstill.speed_mode);
+    assert_false(f.inst.hold.standstill_armed);
     assert_int_equal(pmstep_set_speed_target(&f.inst, 0.0f, 50.0f), PMSTEP_OK);
-    assert_false(f.inst.scratch.run.standstill.speed_mode);
+    assert_false(f.inst.hold.standstill_armed);
     cfg.standstill.hold_current_A = -0.1f;
     assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_ERR_HOLD_CURRENT);
     cfg.standstill.hold_current_A = cfg.limits.max_phase_current_A; /* the trip itself */

@@ -71,6 +71,11 @@ typedef struct {
     float sin_frame;
     uint32_t settle_periods;      /**< PMSTEP_HOLD_SETTLE_TIME_CONSTANTS / (zeta w_n), in periods */
     bool active;
+    /* The standstill hold of speed mode (its counts in pmstep_standstill_t): flags kept out of
+     * the RUN scratch union, whose bytes are the commissioning sums until t_c. */
+    bool standstill_armed;        /**< RUN with a hold current, in speed mode (not the position library's) */
+    bool standstill_engaged;      /**< this hold is the standstill's */
+    bool standstill_settled;      /**< the held rotor's settling time has passed */
 } pmstep_vector_hold_t;
 
 /** State of the standstill hold in speed mode (part of pmstep_t's RUN scratch). */
@@ -80,9 +85,6 @@ typedef struct {
     float keep_sin;
     uint32_t engage_periods; /**< PMSTEP_STANDSTILL_ENGAGE_TIME_CONSTANTS / k_w, in periods */
     uint32_t rest_periods;   /**< periods at rest: before the hold, to engage it; in it, since the settling */
-    bool speed_mode;         /**< armed: RUN with a hold current, in speed mode (not the position library's) */
-    bool engaged;            /**< the core's vector hold is this one's */
-    bool settled;            /**< the held rotor's settling time has passed */
 } pmstep_standstill_t;
 
 #ifdef __cplusplus
