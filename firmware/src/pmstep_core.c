@@ -175,15 +175,7 @@ pmstep_status_t pmstep_set_speed_target(pmstep_t *inst, float target_rad_s, floa
     if (!pmstep_all_finite4(target_rad_s, ramp_rate_rad_s2, 0.0f, 0.0f) || !(ramp_rate_rad_s2 > 0.0f)) {
         return PMSTEP_ERR_BAD_COMMAND_VALUE;
     }
-    if (inst->mode == PMSTEP_MODE_RUN && inst->run_started) {
-        if (!(inst->hold.standstill_engaged && !(pmstep_abs(target_rad_s) > 0.0f))) {
-            pmstep_release_vector(inst); /* a speed command ends a hold; a zero one keeps the standstill's */
-            inst->hold.standstill_engaged = false;
-        }
-        inst->hold.standstill_armed = inst->cfg->standstill.hold_current_A > 0.0f;
-    } else {
-        pmstep_release_vector(inst);
-    }
+    pmstep_standstill_command(inst, target_rad_s); /* ends a hold; a zero command keeps the standstill's */
     pmstep_ref_set_target(&inst->speed_ref, target_rad_s, ramp_rate_rad_s2);
     return PMSTEP_OK;
 }

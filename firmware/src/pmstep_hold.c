@@ -7,6 +7,22 @@
  * float-to-integer range. */
 #define HOLD_MAX_SETTLE_PERIODS 1.0e6f
 
+/* A time in periods as a count: NaN and anything outside [0, max) count as the longest. A model
+ * with k_M, J and k_w positive gives neither; the test keeps the conversion defined whatever the
+ * model. NaN is tested apart as well, for Frama-C EVA, which does not take it out through an
+ * ordered compare (eva.step). */
+static uint32_t period_count(float periods)
+{
+    const bool defined = periods == periods /* not NaN */ && periods >= 0.0f && periods < HOLD_MAX_SETTLE_PERIODS;
+    return (uint32_t)(defined ? periods : HOLD_MAX_SETTLE_PERIODS);
+}
+
+/* sqrt(p k_M I cos(delta) / J): the held rotor's natural frequency (rad/s), the commissioned model's. */
+static float hold_natural_rad_s(const pmstep_law_coeffs_t *law, float current_A, float cos_delta)
+{
+    return sqrtf(law->pole_pairs * current_A * cos_delta / law->j_over_km);
+}
+
 pmstep_status_t pmstep_hold_vector(pmstep_t *inst, float cos_rest, float sin_rest, float current_A, float load_Nm)
 {
     const pmstep_law_coeffs_t *law;
@@ -39,21 +55,14 @@ pmstep_status_t pmstep_hold_vector(pmstep_t *inst, float cos_rest, float sin_res
     hold = &inst->hold;
     cos_delta = sqrtf(1.0f - sin_delta * sin_delta);
     pmstep_turn(cos_rest, sin_rest, cos_delta, sin_delta, &hold->cos_vector, &hold->sin_vector);
-    natural_rad_s = sqrtf(law->pole_pairs * current_A * cos_delta / law->j_over_km); /* sqrt(p k_M I cos d / J) */
+    natural_rad_s = hold_natural_rad_s(law, current_A, cos_delta);
     hold->current_A = current_A;
     hold->damping_s = 2.0f * PMSTEP_HOLD_DAMPING_RATIO * law->pole_pairs / natural_rad_s;
     hold->quiet_band_rad_s = PMSTEP_HOLD_QUIET_FRACTION * natural_rad_s / law->pole_pairs;
     hold->bias_gain = natural_rad_s * inst->cfg->timing.period_s / PMSTEP_HOLD_BIAS_CORNER_RATIO;
     settle_periods = PMSTEP_HOLD_SETTLE_TIME_CONSTANTS
                      / (PMSTEP_HOLD_DAMPING_RATIO * natural_rad_s * inst->cfg->timing.period_s);
-    /* NaN and anything outside [0, max) count as the longest: a model with k_M and J positive gives
-     * neither, the test keeps the conversion defined whatever the model. NaN is tested apart as
-     * well, for Frama-C EVA, which does not take it out through an ordered compare (eva.step). */
-    if (settle_periods != settle_periods /* NaN */
-        || !(settle_periods >= 0.0f && settle_periods < HOLD_MAX_SETTLE_PERIODS)) {
-        settle_periods = HOLD_MAX_SETTLE_PERIODS;
-    }
-    hold->settle_periods = (uint32_t)settle_periods;
+    hold->settle_periods = period_count(settle_periods);
     hold->cos_frame = hold->cos_vector;
     hold->sin_frame = hold->sin_vector;
     if (!hold->active) { /* from the law: its integrals were of other errors */
@@ -145,14 +154,10 @@ void pmstep_standstill_start(pmstep_t *inst)
     standstill->engage_periods = 0u;
     if (inst->hold.standstill_armed) {
         const pmstep_law_coeffs_t *law = &inst->law_coeffs;
-        const float natural_rad_s = sqrtf(law->pole_pairs * current_A / law->j_over_km); /* sqrt(p k_M I / J) */
-        standstill->quiet_band_rad_s = PMSTEP_HOLD_QUIET_FRACTION * natural_rad_s / law->pole_pairs;
-        float engage_periods = PMSTEP_STANDSTILL_ENGAGE_TIME_CONSTANTS
-                               / (inst->cfg->gains.speed_gain_per_s * inst->cfg->timing.period_s);
-        if (!(engage_periods < HOLD_MAX_SETTLE_PERIODS)) { /* a slow speed loop: the longest counted */
-            engage_periods = HOLD_MAX_SETTLE_PERIODS;
-        }
-        standstill->engage_periods = (uint32_t)engage_periods;
+        standstill->quiet_band_rad_s = PMSTEP_HOLD_QUIET_FRACTION * hold_natural_rad_s(law, current_A, 1.0f)
+                                       / law->pole_pairs;
+        standstill->engage_periods = period_count(PMSTEP_STANDSTILL_ENGAGE_TIME_CONSTANTS
+                                                  / (inst->cfg->gains.speed_gain_per_s * inst->cfg->timing.period_s));
     }
 }
 
@@ -208,6 +213,18 @@ void pmstep_standstill_advance(pmstep_t *inst, const pmstep_output_t *out)
         }
     } else {
         standstill->rest_periods = 0u; /* moving: the estimate follows the flux integrals */
+    }
+}
+
+void pmstep_standstill_command(pmstep_t *inst, float target_rad_s)
+{
+    const bool in_run = inst->mode == PMSTEP_MODE_RUN && inst->run_started;
+    if (!in_run || pmstep_abs(target_rad_s) > 0.0f || !inst->hold.standstill_engaged) {
+        pmstep_release_vector(inst); /* a speed command ends a hold; a zero one keeps the standstill's */
+        inst->hold.standstill_engaged = false;
+    }
+    if (in_run) {
+        inst->hold.standstill_armed = inst->cfg->standstill.hold_current_A > 0.0f; /* speed mode again */
     }
 }
 

@@ -69,8 +69,10 @@ bool pmstep_control_advance(pmstep_t *inst, const pmstep_control_scratch_t *scra
  * damping, the PI current loop's errors in its frame into @p obs_in, the voltage into @p out. */
 void pmstep_hold_voltages(pmstep_t *inst, pmstep_observer_input_t *obs_in, pmstep_output_t *out);
 
-/* Standstill hold in speed mode (pmstep_hold.h): armed at RUN's start, run after each period. */
+/* Standstill hold in speed mode (pmstep_hold.h): armed at RUN's start, run after each period; a
+ * speed command's part (ends a hold, except the standstill's for a zero command; re-arms it). */
 void pmstep_standstill_start(pmstep_t *inst);
 void pmstep_standstill_advance(pmstep_t *inst, const pmstep_output_t *out);
+void pmstep_standstill_command(pmstep_t *inst, float target_rad_s);
 
 #endif /* PMSTEP_INTERNAL_H */

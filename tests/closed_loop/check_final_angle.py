@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Checks a pmstep-sil summary.json: the run ended in RUN and the angle estimate's error at its
-end is within a bound (electrical rad). Prints the measured value; exits 1 on a miss."""
+end is below --max-final-angle-error, or (a run that shows a drift) at least
+--min-final-angle-error (electrical rad). Prints the measured value; exits 1 on a miss."""
 import argparse
 import json
 import sys
@@ -9,19 +10,25 @@ import sys
 def main():
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("summary", help="pmstep-sil summary.json")
-    parser.add_argument("--max-final-angle-error", type=float, required=True, metavar="RAD",
-                        help="bound on |angle error| at the run's end (electrical rad)")
+    bound = parser.add_mutually_exclusive_group(required=True)
+    bound.add_argument("--max-final-angle-error", type=float, metavar="RAD",
+                       help="|angle error| at the run's end must be below this (electrical rad)")
+    bound.add_argument("--min-final-angle-error", type=float, metavar="RAD",
+                       help="|angle error| at the run's end must be at least this (electrical rad)")
     args = parser.parse_args()
     with open(args.summary, encoding="utf-8") as f:
         summary = json.load(f)
     mode = summary["final_mode"]
     error = summary["robustness"]["final_angle_error_rad"]
-    print(f"final mode {mode}, final angle error {error:.4f} rad (bound {args.max_final_angle_error:g})")
+    print(f"final mode {mode}, final angle error {error:.4f} rad")
     if mode != "RUN":
         print("check_final_angle: the run did not end in RUN", file=sys.stderr)
         return 1
-    if not abs(error) < args.max_final_angle_error:
-        print("check_final_angle: final angle error over the bound", file=sys.stderr)
+    if args.max_final_angle_error is not None and not abs(error) < args.max_final_angle_error:
+        print(f"check_final_angle: not below {args.max_final_angle_error:g} rad", file=sys.stderr)
+        return 1
+    if args.min_final_angle_error is not None and not abs(error) >= args.min_final_angle_error:
+        print(f"check_final_angle: not at least {args.min_final_angle_error:g} rad", file=sys.stderr)
         return 1
     return 0
 

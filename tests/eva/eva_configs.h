@@ -28,6 +28,7 @@ static pmstep_config_t eva_known_load_config(void)
 {
     pmstep_config_t cfg = eva_features_config();
     cfg.known_load_mode = true;
+    cfg.standstill.hold_current_A = 0.0f; /* a vector hold needs (6) */
     cfg.commissioning.voltage_bias_level_fraction = 0.0f;
     cfg.commissioning.offset_calibration_time_s = 0.0f;
     cfg.timing.computational_delay_periods = 0u;

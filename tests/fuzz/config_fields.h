@@ -28,8 +28,8 @@ static const size_t fuzz_bool_fields[] = {
 /* Base configurations the fuzzer perturbs. 0: the paper's. 1: every optional feature on
  * (offset calibration, alignment windows with the voltage bias, inductance window, commissioned
  * R, L, k_M used, dead-time compensation, drift-free angle, detent compensation, PI current loop, all
- * detectors, re-alignments).
- * 2: as 1 in known-load mode. 3: the paper's with short alignments (RUN after 400 periods) and
+ * detectors, re-alignments, the standstill hold).
+ * 2: as 1 in known-load mode (no standstill hold). 3: the paper's with short alignments (RUN after 400 periods) and
  * phase-voltage sensing. */
 #define FUZZ_BASE_CONFIGS 4u
 static inline pmstep_config_t fuzz_base_config(unsigned which)
@@ -38,6 +38,9 @@ static inline pmstep_config_t fuzz_base_config(unsigned which)
     if (which == 1u || which == 2u) {
         cfg = pmstep_test_features_config(); /* tests/include, shared with the EVA harnesses */
         cfg.known_load_mode = which == 2u;
+        if (cfg.known_load_mode) {
+            cfg.standstill.hold_current_A = 0.0f; /* a vector hold needs (6) */
+        }
     } else if (which == 3u) {
         cfg.alignment.s_align_time_s = 0.01f;
         cfg.alignment.c_align_time_s = 0.02f;

@@ -8,7 +8,8 @@
 /* Every optional feature on: offset calibration, alignment windows with the voltage bias,
  * inductance window, commissioned R, L, k_M used, J and F identified over 20 ms of RUN and
  * used, dead-time compensation, drift-free angle, detent compensation, PI current loop,
- * every detector (the paper's bounds), two re-alignments, one period of delay. */
+ * every detector (the paper's bounds), two re-alignments, one period of delay, the standstill hold
+ * of speed mode at 7.5 A (half the current trip). */
 static inline pmstep_config_t pmstep_test_features_config(void)
 {
     pmstep_config_t cfg = pmstep_paper_config();
@@ -29,6 +30,7 @@ static inline pmstep_config_t pmstep_test_features_config(void)
     cfg.motor.detent_torque_Nm = 0.05f;
     cfg.detection.max_realignments = 2u;
     cfg.timing.computational_delay_periods = 1u;
+    cfg.standstill.hold_current_A = 7.5f;
     return cfg;
 }
 
