@@ -9,7 +9,9 @@ then runs pmstep-sil:
   ramps     RUN of --duration s: ramps to +-80 % and +-5 % of the top speed and holds, repeated;
             fault, max |w - w*| after the transients (% of top), max angle-estimate error
   steps     half the holding torque stepped on at 50 % and 5 % of the top speed: fault, loss of
-            synchronism, speed dip, recovery time (back within 2 % of top speed)
+            synchronism, speed dip, recovery time (back within 2 % of top speed); then the same step
+            at STEP_POSITIONS rotor positions spread over one detent period (4 p steps a turn), each
+            one survived or not, since a step's outcome near the limit depends on where it lands
   pull-out  the largest load step (fraction of the holding torque, bisection) survived at 50 %
             of the top speed without a fault or a loss of synchronism, ours and microstepping
   copper    per-phase RMS current at 50 % of the top speed without load, ours and microstepping
@@ -20,6 +22,7 @@ then runs pmstep-sil:
 import argparse
 import csv
 import json
+import math
 import os
 import re
 import subprocess
@@ -35,6 +38,7 @@ ROBUST_CHAINS = ("realistic", "sensed")  # designed with --robust, behind mc_pre
 HOLD_S = 1.0
 SETTLE_S = 0.1  # after each ramp, before the tracking error counts ("after transients")
 BISECTION_STEPS = 6
+STEP_POSITIONS = 8  # load steps spread over one detent period, the nominal one first
 
 
 def run(cmd):
@@ -132,6 +136,7 @@ def envelope(args, name, chain):
     out = os.path.join(args.out, name, chain)
     os.makedirs(out, exist_ok=True)
     ini, top, start, preset = design(args, name, chain, out)
+    pole_pairs = int(re.search(r"^pole_pairs\s*=\s*(\d+)", open(ini).read(), re.M).group(1))
     ramp_s = max(0.05, 0.8 * top / 2000.0)
     row = {"preset": name, "chain": chain, "top_speed_rad_s": top}
     # Ramps for --duration s of RUN.
@@ -155,14 +160,15 @@ def envelope(args, name, chain):
         name, chain, top, row["ramps_fault"], row["ramps_speed_error_pct_top"], row["ramps_angle_error_rad"]),
         flush=True)
 
-    def step_run(fraction_of_top, load_fraction, microstep, csv_out=False):
+    def step_run(fraction_of_top, load_fraction, microstep, csv_out=False, delay_s=0.0):
         pts, end = profile(start, [(ramp_s, fraction_of_top * top, 1.0)])
-        step_time = end - 0.5
+        step_time = end - 0.5 + delay_s
         extra = ["speed.points=" + pts, "run.duration_s=%g" % end, "load.type=step",
                  "load.torque_Nm=%g" % (load_fraction * preset["holding_torque_Nm"]), "load.step_time_s=%g" % step_time]
         if microstep:
             extra.append("run.controller=microstep")
-        d = os.path.join(out, "step_%s_%g_%g" % ("ms" if microstep else "ours", fraction_of_top, load_fraction))
+        d = os.path.join(out, "step_%s_%g_%g%s" % ("ms" if microstep else "ours", fraction_of_top, load_fraction,
+                                                   "_at_%.6f" % delay_s if delay_s else ""))
         summary, _ = sil(args, ini, d, extra, csv_out)
         return summary, d, step_time
 
@@ -172,8 +178,15 @@ def envelope(args, name, chain):
         key = "step_at_%g" % fraction
         row[key] = {"fault": fault_name(s), "lost_sync": s.get("loss_of_synchronism"), "dip_rad_s": dip,
                     "recovery_ms": 1e3 * recovery, "max_angle_error_rad": s["robustness"]["max_angle_error_rad"]}
-        print("%-9s %-9s 0.5 T_H at %g top: fault %s, sync lost %s, dip %.2f rad/s, recovery %.1f ms" % (
-            name, chain, fraction, fault_name(s), s.get("loss_of_synchronism"), dip, 1e3 * recovery), flush=True)
+        detent_period_s = 2.0 * math.pi / (4.0 * pole_pairs * fraction * top)
+        survived = int(ok(s)) + sum(
+            int(ok(step_run(fraction, 0.5, False, delay_s=k * detent_period_s / STEP_POSITIONS)[0]))
+            for k in range(1, STEP_POSITIONS))
+        row[key]["survived_positions"] = survived
+        print("%-9s %-9s 0.5 T_H at %g top: fault %s, sync lost %s, dip %.2f rad/s, recovery %.1f ms; "
+              "survived at %d of %d positions over a detent period" % (
+                  name, chain, fraction, fault_name(s), s.get("loss_of_synchronism"), dip, 1e3 * recovery,
+                  survived, STEP_POSITIONS), flush=True)
 
     for microstep in (False, True):
         lo, hi = 0.0, 1.0
@@ -201,15 +214,17 @@ def envelope(args, name, chain):
 
 def markdown(rows):
     lines = ["| preset | chain | top speed (rad/s) | ramps: fault, max |w-w*| (% top), angle error (rad) | "
-             "0.5 T_H step at 50 % / 5 % top: dip (rad/s), recovery (ms) | largest step at 50 % top, ours / "
+             "0.5 T_H step at 50 % / 5 % top: dip (rad/s), recovery (ms); survived at k of "
+             + str(STEP_POSITIONS) + " positions | largest step at 50 % top, ours / "
              "microstepping (x T_H) | RMS phase current at 50 % top, no load: ours / microstepping (A) |",
              "|---|---|---|---|---|---|---|"]
     for r in rows:
         def step(k):
             x = r[k]
+            positions = "; %d/%d" % (x["survived_positions"], STEP_POSITIONS)
             if x["fault"] not in ("NONE", None) or x["lost_sync"]:
-                return "%s%s" % (x["fault"], ", sync lost" if x["lost_sync"] else "")
-            return "%.1f, %.0f" % (x["dip_rad_s"], x["recovery_ms"])
+                return "%s%s%s" % (x["fault"], ", sync lost" if x["lost_sync"] else "", positions)
+            return "%.1f, %.0f%s" % (x["dip_rad_s"], x["recovery_ms"], positions)
         lines.append("| %s | %s | %.1f | %s, %.2f, %.4f | %s / %s | %.3f / %.3f | %.3f / %.3f |" % (
             r["preset"], r["chain"], r["top_speed_rad_s"], r["ramps_fault"], r["ramps_speed_error_pct_top"],
             r["ramps_angle_error_rad"] or float("nan"), step("step_at_0.5"), step("step_at_0.05"),
