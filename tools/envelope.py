@@ -136,7 +136,8 @@ def envelope(args, name, chain):
     out = os.path.join(args.out, name, chain)
     os.makedirs(out, exist_ok=True)
     ini, top, start, preset = design(args, name, chain, out)
-    pole_pairs = int(re.search(r"^pole_pairs\s*=\s*(\d+)", open(ini).read(), re.M).group(1))
+    with open(ini) as f:
+        pole_pairs = int(re.search(r"^pole_pairs\s*=\s*(\d+)", f.read(), re.M).group(1))
     ramp_s = max(0.05, 0.8 * top / 2000.0)
     row = {"preset": name, "chain": chain, "top_speed_rad_s": top}
     # Ramps for --duration s of RUN.
@@ -162,8 +163,8 @@ def envelope(args, name, chain):
 
     def step_run(fraction_of_top, load_fraction, microstep, csv_out=False, delay_s=0.0):
         pts, end = profile(start, [(ramp_s, fraction_of_top * top, 1.0)])
-        step_time = end - 0.5 + delay_s
-        extra = ["speed.points=" + pts, "run.duration_s=%g" % end, "load.type=step",
+        step_time = end - 0.5 + delay_s  # the run lasts 0.5 s past every step (the speed holds)
+        extra = ["speed.points=" + pts, "run.duration_s=%g" % (end + delay_s), "load.type=step",
                  "load.torque_Nm=%g" % (load_fraction * preset["holding_torque_Nm"]), "load.step_time_s=%g" % step_time]
         if microstep:
             extra.append("run.controller=microstep")
