@@ -7,6 +7,9 @@
  * float-to-integer range. */
 #define HOLD_MAX_SETTLE_PERIODS 1.0e6f
 
+/* The most a vector can be clear of both phase axes: 1/sqrt(2), on a diagonal. */
+#define HOLD_MAX_CLEAR_SIN 0.70710678f
+
 /* A time in periods as a count: NaN and anything outside [0, max) count as the longest. A model
  * with k_M, J and k_w positive gives neither; the test keeps the conversion defined whatever the
  * model. NaN is tested apart as well, for Frama-C EVA, which does not take it out through an
@@ -149,6 +152,8 @@ void pmstep_standstill_start(pmstep_t *inst)
     standstill->rest_periods = 0u;
     standstill->keep_cos = 1.0f;
     standstill->keep_sin = 0.0f;
+    standstill->motion_rad = 0.0f;
+    standstill->motion_leak = 0.0f;
     inst->hold.standstill_armed = current_A > 0.0f;
     standstill->quiet_band_rad_s = 0.0f;
     standstill->engage_periods = 0u;
@@ -161,8 +166,25 @@ void pmstep_standstill_start(pmstep_t *inst)
     }
 }
 
+/* (c, s) moved to the nearest direction whose smaller component is at least min_sin (at most
+ * 1/sqrt(2)): a vector with both phase currents clear of zero. */
+static void aim_clear_of_phase_axes(float *c, float *s, float min_sin)
+{
+    const float larger = sqrtf(1.0f - min_sin * min_sin);
+    if (pmstep_abs(*s) < min_sin) {
+        *s = *s < 0.0f ? -min_sin : min_sin;
+        *c = *c < 0.0f ? -larger : larger;
+    } else if (pmstep_abs(*c) < min_sin) {
+        *c = *c < 0.0f ? -min_sin : min_sin;
+        *s = *s < 0.0f ? -larger : larger;
+    } else {
+        /* clear already */
+    }
+}
+
 /* Not yet holding: the hold once the zero command is reached and the rotor has been at rest for
- * engage_periods, aimed at the estimate (normalised) ahead by T_L-hat's load angle. */
+ * engage_periods, aimed at the estimate (normalised, then clear of the phase axes) ahead by
+ * T_L-hat's load angle. */
 static void standstill_engage(pmstep_t *inst, pmstep_standstill_t *standstill, const pmstep_output_t *out)
 {
     const pmstep_ref_t *ref = &inst->speed_ref;
@@ -177,15 +199,48 @@ static void standstill_engage(pmstep_t *inst, pmstep_standstill_t *standstill, c
     }
     standstill->rest_periods++;
     if (standstill->rest_periods >= standstill->engage_periods) {
+        const float current_A = inst->cfg->standstill.hold_current_A;
         const float length = sqrtf(out->cos_hat * out->cos_hat + out->sin_hat * out->sin_hat);
+        const float clear_sin = PMSTEP_HOLD_PHASE_CLEARANCE_BANDS * inst->cfg->inverter.dead_time_current_band_A / current_A;
+        float c = 0.0f;
+        float s = 0.0f;
         standstill->rest_periods = 0u;
         inst->hold.standstill_settled = false;
+        if (length > 0.0f) {
+            c = out->cos_hat / length;
+            s = out->sin_hat / length;
+            aim_clear_of_phase_axes(&c, &s, clear_sin < HOLD_MAX_CLEAR_SIN ? clear_sin : HOLD_MAX_CLEAR_SIN);
+        }
         /* refused (a load beyond the vector's pull, an estimate at the origin): the law holds on */
         inst->hold.standstill_engaged = length > 0.0f
-                              && pmstep_hold_vector(inst, out->cos_hat / length, out->sin_hat / length,
-                                                    inst->cfg->standstill.hold_current_A, inst->observer.load_hat_Nm)
-                                     == PMSTEP_OK;
+                                        && pmstep_hold_vector(inst, c, s, current_A, inst->observer.load_hat_Nm)
+                                               == PMSTEP_OK;
+        {
+            const uint32_t leak_periods = inst->hold.settle_periods + 1u; /* a settling time, at least a period */
+            standstill->motion_leak = 1.0f / (float)leak_periods;
+        }
     }
+}
+
+/* The held rotor moved (a load step): the kept estimate turned by the summed motion ((cos t,
+ * sin t) to second order), T_L-hat the held rotor's balance there (pmstep_hold_vector's relation
+ * solved for the load), and the rest started again. */
+static void follow_held_rotor(pmstep_t *inst, pmstep_standstill_t *standstill)
+{
+    const pmstep_law_coeffs_t *law = &inst->law_coeffs;
+    const pmstep_vector_hold_t *hold = &inst->hold;
+    const float turn = standstill->motion_rad;
+    pmstep_detent_t detent;
+    float c;
+    float s;
+    pmstep_turn(standstill->keep_cos, standstill->keep_sin, 1.0f - 0.5f * turn * turn, turn, &c, &s);
+    pmstep_angle_set(&inst->angle, &inst->angle_coeffs, c, s);
+    detent = pmstep_law_detent(law, c, s, 0.0f);
+    /* k_M I sin(v - x-hat) + T_detent(x-hat) */
+    inst->observer.load_hat_Nm = law->km_over_l * law->inductance_H * hold->current_A
+                                 * (hold->sin_vector * c - hold->cos_vector * s) + detent.torque_Nm;
+    standstill->rest_periods = 0u;
+    standstill->motion_rad = 0.0f;
 }
 
 void pmstep_standstill_advance(pmstep_t *inst, const pmstep_output_t *out)
@@ -208,8 +263,16 @@ void pmstep_standstill_advance(pmstep_t *inst, const pmstep_output_t *out)
         if (standstill->rest_periods <= inst->hold.settle_periods) {
             standstill->keep_cos = out->cos_hat; /* the rest's first settling time: taken */
             standstill->keep_sin = out->sin_hat;
+            standstill->motion_rad = 0.0f;
         } else {
-            pmstep_angle_set(&inst->angle, &inst->angle_coeffs, standstill->keep_cos, standstill->keep_sin);
+            /* the period's turn of the integrals off the kept estimate, summed with the leak */
+            standstill->motion_rad += standstill->keep_cos * out->sin_hat - standstill->keep_sin * out->cos_hat
+                                      - standstill->motion_leak * standstill->motion_rad;
+            if (pmstep_abs(standstill->motion_rad) > PMSTEP_HOLD_MOTION_BOUND_RAD) {
+                follow_held_rotor(inst, standstill);
+            } else {
+                pmstep_angle_set(&inst->angle, &inst->angle_coeffs, standstill->keep_cos, standstill->keep_sin);
+            }
         }
     } else {
         standstill->rest_periods = 0u; /* moving: the estimate follows the flux integrals */

@@ -240,37 +240,67 @@ static void standstill_waits_for_the_zero_command_reached(void **state)
     assert_false(f.inst.hold.active);
 }
 
-/* Settling, then the estimate taken over the rest's first settling time and put back every
- * period after it (a drift moves it no more); while the rotor moves it follows the integrals. */
-static void standstill_keeps_the_estimate_while_the_rotor_rests(void **state)
+/* The hold engaged on an estimate at (1, 0) and settled, the estimate then taken over the rest's
+ * first settling time as it turns by 0.001 rad a period; @return the settling periods. */
+static uint32_t standstill_settled_and_taken(fixture_t *f)
 {
-    fixture_t f;
     pmstep_output_t out = at_rest_output(1.0f, 0.0f);
     uint32_t settle;
     uint32_t n;
+    fixture_with_standstill(f);
+    while (!f->inst.hold.active) {
+        pmstep_standstill_advance(&f->inst, &out);
+    }
+    settle = f->inst.hold.settle_periods;
+    for (n = 0; n < settle; ++n) {
+        pmstep_standstill_advance(&f->inst, &out);
+    }
+    assert_true(f->inst.hold.standstill_settled);
+    for (n = 0; n < settle; ++n) { /* the rest's first settling time: taken, not put back */
+        out = at_rest_output(cosf(0.001f * (float)n), sinf(0.001f * (float)n));
+        pmstep_standstill_advance(&f->inst, &out);
+    }
+    assert_float_equal(f->inst.scratch.run.standstill.keep_sin, sinf(0.001f * (float)(settle - 1u)), 1e-7f);
+    return settle;
+}
+
+/* The estimate's angle now (the one the next period's integrals start from). */
+static float estimate_angle(const fixture_t *f)
+{
+    float c;
+    float s;
+    pmstep_angle_estimate(&f->inst.angle, &f->inst.angle_coeffs, f->inst.angle.i_a_prev_A, f->inst.angle.i_b_prev_A,
+                          &c, &s);
+    return atan2f(s, c);
+}
+
+/* Settling, then the estimate taken over the rest's first settling time and put back every
+ * period after it: a drift whose rate times the settling time stays below the motion bound
+ * moves it no more; while the rotor moves (w-hat) it follows the integrals. */
+static void standstill_keeps_the_estimate_while_the_rotor_rests(void **state)
+{
+    fixture_t f;
+    pmstep_output_t out;
+    uint32_t settle;
+    uint32_t n;
+    float kept_rad;
+    float drift_rad;
     float c;
     float s;
     (void)state;
-    fixture_with_standstill(&f);
-    while (!f.inst.hold.active) {
+    settle = standstill_settled_and_taken(&f);
+    kept_rad = atan2f(f.inst.scratch.run.standstill.keep_sin, f.inst.scratch.run.standstill.keep_cos);
+    /* each period the integrals turn the estimate on by the drift; over 10 settling times the sum
+     * levels at drift x (settle + 1) = 0.9 x the bound, and the estimate is put back every time */
+    drift_rad = 0.9f * PMSTEP_HOLD_MOTION_BOUND_RAD / (float)(settle + 1u);
+    for (n = 0; n < 10u * settle; ++n) {
+        out = at_rest_output(cosf(kept_rad + drift_rad), sinf(kept_rad + drift_rad));
         pmstep_standstill_advance(&f.inst, &out);
+        assert_float_equal(estimate_angle(&f), kept_rad, 1e-6f);
     }
-    settle = f.inst.hold.settle_periods;
-    for (n = 0; n < settle; ++n) {
-        pmstep_standstill_advance(&f.inst, &out);
-    }
-    assert_true(f.inst.hold.standstill_settled);
-    for (n = 0; n < settle; ++n) { /* the rest's first settling time: taken, not put back */
-        out = at_rest_output(cosf(0.001f * (float)n), sinf(0.001f * (float)n));
-        pmstep_standstill_advance(&f.inst, &out);
-    }
-    assert_float_equal(f.inst.scratch.run.standstill.keep_sin, sinf(0.001f * (float)(settle - 1u)), 1e-7f);
-    out = at_rest_output(0.8f, 0.6f); /* a drifted estimate, the rotor at rest */
-    pmstep_standstill_advance(&f.inst, &out);
-    pmstep_angle_estimate(&f.inst.angle, &f.inst.angle_coeffs, f.inst.angle.i_a_prev_A, f.inst.angle.i_b_prev_A, &c,
-                          &s);
-    assert_float_equal(c, f.inst.scratch.run.standstill.keep_cos, 1e-6f);
-    assert_float_equal(s, f.inst.scratch.run.standstill.keep_sin, 1e-6f);
+    assert_true(f.inst.scratch.run.standstill.motion_rad > 0.85f * PMSTEP_HOLD_MOTION_BOUND_RAD);
+    assert_true(f.inst.scratch.run.standstill.motion_rad < PMSTEP_HOLD_MOTION_BOUND_RAD);
+    assert_true(f.inst.scratch.run.standstill.rest_periods > 10u * settle);
     /* moving (|w-hat - w-bar| over the hold's band): the estimate is left to the integrals */
     pmstep_angle_set(&f.inst.angle, &f.inst.angle_coeffs, 0.8f, 0.6f);
     f.inst.observer.speed_hat_rad_s = 2.0f * f.inst.hold.quiet_band_rad_s; /* the observer's, after the period */
@@ -280,6 +310,75 @@ static void standstill_keeps_the_estimate_while_the_rotor_rests(void **state)
     assert_float_equal(c, 0.8f, 1e-6f);
     assert_float_equal(s, 0.6f, 1e-6f);
     assert_int_equal(f.inst.scratch.run.standstill.rest_periods, 0u);
+}
+
+/* A load step on the held rotor: the integrals turn the estimate by 0.01 rad a period, which
+ * w-hat does not see. Once the summed turn passes the bound the estimate is turned by it,
+ * T_L-hat set to the held rotor's balance there, and the rest starts again. */
+static void standstill_follows_a_held_rotor_that_moves(void **state)
+{
+    fixture_t f;
+    pmstep_output_t out;
+    float kept_rad;
+    float moved_rad = 0.0f;
+    float estimate_rad;
+    uint32_t periods = 0u;
+    (void)state;
+    (void)standstill_settled_and_taken(&f);
+    kept_rad = atan2f(f.inst.scratch.run.standstill.keep_sin, f.inst.scratch.run.standstill.keep_cos);
+    f.inst.observer.load_hat_Nm = 0.0f;
+    while (f.inst.scratch.run.standstill.rest_periods > 0u) {
+        /* the kept estimate turned on by this period's 0.01 rad */
+        out = at_rest_output(cosf(kept_rad - 0.01f), sinf(kept_rad - 0.01f));
+        moved_rad = f.inst.scratch.run.standstill.motion_rad;
+        pmstep_standstill_advance(&f.inst, &out);
+        assert_true(++periods < 10u);
+    }
+    /* 6 periods: the sum (leaking by 1/(settle + 1) a period) passes 0.05 rad at the sixth */
+    assert_int_equal(periods, 6u);
+    assert_true(-moved_rad < PMSTEP_HOLD_MOTION_BOUND_RAD);
+    estimate_rad = estimate_angle(&f);
+    assert_true(estimate_rad < kept_rad - PMSTEP_HOLD_MOTION_BOUND_RAD);
+    assert_true(estimate_rad > kept_rad - 0.06f);
+    assert_float_equal(f.inst.scratch.run.standstill.motion_rad, 0.0f, 0.0f);
+    /* T_L-hat = k_M I sin(v - x-hat): v the vector aimed at engagement, (1, 0); no detent torque */
+    assert_float_equal(f.inst.hold.cos_vector, 1.0f, 0.0f);
+    assert_float_equal(f.inst.observer.load_hat_Nm, 2.0f * 7.5f * sinf(-estimate_rad), 1e-3f);
+    /* the rest's first settling time again: the estimate taken where the integrals go */
+    out = at_rest_output(cosf(estimate_rad - 0.01f), sinf(estimate_rad - 0.01f));
+    pmstep_standstill_advance(&f.inst, &out);
+    assert_float_equal(f.inst.scratch.run.standstill.keep_cos, cosf(estimate_rad - 0.01f), 1e-6f);
+    assert_float_equal(f.inst.scratch.run.standstill.keep_sin, sinf(estimate_rad - 0.01f), 1e-6f);
+}
+
+/* With a compensation band the standstill aims its vector so that both phase currents are
+ * PMSTEP_HOLD_PHASE_CLEARANCE_BANDS bands clear of zero; without one, at the estimate. */
+static void standstill_aims_clear_of_the_phase_axes(void **state)
+{
+    static const struct {
+        float cos_hat, sin_hat, band_A, cos_vector, sin_vector;
+    } cases[] = {
+        /* 25 x 0.01 A of 7.5 A: the smaller component at least 1/30 */
+        {1.0f, 0.0f, 0.01f, 0.99944427f, 1.0f / 30.0f},
+        {-0.9999f, -0.0141418f, 0.01f, -0.99944427f, -1.0f / 30.0f},
+        {0.02f, -0.9998f, 0.01f, 1.0f / 30.0f, -0.99944427f},
+        {0.6f, 0.8f, 0.01f, 0.6f, 0.8f},    /* clear already */
+        {1.0f, 0.0f, 0.0f, 1.0f, 0.0f},     /* no band: at the estimate */
+        {1.0f, 0.0f, 1.0f, 0.70710678f, 0.70710678f}, /* a clearance beyond the diagonal: the diagonal */
+    };
+    size_t k;
+    (void)state;
+    for (k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        fixture_t f;
+        pmstep_output_t out = at_rest_output(cases[k].cos_hat, cases[k].sin_hat);
+        fixture_with_standstill(&f);
+        f.cfg.inverter.dead_time_current_band_A = cases[k].band_A;
+        while (!f.inst.hold.active) {
+            pmstep_standstill_advance(&f.inst, &out);
+        }
+        assert_float_equal(f.inst.hold.cos_vector, cases[k].cos_vector, 1e-5f);
+        assert_float_equal(f.inst.hold.sin_vector, cases[k].sin_vector, 1e-5f);
+    }
 }
 
 static void standstill_zero_command_keeps_it_other_commands_end_it(void **state)
@@ -352,6 +451,8 @@ int main(void)
         cmocka_unit_test(standstill_engages_after_the_engage_time_at_rest),
         cmocka_unit_test(standstill_waits_for_the_zero_command_reached),
         cmocka_unit_test(standstill_keeps_the_estimate_while_the_rotor_rests),
+        cmocka_unit_test(standstill_follows_a_held_rotor_that_moves),
+        cmocka_unit_test(standstill_aims_clear_of_the_phase_axes),
         cmocka_unit_test(standstill_zero_command_keeps_it_other_commands_end_it),
         cmocka_unit_test(standstill_off_without_a_current_and_validated),
     };
