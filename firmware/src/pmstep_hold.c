@@ -154,6 +154,7 @@ void pmstep_standstill_start(pmstep_t *inst)
     standstill->keep_sin = 0.0f;
     standstill->motion_rad = 0.0f;
     standstill->motion_leak = 0.0f;
+    standstill->drift_rad = 0.0f;
     inst->hold.standstill_armed = current_A > 0.0f;
     standstill->quiet_band_rad_s = 0.0f;
     standstill->engage_periods = 0u;
@@ -215,11 +216,20 @@ static void standstill_engage(pmstep_t *inst, pmstep_standstill_t *standstill, c
         inst->hold.standstill_engaged = length > 0.0f
                                         && pmstep_hold_vector(inst, c, s, current_A, inst->observer.load_hat_Nm)
                                                == PMSTEP_OK;
+        standstill->keep_cos = c; /* where the vector will hold the rotor: T_L-hat's load angle behind it */
+        standstill->keep_sin = s;
+        standstill->drift_rad = 0.0f; /* this vector's drift is learnt afresh */
         {
             const uint32_t leak_periods = inst->hold.settle_periods + 1u; /* a settling time, at least a period */
             standstill->motion_leak = 1.0f / (float)leak_periods;
         }
     }
+}
+
+/* The turn of this period's estimate off the kept one (electrical rad, small). */
+static float turn_off_kept(const pmstep_standstill_t *standstill, const pmstep_output_t *out)
+{
+    return standstill->keep_cos * out->sin_hat - standstill->keep_sin * out->cos_hat;
 }
 
 /* The held rotor moved (a load step): the kept estimate turned by the summed motion ((cos t,
@@ -256,8 +266,17 @@ void pmstep_standstill_advance(pmstep_t *inst, const pmstep_output_t *out)
     standstill->rest_periods++;
     if (!inst->hold.standstill_settled) {
         if (standstill->rest_periods >= inst->hold.settle_periods) {
+            /* Settled where the vector holds it (the aim: T_L-hat's load angle behind the vector),
+             * not where the integrals drifted to while the current stepped up (R and voltage errors
+             * times the hold current), unless they put the rotor beyond the motion bound from it (a
+             * load T_L-hat did not know). T_L-hat the balance there, w-hat the rest's (its
+             * transient from the step is behind), and no first settling time to take. */
+            const float off_aim_rad = turn_off_kept(standstill, out);
             inst->hold.standstill_settled = true;
-            standstill->rest_periods = 0u;
+            standstill->motion_rad = pmstep_abs(off_aim_rad) > PMSTEP_HOLD_MOTION_BOUND_RAD ? off_aim_rad : 0.0f;
+            follow_held_rotor(inst, standstill);
+            standstill->rest_periods = inst->hold.settle_periods + 1u;
+            inst->observer.speed_hat_rad_s = inst->hold.speed_bias_rad_s;
         }
     } else if (pmstep_abs(inst->observer.speed_hat_rad_s - inst->hold.speed_bias_rad_s) < inst->hold.quiet_band_rad_s) {
         if (standstill->rest_periods <= inst->hold.settle_periods) {
@@ -265,9 +284,12 @@ void pmstep_standstill_advance(pmstep_t *inst, const pmstep_output_t *out)
             standstill->keep_sin = out->sin_hat;
             standstill->motion_rad = 0.0f;
         } else {
-            /* the period's turn of the integrals off the kept estimate, summed with the leak */
-            standstill->motion_rad += standstill->keep_cos * out->sin_hat - standstill->keep_sin * out->cos_hat
-                                      - standstill->motion_leak * standstill->motion_rad;
+            /* the period's turn of the integrals off the kept estimate less their learnt drift, summed
+             * with the leak */
+            const float turn_rad = turn_off_kept(standstill, out);
+            standstill->drift_rad += PMSTEP_HOLD_DRIFT_LEAK_FRACTION * standstill->motion_leak
+                                     * (turn_rad - standstill->drift_rad);
+            standstill->motion_rad += turn_rad - standstill->drift_rad - standstill->motion_leak * standstill->motion_rad;
             if (pmstep_abs(standstill->motion_rad) > PMSTEP_HOLD_MOTION_BOUND_RAD) {
                 follow_held_rotor(inst, standstill);
             } else {

@@ -240,11 +240,11 @@ static void standstill_waits_for_the_zero_command_reached(void **state)
     assert_false(f.inst.hold.active);
 }
 
-/* The hold engaged on an estimate at (1, 0) and settled, the estimate then taken over the rest's
- * first settling time as it turns by 0.001 rad a period; @return the settling periods. */
-static uint32_t standstill_settled_and_taken(fixture_t *f)
+/* The hold engaged on an estimate at (1, 0) and settled with the integrals on the aim: the
+ * estimate kept there from the settling on; @return the settling periods. */
+static uint32_t standstill_settled(fixture_t *f)
 {
-    pmstep_output_t out = at_rest_output(1.0f, 0.0f);
+    const pmstep_output_t out = at_rest_output(1.0f, 0.0f);
     uint32_t settle;
     uint32_t n;
     fixture_with_standstill(f);
@@ -256,11 +256,9 @@ static uint32_t standstill_settled_and_taken(fixture_t *f)
         pmstep_standstill_advance(&f->inst, &out);
     }
     assert_true(f->inst.hold.standstill_settled);
-    for (n = 0; n < settle; ++n) { /* the rest's first settling time: taken, not put back */
-        out = at_rest_output(cosf(0.001f * (float)n), sinf(0.001f * (float)n));
-        pmstep_standstill_advance(&f->inst, &out);
-    }
-    assert_float_equal(f->inst.scratch.run.standstill.keep_sin, sinf(0.001f * (float)(settle - 1u)), 1e-7f);
+    assert_float_equal(f->inst.scratch.run.standstill.keep_cos, 1.0f, 0.0f);
+    assert_float_equal(f->inst.scratch.run.standstill.keep_sin, 0.0f, 0.0f);
+    assert_true(f->inst.scratch.run.standstill.rest_periods > settle); /* nothing to take: kept from now */
     return settle;
 }
 
@@ -274,32 +272,35 @@ static float estimate_angle(const fixture_t *f)
     return atan2f(s, c);
 }
 
-/* Settling, then the estimate taken over the rest's first settling time and put back every
- * period after it: a drift whose rate times the settling time stays below the motion bound
- * moves it no more; while the rotor moves (w-hat) it follows the integrals. */
+/* Settled, the estimate is put back every period: a drift of the integrals whose rate times the
+ * settling time is 0.9 x the motion bound is learnt before the sum reaches the bound (the sum
+ * then falls back as the learnt drift is taken off the turns); while the rotor moves (w-hat) the
+ * estimate follows the integrals. */
 static void standstill_keeps_the_estimate_while_the_rotor_rests(void **state)
 {
     fixture_t f;
     pmstep_output_t out;
     uint32_t settle;
     uint32_t n;
-    float kept_rad;
     float drift_rad;
+    float largest_sum_rad = 0.0f;
     float c;
     float s;
     (void)state;
-    settle = standstill_settled_and_taken(&f);
-    kept_rad = atan2f(f.inst.scratch.run.standstill.keep_sin, f.inst.scratch.run.standstill.keep_cos);
-    /* each period the integrals turn the estimate on by the drift; over 10 settling times the sum
-     * levels at drift x (settle + 1) = 0.9 x the bound, and the estimate is put back every time */
+    settle = standstill_settled(&f);
     drift_rad = 0.9f * PMSTEP_HOLD_MOTION_BOUND_RAD / (float)(settle + 1u);
     for (n = 0; n < 10u * settle; ++n) {
-        out = at_rest_output(cosf(kept_rad + drift_rad), sinf(kept_rad + drift_rad));
+        out = at_rest_output(cosf(drift_rad), sinf(drift_rad)); /* the kept (1, 0) turned on by the drift */
         pmstep_standstill_advance(&f.inst, &out);
-        assert_float_equal(estimate_angle(&f), kept_rad, 1e-6f);
+        assert_float_equal(estimate_angle(&f), 0.0f, 1e-6f);
+        if (f.inst.scratch.run.standstill.motion_rad > largest_sum_rad) {
+            largest_sum_rad = f.inst.scratch.run.standstill.motion_rad;
+        }
     }
-    assert_true(f.inst.scratch.run.standstill.motion_rad > 0.85f * PMSTEP_HOLD_MOTION_BOUND_RAD);
-    assert_true(f.inst.scratch.run.standstill.motion_rad < PMSTEP_HOLD_MOTION_BOUND_RAD);
+    assert_true(largest_sum_rad > 0.3f * PMSTEP_HOLD_MOTION_BOUND_RAD); /* it was seen */
+    assert_true(largest_sum_rad < PMSTEP_HOLD_MOTION_BOUND_RAD);
+    assert_true(f.inst.scratch.run.standstill.motion_rad < 0.2f * PMSTEP_HOLD_MOTION_BOUND_RAD);
+    assert_float_equal(f.inst.scratch.run.standstill.drift_rad, drift_rad, 0.1f * drift_rad);
     assert_true(f.inst.scratch.run.standstill.rest_periods > 10u * settle);
     /* moving (|w-hat - w-bar| over the hold's band): the estimate is left to the integrals */
     pmstep_angle_set(&f.inst.angle, &f.inst.angle_coeffs, 0.8f, 0.6f);
@@ -310,6 +311,43 @@ static void standstill_keeps_the_estimate_while_the_rotor_rests(void **state)
     assert_float_equal(c, 0.8f, 1e-6f);
     assert_float_equal(s, 0.6f, 1e-6f);
     assert_int_equal(f.inst.scratch.run.standstill.rest_periods, 0u);
+}
+
+/* At the settling the estimate is put where the vector holds the rotor: the aim, T_L-hat's load
+ * angle behind the vector, however far the integrals drifted while the current stepped up, as
+ * long as that is within the motion bound; beyond it the rotor went elsewhere (a load that
+ * T_L-hat did not know), and the integrals' estimate is kept. T_L-hat is the held rotor's balance
+ * at the estimate kept. */
+static void standstill_settles_on_the_aim(void **state)
+{
+    static const float drifted_rad[] = {0.04f, -0.04f, 0.08f};
+    size_t k;
+    (void)state;
+    for (k = 0; k < sizeof drifted_rad / sizeof drifted_rad[0]; ++k) {
+        fixture_t f;
+        const float aim_rad = 0.3f;
+        const float load_Nm = 3.0f; /* k_M I = 15 N m: a load angle of asin(0.2) */
+        pmstep_output_t out = at_rest_output(cosf(aim_rad), sinf(aim_rad));
+        const float kept_rad = pmstep_abs(drifted_rad[k]) > PMSTEP_HOLD_MOTION_BOUND_RAD ? aim_rad + drifted_rad[k]
+                                                                                         : aim_rad;
+        uint32_t n;
+        fixture_with_standstill(&f);
+        f.inst.observer.load_hat_Nm = load_Nm;
+        while (!f.inst.hold.active) {
+            pmstep_standstill_advance(&f.inst, &out);
+        }
+        f.inst.observer.speed_hat_rad_s = 0.3f; /* the observer's transient from the current step */
+        assert_float_equal(atan2f(f.inst.hold.sin_vector, f.inst.hold.cos_vector), aim_rad + asinf(0.2f), 1e-5f);
+        out = at_rest_output(cosf(aim_rad + drifted_rad[k]), sinf(aim_rad + drifted_rad[k]));
+        for (n = 0; n < f.inst.hold.settle_periods; ++n) {
+            assert_false(f.inst.hold.standstill_settled);
+            pmstep_standstill_advance(&f.inst, &out);
+        }
+        assert_true(f.inst.hold.standstill_settled);
+        assert_float_equal(estimate_angle(&f), kept_rad, 1e-5f);
+        assert_float_equal(f.inst.observer.speed_hat_rad_s, f.inst.hold.speed_bias_rad_s, 0.0f);
+        assert_float_equal(f.inst.observer.load_hat_Nm, 15.0f * sinf(aim_rad + asinf(0.2f) - kept_rad), 1e-3f);
+    }
 }
 
 /* A load step on the held rotor: the integrals turn the estimate by 0.01 rad a period, which
@@ -324,7 +362,7 @@ static void standstill_follows_a_held_rotor_that_moves(void **state)
     float estimate_rad;
     uint32_t periods = 0u;
     (void)state;
-    (void)standstill_settled_and_taken(&f);
+    (void)standstill_settled(&f);
     kept_rad = atan2f(f.inst.scratch.run.standstill.keep_sin, f.inst.scratch.run.standstill.keep_cos);
     f.inst.observer.load_hat_Nm = 0.0f;
     while (f.inst.scratch.run.standstill.rest_periods > 0u) {
@@ -451,6 +489,7 @@ int main(void)
         cmocka_unit_test(standstill_engages_after_the_engage_time_at_rest),
         cmocka_unit_test(standstill_waits_for_the_zero_command_reached),
         cmocka_unit_test(standstill_keeps_the_estimate_while_the_rotor_rests),
+        cmocka_unit_test(standstill_settles_on_the_aim),
         cmocka_unit_test(standstill_follows_a_held_rotor_that_moves),
         cmocka_unit_test(standstill_aims_clear_of_the_phase_axes),
         cmocka_unit_test(standstill_zero_command_keeps_it_other_commands_end_it),

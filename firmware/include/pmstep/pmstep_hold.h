@@ -64,6 +64,10 @@ extern "C" {
 /** A summed turn of the flux integrals off the kept estimate beyond this is the rotor's motion
  * (electrical rad; the envelope's angle bound). */
 #define PMSTEP_HOLD_MOTION_BOUND_RAD 0.05f
+/** The integrals' drift at rest (R and voltage errors times the hold current) is learnt at this
+ * fraction of the motion sum's leak: over four settling times, slower than a held rotor's move,
+ * which the sum is to see. */
+#define PMSTEP_HOLD_DRIFT_LEAK_FRACTION 0.25f
 /** The standstill aims its vector so that both phase currents are at least this many dead-time
  * compensation bands clear of zero (0.125 A with the designer's 5 mA band; a load step's swing
  * moves the smaller one by about 0.1 A on the 17HS4401). Measured, Monte Carlo of 200 cases per
@@ -103,6 +107,7 @@ typedef struct {
     float keep_sin;
     float motion_rad;        /**< the integrals' turn off the kept estimate, summed with the leak */
     float motion_leak;       /**< 1 / the hold's settling periods: the sum's leak per period */
+    float drift_rad;         /**< the integrals' turn per period at rest (R and voltage errors), learnt */
     uint32_t engage_periods; /**< PMSTEP_STANDSTILL_ENGAGE_TIME_CONSTANTS / k_w, in periods */
     uint32_t rest_periods;   /**< periods at rest: before the hold, to engage it; in it, since the settling */
 } pmstep_standstill_t;
