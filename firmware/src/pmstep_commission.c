@@ -1,6 +1,8 @@
 /* Remark 2 calibration and self-commissioning from the alignment phases (see pmstep_commission.h). */
 #include "pmstep/pmstep_commission.h"
 
+#include "pmstep_internal.h"
+
 #include <math.h> /* isfinite: a classification macro, no libm call */
 #include <string.h>
 
@@ -68,52 +70,79 @@ static void add_drop_sample(pmstep_flux_sums_t *drop, const pmstep_commission_pl
     }
 }
 
-COMMISSION_OUT_OF_LINE void pmstep_commission_add_alignment(pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
-                                     uint32_t sample, float i_a_A, float i_b_A, float u_a_V, float u_b_V)
+static float mean_or_zero(float sum, uint32_t count)
 {
-    if (sample >= plan->inductance_start_step && sample - plan->inductance_start_step <= plan->inductance_steps) {
-        /* Samples m0..m0+N of the rise, voltages over the N periods between them. */
-        add_flux_sample(&sums->rise, sample == plan->inductance_start_step, i_b_A, u_b_V);
-    }
-    if (sample < plan->s_align_steps) {
-        if (in_window(sample, high_window_end(plan, plan->s_align_steps), plan->window_steps)) {
-            sums->s_current_sum_A += i_b_A;
-            sums->s_voltage_sum_V += u_b_V;
-            sums->s_undriven_sum_A += i_a_A;
-            if (plan->offsets_from_alignment) {
-                sums->zero_sum_a_A += i_a_A; /* u_a = 0: i_a -> 0 */
-                sums->zero_count_a++;
-            }
-        }
-        if (plan->bias_estimation && in_window(sample, plan->s_align_steps, plan->window_steps / 2u)) {
-            sums->s_low_current_sum_A += i_b_A;
-            sums->s_low_voltage_sum_V += u_b_V;
-            sums->s_low_undriven_sum_A += i_a_A;
-        }
-        add_drop_sample(&sums->s_drop, plan, sample, plan->s_align_steps, i_b_A, u_b_V);
-        return;
-    }
-    add_flux_sample(&sums->swing, sample == plan->s_align_steps, i_a_A, u_a_V);
-    if (plan->bias_estimation && in_window(sample, plan->c_align_end_step, plan->window_steps / 2u)) {
-        sums->c_low_current_sum_A += i_a_A;
-        sums->c_low_voltage_sum_V += u_a_V;
-        sums->c_low_undriven_sum_A += i_b_A;
-    }
-    add_drop_sample(&sums->c_drop, plan, sample, plan->c_align_end_step, i_a_A, u_a_V);
-    if (in_window(sample, high_window_end(plan, plan->c_align_end_step), plan->window_steps)) {
-        sums->c_current_sum_A += i_a_A;
-        sums->c_voltage_sum_V += u_a_V;
-        sums->c_undriven_sum_A += i_b_A;
-        if (plan->offsets_from_alignment) {
-            sums->zero_sum_b_A += i_b_A; /* u_b = 0: i_b -> 0 */
-            sums->zero_count_b++;
+    return count > 0u ? sum / (float)count : 0.0f;
+}
+
+/* A sample of the steady-state window of @p window samples ending at @p end, if it is one. */
+static void add_window_sample(pmstep_window_sums_t *sums, uint32_t sample, uint32_t end, uint32_t window,
+                              float driven_A, float voltage_V, float undriven_A)
+{
+    if (in_window(sample, end, window)) {
+        sums->current_sum_A += driven_A;
+        sums->voltage_sum_V += voltage_V;
+        sums->undriven_sum_A += undriven_A;
+        if (in_window(sample, end, window / 2u)) {
+            sums->late_current_sum_A += driven_A;
         }
     }
 }
 
-static float mean_or_zero(float sum, uint32_t count)
+/* The samples of an alignment ending at @p end, phase @p driven driven: its steady-state windows,
+ * the undriven phase's offset at the full level's, the drop to the lower level. */
+static void add_alignment_sample(pmstep_alignment_sums_t *sums, const pmstep_commission_plan_t *plan,
+                                 uint32_t sample, uint32_t end, bool phase_b_driven, float driven_A,
+                                 float voltage_V, float undriven_A)
 {
-    return count > 0u ? sum / (float)count : 0.0f;
+    pmstep_window_sums_t *full = phase_b_driven ? &sums->s_full : &sums->c_full;
+    pmstep_window_sums_t *low = phase_b_driven ? &sums->s_low : &sums->c_low;
+    const uint32_t full_end = high_window_end(plan, end);
+    add_window_sample(full, sample, full_end, plan->window_steps, driven_A, voltage_V, undriven_A);
+    if (plan->offsets_from_alignment && in_window(sample, full_end, plan->window_steps)) {
+        /* The undriven phase's voltage is 0: its current -> 0. */
+        if (phase_b_driven) {
+            sums->zero_sum_a_A += undriven_A;
+            sums->zero_count_a++;
+        } else {
+            sums->zero_sum_b_A += undriven_A;
+            sums->zero_count_b++;
+        }
+    }
+    if (plan->bias_estimation) {
+        add_window_sample(low, sample, end, plan->window_steps / 2u, driven_A, voltage_V, undriven_A);
+    }
+    add_drop_sample(phase_b_driven ? &sums->s_drop : &sums->c_drop, plan, sample, end, driven_A, voltage_V);
+}
+
+COMMISSION_OUT_OF_LINE void pmstep_commission_add_alignment(pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
+                                     uint32_t sample, float i_a_A, float i_b_A, float u_a_V, float u_b_V)
+{
+    pmstep_alignment_sums_t *alignment = &sums->alignment;
+    if (sample >= plan->inductance_start_step && sample - plan->inductance_start_step <= plan->inductance_steps) {
+        /* Samples m0..m0+N of the rise, voltages over the N periods between them. */
+        add_flux_sample(&alignment->rise, sample == plan->inductance_start_step, i_b_A, u_b_V);
+    }
+    if (sample < plan->s_align_steps) {
+        add_alignment_sample(alignment, plan, sample, plan->s_align_steps, true, i_b_A, u_b_V, i_a_A);
+        return;
+    }
+    add_flux_sample(&alignment->swing, sample == plan->s_align_steps, i_a_A, u_a_V);
+    add_alignment_sample(alignment, plan, sample, plan->c_align_end_step, false, i_a_A, u_a_V, i_b_A);
+}
+
+void pmstep_commission_repeat(pmstep_commission_sums_t *sums, pmstep_commissioning_t *result)
+{
+    /* What the alignments' samples are calibrated and compensated with goes back to its value
+     * before the first run; the rest is written again at the repeat's t_c. */
+    memset(&sums->alignment, 0, sizeof sums->alignment);
+    result->offset_a_A = mean_or_zero(sums->zero_sum_a_A, sums->zero_count_a);
+    result->offset_b_A = mean_or_zero(sums->zero_sum_b_A, sums->zero_count_b);
+    result->phase_a_current_scale = 1.0f;
+    result->voltage_bias_a_V = 0.0f; /* compensated from t_c on, in every mode */
+    result->voltage_bias_b_V = 0.0f;
+    result->measured = false;
+    result->alignment_repeats++;
 }
 
 /* Measured value plausible: finite and within [1/2, 2] x the configured one. */
@@ -149,6 +178,38 @@ static float window_flux(const pmstep_flux_sums_t *flux, uint32_t periods, float
     const float charge_A_s = current_integral(flux->current_sum_A, flux->start_A, flux->end_A, periods, offset_A,
                                               period_s);
     return period_s * (flux->voltage_sum_V - (float)periods * bias_V) - resistance_Ohm * charge_A_s;
+}
+
+/* The window of @p window samples held a steady state: the means of its halves of the driven
+ * phase's current differ by at most PMSTEP_ALIGNMENT_STEADY_TOLERANCE times @p level_A, the
+ * alignment's full-level current. (The undriven phase's is not compared: a rotor still swinging
+ * a little about its rest moves it by several %, its mean and R stay right.) Non-finite sums
+ * pass: the plausibility check names them. */
+static bool steady(const pmstep_window_sums_t *sums, uint32_t window, float level_A)
+{
+    const uint32_t late = window / 2u;
+    float change_A;
+    if (late == 0u) {
+        return true; /* a window of one sample has no halves to compare */
+    }
+    change_A = (sums->current_sum_A - sums->late_current_sum_A) / (float)(window - late)
+               - sums->late_current_sum_A / (float)late;
+    return !(pmstep_abs(change_A) > PMSTEP_ALIGNMENT_STEADY_TOLERANCE * pmstep_abs(level_A));
+}
+
+/* Every steady-state window of the alignments held a steady state (see steady()). */
+static bool alignments_steady(const pmstep_alignment_sums_t *sums, const pmstep_commission_plan_t *plan,
+                              float offset_a_A, float offset_b_A)
+{
+    const uint32_t low_window = plan->window_steps / 2u;
+    const float s_level_A = sums->s_full.current_sum_A / (float)plan->window_steps - offset_b_A;
+    const float c_level_A = sums->c_full.current_sum_A / (float)plan->window_steps - offset_a_A;
+    bool all = steady(&sums->s_full, plan->window_steps, s_level_A)
+               && steady(&sums->c_full, plan->window_steps, c_level_A);
+    if (plan->bias_estimation) {
+        all = all && steady(&sums->s_low, low_window, s_level_A) && steady(&sums->c_low, low_window, c_level_A);
+    }
+    return all;
 }
 
 /* Newton steps on the rotor's rest angle under the currents (i_a, i_b), from (cos, sin) of p theta
@@ -212,8 +273,11 @@ COMMISSION_OUT_OF_LINE pmstep_fault_t pmstep_commission_finish(const pmstep_comm
                                         pmstep_commissioning_t *result)
 {
     const float period_s = cfg->timing.period_s;
-    const float offset_a = mean_or_zero(sums->zero_sum_a_A, sums->zero_count_a);
-    const float offset_b = mean_or_zero(sums->zero_sum_b_A, sums->zero_count_b);
+    const pmstep_alignment_sums_t *alignment = &sums->alignment;
+    const float offset_a = mean_or_zero(sums->zero_sum_a_A + alignment->zero_sum_a_A,
+                                        sums->zero_count_a + alignment->zero_count_a);
+    const float offset_b = mean_or_zero(sums->zero_sum_b_A + alignment->zero_sum_b_A,
+                                        sums->zero_count_b + alignment->zero_count_b);
     const bool windows = plan->window_steps > 0u;
     /* Both phases start at the configured R on purpose; each is then measured apart. */
     /* cppcheck-suppress duplicateAssignExpression ; the same start value for both phases, intended */
@@ -228,7 +292,7 @@ COMMISSION_OUT_OF_LINE pmstep_fault_t pmstep_commission_finish(const pmstep_comm
 
     result->offset_a_A = offset_a;
     result->offset_b_A = offset_b;
-    result->offset_samples = sums->zero_count_a + sums->zero_count_b;
+    result->offset_samples = sums->zero_count_a + sums->zero_count_b + alignment->zero_count_a + alignment->zero_count_b;
     result->resistance_Ohm = 0.0f;
     result->phase_a_current_scale = 1.0f;
     result->inductance_H = 0.0f;
@@ -240,27 +304,35 @@ COMMISSION_OUT_OF_LINE pmstep_fault_t pmstep_commission_finish(const pmstep_comm
     result->measured = true;
     if (windows && plan->bias_estimation) {
         /* Two steady states per phase: R and the voltage bias. */
-        r_b = two_level_resistance(sums->s_voltage_sum_V / n_full, sums->s_current_sum_A / n_full - offset_b,
-                                   sums->s_low_voltage_sum_V / n_low, sums->s_low_current_sum_A / n_low - offset_b,
-                                   &result->voltage_bias_b_V);
-        r_a = two_level_resistance(sums->c_voltage_sum_V / n_full, sums->c_current_sum_A / n_full - offset_a,
-                                   sums->c_low_voltage_sum_V / n_low, sums->c_low_current_sum_A / n_low - offset_a,
-                                   &result->voltage_bias_a_V);
+        r_b = two_level_resistance(alignment->s_full.voltage_sum_V / n_full,
+                                   alignment->s_full.current_sum_A / n_full - offset_b,
+                                   alignment->s_low.voltage_sum_V / n_low,
+                                   alignment->s_low.current_sum_A / n_low - offset_b, &result->voltage_bias_b_V);
+        r_a = two_level_resistance(alignment->c_full.voltage_sum_V / n_full,
+                                   alignment->c_full.current_sum_A / n_full - offset_a,
+                                   alignment->c_low.voltage_sum_V / n_low,
+                                   alignment->c_low.current_sum_A / n_low - offset_a, &result->voltage_bias_a_V);
     } else if (windows) {
         /* Steady states of (3) and (5): R = u/i on each phase. */
-        r_b = window_resistance(sums->s_voltage_sum_V, sums->s_current_sum_A, plan->window_steps, offset_b);
-        r_a = window_resistance(sums->c_voltage_sum_V, sums->c_current_sum_A, plan->window_steps, offset_a);
+        r_b = window_resistance(alignment->s_full.voltage_sum_V, alignment->s_full.current_sum_A, plan->window_steps,
+                                offset_b);
+        r_a = window_resistance(alignment->c_full.voltage_sum_V, alignment->c_full.current_sum_A, plan->window_steps,
+                                offset_a);
     }
     if (windows) {
         /* The phases' apparent R differ by their sensors' gains: phase b is the reference. Then
          * where the rotor rests in each alignment. */
         const float scale_a = r_a / r_b;
         const pmstep_window_currents_t s_currents = {
-            (sums->s_undriven_sum_A / n_full - offset_a) * scale_a, sums->s_current_sum_A / n_full - offset_b,
-            (sums->s_low_undriven_sum_A / n_low - offset_a) * scale_a, sums->s_low_current_sum_A / n_low - offset_b};
+            (alignment->s_full.undriven_sum_A / n_full - offset_a) * scale_a,
+            alignment->s_full.current_sum_A / n_full - offset_b,
+            (alignment->s_low.undriven_sum_A / n_low - offset_a) * scale_a,
+            alignment->s_low.current_sum_A / n_low - offset_b};
         const pmstep_window_currents_t c_currents = {
-            (sums->c_current_sum_A / n_full - offset_a) * scale_a, sums->c_undriven_sum_A / n_full - offset_b,
-            (sums->c_low_current_sum_A / n_low - offset_a) * scale_a, sums->c_low_undriven_sum_A / n_low - offset_b};
+            (alignment->c_full.current_sum_A / n_full - offset_a) * scale_a,
+            alignment->c_full.undriven_sum_A / n_full - offset_b,
+            (alignment->c_low.current_sum_A / n_low - offset_a) * scale_a,
+            alignment->c_low.undriven_sum_A / n_low - offset_b};
         result->resistance_Ohm = r_b;
         result->phase_a_current_scale = scale_a;
         s_rest = alignment_rest(&s_currents, plan->bias_estimation, &cfg->motor, 0.0f, 1.0f);
@@ -274,21 +346,21 @@ COMMISSION_OUT_OF_LINE pmstep_fault_t pmstep_commission_finish(const pmstep_comm
          * so its apparent L is divided by that). The rotor follows its equilibrium down, so each
          * drop's flux also holds k_M / p times the change of the driven phase's flux direction
          * (sin on b, cos on a): L = L_0 - (k_M / p) m, L_0 here, m's share once k_M is known. */
-        const float step_b_A = sums->s_low_current_sum_A / n_low - sums->s_current_sum_A / n_full;
-        const float step_a_A = (sums->c_low_current_sum_A / n_low - sums->c_current_sum_A / n_full)
+        const float step_b_A = alignment->s_low.current_sum_A / n_low - alignment->s_full.current_sum_A / n_full;
+        const float step_a_A = (alignment->c_low.current_sum_A / n_low - alignment->c_full.current_sum_A / n_full)
                                * result->phase_a_current_scale;
-        result->inductance_H = 0.5f * (window_flux(&sums->s_drop, plan->window_steps, offset_b, r_b,
+        result->inductance_H = 0.5f * (window_flux(&alignment->s_drop, plan->window_steps, offset_b, r_b,
                                                    result->voltage_bias_b_V, period_s) / step_b_A
-                                       + window_flux(&sums->c_drop, plan->window_steps, offset_a, r_a,
+                                       + window_flux(&alignment->c_drop, plan->window_steps, offset_a, r_a,
                                                      result->voltage_bias_a_V, period_s) / step_a_A);
         drop_turn_per_A = 0.5f * ((s_rest.sin_end - s_rest.sin_full) / step_b_A
                                   + (c_rest.cos_end - c_rest.cos_full) / step_a_A);
     }
     if (plan->inductance_steps > 0u) {
         /* L delta i = integral(u - R i) over the rise; the rotor has not moved yet. */
-        result->inductance_H = window_flux(&sums->rise, plan->inductance_steps, offset_b, r_b,
+        result->inductance_H = window_flux(&alignment->rise, plan->inductance_steps, offset_b, r_b,
                                            result->voltage_bias_b_V, period_s)
-                               / (sums->rise.end_A - sums->rise.start_A);
+                               / (alignment->rise.end_A - alignment->rise.start_A);
     }
     if (cfg->commissioning.use_measured_inductance) {
         inductance_H = result->inductance_H;
@@ -300,7 +372,7 @@ COMMISSION_OUT_OF_LINE pmstep_fault_t pmstep_commission_finish(const pmstep_comm
          * F = L delta i_a + (k_M / p) (cos(p theta_c) - cos(p theta_s)), delta i_a on phase b's
          * scale, L the one RUN takes (the drops' L_0 - (k_M / p) m: solved with k_M). */
         const float run_turn_per_A = cfg->commissioning.use_measured_inductance ? drop_turn_per_A : 0.0f;
-        pmstep_flux_sums_t swing = sums->swing;
+        pmstep_flux_sums_t swing = alignment->swing;
         float step_a_A;
         float flux_per_pole_pair;
         add_flux_sample(&swing, false, i_a_A, u_a_V); /* t_c's sample closes it */
@@ -312,6 +384,9 @@ COMMISSION_OUT_OF_LINE pmstep_fault_t pmstep_commission_finish(const pmstep_comm
         result->torque_constant_Nm_A = flux_per_pole_pair * (float)cfg->motor.pole_pairs;
         result->inductance_H -= flux_per_pole_pair * drop_turn_per_A;
         inductance_H -= flux_per_pole_pair * run_turn_per_A;
+    }
+    if (windows && !alignments_steady(alignment, plan, offset_a, offset_b)) {
+        return PMSTEP_FAULT_ALIGNMENT_MOTION;
     }
     if ((windows && !(plausible(r_a, cfg->motor.resistance_Ohm) && plausible(r_b, cfg->motor.resistance_Ohm)
                       && plausible(result->torque_constant_Nm_A, cfg->motor.torque_constant_Nm_A)))

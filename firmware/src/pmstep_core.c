@@ -340,10 +340,13 @@ static void identify_stage(pmstep_t *inst, const pmstep_output_t *out)
 }
 
 /* Commission stage: the mode of this period from the alignment timing; the alignment's samples
- * into the Remark 2 sums, or at t_c the commissioned model. */
+ * into the Remark 2 sums, or at t_c the commissioned model. A rotor that still moved in the
+ * steady-state windows has the alignments repeated from s-alignment (this period its first). */
 static pmstep_fault_t commission_stage(pmstep_t *inst, const pmstep_meas_t *meas)
 {
     const pmstep_commission_plan_t *plan = &inst->commission_plan;
+    float u_a_V;
+    float u_b_V;
     if (inst->mode_step >= plan->c_align_end_step) {
         inst->mode = PMSTEP_MODE_RUN;
     } else if (inst->mode_step >= plan->s_align_steps) {
@@ -352,17 +355,23 @@ static pmstep_fault_t commission_stage(pmstep_t *inst, const pmstep_meas_t *meas
     if (inst->commissioning.measured) {
         return PMSTEP_FAULT_NONE;
     }
-    if (inst->mode != PMSTEP_MODE_RUN) {
-        float u_a_V = inst->actuator.u_applied_a_V;
-        float u_b_V = inst->actuator.u_applied_b_V;
-        if (inst->cfg->inverter.phase_voltage_sensing) {
-            pmstep_sensed_voltages(inst, meas, &u_a_V, &u_b_V);
+    if (inst->mode == PMSTEP_MODE_RUN) {
+        const pmstep_fault_t fault = finish_commissioning(inst, meas);
+        if (fault != PMSTEP_FAULT_ALIGNMENT_MOTION || inst->commissioning.alignment_repeats >= PMSTEP_ALIGNMENT_MAX_REPEATS) {
+            return fault;
         }
-        pmstep_commission_add_alignment(&inst->scratch.sums, plan, inst->mode_step, meas->i_a_A, meas->i_b_A,
-                                        u_a_V, u_b_V);
-        return PMSTEP_FAULT_NONE;
+        pmstep_commission_repeat(&inst->scratch.sums, &inst->commissioning);
+        inst->mode = PMSTEP_MODE_S_ALIGN;
+        inst->mode_step = 0u;
     }
-    return finish_commissioning(inst, meas);
+    u_a_V = inst->actuator.u_applied_a_V;
+    u_b_V = inst->actuator.u_applied_b_V;
+    if (inst->cfg->inverter.phase_voltage_sensing) {
+        pmstep_sensed_voltages(inst, meas, &u_a_V, &u_b_V);
+    }
+    pmstep_commission_add_alignment(&inst->scratch.sums, plan, inst->mode_step, meas->i_a_A, meas->i_b_A, u_a_V,
+                                    u_b_V);
+    return PMSTEP_FAULT_NONE;
 }
 
 /* Remark 2: the sensor offsets (zero until measured) come off every sample; phase a is put on

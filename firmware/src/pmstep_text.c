@@ -85,6 +85,7 @@ const char *pmstep_fault_str(pmstep_fault_t fault)
     case PMSTEP_FAULT_COMMISSIONING: return "COMMISSIONING";
     case PMSTEP_FAULT_OBSERVER_RESIDUAL: return "OBSERVER_RESIDUAL";
     case PMSTEP_FAULT_PHASE_VOLTAGE_RANGE: return "PHASE_VOLTAGE_RANGE";
+    case PMSTEP_FAULT_ALIGNMENT_MOTION: return "ALIGNMENT_MOTION";
     }
     return "UNKNOWN";
 }

@@ -153,6 +153,7 @@ static void add_robustness_json(cJSON *root, const sil_summary_t *s)
     cJSON_AddNumberToObject(comm, "friction_Nms_rad", (double)c->friction_Nms_rad);
     cJSON_AddStringToObject(comm, "identification", pmstep_identification_str(c->identification));
     cJSON_AddNumberToObject(comm, "realignments", (double)c->realignments);
+    cJSON_AddNumberToObject(comm, "alignment_repeats", (double)c->alignment_repeats);
     cJSON_AddBoolToObject(comm, "measured", c->measured);
     cJSON_AddItemToObject(root, "commissioning", comm);
 }

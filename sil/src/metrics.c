@@ -153,7 +153,8 @@ void sil_metrics_add(sil_metrics_t *m, const sil_sample_t *x, sil_summary_t *s)
         s->sin_ptheta_at_ts = x->sin_ptheta;
         s->i_b_residual_at_ts_A = x->i_b_A - m->s_align_current_A;
     }
-    if (x->step == m->tc_step && !m->microstep) {
+    if (out->mode == PMSTEP_MODE_RUN && !m->run_reached && !m->microstep) {
+        m->run_reached = true;
         s->cos_ptheta_at_tc = x->cos_ptheta;
         s->sin_ptheta_at_tc = x->sin_ptheta;
         s->i_a_residual_at_tc_A = x->i_a_A - m->c_align_current_A;

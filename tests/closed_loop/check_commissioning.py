@@ -1,10 +1,12 @@
 """Checks a SIL run's commissioning in summary.json against the plant's motor in the scenario
 file it ran: no fault latched, the measured L within --max-inductance-error of the motor's,
-k_M within --max-torque-constant-error of the motor's, and (with --max-rest-angle-error) the
-rotor's rest at t_c that RUN starts from within that many electrical rad of the plant's p theta.
+k_M within --max-torque-constant-error of the motor's, (with --max-resistance-error) R within
+that of the motor's, (with --alignment-repeats N) the alignments repeated exactly N times, and
+(with --max-rest-angle-error) the rotor's rest at t_c that RUN starts from within that many
+electrical rad of the plant's p theta.
 
 usage: check_commissioning.py SUMMARY SCENARIO --max-inductance-error E --max-torque-constant-error E
-                              [--max-rest-angle-error RAD]"""
+                              [--max-resistance-error E] [--alignment-repeats N] [--max-rest-angle-error RAD]"""
 import argparse
 import configparser
 import json
@@ -18,6 +20,8 @@ def main():
     ap.add_argument("scenario")
     for k in ("max-inductance-error", "max-torque-constant-error"):
         ap.add_argument(f"--{k}", type=float, required=True)
+    ap.add_argument("--max-resistance-error", type=float)
+    ap.add_argument("--alignment-repeats", type=int)
     ap.add_argument("--max-rest-angle-error", type=float)
     a = ap.parse_args()
     with open(a.summary) as f:
@@ -27,11 +31,13 @@ def main():
         sys.exit(f"check_commissioning: cannot read {a.scenario}")
     motor_inductance_H = float(scenario["motor"]["inductance_H"])
     motor_torque_constant = float(scenario["motor"]["torque_constant_Nm_A"])
+    motor_resistance_Ohm = float(scenario["motor"]["resistance_Ohm"])
     c = s["commissioning"]
     l_ratio = c["inductance_H"] / motor_inductance_H
     k_error = c["torque_constant_Nm_A"] / motor_torque_constant - 1.0
     print(f"fault {s['fault']['name']}; measured L {c['inductance_H']:.6g} H ({l_ratio:.3f} x the motor's), "
-          f"k_M {c['torque_constant_Nm_A']:.6g} N m/A ({100 * k_error:+.2f} %), R {c['resistance_Ohm']:.6g} Ohm")
+          f"k_M {c['torque_constant_Nm_A']:.6g} N m/A ({100 * k_error:+.2f} %), R {c['resistance_Ohm']:.6g} Ohm, "
+          f"alignments repeated {c['alignment_repeats']:g} time(s)")
     failures = []
     if s["fault"]["name"] != "NONE":
         failures.append(f"fault {s['fault']['name']} latched")
@@ -40,6 +46,15 @@ def main():
     if not abs(k_error) <= a.max_torque_constant_error:
         failures.append(f"k_M {100 * k_error:+.2f} % off, bound {100 * a.max_torque_constant_error:.1f} %")
     checks = 3
+    if a.max_resistance_error is not None:
+        checks += 1
+        r_error = c["resistance_Ohm"] / motor_resistance_Ohm - 1.0
+        if not abs(r_error) <= a.max_resistance_error:
+            failures.append(f"R {100 * r_error:+.2f} % off, bound {100 * a.max_resistance_error:.1f} %")
+    if a.alignment_repeats is not None:
+        checks += 1
+        if c["alignment_repeats"] != a.alignment_repeats:
+            failures.append(f"alignments repeated {c['alignment_repeats']:g} time(s), expected {a.alignment_repeats}")
     if a.max_rest_angle_error is not None:
         checks += 1
         t = s["alignment"]

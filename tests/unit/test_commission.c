@@ -42,6 +42,7 @@ static pmstep_config_t two_level_config(void)
 typedef struct {
     double r_Ohm, l_H, i_a_A, i_b_A, offset_a_A, offset_b_A;
     double bias_V; /* the bridge falls short by this at positive current (a dead time) */
+    double emf_b_V; /* a rotor's back-EMF on phase b, where a test moves it */
 } rl_plant_t;
 
 static pmstep_meas_t rl_sample(const rl_plant_t *p)
@@ -60,7 +61,8 @@ static void rl_advance(rl_plant_t *p, const pmstep_output_t *out, double period_
 {
     const double decay = exp(-p->r_Ohm * period_s / p->l_H);
     const double u_a = out->bridge_enable ? (double)out->u_a_V - (p->i_a_A > 0.0 ? p->bias_V : 0.0) : 0.0;
-    const double u_b = out->bridge_enable ? (double)out->u_b_V - (p->i_b_A > 0.0 ? p->bias_V : 0.0) : 0.0;
+    const double u_b = (out->bridge_enable ? (double)out->u_b_V - (p->i_b_A > 0.0 ? p->bias_V : 0.0) : 0.0)
+                       - p->emf_b_V;
     p->i_a_A = p->i_a_A * decay + u_a / p->r_Ohm * (1.0 - decay);
     p->i_b_A = p->i_b_A * decay + u_b / p->r_Ohm * (1.0 - decay);
 }
@@ -222,6 +224,58 @@ static void two_levels_give_r_and_the_voltage_bias(void **state)
     assert_true(fabsf(result.voltage_bias_b_V - 0.3f) < 1e-3f);
 }
 
+/* A rotor still moving in a steady-state window: one that sat on s-alignment's unstable
+ * equilibrium and tips over late, passing through p theta = 0 where the driven phase b sees its
+ * whole back-EMF: 10 V for 5 ms early in s-alignment's full-level window (periods 1700..1799 of
+ * 6400), which moves that window's first half's mean of i_b by about 0.7 A, against a tolerance of
+ * 5 % of the 6.7 A driven. Moving in the
+ * first run only: the alignments are repeated once and give R and the bias as when nothing moved
+ * (then the locked rotor's k_M fails, as above). Moving in every run: ALIGNMENT_MOTION after the
+ * repeat. */
+static void moving_rotor_repeats_the_alignments(void **state)
+{
+    const uint32_t run_periods = 6400u;
+    uint32_t moving_runs;
+    (void)state;
+    for (moving_runs = 1u; moving_runs <= 2u; ++moving_runs) {
+        pmstep_config_t cfg = two_level_config();
+        rl_plant_t plant = {3.6, 0.0066, 0.0, 0.0, 0.02, -0.01, 0.3, 0.0};
+        pmstep_t inst;
+        pmstep_output_t out;
+        pmstep_commissioning_t result;
+        uint32_t k;
+        assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
+        assert_int_equal(pmstep_start(&inst), PMSTEP_OK);
+        for (k = 0u; k < 3u * run_periods; ++k) {
+            const pmstep_meas_t m = rl_sample(&plant);
+            const uint32_t in_run = k % run_periods;
+            pmstep_step(&inst, &m, &out);
+            if (out.mode == PMSTEP_MODE_RUN || out.mode == PMSTEP_MODE_FAULT) {
+                break;
+            }
+            plant.emf_b_V = (k / run_periods < moving_runs && in_run >= 1700u && in_run < 1800u) ? 10.0 : 0.0;
+            rl_advance(&plant, &out, 50e-6);
+        }
+        pmstep_get_commissioning(&inst, &result);
+        print_message("moving in %u run(s): mode %s, fault %s at period %u, repeats %u, R %.6f, bias %.6f %.6f V\n",
+                      (unsigned)moving_runs, pmstep_mode_str(out.mode), pmstep_fault_str(out.fault), (unsigned)k,
+                      (unsigned)result.alignment_repeats, (double)result.resistance_Ohm,
+                      (double)result.voltage_bias_a_V, (double)result.voltage_bias_b_V);
+        assert_int_equal(k, 2u * run_periods); /* t_c of the repeat */
+        assert_int_equal(result.alignment_repeats, 1u);
+        assert_int_equal(out.mode, PMSTEP_MODE_FAULT);
+        assert_false(out.bridge_enable);
+        if (moving_runs == 1u) {
+            assert_int_equal(out.fault, PMSTEP_FAULT_COMMISSIONING);
+            assert_true(fabsf(result.resistance_Ohm - 3.6f) < 3.6f * 1e-4f);
+            assert_true(fabsf(result.voltage_bias_a_V - 0.3f) < 1e-3f);
+            assert_true(fabsf(result.voltage_bias_b_V - 0.3f) < 1e-3f);
+        } else {
+            assert_int_equal(out.fault, PMSTEP_FAULT_ALIGNMENT_MOTION);
+        }
+    }
+}
+
 /* Without a rise window, L comes from the drops to the lower level: the same two levels as above
  * (bridge 0.3 V short, offsets), L 10 % above the configured 6 mH. Over each drop the integrand
  * u - bias - R i vanishes in both steady states, so L (i_2 - i_1) is the integral over the decay:
@@ -269,6 +323,17 @@ static double rest_by_bisection(double i_a_A, double i_b_A, double k_Nm_A, doubl
     return 0.5 * (lo + hi);
 }
 
+/* The sums of a steady state held over a window of @p window samples. */
+static void steady_window(pmstep_window_sums_t *sums, uint32_t window, double driven_A, double voltage_V,
+                          double undriven_A)
+{
+    const double late = (double)(window / 2u);
+    sums->current_sum_A = (float)(window * driven_A);
+    sums->voltage_sum_V = (float)(window * voltage_V);
+    sums->undriven_sum_A = (float)(window * undriven_A);
+    sums->late_current_sum_A = (float)(late * driven_A);
+}
+
 /* The windows' sums of a rotor resting where an undriven phase's current of 0.2 x the driven one
  * (a dead-time compensation above the bridge's) and the detent torque put it, and the swing's flux
  * (k_M / p)(cos p theta_c - cos p theta_s) between the rests at a held current: k_M and the rest
@@ -298,17 +363,13 @@ static void rest_comes_from_both_phases_currents(void **state)
         plan.s_align_steps = 1000u;
         plan.c_align_end_step = plan.s_align_steps + swing_periods;
         pmstep_commission_clear(&sums);
-        sums.s_current_sum_A = (float)(window * driven_A);
-        sums.s_voltage_sum_V = (float)(window * r_Ohm * driven_A);
-        sums.s_undriven_sum_A = (float)(window * undriven_A);
-        sums.c_current_sum_A = (float)(window * driven_A);
-        sums.c_voltage_sum_V = (float)(window * r_Ohm * driven_A);
-        sums.c_undriven_sum_A = (float)(window * undriven_A);
+        steady_window(&sums.alignment.s_full, window, driven_A, r_Ohm * driven_A, undriven_A);
+        steady_window(&sums.alignment.c_full, window, driven_A, r_Ohm * driven_A, undriven_A);
         /* Phase a held at the driven current over the swing (the last sample added by finish). */
-        sums.swing.start_A = (float)driven_A;
-        sums.swing.end_A = (float)driven_A;
-        sums.swing.current_sum_A = (float)(swing_periods * driven_A);
-        sums.swing.voltage_sum_V = (float)((swing_periods - 1u) * r_Ohm * driven_A);
+        sums.alignment.swing.start_A = (float)driven_A;
+        sums.alignment.swing.end_A = (float)driven_A;
+        sums.alignment.swing.current_sum_A = (float)(swing_periods * driven_A);
+        sums.alignment.swing.voltage_sum_V = (float)((swing_periods - 1u) * r_Ohm * driven_A);
         assert_int_equal(pmstep_commission_finish(&sums, &plan, &cfg, (float)driven_A,
                                                   (float)(r_Ohm * driven_A + flux_Wb / (double)cfg.timing.period_s),
                                                   &result),
@@ -457,6 +518,7 @@ int main(void)
         cmocka_unit_test(bridge_off_calibration_measures_the_offsets),
         cmocka_unit_test(locked_rotor_gives_r_and_l_and_fails_the_torque_constant),
         cmocka_unit_test(two_levels_give_r_and_the_voltage_bias),
+        cmocka_unit_test(moving_rotor_repeats_the_alignments),
         cmocka_unit_test(level_drops_give_l_without_a_rise_window),
         cmocka_unit_test(rest_comes_from_both_phases_currents),
         cmocka_unit_test(sensed_voltages_give_r_as_the_sensor_sees_it),

@@ -55,6 +55,16 @@
 extern "C" {
 #endif
 
+/** The driven phase's mean currents over a steady-state window's halves may differ by this
+ *  fraction of the alignment's full-level current. A rotor at rest or still swinging a little
+ *  about its rest: below 1 % (Monte Carlo of the presets); one tipping over from s-alignment's
+ *  unstable equilibrium inside the window: 38 % (17HS4401, R read 51 % high). */
+#define PMSTEP_ALIGNMENT_STEADY_TOLERANCE 0.05f
+/** Repeats of the alignments after a window that was not steady; then
+ *  PMSTEP_FAULT_ALIGNMENT_MOTION latches. The first run leaves the rotor at c-alignment's
+ *  equilibrium, a quarter turn from s-alignment's unstable one. */
+#define PMSTEP_ALIGNMENT_MAX_REPEATS 1u
+
 /** When each measurement is taken, in samples from the start of s-alignment. */
 typedef struct {
     uint32_t s_align_steps;     /**< first sample of c-alignment (t_s) */
@@ -76,24 +86,46 @@ typedef struct {
     float end_A;         /**< the last sample's current */
 } pmstep_flux_sums_t;
 
-/** Running sums (raw samples; offsets are removed at the end). */
+/** Sums over one steady-state window of an alignment (raw samples). The driven phase's means over
+ *  its two halves are compared: a steady state has the same in both (see pmstep_commission_finish()). */
 typedef struct {
-    float zero_sum_a_A, zero_sum_b_A;       /**< samples of a phase whose true current is 0 */
+    float current_sum_A;       /**< the driven phase's current */
+    float voltage_sum_V;       /**< the driven phase's voltage */
+    float undriven_sum_A;      /**< the undriven phase's current */
+    float late_current_sum_A;  /**< the driven phase's current over the window's second half */
+} pmstep_window_sums_t;
+
+/** Running sums of one run of the alignments (raw samples); a repeat of the alignments starts
+ *  them afresh. */
+typedef struct {
+    float zero_sum_a_A, zero_sum_b_A;       /**< the undriven phase at the ends of the alignments (true current 0) */
     uint32_t zero_count_a, zero_count_b;
-    float zero_voltage_sum_a_V, zero_voltage_sum_b_V; /**< sensed phase voltages with the bridge off (true 0) */
     pmstep_flux_sums_t rise;                /**< L from the current rise, phase b */
-    float s_current_sum_A, s_voltage_sum_V; /**< end of s-alignment, phase b */
-    float c_current_sum_A, c_voltage_sum_V; /**< end of c-alignment, phase a */
-    float s_low_current_sum_A, s_low_voltage_sum_V; /**< lower steady state of s-alignment (bias option) */
-    float c_low_current_sum_A, c_low_voltage_sum_V; /**< lower steady state of c-alignment */
-    float s_undriven_sum_A, s_low_undriven_sum_A; /**< the undriven phase a over s-alignment's windows */
-    float c_undriven_sum_A, c_low_undriven_sum_A; /**< the undriven phase b over c-alignment's windows */
+    pmstep_window_sums_t s_full;            /**< end of s-alignment (phase b driven) */
+    pmstep_window_sums_t c_full;            /**< end of c-alignment (phase a driven) */
+    pmstep_window_sums_t s_low;             /**< lower steady state of s-alignment (bias option) */
+    pmstep_window_sums_t c_low;             /**< lower steady state of c-alignment */
     pmstep_flux_sums_t swing;               /**< c-alignment from t_s, phase a: k_M (t_c's sample added at the end) */
     pmstep_flux_sums_t s_drop;              /**< L from s-alignment's level drop, phase b */
     pmstep_flux_sums_t c_drop;              /**< L from c-alignment's level drop, phase a */
+} pmstep_alignment_sums_t;
+
+/** Running sums (raw samples; offsets are removed at the end). */
+typedef struct {
+    float zero_sum_a_A, zero_sum_b_A;       /**< bridge off before s-alignment: true currents 0 */
+    uint32_t zero_count_a, zero_count_b;
+    float zero_voltage_sum_a_V, zero_voltage_sum_b_V; /**< sensed phase voltages with the bridge off (true 0) */
+    pmstep_alignment_sums_t alignment;      /**< the alignments' */
 } pmstep_commission_sums_t;
 
 void pmstep_commission_clear(pmstep_commission_sums_t *sums);
+
+/** A repeat of the alignments (pmstep_commission_finish() found the rotor moving): their sums
+ *  start afresh, the bridge-off ones stay; in @p result what the alignment's samples are
+ *  calibrated and compensated with (offsets, phase scale, voltage biases) goes back to its value
+ *  before the first run, measured to false, and the repeats are counted up (the other values are
+ *  the first run's until the repeat's t_c). */
+void pmstep_commission_repeat(pmstep_commission_sums_t *sums, pmstep_commissioning_t *result);
 
 /** True from the sample where an alignment ending at sample @p end runs at its lower level. */
 bool pmstep_commission_low_level(const pmstep_commission_plan_t *plan, uint32_t sample, uint32_t end);
@@ -117,8 +149,14 @@ void pmstep_commission_add_alignment(pmstep_commission_sums_t *sums, const pmste
  * the measured one with use_measured_inductance, else the configured one (a rise during which
  * the rotor turns - hybrid steppers - measures back EMF too; the designer then keeps the
  * datasheet's L, and its measurement is only reported).
- * @return PMSTEP_FAULT_NONE, or PMSTEP_FAULT_COMMISSIONING when R or k_M, or L where RUN takes
- *         it, is not finite or outside [1/2, 2] x the configured one.
+ * A steady-state window is steady when the driven phase's mean currents over its two halves
+ * agree within PMSTEP_ALIGNMENT_STEADY_TOLERANCE of the alignment's full-level current (offset
+ * off): a rotor that still moves - an alignment that started it from its unstable
+ * equilibrium, where it sits until a small torque tips it over - makes them differ through its
+ * back-EMF, and its R, rest and k_M would be wrong.
+ * @return PMSTEP_FAULT_NONE; PMSTEP_FAULT_ALIGNMENT_MOTION when a window was not steady; else
+ *         PMSTEP_FAULT_COMMISSIONING when R or k_M, or L where RUN takes it, is not finite or
+ *         outside [1/2, 2] x the configured one.
  */
 pmstep_fault_t pmstep_commission_finish(const pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
                                         const pmstep_config_t *cfg, float i_a_A, float u_a_V,

@@ -146,9 +146,11 @@ typedef enum {
     PMSTEP_FAULT_COMMISSIONING = 9,         /**< measured R, L or k_M outside [1/2, 2] x the configured value */
     PMSTEP_FAULT_OBSERVER_RESIDUAL = 10,    /**< |i_a - i_a-hat| + |i_b - i_b-hat| low-passed above its bound: the
                                                  observer's model no longer explains the currents */
-    PMSTEP_FAULT_PHASE_VOLTAGE_RANGE = 11   /**< with phase-voltage sensing: a sensed mean phase voltage beyond
+    PMSTEP_FAULT_PHASE_VOLTAGE_RANGE = 11,  /**< with phase-voltage sensing: a sensed mean phase voltage beyond
                                                  PMSTEP_PHASE_VOLTAGE_RANGE_FACTOR x the measured bus (a mean
                                                  phase voltage cannot exceed the bus: a sensor fault) */
+    PMSTEP_FAULT_ALIGNMENT_MOTION = 12      /**< the rotor still moved in an alignment's steady-state window, in the
+                                                 alignments' repeat too (pmstep_commission_finish()) */
 } pmstep_fault_t;
 
 /** A sensed mean phase voltage above this many times the measured bus latches
@@ -370,6 +372,8 @@ typedef struct {
     float friction_Nms_rad;         /**< F identified in RUN (may be < 0: see identification) */
     pmstep_identification_t identification; /**< state and outcome of the identification of J and F */
     uint32_t realignments;          /**< re-alignments after a detection since start */
+    uint32_t alignment_repeats;     /**< repeats of the alignments after one whose steady-state windows saw the
+                                         rotor move (PMSTEP_ALIGNMENT_MAX_REPEATS at most) */
     bool measured;                  /**< alignment finished and the values above were taken */
 } pmstep_commissioning_t;
 

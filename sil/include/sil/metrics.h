@@ -108,7 +108,9 @@ typedef struct {
 
 /** Running sums behind the summary. */
 typedef struct {
-    long ts_step, tc_step, transient_end_step; /**< sample indices of t_s, t_c, t_c + W */
+    long ts_step, tc_step, transient_end_step; /**< sample indices of t_s, t_c, t_c + W (as scheduled) */
+    bool run_reached;                          /**< a RUN sample was seen: the plant at t_c is recorded at the
+                                                    first (later than tc_step after a repeat of the alignments) */
     double s_align_current_A, c_align_current_A; /**< u_cs/R, u_cc/R with the plant's R */
     long settle_step;                          /**< first sample counted "after transients" */
     double loss_speed_error_rad_s, loss_angle_error_rad; /**< the scenario's loss-of-control bounds */
