@@ -57,8 +57,9 @@ extern "C" {
 
 /** The driven phase's mean currents over a steady-state window's halves may differ by this
  *  fraction of the alignment's full-level current. A rotor at rest or still swinging a little
- *  about its rest: below 1 % (Monte Carlo of the presets); one tipping over from s-alignment's
- *  unstable equilibrium inside the window: 38 % (17HS4401, R read 51 % high). */
+ *  about its rest: within 1 % in the runs traced; in 1600 Monte Carlo runs (4 presets, 2 chains)
+ *  only the 5 that started within 31 deg of s-alignment's unstable equilibrium went beyond 5 %;
+ *  one tipping over inside the window: 38 % (17HS4401, R read 51 % high). */
 #define PMSTEP_ALIGNMENT_STEADY_TOLERANCE 0.05f
 /** Repeats of the alignments after a window that was not steady; then
  *  PMSTEP_FAULT_ALIGNMENT_MOTION latches. The first run leaves the rotor at c-alignment's
