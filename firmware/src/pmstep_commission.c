@@ -131,13 +131,20 @@ COMMISSION_OUT_OF_LINE void pmstep_commission_add_alignment(pmstep_commission_su
     add_alignment_sample(alignment, plan, sample, plan->c_align_end_step, false, i_a_A, u_a_V, i_b_A);
 }
 
+void pmstep_commission_take_bridge_off(const pmstep_commission_sums_t *sums, pmstep_commissioning_t *result)
+{
+    result->offset_a_A = mean_or_zero(sums->zero_sum_a_A, sums->zero_count_a);
+    result->offset_b_A = mean_or_zero(sums->zero_sum_b_A, sums->zero_count_b);
+    result->phase_voltage_offset_a_V = mean_or_zero(sums->zero_voltage_sum_a_V, sums->zero_count_a);
+    result->phase_voltage_offset_b_V = mean_or_zero(sums->zero_voltage_sum_b_V, sums->zero_count_b);
+}
+
 void pmstep_commission_repeat(pmstep_commission_sums_t *sums, pmstep_commissioning_t *result)
 {
     /* What the alignments' samples are calibrated and compensated with goes back to its value
      * before the first run; the rest is written again at the repeat's t_c. */
     memset(&sums->alignment, 0, sizeof sums->alignment);
-    result->offset_a_A = mean_or_zero(sums->zero_sum_a_A, sums->zero_count_a);
-    result->offset_b_A = mean_or_zero(sums->zero_sum_b_A, sums->zero_count_b);
+    pmstep_commission_take_bridge_off(sums, result);
     result->phase_a_current_scale = 1.0f;
     result->voltage_bias_a_V = 0.0f; /* compensated from t_c on, in every mode */
     result->voltage_bias_b_V = 0.0f;

@@ -268,14 +268,8 @@ static void offset_calibration_stage(pmstep_t *inst, const pmstep_meas_t *meas, 
                                      sensing ? meas->phase_voltage_a_V : 0.0f,
                                      sensing ? meas->phase_voltage_b_V : 0.0f);
     if (++inst->mode_step >= inst->offset_cal_steps) {
-        /* Provisional offsets for the alignment (the dead-time compensation needs the sign of
-         * small currents); t_c refines them with the alignment steady states. The phase-voltage
-         * offsets are final (the sums hold 0 without sensing). */
-        const pmstep_commission_sums_t *sums = &inst->scratch.sums;
-        inst->commissioning.offset_a_A = sums->zero_sum_a_A / (float)sums->zero_count_a;
-        inst->commissioning.offset_b_A = sums->zero_sum_b_A / (float)sums->zero_count_b;
-        inst->commissioning.phase_voltage_offset_a_V = sums->zero_voltage_sum_a_V / (float)sums->zero_count_a;
-        inst->commissioning.phase_voltage_offset_b_V = sums->zero_voltage_sum_b_V / (float)sums->zero_count_b;
+        /* Offsets for the alignment: the dead-time compensation needs the sign of small currents. */
+        pmstep_commission_take_bridge_off(&inst->scratch.sums, &inst->commissioning);
         inst->mode = PMSTEP_MODE_S_ALIGN;
         inst->mode_step = 0u;
     }

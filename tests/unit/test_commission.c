@@ -1,5 +1,6 @@
-/* Remark 2 calibration, self-commissioning, dead-time compensation and detection on
- * the real core, fed by a locked-rotor RL model of both phases (the only fake). */
+/* Remark 2 calibration, self-commissioning and the alignments' dead-time compensation on the
+ * real core, fed by a locked-rotor RL model of both phases (the only fake). Detection in RUN:
+ * test_detect.c. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -452,65 +453,6 @@ static void dead_time_is_compensated_on_the_driven_phase(void **state)
     assert_true(fabsf(inst.actuator.u_applied_b_V - 24.0f) < 1e-5f);
 }
 
-/* Holds the c-aligned state (i_a = 8 A, rotor still) into RUN. */
-static void hold_to_run(pmstep_t *inst, pmstep_output_t *out)
-{
-    const pmstep_meas_t m = {8.0f, 0.0f, 48.0f, 0.0f, 0.0f, 0.0f};
-    uint32_t k;
-    assert_int_equal(pmstep_start(inst), PMSTEP_OK);
-    for (k = 0; k <= inst->commission_plan.c_align_end_step; ++k) {
-        pmstep_step(inst, &m, out);
-    }
-    assert_int_equal(out->mode, PMSTEP_MODE_RUN);
-}
-
-static void lost_angle_faults_or_realigns_after_the_detection_time(void **state)
-{
-    pmstep_config_t cfg = pmstep_paper_config();
-    const pmstep_meas_t m = {8.0f, 0.0f, 48.0f, 0.0f, 0.0f, 0.0f};
-    pmstep_t inst;
-    pmstep_output_t out;
-    uint32_t k;
-    uint32_t jump_step;
-    (void)state;
-    cfg.alignment.s_align_time_s = 0.02f;
-    cfg.alignment.c_align_time_s = 0.04f;
-    cfg.detection.speed_consistency_bound_rad_s = 0.0f; /* only the magnitude check in this test */
-    cfg.detection.stall_speed_error_rad_s = 0.0f;
-    for (cfg.detection.max_realignments = 0u; cfg.detection.max_realignments <= 1u; ++cfg.detection.max_realignments) {
-        assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
-        hold_to_run(&inst, &out);
-        /* Hold c-hat at 1.5 (|c^2 + s^2 - 1| = 1.25): with i_a = i_a(t_c), c-hat = 1 + (L p/k_M) phi1. */
-        jump_step = inst.step_count;
-        for (k = 0; k < 1000u && out.mode == PMSTEP_MODE_RUN; ++k) {
-            inst.angle.phi_a = 0.5f / inst.angle_coeffs.flux_to_angle;
-            inst.angle.phi_a_compensation = 0.0f;
-            inst.angle.phi_b = 0.0f;
-            inst.angle.phi_b_compensation = 0.0f;
-            pmstep_step(&inst, &m, &out);
-        }
-        print_message("max_realignments %u: mode %s after %u periods\n", (unsigned)cfg.detection.max_realignments,
-                      pmstep_mode_str(out.mode), (unsigned)k);
-        /* detected after 20 ms of the condition: 100 checks, one every PMSTEP_DETECTION_DECIMATION periods */
-        assert_true(inst.step_count - jump_step >= 397u && inst.step_count - jump_step <= 400u);
-        assert_false(out.bridge_enable);
-        if (cfg.detection.max_realignments == 0u) {
-            assert_int_equal(out.mode, PMSTEP_MODE_FAULT);
-            assert_int_equal(out.fault, PMSTEP_FAULT_ANGLE_MAGNITUDE);
-            assert_string_equal(pmstep_fault_str(out.fault), "ANGLE_MAGNITUDE");
-        } else {
-            pmstep_commissioning_t result;
-            assert_int_equal(out.mode, PMSTEP_MODE_S_ALIGN);
-            assert_int_equal(out.fault, PMSTEP_FAULT_NONE);
-            pmstep_get_commissioning(&inst, &result);
-            assert_int_equal(result.realignments, 1u);
-            pmstep_step(&inst, &m, &out); /* the alignment drives again */
-            assert_true(out.bridge_enable);
-            assert_true(out.u_b_V == cfg.alignment.s_align_voltage_V);
-        }
-    }
-}
-
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -523,7 +465,6 @@ int main(void)
         cmocka_unit_test(rest_comes_from_both_phases_currents),
         cmocka_unit_test(sensed_voltages_give_r_as_the_sensor_sees_it),
         cmocka_unit_test(dead_time_is_compensated_on_the_driven_phase),
-        cmocka_unit_test(lost_angle_faults_or_realigns_after_the_detection_time),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

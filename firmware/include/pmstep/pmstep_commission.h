@@ -121,6 +121,11 @@ typedef struct {
 
 void pmstep_commission_clear(pmstep_commission_sums_t *sums);
 
+/** The bridge-off samples' means into @p result: the current offsets (provisional for the
+ *  alignments, refined at t_c with the alignment offsets) and the phase-voltage offsets (final;
+ *  0 without sensing). Offsets 0 where no sample was taken. */
+void pmstep_commission_take_bridge_off(const pmstep_commission_sums_t *sums, pmstep_commissioning_t *result);
+
 /** A repeat of the alignments (pmstep_commission_finish() found the rotor moving): their sums
  *  start afresh, the bridge-off ones stay; in @p result what the alignment's samples are
  *  calibrated and compensated with (offsets, phase scale, voltage biases) goes back to its value
