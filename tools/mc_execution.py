@@ -255,7 +255,8 @@ def make_record(args, result, params, base, command):
         "latency_s": outcome["latency_s"],
         "reason": outcome["reason"],
         "fault_name": fault_name(summary) if isinstance(summary, dict) and outcome["class"] != "crashed" else "",
-        "metrics": extract_metrics(summary, params, base) if outcome["class"] != "crashed" else {},
+        "metrics": (dict(extract_metrics(summary, params, base), failure_time_s=outcome["failure_time_s"])
+                    if outcome["class"] != "crashed" else {}),
         "stderr_tail": result["stderr_tail"] if outcome["class"] == "crashed" else "",
         "summary": summary,
         "host": result.get("host", ""),

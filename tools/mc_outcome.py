@@ -82,8 +82,9 @@ def classify(summary, exit_status, speed_bound_rad_s=0.5, angle_bound_rad=0.05, 
     position_bound_rad: a position scenario's success also needs every move issued, finished and
     ending within this many electrical rad of its target (summary.json "position").
     """
-    def result(cls, reason, false_trip=False, latency_s=None):
-        return {"class": cls, "false_trip": false_trip, "latency_s": latency_s, "reason": reason}
+    def result(cls, reason, false_trip=False, latency_s=None, failure_time_s=None):
+        return {"class": cls, "false_trip": false_trip, "latency_s": latency_s, "reason": reason,
+                "failure_time_s": failure_time_s}
 
     if problem:
         return result("crashed", problem)
@@ -112,33 +113,40 @@ def classify(summary, exit_status, speed_bound_rad_s=0.5, angle_bound_rad=0.05, 
 
     if fault_code != 0:
         if not lost:
-            return result("detected", f"false trip: {fault_name(summary)} without loss of control", false_trip=True)
+            return result("detected", f"false trip: {fault_name(summary)} without loss of control", false_trip=True,
+                          failure_time_s=summary["fault"]["time_s"])
         latency_s = number_or_none(rob.get("detection_latency_s"))
         if latency_s is None:
             latency_s = summary["fault"]["time_s"] - loss_time_s
         if latency_s > latency_bound_s:
             return result("silent", f"loss of control at {loss_time_s:.6g} s, {fault_name(summary)} "
-                                    f"only {latency_s:.3g} s later (> {latency_bound_s:g} s)", latency_s=latency_s)
+                                    f"only {latency_s:.3g} s later (> {latency_bound_s:g} s)", latency_s=latency_s,
+                          failure_time_s=loss_time_s)
         return result("detected", f"loss of control at {loss_time_s:.6g} s caught by {fault_name(summary)} "
-                                  f"after {latency_s:.3g} s", latency_s=latency_s)
+                                  f"after {latency_s:.3g} s", latency_s=latency_s, failure_time_s=loss_time_s)
     if lost:
         realignments = number_or_none((summary.get("commissioning") or {}).get("realignments"))
         note = f" ({realignments:g} re-alignment(s))" if realignments else ""
-        return result("silent", f"loss of control at {loss_time_s:.6g} s, no fault latched{note}")
+        return result("silent", f"loss of control at {loss_time_s:.6g} s, no fault latched{note}",
+                      failure_time_s=loss_time_s)
 
     speed_error = number_or_none(rob["max_speed_error_rad_s"])
     angle_error = number_or_none(rob["max_angle_error_rad"])
     exceeded = []
+    failure_time_s = None  # where the exceeded maximum was (the angle's first; the SIL's older summaries have none)
     if rob["nonfinite_seen"]:
         exceeded.append("non-finite value seen")
     if speed_error is None or speed_error >= speed_bound_rad_s:
         exceeded.append(f"max speed error {rob['max_speed_error_rad_s']} rad/s >= {speed_bound_rad_s:g}")
+        failure_time_s = number_or_none(rob.get("max_speed_error_time_s"))
     if angle_error is None or angle_error >= angle_bound_rad:
         exceeded.append(f"max angle error {rob['max_angle_error_rad']} rad >= {angle_bound_rad:g}")
+        failure_time_s = number_or_none(rob.get("max_angle_error_time_s"))
     if position_bound_rad is not None:
         exceeded += position_exceeded(summary.get("position"), position_bound_rad)
     if exceeded:
-        return result("out_of_spec", "; ".join(exceeded))
+        return result("out_of_spec", "; ".join(exceeded),
+                      failure_time_s=failure_time_s if failure_time_s is None or failure_time_s >= 0.0 else None)
     return result("success", "")
 
 

@@ -240,6 +240,16 @@ def write_report(path, records, agg, args, scenario, version, plots, started_utc
     else:
         lines += ["No fault latched in any case.", ""]
 
+    by_segment = agg.get("failures_by_segment") or []
+    if by_segment:
+        classes = list(by_segment[0][1])
+        lines += ["Failures by the speed profile's segment at their failure time (the loss of control; a false "
+                  "trip's fault; out of spec: the largest angle error's sample, or the speed error's where only "
+                  "that bound was exceeded):", "",
+                  "| segment | " + " | ".join(classes) + " |", "|---|" + "---|" * len(classes)]
+        lines += ["| " + segment + " | " + " | ".join(str(row[cls]) for cls in classes) + " |"
+                  for segment, row in by_segment]
+        lines.append("")
     lines += ["## Distributions", "",
               "Over the cases that produced the value: the errors after settling over the cases not stopped by "
               "a fault before settling, the commissioning errors where the core measured, a position "
@@ -317,10 +327,11 @@ POSITION_TITLES = ("largest final error of a move (electrical rad)",
                    "largest hold error (electrical rad)",
                    "\\|hold drift\\| (electrical rad/s)")
 
-CSV_METRICS = ("max_speed_error_rad_s", "max_angle_error_rad", "settle_time_s", "loss_of_control_time_s",
-               "detection_latency_s", "fault_time_s", "nonfinite_seen", "tracking_max_abs_error_rad_s",
-               "commissioning_measured", "r_rel_error", "l_rel_error", "k_rel_error", "offset_a_error_A",
-               "offset_b_error_A", "rest_angle_error_rad", "realignments", "final_mode", "past_settle", "wall_s") + POSITION_METRICS
+CSV_METRICS = ("max_speed_error_rad_s", "max_angle_error_rad", "failure_time_s", "failure_segment", "settle_time_s",
+               "loss_of_control_time_s", "detection_latency_s", "fault_time_s", "nonfinite_seen",
+               "tracking_max_abs_error_rad_s", "commissioning_measured", "r_rel_error", "l_rel_error", "k_rel_error",
+               "offset_a_error_A", "offset_b_error_A", "rest_angle_error_rad", "realignments", "final_mode",
+               "past_settle", "wall_s") + POSITION_METRICS
 
 
 def write_cases_csv(path, records):

@@ -95,6 +95,10 @@ from mc_execution import (ENGINES, check_keys, read_scenario, rerun_command, run
 from mc_outcome import (CLASSES, CLASS_TEXT, FAULT_EXIT_STATUS, REQUIRED_FIELDS, classify,  # noqa: E402,F401
                         extract_metrics, fault_name, get_path, number_or_none, summary_problem)
 from mc_preset import design_scenario, preset_distributions, read_preset  # noqa: E402
+from mc_segments import (failures_by_segment, label_failures, profile_segments, segment_of,  # noqa: E402,F401
+                         speed_points)
+
+FAILURE_CLASSES = ("detected", "silent", "out_of_spec")  # the classes the segment table counts
 from mc_report import (CSV_METRICS, WORST_CASES, aggregate, check_verdict, make_plots,  # noqa: E402,F401
                        percentile, spans_decades, wilson_interval, worst_order, write_cases_csv,
                        write_report)
@@ -289,7 +293,9 @@ def main(argv):
         values = [r["metrics"].get(name) for r in records if r["metrics"].get(name) is not None]
         return sum(values) / len(values) if values else None
 
+    segments = label_failures(records, scenario)
     agg = aggregate(records, args)
+    agg["failures_by_segment"] = failures_by_segment(records, FAILURE_CLASSES, segments)
     agg.update({"scenario": args.scenario, "command": shlex.join(args.argv), "date": started_utc,
                 "pmstep_sil_version": version, "duration_s": args.duration,
                 "execution": {"engine": engine, "workers": workers, "cases_run": len(records) - resumed,

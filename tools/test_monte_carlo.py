@@ -148,6 +148,22 @@ class Classification(unittest.TestCase):
         late = dict(good, unfinished_moves=1)
         self.assertEqual(self.cls(dict(base, position=late), position_bound_rad=0.5)["class"], "out_of_spec")
 
+    def test_failure_time(self):
+        """Where the failure is: the loss of control, a false trip's fault, the exceeded maximum's sample
+        (the angle's where both bounds are exceeded), none for a success or an older summary."""
+        def timed(**kw):
+            s = summary(**kw)
+            s["robustness"].update(max_speed_error_time_s=1.5, max_angle_error_time_s=1.9)
+            return s
+        self.assertIsNone(self.cls(timed())["failure_time_s"])
+        self.assertEqual(self.cls(timed(speed=0.6))["failure_time_s"], 1.5)
+        self.assertEqual(self.cls(timed(angle=0.06))["failure_time_s"], 1.9)
+        self.assertEqual(self.cls(timed(speed=0.6, angle=0.06))["failure_time_s"], 1.9)
+        self.assertIsNone(self.cls(summary(angle=0.06))["failure_time_s"])            # no time in the summary
+        self.assertEqual(self.cls(timed(loss_s=1.2))["failure_time_s"], 1.2)           # silent
+        self.assertEqual(self.cls(timed(fault_code=6, fault_time_s=1.25, loss_s=1.2))["failure_time_s"], 1.2)
+        self.assertEqual(self.cls(timed(fault_code=6, fault_time_s=0.9))["failure_time_s"], 0.9)  # false trip
+
     def test_detected_loss_with_latency(self):
         r = self.cls(summary(fault_code=2, fault_time_s=1.23, loss_s=1.2, latency_s=0.03))
         self.assertEqual(r["class"], "detected")
@@ -288,6 +304,37 @@ class Statistics(unittest.TestCase):
                  case(4, "crashed", None), case(5, "out_of_spec", 3.0)]
         self.assertEqual([c["seed"] for c in mc.worst_order(cases)], [4, 5, 2, 3, 1])
 
+
+
+class FailureSegments(unittest.TestCase):
+    SCENARIO = {"speed.points": "0:0, 0.33:0, 0.38:55.2,\n0.68:55.2, 0.73:-55.2, 1.0:0, 1.3:0",
+                "position.points": "0:0"}
+
+    def test_segments_of_the_profile(self):
+        segments = mc.profile_segments(mc.speed_points(self.SCENARIO))
+        self.assertEqual([label for _, _, label in segments],
+                         ["standstill, 0.000-0.330 s", "ramp 0 -> 55.2 rad/s, 0.330-0.380 s",
+                          "at 55.2 rad/s, 0.380-0.680 s", "ramp 55.2 -> -55.2 rad/s, 0.680-0.730 s",
+                          "ramp -55.2 -> 0 rad/s, 0.730-1.000 s", "standstill, 1.000-1.300 s"])
+        self.assertEqual(mc.segment_of(0.2, 0.23, segments), "commissioning")
+        self.assertEqual(mc.segment_of(0.3, 0.23, segments), "standstill, 0.000-0.330 s")
+        self.assertEqual(mc.segment_of(0.38, 0.23, segments), "at 55.2 rad/s, 0.380-0.680 s")  # a start belongs to it
+        self.assertEqual(mc.segment_of(1.3, 0.23, segments), "after the profile")
+        self.assertIsNone(mc.segment_of(None, 0.23, segments))
+        self.assertEqual(mc.speed_points(dict(self.SCENARIO, **{"position.points": "0.5:3"})), [])
+
+    def test_table_in_profile_order(self):
+        def record(cls, time_s, run_start=0.23):
+            return {"class": cls, "metrics": {"failure_time_s": time_s},
+                    "summary": {"robustness": {"run_start_time_s": run_start}}}
+        records = [record("out_of_spec", 1.1), record("silent", 0.5), record("detected", 0.1),
+                   record("out_of_spec", 1.2), record("success", None), {"class": "crashed", "metrics": {}}]
+        segments = mc.label_failures(records, self.SCENARIO)
+        self.assertIsNone(records[4]["metrics"]["failure_segment"])
+        table = mc.failures_by_segment(records, ("detected", "silent", "out_of_spec"), segments)
+        self.assertEqual(table, [["commissioning", {"detected": 1, "silent": 0, "out_of_spec": 0}],
+                                 ["at 55.2 rad/s, 0.380-0.680 s", {"detected": 0, "silent": 1, "out_of_spec": 0}],
+                                 ["standstill, 1.000-1.300 s", {"detected": 0, "silent": 0, "out_of_spec": 2}]])
 
 if __name__ == "__main__":
     unittest.main()

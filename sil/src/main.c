@@ -129,8 +129,10 @@ static void add_robustness_json(cJSON *root, const sil_summary_t *s)
     cJSON_AddNumberToObject(robust, "run_start_time_s", s->run_start_time_s);
     cJSON_AddNumberToObject(robust, "settle_time_s", s->settle_time_s);
     cJSON_AddNumberToObject(robust, "max_angle_error_rad", s->max_angle_error_rad);
+    cJSON_AddNumberToObject(robust, "max_angle_error_time_s", s->max_angle_error_time_s);
     cJSON_AddNumberToObject(robust, "final_angle_error_rad", s->final_angle_error_rad);
     cJSON_AddNumberToObject(robust, "max_speed_error_rad_s", s->max_speed_error_after_settle_rad_s);
+    cJSON_AddNumberToObject(robust, "max_speed_error_time_s", s->max_speed_error_time_s);
     cJSON_AddNumberToObject(robust, "loss_of_control_time_s", s->loss_of_control_time_s);
     if (isnan(s->detection_latency_s)) {
         cJSON_AddNullToObject(robust, "detection_latency_s");

@@ -53,6 +53,8 @@ void sil_metrics_init(sil_metrics_t *m, const sil_scenario_t *sc, sil_summary_t 
     s->run_start_time_s = (double)m->tc_step * period_s;
     s->settle_time_s = (double)m->settle_step * period_s;
     s->loss_of_control_time_s = -1.0;
+    s->max_angle_error_time_s = -1.0;
+    s->max_speed_error_time_s = -1.0;
     s->detection_latency_s = NAN;
     m->s_align_current_A = (double)sc->controller.alignment.s_align_voltage_V / sc->motor.resistance_Ohm;
     m->c_align_current_A = (double)sc->controller.alignment.c_align_voltage_V / sc->motor.resistance_Ohm;
@@ -132,6 +134,15 @@ static bool off_course(const sil_metrics_t *m, const sil_sample_t *x, double spe
     return speed_error > m->loss_speed_error_rad_s;
 }
 
+/* The largest |omega - omega*| after settling and the time of its first sample. */
+static void note_speed_error_after_settle(sil_summary_t *s, double speed_error, double t_s)
+{
+    if (speed_error > s->max_speed_error_after_settle_rad_s) {
+        s->max_speed_error_after_settle_rad_s = speed_error;
+        s->max_speed_error_time_s = t_s;
+    }
+}
+
 void sil_metrics_add(sil_metrics_t *m, const sil_sample_t *x, sil_summary_t *s)
 {
     const pmstep_output_t *out = x->out;
@@ -179,7 +190,7 @@ void sil_metrics_add(sil_metrics_t *m, const sil_sample_t *x, sil_summary_t *s)
         s->final_load_Nm = x->load_Nm;
         if (m->microstep) {
             if (x->step >= m->settle_step) {
-                s->max_speed_error_after_settle_rad_s = max_of(s->max_speed_error_after_settle_rad_s, speed_error);
+                note_speed_error_after_settle(s, speed_error, x->t_s);
             }
         } else {
             /* The angle estimate (c-hat, s-hat) against the plant's p theta. */
@@ -194,10 +205,11 @@ void sil_metrics_add(sil_metrics_t *m, const sil_sample_t *x, sil_summary_t *s)
                 if (ey * m->max_angle_cos - ex * m->max_angle_sin > 0.0) { /* above the max so far */
                     const double r = hypot(ex, ey);
                     s->max_angle_error_rad = atan2(ey, ex);
+                    s->max_angle_error_time_s = x->t_s;
                     m->max_angle_cos = ex / r;
                     m->max_angle_sin = ey / r;
                 }
-                s->max_speed_error_after_settle_rad_s = max_of(s->max_speed_error_after_settle_rad_s, speed_error);
+                note_speed_error_after_settle(s, speed_error, x->t_s);
             }
             angle_lost = m->loss_angle_reachable && ey * m->loss_angle_cos - ex * m->loss_angle_sin > 0.0;
             if (s->loss_of_control_time_s < 0.0 && (off_course(m, x, speed_error) || angle_lost)) {

@@ -122,12 +122,78 @@ static void every_initial_angle_aligns_and_tracks(void **state)
     }
 }
 
+/* Every RUN sample's errors, for the summary's largest errors and their times (sil/metrics.h). */
+#define MAX_SAMPLES 60000
+typedef struct {
+    int n;
+    double t_s[MAX_SAMPLES];
+    double angle_error_rad[MAX_SAMPLES]; /* |wrapped angle(c-hat, s-hat) - p theta| */
+    double speed_error_rad_s[MAX_SAMPLES];
+} run_errors_t;
+
+static bool record_errors(const sil_sample_t *x, void *user)
+{
+    run_errors_t *r = (run_errors_t *)user;
+    const pmstep_output_t *o = x->out;
+    if (o->mode == PMSTEP_MODE_RUN && r->n < MAX_SAMPLES) {
+        const double ex = (double)o->cos_hat * x->cos_ptheta + (double)o->sin_hat * x->sin_ptheta;
+        const double ey = (double)o->sin_hat * x->cos_ptheta - (double)o->cos_hat * x->sin_ptheta;
+        r->t_s[r->n] = x->t_s;
+        r->angle_error_rad[r->n] = fabs(atan2(ey, ex));
+        r->speed_error_rad_s[r->n] = fabs(x->omega_rad_s - (double)o->speed_ref_rad_s);
+        r->n++;
+    }
+    return true;
+}
+
+/* The index of the first largest value[k] with t_s[k] >= from_s (-1 if none). */
+static int first_largest(const double *t_s, const double *value, int n, double from_s)
+{
+    int k;
+    int best = -1;
+    for (k = 0; k < n; ++k) {
+        if (t_s[k] >= from_s && (best < 0 || value[k] > value[best])) {
+            best = k;
+        }
+    }
+    return best;
+}
+
+static void largest_errors_are_reported_with_their_times(void **state)
+{
+    /* The paper's scenario at 20 kHz with one period of delay: the summary's largest angle and
+     * speed errors after settling, and the times of their first samples, against the samples. */
+    static run_errors_t r;
+    sil_scenario_t sc;
+    sil_summary_t s;
+    int angle_k;
+    int speed_k;
+    (void)state;
+    sil_scenario_paper(&sc);
+    sc.controller.timing.computational_delay_periods = 1u;
+    r.n = 0;
+    assert_int_equal(sil_run(&sc, record_errors, &r, false, &s), 0);
+    assert_true(r.n > 0 && r.n < MAX_SAMPLES);
+    angle_k = first_largest(r.t_s, r.angle_error_rad, r.n, s.settle_time_s);
+    speed_k = first_largest(r.t_s, r.speed_error_rad_s, r.n, s.settle_time_s);
+    print_message("  largest angle error %.3e rad at %.5f s, speed error %.3e rad/s at %.5f s\n",
+                  fabs(s.max_angle_error_rad), s.max_angle_error_time_s, s.max_speed_error_after_settle_rad_s,
+                  s.max_speed_error_time_s);
+    assert_true(angle_k >= 0 && speed_k >= 0);
+    assert_true(fabs(fabs(s.max_angle_error_rad) - r.angle_error_rad[angle_k]) < 1e-12);
+    assert_true(s.max_angle_error_time_s == r.t_s[angle_k]);
+    assert_true(s.max_speed_error_after_settle_rad_s == r.speed_error_rad_s[speed_k]);
+    assert_true(s.max_speed_error_time_s == r.t_s[speed_k]);
+    assert_true(s.max_angle_error_time_s != s.max_speed_error_time_s); /* two maxima, two times */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(paper_at_20khz_meets_the_paper),
         cmocka_unit_test(other_rates_and_delay_converge_and_track),
         cmocka_unit_test(every_initial_angle_aligns_and_tracks),
+        cmocka_unit_test(largest_errors_are_reported_with_their_times),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -88,8 +88,10 @@ typedef struct {
     double run_start_time_s;               /**< t_c from the start (offset calibration included) */
     double settle_time_s;                  /**< run_start_time_s + transient window: "after transients" */
     double max_angle_error_rad;            /**< max |wrapped angle(c-hat, s-hat) - p theta| in RUN after settle */
+    double max_angle_error_time_s;         /**< the time of its first sample; -1 if none */
     double final_angle_error_rad;          /**< at the last RUN sample */
     double max_speed_error_after_settle_rad_s; /**< max |omega - omega*| in RUN after settle */
+    double max_speed_error_time_s;         /**< the time of its first sample; -1 if none */
     double loss_of_control_time_s;         /**< first RUN sample with |omega - omega*| or the angle error above the
                                                 scenario's loss bounds; -1 if none */
     double detection_latency_s;            /**< fault time - loss time (negative: fault first); NaN if not both */
