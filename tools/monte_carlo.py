@@ -67,7 +67,9 @@ Classes (see classify()):
 
 Outputs in DIR: report.md (with PNG histograms unless --no-plots), cases.csv (one row per
 case), summary.json (the aggregate numbers), campaign.json, cases/<case seed>/summary.json
-and result.json (each run).
+and result.json (each run). Each failed case has a failure time (the loss of control, a false
+trip's fault, the exceeded maximum's sample) and the speed profile's segment holding it
+(mc_segments.py); the report and summary.json count the failures by segment.
 
 --check exits with status 1 unless the success rate is >= --min-success (0.99), no case is
 silent, none crashed and none saw a non-finite value. The last line printed is always
