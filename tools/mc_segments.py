@@ -53,7 +53,8 @@ def profile_segments(points):
 
 def segment_of(time_s, run_start_s, segments):
     """The label of the segment holding time_s; COMMISSIONING before run_start_s (when known),
-    AFTER_PROFILE past the last segment; None without a time or without segments."""
+    AFTER_PROFILE past the last segment; None without a time, without segments, or before the
+    profile's first point."""
     if time_s is None or not segments:
         return None
     if run_start_s is not None and time_s < run_start_s:
@@ -61,7 +62,7 @@ def segment_of(time_s, run_start_s, segments):
     for t0, t1, label in segments:
         if t0 <= time_s < t1:
             return label
-    return AFTER_PROFILE if time_s >= segments[-1][1] else segments[0][2]
+    return AFTER_PROFILE if time_s >= segments[-1][1] else None
 
 
 def label_failures(records, scenario):

@@ -321,6 +321,7 @@ class FailureSegments(unittest.TestCase):
         self.assertEqual(mc.segment_of(0.38, 0.23, segments), "at 55.2 rad/s, 0.380-0.680 s")  # a start belongs to it
         self.assertEqual(mc.segment_of(1.3, 0.23, segments), "after the profile")
         self.assertIsNone(mc.segment_of(None, 0.23, segments))
+        self.assertIsNone(mc.segment_of(0.3, 0.23, segments[1:]))  # before a profile that starts later
         self.assertEqual(mc.speed_points(dict(self.SCENARIO, **{"position.points": "0.5:3"})), [])
 
     def test_table_in_profile_order(self):

@@ -299,7 +299,8 @@ COMMISSION_OUT_OF_LINE pmstep_fault_t pmstep_commission_finish(const pmstep_comm
 
     result->offset_a_A = offset_a;
     result->offset_b_A = offset_b;
-    result->offset_samples = sums->zero_count_a + sums->zero_count_b + alignment->zero_count_a + alignment->zero_count_b;
+    result->offset_samples = sums->zero_count_a + sums->zero_count_b + alignment->zero_count_a
+                             + alignment->zero_count_b;
     result->resistance_Ohm = 0.0f;
     result->phase_a_current_scale = 1.0f;
     result->inductance_H = 0.0f;

@@ -351,7 +351,8 @@ static pmstep_fault_t commission_stage(pmstep_t *inst, const pmstep_meas_t *meas
     }
     if (inst->mode == PMSTEP_MODE_RUN) {
         const pmstep_fault_t fault = finish_commissioning(inst, meas);
-        if (fault != PMSTEP_FAULT_ALIGNMENT_MOTION || inst->commissioning.alignment_repeats >= PMSTEP_ALIGNMENT_MAX_REPEATS) {
+        if (fault != PMSTEP_FAULT_ALIGNMENT_MOTION
+            || inst->commissioning.alignment_repeats >= PMSTEP_ALIGNMENT_MAX_REPEATS) {
             return fault;
         }
         pmstep_commission_repeat(&inst->scratch.sums, &inst->commissioning);

@@ -202,7 +202,8 @@ static void standstill_engage(pmstep_t *inst, pmstep_standstill_t *standstill, c
     if (standstill->rest_periods >= standstill->engage_periods) {
         const float current_A = inst->cfg->standstill.hold_current_A;
         const float length = sqrtf(out->cos_hat * out->cos_hat + out->sin_hat * out->sin_hat);
-        const float clear_sin = PMSTEP_HOLD_PHASE_CLEARANCE_BANDS * inst->cfg->inverter.dead_time_current_band_A / current_A;
+        const float clear_sin = PMSTEP_HOLD_PHASE_CLEARANCE_BANDS * inst->cfg->inverter.dead_time_current_band_A
+                                / current_A;
         float c = 0.0f;
         float s = 0.0f;
         standstill->rest_periods = 0u;
@@ -289,7 +290,8 @@ void pmstep_standstill_advance(pmstep_t *inst, const pmstep_output_t *out)
             const float turn_rad = turn_off_kept(standstill, out);
             standstill->drift_rad += PMSTEP_HOLD_DRIFT_LEAK_FRACTION * standstill->motion_leak
                                      * (turn_rad - standstill->drift_rad);
-            standstill->motion_rad += turn_rad - standstill->drift_rad - standstill->motion_leak * standstill->motion_rad;
+            standstill->motion_rad += turn_rad - standstill->drift_rad
+                                      - standstill->motion_leak * standstill->motion_rad;
             if (pmstep_abs(standstill->motion_rad) > PMSTEP_HOLD_MOTION_BOUND_RAD) {
                 follow_held_rotor(inst, standstill);
             } else {
