@@ -146,8 +146,8 @@ def preset_distributions(preset, peak_speed_rad_s, paper_holding_Nm, phase_volta
     return table + (PHASE_VOLTAGE_DISTRIBUTIONS if phase_voltage_sensing else [])
 
 
-def _design(tune, preset_path, chain_sets):
-    cmd = [tune, "--motor", preset_path, "--robust"]
+def _design(tune, preset_path, chain_sets, low_speed_drive=False):
+    cmd = [tune, "--motor", preset_path, "--robust"] + (["--low-speed-drive"] if low_speed_drive else [])
     for item in chain_sets:
         cmd += ["--set", item]
     return cmd
@@ -173,7 +173,7 @@ def _points_lines(points):
     return ",\n    ".join(rows)
 
 
-def design_scenario(tune, preset_path, out_dir, phase_voltage_sensing=False):
+def design_scenario(tune, preset_path, out_dir, phase_voltage_sensing=False, low_speed_drive=False):
     """Designs the preset with pmstep-tune (robust mode, realistic chain) and writes the
     campaign's scenario to out_dir/preset_scenario.ini. Returns (its path, info) with info =
     {"preset", "top_speed_rad_s", "run_start_s", "peak_speed_rad_s", "load_Nm", "tune_command", ...}."""
@@ -182,7 +182,7 @@ def design_scenario(tune, preset_path, out_dir, phase_voltage_sensing=False):
     chain = chain_sets(preset, phase_voltage_sensing)
     os.makedirs(out_dir, exist_ok=True)
     design_path = os.path.join(out_dir, "preset_design.ini")
-    cmd = _design(tune, preset_path, chain) + ["--write-ini", design_path]
+    cmd = _design(tune, preset_path, chain, low_speed_drive) + ["--write-ini", design_path]
     top = _run_designer(cmd)
     # The paper motor's top speed, which the paper campaign's speed thresholds are relative to.
     paper_span = ADC_SPAN_RATED * read_preset(PAPER_PRESET)["rated_current_A"]

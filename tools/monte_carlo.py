@@ -120,6 +120,9 @@ def parse_args(argv):
     parser.add_argument("--phase-voltage-sensing", action="store_true",
                         help="with --preset: the drive also senses each phase's mean voltage per period, and the "
                              "cases draw that sensor's errors (mc_preset.py)")
+    parser.add_argument("--low-speed-drive", action="store_true",
+                        help="with --preset: the design turns the standstill hold's vector below 2 V_bus t_d / (T_s k_M) "
+                             "(pmstep-tune --low-speed-drive)")
     parser.add_argument("--out", required=True, help="output folder")
     parser.add_argument("--cases", type=int, default=100, help="number of cases N (default 100)")
     parser.add_argument("--seed", type=int, default=1, help="base seed S: case k has seed S*100000+k (default 1)")
@@ -158,6 +161,8 @@ def parse_args(argv):
         parser.error("give one of --scenario and --preset")
     if args.tune is not None and args.preset is None:
         parser.error("--tune is for --preset")
+    if args.low_speed_drive and args.preset is None:
+        parser.error("--low-speed-drive is for --preset (a scenario file sets controller.standstill itself)")
     if args.phase_voltage_sensing and args.preset is None:
         parser.error("--phase-voltage-sensing is for --preset (a scenario file sets the sensor itself)")
     if args.preset is not None and args.tune is None:
@@ -213,7 +218,8 @@ def use_preset(args):
     if not (os.path.isfile(args.tune) and os.access(args.tune, os.X_OK)):
         raise ToolError(f"{args.tune} is not an executable file (pmstep-tune, built beside pmstep-sil; or give --tune)")
     read_preset(args.preset)  # a clear error for a bad preset before the designer runs
-    args.scenario, info = design_scenario(args.tune, args.preset, args.out, args.phase_voltage_sensing)
+    args.scenario, info = design_scenario(args.tune, args.preset, args.out, args.phase_voltage_sensing,
+                                          args.low_speed_drive)
     # In place, so every function's default table (the same list object) sees it.
     DISTRIBUTIONS[:] = preset_distributions(info["figures"], info["peak_speed_rad_s"], info["paper_holding_torque_Nm"],
                                             args.phase_voltage_sensing)

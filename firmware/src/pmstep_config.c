@@ -78,6 +78,7 @@ static pmstep_status_t validate_signs(const pmstep_config_t *cfg)
         SIGN_RULE(alignment.c_align_time_s, SIGN_ANY, PMSTEP_OK),
         SIGN_RULE(limits.max_bus_voltage_V, SIGN_ANY, PMSTEP_OK),
         SIGN_RULE(standstill.hold_current_A, SIGN_ANY, PMSTEP_OK), /* its code is below a signed char's range */
+        SIGN_RULE(standstill.vector_speed_rad_s, SIGN_ANY, PMSTEP_OK), /* so is this one's */
     };
     size_t n;
     for (n = 0; n < sizeof sign_rules / sizeof sign_rules[0]; ++n) {
@@ -263,6 +264,9 @@ static pmstep_status_t validate_standstill(const pmstep_config_t *cfg)
     const float current_A = cfg->standstill.hold_current_A;
     if (current_A < 0.0f || (current_A > 0.0f && !(current_A < cfg->limits.max_phase_current_A))) {
         return PMSTEP_ERR_HOLD_CURRENT;
+    }
+    if (cfg->standstill.vector_speed_rad_s < 0.0f || (cfg->standstill.vector_speed_rad_s > 0.0f && !(current_A > 0.0f))) {
+        return PMSTEP_ERR_VECTOR_SPEED; /* the low-speed drive turns the hold's vector */
     }
     return (current_A > 0.0f && cfg->known_load_mode) ? PMSTEP_ERR_STANDSTILL_KNOWN_LOAD : PMSTEP_OK;
 }

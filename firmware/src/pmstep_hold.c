@@ -72,6 +72,7 @@ pmstep_status_t pmstep_hold_vector(pmstep_t *inst, float cos_rest, float sin_res
         inst->current_integral.i_d_error_integral_As = 0.0f;
         inst->current_integral.i_q_error_integral_As = 0.0f;
         hold->speed_bias_rad_s = 0.0f;
+        hold->vector_speed_rad_s = 0.0f;
         hold->active = true;
     }
     return PMSTEP_OK;
@@ -81,6 +82,7 @@ void pmstep_release_vector(pmstep_t *inst)
 {
     if (inst != NULL && inst->hold.active) {
         inst->hold.active = false;
+        inst->hold.vector_speed_rad_s = 0.0f;
         inst->current_integral.i_d_error_integral_As = 0.0f;
         inst->current_integral.i_q_error_integral_As = 0.0f;
     }
@@ -108,10 +110,15 @@ void pmstep_hold_voltages(pmstep_t *inst, pmstep_observer_input_t *obs_in, pmste
 {
     pmstep_vector_hold_t *hold = &inst->hold;
     const pmstep_law_coeffs_t *law = &inst->law_coeffs;
-    const float speed_change = inst->observer.speed_hat_rad_s - hold->speed_bias_rad_s;
+    const float vector_speed = hold->vector_speed_rad_s;
+    const float speed_change = inst->observer.speed_hat_rad_s - vector_speed - hold->speed_bias_rad_s;
+    /* the frame's own speed: the rotor's w_v plus the load angle's rate (the detent torque's) */
+    const float frame_speed = pmstep_abs(vector_speed) > 0.0f ? inst->scratch.run.standstill.vector_rate_rad_s : 0.0f;
     float turn = -hold->damping_s * speed_change;
     float c;
     float s;
+    float c_act;
+    float s_act;
     float i_d_err;
     float i_q_err;
     float u_d;
@@ -119,7 +126,7 @@ void pmstep_hold_voltages(pmstep_t *inst, pmstep_observer_input_t *obs_in, pmste
     if (pmstep_abs(turn) > PMSTEP_HOLD_MAX_DAMPING_TURN) {
         turn = turn > 0.0f ? PMSTEP_HOLD_MAX_DAMPING_TURN : -PMSTEP_HOLD_MAX_DAMPING_TURN;
     }
-    hold->speed_bias_rad_s += hold->bias_gain * speed_change; /* w-bar: w-hat low-passed at w_n / 20 */
+    hold->speed_bias_rad_s += hold->bias_gain * speed_change; /* w-bar: (w-hat - w_v) low-passed at w_n / 20 */
     {
         /* the vector turned by the damping, (cos t, sin t) to second order: |t| <= 0.5, and the
          * frame needs no more than a damping term's accuracy */
@@ -127,8 +134,17 @@ void pmstep_hold_voltages(pmstep_t *inst, pmstep_observer_input_t *obs_in, pmste
         c = hold->cos_vector * cos_turn - hold->sin_vector * turn;
         s = hold->sin_vector * cos_turn + hold->cos_vector * turn;
     }
-    hold->cos_frame = c;
-    hold->sin_frame = s;
+    {
+        /* the frame the voltage acts in: turned on at w_frame over the delay and half the period
+         * (none at rest), to second order (pmstep_law_acting_angle's first terms: at the band's
+         * speed the turn is a few hundredths of a radian) */
+        const float cos_act = 1.0f + frame_speed * frame_speed * law->turn_cos_w2;
+        const float sin_act = frame_speed * law->turn_sin_w1;
+        c_act = c * cos_act - s * sin_act;
+        s_act = s * cos_act + c * sin_act;
+    }
+    hold->cos_frame = c_act;
+    hold->sin_frame = s_act;
     /* the currents in the frame (Park), their errors from i_d* = I, i_q* = 0 */
     i_d_err = c * obs_in->i_a_A + s * obs_in->i_b_A - hold->current_A;
     i_q_err = c * obs_in->i_b_A - s * obs_in->i_a_A;
@@ -137,10 +153,13 @@ void pmstep_hold_voltages(pmstep_t *inst, pmstep_observer_input_t *obs_in, pmste
     /* the law's current loop (pmstep_law_voltages) at zero speed: u = L [(R/L) i* - K_i e - K_I z] */
     u_d = law->inductance_H * (law->r_over_l_per_s * hold->current_A - law->current_gain_per_s * i_d_err
                                - law->current_integral_gain_per_s2 * inst->current_integral.i_d_error_integral_As);
-    u_q = law->inductance_H * (-law->current_gain_per_s * i_q_err
+    /* turning: L I p w_frame for the vector's rotation and the back-EMF k_M w_v, on q (the load
+     * angle's share on d is left to the integral) */
+    u_q = law->inductance_H * (frame_speed * law->pole_pairs * hold->current_A + vector_speed * law->km_over_l
+                               - law->current_gain_per_s * i_q_err
                                - law->current_integral_gain_per_s2 * inst->current_integral.i_q_error_integral_As);
-    out->u_a_V = c * u_d - s * u_q;
-    out->u_b_V = s * u_d + c * u_q;
+    out->u_a_V = c_act * u_d - s_act * u_q;
+    out->u_b_V = s_act * u_d + c_act * u_q;
 }
 
 void pmstep_standstill_start(pmstep_t *inst)
@@ -155,6 +174,8 @@ void pmstep_standstill_start(pmstep_t *inst)
     standstill->motion_rad = 0.0f;
     standstill->motion_leak = 0.0f;
     standstill->drift_rad = 0.0f;
+    standstill->aim_load_Nm = 0.0f;
+    standstill->vector_rate_rad_s = 0.0f;
     inst->hold.standstill_armed = current_A > 0.0f;
     standstill->quiet_band_rad_s = 0.0f;
     standstill->engage_periods = 0u;
@@ -165,6 +186,13 @@ void pmstep_standstill_start(pmstep_t *inst)
         standstill->engage_periods = period_count(PMSTEP_STANDSTILL_ENGAGE_TIME_CONSTANTS
                                                   / (inst->cfg->gains.speed_gain_per_s * inst->cfg->timing.period_s));
     }
+}
+
+/* The low-speed drive is on and the reference is not at rest: the vector turns. */
+static bool standstill_turning(const pmstep_t *inst, const pmstep_standstill_t *standstill, const pmstep_output_t *out)
+{
+    return inst->cfg->standstill.vector_speed_rad_s > 0.0f
+           && pmstep_abs(out->speed_ref_rad_s) >= PMSTEP_STANDSTILL_REFERENCE_FRACTION * standstill->quiet_band_rad_s;
 }
 
 /* (c, s) moved to the nearest direction whose smaller component is at least min_sin (at most
@@ -189,10 +217,12 @@ static void aim_clear_of_phase_axes(float *c, float *s, float min_sin)
 static void standstill_engage(pmstep_t *inst, pmstep_standstill_t *standstill, const pmstep_output_t *out)
 {
     const pmstep_ref_t *ref = &inst->speed_ref;
-    const bool at_rest = !(pmstep_abs(ref->target) > 0.0f) && !(pmstep_abs(ref->setpoint) > 0.0f)
+    const float band_rad_s = inst->cfg->standstill.vector_speed_rad_s; /* 0: the standstill only */
+    const float vector_speed = band_rad_s > 0.0f ? out->speed_ref_rad_s : 0.0f;
+    const bool at_rest = !(pmstep_abs(ref->target) > band_rad_s) && !(pmstep_abs(ref->setpoint) > band_rad_s)
                          && pmstep_abs(out->speed_ref_rad_s)
-                                < PMSTEP_STANDSTILL_REFERENCE_FRACTION * standstill->quiet_band_rad_s
-                         && pmstep_abs(out->speed_hat_rad_s) < standstill->quiet_band_rad_s;
+                                < PMSTEP_STANDSTILL_REFERENCE_FRACTION * standstill->quiet_band_rad_s + band_rad_s
+                         && pmstep_abs(out->speed_hat_rad_s - vector_speed) < standstill->quiet_band_rad_s + band_rad_s;
     inst->hold.standstill_engaged = false;
     if (!at_rest) {
         standstill->rest_periods = 0u;
@@ -211,7 +241,9 @@ static void standstill_engage(pmstep_t *inst, pmstep_standstill_t *standstill, c
         if (length > 0.0f) {
             c = out->cos_hat / length;
             s = out->sin_hat / length;
-            aim_clear_of_phase_axes(&c, &s, clear_sin < HOLD_MAX_CLEAR_SIN ? clear_sin : HOLD_MAX_CLEAR_SIN);
+            if (!standstill_turning(inst, standstill, out)) { /* a turning vector's currents cross zero anyway */
+                aim_clear_of_phase_axes(&c, &s, clear_sin < HOLD_MAX_CLEAR_SIN ? clear_sin : HOLD_MAX_CLEAR_SIN);
+            }
         }
         /* refused (a load beyond the vector's pull, an estimate at the origin): the law holds on */
         inst->hold.standstill_engaged = length > 0.0f
@@ -219,6 +251,9 @@ static void standstill_engage(pmstep_t *inst, pmstep_standstill_t *standstill, c
                                                == PMSTEP_OK;
         standstill->keep_cos = c; /* where the vector will hold the rotor: T_L-hat's load angle behind it */
         standstill->keep_sin = s;
+        standstill->aim_load_Nm = inst->observer.load_hat_Nm;
+        inst->hold.vector_speed_rad_s = vector_speed;
+        standstill->vector_rate_rad_s = vector_speed;
         standstill->drift_rad = 0.0f; /* this vector's drift is learnt afresh */
         {
             const uint32_t leak_periods = inst->hold.settle_periods + 1u; /* a settling time, at least a period */
@@ -233,25 +268,131 @@ static float turn_off_kept(const pmstep_standstill_t *standstill, const pmstep_o
     return standstill->keep_cos * out->sin_hat - standstill->keep_sin * out->cos_hat;
 }
 
-/* The held rotor moved (a load step): the kept estimate turned by the summed motion ((cos t,
- * sin t) to second order), T_L-hat the held rotor's balance there (pmstep_hold_vector's relation
- * solved for the load), and the rest started again. */
-static void follow_held_rotor(pmstep_t *inst, pmstep_standstill_t *standstill)
+/* (J w_v' + F w_v) / k_M (A): the current the vector's own speed profile takes; 0 at rest. */
+static float hold_acceleration_A(const pmstep_law_coeffs_t *law, const pmstep_vector_hold_t *hold,
+                                 const pmstep_output_t *out)
+{
+    const bool turning = pmstep_abs(hold->vector_speed_rad_s) > 0.0f;
+    return turning ? law->j_over_km * (out->speed_ref_rate_rad_s2 + law->f_over_j_per_s * hold->vector_speed_rad_s)
+                   : 0.0f;
+}
+
+/* The low-speed drive, each period the vector turns: the kept rotor advanced by p w* T_s (its
+ * length put back to 1 by a Newton step), the vector aimed ahead of it by the load angle of
+ * T_L + J w*' + F w* - T_detent. @return false where that is beyond the vector's pull
+ * (PMSTEP_HOLD_MAX_TORQUE_FRACTION): the law takes over. */
+static bool turn_vector(pmstep_t *inst, pmstep_standstill_t *standstill, const pmstep_output_t *out)
+{
+    const pmstep_law_coeffs_t *law = &inst->law_coeffs;
+    pmstep_vector_hold_t *hold = &inst->hold;
+    const float turn = law->pole_pairs * out->speed_ref_rad_s * inst->cfg->timing.period_s;
+    float c;
+    float s;
+    float sin_delta;
+    float cos_delta;
+    pmstep_detent_t detent;
+    pmstep_turn(standstill->keep_cos, standstill->keep_sin, 1.0f - 0.5f * turn * turn, turn, &c, &s);
+    {
+        const float renorm = 1.5f - 0.5f * (c * c + s * s);
+        c *= renorm;
+        s *= renorm;
+    }
+    standstill->keep_cos = c;
+    standstill->keep_sin = s;
+    hold->vector_speed_rad_s = out->speed_ref_rad_s;
+    detent = pmstep_law_detent(law, c, s, out->speed_ref_rad_s);
+    sin_delta = ((standstill->aim_load_Nm - detent.torque_Nm) / (law->km_over_l * law->inductance_H)
+                 + hold_acceleration_A(law, hold, out))
+                / hold->current_A;
+    if (!(pmstep_abs(sin_delta) <= PMSTEP_HOLD_MAX_TORQUE_FRACTION)) {
+        return false;
+    }
+    cos_delta = sqrtf(1.0f - sin_delta * sin_delta);
+    pmstep_turn(c, s, cos_delta, sin_delta, &hold->cos_vector, &hold->sin_vector);
+    /* d delta / dt = -(d T_detent / dt) / (k_M I cos delta) */
+    standstill->vector_rate_rad_s = out->speed_ref_rad_s
+                                    - detent.rate_Nm_s
+                                          / (law->pole_pairs * law->km_over_l * law->inductance_H * hold->current_A
+                                             * cos_delta);
+    return true;
+}
+
+/* The load T_L the held rotor at (c, s) balances: k_M I sin(v - x) + T_detent(x), less
+ * J w_v' + F w_v where the vector turns (pmstep_hold_vector's relation solved for the load). */
+static float held_balance_Nm(const pmstep_t *inst, float c, float s, const pmstep_output_t *out)
 {
     const pmstep_law_coeffs_t *law = &inst->law_coeffs;
     const pmstep_vector_hold_t *hold = &inst->hold;
+    const pmstep_detent_t detent = pmstep_law_detent(law, c, s, 0.0f);
+    return law->km_over_l * law->inductance_H
+               * (hold->current_A * (hold->sin_vector * c - hold->cos_vector * s) - hold_acceleration_A(law, hold, out))
+           + detent.torque_Nm;
+}
+
+/* The held rotor moved (a load step): the kept estimate turned by the summed motion ((cos t,
+ * sin t) to second order), T_L-hat the held rotor's balance there, and the rest started again. */
+static void follow_held_rotor(pmstep_t *inst, pmstep_standstill_t *standstill, const pmstep_output_t *out)
+{
     const float turn = standstill->motion_rad;
-    pmstep_detent_t detent;
     float c;
     float s;
     pmstep_turn(standstill->keep_cos, standstill->keep_sin, 1.0f - 0.5f * turn * turn, turn, &c, &s);
     pmstep_angle_set(&inst->angle, &inst->angle_coeffs, c, s);
-    detent = pmstep_law_detent(law, c, s, 0.0f);
-    /* k_M I sin(v - x-hat) + T_detent(x-hat) */
-    inst->observer.load_hat_Nm = law->km_over_l * law->inductance_H * hold->current_A
-                                 * (hold->sin_vector * c - hold->cos_vector * s) + detent.torque_Nm;
+    inst->observer.load_hat_Nm = held_balance_Nm(inst, c, s, out);
+    standstill->aim_load_Nm = inst->observer.load_hat_Nm;
     standstill->rest_periods = 0u;
     standstill->motion_rad = 0.0f;
+}
+
+/* One period of the standstill's hold: settling, then the kept estimate and the motion sum. */
+static void standstill_hold_period(pmstep_t *inst, pmstep_standstill_t *standstill, const pmstep_output_t *out)
+{
+    const bool turning = standstill_turning(inst, standstill, out);
+    const float speed_change = inst->observer.speed_hat_rad_s - inst->hold.vector_speed_rad_s
+                               - inst->hold.speed_bias_rad_s;
+    standstill->rest_periods++;
+    if (turning && (inst->hold.standstill_settled || standstill->rest_periods < inst->hold.settle_periods)) {
+        /* Turning: the flux integrals' phase is not the rotor's at low speed (the voltage errors
+         * against a back-EMF of the same order), the estimate is the vector's aim throughout. */
+        pmstep_angle_set(&inst->angle, &inst->angle_coeffs, standstill->keep_cos, standstill->keep_sin);
+    } else if (!inst->hold.standstill_settled) {
+        if (standstill->rest_periods >= inst->hold.settle_periods) {
+            /* Settled where the vector holds it (the aim: T_L-hat's load angle behind the vector),
+             * not where the integrals drifted to while the current stepped up (R and voltage errors
+             * times the hold current), unless they put the rotor beyond the motion bound from it (a
+             * load T_L-hat did not know). T_L-hat the balance there, w-hat the rest's (its
+             * transient from the step is behind), and no first settling time to take. */
+            const float off_aim_rad = turning ? 0.0f : turn_off_kept(standstill, out); /* turning: at the aim */
+            inst->hold.standstill_settled = true;
+            standstill->motion_rad = pmstep_abs(off_aim_rad) > PMSTEP_HOLD_MOTION_BOUND_RAD ? off_aim_rad : 0.0f;
+            follow_held_rotor(inst, standstill, out);
+            standstill->rest_periods = inst->hold.settle_periods + 1u;
+            inst->observer.speed_hat_rad_s = inst->hold.vector_speed_rad_s + inst->hold.speed_bias_rad_s;
+        }
+    } else if (pmstep_abs(speed_change) < inst->hold.quiet_band_rad_s) {
+        if (standstill->rest_periods <= inst->hold.settle_periods) {
+            standstill->keep_cos = out->cos_hat; /* the rest's first settling time: taken */
+            standstill->keep_sin = out->sin_hat;
+            standstill->motion_rad = 0.0f;
+            /* the load the vector is aimed for when it turns: the balance where the rotor came to rest */
+            standstill->aim_load_Nm = held_balance_Nm(inst, out->cos_hat, out->sin_hat, out);
+        } else {
+            /* the period's turn of the integrals off the kept estimate less their learnt drift, summed
+             * with the leak */
+            const float turn_rad = turn_off_kept(standstill, out);
+            standstill->drift_rad += PMSTEP_HOLD_DRIFT_LEAK_FRACTION * standstill->motion_leak
+                                     * (turn_rad - standstill->drift_rad);
+            standstill->motion_rad += turn_rad - standstill->drift_rad
+                                      - standstill->motion_leak * standstill->motion_rad;
+            if (pmstep_abs(standstill->motion_rad) > PMSTEP_HOLD_MOTION_BOUND_RAD) {
+                follow_held_rotor(inst, standstill, out);
+            } else {
+                pmstep_angle_set(&inst->angle, &inst->angle_coeffs, standstill->keep_cos, standstill->keep_sin);
+            }
+        }
+    } else {
+        standstill->rest_periods = 0u; /* moving: the estimate follows the flux integrals */
+    }
 }
 
 void pmstep_standstill_advance(pmstep_t *inst, const pmstep_output_t *out)
@@ -264,49 +405,26 @@ void pmstep_standstill_advance(pmstep_t *inst, const pmstep_output_t *out)
     if (!inst->hold.standstill_engaged) {
         return; /* a hold of the application's own (pmstep_hold_vector) */
     }
-    standstill->rest_periods++;
-    if (!inst->hold.standstill_settled) {
-        if (standstill->rest_periods >= inst->hold.settle_periods) {
-            /* Settled where the vector holds it (the aim: T_L-hat's load angle behind the vector),
-             * not where the integrals drifted to while the current stepped up (R and voltage errors
-             * times the hold current), unless they put the rotor beyond the motion bound from it (a
-             * load T_L-hat did not know). T_L-hat the balance there, w-hat the rest's (its
-             * transient from the step is behind), and no first settling time to take. */
-            const float off_aim_rad = turn_off_kept(standstill, out);
-            inst->hold.standstill_settled = true;
-            standstill->motion_rad = pmstep_abs(off_aim_rad) > PMSTEP_HOLD_MOTION_BOUND_RAD ? off_aim_rad : 0.0f;
-            follow_held_rotor(inst, standstill);
-            standstill->rest_periods = inst->hold.settle_periods + 1u;
-            inst->observer.speed_hat_rad_s = inst->hold.speed_bias_rad_s;
-        }
-    } else if (pmstep_abs(inst->observer.speed_hat_rad_s - inst->hold.speed_bias_rad_s) < inst->hold.quiet_band_rad_s) {
-        if (standstill->rest_periods <= inst->hold.settle_periods) {
-            standstill->keep_cos = out->cos_hat; /* the rest's first settling time: taken */
-            standstill->keep_sin = out->sin_hat;
-            standstill->motion_rad = 0.0f;
-        } else {
-            /* the period's turn of the integrals off the kept estimate less their learnt drift, summed
-             * with the leak */
-            const float turn_rad = turn_off_kept(standstill, out);
-            standstill->drift_rad += PMSTEP_HOLD_DRIFT_LEAK_FRACTION * standstill->motion_leak
-                                     * (turn_rad - standstill->drift_rad);
-            standstill->motion_rad += turn_rad - standstill->drift_rad
-                                      - standstill->motion_leak * standstill->motion_rad;
-            if (pmstep_abs(standstill->motion_rad) > PMSTEP_HOLD_MOTION_BOUND_RAD) {
-                follow_held_rotor(inst, standstill);
-            } else {
-                pmstep_angle_set(&inst->angle, &inst->angle_coeffs, standstill->keep_cos, standstill->keep_sin);
-            }
-        }
+    standstill_hold_period(inst, standstill, out);
+    if (!standstill_turning(inst, standstill, out)) {
+        inst->hold.vector_speed_rad_s = 0.0f; /* at rest the vector stays where it is */
+    } else if (!turn_vector(inst, standstill, out)) {
+        pmstep_release_vector(inst); /* a load beyond the turning vector's pull: the law's */
+        inst->hold.standstill_engaged = false;
+        standstill->rest_periods = 0u;
     } else {
-        standstill->rest_periods = 0u; /* moving: the estimate follows the flux integrals */
+        /* turned and aimed for the next period */
     }
 }
 
 void pmstep_standstill_command(pmstep_t *inst, float target_rad_s)
 {
     const bool in_run = inst->mode == PMSTEP_MODE_RUN && inst->run_started;
-    if (!in_run || pmstep_abs(target_rad_s) > 0.0f || !inst->hold.standstill_engaged) {
+    if (!in_run || pmstep_abs(target_rad_s) > inst->cfg->standstill.vector_speed_rad_s
+        || !inst->hold.standstill_engaged) {
+        if (inst->hold.standstill_engaged && inst->cfg->standstill.vector_speed_rad_s > 0.0f) {
+            inst->observer.load_hat_Nm = inst->scratch.run.standstill.aim_load_Nm; /* the law starts from the aim's */
+        }
         pmstep_release_vector(inst); /* a speed command ends a hold; a zero one keeps the standstill's */
         inst->hold.standstill_engaged = false;
     }

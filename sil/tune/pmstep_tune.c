@@ -12,7 +12,7 @@
 static void usage(FILE *f)
 {
     fprintf(f,
-            "usage: pmstep-tune --motor FILE [--robust] [--set section.key=value]...\n"
+            "usage: pmstep-tune --motor FILE [--robust [--low-speed-drive]] [--set section.key=value]...\n"
             "                   [--write-ini FILE] [--write-c FILE] [--validate]\n"
             "                   [--told-inertia J] [--told-friction F] [--identify [--max-inertia-error PCT]]\n"
             "                   [--identify-in-run]\n"
@@ -20,6 +20,9 @@ static void usage(FILE *f)
             "               run.period_s, run.delay_periods, [inverter] and [sensors] are the drive's\n"
             "  --robust     robust mode: Remark 2 calibration, commissioned R/L/k_M, drift-free angle,\n"
             "               dead-time compensation of inverter.dead_time_s\n"
+            "  --low-speed-drive  robust mode without phase-voltage sensing: below 2 V_bus t_d / (T_s k_M)\n"
+            "               the standstill hold's vector turns at the reference speed (a load step there is\n"
+            "               not learnt)\n"
             "  --set        override a key of the preset before designing (e.g. run.period_s=25e-6)\n"
             "  --write-ini  the whole scenario with the designed [controller.*] and a validation profile\n"
             "  --write-c    the design as a C99 initialiser of pmstep_config_t\n"
@@ -45,6 +48,7 @@ int main(int argc, char **argv)
     const char *ini_path = NULL;
     const char *c_path = NULL;
     bool robust = false;
+    bool low_speed_drive = false;
     bool run_validation = false;
     bool run_identification = false;
     bool identify_in_run = false;
@@ -69,6 +73,8 @@ int main(int argc, char **argv)
             }
         } else if (strcmp(argv[k], "--robust") == 0) {
             robust = true;
+        } else if (strcmp(argv[k], "--low-speed-drive") == 0) {
+            low_speed_drive = true;
         } else if (strcmp(argv[k], "--write-ini") == 0 && k + 1 < argc) {
             ini_path = argv[++k];
         } else if (strcmp(argv[k], "--write-c") == 0 && k + 1 < argc) {
@@ -110,7 +116,7 @@ int main(int argc, char **argv)
     }
 
     /* The drive is told the datasheet's motor: the preset's [motor], J and F as --told-* say. */
-    design_input(&sc, robust, &in);
+    design_input(&sc, robust, low_speed_drive, &in);
     if (told_inertia >= 0.0) {
         in.motor.inertia_kgm2 = (float)told_inertia;
     }

@@ -24,7 +24,7 @@ int validate(const sil_scenario_t *designed, double top_speed_rad_s, double max_
 /* ---- tune_design.c ---- */
 
 /* The designer's input for the motor the drive is told: the preset's [motor], J and F overridable. */
-void design_input(const sil_scenario_t *sc, bool robust, pmstep_design_input_t *in);
+void design_input(const sil_scenario_t *sc, bool robust, bool low_speed_drive, pmstep_design_input_t *in);
 
 void print_design(const sil_scenario_t *sc, const pmstep_design_report_t *r, bool robust);
 

@@ -7,7 +7,7 @@
 #include "pmstep_tune.h"
 
 /* The designer's input for the motor the drive is told: the preset's [motor], J and F overridable. */
-void design_input(const sil_scenario_t *sc, bool robust, pmstep_design_input_t *in)
+void design_input(const sil_scenario_t *sc, bool robust, bool low_speed_drive, pmstep_design_input_t *in)
 {
     memset(in, 0, sizeof *in);
     in->motor.resistance_Ohm = (float)sc->motor.resistance_Ohm;
@@ -24,6 +24,7 @@ void design_input(const sil_scenario_t *sc, bool robust, pmstep_design_input_t *
     in->self_commissioning = robust;
     in->dead_time_s = (float)sc->inverter.dead_time_s;
     in->phase_voltage_sensing = sc->controller.inverter.phase_voltage_sensing;
+    in->low_speed_drive = low_speed_drive;
     {
         const double step_A = sc->sensors.adc_bits > 0 ? 2.0 * sc->sensors.current_full_scale_A
                                                              / (double)(1L << sc->sensors.adc_bits)
@@ -60,6 +61,8 @@ void print_design(const sil_scenario_t *sc, const pmstep_design_report_t *r, boo
            (double)c->limits.max_bus_voltage_V, (double)c->detection.stall_speed_error_rad_s,
            (double)c->detection.observer_residual_bound_A, (double)c->detection.persistence_s);
     printf("  standstill hold in speed mode: %.3f A (0 = off)\n", (double)c->standstill.hold_current_A);
+    printf("  low-speed drive (the hold's vector turning) below: %.3f rad/s (0 = off)\n",
+           (double)c->standstill.vector_speed_rad_s);
     if (robust) {
         printf("  commissioning: offsets %.3f s, windows %.3f s, L window %.5f s, bias level %.2f, "
                "dead time %g s (band %g A), i_d* %.3f A; RUN uses the measured R%s\n",
@@ -129,7 +132,8 @@ int write_c(const char *path, const sil_scenario_t *sc)
             (double)c->detection.angle_magnitude_bound, (double)c->detection.speed_consistency_bound_rad_s,
             (double)c->detection.stall_speed_error_rad_s, (double)c->detection.observer_residual_bound_A,
             (double)c->detection.persistence_s, (unsigned)c->detection.max_realignments);
-    fprintf(f, "    .standstill = {.hold_current_A = %.9gf},\n", (double)c->standstill.hold_current_A);
+    fprintf(f, "    .standstill = {.hold_current_A = %.9gf, .vector_speed_rad_s = %.9gf},\n",
+            (double)c->standstill.hold_current_A, (double)c->standstill.vector_speed_rad_s);
     fprintf(f, "    .known_load_mode = false,\n};\n");
     if (fclose(f) != 0) {
         fprintf(stderr, "pmstep-tune: error writing %s\n", path);

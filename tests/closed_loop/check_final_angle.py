@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Checks a pmstep-sil summary.json: the run ended in RUN and the angle estimate's error at its
 end is below --max-final-angle-error, or (a run that shows a drift) at least
---min-final-angle-error (electrical rad). Prints the measured value; exits 1 on a miss."""
+--min-final-angle-error (electrical rad); optionally its largest error after settling below
+--max-angle-error. Prints the measured values; exits 1 on a miss."""
 import argparse
 import json
 import sys
@@ -15,12 +16,16 @@ def main():
                        help="|angle error| at the run's end must be below this (electrical rad)")
     bound.add_argument("--min-final-angle-error", type=float, metavar="RAD",
                        help="|angle error| at the run's end must be at least this (electrical rad)")
+    parser.add_argument("--max-angle-error", type=float, metavar="RAD",
+                        help="the largest |angle error| after settling must be below this (electrical rad)")
     args = parser.parse_args()
     with open(args.summary, encoding="utf-8") as f:
         summary = json.load(f)
     mode = summary["final_mode"]
     error = summary["robustness"]["final_angle_error_rad"]
-    print(f"final mode {mode}, final angle error {error:.4f} rad")
+    largest = summary["robustness"]["max_angle_error_rad"]
+    print(f"final mode {mode}, final angle error {error:.4f} rad, largest after settling {largest:.4f} rad "
+          f"at {summary['robustness']['max_angle_error_time_s']:.4f} s")
     if mode != "RUN":
         print("check_final_angle: the run did not end in RUN", file=sys.stderr)
         return 1
@@ -29,6 +34,10 @@ def main():
         return 1
     if args.min_final_angle_error is not None and not abs(error) >= args.min_final_angle_error:
         print(f"check_final_angle: not at least {args.min_final_angle_error:g} rad", file=sys.stderr)
+        return 1
+    if args.max_angle_error is not None and not largest < args.max_angle_error:
+        print(f"check_final_angle: largest error after settling not below {args.max_angle_error:g} rad",
+              file=sys.stderr)
         return 1
     return 0
 

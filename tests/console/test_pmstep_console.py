@@ -81,11 +81,12 @@ class AgainstTheFirmwareConsole(unittest.TestCase):
         self.assertEqual(hello["protocol"], 1)
         self.assertEqual(hello["identity"], "pmstep host-drive")
         table = c.list_config()
-        self.assertEqual(len(table), 48)
+        self.assertEqual(len(table), 49)
         names = [e["name"] for e in table]
         self.assertEqual(len(set(names)), len(names))
         self.assertIn("inverter.phase_voltage_sensing", names)
         self.assertIn("standstill.hold_current_A", names)
+        self.assertIn("standstill.vector_speed_rad_s", names)
         self.assertEqual(c.get_config("gains.speed_gain_per_s")["value"], 100.0)
         self.assertTrue(c.get_config("timing.period_s")["read_only"])
         c.set_config("gains.speed_gain_per_s", 120.0)

@@ -29,6 +29,7 @@ static pmstep_config_t eva_known_load_config(void)
     pmstep_config_t cfg = eva_features_config();
     cfg.known_load_mode = true;
     cfg.standstill.hold_current_A = 0.0f; /* a vector hold needs (6) */
+    cfg.standstill.vector_speed_rad_s = 0.0f; /* and the low-speed drive turns it */
     cfg.commissioning.voltage_bias_level_fraction = 0.0f;
     cfg.commissioning.offset_calibration_time_s = 0.0f;
     cfg.timing.computational_delay_periods = 0u;
@@ -102,6 +103,7 @@ static void eva_any_config(pmstep_config_t *cfg)
     cfg->commissioning.identification_min_speed_rad_s = eva_any_finite();
     cfg->commissioning.use_identified_mechanics = Frama_C_nondet(0, 1) != 0;
     cfg->standstill.hold_current_A = eva_any_finite();
+    cfg->standstill.vector_speed_rad_s = eva_any_finite();
 }
 
 #endif /* PMSTEP_EVA_CONFIGS_H */

@@ -40,6 +40,7 @@ static inline pmstep_config_t fuzz_base_config(unsigned which)
         cfg.known_load_mode = which == 2u;
         if (cfg.known_load_mode) {
             cfg.standstill.hold_current_A = 0.0f; /* a vector hold needs (6) */
+            cfg.standstill.vector_speed_rad_s = 0.0f; /* and the low-speed drive turns it */
         }
     } else if (which == 3u) {
         cfg.alignment.s_align_time_s = 0.01f;

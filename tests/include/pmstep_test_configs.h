@@ -31,6 +31,7 @@ static inline pmstep_config_t pmstep_test_features_config(void)
     cfg.detection.max_realignments = 2u;
     cfg.timing.computational_delay_periods = 1u;
     cfg.standstill.hold_current_A = 7.5f;
+    cfg.standstill.vector_speed_rad_s = 2.0f; /* the low-speed drive below 2 rad/s */
     return cfg;
 }
 

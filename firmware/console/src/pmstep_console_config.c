@@ -66,6 +66,7 @@ static const pmstep_console_config_entry_t table[] = {
     BOOL(commissioning.use_identified_mechanics),
     BOOL(inverter.phase_voltage_sensing),
     F32(standstill.hold_current_A),
+    F32(standstill.vector_speed_rad_s),
 };
 
 const pmstep_console_config_entry_t *pmstep_console_config_table(uint32_t *count)

@@ -41,6 +41,9 @@
 #define VOLTAGE_BIAS_LEVEL 0.5f
 #define MAGNETISING_PER_RATED_CURRENT 0.125f
 #define MIN_DEAD_TIME_BAND_A 1e-4f
+/* Robust mode, currents sensed only: the low-speed drive below the speed whose back EMF is this
+ * many times the dead time's loss V_bus t_d / T_s (DESIGN.md, "The low-speed drive"). */
+#define LOW_SPEED_EMF_PER_DEAD_TIME_LOSS 2.0f
 /* Identification of J and F (pmstep_identify.h): periods with |w*| below this fraction of the top
  * speed stay out of the fit (a hybrid's detent torque does not average out at low speed). */
 #define IDENTIFICATION_MIN_SPEED_OF_TOP 0.2f
@@ -253,6 +256,14 @@ static void design_commissioning(const pmstep_design_input_t *in, float window_s
     /* Robust mode holds a zero speed command with a vector at rated current (pmstep_hold.h): the
      * estimate would drift there with what is left of the voltage errors. */
     cfg->standstill.hold_current_A = robust ? in->rated_current_A : 0.0f;
+    /* Below the speed whose back EMF is of the order of the dead time's loss the flux integrals'
+     * phase is off by tenths of a radian: there the hold's vector can turn at the reference speed
+     * in place of the law (asked for: a load step while it turns is not learnt, DESIGN.md
+     * section 14). A drive that senses its phase voltages integrates the bridge's own. */
+    cfg->standstill.vector_speed_rad_s = (robust && in->low_speed_drive && !in->phase_voltage_sensing)
+                                             ? LOW_SPEED_EMF_PER_DEAD_TIME_LOSS * in->bus_voltage_V * in->dead_time_s
+                                                   / (in->period_s * in->motor.torque_constant_Nm_A)
+                                             : 0.0f;
 }
 
 static void design_protection(const pmstep_design_input_t *in, pmstep_config_t *cfg, float top_speed_rad_s)

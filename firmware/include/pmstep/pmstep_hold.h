@@ -1,6 +1,7 @@
 /**
  * @file pmstep_hold.h
- * @brief Standstill hold by a current vector fixed in the stator frame (for position control).
+ * @brief Standstill hold by a current vector fixed in the stator frame (for position control), and
+ *        the low-speed drive that turns it at the reference speed.
  *
  * At zero speed nothing observes the phase of the flux estimate: an estimate hold drifts with
  * the sum of every small voltage error (offsets, R, dead time). A vector hold does not need the
@@ -38,6 +39,21 @@
  * while its current crosses zero: the standstill aims its vector so that both phase currents
  * stay PMSTEP_HOLD_PHASE_CLEARANCE_BANDS compensation bands clear of zero (the rotor moves by
  * at most asin(clearance / I) to get there; nothing with a zero band).
+ *
+ * Low-speed drive (cfg->standstill.vector_speed_rad_s = w_b > 0): below the speed whose back EMF
+ * is of the order of the voltage errors (the dead time's loss), the flux integrals' phase is off
+ * by tenths of a radian and the law on it loses the rotor. There a command |w_cmd| <= w_b is held
+ * the same way, engaged on the same test with the band widened by w_b (|target|, |set-point|
+ * and |w*| within w_b, |w-hat - w*| within the quiet band plus w_b), and the vector turns: each
+ * period the kept rotor x-hat advances by p w* T_s and the vector is aimed ahead of it,
+ *   v = x-hat + delta,   sin delta = (T_L,aim + J w*' + F w* - T_detent(x-hat)) / (k_M I),
+ * T_L,aim being T_L-hat at the engagement, then the held rotor's balance each time the estimate
+ * is taken or followed. The estimate is x-hat throughout (the integrals are not followed while
+ * turning); w-bar is the low-passed w-hat - w*; the voltage adds L I p w_f + k_M w* on q, w_f =
+ * w* + (d delta / dt) / p the frame's speed with the detent's rate, and is put out in the frame
+ * turned on by p w_f T_s (delay + 1/2). At rest (|w*| below 1 % of the quiet band) the vector
+ * stops and the standstill's rules above apply. A command beyond w_b releases the vector and the
+ * law starts from T_L,aim; so does a load angle beyond PMSTEP_HOLD_MAX_TORQUE_FRACTION.
  */
 #ifndef PMSTEP_HOLD_H
 #define PMSTEP_HOLD_H
@@ -89,6 +105,7 @@ typedef struct {
     float speed_bias_rad_s;    /**< w-bar, the speed estimate at rest (w-hat low-passed) */
     float bias_gain;           /**< w_n T_s / PMSTEP_HOLD_BIAS_CORNER_RATIO, w-bar's filter per period */
     float quiet_band_rad_s;    /**< PMSTEP_HOLD_QUIET_FRACTION w_n / p */
+    float vector_speed_rad_s;  /**< w_v, the speed the vector turns at (the standstill's low-speed drive; else 0) */
     float cos_frame;           /**< the period's frame: the vector turned by the damping */
     float sin_frame;
     uint32_t settle_periods;      /**< PMSTEP_HOLD_SETTLE_TIME_CONSTANTS / (zeta w_n), in periods */
@@ -108,6 +125,8 @@ typedef struct {
     float motion_rad;        /**< the integrals' turn off the kept estimate, summed with the leak */
     float motion_leak;       /**< 1 / the hold's settling periods: the sum's leak per period */
     float drift_rad;         /**< the integrals' turn per period at rest (R and voltage errors), learnt */
+    float aim_load_Nm;       /**< T_L the vector is aimed for (the load angle's), turning or at rest */
+    float vector_rate_rad_s; /**< the turning vector's speed, w* + (d delta / dt) / p (rad/s, mechanical) */
     uint32_t engage_periods; /**< PMSTEP_STANDSTILL_ENGAGE_TIME_CONSTANTS / k_w, in periods */
     uint32_t rest_periods;   /**< periods at rest: before the hold, to engage it; in it, since the settling */
 } pmstep_standstill_t;

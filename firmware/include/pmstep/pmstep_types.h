@@ -99,7 +99,9 @@ typedef enum {
     PMSTEP_ERR_HOLD_CURRENT = -132,         /**< hold current <= 0 or not below max_phase_current_A, or too small
                                                  for the load: |T_L - T_detent| above 0.9 k_M I (pmstep_hold.h);
                                                  the standstill hold's current < 0 or not below max_phase_current_A */
-    PMSTEP_ERR_STANDSTILL_KNOWN_LOAD = -133  /**< a standstill hold with known_load_mode (a vector hold needs (6)) */
+    PMSTEP_ERR_STANDSTILL_KNOWN_LOAD = -133, /**< a standstill hold with known_load_mode (a vector hold needs (6)) */
+    PMSTEP_ERR_VECTOR_SPEED = -134           /**< the standstill's low-speed drive: a speed < 0, or > 0 without a
+                                                  hold current */
 } pmstep_status_t;
 
 /** Shortest and longest control period accepted (s): 1 MHz down to 100 Hz. */
@@ -262,6 +264,8 @@ typedef struct {
 typedef struct {
     float hold_current_A; /**< I of the hold, 0 < I < max_phase_current_A; 0 = off (the law holds on the
                                estimate, which drifts). Not with known_load_mode. */
+    float vector_speed_rad_s; /**< below this |speed command| (rad/s) the hold's vector turns at the
+                                   reference speed in place of the law (pmstep_hold.h); 0 = standstill only */
 } pmstep_standstill_config_t;
 
 /** Constant configuration (may live in flash; must outlive the instance). */
