@@ -258,14 +258,15 @@ static pmstep_status_t validate_detection(const pmstep_config_t *cfg)
 }
 
 /* The standstill hold of speed mode (pmstep_hold.h): below the trip current, and a vector hold
- * needs controller (6). */
+ * needs controller (6); its low-speed drive needs the hold. */
 static pmstep_status_t validate_standstill(const pmstep_config_t *cfg)
 {
     const float current_A = cfg->standstill.hold_current_A;
+    const float band_rad_s = cfg->standstill.vector_speed_rad_s;
     if (current_A < 0.0f || (current_A > 0.0f && !(current_A < cfg->limits.max_phase_current_A))) {
         return PMSTEP_ERR_HOLD_CURRENT;
     }
-    if (cfg->standstill.vector_speed_rad_s < 0.0f || (cfg->standstill.vector_speed_rad_s > 0.0f && !(current_A > 0.0f))) {
+    if (band_rad_s < 0.0f || (band_rad_s > 0.0f && !(current_A > 0.0f))) {
         return PMSTEP_ERR_VECTOR_SPEED; /* the low-speed drive turns the hold's vector */
     }
     return (current_A > 0.0f && cfg->known_load_mode) ? PMSTEP_ERR_STANDSTILL_KNOWN_LOAD : PMSTEP_OK;
