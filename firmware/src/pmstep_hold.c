@@ -26,12 +26,28 @@ static float hold_natural_rad_s(const pmstep_law_coeffs_t *law, float current_A,
     return sqrtf(law->pole_pairs * current_A * cos_delta / law->j_over_km);
 }
 
+/* The vector aimed ahead of the rotor at (c, s) by the load angle of T_L + k_M extra_A:
+ * k_M I sin(delta) = T_L - T_detent(rest) + k_M extra_A, k_M from the commissioned model.
+ * @return false, the vector untouched, where |sin delta| is beyond PMSTEP_HOLD_MAX_TORQUE_FRACTION. */
+static bool aim_ahead_of_rotor(pmstep_vector_hold_t *hold, const pmstep_law_coeffs_t *law, float c, float s,
+                               float current_A, float load_Nm, float extra_A, const pmstep_detent_t *detent,
+                               float *cos_delta)
+{
+    const float sin_delta = ((load_Nm - detent->torque_Nm) / (law->km_over_l * law->inductance_H) + extra_A)
+                            / current_A;
+    if (!(pmstep_abs(sin_delta) <= PMSTEP_HOLD_MAX_TORQUE_FRACTION)) {
+        return false;
+    }
+    *cos_delta = sqrtf(1.0f - sin_delta * sin_delta);
+    pmstep_turn(c, s, *cos_delta, sin_delta, &hold->cos_vector, &hold->sin_vector);
+    return true;
+}
+
 pmstep_status_t pmstep_hold_vector(pmstep_t *inst, float cos_rest, float sin_rest, float current_A, float load_Nm)
 {
     const pmstep_law_coeffs_t *law;
     pmstep_vector_hold_t *hold;
     pmstep_detent_t detent;
-    float sin_delta;
     float cos_delta;
     float natural_rad_s;
     float settle_periods;
@@ -49,15 +65,11 @@ pmstep_status_t pmstep_hold_vector(pmstep_t *inst, float cos_rest, float sin_res
         return PMSTEP_ERR_HOLD_CURRENT;
     }
     law = &inst->law_coeffs;
+    hold = &inst->hold;
     detent = pmstep_law_detent(law, cos_rest, sin_rest, 0.0f);
-    /* k_M I sin(delta) = T_L - T_detent(rest), k_M from the commissioned model */
-    sin_delta = (load_Nm - detent.torque_Nm) / (law->km_over_l * law->inductance_H * current_A);
-    if (!(pmstep_abs(sin_delta) <= PMSTEP_HOLD_MAX_TORQUE_FRACTION)) {
+    if (!aim_ahead_of_rotor(hold, law, cos_rest, sin_rest, current_A, load_Nm, 0.0f, &detent, &cos_delta)) {
         return PMSTEP_ERR_HOLD_CURRENT;
     }
-    hold = &inst->hold;
-    cos_delta = sqrtf(1.0f - sin_delta * sin_delta);
-    pmstep_turn(cos_rest, sin_rest, cos_delta, sin_delta, &hold->cos_vector, &hold->sin_vector);
     natural_rad_s = hold_natural_rad_s(law, current_A, cos_delta);
     hold->current_A = current_A;
     hold->damping_s = 2.0f * PMSTEP_HOLD_DAMPING_RATIO * law->pole_pairs / natural_rad_s;
@@ -288,7 +300,6 @@ static bool turn_vector(pmstep_t *inst, pmstep_standstill_t *standstill, const p
     const float turn = law->pole_pairs * out->speed_ref_rad_s * inst->cfg->timing.period_s;
     float c;
     float s;
-    float sin_delta;
     float cos_delta;
     pmstep_detent_t detent;
     pmstep_turn(standstill->keep_cos, standstill->keep_sin, 1.0f - 0.5f * turn * turn, turn, &c, &s);
@@ -301,14 +312,10 @@ static bool turn_vector(pmstep_t *inst, pmstep_standstill_t *standstill, const p
     standstill->keep_sin = s;
     hold->vector_speed_rad_s = out->speed_ref_rad_s;
     detent = pmstep_law_detent(law, c, s, out->speed_ref_rad_s);
-    sin_delta = ((standstill->aim_load_Nm - detent.torque_Nm) / (law->km_over_l * law->inductance_H)
-                 + hold_acceleration_A(law, hold, out))
-                / hold->current_A;
-    if (!(pmstep_abs(sin_delta) <= PMSTEP_HOLD_MAX_TORQUE_FRACTION)) {
+    if (!aim_ahead_of_rotor(hold, law, c, s, hold->current_A, standstill->aim_load_Nm,
+                            hold_acceleration_A(law, hold, out), &detent, &cos_delta)) {
         return false;
     }
-    cos_delta = sqrtf(1.0f - sin_delta * sin_delta);
-    pmstep_turn(c, s, cos_delta, sin_delta, &hold->cos_vector, &hold->sin_vector);
     /* d delta / dt = -(d T_detent / dt) / (k_M I cos delta) */
     standstill->vector_rate_rad_s = out->speed_ref_rad_s
                                     - detent.rate_Nm_s

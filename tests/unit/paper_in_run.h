@@ -3,6 +3,8 @@
 #ifndef PAPER_IN_RUN_H
 #define PAPER_IN_RUN_H
 
+#include <math.h>
+
 #include "pmstep/pmstep.h"
 #include "pmstep/pmstep_angle.h"
 
@@ -15,6 +17,15 @@ static inline pmstep_status_t paper_instance_in_run(pmstep_config_t *cfg, pmstep
     inst->run_started = true;
     pmstep_angle_start(&inst->angle, 0.0f, 0.0f);
     return status;
+}
+
+/* The estimate's angle now (the one the next period's integrals start from), electrical rad. */
+static inline float paper_estimate_angle(const pmstep_t *inst)
+{
+    float c;
+    float s;
+    pmstep_angle_estimate(&inst->angle, &inst->angle_coeffs, inst->angle.i_a_prev_A, inst->angle.i_b_prev_A, &c, &s);
+    return atan2f(s, c);
 }
 
 #endif /* PAPER_IN_RUN_H */

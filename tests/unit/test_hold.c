@@ -262,14 +262,9 @@ static uint32_t standstill_settled(fixture_t *f)
     return settle;
 }
 
-/* The estimate's angle now (the one the next period's integrals start from). */
 static float estimate_angle(const fixture_t *f)
 {
-    float c;
-    float s;
-    pmstep_angle_estimate(&f->inst.angle, &f->inst.angle_coeffs, f->inst.angle.i_a_prev_A, f->inst.angle.i_b_prev_A,
-                          &c, &s);
-    return atan2f(s, c);
+    return paper_estimate_angle(&f->inst);
 }
 
 /* Settled, the estimate is put back every period: a drift of the integrals whose rate times the

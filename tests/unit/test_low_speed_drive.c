@@ -50,14 +50,9 @@ static float angle_of(float c, float s)
     return atan2f(s, c);
 }
 
-/* The estimate's angle now (the one the next period's integrals start from). */
 static float estimate_angle(const fixture_t *f)
 {
-    float c;
-    float s;
-    pmstep_angle_estimate(&f->inst.angle, &f->inst.angle_coeffs, f->inst.angle.i_a_prev_A, f->inst.angle.i_b_prev_A,
-                          &c, &s);
-    return angle_of(c, s);
+    return paper_estimate_angle(&f->inst);
 }
 
 /* A command of SPEED_RAD_S (within the band) reached: the drive engages after the engage time. */
