@@ -48,7 +48,7 @@ pmstep_status_t pmstep_hold_vector(pmstep_t *inst, float cos_rest, float sin_res
     const pmstep_law_coeffs_t *law;
     pmstep_vector_hold_t *hold;
     pmstep_detent_t detent;
-    float cos_delta;
+    float cos_delta = 1.0f; /* aim_ahead_of_rotor's where it aims */
     float natural_rad_s;
     float settle_periods;
     if (inst == NULL) {
@@ -300,7 +300,7 @@ static bool turn_vector(pmstep_t *inst, pmstep_standstill_t *standstill, const p
     const float turn = law->pole_pairs * out->speed_ref_rad_s * inst->cfg->timing.period_s;
     float c;
     float s;
-    float cos_delta;
+    float cos_delta = 1.0f; /* aim_ahead_of_rotor's where it aims */
     pmstep_detent_t detent;
     pmstep_turn(standstill->keep_cos, standstill->keep_sin, 1.0f - 0.5f * turn * turn, turn, &c, &s);
     {
