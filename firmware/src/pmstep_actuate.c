@@ -41,6 +41,20 @@ static float dead_time_voltage(const pmstep_actuate_coeffs_t *coeffs, float curr
     return (coeffs->dead_time_duty * bus_voltage_V + bias_V) * share;
 }
 
+float pmstep_actuate_mean_loss_current(const pmstep_actuate_coeffs_t *coeffs, float band_A, float current_A,
+                                       float sweep_A, float u_V, float bus_voltage_V)
+{
+    const float range_A = sweep_A > band_A ? sweep_A : band_A;
+    const float duty = pmstep_abs(u_V) / bus_voltage_V;
+    /* h = V_bus d (1 - d) T_s / (4 L); T_s / (4 L) is 4 x sign_threshold_A_per_V, T_s / (16 L).
+     * A command beyond the bus (d > 1, limited later) gives h < 0: the share stays within +-1. */
+    const float ripple_A = 4.0f * coeffs->sign_threshold_A_per_V * pmstep_abs(u_V) * (1.0f - duty);
+    /* the parts of the range beyond +h and below -h, each less half the range */
+    const float above_A = clamp_f(current_A - ripple_A, range_A);
+    const float below_A = clamp_f(-current_A - ripple_A, range_A);
+    return (above_A - below_A) * band_A / (2.0f * range_A);
+}
+
 /* Scales (u_a, u_b) so neither H-bridge exceeds the bus; keeps the vector's direction. */
 static bool limit_to_bus(float *u_a_V, float *u_b_V, float bus_voltage_V)
 {

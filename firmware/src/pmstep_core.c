@@ -411,32 +411,28 @@ static pmstep_fault_t supervise_stage(pmstep_t *inst, const pmstep_output_t *out
 }
 
 /* Dead-time compensation in RUN: the current references (i_d*, i_q*) in the stator frame at the
- * angle the voltage acts at (the law's turn, p w-hat T_s (delay + 1/2)). Over the period a phase
- * current sweeps +-h = |the other phase's current| p |w-hat| T_s / 2 about that value, so where it
- * crosses zero within the period the bridge loses the dead time for the part of the period on
- * each side: the mean of sign(i) is i_mid / h within the sweep. It is handed on scaled so that
- * the compensation's linear band (b) gives that mean: i_mid b / h where h > b. */
-static void reference_current_over_period(const pmstep_t *inst, const pmstep_output_t *out,
-                                          pmstep_compensation_input_t *in)
+ * angle the voltage acts at (the law's turn, p w-hat T_s (delay + 1/2)); over the period a phase
+ * current sweeps +-s = |the other phase's current| p |w-hat| T_s / 2 about that value, and its
+ * PWM ripple straddles zero near it (pmstep_actuate_mean_loss_current). */
+static void reference_current_over_period(const pmstep_t *inst, const pmstep_meas_t *sample,
+                                          const pmstep_output_t *out, pmstep_compensation_input_t *in)
 {
     const float band_A = inst->cfg->inverter.dead_time_current_band_A;
     const float half_turn = 0.5f * inst->law_coeffs.pole_pairs * inst->cfg->timing.period_s
                             * pmstep_abs(out->speed_hat_rad_s);
     float cos_act;
     float sin_act;
-    float sweep_a_A;
-    float sweep_b_A;
+    float current_a_A;
+    float current_b_A;
     pmstep_law_acting_angle(&inst->law_coeffs, out->cos_hat, out->sin_hat, out->speed_hat_rad_s, &cos_act, &sin_act);
-    in->sign_current_a_A = cos_act * out->i_d_ref_A - sin_act * out->i_q_ref_A;
-    in->sign_current_b_A = sin_act * out->i_d_ref_A + cos_act * out->i_q_ref_A;
-    sweep_a_A = pmstep_abs(in->sign_current_b_A) * half_turn;
-    sweep_b_A = pmstep_abs(in->sign_current_a_A) * half_turn;
-    if (sweep_a_A > band_A) {
-        in->sign_current_a_A *= band_A / sweep_a_A;
-    }
-    if (sweep_b_A > band_A) {
-        in->sign_current_b_A *= band_A / sweep_b_A;
-    }
+    current_a_A = cos_act * out->i_d_ref_A - sin_act * out->i_q_ref_A;
+    current_b_A = sin_act * out->i_d_ref_A + cos_act * out->i_q_ref_A;
+    in->sign_current_a_A = pmstep_actuate_mean_loss_current(&inst->actuate_coeffs, band_A, current_a_A,
+                                                            pmstep_abs(current_b_A) * half_turn, out->u_a_V,
+                                                            sample->bus_voltage_V);
+    in->sign_current_b_A = pmstep_actuate_mean_loss_current(&inst->actuate_coeffs, band_A, current_b_A,
+                                                            pmstep_abs(current_a_A) * half_turn, out->u_b_V,
+                                                            sample->bus_voltage_V);
 }
 
 /* What the dead-time compensation works from. Both phases in every mode: the undriven phase
@@ -458,7 +454,7 @@ static pmstep_compensation_input_t compensation_input(const pmstep_t *inst, cons
         in.sign_current_a_A = inst->hold.current_A * inst->hold.cos_frame;
         in.sign_current_b_A = inst->hold.current_A * inst->hold.sin_frame;
     } else if (inst->mode == PMSTEP_MODE_RUN) {
-        reference_current_over_period(inst, out, &in);
+        reference_current_over_period(inst, sample, out, &in);
     } else if (out->u_a_V > 0.0f) {
         in.sign_current_a_A = out->u_a_V / inst->cfg->motor.resistance_Ohm;
     } else if (out->u_b_V > 0.0f) {

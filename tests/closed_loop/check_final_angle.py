@@ -2,7 +2,8 @@
 """Checks a pmstep-sil summary.json: the run ended in RUN and the angle estimate's error at its
 end is below --max-final-angle-error, or (a run that shows a drift) at least
 --min-final-angle-error (electrical rad); optionally its largest error after settling below
---max-angle-error. Prints the measured values; exits 1 on a miss."""
+--max-angle-error, and its largest speed error after settling below --max-speed-error. Prints
+the measured values; exits 1 on a miss."""
 import argparse
 import json
 import sys
@@ -18,14 +19,17 @@ def main():
                        help="|angle error| at the run's end must be at least this (electrical rad)")
     parser.add_argument("--max-angle-error", type=float, metavar="RAD",
                         help="the largest |angle error| after settling must be below this (electrical rad)")
+    parser.add_argument("--max-speed-error", type=float, metavar="RAD_S",
+                        help="the largest |w - w*| after settling must be below this (rad/s)")
     args = parser.parse_args()
     with open(args.summary, encoding="utf-8") as f:
         summary = json.load(f)
     mode = summary["final_mode"]
     error = summary["robustness"]["final_angle_error_rad"]
     largest = summary["robustness"]["max_angle_error_rad"]
+    largest_speed = summary["robustness"]["max_speed_error_rad_s"]
     print(f"final mode {mode}, final angle error {error:.4f} rad, largest after settling {largest:.4f} rad "
-          f"at {summary['robustness']['max_angle_error_time_s']:.4f} s")
+          f"at {summary['robustness']['max_angle_error_time_s']:.4f} s, largest speed error {largest_speed:.3f} rad/s")
     if mode != "RUN":
         print("check_final_angle: the run did not end in RUN", file=sys.stderr)
         return 1
@@ -37,6 +41,10 @@ def main():
         return 1
     if args.max_angle_error is not None and not largest < args.max_angle_error:
         print(f"check_final_angle: largest error after settling not below {args.max_angle_error:g} rad",
+              file=sys.stderr)
+        return 1
+    if args.max_speed_error is not None and not largest_speed < args.max_speed_error:
+        print(f"check_final_angle: largest speed error after settling not below {args.max_speed_error:g} rad/s",
               file=sys.stderr)
         return 1
     return 0

@@ -71,6 +71,21 @@ typedef struct {
 bool pmstep_actuate(pmstep_actuator_t *actuator, const pmstep_actuate_coeffs_t *coeffs,
                     const pmstep_compensation_input_t *compensation, float bus_voltage_V, pmstep_output_t *out);
 
+/**
+ * One phase's mean dead-time loss over a period, as the current to hand the compensation
+ * (pmstep_compensation_input_t): the share of the full loss times @p band_A. Over the period
+ * the phase current moves through [i - s, i + s], s = max(@p sweep_A, @p band_A) (the band:
+ * the sample noise). Each leg loses at the edge where it turns on against the current and gains
+ * at the one where it turns off, and the legs' centred windows put those edges at the PWM
+ * ripple's extremes: the loss is sign(i) where the current keeps its sign through the ripple
+ * (|i| > h) and 0 where the ripple straddles zero. h = V_bus d (1 - d) T_s / (4 L) at duty
+ * d = |u| / V_bus: two pulses of d T_s / 2 at (V_bus - u) / L.
+ * @param band_A  the compensation's band (> 0); @param bus_voltage_V  > 0
+ * @return within [-band_A, band_A]
+ */
+float pmstep_actuate_mean_loss_current(const pmstep_actuate_coeffs_t *coeffs, float band_A, float current_A,
+                                       float sweep_A, float u_V, float bus_voltage_V);
+
 /** The currents sampled at the two ends of a period, and the voltage biases (Remark 2). */
 typedef struct {
     float i_start_a_A, i_start_b_A; /**< at the period's start */
