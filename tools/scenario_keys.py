@@ -33,6 +33,7 @@ KEYS = {
     # [controller]: what the firmware is told
     "firmware_dead_time": "controller.inverter.dead_time_s",
     "phase_voltage_sensing": "controller.inverter.phase_voltage_sensing",
+    "ripple_dead_zone": "controller.inverter.ripple_dead_zone",
     # [run] and [load]
     "seed": "run.seed",
     "duration": "run.duration_s",

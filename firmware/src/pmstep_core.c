@@ -413,13 +413,14 @@ static pmstep_fault_t supervise_stage(pmstep_t *inst, const pmstep_output_t *out
 /* Dead-time compensation in RUN: the current references (i_d*, i_q*) in the stator frame at the
  * angle the voltage acts at (the law's turn, p w-hat T_s (delay + 1/2)); over the period a phase
  * current sweeps +-s = |the other phase's current| p |w-hat| T_s / 2 about that value, and its
- * PWM ripple straddles zero near it (pmstep_actuate_mean_loss_current). */
+ * PWM ripple straddles zero near it (pmstep_actuate_mean_loss_current; inverter.ripple_dead_zone). */
 static void reference_current_over_period(const pmstep_t *inst, const pmstep_meas_t *sample,
                                           const pmstep_output_t *out, pmstep_compensation_input_t *in)
 {
     const float band_A = inst->cfg->inverter.dead_time_current_band_A;
     const float half_turn = 0.5f * inst->law_coeffs.pole_pairs * inst->cfg->timing.period_s
                             * pmstep_abs(out->speed_hat_rad_s);
+    const float ripple_share = inst->cfg->inverter.ripple_dead_zone ? 1.0f : 0.0f; /* 0: no ripple, h = 0 */
     float cos_act;
     float sin_act;
     float current_a_A;
@@ -428,10 +429,10 @@ static void reference_current_over_period(const pmstep_t *inst, const pmstep_mea
     current_a_A = cos_act * out->i_d_ref_A - sin_act * out->i_q_ref_A;
     current_b_A = sin_act * out->i_d_ref_A + cos_act * out->i_q_ref_A;
     in->sign_current_a_A = pmstep_actuate_mean_loss_current(&inst->actuate_coeffs, band_A, current_a_A,
-                                                            pmstep_abs(current_b_A) * half_turn, out->u_a_V,
+                                                            pmstep_abs(current_b_A) * half_turn, ripple_share * out->u_a_V,
                                                             sample->bus_voltage_V);
     in->sign_current_b_A = pmstep_actuate_mean_loss_current(&inst->actuate_coeffs, band_A, current_b_A,
-                                                            pmstep_abs(current_a_A) * half_turn, out->u_b_V,
+                                                            pmstep_abs(current_a_A) * half_turn, ripple_share * out->u_b_V,
                                                             sample->bus_voltage_V);
 }
 

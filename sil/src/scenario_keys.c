@@ -59,6 +59,7 @@ const key_t_ scenario_keys[] = {
     {"controller.inverter.dead_time_s", KEY_FLOAT, OFF(controller.inverter.dead_time_s), -BIG, 0, BIG, 0, "dead time per half-bridge to compensate (s); 0 = none"},
     {"controller.inverter.dead_time_current_band_A", KEY_FLOAT, OFF(controller.inverter.dead_time_current_band_A), -BIG, 0, BIG, 0, "dead-time compensation linear within +/- this current (A)"},
     {"controller.inverter.phase_voltage_sensing", KEY_BOOL, OFF(controller.inverter.phase_voltage_sensing), 0, 0, 1, 0, "the drive senses each phase's mean voltage per period (sensors.phase_voltage_*): RUN's flux integrals and observer use it (true/false)"},
+    {"controller.inverter.ripple_dead_zone", KEY_BOOL, OFF(controller.inverter.ripple_dead_zone), 0, 0, 1, 0, "RUN's dead-time compensation counts no loss where the PWM ripple straddles zero (a switching bridge; false for the averaged inverter) (true/false)"},
     {"controller.detection.angle_magnitude_bound", KEY_FLOAT, OFF(controller.detection.angle_magnitude_bound), -BIG, 0, BIG, 0, "|c-hat^2 + s-hat^2 - 1| above -> angle lost; 0 = off"},
     {"controller.detection.speed_consistency_bound_rad_s", KEY_FLOAT, OFF(controller.detection.speed_consistency_bound_rad_s), -BIG, 0, BIG, 0, "|speed from the angle's rotation - omega-hat| above -> inconsistent (rad/s); 0 = off"},
     {"controller.detection.stall_speed_error_rad_s", KEY_FLOAT, OFF(controller.detection.stall_speed_error_rad_s), -BIG, 0, BIG, 0, "|omega-hat - omega*| above -> stall (rad/s); 0 = off"},

@@ -65,10 +65,11 @@ void print_design(const sil_scenario_t *sc, const pmstep_design_report_t *r, boo
            (double)c->standstill.vector_speed_rad_s);
     if (robust) {
         printf("  commissioning: offsets %.3f s, windows %.3f s, L window %.5f s, bias level %.2f, "
-               "dead time %g s (band %g A), i_d* %.3f A; RUN uses the measured R%s\n",
+               "dead time %g s (band %g A, %s), i_d* %.3f A; RUN uses the measured R%s\n",
                (double)c->commissioning.offset_calibration_time_s, (double)c->commissioning.steady_state_window_s,
                (double)c->commissioning.inductance_window_s, (double)c->commissioning.voltage_bias_level_fraction,
                (double)c->inverter.dead_time_s, (double)c->inverter.dead_time_current_band_A,
+               c->inverter.ripple_dead_zone ? "none lost within the PWM ripple" : "no ripple",
                (double)r->magnetising_current_A,
                c->commissioning.use_measured_inductance ? ", L and k_M"
                                                         : " (L, k_M from the datasheet: the rotor swings within the L window)");
@@ -123,9 +124,10 @@ int write_c(const char *path, const sil_scenario_t *sc)
             (double)c->commissioning.voltage_bias_level_fraction, (double)c->commissioning.identification_time_s,
             (double)c->commissioning.identification_min_speed_rad_s,
             c->commissioning.use_identified_mechanics ? "true" : "false");
-    fprintf(f, "    .inverter = {.dead_time_s = %.9gf, .dead_time_current_band_A = %.9gf, .phase_voltage_sensing = %s},\n",
+    fprintf(f, "    .inverter = {.dead_time_s = %.9gf, .dead_time_current_band_A = %.9gf, .phase_voltage_sensing = %s,\n"
+               "                 .ripple_dead_zone = %s},\n",
             (double)c->inverter.dead_time_s, (double)c->inverter.dead_time_current_band_A,
-            c->inverter.phase_voltage_sensing ? "true" : "false");
+            c->inverter.phase_voltage_sensing ? "true" : "false", c->inverter.ripple_dead_zone ? "true" : "false");
     fprintf(f, "    .detection = {.angle_magnitude_bound = %.9gf, .speed_consistency_bound_rad_s = %.9gf,\n"
                "                  .stall_speed_error_rad_s = %.9gf, .observer_residual_bound_A = %.9gf,\n"
                "                  .persistence_s = %.9gf, .max_realignments = %uu},\n",

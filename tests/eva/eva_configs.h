@@ -90,6 +90,7 @@ static void eva_any_config(pmstep_config_t *cfg)
     cfg->inverter.dead_time_s = eva_any_finite();
     cfg->inverter.dead_time_current_band_A = eva_any_finite();
     cfg->inverter.phase_voltage_sensing = Frama_C_nondet(0, 1) != 0;
+    cfg->inverter.ripple_dead_zone = Frama_C_nondet(0, 1) != 0;
     cfg->gains.angle_correction_gain_per_s = eva_any_finite();
     cfg->gains.current_integral_gain_per_s2 = eva_any_finite();
     cfg->motor.detent_torque_Nm = eva_any_finite();

@@ -32,6 +32,7 @@ static inline pmstep_config_t pmstep_test_features_config(void)
     cfg.timing.computational_delay_periods = 1u;
     cfg.standstill.hold_current_A = 7.5f;
     cfg.standstill.vector_speed_rad_s = 2.0f; /* the low-speed drive below 2 rad/s */
+    cfg.inverter.ripple_dead_zone = true;     /* the compensation's ripple dead zone */
     return cfg;
 }
 

@@ -222,6 +222,9 @@ static void phase_voltage_sensing_is_passed_on(void **state)
     assert_int_equal(pmstep_design(&in, &with, &report), PMSTEP_OK);
     assert_false(without.inverter.phase_voltage_sensing);
     assert_true(with.inverter.phase_voltage_sensing);
+    /* the compensation's ripple dead zone: robust mode without sensing only */
+    assert_true(without.inverter.ripple_dead_zone);
+    assert_false(with.inverter.ripple_dead_zone);
     with.inverter.phase_voltage_sensing = false;
     assert_memory_equal(&with.gains, &without.gains, sizeof with.gains);
     assert_int_equal(pmstep_validate_config(&with), PMSTEP_OK);
@@ -253,6 +256,7 @@ static void low_speed_drive_below_twice_the_dead_time_loss(void **state)
         assert_float_equal(cfg.standstill.vector_speed_rad_s, 0.0f, 0.0f);
         assert_int_equal(pmstep_design(&ideal, &cfg, &report), PMSTEP_OK);
         assert_float_equal(cfg.standstill.vector_speed_rad_s, 0.0f, 0.0f);
+        assert_false(cfg.inverter.ripple_dead_zone); /* no compensation to shape */
     }
 }
 

@@ -67,6 +67,7 @@ static const pmstep_console_config_entry_t table[] = {
     BOOL(inverter.phase_voltage_sensing),
     F32(standstill.hold_current_A),
     F32(standstill.vector_speed_rad_s),
+    BOOL(inverter.ripple_dead_zone),
 };
 
 const pmstep_console_config_entry_t *pmstep_console_config_table(uint32_t *count)

@@ -81,6 +81,7 @@ bool pmstep_actuate(pmstep_actuator_t *actuator, const pmstep_actuate_coeffs_t *
  * (|i| > h) and 0 where the ripple straddles zero. h = V_bus d (1 - d) T_s / (4 L) at duty
  * d = |u| / V_bus: two pulses of d T_s / 2 at (V_bus - u) / L.
  * @param band_A  the compensation's band (> 0); @param bus_voltage_V  > 0
+ * @param u_V  the phase's command; 0 for a bridge without ripple (h = 0)
  * @return within [-band_A, band_A]
  */
 float pmstep_actuate_mean_loss_current(const pmstep_actuate_coeffs_t *coeffs, float band_A, float current_A,

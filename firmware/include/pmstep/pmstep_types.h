@@ -244,6 +244,10 @@ typedef struct {
                                          steady states take it for R (so R is as that sensor sees it, and the
                                          voltage bias only what it leaves unexplained); its offsets come from
                                          the offset calibration. false = not measured (fields unread) */
+    bool ripple_dead_zone;          /**< the bridge's PWM ripple is taken into RUN's compensation: no loss
+                                         where it straddles zero (pmstep_actuate_mean_loss_current; the
+                                         legs' windows centred, as the ports drive them). false = a bridge
+                                         without ripple (the SIL's averaged inverter): the sweep's mean only */
 } pmstep_inverter_config_t;
 
 /** Detection in RUN, every PMSTEP_DETECTION_DECIMATION periods; a bound of 0 switches its detector off.
