@@ -420,7 +420,9 @@ static void reference_current_over_period(const pmstep_t *inst, const pmstep_mea
     const float band_A = inst->cfg->inverter.dead_time_current_band_A;
     const float half_turn = 0.5f * inst->law_coeffs.pole_pairs * inst->cfg->timing.period_s
                             * pmstep_abs(out->speed_hat_rad_s);
-    const float ripple_share = inst->cfg->inverter.ripple_dead_zone ? 1.0f : 0.0f; /* 0: no ripple, h = 0 */
+    /* the command's voltage sets the ripple; a bridge without ripple is handed 0 V (h = 0), as a
+     * factor rather than a branch (one instruction a period less) */
+    const float ripple_voltage_factor = inst->cfg->inverter.ripple_dead_zone ? 1.0f : 0.0f;
     float cos_act;
     float sin_act;
     float current_a_A;
@@ -429,11 +431,11 @@ static void reference_current_over_period(const pmstep_t *inst, const pmstep_mea
     current_a_A = cos_act * out->i_d_ref_A - sin_act * out->i_q_ref_A;
     current_b_A = sin_act * out->i_d_ref_A + cos_act * out->i_q_ref_A;
     in->sign_current_a_A = pmstep_actuate_mean_loss_current(&inst->actuate_coeffs, band_A, current_a_A,
-                                                            pmstep_abs(current_b_A) * half_turn, ripple_share * out->u_a_V,
-                                                            sample->bus_voltage_V);
+                                                            pmstep_abs(current_b_A) * half_turn,
+                                                            ripple_voltage_factor * out->u_a_V, sample->bus_voltage_V);
     in->sign_current_b_A = pmstep_actuate_mean_loss_current(&inst->actuate_coeffs, band_A, current_b_A,
-                                                            pmstep_abs(current_a_A) * half_turn, ripple_share * out->u_b_V,
-                                                            sample->bus_voltage_V);
+                                                            pmstep_abs(current_a_A) * half_turn,
+                                                            ripple_voltage_factor * out->u_b_V, sample->bus_voltage_V);
 }
 
 /* What the dead-time compensation works from. Both phases in every mode: the undriven phase

@@ -124,8 +124,8 @@ int write_c(const char *path, const sil_scenario_t *sc)
             (double)c->commissioning.voltage_bias_level_fraction, (double)c->commissioning.identification_time_s,
             (double)c->commissioning.identification_min_speed_rad_s,
             c->commissioning.use_identified_mechanics ? "true" : "false");
-    fprintf(f, "    .inverter = {.dead_time_s = %.9gf, .dead_time_current_band_A = %.9gf, .phase_voltage_sensing = %s,\n"
-               "                 .ripple_dead_zone = %s},\n",
+    fprintf(f, "    .inverter = {.dead_time_s = %.9gf, .dead_time_current_band_A = %.9gf,\n"
+               "                 .phase_voltage_sensing = %s, .ripple_dead_zone = %s},\n",
             (double)c->inverter.dead_time_s, (double)c->inverter.dead_time_current_band_A,
             c->inverter.phase_voltage_sensing ? "true" : "false", c->inverter.ripple_dead_zone ? "true" : "false");
     fprintf(f, "    .detection = {.angle_magnitude_bound = %.9gf, .speed_consistency_bound_rad_s = %.9gf,\n"

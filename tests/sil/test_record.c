@@ -63,7 +63,8 @@ static void config_round_trips_through_the_words(void **state)
                 && out.commissioning.use_identified_mechanics);
     assert_true(out.inverter.phase_voltage_sensing && w[44] == 1u);
     assert_true(out.standstill.hold_current_A == in.standstill.hold_current_A && w[45] == sil_record_bits(1.75f));
-    assert_true(out.standstill.vector_speed_rad_s == in.standstill.vector_speed_rad_s && w[46] == sil_record_bits(5.75f));
+    assert_true(out.standstill.vector_speed_rad_s == in.standstill.vector_speed_rad_s
+                && w[46] == sil_record_bits(5.75f));
     /* The last word is the last field. */
     assert_true(out.inverter.ripple_dead_zone && w[SIL_RECORD_CONFIG_WORDS - 1u] == 1u);
 }

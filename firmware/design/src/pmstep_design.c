@@ -255,8 +255,8 @@ static void design_commissioning(const pmstep_design_input_t *in, float window_s
     /* The ports' centred PWM has a ripple: no dead-time loss where it straddles zero. Without
      * phase-voltage sensing the flux integrals take the compensation's figure for the bridge's
      * voltage, and that is where it counts (DESIGN.md section 8); a sensing drive integrates the
-     * sensed voltage, and its Monte Carlo gained nothing from it (181 / 194 / 200 / 200 against
-     * 180 / 196 / 200 / 200). */
+     * sensed voltage, and its Monte Carlo gained nothing from it (181 / 194 / 200 / 200 with it,
+     * 182 / 195 / 200 / 200 without). */
     cfg->inverter.ripple_dead_zone = robust && !in->phase_voltage_sensing;
     report->magnetising_current_A = robust ? MAGNETISING_PER_RATED_CURRENT * in->rated_current_A : 0.0f;
     /* Robust mode holds a zero speed command with a vector at rated current (pmstep_hold.h): the
