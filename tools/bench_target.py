@@ -221,6 +221,12 @@ def model_cycles(profile_path, insns, penalty, pipelining):
 
 
 # ---- static stack bound: -fstack-usage of the non-LTO library + its call graph ----
+def clone_name(symbol):
+    """A GCC clone's name without its numbers: the .su file lists aim.constprop.isra for the
+    object's aim.constprop.0.isra.0."""
+    return re.sub(r"\.[0-9]+(?=\.|$)", "", symbol)
+
+
 def static_stack(root_function="pmstep_step"):
     su_dir = ARM_M4F / "firmware" / "CMakeFiles" / "pmstep_core.dir" / "src"
     lib = ARM_M4F / "firmware" / "libpmstep_core.a"
@@ -228,17 +234,17 @@ def static_stack(root_function="pmstep_step"):
     for su in su_dir.glob("*.su"):
         for l in su.read_text().splitlines():
             name, size, _kind = l.rsplit("\t", 2)
-            frames[name.rsplit(":", 1)[1]] = int(size)
+            frames[clone_name(name.rsplit(":", 1)[1])] = int(size)
     dis = run(["arm-none-eabi-objdump", "-dr", lib], stdout=subprocess.PIPE, text=True).stdout
     calls, current = collections.defaultdict(set), None
     for l in dis.splitlines():
         m = re.match(r"^[0-9a-f]+ <([^>]+)>:$", l)
         if m:
-            current = m.group(1)
+            current = clone_name(m.group(1))
             continue
         m = re.search(r"R_ARM_THM_(?:CALL|JUMP24)\s+(\S+)", l)
         if m and current:
-            calls[current].add(m.group(1))
+            calls[current].add(clone_name(m.group(1)))
     unknown = set()
 
     def depth(f, seen=()):

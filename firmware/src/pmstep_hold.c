@@ -26,20 +26,26 @@ static float hold_natural_rad_s(const pmstep_law_coeffs_t *law, float current_A,
     return sqrtf(law->pole_pairs * current_A * cos_delta / law->j_over_km);
 }
 
+/* Where a vector is aimed: its direction and the cosine of its load angle delta. */
+typedef struct {
+    float cos_vector;
+    float sin_vector;
+    float cos_delta;
+} hold_aim_t;
+
 /* The vector aimed ahead of the rotor at (c, s) by the load angle of T_L + k_M extra_A:
  * k_M I sin(delta) = T_L - T_detent(rest) + k_M extra_A, k_M from the commissioned model.
- * @return false, the vector untouched, where |sin delta| is beyond PMSTEP_HOLD_MAX_TORQUE_FRACTION. */
-static bool aim_ahead_of_rotor(pmstep_vector_hold_t *hold, const pmstep_law_coeffs_t *law, float c, float s,
-                               float current_A, float load_Nm, float extra_A, const pmstep_detent_t *detent,
-                               float *cos_delta)
+ * @return false, @p aim untouched, where |sin delta| is beyond PMSTEP_HOLD_MAX_TORQUE_FRACTION. */
+static bool aim_ahead_of_rotor(const pmstep_law_coeffs_t *law, float c, float s, float current_A, float load_Nm,
+                               float extra_A, const pmstep_detent_t *detent, hold_aim_t *aim)
 {
     const float sin_delta = ((load_Nm - detent->torque_Nm) / (law->km_over_l * law->inductance_H) + extra_A)
                             / current_A;
     if (!(pmstep_abs(sin_delta) <= PMSTEP_HOLD_MAX_TORQUE_FRACTION)) {
         return false;
     }
-    *cos_delta = sqrtf(1.0f - sin_delta * sin_delta);
-    pmstep_turn(c, s, *cos_delta, sin_delta, &hold->cos_vector, &hold->sin_vector);
+    aim->cos_delta = sqrtf(1.0f - sin_delta * sin_delta);
+    pmstep_turn(c, s, aim->cos_delta, sin_delta, &aim->cos_vector, &aim->sin_vector);
     return true;
 }
 
@@ -48,7 +54,7 @@ pmstep_status_t pmstep_hold_vector(pmstep_t *inst, float cos_rest, float sin_res
     const pmstep_law_coeffs_t *law;
     pmstep_vector_hold_t *hold;
     pmstep_detent_t detent;
-    float cos_delta = 1.0f; /* aim_ahead_of_rotor's where it aims */
+    hold_aim_t aim = {1.0f, 0.0f, 1.0f}; /* aim_ahead_of_rotor's */
     float natural_rad_s;
     float settle_periods;
     if (inst == NULL) {
@@ -67,10 +73,12 @@ pmstep_status_t pmstep_hold_vector(pmstep_t *inst, float cos_rest, float sin_res
     law = &inst->law_coeffs;
     hold = &inst->hold;
     detent = pmstep_law_detent(law, cos_rest, sin_rest, 0.0f);
-    if (!aim_ahead_of_rotor(hold, law, cos_rest, sin_rest, current_A, load_Nm, 0.0f, &detent, &cos_delta)) {
+    if (!aim_ahead_of_rotor(law, cos_rest, sin_rest, current_A, load_Nm, 0.0f, &detent, &aim)) {
         return PMSTEP_ERR_HOLD_CURRENT;
     }
-    natural_rad_s = hold_natural_rad_s(law, current_A, cos_delta);
+    hold->cos_vector = aim.cos_vector;
+    hold->sin_vector = aim.sin_vector;
+    natural_rad_s = hold_natural_rad_s(law, current_A, aim.cos_delta);
     hold->current_A = current_A;
     hold->damping_s = 2.0f * PMSTEP_HOLD_DAMPING_RATIO * law->pole_pairs / natural_rad_s;
     hold->quiet_band_rad_s = PMSTEP_HOLD_QUIET_FRACTION * natural_rad_s / law->pole_pairs;
@@ -223,6 +231,26 @@ static void aim_clear_of_phase_axes(float *c, float *s, float min_sin)
     }
 }
 
+/* The rest (c, s) turned with the vector T_L-hat's load angle ahead of it, so that the vector's
+ * currents are clear of zero by min_sin (aim_clear_of_phase_axes); the load angle is the one at the
+ * rest before the turn (the detent torque's change over the turn is left, a few hundredths of a
+ * radian). Unchanged where the load is beyond the vector's pull (pmstep_hold_vector refuses it). */
+static void rest_for_clear_vector(const pmstep_t *inst, float *c, float *s, float min_sin)
+{
+    const pmstep_law_coeffs_t *law = &inst->law_coeffs;
+    const pmstep_detent_t detent = pmstep_law_detent(law, *c, *s, 0.0f);
+    hold_aim_t aim = {1.0f, 0.0f, 1.0f};
+    if (aim_ahead_of_rotor(law, *c, *s, inst->cfg->standstill.hold_current_A, inst->observer.load_hat_Nm, 0.0f,
+                           &detent, &aim)) {
+        float cos_clear = aim.cos_vector;
+        float sin_clear = aim.sin_vector;
+        aim_clear_of_phase_axes(&cos_clear, &sin_clear, min_sin);
+        /* the rest turned by the vector's turn, (cos_clear, sin_clear) against (cos_vector, sin_vector) */
+        pmstep_turn(*c, *s, cos_clear * aim.cos_vector + sin_clear * aim.sin_vector,
+                    sin_clear * aim.cos_vector - cos_clear * aim.sin_vector, c, s);
+    }
+}
+
 /* Not yet holding: the hold once the zero command is reached and the rotor has been at rest for
  * engage_periods, aimed at the estimate (normalised, then clear of the phase axes) ahead by
  * T_L-hat's load angle. */
@@ -254,7 +282,7 @@ static void standstill_engage(pmstep_t *inst, pmstep_standstill_t *standstill, c
             c = out->cos_hat / length;
             s = out->sin_hat / length;
             if (!standstill_turning(inst, standstill, out)) { /* a turning vector's currents cross zero anyway */
-                aim_clear_of_phase_axes(&c, &s, clear_sin < HOLD_MAX_CLEAR_SIN ? clear_sin : HOLD_MAX_CLEAR_SIN);
+                rest_for_clear_vector(inst, &c, &s, clear_sin < HOLD_MAX_CLEAR_SIN ? clear_sin : HOLD_MAX_CLEAR_SIN);
             }
         }
         /* refused (a load beyond the vector's pull, an estimate at the origin): the law holds on */
@@ -300,7 +328,7 @@ static bool turn_vector(pmstep_t *inst, pmstep_standstill_t *standstill, const p
     const float turn = law->pole_pairs * out->speed_ref_rad_s * inst->cfg->timing.period_s;
     float c;
     float s;
-    float cos_delta = 1.0f; /* aim_ahead_of_rotor's where it aims */
+    hold_aim_t aim = {1.0f, 0.0f, 1.0f}; /* aim_ahead_of_rotor's */
     pmstep_detent_t detent;
     pmstep_turn(standstill->keep_cos, standstill->keep_sin, 1.0f - 0.5f * turn * turn, turn, &c, &s);
     {
@@ -312,15 +340,17 @@ static bool turn_vector(pmstep_t *inst, pmstep_standstill_t *standstill, const p
     standstill->keep_sin = s;
     hold->vector_speed_rad_s = out->speed_ref_rad_s;
     detent = pmstep_law_detent(law, c, s, out->speed_ref_rad_s);
-    if (!aim_ahead_of_rotor(hold, law, c, s, hold->current_A, standstill->aim_load_Nm,
-                            hold_acceleration_A(law, hold, out), &detent, &cos_delta)) {
+    if (!aim_ahead_of_rotor(law, c, s, hold->current_A, standstill->aim_load_Nm, hold_acceleration_A(law, hold, out),
+                            &detent, &aim)) {
         return false;
     }
+    hold->cos_vector = aim.cos_vector;
+    hold->sin_vector = aim.sin_vector;
     /* d delta / dt = -(d T_detent / dt) / (k_M I cos delta) */
     standstill->vector_rate_rad_s = out->speed_ref_rad_s
                                     - detent.rate_Nm_s
                                           / (law->pole_pairs * law->km_over_l * law->inductance_H * hold->current_A
-                                             * cos_delta);
+                                             * aim.cos_delta);
     return true;
 }
 

@@ -385,32 +385,44 @@ static void standstill_follows_a_held_rotor_that_moves(void **state)
 }
 
 /* With a compensation band the standstill aims its vector so that both phase currents are
- * PMSTEP_HOLD_PHASE_CLEARANCE_BANDS bands clear of zero; without one, at the estimate. */
+ * PMSTEP_HOLD_PHASE_CLEARANCE_BANDS bands clear of zero; without one, at the estimate. The
+ * clearance is of the vector, T_L-hat's load angle ahead of the rest: with k_M I = 15 N m and
+ * T_L-hat = 3 N m (delta = asin 0.2), an estimate at 0.01 - delta put the vector 0.01 rad off phase
+ * a's axis, with phase b's current almost zero; the rest is turned with the vector. */
 static void standstill_aims_clear_of_the_phase_axes(void **state)
 {
     static const struct {
-        float cos_hat, sin_hat, band_A, cos_vector, sin_vector;
+        float cos_hat, sin_hat, band_A, load_Nm, cos_vector, sin_vector;
     } cases[] = {
         /* 25 x 0.01 A of 7.5 A: the smaller component at least 1/30 */
-        {1.0f, 0.0f, 0.01f, 0.99944427f, 1.0f / 30.0f},
-        {-0.9999f, -0.0141418f, 0.01f, -0.99944427f, -1.0f / 30.0f},
-        {0.02f, -0.9998f, 0.01f, 1.0f / 30.0f, -0.99944427f},
-        {0.6f, 0.8f, 0.01f, 0.6f, 0.8f},    /* clear already */
-        {1.0f, 0.0f, 0.0f, 1.0f, 0.0f},     /* no band: at the estimate */
-        {1.0f, 0.0f, 1.0f, 0.70710678f, 0.70710678f}, /* a clearance beyond the diagonal: the diagonal */
+        {1.0f, 0.0f, 0.01f, 0.0f, 0.99944427f, 1.0f / 30.0f},
+        {-0.9999f, -0.0141418f, 0.01f, 0.0f, -0.99944427f, -1.0f / 30.0f},
+        {0.02f, -0.9998f, 0.01f, 0.0f, 1.0f / 30.0f, -0.99944427f},
+        {0.6f, 0.8f, 0.01f, 0.0f, 0.6f, 0.8f},    /* clear already */
+        {1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f},     /* no band: at the estimate */
+        {1.0f, 0.0f, 1.0f, 0.0f, 0.70710678f, 0.70710678f}, /* a clearance beyond the diagonal: the diagonal */
+        /* the estimate clear, its vector not: at 0.01 rad from phase a's axis */
+        {0.9817469f, -0.1901922f, 0.01f, 3.0f, 0.99944427f, 1.0f / 30.0f},
+        {0.9817469f, 0.1901922f, 0.01f, -3.0f, 0.99944427f, -1.0f / 30.0f},
     };
     size_t k;
     (void)state;
     for (k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
         fixture_t f;
         pmstep_output_t out = at_rest_output(cases[k].cos_hat, cases[k].sin_hat);
+        const float delta_rad = asinf(cases[k].load_Nm / 15.0f);
+        float rest_rad;
         fixture_with_standstill(&f);
         f.cfg.inverter.dead_time_current_band_A = cases[k].band_A;
+        f.inst.observer.load_hat_Nm = cases[k].load_Nm;
         while (!f.inst.hold.active) {
             pmstep_standstill_advance(&f.inst, &out);
         }
         assert_float_equal(f.inst.hold.cos_vector, cases[k].cos_vector, 1e-5f);
         assert_float_equal(f.inst.hold.sin_vector, cases[k].sin_vector, 1e-5f);
+        /* the rest the vector holds: the load angle behind it */
+        rest_rad = atan2f(f.inst.scratch.run.standstill.keep_sin, f.inst.scratch.run.standstill.keep_cos);
+        assert_float_equal(rest_rad, atan2f(cases[k].sin_vector, cases[k].cos_vector) - delta_rad, 1e-5f);
     }
 }
 

@@ -36,9 +36,10 @@
  * T_L-hat set to the held rotor's balance k_M I sin(v - x-hat) + T_detent(x-hat), and the rest
  * starts again (the estimate follows the integrals for a settling time, then is kept there).
  * That turn is read in the phase with the smaller current, whose dead-time loss is unknown
- * while its current crosses zero: the standstill aims its vector so that both phase currents
- * stay PMSTEP_HOLD_PHASE_CLEARANCE_BANDS compensation bands clear of zero (the rotor moves by
- * at most asin(clearance / I) to get there; nothing with a zero band).
+ * while its current crosses zero: the standstill aims its vector, T_L-hat's load angle ahead
+ * of the rest, so that both phase currents stay PMSTEP_HOLD_PHASE_CLEARANCE_BANDS compensation
+ * bands clear of zero, and the rest with it (the rotor moves by at most asin(clearance / I) to
+ * get there; nothing with a zero band).
  *
  * Low-speed drive (cfg->standstill.vector_speed_rad_s = w_b > 0): below the speed whose back EMF
  * is of the order of the voltage errors (the dead time's loss), the flux integrals' phase is off
