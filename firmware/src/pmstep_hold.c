@@ -252,8 +252,8 @@ static void rest_for_clear_vector(const pmstep_t *inst, float *c, float *s, floa
 }
 
 /* Not yet holding: the hold once the zero command is reached and the rotor has been at rest for
- * engage_periods, aimed at the estimate (normalised, then clear of the phase axes) ahead by
- * T_L-hat's load angle. */
+ * engage_periods, aimed at the estimate (normalised) ahead by T_L-hat's load angle, the vector
+ * and its rest turned clear of the phase axes (rest_for_clear_vector). */
 static void standstill_engage(pmstep_t *inst, pmstep_standstill_t *standstill, const pmstep_output_t *out)
 {
     const pmstep_ref_t *ref = &inst->speed_ref;
