@@ -8,6 +8,12 @@
 #include "pmstep/pmstep.h"
 #include "pmstep/pmstep_angle.h"
 
+/* A configuration and the instance that points at it: the vector hold's tests' fixture. */
+typedef struct {
+    pmstep_config_t cfg;
+    pmstep_t inst;
+} paper_run_t;
+
 static inline pmstep_status_t paper_instance_in_run(pmstep_config_t *cfg, pmstep_t *inst)
 {
     pmstep_status_t status;

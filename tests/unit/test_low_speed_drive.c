@@ -21,12 +21,7 @@
 #define SPEED_RAD_S 5.0f
 #define LOAD_NM 3.0f /* a load angle of asin(0.2) at k_M I = 15 N m */
 
-typedef struct {
-    pmstep_config_t cfg;
-    pmstep_t inst;
-} fixture_t;
-
-static void fixture_with_drive(fixture_t *f)
+static void fixture_with_drive(paper_run_t *f)
 {
     assert_int_equal(paper_instance_in_run(&f->cfg, &f->inst), PMSTEP_OK);
     f->cfg.standstill.hold_current_A = HOLD_A;
@@ -50,13 +45,13 @@ static float angle_of(float c, float s)
     return atan2f(s, c);
 }
 
-static float estimate_angle(const fixture_t *f)
+static float estimate_angle(const paper_run_t *f)
 {
     return paper_estimate_angle(&f->inst);
 }
 
 /* A command of SPEED_RAD_S (within the band) reached: the drive engages after the engage time. */
-static void engaged_turning(fixture_t *f, const pmstep_output_t *out)
+static void engaged_turning(paper_run_t *f, const pmstep_output_t *out)
 {
     uint32_t n;
     fixture_with_drive(f);
@@ -95,7 +90,7 @@ static void low_speed_drive_validated(void **state)
  * the estimate is the kept rotor of the period throughout (the integrals are not followed). */
 static void low_speed_drive_turns_the_vector_at_the_reference_speed(void **state)
 {
-    fixture_t f;
+    paper_run_t f;
     const pmstep_output_t out = turning_output();
     const float turn_rad = 6.0f * SPEED_RAD_S * 50e-6f;
     const float load_angle_rad = asinf(LOAD_NM / (2.0f * HOLD_A));
@@ -128,7 +123,7 @@ static void low_speed_drive_turns_the_vector_at_the_reference_speed(void **state
  * where the detent's share (4 p T_d w* / (p k_M I cos delta)) swings by up to 2 rad/s. */
 static void low_speed_drive_vector_rate_follows_the_detent(void **state)
 {
-    fixture_t f;
+    paper_run_t f;
     const pmstep_output_t out = turning_output();
     const float period_s = 50e-6f;
     float largest_share_rad_s = 0.0f;
@@ -161,7 +156,7 @@ static void low_speed_drive_vector_rate_follows_the_detent(void **state)
  * on by p w_v T_s (delay + 1/2), which the dead-time compensation's signs use too. */
 static void low_speed_drive_voltage_turns_with_the_vector(void **state)
 {
-    fixture_t f;
+    paper_run_t f;
     pmstep_observer_input_t obs_in = {0};
     pmstep_output_t out = {0};
     const float act_rad = 6.0f * SPEED_RAD_S * 50e-6f * 0.5f; /* paper: no computational delay */
@@ -195,7 +190,7 @@ static void low_speed_drive_voltage_turns_with_the_vector(void **state)
  * load beyond 0.9 k_M I is beyond the vector's pull: the law takes over. */
 static void low_speed_drive_hands_over_to_the_law(void **state)
 {
-    fixture_t f;
+    paper_run_t f;
     const pmstep_output_t out = turning_output();
     uint32_t n;
     (void)state;
@@ -222,7 +217,7 @@ static void low_speed_drive_hands_over_to_the_law(void **state)
  * the estimate over (the first settling time taken from the integrals, then kept). */
 static void low_speed_drive_stops_at_rest(void **state)
 {
-    fixture_t f;
+    paper_run_t f;
     pmstep_output_t out = turning_output();
     float c;
     float s;
@@ -250,7 +245,7 @@ static void low_speed_drive_stops_at_rest(void **state)
 /* Without the band (0) a command within 10 rad/s is the law's: nothing engages. */
 static void low_speed_drive_off_without_a_band(void **state)
 {
-    fixture_t f;
+    paper_run_t f;
     const pmstep_output_t out = turning_output();
     uint32_t n;
     (void)state;
