@@ -40,6 +40,11 @@
 #define MIN_INDUCTANCE_WINDOW_PERIODS 4.0f
 #define VOLTAGE_BIAS_LEVEL 0.5f
 #define MAGNETISING_PER_RATED_CURRENT 0.125f
+/* Robust mode, currents sensed only: the magnetising current is this many times the current one
+ * period's dead-time volt-seconds move, within [MAGNETISING_PER_RATED_CURRENT,
+ * MAX_MAGNETISING_PER_RATED_CURRENT] x I (magnetising_current, DESIGN.md section 8). */
+#define MAGNETISING_PER_DEAD_TIME_CURRENT 25.0f
+#define MAX_MAGNETISING_PER_RATED_CURRENT 0.5f
 #define MIN_DEAD_TIME_BAND_A 1e-4f
 /* Robust mode, currents sensed only: the low-speed drive below the speed whose back EMF is this
  * many times the dead time's loss V_bus t_d / T_s (DESIGN.md, "The low-speed drive"). */
@@ -218,6 +223,22 @@ static float design_alignment(const pmstep_design_input_t *in, pmstep_config_t *
     return window_s;
 }
 
+/* i_d* of robust mode: I/8, or more where the flux integrals take the compensation's figure for
+ * the dead time's loss (no phase-voltage sensing): MAGNETISING_PER_DEAD_TIME_CURRENT times the
+ * current one period's dead-time volt-seconds move, 2 V_bus t_d / L, at most I/2 (DESIGN.md
+ * section 8). The faster a light-load phase current passes zero, the fewer periods the integrals
+ * take on the compensation's word for the sign of its loss. */
+static float magnetising_current(const pmstep_design_input_t *in)
+{
+    const float floor_A = MAGNETISING_PER_RATED_CURRENT * in->rated_current_A;
+    const float dead_time_current_A = 2.0f * in->bus_voltage_V * in->dead_time_s / in->motor.inductance_H;
+    if (in->phase_voltage_sensing) {
+        return floor_A;
+    }
+    return min2(max2(MAGNETISING_PER_DEAD_TIME_CURRENT * dead_time_current_A, floor_A),
+                MAX_MAGNETISING_PER_RATED_CURRENT * in->rated_current_A);
+}
+
 static void design_commissioning(const pmstep_design_input_t *in, float window_s, pmstep_config_t *cfg,
                                  pmstep_design_report_t *report)
 {
@@ -258,7 +279,7 @@ static void design_commissioning(const pmstep_design_input_t *in, float window_s
      * sensed voltage, and its Monte Carlo gained nothing from it (181 / 194 / 200 / 200 with it,
      * 182 / 195 / 200 / 200 without). */
     cfg->inverter.ripple_dead_zone = robust && !in->phase_voltage_sensing;
-    report->magnetising_current_A = robust ? MAGNETISING_PER_RATED_CURRENT * in->rated_current_A : 0.0f;
+    report->magnetising_current_A = robust ? magnetising_current(in) : 0.0f;
     /* Robust mode holds a zero speed command with a vector at rated current (pmstep_hold.h): the
      * estimate would drift there with what is left of the voltage errors. */
     cfg->standstill.hold_current_A = robust ? in->rated_current_A : 0.0f;
