@@ -261,13 +261,15 @@ static void low_speed_drive_below_twice_the_dead_time_loss(void **state)
 }
 
 /* The magnetising current of robust mode (DESIGN.md section 8): 25 times the current one period's
- * dead-time volt-seconds move, 2 V t_d / L, within [I/8, I/2]; I/8 with phase-voltage sensing
+ * dead-time volt-seconds move, 2 V t_d / L, within [I/8, I/4]; I/8 with phase-voltage sensing
  * (the integrals take the sensed voltage), 0 in the paper's design. At 1 us: the paper motor
- * 25 x 0.016 A = 0.4 A, below its floor of 1 A; 17HS4401 25 x 2 x 24 V x 1 us / 2.8 mH = 0.4286 A;
- * BJ42D29 0.4615 A; AS1050 2.79 A, above its cap of 2.5 A. */
+ * 25 x 0.016 A = 0.4 A, below its floor of 1 A; 17HS4401 25 x 2 x 24 V x 1 us / 2.8 mH = 0.4286 A,
+ * above its cap of 0.425 A; BJ42D29 0.4615 A, capped at 0.375 A; AS1050 2.79 A, capped at 1.25 A.
+ * The same at 0.5 us: 17HS4401 0.2143 A, BJ42D29 0.2308 A (within), AS1050 1.25 A (capped). */
 static void magnetising_current_follows_the_dead_time(void **state)
 {
-    static const float expected_A[] = {1.0f, 0.428571f, 0.461538f, 2.5f};
+    static const float expected_A[] = {1.0f, 0.425f, 0.375f, 1.25f};
+    static const float expected_half_dead_time_A[] = {1.0f, 0.214286f, 0.230769f, 1.25f};
     size_t n;
     (void)state;
     for (n = 0; n < sizeof presets / sizeof presets[0]; ++n) {
@@ -277,6 +279,10 @@ static void magnetising_current_follows_the_dead_time(void **state)
         pmstep_design_report_t report;
         assert_int_equal(pmstep_design(&in, &cfg, &report), PMSTEP_OK);
         assert_float_equal(report.magnetising_current_A, expected_A[n], 1e-5f);
+        in.dead_time_s = 0.5e-6f;
+        assert_int_equal(pmstep_design(&in, &cfg, &report), PMSTEP_OK);
+        assert_float_equal(report.magnetising_current_A, expected_half_dead_time_A[n], 1e-5f);
+        in.dead_time_s = 1e-6f;
         in.phase_voltage_sensing = true;
         assert_int_equal(pmstep_design(&in, &cfg, &report), PMSTEP_OK);
         assert_float_equal(report.magnetising_current_A, 0.125f * presets[n].rated_A, 1e-6f);

@@ -44,7 +44,9 @@
  * period's dead-time volt-seconds move, within [MAGNETISING_PER_RATED_CURRENT,
  * MAX_MAGNETISING_PER_RATED_CURRENT] x I (magnetising_current, DESIGN.md section 8). */
 #define MAGNETISING_PER_DEAD_TIME_CURRENT 25.0f
-#define MAX_MAGNETISING_PER_RATED_CURRENT 0.5f
+/* The cap keeps the voltage p w L i_d* adds within the bus, whose top speed is worked out with
+ * i_d = 0: at I/2 the AS1050's position moves reached the bus accelerating near 120 rad/s. */
+#define MAX_MAGNETISING_PER_RATED_CURRENT 0.25f
 #define MIN_DEAD_TIME_BAND_A 1e-4f
 /* Robust mode, currents sensed only: the low-speed drive below the speed whose back EMF is this
  * many times the dead time's loss V_bus t_d / T_s (DESIGN.md, "The low-speed drive"). */
@@ -225,7 +227,7 @@ static float design_alignment(const pmstep_design_input_t *in, pmstep_config_t *
 
 /* i_d* of robust mode: I/8, or more where the flux integrals take the compensation's figure for
  * the dead time's loss (no phase-voltage sensing): MAGNETISING_PER_DEAD_TIME_CURRENT times the
- * current one period's dead-time volt-seconds move, 2 V_bus t_d / L, at most I/2 (DESIGN.md
+ * current one period's dead-time volt-seconds move, 2 V_bus t_d / L, at most I/4 (DESIGN.md
  * section 8). The faster a light-load phase current passes zero, the fewer periods the integrals
  * take on the compensation's word for the sign of its loss. */
 static float magnetising_current(const pmstep_design_input_t *in)
