@@ -34,6 +34,7 @@ KEYS = {
     "firmware_dead_time": "controller.inverter.dead_time_s",
     "phase_voltage_sensing": "controller.inverter.phase_voltage_sensing",
     "ripple_dead_zone": "controller.inverter.ripple_dead_zone",
+    "detent_fade_speed": "controller.gains.detent_fade_speed_rad_s",
     # [run] and [load]
     "seed": "run.seed",
     "duration": "run.duration_s",

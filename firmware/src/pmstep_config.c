@@ -55,6 +55,7 @@ static pmstep_status_t validate_signs(const pmstep_config_t *cfg)
         SIGN_RULE(gains.reference_bandwidth_rad_s, SIGN_POSITIVE, PMSTEP_ERR_REFERENCE_BANDWIDTH),
         SIGN_RULE(gains.angle_correction_gain_per_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_ANGLE_CORRECTION_GAIN),
         SIGN_RULE(gains.current_integral_gain_per_s2, SIGN_NON_NEGATIVE, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN),
+        SIGN_RULE(gains.detent_fade_speed_rad_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETENT_FADE_SPEED),
         SIGN_RULE(limits.max_phase_current_A, SIGN_POSITIVE, PMSTEP_ERR_MAX_CURRENT),
         SIGN_RULE(limits.min_bus_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_MIN_BUS),
         SIGN_RULE(alignment.s_align_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_ALIGNMENT_VOLTAGE),

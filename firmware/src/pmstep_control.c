@@ -88,8 +88,10 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
         ref.rate = 0.0f;
         load_Nm = inst->observer.load_hat_Nm;
     }
-    /* The detent torque is known in form: the law supplies it, the observer expects it. */
+    /* The detent torque is known in form: the law supplies it, the observer expects it (both faded with w-hat). */
     detent = pmstep_law_detent(&inst->law_coeffs, cos_hat, sin_hat, inst->observer.speed_hat_rad_s);
+    pmstep_law_fade_detent(inst->cfg->gains.detent_fade_speed_rad_s, inst->observer.speed_hat_rad_s,
+                           refs.speed_ref_rate_rad_s2, &detent);
     obs_in->i_a_A = sample->i_a_A;
     obs_in->i_b_A = sample->i_b_A;
     obs_in->cos_hat = cos_hat;

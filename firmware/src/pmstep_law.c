@@ -100,3 +100,16 @@ void pmstep_law_voltages(const pmstep_law_coeffs_t *coeffs, const pmstep_law_ref
     *u_b_V = sin_act * u_d + cos_act * u_q;
 }
 
+
+void pmstep_law_fade_detent(float fade_speed_rad_s, float speed_hat_rad_s, float accel_rad_s2,
+                            pmstep_detent_t *detent)
+{
+    if (fade_speed_rad_s > 0.0f) {
+        const float fade_sq = fade_speed_rad_s * fade_speed_rad_s;
+        const float inv_sum = 1.0f / (fade_sq + speed_hat_rad_s * speed_hat_rad_s);
+        const float gain = fade_sq * inv_sum;
+        const float slope_s_rad = -2.0f * speed_hat_rad_s * gain * inv_sum;
+        detent->rate_Nm_s = detent->rate_Nm_s * gain + detent->torque_Nm * slope_s_rad * accel_rad_s2;
+        detent->torque_Nm *= gain;
+    }
+}

@@ -7,7 +7,7 @@
 
 /* Every optional feature on: offset calibration, alignment windows with the voltage bias,
  * inductance window, commissioned R, L, k_M used, J and F identified over 20 ms of RUN and
- * used, dead-time compensation, drift-free angle, detent compensation, PI current loop,
+ * used, dead-time compensation, drift-free angle, detent compensation (faded with the speed), PI current loop,
  * every detector (the paper's bounds), two re-alignments, one period of delay, the standstill hold
  * of speed mode at 7.5 A (half the current trip). */
 static inline pmstep_config_t pmstep_test_features_config(void)
@@ -28,6 +28,7 @@ static inline pmstep_config_t pmstep_test_features_config(void)
     cfg.gains.angle_correction_gain_per_s = 20.0f;
     cfg.gains.current_integral_gain_per_s2 = 33800.0f; /* (R/L + K_i)^2 / 8 = 520^2 / 8 */
     cfg.motor.detent_torque_Nm = 0.05f;
+    cfg.gains.detent_fade_speed_rad_s = 166.7f; /* the designer's: 4 p w_f = 2 x 2000 rad/s, p = 6 */
     cfg.detection.max_realignments = 2u;
     cfg.timing.computational_delay_periods = 1u;
     cfg.standstill.hold_current_A = 7.5f;

@@ -41,6 +41,9 @@ static void config_round_trips_through_the_words(void **state)
     in.standstill.hold_current_A = 1.75f;
     in.standstill.vector_speed_rad_s = 5.75f;
     in.inverter.ripple_dead_zone = true;
+    in.motor.detent_torque_Nm = 0.0625f;
+    in.gains.current_integral_gain_per_s2 = 33800.0f;
+    in.gains.detent_fade_speed_rad_s = 20.5f;
     sil_record_config_to_words(&in, w);
     sil_record_config_from_words(w, &out);
     assert_memory_equal(&in.motor.resistance_Ohm, &out.motor.resistance_Ohm, sizeof(float));
@@ -65,8 +68,12 @@ static void config_round_trips_through_the_words(void **state)
     assert_true(out.standstill.hold_current_A == in.standstill.hold_current_A && w[45] == sil_record_bits(1.75f));
     assert_true(out.standstill.vector_speed_rad_s == in.standstill.vector_speed_rad_s
                 && w[46] == sil_record_bits(5.75f));
+    assert_true(out.inverter.ripple_dead_zone && w[47] == 1u);
+    assert_true(out.motor.detent_torque_Nm == 0.0625f && w[48] == sil_record_bits(0.0625f));
+    assert_true(out.gains.current_integral_gain_per_s2 == 33800.0f && w[49] == sil_record_bits(33800.0f));
     /* The last word is the last field. */
-    assert_true(out.inverter.ripple_dead_zone && w[SIL_RECORD_CONFIG_WORDS - 1u] == 1u);
+    assert_true(out.gains.detent_fade_speed_rad_s == 20.5f
+                && w[SIL_RECORD_CONFIG_WORDS - 1u] == sil_record_bits(20.5f));
 }
 
 /* A period's input, the sensed phase voltages included, comes back bit for bit. */

@@ -20,7 +20,8 @@ static const pmstep_status_t all_status_codes[] = {
     PMSTEP_ERR_DELAY, PMSTEP_ERR_SPEED_GAIN, PMSTEP_ERR_OBSERVER_GAIN, PMSTEP_ERR_CURRENT_GAIN,
     PMSTEP_ERR_ADAPT_GAMMA, PMSTEP_ERR_ADAPT_LAMBDA, PMSTEP_ERR_ADAPT_R, PMSTEP_ERR_SAT_KAPPA,
     PMSTEP_ERR_OBSERVER_GAIN_FOR_PERIOD, PMSTEP_ERR_CURRENT_GAIN_FOR_PERIOD, PMSTEP_ERR_REFERENCE_BANDWIDTH,
-    PMSTEP_ERR_ANGLE_CORRECTION_GAIN, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN, PMSTEP_ERR_MAX_CURRENT, PMSTEP_ERR_MIN_BUS,
+    PMSTEP_ERR_ANGLE_CORRECTION_GAIN, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN, PMSTEP_ERR_DETENT_FADE_SPEED,
+    PMSTEP_ERR_MAX_CURRENT, PMSTEP_ERR_MIN_BUS,
     PMSTEP_ERR_BUS_ORDER,
     PMSTEP_ERR_ALIGNMENT_VOLTAGE, PMSTEP_ERR_ALIGNMENT_ABOVE_BUS, PMSTEP_ERR_ALIGNMENT_CURRENT,
     PMSTEP_ERR_S_ALIGN_TIME, PMSTEP_ERR_C_ALIGN_TIME, PMSTEP_ERR_ALIGNMENT_TOO_LONG, PMSTEP_ERR_ALIGNMENT_CONDITION,
@@ -38,6 +39,7 @@ typedef void (*config_edit_t)(pmstep_config_t *cfg);
 static void bad_r(pmstep_config_t *c) { c->motor.resistance_Ohm = 0.0f; }
 static void negative_detent(pmstep_config_t *c) { c->motor.detent_torque_Nm = -1e-3f; }
 static void negative_current_integral(pmstep_config_t *c) { c->gains.current_integral_gain_per_s2 = -1.0f; }
+static void negative_detent_fade(pmstep_config_t *c) { c->gains.detent_fade_speed_rad_s = -1.0f; }
 /* Paper: R/L + K_i = 500 + 20 = 520 1/s, so K_I may reach 520^2/4 = 67600 1/s^2. */
 static void current_integral_complex_poles(pmstep_config_t *c) { c->gains.current_integral_gain_per_s2 = 68000.0f; }
 static void current_integral_at_bound(pmstep_config_t *c) { c->gains.current_integral_gain_per_s2 = 67000.0f; }
@@ -111,6 +113,7 @@ static const struct {
     {bad_p, PMSTEP_ERR_POLE_PAIRS},
     {negative_detent, PMSTEP_ERR_DETENT_TORQUE},
     {negative_current_integral, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN},
+    {negative_detent_fade, PMSTEP_ERR_DETENT_FADE_SPEED},
     {current_integral_complex_poles, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN},
     {bad_period, PMSTEP_ERR_PERIOD},
     {bad_k_omega, PMSTEP_ERR_SPEED_GAIN},

@@ -127,6 +127,25 @@ static void every_preset_gets_a_valid_design(void **state)
     }
 }
 
+static void detent_compensation_fades_where_the_current_loop_ends(void **state)
+{
+    /* 4 p w_f = 2 x the current loop's bandwidth 0.1 / T_s: 20 rad/s on the hybrids (p = 50) at
+     * 20 kHz, 166.7 rad/s on a p = 6 motor; no fade without a detent torque. */
+    size_t n;
+    (void)state;
+    for (n = 0; n < sizeof presets / sizeof presets[0]; ++n) {
+        pmstep_design_input_t in = input_of(&presets[n], true);
+        pmstep_config_t cfg;
+        pmstep_design_report_t report;
+        assert_int_equal(pmstep_design(&in, &cfg, &report), PMSTEP_OK);
+        assert_true(cfg.gains.detent_fade_speed_rad_s == 0.0f);
+        in.motor.detent_torque_Nm = 0.02f;
+        assert_int_equal(pmstep_design(&in, &cfg, &report), PMSTEP_OK);
+        assert_float_equal(cfg.gains.detent_fade_speed_rad_s, 2.0f * 2000.0f / (4.0f * (float)presets[n].p),
+                           1e-3f);
+    }
+}
+
 static void observer_poles_are_placed(void **state)
 {
     /* s^3 + (a_e + F/J) s^2 + (a_e F/J + g_w b^2) s + g_T b^2/J = (s + w_o)^3, b = k_M/L,
@@ -299,6 +318,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(every_preset_gets_a_valid_design),
+        cmocka_unit_test(detent_compensation_fades_where_the_current_loop_ends),
         cmocka_unit_test(residual_bound_has_the_dead_time_floor),
         cmocka_unit_test(observer_poles_are_placed),
         cmocka_unit_test(bad_motor_data_gets_a_named_error),

@@ -118,6 +118,54 @@ static void detent_torque_and_rate_follow_the_angle(void **state)
     }
 }
 
+static pmstep_detent_t faded_detent_at(const pmstep_law_coeffs_t *coeffs, double t_s, float fade_speed_rad_s)
+{
+    /* w-hat(t) = 5 + 300 t rad/s, theta(t) its integral, p = 6. */
+    const double speed = 5.0 + 300.0 * t_s;
+    const double x = 6.0 * (5.0 * t_s + 150.0 * t_s * t_s);
+    pmstep_detent_t d = pmstep_law_detent(coeffs, (float)cos(x), (float)sin(x), (float)speed);
+    pmstep_law_fade_detent(fade_speed_rad_s, (float)speed, 300.0f, &d);
+    return d;
+}
+
+static void detent_compensation_fades_with_the_speed(void **state)
+{
+    /* g = w_f^2 / (w_f^2 + w-hat^2); the faded rate is the faded torque's derivative along the
+     * trajectory (central differences), w-hat passing w_f = 20 rad/s. */
+    pmstep_config_t cfg = pmstep_paper_config();
+    pmstep_law_coeffs_t coeffs;
+    pmstep_electrical_t model;
+    const double h_s = 1e-5;
+    double worst_rate = 0.0, largest_rate = 0.0;
+    int k;
+    (void)state;
+    cfg.motor.detent_torque_Nm = 0.05f;
+    model = pmstep_configured_electrical(&cfg);
+    pmstep_law_coeffs_init(&coeffs, &cfg, &model);
+    for (k = 1; k < 200; ++k) {
+        const double t_s = 0.001 * k;
+        const pmstep_detent_t d = faded_detent_at(&coeffs, t_s, 20.0f);
+        const double slope = ((double)faded_detent_at(&coeffs, t_s + h_s, 20.0f).torque_Nm
+                              - (double)faded_detent_at(&coeffs, t_s - h_s, 20.0f).torque_Nm) / (2.0 * h_s);
+        const pmstep_detent_t whole = faded_detent_at(&coeffs, t_s, 0.0f);
+        const double speed = 5.0 + 300.0 * t_s;
+        const double gain = 400.0 / (400.0 + speed * speed);
+        assert_true(fabs((double)d.torque_Nm - gain * (double)whole.torque_Nm) < 1e-6 * 0.05);
+        worst_rate = fmax(worst_rate, fabs((double)d.rate_Nm_s - slope));
+        largest_rate = fmax(largest_rate, fabs(slope));
+    }
+    print_message("detent fade: worst rate error %.3g of %.3g Nm/s\n", worst_rate, largest_rate);
+    assert_true(worst_rate < 1e-3 * largest_rate);
+    {
+        /* At w-hat = 0 and with w_f = 0: the whole compensation. */
+        pmstep_detent_t d = {0.04f, 3.0f};
+        pmstep_law_fade_detent(20.0f, 0.0f, 100.0f, &d);
+        assert_true(d.torque_Nm == 0.04f && d.rate_Nm_s == 3.0f);
+        pmstep_law_fade_detent(0.0f, 50.0f, 100.0f, &d);
+        assert_true(d.torque_Nm == 0.04f && d.rate_Nm_s == 3.0f);
+    }
+}
+
 static void current_integral_adds_its_voltage_and_integrates(void **state)
 {
     /* u_dq changes by -L K_I z with the integral z; z advances by T_s (i - i*) only with K_I > 0. */
@@ -155,6 +203,7 @@ int main(void)
         cmocka_unit_test(park_and_inverse_are_orthogonal),
         cmocka_unit_test(current_loop_gives_error_dynamics_8),
         cmocka_unit_test(detent_torque_and_rate_follow_the_angle),
+        cmocka_unit_test(detent_compensation_fades_with_the_speed),
         cmocka_unit_test(current_integral_adds_its_voltage_and_integrates),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -56,6 +56,9 @@
 #define IDENTIFICATION_MIN_SPEED_OF_TOP 0.2f
 /* Paper's r: only matters with F > 0 (DESIGN.md, section 3). */
 #define ADAPT_R 1.0f
+/* The detent torque's compensation fades where its frequency 4 p w* is this many current-loop
+ * bandwidths (DESIGN.md section 2): calibrated on the Monte Carlo, as section 2 reports. */
+#define DETENT_FADE_PER_CURRENT_BANDWIDTH 2.0f
 
 static float max2(float a, float b)
 {
@@ -180,6 +183,9 @@ static void design_gains(const pmstep_design_input_t *in, pmstep_gains_config_t 
                              / (m->inertia_kgm2 * speed_gain);
     gains->reference_bandwidth_rad_s = REFERENCE_PER_SPEED_BANDWIDTH * speed_gain;
     gains->angle_correction_gain_per_s = in->self_commissioning ? DRIFT_FREE_PER_OBSERVER_BANDWIDTH * w_o : 0.0f;
+    gains->detent_fade_speed_rad_s = m->detent_torque_Nm > 0.0f ? DETENT_FADE_PER_CURRENT_BANDWIDTH * current_bandwidth
+                                                                       / (4.0f * (float)m->pole_pairs)
+                                                                 : 0.0f;
 
     report->current_bandwidth_rad_s = current_bandwidth;
     report->observer_bandwidth_rad_s = w_o;

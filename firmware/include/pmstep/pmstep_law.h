@@ -79,6 +79,16 @@ static inline pmstep_detent_t pmstep_law_detent(const pmstep_law_coeffs_t *coeff
 }
 
 /**
+ * The detent torque's compensation faded with the speed (gains.detent_fade_speed_rad_s, w_f; none
+ * with 0): g = w_f^2 / (w_f^2 + w-hat^2), the rate with g's own, dg/dw-hat = -2 w-hat g /
+ * (w_f^2 + w-hat^2), along the acceleration given (the reference's: w-hat' is not known yet, and
+ * w-hat follows w*). Beyond w_f the compensation's frequency 4 p w passes the current loop's
+ * reach, the angle error enters it 4p-fold, and the inertia filters the torque.
+ */
+void pmstep_law_fade_detent(float fade_speed_rad_s, float speed_hat_rad_s, float accel_rad_s2,
+                            pmstep_detent_t *detent);
+
+/**
  * (c-hat, s-hat) turned from the sample to the middle of the period the voltage acts in,
  * p w-hat T_s (delay + 1/2), and shortened for the hold by 1 - x^2/6 (see pmstep_law_voltages):
  * the turn as (cos, sin) polynomials in w-hat.

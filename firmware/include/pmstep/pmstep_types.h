@@ -51,6 +51,7 @@ typedef enum {
     PMSTEP_ERR_ANGLE_CORRECTION_GAIN = -50, /**< drift-free gain g < 0 or g T_s >= 0.5 */
     PMSTEP_ERR_CURRENT_INTEGRAL_GAIN = -51, /**< current-loop integral gain < 0, or above (R/L + K_i)^2 / 4 (the
                                                  loop's poles would turn complex) */
+    PMSTEP_ERR_DETENT_FADE_SPEED = -52,     /**< detent compensation's fade speed < 0 */
     /* limits */
     PMSTEP_ERR_MAX_CURRENT = -60,           /**< max_phase_current_A <= 0 */
     PMSTEP_ERR_MIN_BUS = -61,               /**< min_bus_voltage_V <= 0 */
@@ -201,6 +202,8 @@ typedef struct {
     float current_integral_gain_per_s2; /**< K_I: integral of the current error in the law's voltage (a PI current
                                              loop); holds i_q = i_q* against voltage the model does not know, which
                                              (6) otherwise turns into a speed offset. 0 = the paper's law */
+    float detent_fade_speed_rad_s; /**< the detent torque's compensation (law and observer) fades with the
+                                        estimated speed as w_f^2 / (w_f^2 + w-hat^2); 0 = no fade */
 } pmstep_gains_config_t;
 
 /** Protections. */
