@@ -44,8 +44,8 @@
  * period's dead-time volt-seconds move, within [MAGNETISING_PER_RATED_CURRENT,
  * MAX_MAGNETISING_PER_RATED_CURRENT] x I (magnetising_current, DESIGN.md section 8). */
 #define MAGNETISING_PER_DEAD_TIME_CURRENT 25.0f
-/* The cap keeps the voltage p w L i_d* adds within the bus, whose top speed is worked out with
- * i_d = 0: at I/2 the AS1050's position moves reached the bus accelerating near 120 rad/s. */
+/* The cap: I/2 gained nothing on the Monte Carlo over I/4 once the detent compensation fades
+ * with the speed, and costs copper and the voltage p w L i_d* (DESIGN.md section 8). */
 #define MAX_MAGNETISING_PER_RATED_CURRENT 0.25f
 #define MIN_DEAD_TIME_BAND_A 1e-4f
 /* Robust mode, currents sensed only: the low-speed drive below the speed whose back EMF is this
