@@ -85,19 +85,25 @@ static void current_loop_gives_error_dynamics_8(void **state)
     assert_true(fabs(di_d - (-(520.0) * i_d)) < 1e-2);
 }
 
+/* The law's coefficients on the paper's configuration (p = 6) with this detent torque. */
+static void paper_law_with_detent(pmstep_law_coeffs_t *coeffs, float detent_torque_Nm)
+{
+    pmstep_config_t cfg = pmstep_paper_config();
+    pmstep_electrical_t model;
+    cfg.motor.detent_torque_Nm = detent_torque_Nm;
+    model = pmstep_configured_electrical(&cfg);
+    pmstep_law_coeffs_init(coeffs, &cfg, &model);
+}
+
 static void detent_torque_and_rate_follow_the_angle(void **state)
 {
     /* -T_d sin(4x) and -4 p T_d w cos(4x), from (cos x, sin x) by polynomials. */
-    pmstep_config_t cfg = pmstep_paper_config();
     pmstep_law_coeffs_t coeffs;
-    pmstep_electrical_t model;
     const float speed = 7.0f;
     double worst_torque = 0.0, worst_rate = 0.0;
     int k;
     (void)state;
-    cfg.motor.detent_torque_Nm = 0.05f;
-    model = pmstep_configured_electrical(&cfg);
-    pmstep_law_coeffs_init(&coeffs, &cfg, &model);
+    paper_law_with_detent(&coeffs, 0.05f);
     for (k = 0; k < 360; ++k) {
         const double x = 2.0 * 3.14159265358979 * k / 360.0;
         const pmstep_detent_t d = pmstep_law_detent(&coeffs, (float)cos(x), (float)sin(x), speed);
@@ -110,8 +116,7 @@ static void detent_torque_and_rate_follow_the_angle(void **state)
     assert_true(worst_torque < 1e-6 * 0.05);
     assert_true(worst_rate < 1e-6 * 0.05 * 4.0 * 6.0 * (double)speed);
     /* No detent torque in the model: exactly zero. */
-    cfg.motor.detent_torque_Nm = 0.0f;
-    pmstep_law_coeffs_init(&coeffs, &cfg, &model);
+    paper_law_with_detent(&coeffs, 0.0f);
     {
         const pmstep_detent_t d = pmstep_law_detent(&coeffs, 0.6f, 0.8f, speed);
         assert_true(d.torque_Nm == 0.0f && d.rate_Nm_s == 0.0f);
@@ -132,16 +137,12 @@ static void detent_compensation_fades_with_the_speed(void **state)
 {
     /* g = w_f^2 / (w_f^2 + w-hat^2); the faded rate is the faded torque's derivative along the
      * trajectory (central differences), w-hat passing w_f = 20 rad/s. */
-    pmstep_config_t cfg = pmstep_paper_config();
     pmstep_law_coeffs_t coeffs;
-    pmstep_electrical_t model;
     const double h_s = 1e-5;
     double worst_rate = 0.0, largest_rate = 0.0;
     int k;
     (void)state;
-    cfg.motor.detent_torque_Nm = 0.05f;
-    model = pmstep_configured_electrical(&cfg);
-    pmstep_law_coeffs_init(&coeffs, &cfg, &model);
+    paper_law_with_detent(&coeffs, 0.05f);
     for (k = 1; k < 200; ++k) {
         const double t_s = 0.001 * k;
         const pmstep_detent_t d = faded_detent_at(&coeffs, t_s, 20.0f);
