@@ -100,7 +100,6 @@ void pmstep_law_voltages(const pmstep_law_coeffs_t *coeffs, const pmstep_law_ref
     *u_b_V = sin_act * u_d + cos_act * u_q;
 }
 
-
 void pmstep_law_fade_detent(float fade_speed_rad_s, float speed_hat_rad_s, float accel_rad_s2,
                             pmstep_detent_t *detent)
 {

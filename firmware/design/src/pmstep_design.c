@@ -56,7 +56,7 @@
 #define IDENTIFICATION_MIN_SPEED_OF_TOP 0.2f
 /* Paper's r: only matters with F > 0 (DESIGN.md, section 3). */
 #define ADAPT_R 1.0f
-/* The detent torque's compensation fades where its frequency 4 p w* is this many current-loop
+/* The detent torque's compensation fades where its frequency 4 p w-hat is this many current-loop
  * bandwidths (DESIGN.md section 2): calibrated on the Monte Carlo, as section 2 reports. */
 #define DETENT_FADE_PER_CURRENT_BANDWIDTH 2.0f
 
