@@ -45,6 +45,12 @@ static inline uint32_t pmstep_periods_in(float duration_s, float period_s)
  * configuration) is finite in float32. */
 bool pmstep_derived_coefficients_finite(const pmstep_config_t *cfg);
 
+/* Coefficients of the angle, observer and law for the model @p model (pmstep_lifecycle.c). */
+void pmstep_apply_model(pmstep_t *inst, const pmstep_electrical_t *model);
+
+/* Clears the dynamic state of the strategy; keeps commands (targets) untouched (pmstep_lifecycle.c). */
+void pmstep_clear_dynamic_state(pmstep_t *inst);
+
 /* ---- Controller (6) / (13) in RUN (pmstep_control.c) ---- */
 
 /* What the control stage hands to the advance stage within one period. */
