@@ -173,6 +173,44 @@ def _points_lines(points):
     return ",\n    ".join(rows)
 
 
+def _top_speeds(tune, preset_path, chain, low_speed_drive, extra=()):
+    """(the preset's top speed, the paper motor's; rad/s) from pmstep-tune, and the preset's command."""
+    cmd = _design(tune, preset_path, chain, low_speed_drive) + list(extra)
+    top = _run_designer(cmd)
+    # The paper motor's top speed, which the paper campaign's speed thresholds are relative to.
+    paper_span = ADC_SPAN_RATED * read_preset(PAPER_PRESET)["rated_current_A"]
+    paper_chain = list(REALISTIC_CHAIN) + [f"sensors.current_full_scale_A={paper_span:g}"]
+    return top, _run_designer(_design(tune, PAPER_PRESET, paper_chain)), cmd
+
+
+def _scenario_peak_and_load(ini, path):
+    """(peak |w*| of the scenario's profile, its load torque); a position scenario's peak is its v_max."""
+    try:
+        moves = [p for p in ini.get("position", "points", fallback="0:0").replace("\n", " ").split(",") if p.strip()]
+        if len(moves) > 1 or (moves and float(moves[0].split(":")[1]) != 0.0):
+            peak = float(ini.get("position", "v_max_rad_s"))
+        else:
+            points = [p for p in ini.get("speed", "points").replace("\n", " ").split(",") if p.strip()]
+            peak = max(abs(float(p.split(":")[1])) for p in points)
+        load = float(ini.get("load", "torque_Nm", fallback="0"))
+    except (configparser.Error, ValueError, IndexError) as e:
+        raise ToolError(f"{path}: cannot read the profile's peak speed and the load ({e})") from None
+    return peak, load
+
+
+def scenario_info(tune, preset_path, scenario_path, phase_voltage_sensing=False, low_speed_drive=False):
+    """A campaign on a scenario written for the preset (e.g. position_acceptance.py --write-scenarios):
+    the scenario runs as it is, the preset scales the distributions. Returns the info of
+    design_scenario, with the scenario's own peak speed (a position scenario's v_max) and load."""
+    preset = read_preset(preset_path)
+    top, paper_top, cmd = _top_speeds(tune, preset_path, chain_sets(preset, phase_voltage_sensing), low_speed_drive)
+    peak, load = _scenario_peak_and_load(_ini(scenario_path), scenario_path)
+    return {"preset": preset["name"], "preset_file": preset_path, "top_speed_rad_s": top,
+            "paper_top_speed_rad_s": paper_top, "run_start_s": None, "peak_speed_rad_s": peak, "load_Nm": load,
+            "tune_command": cmd, "figures": preset, "paper_holding_torque_Nm": paper_holding_torque(),
+            "speed_bound_rad_s": PAPER_SPEED_BOUND_RAD_S * top / paper_top}
+
+
 def design_scenario(tune, preset_path, out_dir, phase_voltage_sensing=False, low_speed_drive=False):
     """Designs the preset with pmstep-tune (robust mode, realistic chain) and writes the
     campaign's scenario to out_dir/preset_scenario.ini. Returns (its path, info) with info =
@@ -182,12 +220,7 @@ def design_scenario(tune, preset_path, out_dir, phase_voltage_sensing=False, low
     chain = chain_sets(preset, phase_voltage_sensing)
     os.makedirs(out_dir, exist_ok=True)
     design_path = os.path.join(out_dir, "preset_design.ini")
-    cmd = _design(tune, preset_path, chain, low_speed_drive) + ["--write-ini", design_path]
-    top = _run_designer(cmd)
-    # The paper motor's top speed, which the paper campaign's speed thresholds are relative to.
-    paper_span = ADC_SPAN_RATED * read_preset(PAPER_PRESET)["rated_current_A"]
-    paper_chain = list(REALISTIC_CHAIN) + [f"sensors.current_full_scale_A={paper_span:g}"]
-    paper_top = _run_designer(_design(tune, PAPER_PRESET, paper_chain))
+    top, paper_top, cmd = _top_speeds(tune, preset_path, chain, low_speed_drive, ["--write-ini", design_path])
     ini = _ini(design_path)
     try:
         points = [p.strip() for p in ini.get("speed", "points").replace("\n", " ").split(",") if p.strip()]

@@ -13,6 +13,8 @@ designer's settings (pmstep-tune --robust, --tune PATH, by default next to --sil
 realistic chain, and a distribution table scaled to the motor (mc_preset.py says how); the
 speed bounds are then the paper campaign's as fractions of the designer's top speed (the
 success bound 0.5 rad/s x top speed / 9.6 rad/s, the paper motor's) unless --speed-bound is given.
+With --scenario FILE as well, the campaign runs that scenario as it is (one written for the
+preset, e.g. by position_acceptance.py --write-scenarios) with the preset's distribution table.
 
 Parts: mc_distributions.py (what is drawn), mc_execution.py (running the cases on an
 engine, resuming), mc_outcome.py (a case's class and numbers), mc_report.py (aggregate,
@@ -96,7 +98,7 @@ from mc_execution import (ENGINES, check_keys, read_scenario, rerun_command, run
                           run_case, sil_command, sil_version)
 from mc_outcome import (CLASSES, CLASS_TEXT, FAULT_EXIT_STATUS, REQUIRED_FIELDS, classify,  # noqa: E402,F401
                         extract_metrics, fault_name, get_path, number_or_none, summary_problem)
-from mc_preset import design_scenario, preset_distributions, read_preset  # noqa: E402
+from mc_preset import design_scenario, preset_distributions, read_preset, scenario_info  # noqa: E402
 from mc_segments import (failures_by_segment, label_failures, profile_segments, segment_of,  # noqa: E402,F401
                          speed_points)
 
@@ -113,8 +115,9 @@ def parse_args(argv):
     parser.add_argument("--sil", required=True, help="the pmstep-sil executable")
     parser.add_argument("--scenario", default=None, help="scenario INI file the cases start from")
     parser.add_argument("--preset", default=None, metavar="FILE",
-                        help="a motor preset (sil/scenarios/motors/*.ini) instead of --scenario: the designer's gains, "
-                             "the realistic chain, distributions scaled to the motor (mc_preset.py)")
+                        help="a motor preset (sil/scenarios/motors/*.ini): the designer's gains, the realistic chain, "
+                             "distributions scaled to the motor (mc_preset.py); with --scenario, that scenario "
+                             "(written for the preset) with the preset's distributions")
     parser.add_argument("--tune", default=None, metavar="PATH",
                         help="pmstep-tune for --preset (default: the one next to --sil)")
     parser.add_argument("--phase-voltage-sensing", action="store_true",
@@ -157,8 +160,8 @@ def parse_args(argv):
     parser.add_argument("--case-timeout", type=float, default=600.0, metavar="SECONDS",
                         help="wall time after which one run counts as crashed (default 600 s)")
     args = parser.parse_args(argv[1:])
-    if (args.scenario is None) == (args.preset is None):
-        parser.error("give one of --scenario and --preset")
+    if args.scenario is None and args.preset is None:
+        parser.error("give --scenario, --preset or both")
     if args.tune is not None and args.preset is None:
         parser.error("--tune is for --preset")
     if args.low_speed_drive and args.preset is None:
@@ -211,15 +214,21 @@ def run_one(args, scenario, base):
 
 
 def use_preset(args):
-    """--preset: designs the campaign's scenario into DIR, puts the preset's distribution table in
-    place of the paper's, and sets the speed bound; returns what the report says of the preset."""
+    """--preset: designs the campaign's scenario into DIR (or, with --scenario, takes that one as
+    it is), puts the preset's distribution table in place of the paper's, and sets the speed
+    bound; returns what the report says of the preset."""
     if not os.path.isfile(args.preset):
         raise ToolError(f"motor preset {args.preset} not found")
     if not (os.path.isfile(args.tune) and os.access(args.tune, os.X_OK)):
         raise ToolError(f"{args.tune} is not an executable file (pmstep-tune, built beside pmstep-sil; or give --tune)")
     read_preset(args.preset)  # a clear error for a bad preset before the designer runs
-    args.scenario, info = design_scenario(args.tune, args.preset, args.out, args.phase_voltage_sensing,
-                                          args.low_speed_drive)
+    if args.scenario is not None:
+        if not os.path.isfile(args.scenario):
+            raise ToolError(f"scenario file {args.scenario} not found")
+        info = scenario_info(args.tune, args.preset, args.scenario, args.phase_voltage_sensing, args.low_speed_drive)
+    else:
+        args.scenario, info = design_scenario(args.tune, args.preset, args.out, args.phase_voltage_sensing,
+                                              args.low_speed_drive)
     # In place, so every function's default table (the same list object) sees it.
     DISTRIBUTIONS[:] = preset_distributions(info["figures"], info["peak_speed_rad_s"], info["paper_holding_torque_Nm"],
                                             args.phase_voltage_sensing)
@@ -228,8 +237,9 @@ def use_preset(args):
     print(f"monte_carlo: preset {info['preset']}: top speed {info['top_speed_rad_s']:g} rad/s, profile peak "
           f"{info['peak_speed_rad_s']:g} rad/s, load step {info['load_Nm']:.4g} N m, speed bound "
           f"{args.speed_bound:.4g} rad/s; scenario {args.scenario}", file=sys.stderr)
-    return {key: info[key] for key in ("preset", "preset_file", "top_speed_rad_s", "run_start_s", "peak_speed_rad_s",
+    kept = {key: info[key] for key in ("preset", "preset_file", "top_speed_rad_s", "run_start_s", "peak_speed_rad_s",
                                        "load_Nm", "speed_bound_rad_s", "tune_command")}
+    return dict(kept, designed=info["run_start_s"] is not None)
 
 
 def main(argv):

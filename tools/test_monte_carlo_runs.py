@@ -137,6 +137,28 @@ class PresetDistributions(unittest.TestCase):
             self.assertEqual(command[command.index(item) - 1], "--set", item)
         self.assertTrue(all(len(line) < 197 for line in text.splitlines()))  # the INI reader's limit
 
+    def test_position_scenario_with_the_preset(self):
+        """--preset with --scenario: the scenario as written, its v_max as the peak and its load."""
+        with tempfile.TemporaryDirectory() as tmp:
+            tune = os.path.join(tmp, "fake-tune")
+            with open(tune, "w") as f:
+                f.write(f"#!{sys.executable}\n" + FAKE_TUNE)
+            os.chmod(tune, 0o755)
+            scenario = os.path.join(tmp, "moves.ini")
+            with open(scenario, "w") as f:
+                f.write("[speed]\npoints = 0:0\n[load]\ntype = step\ntorque_Nm = 0.0849\nstep_time_s = 87.8\n"
+                        "[position]\npoints = 0.33:-45.9, 2.17:43.7\nv_max_rad_s = 34.5\n")
+            info = mc_preset.scenario_info(tune, PRESET_17HS, scenario)
+            self.assertEqual(sorted(os.listdir(tmp)), ["fake-tune", "moves.ini"])  # nothing designed or written
+        self.assertEqual(info["peak_speed_rad_s"], 34.5)
+        self.assertEqual(info["load_Nm"], 0.0849)
+        self.assertIsNone(info["run_start_s"])
+        self.assertAlmostEqual(info["speed_bound_rad_s"], 0.5 * 69.0 / 9.6, places=12)
+        table = {row[0]: row for row in mc.preset_distributions(info["figures"], info["peak_speed_rad_s"],
+                                                                 info["paper_holding_torque_Nm"])}
+        self.assertEqual(table["load.torque_Nm"][1:], ("scale", 0.0, 1.0))  # of the scenario's 0.0849 N m
+        self.assertEqual(table["motor.inertia_kgm2"][1:], ("scale", 0.8, 1.2))
+
     def test_bad_preset(self):
         with tempfile.TemporaryDirectory() as tmp:
             bad = os.path.join(tmp, "bad.ini")
@@ -144,10 +166,10 @@ class PresetDistributions(unittest.TestCase):
                 f.write("[datasheet]\nrated_current_A = 1.7\n[motor]\nresistance_Ohm = 1.5\n")
             with self.assertRaises(mc.ToolError):
                 mc.read_preset(bad)
-        proc = subprocess.run([sys.executable, SCRIPT, "--sil", sys.executable, "--scenario", PRESET_17HS,
-                               "--preset", PRESET_17HS, "--out", "unused"], capture_output=True, text=True, timeout=60)
+        proc = subprocess.run([sys.executable, SCRIPT, "--sil", sys.executable, "--out", "unused"],
+                              capture_output=True, text=True, timeout=60)
         self.assertEqual(proc.returncode, 2)
-        self.assertIn("one of --scenario and --preset", proc.stderr)
+        self.assertIn("give --scenario, --preset or both", proc.stderr)
 
 
 FAKE_SIL = textwrap.dedent('''\
