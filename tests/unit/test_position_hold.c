@@ -2,8 +2,9 @@
  * real modules on a paper-configured instance put in RUN: the aim (the estimate turned by
  * p (theta* - theta-hat), ahead by the load angle of T_L-hat), and the two refusals that leave
  * the position loop holding - a load beyond the vector's pull, a move ending more than 1
- * electrical rad off - until the next move. The rotor is held still by the test (the estimate
- * stays where the test puts it), so the error a move ends with is chosen exactly. */
+ * electrical rad off - until the next move; and the T_L-hat a move or a stop from the hold starts
+ * with. The rotor is held still by the test (the estimate stays where the test puts it), so the
+ * error a move ends with is chosen exactly. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -140,12 +141,46 @@ static void move_ending_more_than_a_radian_off_is_not_aimed(void **state)
                        pow(0.95, 6) / 720.0 + pow(0.95, 7) / 5040.0);
 }
 
+/* Held, the observer balances the vector's torque at the estimated angle: an angle error puts
+ * part of the hold current into T_L-hat. A move from the hold gives the law the aim's T_L-hat
+ * back; a move from a refused hold (no vector) leaves T_L-hat as the observer has it. */
+static void move_from_the_hold_starts_from_the_aims_load(void **state)
+{
+    fixture_t f;
+    (void)state;
+    fixture_in_run(&f);
+    rest_at(&f, REST_ELECTRICAL_RAD, 10);
+    move_and_stay(&f, 0.4, 4.8f);
+    assert_int_equal(f.pos.hold_stage, POSITION_HOLD_SETTLING);
+    assert_float_equal(f.pos.aim_load_Nm, 4.8f, 0.0f);
+    f.inst.observer.load_hat_Nm = 6.3f; /* 2 N m/A x 7.5 A x sin(0.1): an estimate 0.1 rad off */
+    assert_int_equal(pmstep_position_move_to(&f.pos, 0.0f, 1.0f, 10.0f, 0.0f), PMSTEP_OK);
+    assert_false(f.inst.hold.active);
+    assert_int_equal(f.pos.hold_stage, POSITION_HOLD_NONE);
+    assert_float_equal(f.inst.observer.load_hat_Nm, 4.8f, 0.0f);
+    /* the same from a stop (pmstep_position_hold) once held again */
+    move_and_stay(&f, 0.2, 3.0f);
+    assert_int_equal(f.pos.hold_stage, POSITION_HOLD_SETTLING);
+    f.inst.observer.load_hat_Nm = 1.5f;
+    assert_int_equal(pmstep_position_hold(&f.pos, 10.0f), PMSTEP_OK);
+    assert_float_equal(f.inst.observer.load_hat_Nm, 3.0f, 0.0f);
+    /* refused (beyond the pull): no vector held, T_L-hat is the observer's own */
+    fixture_in_run(&f);
+    rest_at(&f, REST_ELECTRICAL_RAD, 10);
+    move_and_stay(&f, 0.4, 13.6f);
+    assert_int_equal(f.pos.hold_stage, POSITION_HOLD_REFUSED);
+    f.inst.observer.load_hat_Nm = 12.0f;
+    assert_int_equal(pmstep_position_move_to(&f.pos, 0.0f, 1.0f, 10.0f, 0.0f), PMSTEP_OK);
+    assert_float_equal(f.inst.observer.load_hat_Nm, 12.0f, 0.0f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(move_end_aims_at_the_target_ahead_by_the_load_angle),
         cmocka_unit_test(load_beyond_the_vectors_pull_leaves_the_loop_holding),
         cmocka_unit_test(move_ending_more_than_a_radian_off_is_not_aimed),
+        cmocka_unit_test(move_from_the_hold_starts_from_the_aims_load),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
