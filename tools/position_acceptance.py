@@ -7,10 +7,12 @@ For each motor (sil/scenarios/motors/*.ini) and chain:
               equilibrium RUN starts at, every move at v_max = 1/2 of the design's top speed and
               a_max = 1/4 of k_M I / J, the jerk a_max varpi_0), each given the profile's time
               plus a settling time before the next;
-  realistic   pmstep-tune --robust under sil/scenarios/robust.ini's measurement chain (12-bit ADC
-              over +-3 x rated current, +-20 mA offsets, 5 mA noise, one period of delay, 1 us dead
-              time, the plant's R 20 % above the firmware's), the same moves, then a hold of
-              --hold-s seconds under a load stepped to 30 % of the rated torque k_M I.
+  realistic   pmstep-tune --robust under the presets' realistic chain (mc_preset.py, as the envelope
+              and the Monte Carlo: sil/scenarios/robust.ini's sensors, a 12-bit ADC over +-3 x rated
+              current, +-20 mA offsets, 5 mA noise, one period of delay, 1 us dead time, and a
+              switching inverter, the bridge the designer's dead-time compensation is shaped for),
+              the plant's R 20 % above the firmware's, the same moves, then a hold of --hold-s
+              seconds under a load stepped to 30 % of the rated torque k_M I.
 Each run is pmstep-sil on the scenario with --set overrides; the figures come from its
 summary.json ("position", electrical rad = p x mechanical). Prints one line per run and the
 issue's criteria, and exits 1 if one fails (--check): ideal chain, final error < 0.1 electrical
@@ -32,6 +34,9 @@ import re
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from mc_preset import chain_sets  # noqa: E402  (the realistic chain, with the ADC span sized to the motor)
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 MOTORS = ["paper", "17hs4401", "bj42d29", "as1050"]
 REVOLUTION = 2.0 * math.pi
@@ -40,10 +45,6 @@ FINAL_BOUND = 0.1       # electrical rad, the issue's (ideal chain)
 OVERSHOOT_BOUND = 0.01  # of the move (ideal chain)
 HOLD_BOUND = 0.5        # electrical rad (realistic chain: the whole time)
 
-# robust.ini's measurement chain; the current span scaled to the motor (3 x rated current, as the
-# closed_loop.tune_realistic tests), R of the plant 20 % above the firmware's.
-CHAIN = ["sensors.adc_bits=12", "sensors.offset_a_A=0.02", "sensors.offset_b_A=-0.02", "sensors.noise_rms_A=0.005",
-         "inverter.model=averaged", "inverter.dead_time_s=1e-6", "run.delay_periods=1"]
 
 
 def read_preset(path):
@@ -138,7 +139,7 @@ def main():
             base = os.path.join(args.out, f"{motor}_{chain}.ini")
             tune_sets = []
             if robust:
-                tune_sets = CHAIN + [f"sensors.current_full_scale_A={max(3.0 * preset['rated_A'], 1.0):g}"]
+                tune_sets = chain_sets({"rated_current_A": preset["rated_A"]})
             top, varpi, k_theta = design(args.tune, motor_ini, base, robust, tune_sets)
             v_max = args.speed_fraction * top
             a_max = args.accel_fraction * preset["k_M"] * preset["rated_A"] / preset["J"]
