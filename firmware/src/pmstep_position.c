@@ -253,7 +253,7 @@ POSITION_OUT_OF_LINE static void update(pmstep_position_t *pos)
         pos->hold_stage = POSITION_HOLD_NONE; /* the command released the core's hold */
     }
     if (pos->out.position_mode) {
-        if (pos->hold_stage == POSITION_HOLD_SETTLING || pos->hold_stage == POSITION_HOLD_ANCHORED) {
+        if (pmstep_position_vector_held(pos)) {
             pmstep_position_vector_hold(pos, position_rad);
         } else {
             position_loop(pos, position_rad);

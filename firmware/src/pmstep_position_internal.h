@@ -11,13 +11,17 @@
 #define POSITION_HOLD_SETTLING ((int32_t)2)
 #define POSITION_HOLD_ANCHORED ((int32_t)3)
 #define POSITION_HOLD_REFUSED ((int32_t)4) /* until the next move: the loop holds on the estimate */
+#define POSITION_HOLD_TURNING ((int32_t)5) /* settling after a re-aim, the estimate kept turned with it */
 
 /* An update in position mode with the profile ended and no vector yet: the loop holds
  * POSITION_AIM_WAIT_TIME_CONSTANTS / k_theta, then aims the core's vector at the target (or the
  * stage becomes refused). */
 void pmstep_position_wait_and_aim(pmstep_position_t *pos, float position_rad);
 
-/* An update while the vector holds (settling or anchored). */
+/* The core's vector holds the rotor (settling, anchored or turning). */
+bool pmstep_position_vector_held(const pmstep_position_t *pos);
+
+/* An update while the vector holds. */
 void pmstep_position_vector_hold(pmstep_position_t *pos, float position_rad);
 
 /* Ends a vector hold (a move, a stop); the stage returns to none. */
