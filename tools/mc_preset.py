@@ -208,7 +208,7 @@ def scenario_info(tune, preset_path, scenario_path, phase_voltage_sensing=False,
     return {"preset": preset["name"], "preset_file": preset_path, "top_speed_rad_s": top,
             "paper_top_speed_rad_s": paper_top, "run_start_s": None, "peak_speed_rad_s": peak, "load_Nm": load,
             "tune_command": cmd, "figures": preset, "paper_holding_torque_Nm": paper_holding_torque(),
-            "speed_bound_rad_s": PAPER_SPEED_BOUND_RAD_S * top / paper_top}
+            "speed_bound_rad_s": PAPER_SPEED_BOUND_RAD_S * top / paper_top, "designed": False}
 
 
 def design_scenario(tune, preset_path, out_dir, phase_voltage_sensing=False, low_speed_drive=False):
@@ -233,7 +233,7 @@ def design_scenario(tune, preset_path, out_dir, phase_voltage_sensing=False, low
     info = {"preset": preset["name"], "preset_file": preset_path, "top_speed_rad_s": top,
             "paper_top_speed_rad_s": paper_top, "run_start_s": run_start, "peak_speed_rad_s": peak,
             "load_Nm": PAPER_LOAD_NM * preset["holding_torque_Nm"] / paper_holding,
-            "tune_command": cmd, "figures": preset, "paper_holding_torque_Nm": paper_holding}
+            "tune_command": cmd, "figures": preset, "paper_holding_torque_Nm": paper_holding, "designed": True}
     speed_bound = PAPER_SPEED_BOUND_RAD_S * top / paper_top
     loss_speed = PAPER_LOSS_SPEED_RAD_S * top / paper_top
     ini.set("scenario", "name", f"{preset['name']}_mc")

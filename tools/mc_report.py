@@ -203,8 +203,8 @@ def write_report(path, records, agg, args, scenario, version, plots, started_utc
               f"- date: {started_utc}"]
     preset = agg.get("preset")
     if preset:
-        designed = "designed by" if preset.get("designed", True) else "the scenario as given; top speed from"
-        load_step = f" 30 ms into RUN" if preset.get("designed", True) else " (the scenario's)"
+        designed = "designed by" if preset["designed"] else "the scenario as given; top speed from"
+        load_step = " 30 ms into RUN" if preset["designed"] else " (the scenario's)"
         lines.append(f"- motor preset: `{preset['preset_file']}`, {designed} `{shlex.join(preset['tune_command'])}`: "
                      f"top speed {preset['top_speed_rad_s']:g} rad/s, profile peak {preset['peak_speed_rad_s']:g} rad/s, "
                      f"load step {preset['load_Nm']:.4g} N m{load_step} (distributions scaled to the motor: "

@@ -237,9 +237,8 @@ def use_preset(args):
     print(f"monte_carlo: preset {info['preset']}: top speed {info['top_speed_rad_s']:g} rad/s, profile peak "
           f"{info['peak_speed_rad_s']:g} rad/s, load step {info['load_Nm']:.4g} N m, speed bound "
           f"{args.speed_bound:.4g} rad/s; scenario {args.scenario}", file=sys.stderr)
-    kept = {key: info[key] for key in ("preset", "preset_file", "top_speed_rad_s", "run_start_s", "peak_speed_rad_s",
-                                       "load_Nm", "speed_bound_rad_s", "tune_command")}
-    return dict(kept, designed=info["run_start_s"] is not None)
+    return {key: info[key] for key in ("preset", "preset_file", "top_speed_rad_s", "run_start_s", "peak_speed_rad_s",
+                                       "load_Nm", "speed_bound_rad_s", "tune_command", "designed")}
 
 
 def main(argv):

@@ -45,6 +45,15 @@ FAKE_TUNE = textwrap.dedent('''\
     ''')
 
 
+def write_fake_tune(folder):
+    """FAKE_TUNE as an executable in @p folder; returns its path."""
+    tune = os.path.join(folder, "fake-tune")
+    with open(tune, "w") as f:
+        f.write(f"#!{sys.executable}\n" + FAKE_TUNE)
+    os.chmod(tune, 0o755)
+    return tune
+
+
 class PresetDistributions(unittest.TestCase):
     """--preset: the table scaled to the motor (17HS4401: 0.40 N m holding, 1.5 Ohm, 24 V bus)."""
 
@@ -110,15 +119,13 @@ class PresetDistributions(unittest.TestCase):
 
     def test_designed_scenario(self):
         with tempfile.TemporaryDirectory() as tmp:
-            tune = os.path.join(tmp, "fake-tune")
-            with open(tune, "w") as f:
-                f.write(f"#!{sys.executable}\n" + FAKE_TUNE)
-            os.chmod(tune, 0o755)
+            tune = write_fake_tune(tmp)
             path, info = mc_preset.design_scenario(tune, PRESET_17HS, tmp)
             with open(path) as f:
                 text = f.read()
         self.assertEqual(info["top_speed_rad_s"], 69.0)
         self.assertEqual(info["peak_speed_rad_s"], 55.2)
+        self.assertTrue(info["designed"])
         self.assertAlmostEqual(info["load_Nm"], self.load, places=15)
         # The paper campaign's 0.5 rad/s and 2 rad/s on a motor of 9.6 rad/s top speed, scaled to 69 rad/s.
         self.assertEqual(info["paper_top_speed_rad_s"], 9.6)
@@ -140,10 +147,7 @@ class PresetDistributions(unittest.TestCase):
     def test_position_scenario_with_the_preset(self):
         """--preset with --scenario: the scenario as written, its v_max as the peak and its load."""
         with tempfile.TemporaryDirectory() as tmp:
-            tune = os.path.join(tmp, "fake-tune")
-            with open(tune, "w") as f:
-                f.write(f"#!{sys.executable}\n" + FAKE_TUNE)
-            os.chmod(tune, 0o755)
+            tune = write_fake_tune(tmp)
             scenario = os.path.join(tmp, "moves.ini")
             with open(scenario, "w") as f:
                 f.write("[speed]\npoints = 0:0\n[load]\ntype = step\ntorque_Nm = 0.0849\nstep_time_s = 87.8\n"
@@ -151,6 +155,7 @@ class PresetDistributions(unittest.TestCase):
             info = mc_preset.scenario_info(tune, PRESET_17HS, scenario)
             self.assertEqual(sorted(os.listdir(tmp)), ["fake-tune", "moves.ini"])  # nothing designed or written
         self.assertEqual(info["peak_speed_rad_s"], 34.5)
+        self.assertFalse(info["designed"])
         self.assertEqual(info["load_Nm"], 0.0849)
         self.assertIsNone(info["run_start_s"])
         self.assertAlmostEqual(info["speed_bound_rad_s"], 0.5 * 69.0 / 9.6, places=12)

@@ -30,7 +30,7 @@ static bool aim_core_vector(pmstep_position_t *pos)
 bool pmstep_position_vector_held(const pmstep_position_t *pos)
 {
     return (pos->hold_stage == POSITION_HOLD_SETTLING) || (pos->hold_stage == POSITION_HOLD_ANCHORED)
-           || (pos->hold_stage == POSITION_HOLD_TURNING);
+           || (pos->hold_stage == POSITION_HOLD_REAIMED);
 }
 
 /* Vector hold: the vector aimed; the speed reference at rest, the loop's integral cleared (the
@@ -98,11 +98,12 @@ static void correct_aim(pmstep_position_t *pos)
     pmstep_turn(c, pos->rest_sin, cos_error, sin_error, &pos->rest_cos, &pos->rest_sin);
     c = pos->frozen_cos;
     pmstep_turn(c, pos->frozen_sin, cos_error, sin_error, &pos->frozen_cos, &pos->frozen_sin);
-    hold_at_rest(pos, POSITION_HOLD_TURNING);
+    hold_at_rest(pos, POSITION_HOLD_REAIMED);
 }
 
-/* An update in a vector hold: settling, then the estimate kept while the rotor is at rest (it
- * would drift: nothing observes its phase at zero speed) and followed while the rotor moves;
+/* An update in a vector hold: settling (after a re-aim, with the turned estimate kept), then the
+ * estimate kept while the rotor is at rest (it would drift: nothing observes its phase at zero
+ * speed) and followed while the rotor moves;
  * after POSITION_REAIM_PERIODS more at rest more than POSITION_REAIM_ERROR_RAD from the target
  * (the aim's load angle off, or the load changed), the aim is corrected (pmstep_position.h). */
 void pmstep_position_vector_hold(pmstep_position_t *pos, float position_rad)
@@ -112,14 +113,14 @@ void pmstep_position_vector_hold(pmstep_position_t *pos, float position_rad)
     pos->out.position_ref_rad = pos->now.position;
     pos->out.position_error_rad = pos->now.position - position_rad;
     if (pos->hold_stage != POSITION_HOLD_ANCHORED) {
-        const bool turning = pos->hold_stage == POSITION_HOLD_TURNING;
-        if (turning) {
+        const bool reaimed = pos->hold_stage == POSITION_HOLD_REAIMED;
+        if (reaimed) {
             (void)pmstep_set_angle_estimate(inst, pos->frozen_cos, pos->frozen_sin);
         }
         pos->hold_periods -= PMSTEP_POSITION_DECIMATION;
         if (pos->hold_periods <= 0) {
             /* settled: the rest is counted from here; after a re-aim with the estimate already kept */
-            pos->hold_periods = turning ? (int32_t)inst->hold.settle_periods : 0;
+            pos->hold_periods = reaimed ? (int32_t)inst->hold.settle_periods : 0;
             pos->hold_stage = POSITION_HOLD_ANCHORED;
         }
     } else if (fabsf(pos->speed_hat_rad_s - inst->hold.speed_bias_rad_s) < inst->hold.quiet_band_rad_s) {

@@ -11,14 +11,14 @@
 #define POSITION_HOLD_SETTLING ((int32_t)2)
 #define POSITION_HOLD_ANCHORED ((int32_t)3)
 #define POSITION_HOLD_REFUSED ((int32_t)4) /* until the next move: the loop holds on the estimate */
-#define POSITION_HOLD_TURNING ((int32_t)5) /* settling after a re-aim, the estimate kept turned with it */
+#define POSITION_HOLD_REAIMED ((int32_t)5) /* settling after a re-aim, the estimate kept turned with it */
 
 /* An update in position mode with the profile ended and no vector yet: the loop holds
  * POSITION_AIM_WAIT_TIME_CONSTANTS / k_theta, then aims the core's vector at the target (or the
  * stage becomes refused). */
 void pmstep_position_wait_and_aim(pmstep_position_t *pos, float position_rad);
 
-/* The core's vector holds the rotor (settling, anchored or turning). */
+/* The core's vector holds the rotor (settling, anchored or settling after a re-aim). */
 bool pmstep_position_vector_held(const pmstep_position_t *pos);
 
 /* An update while the vector holds. */

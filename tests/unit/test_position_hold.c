@@ -71,6 +71,16 @@ static void move_and_stay(fixture_t *f, double error_electrical_rad, float load_
     assert_true(n < 20000);
 }
 
+/* In RUN at the rest angle, then a move ending @p error_electrical_rad off with T_L-hat
+ * @p load_hat_Nm: the vector holds, settling. */
+static void held_after_move(fixture_t *f, double error_electrical_rad, float load_hat_Nm)
+{
+    fixture_in_run(f);
+    rest_at(f, REST_ELECTRICAL_RAD, 10);
+    move_and_stay(f, error_electrical_rad, load_hat_Nm);
+    assert_int_equal(f->pos.hold_stage, POSITION_HOLD_SETTLING);
+}
+
 static double vector_angle(const fixture_t *f)
 {
     return atan2((double)f->inst.hold.sin_vector, (double)f->inst.hold.cos_vector);
@@ -81,10 +91,7 @@ static void move_end_aims_at_the_target_ahead_by_the_load_angle(void **state)
     fixture_t f;
     const double delta = asin(4.8 / (2.0 * (double)HOLD_CURRENT_A));
     (void)state;
-    fixture_in_run(&f);
-    rest_at(&f, REST_ELECTRICAL_RAD, 10);
-    move_and_stay(&f, 0.4, 4.8f);
-    assert_int_equal(f.pos.hold_stage, POSITION_HOLD_SETTLING);
+    held_after_move(&f, 0.4, 4.8f);
     assert_true(f.inst.hold.active);
     assert_float_equal(f.inst.hold.current_A, HOLD_CURRENT_A, 0.0f);
     /* the target's direction, 0.3 + 0.4 electrical rad, and the load angle ahead of it */
@@ -168,20 +175,17 @@ static void re_aim_turns_the_kept_estimate_with_the_vector(void **state)
     fixture_t f;
     long n;
     (void)state;
-    fixture_in_run(&f);
-    rest_at(&f, REST_ELECTRICAL_RAD, 10);
-    move_and_stay(&f, 0.4, 0.0f);
-    assert_int_equal(f.pos.hold_stage, POSITION_HOLD_SETTLING);
+    held_after_move(&f, 0.4, 0.0f);
     assert_float_equal(vector_angle(&f), REST_ELECTRICAL_RAD + 0.4, 2e-5);
-    for (n = 0; n < 20000 && f.pos.hold_stage != POSITION_HOLD_TURNING; ++n) {
+    for (n = 0; n < 20000 && f.pos.hold_stage != POSITION_HOLD_REAIMED; ++n) {
         rest_at(&f, REST_ELECTRICAL_RAD, 1); /* the estimate says the rotor stayed at 0.3 */
     }
-    assert_int_equal(f.pos.hold_stage, POSITION_HOLD_TURNING);
+    assert_int_equal(f.pos.hold_stage, POSITION_HOLD_REAIMED);
     print_message("re-aim after %.4f s at rest 0.4 electrical rad short\n", (double)n * 5e-5);
     assert_float_equal(vector_angle(&f), REST_ELECTRICAL_RAD + 0.8, 1e-4);
     rest_at(&f, REST_ELECTRICAL_RAD, PMSTEP_POSITION_DECIMATION); /* the next update puts the estimate */
     assert_float_equal(core_estimate(&f), REST_ELECTRICAL_RAD + 0.4, 1e-4);
-    for (n = 0; n < 20000 && f.pos.hold_stage == POSITION_HOLD_TURNING; ++n) {
+    for (n = 0; n < 20000 && f.pos.hold_stage == POSITION_HOLD_REAIMED; ++n) {
         rest_at(&f, REST_ELECTRICAL_RAD, 1); /* the integrals unmoved: the estimate is still put */
     }
     assert_int_equal(f.pos.hold_stage, POSITION_HOLD_ANCHORED);
@@ -199,10 +203,7 @@ static void move_from_the_hold_starts_from_the_aims_load(void **state)
 {
     fixture_t f;
     (void)state;
-    fixture_in_run(&f);
-    rest_at(&f, REST_ELECTRICAL_RAD, 10);
-    move_and_stay(&f, 0.4, 4.8f);
-    assert_int_equal(f.pos.hold_stage, POSITION_HOLD_SETTLING);
+    held_after_move(&f, 0.4, 4.8f);
     assert_float_equal(f.pos.aim_load_Nm, 4.8f, 0.0f);
     f.inst.observer.load_hat_Nm = 6.3f; /* 2 N m/A x 7.5 A x sin(0.1): an estimate 0.1 rad off */
     assert_int_equal(pmstep_position_move_to(&f.pos, 0.0f, 1.0f, 10.0f, 0.0f), PMSTEP_OK);

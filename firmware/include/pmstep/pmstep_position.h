@@ -31,10 +31,11 @@
  * within the quiet band) for the held rotor's settling time, the estimate is kept where it was
  * then, so it does not drift, and it follows the flux integrals while the rotor moves (a load
  * step). After POSITION_REAIM_PERIODS at rest more than 0.05 electrical rad from the target,
- * the aim is turned by that displacement (the load angle off, or the load changed), and so on
- * until the rotor rests within 0.05. A move, a stop or a speed command releases it; a move or a
- * stop also puts T_L-hat back to the aim's (held, the hold current times the estimate's angle
- * error is in it).
+ * the aim is turned by that displacement (the load angle off, or the load changed), and the kept
+ * estimate with it (the rotor follows the turn; the flux integrals are not read again, their
+ * drift at rest would be taken for the next displacement), and so on until the rotor rests
+ * within 0.05. A move, a stop or a speed command releases it; a move or a stop also puts
+ * T_L-hat back to the aim's (held, the hold current times the estimate's angle error is in it).
  *
  * Rates: the turn count runs every period (it must see every crossing); the fine angle, the
  * profile and the loop run every PMSTEP_POSITION_DECIMATION = N periods (a cascade's outer loop
