@@ -166,10 +166,7 @@ static void put_speed_reference(pmstep_position_t *pos, float speed, float rate,
     const float diff23 = rate * inv_w0;
     const float diff12 = accel * inv_w0 * inv_w0 + diff23;
     const float free_change = pos->hold_c23 * diff23 + pos->hold_c12 * diff12;
-    pmstep_ref_reset(ref, speed + (end_speed - speed - free_change) * pos->hold_inv_gain);
-    ref->diff12 = diff12;
-    ref->diff23 = diff23;
-    ref->value = speed;
+    pmstep_ref_place(ref, speed + (end_speed - speed - free_change) * pos->hold_inv_gain, speed, diff12, diff23);
 }
 
 /* Position mode, an update after period k: the profile's sample for period k+1 (pos->now, taken

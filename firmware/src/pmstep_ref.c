@@ -77,10 +77,12 @@ void pmstep_ref_reset(pmstep_ref_t *ref, float value)
     ref->ramp_rate_per_s = 0.0f;
     ref->ramp_origin = value;
     ref->ramp_periods = 0u;
+    ref->settled = true;
 }
 
 void pmstep_ref_set_target(pmstep_ref_t *ref, float target, float ramp_rate_per_s)
 {
+    ref->settled = ref->settled && (target == ref->value); /* settled: y = r = the old target */
     ref->target = target;
     ref->ramp_origin = ref->setpoint;
     ref->ramp_periods = 0u;
@@ -90,6 +92,15 @@ void pmstep_ref_set_target(pmstep_ref_t *ref, float target, float ramp_rate_per_
         ref->ramp_rate_per_s = 0.0f;
         ref->setpoint = target;
     }
+}
+
+void pmstep_ref_place(pmstep_ref_t *ref, float setpoint, float value, float diff12, float diff23)
+{
+    pmstep_ref_reset(ref, setpoint);
+    ref->diff12 = diff12;
+    ref->diff23 = diff23;
+    ref->value = value;
+    ref->settled = false; /* the next period snaps it if the state is in fact at rest */
 }
 
 pmstep_ref_out_t pmstep_ref_output(const pmstep_ref_coeffs_t *coeffs, const pmstep_ref_t *ref)
@@ -114,8 +125,7 @@ void pmstep_ref_advance(const pmstep_ref_coeffs_t *coeffs, pmstep_ref_t *ref, fl
     float y;
 
     /* At rest on its target (as the snap below leaves it): the period would change nothing. */
-    if (ref->diff12 == 0.0f && ref->diff23 == 0.0f && ref->value == next && start == next
-        && ref->value_compensation == 0.0f) {
+    if (ref->settled) {
         return;
     }
     if (ref->ramp_rate_per_s > 0.0f && next != start) {
@@ -146,6 +156,7 @@ void pmstep_ref_advance(const pmstep_ref_coeffs_t *coeffs, pmstep_ref_t *ref, fl
         d2 = 0.0f;
         y = next;
         ref->value_compensation = 0.0f;
+        ref->settled = (next == ref->target);
     }
     ref->diff12 = d1;
     ref->diff23 = d2;

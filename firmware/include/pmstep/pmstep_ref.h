@@ -40,6 +40,7 @@ typedef struct {
     float ramp_rate_per_s; /**< |dr/dt| limit; 0 means a step */
     float ramp_origin;   /**< set-point when the target was set */
     uint32_t ramp_periods; /**< periods since then: r = origin +/- rate * n T_s, never accumulated */
+    bool settled;        /**< at rest on its target (differences 0, y = r = target): a period changes nothing */
 } pmstep_ref_t;
 
 /** Filter output at one sample. */
@@ -57,6 +58,10 @@ void pmstep_ref_reset(pmstep_ref_t *ref, float value);
 
 /** Sets the target and the ramp rate (rate <= 0 means a step change now). */
 void pmstep_ref_set_target(pmstep_ref_t *ref, float target, float ramp_rate_per_s);
+
+/** Puts the filter at the state (y, x1 - x2, x2 - x3) with the set-point (and target) held at
+ *  @p setpoint, no ramp: a trajectory of H(s) continued from outside (position loop). */
+void pmstep_ref_place(pmstep_ref_t *ref, float setpoint, float value, float diff12, float diff23);
 
 /** Output at the present sample (no state change). */
 pmstep_ref_out_t pmstep_ref_output(const pmstep_ref_coeffs_t *coeffs, const pmstep_ref_t *ref);
