@@ -11,7 +11,9 @@ per period is the cost of pmstep_position_step(). Printed per kind of period: RU
 mode, RUN before the first move (speed mode: the estimate only), the alignments. Exits 1 when the
 position-mode mean exceeds --max-mean (the issue's budget, 600 instructions).
 
-usage: tools/bench_position_target.py [--no-build] [--duration S] [--json FILE] [--max-mean N]
+usage: tools/bench_position_target.py [--no-build] [--image ELF --work DIR] [--duration S] [--json FILE]
+                                     [--max-mean N]
+(ctest's pil.position_cost runs it with --no-build on the image of its own cross build)
 """
 import argparse
 import json
@@ -43,10 +45,10 @@ def call_addresses(elf, callee, caller):
     sys.exit("bench_position_target: no call of %s in %s" % (callee, caller))
 
 
-def counts(plugin, entry, ret, name, duration):
-    modes = bt.BENCH / "position-modes.txt"
-    steps = bt.BENCH / ("position-%s.txt" % name)
-    out = bt.qemu(IMAGE, [modes, "--duration", duration],
+def counts(image, work, plugin, entry, ret, name, duration):
+    modes = work / "position-modes.txt"
+    steps = work / ("position-%s.txt" % name)
+    out = bt.qemu(image, [modes, "--duration", duration],
                   ["-plugin", "%s,entry=0x%x,ret=0x%x,out=%s" % (plugin, entry, ret, steps)]).stdout
     values = [int(l) for l in steps.read_text().splitlines() if not l.startswith("#")]
     return values, modes.read_text(), out.strip()
@@ -54,7 +56,9 @@ def counts(plugin, entry, ret, name, duration):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--no-build", action="store_true", help="use the existing build/qemu-pil")
+    ap.add_argument("--no-build", action="store_true", help="use the existing image")
+    ap.add_argument("--image", type=Path, default=IMAGE, help="position image (default: build/qemu-pil's)")
+    ap.add_argument("--work", type=Path, default=bt.BENCH, help="directory for the plugin and the counts")
     ap.add_argument("--duration", default="3", help="simulated seconds (default 3: two moves and a hold)")
     ap.add_argument("--json", help="also write the figures to this JSON file")
     ap.add_argument("--max-mean", type=float, default=600.0,
@@ -64,13 +68,13 @@ def main():
         bt.run(["cmake", "--preset", "qemu-pil"], cwd=bt.ROOT, stdout=subprocess.DEVNULL)
         bt.run(["cmake", "--build", "--preset", "qemu-pil", "--target", "pmstep-pil-position"], cwd=bt.ROOT,
                stdout=subprocess.DEVNULL)
-    bt.BENCH.mkdir(parents=True, exist_ok=True)
-    plugin = bt.BENCH / "pil_insn_plugin.so"
+    args.work.mkdir(parents=True, exist_ok=True)
+    plugin = args.work / "pil_insn_plugin.so"
     bt.run(["cc", "-shared", "-fPIC", "-O2", "-Wall", "-Wextra", "-o", plugin, bt.PLUGIN_SRC])
-    step_entry, step_ret = call_addresses(IMAGE, "pmstep_step", "Irq10_Handler")
-    update_entry, update_ret = call_addresses(IMAGE, "pmstep_position_update", "main")
-    step, modes, report = counts(plugin, step_entry, step_ret, "step", args.duration)
-    update, modes2, _ = counts(plugin, update_entry, update_ret, "update", args.duration)
+    step_entry, step_ret = call_addresses(args.image, "pmstep_step", "Irq10_Handler")
+    update_entry, update_ret = call_addresses(args.image, "pmstep_position_update", "main")
+    step, modes, report = counts(args.image, args.work, plugin, step_entry, step_ret, "step", args.duration)
+    update, modes2, _ = counts(args.image, args.work, plugin, update_entry, update_ret, "update", args.duration)
     if not (len(step) == len(update) == len(modes) and modes == modes2):
         sys.exit("bench_position_target: %d step counts, %d update counts, %d periods" %
                  (len(step), len(update), len(modes)))
