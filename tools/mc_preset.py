@@ -173,14 +173,24 @@ def _points_lines(points):
     return ",\n    ".join(rows)
 
 
+def paper_top_speed(tune):
+    """The paper motor's top speed (rad/s; pmstep-tune --robust behind its realistic chain), which
+    the paper campaign's speed thresholds are relative to."""
+    paper_span = ADC_SPAN_RATED * read_preset(PAPER_PRESET)["rated_current_A"]
+    paper_chain = list(REALISTIC_CHAIN) + [f"sensors.current_full_scale_A={paper_span:g}"]
+    return _run_designer(_design(tune, PAPER_PRESET, paper_chain))
+
+
+def loss_speed_error(top_speed_rad_s, paper_top_rad_s):
+    """run.loss_speed_error_rad_s for a motor of that top speed: robust.ini's 2 rad/s on the
+    paper motor, the same fraction of the motor's own top speed."""
+    return PAPER_LOSS_SPEED_RAD_S * top_speed_rad_s / paper_top_rad_s
+
+
 def _top_speeds(tune, preset_path, chain, low_speed_drive, extra=()):
     """(the preset's top speed, the paper motor's; rad/s) from pmstep-tune, and the preset's command."""
     cmd = _design(tune, preset_path, chain, low_speed_drive) + list(extra)
-    top = _run_designer(cmd)
-    # The paper motor's top speed, which the paper campaign's speed thresholds are relative to.
-    paper_span = ADC_SPAN_RATED * read_preset(PAPER_PRESET)["rated_current_A"]
-    paper_chain = list(REALISTIC_CHAIN) + [f"sensors.current_full_scale_A={paper_span:g}"]
-    return top, _run_designer(_design(tune, PAPER_PRESET, paper_chain)), cmd
+    return _run_designer(cmd), paper_top_speed(tune), cmd
 
 
 def _scenario_peak_and_load(ini, path):
@@ -235,7 +245,7 @@ def design_scenario(tune, preset_path, out_dir, phase_voltage_sensing=False, low
             "load_Nm": PAPER_LOAD_NM * preset["holding_torque_Nm"] / paper_holding,
             "tune_command": cmd, "figures": preset, "paper_holding_torque_Nm": paper_holding, "designed": True}
     speed_bound = PAPER_SPEED_BOUND_RAD_S * top / paper_top
-    loss_speed = PAPER_LOSS_SPEED_RAD_S * top / paper_top
+    loss_speed = loss_speed_error(top, paper_top)
     ini.set("scenario", "name", f"{preset['name']}_mc")
     ini.set("load", "type", "step")
     ini.set("load", "torque_Nm", repr(info["load_Nm"]))

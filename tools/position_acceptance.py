@@ -12,7 +12,10 @@ For each motor (sil/scenarios/motors/*.ini) and chain:
               current, +-20 mA offsets, 5 mA noise, one period of delay, 1 us dead time, and a
               switching inverter, the bridge the designer's dead-time compensation is shaped for),
               the plant's R 20 % above the firmware's, the same moves, then a hold of --hold-s
-              seconds under a load stepped to 30 % of the rated torque k_M I.
+              seconds under a load stepped to 30 % of the rated torque k_M I. Before the first
+              move (speed mode) a loss of control is |w - w*| above robust.ini's 2 rad/s scaled
+              to the motor's top speed, as the presets' Monte Carlo scenarios have it; in
+              position mode it is a lost step (pmstep-sil's run.loss_position_error_rad).
 Each run is pmstep-sil on the scenario with --set overrides; the figures come from its
 summary.json ("position", electrical rad = p x mechanical). Prints one line per run and the
 issue's criteria, and exits 1 if one fails (--check): ideal chain, final error < 0.1 electrical
@@ -35,7 +38,7 @@ import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from mc_preset import chain_sets  # noqa: E402  (the realistic chain, with the ADC span sized to the motor)
+from mc_preset import chain_sets, loss_speed_error, paper_top_speed  # noqa: E402  (the realistic chain, with the ADC span sized to the motor)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 MOTORS = ["paper", "17hs4401", "bj42d29", "as1050"]
@@ -129,6 +132,7 @@ def main():
     os.makedirs(args.out, exist_ok=True)
     results = []
     failed = False
+    paper_top = None  # designed once, for the first realistic run
     print(f"{'motor':9s} {'chain':9s} {'moves':>5s} {'final max':>10s} {'final mean':>10s} {'overshoot':>9s} "
           f"{'unfin':>5s} {'estimate':>9s} {'hold max':>9s} {'drift':>10s} {'sim s':>6s} {'fault':>6s}  verdict")
     for motor in args.motors.split(","):
@@ -156,6 +160,9 @@ def main():
                     f"position.j_max_rad_s3={j_max:.9g}", f"run.duration_s={end_s:.6f}"]
             if robust:
                 load = 0.3 * preset["k_M"] * preset["rated_A"]
+                if paper_top is None:
+                    paper_top = paper_top_speed(args.tune)
+                sets.append(f"run.loss_speed_error_rad_s={loss_speed_error(top, paper_top):.9g}")
                 sets += [f"motor.resistance_Ohm={1.2 * preset['R']:.9g}",  # the plant's; the firmware keeps R
                          "load.type=step", f"load.torque_Nm={load:.9g}", f"load.step_time_s={end_s:.6f}",
                          f"position.hold_start_s={end_s:.6f}", f"run.duration_s={end_s + args.hold_s:.6f}"]
