@@ -49,6 +49,25 @@ static bool aim_ahead_of_rotor(const pmstep_law_coeffs_t *law, float c, float s,
     return true;
 }
 
+/* Whether the observer's speed estimate follows a rotor swinging at w (rad/s) enough in phase for
+ * the damping term: Re(w-hat/w) >= PMSTEP_HOLD_MIN_IN_PHASE_SHARE. The estimate is kept at the
+ * vector's aim, so the observer's model lacks the swing's restoring torque and sees the rotor's
+ * acceleration as a disturbance d: w~ = s (s + a_e) d / P(s) (DESIGN.md, section 3, d entering
+ * w~'), d = s w, hence w-hat/w = 1 - M/P with P = s^3 + c2 s^2 + c1 s + c0 the observer's
+ * characteristic polynomial and M = s^2 (s + a_e) = -w^2 (a_e + j w) at s = j w. Compared
+ * without a division: (1 - share) |P|^2 >= Re(M conj P) = -w^2 (a_e Re P + w Im P). */
+static bool observer_follows_swing(const pmstep_t *inst, float w)
+{
+    const pmstep_observer_coeffs_t *obs = &inst->observer_coeffs;
+    const float a_e = obs->r_over_l_per_s + obs->observer_gain_per_s;
+    const float b_squared = obs->km_over_l * obs->km_over_l;
+    const float w2 = w * w;
+    const float p_re = (obs->load_injection_gain * b_squared * obs->inv_j) - ((a_e + obs->f_over_j_per_s) * w2);
+    const float p_im = ((a_e * obs->f_over_j_per_s) + (obs->speed_injection_gain * b_squared) - w2) * w;
+    return ((1.0f - PMSTEP_HOLD_MIN_IN_PHASE_SHARE) * ((p_re * p_re) + (p_im * p_im)))
+           + (w2 * ((a_e * p_re) + (w * p_im))) >= 0.0f;
+}
+
 pmstep_status_t pmstep_hold_vector(pmstep_t *inst, float cos_rest, float sin_rest, float current_A, float load_Nm)
 {
     const pmstep_law_coeffs_t *law;
@@ -56,6 +75,7 @@ pmstep_status_t pmstep_hold_vector(pmstep_t *inst, float cos_rest, float sin_res
     pmstep_detent_t detent;
     hold_aim_t aim = {1.0f, 0.0f, 1.0f}; /* aim_ahead_of_rotor's */
     float natural_rad_s;
+    float natural_per_period; /* w_n T_s, rad */
     float settle_periods;
     if (inst == NULL) {
         return PMSTEP_ERR_NULL_ARGUMENT;
@@ -80,11 +100,14 @@ pmstep_status_t pmstep_hold_vector(pmstep_t *inst, float cos_rest, float sin_res
     hold->sin_vector = aim.sin_vector;
     natural_rad_s = hold_natural_rad_s(law, current_A, aim.cos_delta);
     hold->current_A = current_A;
-    hold->damping_s = 2.0f * PMSTEP_HOLD_DAMPING_RATIO * law->pole_pairs / natural_rad_s;
+    /* no damping term where w-hat lags the swing (its term would be a spring, not a damper) */
+    hold->damping_s = observer_follows_swing(inst, natural_rad_s)
+                          ? (2.0f * PMSTEP_HOLD_DAMPING_RATIO * law->pole_pairs / natural_rad_s)
+                          : 0.0f;
     hold->quiet_band_rad_s = PMSTEP_HOLD_QUIET_FRACTION * natural_rad_s / law->pole_pairs;
-    hold->bias_gain = natural_rad_s * inst->cfg->timing.period_s / PMSTEP_HOLD_BIAS_CORNER_RATIO;
-    settle_periods = PMSTEP_HOLD_SETTLE_TIME_CONSTANTS
-                     / (PMSTEP_HOLD_DAMPING_RATIO * natural_rad_s * inst->cfg->timing.period_s);
+    natural_per_period = natural_rad_s * inst->cfg->timing.period_s;
+    hold->bias_gain = natural_per_period / PMSTEP_HOLD_BIAS_CORNER_RATIO;
+    settle_periods = PMSTEP_HOLD_SETTLE_TIME_CONSTANTS / (PMSTEP_HOLD_DAMPING_RATIO * natural_per_period);
     hold->settle_periods = period_count(settle_periods);
     hold->cos_frame = hold->cos_vector;
     hold->sin_frame = hold->sin_vector;

@@ -8,6 +8,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include <complex.h>
 #include <math.h>
 
 #include "pmstep/pmstep.h"
@@ -71,6 +72,53 @@ static void hold_derives_vector_spring_and_damping(void **state)
     assert_float_equal(f.inst.current_integral.i_q_error_integral_As, 0.0f, 0.0f);
     print_message("paper motor, 7.5 A, 4.8 N m: load angle %.4f rad, w_n %.2f rad/s, settling %u periods\n",
                   delta, w_n, (unsigned)f.inst.hold.settle_periods);
+}
+
+/* The damping term needs a speed estimate in phase with the swing. With the observer placed at a
+ * triple pole w_o (DESIGN.md, section 3) and the estimate kept (no restoring torque in its model),
+ * w-hat/w = N(s)/P(s), N = P - s^2 (s + a_e): computed here in complex double, the hold damps
+ * (g = 2 zeta p / w_n) where Re(w-hat/w) at w_n is at least 0.5 and not at all below: for the
+ * triple pole that is w_n <= w_o (Re exactly 0.5 at w_n = w_o, F = 0). The hybrid presets sit at
+ * w_n / w_o = 1.1 to 1.6 (Re 0.38 to -0.06): no damping. */
+static void hold_damps_only_where_the_estimate_follows_the_swing(void **state)
+{
+    const double ratios[] = {0.25, 0.5, 0.7, 0.9, 0.95, 1.05, 1.09, 1.38, 1.57, 2.5};
+    const double w_n = sqrt(6.0 * 2.0 * 7.5 / 0.01); /* no load, 7.5 A */
+    size_t k;
+    int damped = 0;
+    (void)state;
+    for (k = 0; k < sizeof ratios / sizeof ratios[0]; ++k) {
+        paper_run_t f;
+        pmstep_observer_coeffs_t *obs;
+        double w_o, f_j, a_e, b, c0, c1, c2, re;
+        double complex s_jw, n, p;
+        fixture_in_run(&f);
+        obs = &f.inst.observer_coeffs;
+        w_o = w_n / ratios[k];
+        f_j = obs->f_over_j_per_s;
+        b = obs->km_over_l;
+        a_e = 3.0 * w_o - f_j;
+        obs->observer_gain_per_s = (float)(a_e - obs->r_over_l_per_s);
+        obs->speed_injection_gain = (float)((3.0 * w_o * w_o - a_e * f_j) / (b * b));
+        obs->load_injection_gain = (float)(w_o * w_o * w_o / (b * b * obs->inv_j));
+        c2 = a_e + f_j;
+        c1 = a_e * f_j + 3.0 * w_o * w_o - a_e * f_j;
+        c0 = w_o * w_o * w_o;
+        s_jw = I * w_n;
+        p = s_jw * s_jw * s_jw + c2 * s_jw * s_jw + c1 * s_jw + c0;
+        n = p - s_jw * s_jw * (s_jw + a_e);
+        re = creal(n / p);
+        assert_int_equal(pmstep_hold_vector(&f.inst, 1.0f, 0.0f, 7.5f, 0.0f), PMSTEP_OK);
+        print_message("w_n / w_o %.2f: Re(w-hat/w) %+.3f, g %.4g\n", ratios[k], re, (double)f.inst.hold.damping_s);
+        assert_true(fabs(re - 0.5) > 0.01); /* no ratio on the edge */
+        if (re >= 0.5) {
+            assert_float_equal(f.inst.hold.damping_s, 2.0 * 0.7 * 6.0 / w_n, 1e-5 * 2.0 * 0.7 * 6.0 / w_n);
+            damped++;
+        } else {
+            assert_float_equal(f.inst.hold.damping_s, 0.0f, 0.0f);
+        }
+    }
+    assert_true(damped >= 3 && damped <= 7); /* both sides of the rule seen */
 }
 
 static void hold_voltage_is_the_current_loop_in_the_vector_frame(void **state)
@@ -170,6 +218,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(hold_refuses_with_named_codes),
         cmocka_unit_test(hold_derives_vector_spring_and_damping),
+        cmocka_unit_test(hold_damps_only_where_the_estimate_follows_the_swing),
         cmocka_unit_test(hold_voltage_is_the_current_loop_in_the_vector_frame),
         cmocka_unit_test(release_and_speed_command_end_the_hold),
         cmocka_unit_test(angle_estimate_set_gives_that_estimate),

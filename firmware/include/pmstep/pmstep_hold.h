@@ -11,7 +11,9 @@
  * holds the rotor at x_rest under the estimated load. Linearised about the rest the rotor is a
  * spring, J theta'' = -p k_M I cos(delta) theta, of natural frequency
  *   w_n = sqrt(p k_M I cos(delta) / J);
- * turning the vector back by g (w-hat - w-bar), g = 2 zeta p / w_n, adds the damping 2 zeta w_n.
+ * turning the vector back by g (w-hat - w-bar), g = 2 zeta p / w_n, adds the damping 2 zeta w_n
+ * where w-hat follows the swing in phase (PMSTEP_HOLD_MIN_IN_PHASE_SHARE; g = 0 where it does
+ * not: a rotor light enough that w_n passes the observer's bandwidth, DESIGN.md section 12).
  * w-bar is w-hat low-passed at w_n / PMSTEP_HOLD_BIAS_CORNER_RATIO: the speed estimate's bias
  * at rest, which would otherwise turn the vector off the rest for good (g times the bias).
  * The law's PI current loop (pmstep_law_voltages' at zero speed, written out in pmstep_hold.c)
@@ -68,6 +70,11 @@ extern "C" {
 
 /** zeta of the held rotor (the vector's lag g = 2 zeta p / w_n). */
 #define PMSTEP_HOLD_DAMPING_RATIO 0.7f
+/** Smallest in-phase share Re(w-hat/w) of the observer's speed estimate at w_n (the estimate kept,
+ *  so the observer's model has no restoring torque) for the damping term: below it w-hat lags
+ *  the rotor by so much that g (w-hat - w-bar) would turn the vector with the displacement, not
+ *  the speed (the hybrid presets, w_n 1.1 to 1.6 times the observer's w_o: Re 0.38 to -0.06). */
+#define PMSTEP_HOLD_MIN_IN_PHASE_SHARE 0.5f
 /** |w-hat - w-bar| below this fraction of w_n / p counts as at rest (the position library's test). */
 #define PMSTEP_HOLD_QUIET_FRACTION 0.05f
 /** Settling time of the held rotor, in time constants 1/(zeta w_n). */
@@ -102,7 +109,7 @@ typedef struct {
     float cos_vector;          /**< cos v of the aimed vector (stator frame) */
     float sin_vector;          /**< sin v */
     float current_A;           /**< I */
-    float damping_s;           /**< g = 2 zeta p / w_n, electrical rad per rad/s */
+    float damping_s;           /**< g = 2 zeta p / w_n, electrical rad per rad/s (0: w-hat lags the swing) */
     float speed_bias_rad_s;    /**< w-bar, the speed estimate at rest (w-hat low-passed) */
     float bias_gain;           /**< w_n T_s / PMSTEP_HOLD_BIAS_CORNER_RATIO, w-bar's filter per period */
     float quiet_band_rad_s;    /**< PMSTEP_HOLD_QUIET_FRACTION w_n / p */
