@@ -68,7 +68,10 @@ static bool observer_follows_swing(const pmstep_t *inst, float w)
            + (w2 * ((a_e * p_re) + (w * p_im))) >= 0.0f;
 }
 
-pmstep_status_t pmstep_hold_vector(pmstep_t *inst, float cos_rest, float sin_rest, float current_A, float load_Nm)
+/* pmstep_hold_vector's, with the damping term kept whatever the observer's phase where
+ * @p always_damped (the standstill hold of speed mode, pmstep_hold.h). */
+static pmstep_status_t aim_vector(pmstep_t *inst, float cos_rest, float sin_rest, float current_A, float load_Nm,
+                                  bool always_damped)
 {
     const pmstep_law_coeffs_t *law;
     pmstep_vector_hold_t *hold;
@@ -100,8 +103,9 @@ pmstep_status_t pmstep_hold_vector(pmstep_t *inst, float cos_rest, float sin_res
     hold->sin_vector = aim.sin_vector;
     natural_rad_s = hold_natural_rad_s(law, current_A, aim.cos_delta);
     hold->current_A = current_A;
-    /* no damping term where w-hat lags the swing (its term would be a spring, not a damper) */
-    hold->damping_s = observer_follows_swing(inst, natural_rad_s)
+    /* no damping term where w-hat lags the swing (its term would be a spring, not a damper),
+     * but in the standstill hold of speed mode (pmstep_hold.h) */
+    hold->damping_s = (always_damped || observer_follows_swing(inst, natural_rad_s))
                           ? (2.0f * PMSTEP_HOLD_DAMPING_RATIO * law->pole_pairs / natural_rad_s)
                           : 0.0f;
     hold->quiet_band_rad_s = PMSTEP_HOLD_QUIET_FRACTION * natural_rad_s / law->pole_pairs;
@@ -119,6 +123,11 @@ pmstep_status_t pmstep_hold_vector(pmstep_t *inst, float cos_rest, float sin_res
         hold->active = true;
     }
     return PMSTEP_OK;
+}
+
+pmstep_status_t pmstep_hold_vector(pmstep_t *inst, float cos_rest, float sin_rest, float current_A, float load_Nm)
+{
+    return aim_vector(inst, cos_rest, sin_rest, current_A, load_Nm, false);
 }
 
 void pmstep_release_vector(pmstep_t *inst)
@@ -310,7 +319,7 @@ static void standstill_engage(pmstep_t *inst, pmstep_standstill_t *standstill, c
         }
         /* refused (a load beyond the vector's pull, an estimate at the origin): the law holds on */
         inst->hold.standstill_engaged = length > 0.0f
-                                        && pmstep_hold_vector(inst, c, s, current_A, inst->observer.load_hat_Nm)
+                                        && aim_vector(inst, c, s, current_A, inst->observer.load_hat_Nm, true)
                                                == PMSTEP_OK;
         standstill->keep_cos = c; /* where the vector will hold the rotor: T_L-hat's load angle behind it */
         standstill->keep_sin = s;

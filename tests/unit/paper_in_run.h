@@ -34,4 +34,18 @@ static inline float paper_estimate_angle(const pmstep_t *inst)
     return atan2f(s, c);
 }
 
+/* Places the observer's poles at a triple pole w_o (rad/s), as the designer does (DESIGN.md,
+ * section 3): a_e = 3 w_o - F/J, g_w b^2 = 3 w_o^2 - a_e F/J, g_T b^2 / J = w_o^3, b = k_M/L.
+ * Returns a_e. */
+static inline double paper_observer_at_triple_pole(pmstep_observer_coeffs_t *obs, double w_o)
+{
+    const double f_j = obs->f_over_j_per_s;
+    const double b = obs->km_over_l;
+    const double a_e = 3.0 * w_o - f_j;
+    obs->observer_gain_per_s = (float)(a_e - obs->r_over_l_per_s);
+    obs->speed_injection_gain = (float)((3.0 * w_o * w_o - a_e * f_j) / (b * b));
+    obs->load_injection_gain = (float)(w_o * w_o * w_o / (b * b * obs->inv_j));
+    return a_e;
+}
+
 #endif /* PAPER_IN_RUN_H */

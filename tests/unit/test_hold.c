@@ -90,17 +90,13 @@ static void hold_damps_only_where_the_estimate_follows_the_swing(void **state)
     for (k = 0; k < sizeof ratios / sizeof ratios[0]; ++k) {
         paper_run_t f;
         pmstep_observer_coeffs_t *obs;
-        double w_o, f_j, a_e, b, c0, c1, c2, re;
+        double w_o, f_j, a_e, c0, c1, c2, re;
         double complex s_jw, n, p;
         fixture_in_run(&f);
         obs = &f.inst.observer_coeffs;
         w_o = w_n / ratios[k];
         f_j = obs->f_over_j_per_s;
-        b = obs->km_over_l;
-        a_e = 3.0 * w_o - f_j;
-        obs->observer_gain_per_s = (float)(a_e - obs->r_over_l_per_s);
-        obs->speed_injection_gain = (float)((3.0 * w_o * w_o - a_e * f_j) / (b * b));
-        obs->load_injection_gain = (float)(w_o * w_o * w_o / (b * b * obs->inv_j));
+        a_e = paper_observer_at_triple_pole(obs, w_o);
         c2 = a_e + f_j;
         c1 = a_e * f_j + 3.0 * w_o * w_o - a_e * f_j;
         c0 = w_o * w_o * w_o;

@@ -64,6 +64,29 @@ static void standstill_engages_after_the_engage_time_at_rest(void **state)
     assert_float_equal(f.inst.hold.current_A, 7.5f, 0.0f);
 }
 
+/* The standstill keeps the damping term where the vector hold's rule drops it (w-hat lagging the
+ * swing: here the observer's triple pole at w_n / 2, Re(w-hat/w) below 1/2 at w_n): it engages
+ * with a step of the vector's current, whose first swing the term shortens (DESIGN.md section 12). */
+static void standstill_keeps_its_damping_where_the_estimate_lags(void **state)
+{
+    paper_run_t f;
+    const double w_n = sqrt(6.0 * 2.0 * 7.5 / 0.01);
+    const double g = 2.0 * 0.7 * 6.0 / w_n;
+    const pmstep_output_t out = at_rest_output(1.0f, 0.0f);
+    uint32_t n;
+    (void)state;
+    fixture_with_standstill(&f);
+    (void)paper_observer_at_triple_pole(&f.inst.observer_coeffs, 0.5 * w_n);
+    for (n = 0; n < f.inst.scratch.run.standstill.engage_periods; ++n) {
+        pmstep_standstill_advance(&f.inst, &out);
+    }
+    assert_true(f.inst.hold.active && f.inst.hold.standstill_engaged);
+    assert_float_equal(f.inst.hold.damping_s, g, 1e-5 * g);
+    /* the same aim through pmstep_hold_vector: no damping term */
+    assert_int_equal(pmstep_hold_vector(&f.inst, 1.0f, 0.0f, 7.5f, 0.0f), PMSTEP_OK);
+    assert_float_equal(f.inst.hold.damping_s, 0.0f, 0.0f);
+}
+
 static void standstill_waits_for_the_zero_command_reached(void **state)
 {
     paper_run_t f;
@@ -332,6 +355,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(standstill_engages_after_the_engage_time_at_rest),
+        cmocka_unit_test(standstill_keeps_its_damping_where_the_estimate_lags),
         cmocka_unit_test(standstill_waits_for_the_zero_command_reached),
         cmocka_unit_test(standstill_keeps_the_estimate_while_the_rotor_rests),
         cmocka_unit_test(standstill_settles_on_the_aim),
