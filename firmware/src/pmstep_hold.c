@@ -70,7 +70,7 @@ static bool observer_follows_swing(const pmstep_t *inst, float w)
 
 /* pmstep_hold_vector's, with the damping term kept whatever the observer's phase where
  * @p always_damped (the standstill hold of speed mode, pmstep_hold.h). */
-static pmstep_status_t aim_vector(pmstep_t *inst, float cos_rest, float sin_rest, float current_A, float load_Nm,
+static pmstep_status_t engage_vector(pmstep_t *inst, float cos_rest, float sin_rest, float current_A, float load_Nm,
                                   bool always_damped)
 {
     const pmstep_law_coeffs_t *law;
@@ -127,7 +127,7 @@ static pmstep_status_t aim_vector(pmstep_t *inst, float cos_rest, float sin_rest
 
 pmstep_status_t pmstep_hold_vector(pmstep_t *inst, float cos_rest, float sin_rest, float current_A, float load_Nm)
 {
-    return aim_vector(inst, cos_rest, sin_rest, current_A, load_Nm, false);
+    return engage_vector(inst, cos_rest, sin_rest, current_A, load_Nm, false);
 }
 
 void pmstep_release_vector(pmstep_t *inst)
@@ -319,7 +319,7 @@ static void standstill_engage(pmstep_t *inst, pmstep_standstill_t *standstill, c
         }
         /* refused (a load beyond the vector's pull, an estimate at the origin): the law holds on */
         inst->hold.standstill_engaged = length > 0.0f
-                                        && aim_vector(inst, c, s, current_A, inst->observer.load_hat_Nm, true)
+                                        && engage_vector(inst, c, s, current_A, inst->observer.load_hat_Nm, true)
                                                == PMSTEP_OK;
         standstill->keep_cos = c; /* where the vector will hold the rotor: T_L-hat's load angle behind it */
         standstill->keep_sin = s;
