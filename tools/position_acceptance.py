@@ -38,7 +38,8 @@ import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from mc_preset import chain_sets, loss_speed_error, paper_top_speed  # noqa: E402  (the realistic chain, with the ADC span sized to the motor)
+# the realistic chain (ADC span sized to the motor) and the speed-mode loss bound scaled to its top speed
+from mc_preset import chain_sets, loss_speed_error, paper_top_speed  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 MOTORS = ["paper", "17hs4401", "bj42d29", "as1050"]

@@ -75,7 +75,7 @@ extern "C" {
 /** Smallest in-phase share Re(w-hat/w) of the observer's speed estimate at w_n (the estimate kept,
  *  so the observer's model has no restoring torque) for the damping term: below it w-hat lags
  *  the rotor by so much that g (w-hat - w-bar) would turn the vector with the displacement, not
- *  the speed (the hybrid presets, w_n 1.1 to 1.6 times the observer's w_o: Re 0.38 to -0.06). */
+ *  the speed (the hybrid presets, w_n 1.1 to 1.6 times the observer's w_o: Re 0.37 to -0.06). */
 #define PMSTEP_HOLD_MIN_IN_PHASE_SHARE 0.5f
 /** |w-hat - w-bar| below this fraction of w_n / p counts as at rest (the position library's test). */
 #define PMSTEP_HOLD_QUIET_FRACTION 0.05f
