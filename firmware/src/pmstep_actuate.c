@@ -137,11 +137,16 @@ static float phase_voltage_over_period(float applied_V, float compensation_V, fl
     return command_V - loss_full_V * sign;
 }
 
+float pmstep_actuate_sign_threshold(const pmstep_actuate_coeffs_t *coeffs, float bus_voltage_V)
+{
+    return (coeffs->sign_threshold_A_per_V * bus_voltage_V) + coeffs->sign_threshold_A;
+}
+
 void pmstep_actuate_voltage_over_period(const pmstep_actuator_t *actuator, const pmstep_actuate_coeffs_t *coeffs,
                                         const pmstep_period_currents_t *currents, float bus_voltage_V,
                                         float *u_a_V, float *u_b_V)
 {
-    const float threshold_A = coeffs->sign_threshold_A_per_V * bus_voltage_V + coeffs->sign_threshold_A;
+    const float threshold_A = pmstep_actuate_sign_threshold(coeffs, bus_voltage_V);
     const float dead_V = coeffs->dead_time_duty * bus_voltage_V;
     const float switching_limit_V = bus_voltage_V - dead_V;
     *u_a_V = phase_voltage_over_period(actuator->u_applied_a_V, actuator->compensation_applied_a_V,

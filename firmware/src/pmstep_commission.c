@@ -116,7 +116,8 @@ static void add_alignment_sample(pmstep_alignment_sums_t *sums, const pmstep_com
 }
 
 COMMISSION_OUT_OF_LINE void pmstep_commission_add_alignment(pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
-                                     uint32_t sample, float i_a_A, float i_b_A, float u_a_V, float u_b_V)
+                                     uint32_t sample, float i_a_A, float i_b_A, float u_a_V, float u_b_V,
+                                     bool u_a_known)
 {
     pmstep_alignment_sums_t *alignment = &sums->alignment;
     if (sample >= plan->inductance_start_step && sample - plan->inductance_start_step <= plan->inductance_steps) {
@@ -127,7 +128,14 @@ COMMISSION_OUT_OF_LINE void pmstep_commission_add_alignment(pmstep_commission_su
         add_alignment_sample(alignment, plan, sample, plan->s_align_steps, true, i_b_A, u_b_V, i_a_A);
         return;
     }
-    add_flux_sample(&alignment->swing, sample == plan->s_align_steps, i_a_A, u_a_V);
+    if ((alignment->swing_start_step == 0u) && u_a_known) {
+        alignment->swing_start_step = sample; /* >= s_align_steps >= 1 */
+        add_flux_sample(&alignment->swing, true, i_a_A, u_a_V);
+    } else if (alignment->swing_start_step > 0u) {
+        add_flux_sample(&alignment->swing, false, i_a_A, u_a_V);
+    } else {
+        /* phase a's current still negative: the swing has not started */
+    }
     add_alignment_sample(alignment, plan, sample, plan->c_align_end_step, false, i_a_A, u_a_V, i_b_A);
 }
 
@@ -373,10 +381,11 @@ COMMISSION_OUT_OF_LINE pmstep_fault_t pmstep_commission_finish(const pmstep_comm
     if (cfg->commissioning.use_measured_inductance) {
         inductance_H = result->inductance_H;
     }
-    if (windows) {
-        /* Flux swing of c-alignment (see the header), samples t_s .. t_c, on the driven phase a:
-         * its current is far from zero throughout, so its voltage is known (bias included). The
-         * rotor turns from its rest at t_s to its rest at t_c:
+    if (windows && (alignment->swing_start_step > 0u)) {
+        /* Flux swing of c-alignment (see the header), samples from the first with phase a's
+         * current not negative (t_s, or a few periods later) to t_c, on the driven phase a: its
+         * current then rises from there and stays far from zero, so its voltage is known (bias
+         * included). The rotor turns from its rest at t_s to its rest at t_c:
          * F = L delta i_a + (k_M / p) (cos(p theta_c) - cos(p theta_s)), delta i_a on phase b's
          * scale, L the one RUN takes (the drops' L_0 - (k_M / p) m: solved with k_M). */
         const float run_turn_per_A = cfg->commissioning.use_measured_inductance ? drop_turn_per_A : 0.0f;
@@ -385,7 +394,7 @@ COMMISSION_OUT_OF_LINE pmstep_fault_t pmstep_commission_finish(const pmstep_comm
         float flux_per_pole_pair;
         add_flux_sample(&swing, false, i_a_A, u_a_V); /* t_c's sample closes it */
         step_a_A = result->phase_a_current_scale * (swing.end_A - swing.start_A);
-        flux_per_pole_pair = (window_flux(&swing, plan->c_align_end_step - plan->s_align_steps, offset_a, r_a,
+        flux_per_pole_pair = (window_flux(&swing, plan->c_align_end_step - alignment->swing_start_step, offset_a, r_a,
                                           result->voltage_bias_a_V, period_s)
                               - inductance_H * step_a_A)
                              / (c_rest.cos_end - s_rest.cos_end - run_turn_per_A * step_a_A);

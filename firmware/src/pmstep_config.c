@@ -60,6 +60,7 @@ static pmstep_status_t validate_signs(const pmstep_config_t *cfg)
         SIGN_RULE(limits.min_bus_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_MIN_BUS),
         SIGN_RULE(alignment.s_align_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_ALIGNMENT_VOLTAGE),
         SIGN_RULE(alignment.c_align_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_ALIGNMENT_VOLTAGE),
+        SIGN_RULE(alignment.s_lead_in_time_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_S_LEAD_IN_TIME),
         SIGN_RULE(commissioning.offset_calibration_time_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_OFFSET_CALIBRATION_TIME),
         SIGN_RULE(commissioning.steady_state_window_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_STEADY_STATE_WINDOW),
         SIGN_RULE(commissioning.inductance_window_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_INDUCTANCE_WINDOW),
@@ -154,6 +155,9 @@ static pmstep_status_t validate_alignment(const pmstep_config_t *cfg)
     if (!(align->c_align_time_s - align->s_align_time_s >= period_s)) {
         return PMSTEP_ERR_C_ALIGN_TIME;
     }
+    if (!((align->s_align_time_s - align->s_lead_in_time_s) >= period_s)) {
+        return PMSTEP_ERR_S_LEAD_IN_TIME;
+    }
     if (!duration_ok(align->c_align_time_s, period_s)) {
         return PMSTEP_ERR_ALIGNMENT_TOO_LONG;
     }
@@ -176,7 +180,7 @@ static pmstep_status_t validate_alignment(const pmstep_config_t *cfg)
 static pmstep_status_t validate_commissioning(const pmstep_config_t *cfg)
 {
     const pmstep_commissioning_config_t *comm = &cfg->commissioning;
-    const float s_align_s = cfg->alignment.s_align_time_s;
+    const float s_align_s = cfg->alignment.s_align_time_s - cfg->alignment.s_lead_in_time_s; /* (3) proper */
     const float c_align_s = cfg->alignment.c_align_time_s - cfg->alignment.s_align_time_s;
     const bool window = comm->steady_state_window_s > 0.0f;
     if (!duration_ok(comm->offset_calibration_time_s, cfg->timing.period_s)) {

@@ -155,6 +155,19 @@ static void identify_stage(pmstep_t *inst, const pmstep_output_t *out)
     }
 }
 
+/* Phase a's voltage over the period just ended is not the one the core assumed where phase a's
+ * current (offset-corrected) is beyond the compensation's sign threshold with the sign opposite
+ * to c-alignment's: an undriven phase whose dead time is over-compensated runs away to the excess
+ * over R with whatever sign it had, and at c-alignment's start, until that current passes zero,
+ * the bridge applies 2 V_bus t_d / T_s more than the compensation assumed (sensed voltages need
+ * no assumption). */
+static bool phase_a_voltage_known(const pmstep_t *inst, const pmstep_meas_t *meas)
+{
+    return inst->cfg->inverter.phase_voltage_sensing || !inst->actuate_coeffs.compensate
+           || (meas->i_a_A - inst->commissioning.offset_a_A)
+                  >= -pmstep_actuate_sign_threshold(&inst->actuate_coeffs, meas->bus_voltage_V);
+}
+
 /* Commission stage: the mode of this period from the alignment timing; the alignment's samples
  * into the Remark 2 sums, or at t_c the commissioned model. A rotor that still moved in the
  * steady-state windows has the alignments repeated from s-alignment (this period its first). */
@@ -187,7 +200,7 @@ static pmstep_fault_t commission_stage(pmstep_t *inst, const pmstep_meas_t *meas
         pmstep_sensed_voltages(inst, meas, &u_a_V, &u_b_V);
     }
     pmstep_commission_add_alignment(&inst->scratch.sums, plan, inst->mode_step, meas->i_a_A, meas->i_b_A, u_a_V,
-                                    u_b_V);
+                                    u_b_V, phase_a_voltage_known(inst, meas));
     return PMSTEP_FAULT_NONE;
 }
 
@@ -201,14 +214,18 @@ static pmstep_meas_t calibrated_sample(const pmstep_t *inst, const pmstep_meas_t
     return sample; /* the phase-voltage offsets come off where the voltages are used (with sensing only) */
 }
 
-/* Control stage of the alignments: (3) or (5), the last window at the lower level with the
- * Remark 2 voltage bias; no telemetry in alignment. */
+/* Control stage of the alignments: (3) after its lead-in, or (5), the last window at the lower
+ * level with the Remark 2 voltage bias; no telemetry in alignment. */
 static void alignment_stage(const pmstep_t *inst, pmstep_output_t *out)
 {
     const pmstep_config_t *cfg = inst->cfg;
     const pmstep_commission_plan_t *plan = &inst->commission_plan;
     output_off(out, inst);
-    if (inst->mode == PMSTEP_MODE_S_ALIGN) {
+    if ((inst->mode == PMSTEP_MODE_S_ALIGN) && (inst->mode_step < plan->s_lead_in_steps)) {
+        out->u_a_V = cfg->alignment.c_align_voltage_V; /* the lead-in, (5)'s vector: away from (3)'s unstable
+                                                          equilibrium */
+        out->u_b_V = 0.0f;
+    } else if (inst->mode == PMSTEP_MODE_S_ALIGN) {
         out->u_a_V = 0.0f;
         out->u_b_V = cfg->alignment.s_align_voltage_V;
         if (pmstep_commission_low_level(plan, inst->mode_step, plan->s_align_steps)) {

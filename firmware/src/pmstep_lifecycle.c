@@ -24,11 +24,12 @@ static void derive(pmstep_t *inst, const pmstep_config_t *cfg)
     inst->cfg = cfg;
     pmstep_ref_coeffs_init(&inst->ref_coeffs, cfg->gains.reference_bandwidth_rad_s, period_s);
     pmstep_apply_model(inst, &configured);
+    plan->s_lead_in_steps = pmstep_periods_in(cfg->alignment.s_lead_in_time_s, period_s);
     plan->s_align_steps = pmstep_periods_in(cfg->alignment.s_align_time_s, period_s);
     plan->c_align_end_step = pmstep_periods_in(cfg->alignment.c_align_time_s, period_s);
     plan->window_steps = pmstep_periods_in(cfg->commissioning.steady_state_window_s, period_s);
     plan->inductance_steps = pmstep_periods_in(cfg->commissioning.inductance_window_s, period_s);
-    plan->inductance_start_step = 2u + cfg->timing.computational_delay_periods;
+    plan->inductance_start_step = plan->s_lead_in_steps + 2u + cfg->timing.computational_delay_periods;
     plan->offsets_from_alignment = cfg->commissioning.alignment_offset_calibration;
     plan->bias_estimation = cfg->commissioning.voltage_bias_level_fraction > 0.0f;
     plan->identification_steps = pmstep_periods_in(cfg->commissioning.identification_time_s, period_s);

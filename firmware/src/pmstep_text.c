@@ -43,6 +43,7 @@ const char *pmstep_status_str(pmstep_status_t status)
     case PMSTEP_ERR_C_ALIGN_TIME: return "need t_c - t_s >= T_s";
     case PMSTEP_ERR_ALIGNMENT_TOO_LONG: return "t_c over 2^24 periods";
     case PMSTEP_ERR_ALIGNMENT_CONDITION: return "condition (4) violated";
+    case PMSTEP_ERR_S_LEAD_IN_TIME: return "need 0 <= lead-in <= t_s - T_s";
     case PMSTEP_ERR_OFFSET_CALIBRATION_TIME: return "offset time < 0 or over 2^24 periods";
     case PMSTEP_ERR_STEADY_STATE_WINDOW: return "window < 0 or over half an alignment";
     case PMSTEP_ERR_INDUCTANCE_WINDOW: return "L window < 0 or over half of t_s";

@@ -52,10 +52,11 @@ void print_design(const sil_scenario_t *sc, const pmstep_design_report_t *r, boo
            (double)c->gains.angle_correction_gain_per_s);
     printf("  detent torque compensated: %g Nm, fading above %.1f rad/s (0 = no fade)\n",
            (double)c->motor.detent_torque_Nm, (double)c->gains.detent_fade_speed_rad_s);
-    printf("  alignment: %.3f A (u = %.3f V), t_s %.2f s, t_c %.2f s; swing %.0f rad/s, damping %.2f; "
-           "condition (4) holds %.2fx over\n",
+    printf("  alignment: %.3f A (u = %.3f V), lead-in %.2f s, t_s %.2f s, t_c %.2f s; swing %.0f rad/s, "
+           "damping %.2f; condition (4) holds %.2fx over\n",
            (double)r->alignment_current_A, (double)c->alignment.s_align_voltage_V,
-           (double)c->alignment.s_align_time_s, (double)c->alignment.c_align_time_s,
+           (double)c->alignment.s_lead_in_time_s, (double)c->alignment.s_align_time_s,
+           (double)c->alignment.c_align_time_s,
            (double)r->alignment_frequency_rad_s, (double)r->alignment_damping, (double)r->condition_4_margin);
     printf("  trips: %.2f A, bus %.1f..%.1f V; detection: stall/consistency %.2f rad/s, residual %.3f A, %.3f s\n",
            (double)c->limits.max_phase_current_A, (double)c->limits.min_bus_voltage_V,
@@ -95,10 +96,11 @@ int write_c(const char *path, const sil_scenario_t *sc)
             (double)c->motor.detent_torque_Nm);
     fprintf(f, "    .timing = {.period_s = %.9gf, .computational_delay_periods = %uu},\n", (double)c->timing.period_s,
             (unsigned)c->timing.computational_delay_periods);
-    fprintf(f, "    .alignment = {.s_align_time_s = %.9gf, .c_align_time_s = %.9gf, .s_align_voltage_V = %.9gf,\n"
-               "                  .c_align_voltage_V = %.9gf},\n",
-            (double)c->alignment.s_align_time_s, (double)c->alignment.c_align_time_s,
-            (double)c->alignment.s_align_voltage_V, (double)c->alignment.c_align_voltage_V);
+    fprintf(f, "    .alignment = {.s_align_time_s = %.9gf, .s_lead_in_time_s = %.9gf, .c_align_time_s = %.9gf,\n"
+               "                  .s_align_voltage_V = %.9gf, .c_align_voltage_V = %.9gf},\n",
+            (double)c->alignment.s_align_time_s, (double)c->alignment.s_lead_in_time_s,
+            (double)c->alignment.c_align_time_s, (double)c->alignment.s_align_voltage_V,
+            (double)c->alignment.c_align_voltage_V);
     fprintf(f, "    .gains = {.speed_gain_per_s = %.9gf, .observer_gain_per_s = %.9gf, .current_gain_per_s = %.9gf,\n"
                "              .adapt_gamma = %.9gf, .adapt_lambda = %.9gf, .adapt_r = %.9gf, .sat_kappa_rad_s = %.9gf,\n"
                "              .reference_bandwidth_rad_s = %.9gf, .angle_correction_gain_per_s = %.9gf,\n"

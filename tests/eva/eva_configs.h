@@ -65,6 +65,7 @@ static void eva_any_config(pmstep_config_t *cfg)
     cfg->timing.computational_delay_periods = Frama_C_unsigned_int_interval(0u, UINT32_MAX);
     cfg->alignment.s_align_time_s = eva_any_finite();
     cfg->alignment.c_align_time_s = eva_any_finite();
+    cfg->alignment.s_lead_in_time_s = eva_any_finite();
     cfg->alignment.s_align_voltage_V = eva_any_finite();
     cfg->alignment.c_align_voltage_V = eva_any_finite();
     cfg->gains.speed_gain_per_s = eva_any_finite();

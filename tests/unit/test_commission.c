@@ -371,6 +371,7 @@ static void rest_comes_from_both_phases_currents(void **state)
         sums.alignment.swing.end_A = (float)driven_A;
         sums.alignment.swing.current_sum_A = (float)(swing_periods * driven_A);
         sums.alignment.swing.voltage_sum_V = (float)((swing_periods - 1u) * r_Ohm * driven_A);
+        sums.alignment.swing_start_step = plan.s_align_steps; /* phase a's voltage known from t_s */
         assert_int_equal(pmstep_commission_finish(&sums, &plan, &cfg, (float)driven_A,
                                                   (float)(r_Ohm * driven_A + flux_Wb / (double)cfg.timing.period_s),
                                                   &result),

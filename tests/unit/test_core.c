@@ -65,6 +65,44 @@ static void alignment_timing_and_voltages(void **state)
     assert_false(out.bridge_enable);
 }
 
+/* s-alignment's lead-in (its first 0.1 s here): (5)'s u_a = u_cc, u_b = 0, in S_ALIGN; then (3)
+ * to t_s and (5) to t_c as without it, the dead time compensated alike in both. */
+static void lead_in_drives_c_alignment_vector_first(void **state)
+{
+    pmstep_config_t cfg = pmstep_paper_config();
+    pmstep_t inst;
+    pmstep_output_t out;
+    pmstep_meas_t meas = nominal_meas();
+    uint32_t k;
+    const uint32_t lead_in_steps = 2000u; /* 0.1 s / 50 us */
+    const uint32_t s_steps = 6000u;
+    const uint32_t c_steps = 12000u;
+    float lead_in_u_a_V = 0.0f;
+    (void)state;
+    cfg.alignment.s_lead_in_time_s = 0.1f;
+    cfg.inverter.dead_time_s = 1e-6f;
+    cfg.inverter.dead_time_current_band_A = 0.05f;
+    assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
+    assert_int_equal(pmstep_start(&inst), PMSTEP_OK);
+    for (k = 0; k < c_steps + 1u; ++k) {
+        pmstep_step(&inst, &meas, &out);
+        assert_true(out.bridge_enable);
+        if (k < lead_in_steps) {
+            assert_int_equal(out.mode, PMSTEP_MODE_S_ALIGN);
+            assert_true(out.u_a_V > 24.0f && out.u_b_V == 0.0f);
+            lead_in_u_a_V = out.u_a_V;
+        } else if (k < s_steps) {
+            assert_int_equal(out.mode, PMSTEP_MODE_S_ALIGN);
+            assert_true(out.u_a_V == 0.0f && out.u_b_V > 24.0f);
+        } else if (k < c_steps) {
+            assert_int_equal(out.mode, PMSTEP_MODE_C_ALIGN);
+            assert_true(out.u_a_V == lead_in_u_a_V && out.u_b_V == 0.0f);
+        } else {
+            assert_int_equal(out.mode, PMSTEP_MODE_RUN);
+        }
+    }
+}
+
 static void commands_validate_their_values(void **state)
 {
     pmstep_config_t cfg = pmstep_paper_config();
@@ -405,6 +443,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(alignment_timing_and_voltages),
+        cmocka_unit_test(lead_in_drives_c_alignment_vector_first),
         cmocka_unit_test(commands_validate_their_values),
         cmocka_unit_test(each_fault_latches_with_zero_output),
         cmocka_unit_test(nonfinite_known_load_faults_only_in_known_load_mode),

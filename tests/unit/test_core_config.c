@@ -72,6 +72,8 @@ static void align_voltage_above_bus(pmstep_config_t *c) { c->alignment.s_align_v
 static void zero_align_voltage(pmstep_config_t *c) { c->alignment.c_align_voltage_V = 0.0f; }
 static void bad_align_current(pmstep_config_t *c) { c->limits.max_phase_current_A = 7.0f; } /* 24 V / 3 Ohm = 8 A */
 static void bad_align_time(pmstep_config_t *c) { c->alignment.c_align_time_s = c->alignment.s_align_time_s; }
+static void negative_lead_in(pmstep_config_t *c) { c->alignment.s_lead_in_time_s = -1e-3f; }
+static void lead_in_fills_s_alignment(pmstep_config_t *c) { c->alignment.s_lead_in_time_s = c->alignment.s_align_time_s; }
 static void bad_bandwidth(pmstep_config_t *c) { c->gains.reference_bandwidth_rad_s = 20000.0f; }
 static void bad_limits(pmstep_config_t *c) { c->limits.max_bus_voltage_V = 20.0f; }
 static void bad_delay(pmstep_config_t *c) { c->timing.computational_delay_periods = 2u; }
@@ -114,6 +116,8 @@ static const struct {
     {negative_detent, PMSTEP_ERR_DETENT_TORQUE},
     {negative_current_integral, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN},
     {negative_detent_fade, PMSTEP_ERR_DETENT_FADE_SPEED},
+    {negative_lead_in, PMSTEP_ERR_S_LEAD_IN_TIME},
+    {lead_in_fills_s_alignment, PMSTEP_ERR_S_LEAD_IN_TIME},
     {current_integral_complex_poles, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN},
     {bad_period, PMSTEP_ERR_PERIOD},
     {bad_k_omega, PMSTEP_ERR_SPEED_GAIN},

@@ -146,6 +146,40 @@ static void detent_compensation_fades_where_the_current_loop_ends(void **state)
     }
 }
 
+/* DESIGN.md section 4: with a detent torque s-alignment leads in for the swing's settling time
+ * (rounded up to 10 ms), and its own part and c-alignment stay as designed without one. */
+static void s_alignment_leads_in_where_there_is_a_detent(void **state)
+{
+    size_t n;
+    int robust;
+    (void)state;
+    for (n = 0; n < sizeof presets / sizeof presets[0]; ++n) {
+        for (robust = 0; robust <= 1; ++robust) {
+            pmstep_design_input_t in = input_of(&presets[n], robust != 0);
+            pmstep_config_t plain;
+            pmstep_config_t detent;
+            pmstep_design_report_t report;
+            float lead_in_ms;
+            assert_int_equal(pmstep_design(&in, &plain, &report), PMSTEP_OK);
+            assert_true(plain.alignment.s_lead_in_time_s == 0.0f);
+            in.motor.detent_torque_Nm = 0.02f;
+            assert_int_equal(pmstep_design(&in, &detent, &report), PMSTEP_OK);
+            assert_int_equal(pmstep_validate_config(&detent), PMSTEP_OK);
+            lead_in_ms = 1000.0f * detent.alignment.s_lead_in_time_s;
+            print_message("%s robust=%d: lead-in %.0f ms, t_s %.3f s, t_c %.3f s\n", presets[n].name, robust,
+                          (double)lead_in_ms, (double)detent.alignment.s_align_time_s,
+                          (double)detent.alignment.c_align_time_s);
+            assert_true(lead_in_ms >= 9.99f && fabsf(lead_in_ms / 10.0f - roundf(lead_in_ms / 10.0f)) < 1e-3f);
+            /* the settling time, without the windows robust mode adds */
+            assert_true(detent.alignment.s_lead_in_time_s <= plain.alignment.s_align_time_s + 1e-6f);
+            assert_float_equal(detent.alignment.s_align_time_s - detent.alignment.s_lead_in_time_s,
+                               plain.alignment.s_align_time_s, 1e-6f);
+            assert_float_equal(detent.alignment.c_align_time_s - detent.alignment.s_align_time_s,
+                               plain.alignment.c_align_time_s - plain.alignment.s_align_time_s, 1e-6f);
+        }
+    }
+}
+
 static void observer_poles_are_placed(void **state)
 {
     /* s^3 + (a_e + F/J) s^2 + (a_e F/J + g_w b^2) s + g_T b^2/J = (s + w_o)^3, b = k_M/L,
@@ -319,6 +353,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(every_preset_gets_a_valid_design),
         cmocka_unit_test(detent_compensation_fades_where_the_current_loop_ends),
+        cmocka_unit_test(s_alignment_leads_in_where_there_is_a_detent),
         cmocka_unit_test(residual_bound_has_the_dead_time_floor),
         cmocka_unit_test(observer_poles_are_placed),
         cmocka_unit_test(bad_motor_data_gets_a_named_error),

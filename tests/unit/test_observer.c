@@ -51,6 +51,7 @@ static void observer_converges_on_exact_samples(void **state)
         in.i_d_err_A = 0.0f;
         in.i_q_err_A = 0.0f;
         in.known_load_Nm = 0.0f;
+        in.detent_torque_Nm = 0.0f; /* the paper's motor */
         mech = pmstep_observer_mech_rates(&obs, &coeffs, &in, false);
         pmstep_observer_advance(&obs, &coeffs, &in, &mech, u_a, u_b, (float)period_s);
         exact_plant_advance(&plant, u_a, u_b, period_s);

@@ -69,6 +69,7 @@ static const pmstep_console_config_entry_t table[] = {
     F32(standstill.vector_speed_rad_s),
     BOOL(inverter.ripple_dead_zone),
     F32(gains.detent_fade_speed_rad_s),
+    F32(alignment.s_lead_in_time_s),
 };
 
 const pmstep_console_config_entry_t *pmstep_console_config_table(uint32_t *count)

@@ -192,7 +192,8 @@ static void design_gains(const pmstep_design_input_t *in, pmstep_gains_config_t 
     report->speed_bandwidth_rad_s = speed_gain;
 }
 
-/* Alignment voltages from condition (4) and the rated current; times from the swing's decay
+/* Alignment voltages from condition (4) and the rated current; times from the swing's decay, and
+ * s-alignment's lead-in where a detent torque can hold the rotor on (3)'s unstable equilibrium
  * (DESIGN.md, 4). Returns the steady-state window the robust mode uses (0 in paper mode). */
 static float design_alignment(const pmstep_design_input_t *in, pmstep_config_t *cfg, pmstep_design_report_t *report)
 {
@@ -212,6 +213,9 @@ static float design_alignment(const pmstep_design_input_t *in, pmstep_config_t *
     const float settle_s = SETTLING_DECAY / decay + CURRENT_RISE_TIME_CONSTANTS * l_over_r;
     float window_s = 0.0f;
     float align_s = settle_s;
+    /* Detent stiffness 4 T_d against the alignment's -k_M I there: it slows the rotor's escape, and
+     * at 4 T_d >= k_M I (the 17HS4401 at its voltage-bias level) holds it. */
+    const float lead_in_s = m->detent_torque_Nm > 0.0f ? round_up_time(settle_s) : 0.0f;
 
     if (in->self_commissioning) {
         window_s = round_up_time(max2(MIN_STEADY_STATE_WINDOW_S, STEADY_STATE_WINDOW_TIME_CONSTANTS * l_over_r));
@@ -220,8 +224,9 @@ static float design_alignment(const pmstep_design_input_t *in, pmstep_config_t *
     align_s = round_up_time(align_s);
     cfg->alignment.s_align_voltage_V = r * current_A;
     cfg->alignment.c_align_voltage_V = r * current_A;
-    cfg->alignment.s_align_time_s = align_s;
-    cfg->alignment.c_align_time_s = 2.0f * align_s;
+    cfg->alignment.s_lead_in_time_s = lead_in_s;
+    cfg->alignment.s_align_time_s = lead_in_s + align_s;
+    cfg->alignment.c_align_time_s = lead_in_s + 2.0f * align_s;
 
     report->alignment_current_A = current_A;
     report->alignment_frequency_rad_s = natural;

@@ -108,6 +108,9 @@ void pmstep_actuate_voltage_over_period(const pmstep_actuator_t *actuator, const
                                         const pmstep_period_currents_t *currents, float bus_voltage_V,
                                         float *u_a_V, float *u_b_V);
 
+/** The sign threshold above (A) at the bus voltage @p bus_voltage_V. */
+float pmstep_actuate_sign_threshold(const pmstep_actuate_coeffs_t *coeffs, float bus_voltage_V);
+
 #ifdef __cplusplus
 }
 #endif

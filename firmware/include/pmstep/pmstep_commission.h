@@ -40,8 +40,12 @@
  *    [t_s, t_c] on the driven phase a:
  *      (k_M/p) (cos p theta_c - cos p theta_s) = integral(u_a - R i_a) - L delta i_a
  *    with phase a's own R, so a current offset cancels, and its voltage bias taken off.
- *    (Phase b's swing is not used: its current passes through zero, where the
- *    dead time makes its voltage unknown.) With L from the drops, each drop's flux
+ *    The integral starts at the first sample from t_s at which phase a's current is not
+ *    beyond the sign threshold negative: a negative current left in phase a (an
+ *    over-compensated undriven phase runs away with its sign: -0.9 A on an AS1050) makes
+ *    the bridge apply 2 V_bus t_d / T_s more until it passes zero, a few periods in which
+ *    the rotor, at rest and pulled by that small current, has hardly turned. (Phase b's swing is not used: its current passes through zero,
+ *    where the dead time makes its voltage unknown.) With L from the drops, each drop's flux
  *    holds (k_M/p) times the change of its rest's sin (phase b) or cos (phase a) too:
  *    L and k_M are solved together.
  * Currents are integrated by the trapezoid rule, held voltages exactly.
@@ -68,11 +72,12 @@ extern "C" {
 
 /** When each measurement is taken, in samples from the start of s-alignment. */
 typedef struct {
+    uint32_t s_lead_in_steps;   /**< s-alignment's lead-in: its first samples, driven at p theta = 0 */
     uint32_t s_align_steps;     /**< first sample of c-alignment (t_s) */
     uint32_t c_align_end_step;  /**< sample at t_c */
     uint32_t window_steps;      /**< W: steady-state window at the end of each alignment (0 = none) */
     uint32_t inductance_steps;  /**< N: current-rise window (0 = L from the level drops, with bias_estimation) */
-    uint32_t inductance_start_step; /**< m0: first sample of the current-rise window */
+    uint32_t inductance_start_step; /**< m0: first sample of the current-rise window (after the lead-in) */
     bool offsets_from_alignment;/**< take offsets from the alignment steady states too */
     bool bias_estimation;       /**< second, lower steady state at the end of each alignment */
     uint32_t identification_steps; /**< RUN periods of the J and F identification window from t_c (0 = none) */
@@ -109,6 +114,7 @@ typedef struct {
     pmstep_flux_sums_t swing;               /**< c-alignment from t_s, phase a: k_M (t_c's sample added at the end) */
     pmstep_flux_sums_t s_drop;              /**< L from s-alignment's level drop, phase b */
     pmstep_flux_sums_t c_drop;              /**< L from c-alignment's level drop, phase a */
+    uint32_t swing_start_step;              /**< the swing's first sample (0: not yet) */
 } pmstep_alignment_sums_t;
 
 /** Running sums (raw samples; offsets are removed at the end). */
@@ -144,9 +150,11 @@ void pmstep_commission_add_bridge_off(pmstep_commission_sums_t *sums, float i_a_
 /**
  * Sample @p sample (< c_align_end_step) of the alignment.
  * @param[in] u_a_V, u_b_V  voltage applied over the period that ends at this sample
+ * @param[in] u_a_known     phase a's current is not beyond the sign threshold negative (see k_M above)
  */
 void pmstep_commission_add_alignment(pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
-                                     uint32_t sample, float i_a_A, float i_b_A, float u_a_V, float u_b_V);
+                                     uint32_t sample, float i_a_A, float i_b_A, float u_a_V, float u_b_V,
+                                     bool u_a_known);
 
 /**
  * At t_c: offsets, R, L and k_M (and the voltage biases) from the sums and the sample

@@ -64,6 +64,7 @@ typedef enum {
     PMSTEP_ERR_C_ALIGN_TIME = -74,          /**< t_c - t_s shorter than one period */
     PMSTEP_ERR_ALIGNMENT_TOO_LONG = -75,    /**< t_c longer than PMSTEP_MAX_DURATION_PERIODS periods */
     PMSTEP_ERR_ALIGNMENT_CONDITION = -76,   /**< condition (4) violated */
+    PMSTEP_ERR_S_LEAD_IN_TIME = -77,        /**< s-alignment's lead-in < 0, or not leaving t_s at least one period */
     /* commissioning */
     PMSTEP_ERR_OFFSET_CALIBRATION_TIME = -80, /**< offset calibration time < 0 or longer than PMSTEP_MAX_DURATION_PERIODS */
     PMSTEP_ERR_STEADY_STATE_WINDOW = -81,   /**< steady-state window < 0 or longer than half an alignment */
@@ -182,6 +183,9 @@ typedef struct {
 /** Alignment (3), (5). */
 typedef struct {
     float s_align_time_s;    /**< t_s, measured from the start of s-alignment */
+    float s_lead_in_time_s;  /**< s-alignment's first part drives (5)'s u_a = u_cc, u_b = 0 (p theta -> 0), so
+                                  that (3) never starts on its unstable equilibrium p theta = -90 deg, where a
+                                  detent torque can hold the rotor; 0 = none (the paper's) */
     float c_align_time_s;    /**< t_c, measured from the same start (t_c > t_s) */
     float s_align_voltage_V; /**< u_cs */
     float c_align_voltage_V; /**< u_cc */
