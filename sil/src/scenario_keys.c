@@ -29,7 +29,7 @@ const key_t_ scenario_keys[] = {
     {"controller.motor.pole_pairs", KEY_INT, OFF(controller.motor.pole_pairs), -1000, 0, 1000, 0, "p"},
     {"controller.motor.detent_torque_Nm", KEY_FLOAT, OFF(controller.motor.detent_torque_Nm), -BIG, 0, BIG, 0, "detent torque T_d the observer and the law compensate (Nm); 0 = none (the paper)"},
     {"controller.alignment.s_align_time_s", KEY_FLOAT, OFF(controller.alignment.s_align_time_s), -BIG, 0, BIG, 0, "t_s (s)"},
-    {"controller.alignment.s_lead_in_time_s", KEY_FLOAT, OFF(controller.alignment.s_lead_in_time_s), -BIG, 0, BIG, 0, "s-alignment's first part drives u_a = -u_cs, u_b = 0, away from (3)'s unstable equilibrium (s); 0 = none (the paper's)"},
+    {"controller.alignment.s_lead_in_time_s", KEY_FLOAT, OFF(controller.alignment.s_lead_in_time_s), -BIG, 0, BIG, 0, "s-alignment's first part drives (5)'s u_a = u_cc, u_b = 0 (p theta -> 0), away from (3)'s unstable equilibrium (s); 0 = none (the paper's)"},
     {"controller.alignment.c_align_time_s", KEY_FLOAT, OFF(controller.alignment.c_align_time_s), -BIG, 0, BIG, 0, "t_c (s)"},
     {"controller.alignment.s_align_voltage_V", KEY_FLOAT, OFF(controller.alignment.s_align_voltage_V), -BIG, 0, BIG, 0, "u_cs (V)"},
     {"controller.alignment.c_align_voltage_V", KEY_FLOAT, OFF(controller.alignment.c_align_voltage_V), -BIG, 0, BIG, 0, "u_cc (V)"},

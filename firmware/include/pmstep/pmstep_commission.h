@@ -44,8 +44,9 @@
  *    beyond the sign threshold negative: a negative current left in phase a (an
  *    over-compensated undriven phase runs away with its sign: -0.9 A on an AS1050) makes
  *    the bridge apply 2 V_bus t_d / T_s more until it passes zero, a few periods in which
- *    the rotor, at rest and pulled by that small current, has hardly turned. (Phase b's swing is not used: its current passes through zero,
- *    where the dead time makes its voltage unknown.) With L from the drops, each drop's flux
+ *    the rotor, at rest and pulled by that small current, has hardly turned. (Phase b's
+ *    swing is not used: its current passes through zero, where the dead time makes its
+ *    voltage unknown.) With L from the drops, each drop's flux
  *    holds (k_M/p) times the change of its rest's sin (phase b) or cos (phase a) too:
  *    L and k_M are solved together.
  * Currents are integrated by the trapezoid rule, held voltages exactly.
@@ -150,7 +151,8 @@ void pmstep_commission_add_bridge_off(pmstep_commission_sums_t *sums, float i_a_
 /**
  * Sample @p sample (< c_align_end_step) of the alignment.
  * @param[in] u_a_V, u_b_V  voltage applied over the period that ends at this sample
- * @param[in] u_a_known     phase a's current is not beyond the sign threshold negative (see k_M above)
+ * @param[in] u_a_known     @p u_a_V is the voltage the bridge applied to phase a: sensed, or its
+ *                          current not beyond the sign threshold negative (see k_M above)
  */
 void pmstep_commission_add_alignment(pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
                                      uint32_t sample, float i_a_A, float i_b_A, float u_a_V, float u_b_V,
