@@ -55,6 +55,7 @@ static pmstep_status_t validate_signs(const pmstep_config_t *cfg)
         SIGN_RULE(gains.reference_bandwidth_rad_s, SIGN_POSITIVE, PMSTEP_ERR_REFERENCE_BANDWIDTH),
         SIGN_RULE(gains.angle_correction_gain_per_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_ANGLE_CORRECTION_GAIN),
         SIGN_RULE(gains.current_integral_gain_per_s2, SIGN_NON_NEGATIVE, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN),
+        SIGN_RULE(gains.current_integral_gain_q_per_s2, SIGN_NON_NEGATIVE, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN),
         SIGN_RULE(gains.detent_fade_speed_rad_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETENT_FADE_SPEED),
         SIGN_RULE(limits.max_phase_current_A, SIGN_POSITIVE, PMSTEP_ERR_MAX_CURRENT),
         SIGN_RULE(limits.min_bus_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_MIN_BUS),
@@ -130,7 +131,9 @@ static pmstep_status_t validate_gains(const pmstep_config_t *cfg)
     {
         /* e'' + K e' + K_I e = 0, K = R/L + K_i: real poles need K_I <= K^2/4. */
         const float loop_per_s = r_over_l + gains->current_gain_per_s;
-        if (gains->current_integral_gain_per_s2 > 0.25f * loop_per_s * loop_per_s) {
+        const float largest_integral_per_s2 = 0.25f * loop_per_s * loop_per_s;
+        if ((gains->current_integral_gain_per_s2 > largest_integral_per_s2)
+            || (gains->current_integral_gain_q_per_s2 > largest_integral_per_s2)) {
             return PMSTEP_ERR_CURRENT_INTEGRAL_GAIN;
         }
     }

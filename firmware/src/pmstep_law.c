@@ -21,6 +21,7 @@ void pmstep_law_coeffs_init(pmstep_law_coeffs_t *coeffs, const pmstep_config_t *
     coeffs->kappa_rad_s = cfg->gains.sat_kappa_rad_s * (cfg->motor.inertia_kgm2 / model->inertia_kgm2);
     coeffs->linear_speed_term = cfg->known_load_mode;
     coeffs->current_integral_gain_per_s2 = cfg->gains.current_integral_gain_per_s2;
+    coeffs->current_integral_gain_q_per_s2 = cfg->gains.current_integral_gain_q_per_s2;
     coeffs->detent_torque_Nm = cfg->motor.detent_torque_Nm;
     coeffs->detent_order = 4.0f * coeffs->pole_pairs;
     {
@@ -91,7 +92,7 @@ void pmstep_law_voltages(const pmstep_law_coeffs_t *coeffs, const pmstep_law_ref
     const float u_d = coeffs->inductance_H * (-phi_d - coeffs->current_gain_per_s * (i_d_A - refs->i_d_ref_A)
                                               - coeffs->current_integral_gain_per_s2 * integral->i_d_error_integral_As);
     const float u_q = coeffs->inductance_H * (-phi_q - coeffs->current_gain_per_s * (i_q_A - i_q_ref_A)
-                                              - coeffs->current_integral_gain_per_s2 * integral->i_q_error_integral_As);
+                                              - coeffs->current_integral_gain_q_per_s2 * integral->i_q_error_integral_As);
     float cos_act;
     float sin_act;
     /* Inverse Park at the angle the voltage acts at, shortened for the hold. */

@@ -43,11 +43,11 @@ void print_design(const sil_scenario_t *sc, const pmstep_design_report_t *r, boo
     printf("  bandwidths: current %.0f rad/s, observer %.0f rad/s (triple pole), speed %.0f rad/s\n",
            (double)r->current_bandwidth_rad_s, (double)r->observer_bandwidth_rad_s,
            (double)r->speed_bandwidth_rad_s);
-    printf("  gains: k_w %g, K_e %g, K_i %g, K_I %g, gamma %g, lambda %g, r %g, kappa %g rad/s, varpi_0 %g rad/s, "
+    printf("  gains: k_w %g, K_e %g, K_i %g, K_I %g (q axis %g), gamma %g, lambda %g, r %g, kappa %g rad/s, varpi_0 %g rad/s, "
            "g %g 1/s\n",
            (double)c->gains.speed_gain_per_s, (double)c->gains.observer_gain_per_s,
            (double)c->gains.current_gain_per_s, (double)c->gains.current_integral_gain_per_s2,
-           (double)c->gains.adapt_gamma, (double)c->gains.adapt_lambda,
+           (double)c->gains.current_integral_gain_q_per_s2, (double)c->gains.adapt_gamma, (double)c->gains.adapt_lambda,
            (double)c->gains.adapt_r, (double)c->gains.sat_kappa_rad_s, (double)c->gains.reference_bandwidth_rad_s,
            (double)c->gains.angle_correction_gain_per_s);
     printf("  detent torque compensated: %g Nm, fading above %.1f rad/s (0 = no fade)\n",
@@ -104,12 +104,13 @@ int write_c(const char *path, const sil_scenario_t *sc)
     fprintf(f, "    .gains = {.speed_gain_per_s = %.9gf, .observer_gain_per_s = %.9gf, .current_gain_per_s = %.9gf,\n"
                "              .adapt_gamma = %.9gf, .adapt_lambda = %.9gf, .adapt_r = %.9gf, .sat_kappa_rad_s = %.9gf,\n"
                "              .reference_bandwidth_rad_s = %.9gf, .angle_correction_gain_per_s = %.9gf,\n"
-               "              .current_integral_gain_per_s2 = %.9gf, .detent_fade_speed_rad_s = %.9gf},\n",
+               "              .current_integral_gain_per_s2 = %.9gf, .current_integral_gain_q_per_s2 = %.9gf,\n"
+               "              .detent_fade_speed_rad_s = %.9gf},\n",
             (double)c->gains.speed_gain_per_s, (double)c->gains.observer_gain_per_s,
             (double)c->gains.current_gain_per_s, (double)c->gains.adapt_gamma, (double)c->gains.adapt_lambda,
             (double)c->gains.adapt_r, (double)c->gains.sat_kappa_rad_s, (double)c->gains.reference_bandwidth_rad_s,
             (double)c->gains.angle_correction_gain_per_s, (double)c->gains.current_integral_gain_per_s2,
-            (double)c->gains.detent_fade_speed_rad_s);
+            (double)c->gains.current_integral_gain_q_per_s2, (double)c->gains.detent_fade_speed_rad_s);
     fprintf(f, "    .limits = {.max_phase_current_A = %.9gf, .min_bus_voltage_V = %.9gf, .max_bus_voltage_V = %.9gf},\n",
             (double)c->limits.max_phase_current_A, (double)c->limits.min_bus_voltage_V,
             (double)c->limits.max_bus_voltage_V);

@@ -94,6 +94,7 @@ static void eva_any_config(pmstep_config_t *cfg)
     cfg->inverter.ripple_dead_zone = Frama_C_nondet(0, 1) != 0;
     cfg->gains.angle_correction_gain_per_s = eva_any_finite();
     cfg->gains.current_integral_gain_per_s2 = eva_any_finite();
+    cfg->gains.current_integral_gain_q_per_s2 = eva_any_finite();
     cfg->gains.detent_fade_speed_rad_s = eva_any_finite();
     cfg->motor.detent_torque_Nm = eva_any_finite();
     cfg->detection.angle_magnitude_bound = eva_any_finite();

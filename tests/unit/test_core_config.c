@@ -39,10 +39,16 @@ typedef void (*config_edit_t)(pmstep_config_t *cfg);
 static void bad_r(pmstep_config_t *c) { c->motor.resistance_Ohm = 0.0f; }
 static void negative_detent(pmstep_config_t *c) { c->motor.detent_torque_Nm = -1e-3f; }
 static void negative_current_integral(pmstep_config_t *c) { c->gains.current_integral_gain_per_s2 = -1.0f; }
+static void negative_q_current_integral(pmstep_config_t *c) { c->gains.current_integral_gain_q_per_s2 = -1.0f; }
 static void negative_detent_fade(pmstep_config_t *c) { c->gains.detent_fade_speed_rad_s = -1.0f; }
 /* Paper: R/L + K_i = 500 + 20 = 520 1/s, so K_I may reach 520^2/4 = 67600 1/s^2. */
 static void current_integral_complex_poles(pmstep_config_t *c) { c->gains.current_integral_gain_per_s2 = 68000.0f; }
-static void current_integral_at_bound(pmstep_config_t *c) { c->gains.current_integral_gain_per_s2 = 67000.0f; }
+static void q_current_integral_complex_poles(pmstep_config_t *c) { c->gains.current_integral_gain_q_per_s2 = 68000.0f; }
+static void current_integral_at_bound(pmstep_config_t *c)
+{
+    c->gains.current_integral_gain_per_s2 = 67000.0f;
+    c->gains.current_integral_gain_q_per_s2 = 67000.0f;
+}
 static void bad_l(pmstep_config_t *c) { c->motor.inductance_H = -1e-3f; }
 static void bad_j(pmstep_config_t *c) { c->motor.inertia_kgm2 = 0.0f; }
 static void bad_km(pmstep_config_t *c) { c->motor.torque_constant_Nm_A = 0.0f; }
@@ -115,10 +121,12 @@ static const struct {
     {bad_p, PMSTEP_ERR_POLE_PAIRS},
     {negative_detent, PMSTEP_ERR_DETENT_TORQUE},
     {negative_current_integral, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN},
+    {negative_q_current_integral, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN},
     {negative_detent_fade, PMSTEP_ERR_DETENT_FADE_SPEED},
     {negative_lead_in, PMSTEP_ERR_S_LEAD_IN_TIME},
     {lead_in_fills_s_alignment, PMSTEP_ERR_S_LEAD_IN_TIME},
     {current_integral_complex_poles, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN},
+    {q_current_integral_complex_poles, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN},
     {bad_period, PMSTEP_ERR_PERIOD},
     {bad_k_omega, PMSTEP_ERR_SPEED_GAIN},
     {bad_k_e, PMSTEP_ERR_OBSERVER_GAIN},

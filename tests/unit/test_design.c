@@ -99,10 +99,12 @@ static void every_preset_gets_a_valid_design(void **state)
             assert_true(cfg.alignment.s_align_voltage_V / in.motor.resistance_Ohm <= in.rated_current_A * 1.0001f);
             assert_true(cfg.alignment.c_align_voltage_V / in.motor.resistance_Ohm <= in.rated_current_A * 1.0001f);
             assert_true(cfg.limits.max_phase_current_A > in.rated_current_A);
-            /* PI current loop: K_I = K^2/8, K = R/L + K_i (poles 0.15 K and 0.85 K, real). */
+            /* PI current loop: K_I = K^2/8, K = R/L + K_i (poles 0.15 K and 0.85 K, real), the same
+             * on the q axis (DESIGN.md section 2). */
             {
                 const float k = in.motor.resistance_Ohm / in.motor.inductance_H + cfg.gains.current_gain_per_s;
                 assert_float_equal(cfg.gains.current_integral_gain_per_s2, 0.125f * k * k, 1e-3f * k * k);
+                assert_true(cfg.gains.current_integral_gain_q_per_s2 == cfg.gains.current_integral_gain_per_s2);
             }
             /* Robust: RUN takes the measured L and k_M. L from the current rise where the rotor stays
              * still over its window (the paper's motor, w_n T_L ~ 0.05), else from the level drops:

@@ -169,7 +169,8 @@ static void detent_compensation_fades_with_the_speed(void **state)
 
 static void current_integral_adds_its_voltage_and_integrates(void **state)
 {
-    /* u_dq changes by -L K_I z with the integral z; z advances by T_s (i - i*) only with K_I > 0. */
+    /* u_d changes by -L K_I z_d and u_q by -L K_I,q z_q with the integrals z; z advances by T_s (i - i*)
+     * only with K_I > 0 or K_I,q > 0. */
     pmstep_config_t cfg = pmstep_paper_config();
     pmstep_law_coeffs_t coeffs;
     const pmstep_electrical_t model = pmstep_configured_electrical(&cfg);
@@ -180,6 +181,7 @@ static void current_integral_adds_its_voltage_and_integrates(void **state)
     float u_a0, u_b0, u_a1, u_b1, du_d, du_q;
     (void)state;
     cfg.gains.current_integral_gain_per_s2 = 5e4f;
+    cfg.gains.current_integral_gain_q_per_s2 = 1e4f;
     pmstep_law_coeffs_init(&coeffs, &cfg, &model);
     pmstep_law_voltages(&coeffs, &refs, 1.0f, 0.0f, 0.4f, 1.0f, 0.0f, 1.2f, 0.0f, &none, &u_a0, &u_b0);
     pmstep_law_voltages(&coeffs, &refs, 1.0f, 0.0f, 0.4f, 1.0f, 0.0f, 1.2f, 0.0f, &some, &u_a1, &u_b1);
@@ -187,14 +189,18 @@ static void current_integral_adds_its_voltage_and_integrates(void **state)
     du_d = u_a1 - u_a0;
     du_q = u_b1 - u_b0;
     assert_float_equal(du_d, -0.006f * 5e4f * 2e-4f, 1e-5f);
-    assert_float_equal(du_q, -0.006f * 5e4f * -3e-4f, 1e-5f);
+    assert_float_equal(du_q, -0.006f * 1e4f * -3e-4f, 1e-5f);
     pmstep_law_integrate(&z, &coeffs, 0.1f, -0.2f, 5e-5f);
     assert_float_equal(z.i_d_error_integral_As, 5e-6f, 1e-12f);
     assert_float_equal(z.i_q_error_integral_As, -1e-5f, 1e-12f);
     cfg.gains.current_integral_gain_per_s2 = 0.0f;
     pmstep_law_coeffs_init(&coeffs, &cfg, &model);
     pmstep_law_integrate(&z, &coeffs, 0.1f, -0.2f, 5e-5f);
-    assert_float_equal(z.i_d_error_integral_As, 5e-6f, 1e-12f); /* unchanged: the paper's law */
+    assert_float_equal(z.i_q_error_integral_As, -2e-5f, 1e-12f); /* the q axis's integral alone still runs */
+    cfg.gains.current_integral_gain_q_per_s2 = 0.0f;
+    pmstep_law_coeffs_init(&coeffs, &cfg, &model);
+    pmstep_law_integrate(&z, &coeffs, 0.1f, -0.2f, 5e-5f);
+    assert_float_equal(z.i_d_error_integral_As, 1e-5f, 1e-12f); /* unchanged: the paper's law */
 }
 
 int main(void)

@@ -70,6 +70,7 @@ static const pmstep_console_config_entry_t table[] = {
     BOOL(inverter.ripple_dead_zone),
     F32(gains.detent_fade_speed_rad_s),
     F32(alignment.s_lead_in_time_s),
+    F32(gains.current_integral_gain_q_per_s2),
 };
 
 const pmstep_console_config_entry_t *pmstep_console_config_table(uint32_t *count)

@@ -35,7 +35,8 @@ typedef struct {
     float turn_cos_w4;        /**< c4 = a^4/24 + k a^2/2 */
     float turn_sin_w1;        /**< s1 = a */
     float turn_sin_w3;        /**< s3 = -(a^3/6 + k a) */
-    float current_integral_gain_per_s2; /**< K_I of the PI current loop (0 = the paper's law) */
+    float current_integral_gain_per_s2; /**< K_I of the PI current loop, d axis (0 = the paper's law) */
+    float current_integral_gain_q_per_s2; /**< K_I,q, its q axis (0 = none) */
     float detent_torque_Nm;   /**< T_d of the detent model (0 = none) */
     float detent_order;       /**< 4 p: the detent's harmonic of the mechanical angle */
     bool linear_speed_term;   /**< Remark 1 (13): k_w (w-hat - w*) without saturation (last: the floats
@@ -153,7 +154,7 @@ void pmstep_law_voltages(const pmstep_law_coeffs_t *coeffs, const pmstep_law_ref
 static inline void pmstep_law_integrate(pmstep_law_integral_t *integral, const pmstep_law_coeffs_t *coeffs,
                                         float i_d_error_A, float i_q_error_A, float period_s)
 {
-    if (coeffs->current_integral_gain_per_s2 > 0.0f) {
+    if ((coeffs->current_integral_gain_per_s2 > 0.0f) || (coeffs->current_integral_gain_q_per_s2 > 0.0f)) {
         integral->i_d_error_integral_As += period_s * i_d_error_A;
         integral->i_q_error_integral_As += period_s * i_q_error_A;
     }
