@@ -172,8 +172,8 @@ static void design_gains(const pmstep_design_input_t *in, pmstep_gains_config_t 
 
     gains->current_gain_per_s = current_bandwidth - r_over_l;
     gains->current_integral_gain_per_s2 = CURRENT_INTEGRAL_PER_BANDWIDTH_SQUARED * current_bandwidth * current_bandwidth;
-    /* The same on the q axis: K k_w / 5 there ends the AS1050's limit cycle at mid speeds but loses
-     * the low-speed segments after a fast ramp (DESIGN.md section 2). */
+    /* The same on the q axis: K k_w / 5 there ends the AS1050's limit cycle at mid speeds, but lags the
+     * back EMF's error through a fast ramp (a silent failure on the 17HS4401; DESIGN.md section 2). */
     gains->current_integral_gain_q_per_s2 = gains->current_integral_gain_per_s2;
     gains->observer_gain_per_s = a_e - r_over_l;
     gains->adapt_lambda = lambda;
