@@ -9,6 +9,11 @@ void pmstep_angle_coeffs_init(pmstep_angle_coeffs_t *coeffs, const pmstep_config
     coeffs->flux_to_angle = model->inductance_H * (float)cfg->motor.pole_pairs / model->torque_constant_Nm_A;
     /* d c-hat / d phi1 = flux_to_angle, so a change g T_s c e of c-hat is g T_s c e / flux_to_angle of phi1. */
     coeffs->correction_gain = cfg->gains.angle_correction_gain_per_s * cfg->timing.period_s / coeffs->flux_to_angle;
+    /* R + L K_e over k_M: the residual per radian of angle error per rad/s (pmstep_angle.h). */
+    coeffs->emf_turn_gain = cfg->gains.emf_angle_gain_per_s * cfg->timing.period_s
+                            * (model->resistance_Ohm + model->inductance_H * cfg->gains.observer_gain_per_s)
+                            / (model->torque_constant_Nm_A * coeffs->flux_to_angle);
+    coeffs->emf_corner_squared = cfg->gains.emf_angle_corner_rad_s * cfg->gains.emf_angle_corner_rad_s;
 }
 
 void pmstep_angle_start(pmstep_angle_t *angle, float i_a_A, float i_b_A)
@@ -58,6 +63,17 @@ void pmstep_angle_correct(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *co
     const float radial_step = coeffs->correction_gain * (1.0f - cos_hat * cos_hat - sin_hat * sin_hat);
     compensated_add(&angle->phi_a, &angle->phi_a_compensation, radial_step * cos_hat);
     compensated_add(&angle->phi_b, &angle->phi_b_compensation, radial_step * sin_hat);
+}
+
+void pmstep_angle_follow_emf(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs, float cos_hat,
+                             float sin_hat, float i_d_residual_A, float speed_hat_rad_s)
+{
+    /* the turn -K_theta T_s delta-hat, over flux_to_angle: phi's step along (-s-hat, c-hat). Plain sums:
+     * the correction's own loop takes up their round-off. */
+    const float turn = coeffs->emf_turn_gain * i_d_residual_A * speed_hat_rad_s
+                       / (speed_hat_rad_s * speed_hat_rad_s + coeffs->emf_corner_squared);
+    angle->phi_a -= turn * sin_hat;
+    angle->phi_b += turn * cos_hat;
 }
 
 void pmstep_angle_set(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs, float cos_hat, float sin_hat)

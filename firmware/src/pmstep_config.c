@@ -57,6 +57,8 @@ static pmstep_status_t validate_signs(const pmstep_config_t *cfg)
         SIGN_RULE(gains.current_integral_gain_per_s2, SIGN_NON_NEGATIVE, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN),
         SIGN_RULE(gains.current_integral_gain_q_per_s2, SIGN_NON_NEGATIVE, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN),
         SIGN_RULE(gains.detent_fade_speed_rad_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETENT_FADE_SPEED),
+        SIGN_RULE(gains.emf_angle_gain_per_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_EMF_ANGLE_GAIN),
+        SIGN_RULE(gains.emf_angle_corner_rad_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_EMF_ANGLE_GAIN),
         SIGN_RULE(limits.max_phase_current_A, SIGN_POSITIVE, PMSTEP_ERR_MAX_CURRENT),
         SIGN_RULE(limits.min_bus_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_MIN_BUS),
         SIGN_RULE(alignment.s_align_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_ALIGNMENT_VOLTAGE),
@@ -127,6 +129,12 @@ static pmstep_status_t validate_gains(const pmstep_config_t *cfg)
     }
     if (gains->angle_correction_gain_per_s * period_s >= 0.5f) {
         return PMSTEP_ERR_ANGLE_CORRECTION_GAIN;
+    }
+    /* The back-EMF correction reads a residual that settles at R/L + K_e: it must be slower. Without a
+     * corner its fade-in w-hat / (w-hat^2 + w_theta^2) would be 1 / w-hat, unbounded at rest. */
+    if ((gains->emf_angle_gain_per_s >= r_over_l + gains->observer_gain_per_s)
+        || ((gains->emf_angle_gain_per_s > 0.0f) && !(gains->emf_angle_corner_rad_s > 0.0f))) {
+        return PMSTEP_ERR_EMF_ANGLE_GAIN;
     }
     {
         /* e'' + K e' + K_I e = 0, K = R/L + K_i: real poles need K_I <= K^2/4. */

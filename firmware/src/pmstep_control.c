@@ -23,6 +23,7 @@ static void start_run(pmstep_t *inst, const pmstep_meas_t *sample)
     pmstep_identify_clear(&inst->scratch.run.identify); /* a re-alignment reopens the window */
     pmstep_standstill_start(inst);
     inst->run_started = true;
+    inst->speed_mode = true;
 }
 
 /* With phase-voltage sensing: the voltage of the period just ended as measured (offsets off), for
@@ -139,8 +140,32 @@ bool pmstep_control_advance(pmstep_t *inst, const pmstep_control_scratch_t *scra
 {
     const pmstep_config_t *cfg = inst->cfg;
     const float period_s = cfg->timing.period_s;
-    if (inst->angle_coeffs.correction_gain > 0.0f) {
-        pmstep_angle_correct(&inst->angle, &inst->angle_coeffs, out->cos_hat, out->sin_hat);
+    if (inst->angle_corrections) { /* one test a period where neither is on (the paper's estimate) */
+        if (inst->angle_coeffs.correction_gain > 0.0f) {
+            pmstep_angle_correct(&inst->angle, &inst->angle_coeffs, out->cos_hat, out->sin_hat);
+        }
+        /* speed mode only: a hold's vector sets the angle, and in position mode the holds between
+         * short moves kept more error with it (DESIGN.md section 15) */
+        if ((inst->angle_coeffs.emf_turn_gain > 0.0f) && inst->speed_mode && !inst->hold.active) {
+            const pmstep_observer_input_t *in = &scratch->observer_input;
+            const pmstep_observer_coeffs_t *obs = &inst->observer_coeffs;
+            const float err_a = in->i_a_A - inst->observer.i_a_hat_A;
+            const float err_b = in->i_b_A - inst->observer.i_b_hat_A;
+            const float i_d_residual_A = out->cos_hat * err_a + out->sin_hat * err_b;
+            const float i_q_residual_A = out->cos_hat * err_b - out->sin_hat * err_a;
+            const float bound_A = cfg->detection.observer_residual_bound_A;
+            /* Paused where the residuals are no settled reading of the angle (pmstep_angle.h): the
+             * q residual beyond the detection's bound (a transient: a load step, w-hat lagging),
+             * or a d residual that would mean more than PMSTEP_EMF_ANGLE_MAX_READING_RAD. */
+            const bool settled_q = !(bound_A > 0.0f) || (pmstep_abs(i_q_residual_A) < bound_A);
+            const bool settled_d = pmstep_abs(i_d_residual_A) * (obs->r_over_l_per_s + obs->observer_gain_per_s)
+                                   < PMSTEP_EMF_ANGLE_MAX_READING_RAD * obs->km_over_l
+                                         * pmstep_abs(out->speed_hat_rad_s);
+            if (settled_q && settled_d) {
+                pmstep_angle_follow_emf(&inst->angle, &inst->angle_coeffs, out->cos_hat, out->sin_hat,
+                                        i_d_residual_A, out->speed_hat_rad_s);
+            }
+        }
     }
     pmstep_observer_advance(&inst->observer, &inst->observer_coeffs, &scratch->observer_input, &scratch->mech_rates,
                             inst->actuator.u_applied_a_V, inst->actuator.u_applied_b_V, period_s);

@@ -499,6 +499,7 @@ void pmstep_standstill_command(pmstep_t *inst, float target_rad_s)
     }
     if (in_run) {
         inst->hold.standstill_armed = inst->cfg->standstill.hold_current_A > 0.0f; /* speed mode again */
+        inst->speed_mode = true;
     }
 }
 
@@ -511,6 +512,7 @@ void pmstep_leave_speed_mode(pmstep_t *inst)
             inst->hold.standstill_engaged = false;
         }
         inst->hold.standstill_armed = false;
+        inst->speed_mode = false;
         standstill->rest_periods = 0u;
     }
 }

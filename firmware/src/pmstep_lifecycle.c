@@ -35,6 +35,7 @@ static void derive(pmstep_t *inst, const pmstep_config_t *cfg)
     plan->identification_steps = pmstep_periods_in(cfg->commissioning.identification_time_s, period_s);
     inst->offset_cal_steps = pmstep_periods_in(cfg->commissioning.offset_calibration_time_s, period_s);
     inst->optional_inputs = cfg->known_load_mode || cfg->inverter.phase_voltage_sensing;
+    inst->angle_corrections = (cfg->gains.angle_correction_gain_per_s > 0.0f) || (cfg->gains.emf_angle_gain_per_s > 0.0f);
     pmstep_detect_coeffs_init(&inst->detect_coeffs, cfg);
     pmstep_actuate_coeffs_init(&inst->actuate_coeffs, cfg);
 }
@@ -96,6 +97,7 @@ void pmstep_clear_dynamic_state(pmstep_t *inst)
 {
     inst->mode_step = 0u;
     inst->run_started = false;
+    inst->speed_mode = false;
     inst->hold.active = false;
     inst->hold.standstill_armed = false;
     inst->hold.standstill_engaged = false;

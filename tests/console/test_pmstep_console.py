@@ -81,7 +81,7 @@ class AgainstTheFirmwareConsole(unittest.TestCase):
         self.assertEqual(hello["protocol"], 1)
         self.assertEqual(hello["identity"], "pmstep host-drive")
         table = c.list_config()
-        self.assertEqual(len(table), 53)
+        self.assertEqual(len(table), 55)
         names = [e["name"] for e in table]
         self.assertEqual(len(set(names)), len(names))
         self.assertIn("inverter.phase_voltage_sensing", names)

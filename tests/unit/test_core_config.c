@@ -21,6 +21,7 @@ static const pmstep_status_t all_status_codes[] = {
     PMSTEP_ERR_ADAPT_GAMMA, PMSTEP_ERR_ADAPT_LAMBDA, PMSTEP_ERR_ADAPT_R, PMSTEP_ERR_SAT_KAPPA,
     PMSTEP_ERR_OBSERVER_GAIN_FOR_PERIOD, PMSTEP_ERR_CURRENT_GAIN_FOR_PERIOD, PMSTEP_ERR_REFERENCE_BANDWIDTH,
     PMSTEP_ERR_ANGLE_CORRECTION_GAIN, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN, PMSTEP_ERR_DETENT_FADE_SPEED,
+    PMSTEP_ERR_EMF_ANGLE_GAIN,
     PMSTEP_ERR_MAX_CURRENT, PMSTEP_ERR_MIN_BUS,
     PMSTEP_ERR_BUS_ORDER,
     PMSTEP_ERR_ALIGNMENT_VOLTAGE, PMSTEP_ERR_ALIGNMENT_ABOVE_BUS, PMSTEP_ERR_ALIGNMENT_CURRENT,
@@ -48,6 +49,15 @@ static void current_integral_at_bound(pmstep_config_t *c)
 {
     c->gains.current_integral_gain_per_s2 = 67000.0f;
     c->gains.current_integral_gain_q_per_s2 = 67000.0f;
+}
+static void negative_emf_gain(pmstep_config_t *c) { c->gains.emf_angle_gain_per_s = -1.0f; }
+static void negative_emf_corner(pmstep_config_t *c) { c->gains.emf_angle_corner_rad_s = -1.0f; }
+static void emf_gain_without_corner(pmstep_config_t *c) { c->gains.emf_angle_gain_per_s = 100.0f; }
+/* Paper: the residual settles at R/L + K_e = 500 + 100 = 600 1/s; K_theta must stay below. */
+static void emf_gain_at_residual_rate(pmstep_config_t *c)
+{
+    c->gains.emf_angle_gain_per_s = 600.0f;
+    c->gains.emf_angle_corner_rad_s = 5.0f;
 }
 static void bad_l(pmstep_config_t *c) { c->motor.inductance_H = -1e-3f; }
 static void bad_j(pmstep_config_t *c) { c->motor.inertia_kgm2 = 0.0f; }
@@ -123,6 +133,10 @@ static const struct {
     {negative_current_integral, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN},
     {negative_q_current_integral, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN},
     {negative_detent_fade, PMSTEP_ERR_DETENT_FADE_SPEED},
+    {negative_emf_gain, PMSTEP_ERR_EMF_ANGLE_GAIN},
+    {negative_emf_corner, PMSTEP_ERR_EMF_ANGLE_GAIN},
+    {emf_gain_without_corner, PMSTEP_ERR_EMF_ANGLE_GAIN},
+    {emf_gain_at_residual_rate, PMSTEP_ERR_EMF_ANGLE_GAIN},
     {negative_lead_in, PMSTEP_ERR_S_LEAD_IN_TIME},
     {lead_in_fills_s_alignment, PMSTEP_ERR_S_LEAD_IN_TIME},
     {current_integral_complex_poles, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN},
@@ -199,6 +213,17 @@ static void current_integral_within_its_bound_is_accepted(void **state)
     assert_int_equal(pmstep_validate_config(&cfg), PMSTEP_OK);
 }
 
+static void emf_gain_under_the_residual_rate_is_accepted(void **state)
+{
+    pmstep_config_t cfg = pmstep_paper_config();
+    (void)state;
+    cfg.gains.emf_angle_gain_per_s = 590.0f;
+    cfg.gains.emf_angle_corner_rad_s = 5.0f;
+    assert_int_equal(pmstep_validate_config(&cfg), PMSTEP_OK);
+    cfg.gains.emf_angle_gain_per_s = 0.0f; /* off: a corner alone is allowed */
+    assert_int_equal(pmstep_validate_config(&cfg), PMSTEP_OK);
+}
+
 static void every_validation_code_is_provoked(void **state)
 {
     /* Each configuration code (-10 and below) is the expected result of some case above or
@@ -262,6 +287,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(every_invalid_configuration_has_its_code),
         cmocka_unit_test(current_integral_within_its_bound_is_accepted),
+        cmocka_unit_test(emf_gain_under_the_residual_rate_is_accepted),
         cmocka_unit_test(every_code_has_its_own_text),
         cmocka_unit_test(every_validation_code_is_provoked),
         cmocka_unit_test(condition4_cases_are_on_the_right_side),

@@ -106,6 +106,19 @@ static void every_preset_gets_a_valid_design(void **state)
                 assert_float_equal(cfg.gains.current_integral_gain_per_s2, 0.125f * k * k, 1e-3f * k * k);
                 assert_true(cfg.gains.current_integral_gain_q_per_s2 == cfg.gains.current_integral_gain_per_s2);
             }
+            /* Robust: the back-EMF angle correction at the observer's bandwidth w_o = 0.05 / T_s, half on
+             * where the back EMF equals R I + 2 V_bus t_d / T_s (DESIGN.md section 15); off in paper mode. */
+            if (robust != 0) {
+                const float corner_rad_s = (in.motor.resistance_Ohm * in.rated_current_A
+                                            + 2.0f * in.bus_voltage_V * in.dead_time_s / in.period_s)
+                                           / in.motor.torque_constant_Nm_A;
+                assert_float_equal(cfg.gains.emf_angle_gain_per_s, 0.05f / in.period_s, 1e-3f);
+                assert_float_equal(cfg.gains.emf_angle_corner_rad_s, corner_rad_s, 1e-5f * corner_rad_s);
+                assert_true(cfg.gains.emf_angle_gain_per_s
+                            < in.motor.resistance_Ohm / in.motor.inductance_H + cfg.gains.observer_gain_per_s);
+            } else {
+                assert_true(cfg.gains.emf_angle_gain_per_s == 0.0f && cfg.gains.emf_angle_corner_rad_s == 0.0f);
+            }
             /* Robust: RUN takes the measured L and k_M. L from the current rise where the rotor stays
              * still over its window (the paper's motor, w_n T_L ~ 0.05), else from the level drops:
              * no rise window for the hybrids (~0.45-0.75), the voltage-bias level on. */

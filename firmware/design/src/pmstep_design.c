@@ -12,6 +12,9 @@
 #define SPEED_PER_OBSERVER_BANDWIDTH (1.0f / 3.0f) /* k_w = w_o / 3 */
 #define REFERENCE_PER_SPEED_BANDWIDTH 3.0f         /* varpi_0 = 3 k_w */
 #define DRIFT_FREE_PER_OBSERVER_BANDWIDTH (1.0f / 30.0f) /* robust mode's angle correction g = w_o / 30 */
+/* Robust mode's back-EMF angle correction: K_theta = w_o, a third of the residual's R/L + K_e (DESIGN.md
+ * section 15). */
+#define EMF_ANGLE_PER_OBSERVER_BANDWIDTH 1.0f
 #define CURRENT_INTEGRAL_PER_BANDWIDTH_SQUARED 0.125f   /* K_I = K^2/8, K = R/L + K_i: PI poles 0.15 K, 0.85 K */
 #define STILL_ROTOR_SWING_PHASE 0.1f /* RUN takes the measured L, k_M only if w_n x L window is below this */
 /* Speed correction k_w kappa at most this fraction of the rated current's acceleration k_M I / J. */
@@ -186,6 +189,17 @@ static void design_gains(const pmstep_design_input_t *in, pmstep_gains_config_t 
                              / (m->inertia_kgm2 * speed_gain);
     gains->reference_bandwidth_rad_s = REFERENCE_PER_SPEED_BANDWIDTH * speed_gain;
     gains->angle_correction_gain_per_s = in->self_commissioning ? DRIFT_FREE_PER_OBSERVER_BANDWIDTH * w_o : 0.0f;
+    if (in->self_commissioning) {
+        /* Half on where the back EMF equals the voltage the model knows least: the resistive drop at
+         * rated current and the dead time's full loss 2 V_bus t_d / T_s. */
+        const float uncertain_V = m->resistance_Ohm * in->rated_current_A
+                                  + 2.0f * in->bus_voltage_V * in->dead_time_s / in->period_s;
+        gains->emf_angle_gain_per_s = EMF_ANGLE_PER_OBSERVER_BANDWIDTH * w_o;
+        gains->emf_angle_corner_rad_s = uncertain_V / m->torque_constant_Nm_A;
+    } else {
+        gains->emf_angle_gain_per_s = 0.0f;
+        gains->emf_angle_corner_rad_s = 0.0f;
+    }
     gains->detent_fade_speed_rad_s = m->detent_torque_Nm > 0.0f ? DETENT_FADE_PER_CURRENT_BANDWIDTH * current_bandwidth
                                                                        / (4.0f * (float)m->pole_pairs)
                                                                  : 0.0f;

@@ -13,6 +13,21 @@
  *   phi1 += g T_s c-hat e / (L p/k_M),  phi2 += g T_s s-hat e / (L p/k_M),  e = 1 - c-hat^2 - s-hat^2
  * pulls (c-hat, s-hat) back to the unit circle at the rate g (1/s), as the
  * gradient flux observers of PMSM sensorless control do with the flux magnitude.
+ *
+ * Back-EMF option (not in the paper): the correction above only moves the estimate along its
+ * radius, so an error in the voltage the integrals take (a dead time's loss around a current's
+ * zero crossing) turns the estimate for good. The observer of (6) models the back EMF along
+ * (s-hat, -c-hat); with the estimate delta ahead of the rotor its d-axis residual
+ * i~_d = c-hat i~_a + s-hat i~_b settles at -k_M w delta / (R + L K_e), so
+ *   delta-hat = -(R + L K_e) i~_d w-hat / (k_M (w-hat^2 + w_theta^2))
+ * (faded in with the speed: a voltage error dU_d reads as dU_d / (k_M w), large at low speed),
+ * and the estimate is turned by -K_theta T_s delta-hat every period. The caller pauses it while the
+ * q residual is beyond the detection's bound: in a transient (a load step, w-hat lagging w) the d
+ * residual carries the speed error's share too, and on the 17HS4401 at half its top speed a step
+ * of half its holding torque turned the estimate 1.5 rad in 4 ms. It pauses too where the
+ * unfaded reading (R + L K_e) |i~_d| / (k_M |w-hat|) is beyond PMSTEP_EMF_ANGLE_MAX_READING_RAD:
+ * at RUN's start w-hat swings a few rad/s about a still rotor, and 0.3 A of residual read there
+ * as an angle turned the estimate 0.1 rad within 10 ms.
  */
 #ifndef PMSTEP_ANGLE_H
 #define PMSTEP_ANGLE_H
@@ -22,6 +37,9 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
+
+/** The back-EMF option pauses where its reading would put the estimate more than this off (rad). */
+#define PMSTEP_EMF_ANGLE_MAX_READING_RAD 0.25f
 
 typedef struct {
     float phi_a;            /**< phi1, A */
@@ -40,6 +58,9 @@ typedef struct {
     float current_gain;     /**< R T_s / (2 L), trapezoid weight */
     float flux_to_angle;    /**< L p / k_M, per A */
     float correction_gain;  /**< g T_s / flux_to_angle of the drift-free option (0 = paper's method), A */
+    float emf_turn_gain;    /**< K_theta T_s (R + L K_e) / (k_M flux_to_angle) of the back-EMF option (0 = off),
+                                 A s / rad per A of residual */
+    float emf_corner_squared; /**< w_theta^2, (rad/s)^2 */
 } pmstep_angle_coeffs_t;
 
 /** Coefficients for the period and pole pairs of @p cfg and the electrical model @p model. */
@@ -67,6 +88,16 @@ void pmstep_angle_estimate(const pmstep_angle_t *angle, const pmstep_angle_coeff
  * @param[in] cos_hat, sin_hat  the estimate of this period
  */
 void pmstep_angle_correct(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs, float cos_hat, float sin_hat);
+
+/**
+ * Back-EMF option: turns the next estimate toward the back EMF's direction (see above). Call it
+ * only with emf_turn_gain > 0.
+ * @param[in] cos_hat, sin_hat  the estimate of this period
+ * @param[in] i_d_residual_A    the observer's residual of this sample on cos_hat, sin_hat
+ * @param[in] speed_hat_rad_s   the observer's speed
+ */
+void pmstep_angle_follow_emf(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs, float cos_hat,
+                             float sin_hat, float i_d_residual_A, float speed_hat_rad_s);
 
 /** Moves phi1, phi2 (compensations cleared) so that the estimate for the last sampled currents
  *  (those of the last update) is (@p cos_hat, @p sin_hat). */

@@ -31,6 +31,7 @@ typedef struct {
     pmstep_commission_plan_t commission_plan; /**< alignment timing (t_s, t_c in periods) and windows */
     uint32_t offset_cal_steps;                /**< periods of bridge-off offset calibration */
     bool optional_inputs;                     /**< a load torque or phase voltages to check each period */
+    bool angle_corrections;                   /**< the drift-free or the back-EMF angle correction is on */
     pmstep_detect_coeffs_t detect_coeffs;
     pmstep_actuate_coeffs_t actuate_coeffs;
     pmstep_ref_coeffs_t ref_coeffs;
@@ -45,6 +46,7 @@ typedef struct {
     uint32_t step_count;  /**< periods run since init/reset */
     uint32_t mode_step;   /**< periods since the alignment started */
     bool run_started;     /**< RUN initialised at t_c */
+    bool speed_mode;      /**< RUN takes speed commands, not the position library's loop */
 
     /* Controller (6) state and commands. */
     pmstep_ref_t speed_ref;

@@ -52,6 +52,8 @@ typedef enum {
     PMSTEP_ERR_CURRENT_INTEGRAL_GAIN = -51, /**< current-loop integral gain < 0, or above (R/L + K_i)^2 / 4 (the
                                                  loop's poles would turn complex) */
     PMSTEP_ERR_DETENT_FADE_SPEED = -52,     /**< detent compensation's fade speed < 0 */
+    PMSTEP_ERR_EMF_ANGLE_GAIN = -53,        /**< back-EMF angle correction: gain < 0 or not below R/L + K_e, corner
+                                                 < 0, or a gain without a corner */
     /* limits */
     PMSTEP_ERR_MAX_CURRENT = -60,           /**< max_phase_current_A <= 0 */
     PMSTEP_ERR_MIN_BUS = -61,               /**< min_bus_voltage_V <= 0 */
@@ -214,6 +216,11 @@ typedef struct {
                                                ramps (firmware/design/DESIGN.md section 2) */
     float detent_fade_speed_rad_s; /**< the detent torque's compensation (law and observer) fades with the
                                         estimated speed as w_f^2 / (w_f^2 + w-hat^2); 0 = no fade */
+    float emf_angle_gain_per_s; /**< K_theta: turns the flux integrals' estimate toward the back EMF's direction,
+                                     read from the observer's d-axis residual, at this rate (1/s), faded in with
+                                     the speed as w-hat^2 / (w-hat^2 + w_theta^2) (pmstep_angle.h). Below R/L + K_e;
+                                     0 = off (the paper's estimate) */
+    float emf_angle_corner_rad_s; /**< w_theta: the speed at which that correction is half on (> 0 with a gain) */
 } pmstep_gains_config_t;
 
 /** Protections. */
