@@ -151,6 +151,8 @@ bool pmstep_control_advance(pmstep_t *inst, const pmstep_control_scratch_t *scra
             const pmstep_observer_coeffs_t *obs = &inst->observer_coeffs;
             const float err_a = in->i_a_A - inst->observer.i_a_hat_A;
             const float err_b = in->i_b_A - inst->observer.i_b_hat_A;
+            /* Park written out, not pmstep_park(): a second caller makes -Os keep it out of line
+             * (pmstep_hold_voltages) */
             const float i_d_residual_A = out->cos_hat * err_a + out->sin_hat * err_b;
             const float i_q_residual_A = out->cos_hat * err_b - out->sin_hat * err_a;
             const float bound_A = cfg->detection.observer_residual_bound_A;
