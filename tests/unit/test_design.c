@@ -99,12 +99,13 @@ static void every_preset_gets_a_valid_design(void **state)
             assert_true(cfg.alignment.s_align_voltage_V / in.motor.resistance_Ohm <= in.rated_current_A * 1.0001f);
             assert_true(cfg.alignment.c_align_voltage_V / in.motor.resistance_Ohm <= in.rated_current_A * 1.0001f);
             assert_true(cfg.limits.max_phase_current_A > in.rated_current_A);
-            /* PI current loop: K_I = K^2/8, K = R/L + K_i (poles 0.15 K and 0.85 K, real), the same
-             * on the q axis (DESIGN.md section 2). */
+            /* PI current loop: K_I = K^2/8, K = R/L + K_i (poles 0.15 K and 0.85 K, real); on the q
+             * axis K k_w / 5, its slow pole a fifth of the speed loop's (DESIGN.md section 2). */
             {
                 const float k = in.motor.resistance_Ohm / in.motor.inductance_H + cfg.gains.current_gain_per_s;
                 assert_float_equal(cfg.gains.current_integral_gain_per_s2, 0.125f * k * k, 1e-3f * k * k);
-                assert_true(cfg.gains.current_integral_gain_q_per_s2 == cfg.gains.current_integral_gain_per_s2);
+                assert_float_equal(cfg.gains.current_integral_gain_q_per_s2,
+                                   0.2f * k * cfg.gains.speed_gain_per_s, 1e-4f * k * cfg.gains.speed_gain_per_s);
             }
             /* Robust: the back-EMF angle correction at the observer's bandwidth w_o = 0.05 / T_s, half on
              * where the back EMF equals R I + 2 V_bus t_d / T_s (DESIGN.md section 15); off in paper mode. */
@@ -144,8 +145,8 @@ static void every_preset_gets_a_valid_design(void **state)
 
 static void detent_compensation_fades_where_the_current_loop_ends(void **state)
 {
-    /* 4 p w_f = 2 x the current loop's bandwidth 0.1 / T_s: 20 rad/s on the hybrids (p = 50) at
-     * 20 kHz, 166.7 rad/s on a p = 6 motor; no fade without a detent torque. */
+    /* 4 p w_f = 2 x the current loop's bandwidth 0.2 / T_s: 40 rad/s on the hybrids (p = 50) at
+     * 20 kHz, 333.3 rad/s on a p = 6 motor; no fade without a detent torque. */
     size_t n;
     (void)state;
     for (n = 0; n < sizeof presets / sizeof presets[0]; ++n) {
@@ -156,7 +157,7 @@ static void detent_compensation_fades_where_the_current_loop_ends(void **state)
         assert_true(cfg.gains.detent_fade_speed_rad_s == 0.0f);
         in.motor.detent_torque_Nm = 0.02f;
         assert_int_equal(pmstep_design(&in, &cfg, &report), PMSTEP_OK);
-        assert_float_equal(cfg.gains.detent_fade_speed_rad_s, 2.0f * 2000.0f / (4.0f * (float)presets[n].p),
+        assert_float_equal(cfg.gains.detent_fade_speed_rad_s, 2.0f * 4000.0f / (4.0f * (float)presets[n].p),
                            1e-3f);
     }
 }
@@ -217,8 +218,8 @@ static void observer_poles_are_placed(void **state)
         assert_true(fabs((a_e + f / j) / (3.0 * w_o) - 1.0) < 1e-4);
         assert_true(fabs((a_e * f / j + g_w * b * b) / (3.0 * w_o * w_o) - 1.0) < 1e-4);
         assert_true(fabs(g_t * b * b / j / (w_o * w_o * w_o) - 1.0) < 1e-4);
-        /* Current loop R/L + K_i = 0.1 / T_s; speed loop w_o / 3. */
-        assert_true(fabs((r / l + (double)cfg.gains.current_gain_per_s) * 50e-6 - 0.1) < 1e-5);
+        /* Current loop R/L + K_i = 0.2 / T_s; speed loop w_o / 3. */
+        assert_true(fabs((r / l + (double)cfg.gains.current_gain_per_s) * 50e-6 - 0.2) < 1e-5);
         assert_true(fabs((double)cfg.gains.speed_gain_per_s - w_o / 3.0) < 1e-3 * w_o);
     }
 }
@@ -237,7 +238,9 @@ static void low_bus(pmstep_design_input_t *in) { in->bus_voltage_V = 2.5f; } /* 
 static void zero_bus(pmstep_design_input_t *in) { in->bus_voltage_V = 0.0f; }
 static void slow_rate(pmstep_design_input_t *in) { in->period_s = 1e-3f; } /* (R/L) T_s = 0.54 */
 /* (R/L) T_s = 0.085: above 80 % of the current loop's 0.1, below 80 % of the observer's 0.15 */
-static void rate_for_current_loop(pmstep_design_input_t *in) { in->period_s = 1.6e-4f; }
+/* (R/L) T_s = 0.123: above 80 % of the slower pole, the observer's 3 w_o T_s = 0.15 (the current
+ * loop's is 0.2) */
+static void rate_for_winding(pmstep_design_input_t *in) { in->period_s = 2.3e-4f; }
 /* F/J = 1850/s: above 80 % of the observer's 1000 rad/s */
 static void heavy_friction(pmstep_design_input_t *in) { in->motor.friction_Nms_rad = 0.01f; }
 static void bad_period(pmstep_design_input_t *in) { in->period_s = 0.1f; }
@@ -256,7 +259,7 @@ static void bad_motor_data_gets_a_named_error(void **state)
         {nan_r, PMSTEP_ERR_NONFINITE_PARAMETER}, {inf_j, PMSTEP_ERR_NONFINITE_PARAMETER},
         {zero_rated, PMSTEP_ERR_RATED_CURRENT},  {low_bus, PMSTEP_ERR_BUS_BELOW_RATED},
         {zero_bus, PMSTEP_ERR_BUS_BELOW_RATED},  {slow_rate, PMSTEP_ERR_RATE_TOO_SLOW},
-        {rate_for_current_loop, PMSTEP_ERR_RATE_TOO_SLOW}, {heavy_friction, PMSTEP_ERR_RATE_TOO_SLOW},
+        {rate_for_winding, PMSTEP_ERR_RATE_TOO_SLOW}, {heavy_friction, PMSTEP_ERR_RATE_TOO_SLOW},
         {bad_period, PMSTEP_ERR_PERIOD},         {bad_delay, PMSTEP_ERR_DELAY},
         {long_dead_time, PMSTEP_ERR_DEAD_TIME},
     };

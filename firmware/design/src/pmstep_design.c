@@ -7,7 +7,7 @@
 #include <stddef.h>
 
 /* Bandwidths as fractions of the control rate 1/T_s (DESIGN.md, section 2). */
-#define CURRENT_BANDWIDTH_X_PERIOD 0.1f   /* (R/L + K_i) T_s */
+#define CURRENT_BANDWIDTH_X_PERIOD 0.2f   /* (R/L + K_i) T_s */
 #define OBSERVER_BANDWIDTH_X_PERIOD 0.05f /* w_o T_s: the observer's triple pole */
 #define SPEED_PER_OBSERVER_BANDWIDTH (1.0f / 3.0f) /* k_w = w_o / 3 */
 #define REFERENCE_PER_SPEED_BANDWIDTH 3.0f         /* varpi_0 = 3 k_w */
@@ -16,6 +16,7 @@
  * section 15). */
 #define EMF_ANGLE_PER_OBSERVER_BANDWIDTH 1.0f
 #define CURRENT_INTEGRAL_PER_BANDWIDTH_SQUARED 0.125f   /* K_I = K^2/8, K = R/L + K_i: PI poles 0.15 K, 0.85 K */
+#define Q_INTEGRAL_SPEED_DIVISOR 5.0f /* K_I,q = K k_w / 5: the q PI's slow pole at k_w / 5 */
 #define STILL_ROTOR_SWING_PHASE 0.1f /* RUN takes the measured L, k_M only if w_n x L window is below this */
 /* Speed correction k_w kappa at most this fraction of the rated current's acceleration k_M I / J. */
 #define KAPPA_CURRENT_FRACTION 0.5f
@@ -134,7 +135,7 @@ static pmstep_status_t check_input(const pmstep_design_input_t *in)
         return PMSTEP_ERR_DEAD_TIME;
     }
     /* The current loop's and the observer's poles must lie well beyond the winding's own R/L
-     * (K_i, K_e > 0): R/L at most 80 % of the slower of the two, 0.1/T_s and 3 w_o. The
+     * (K_i, K_e > 0): R/L at most 80 % of the slower of the two, 0.2/T_s and 3 w_o. The
      * observer's triple pole must lie beyond the mechanics' F/J (DESIGN.md, 3). */
     if (!(m->resistance_Ohm / m->inductance_H * in->period_s
           < 0.8f * min2(CURRENT_BANDWIDTH_X_PERIOD, 3.0f * OBSERVER_BANDWIDTH_X_PERIOD))
@@ -175,9 +176,9 @@ static void design_gains(const pmstep_design_input_t *in, pmstep_gains_config_t 
 
     gains->current_gain_per_s = current_bandwidth - r_over_l;
     gains->current_integral_gain_per_s2 = CURRENT_INTEGRAL_PER_BANDWIDTH_SQUARED * current_bandwidth * current_bandwidth;
-    /* The same on the q axis: K k_w / 5 there ends the AS1050's limit cycle at mid speeds, but lags the
-     * back EMF's error through a fast ramp (a silent failure on the 17HS4401; DESIGN.md section 2). */
-    gains->current_integral_gain_q_per_s2 = gains->current_integral_gain_per_s2;
+    /* The q axis's slow pole K_I,q / K a fifth of the speed loop's k_w: at K^2/8 it sat on k_w (a
+     * limit cycle on the AS1050) or, at this K, upset the position loop's moves (DESIGN.md section 2). */
+    gains->current_integral_gain_q_per_s2 = current_bandwidth * speed_gain / Q_INTEGRAL_SPEED_DIVISOR;
     gains->observer_gain_per_s = a_e - r_over_l;
     gains->adapt_lambda = lambda;
     /* With r F small against gamma: g_w = 2/lambda and g_T = 2F/lambda + J/gamma = J w_o^3 / b^2,
