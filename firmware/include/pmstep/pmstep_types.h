@@ -210,10 +210,10 @@ typedef struct {
                                              (6) otherwise turns into a speed offset. 0 = the paper's law. On the d
                                              axis, and the hold's; the q axis takes the next */
     float current_integral_gain_q_per_s2; /**< K_I,q: the same on the q axis, the speed loop's (0 = none there).
-                                               Where its slow pole K_I,q / K meets the speed loop's k_w (at
-                                               K^2/8, the designer's), a large dead time's residual can keep
-                                               a limit cycle going; K k_w / 5 ends it but lags through fast
-                                               ramps (firmware/design/DESIGN.md section 2) */
+                                               Where its slow pole K_I,q / K meets the speed loop's k_w, a
+                                               large dead time's residual can keep a limit cycle going; the
+                                               designer puts it at k_w / 5 (K_I,q = K k_w / 5;
+                                               firmware/design/DESIGN.md section 2) */
     float detent_fade_speed_rad_s; /**< the detent torque's compensation (law and observer) fades with the
                                         estimated speed as w_f^2 / (w_f^2 + w-hat^2); 0 = no fade */
     float emf_angle_gain_per_s; /**< K_theta: turns the flux integrals' estimate toward the back EMF's direction,
