@@ -122,6 +122,7 @@ static pmstep_status_t engage_vector(pmstep_t *inst, float cos_rest, float sin_r
         hold->vector_speed_rad_s = 0.0f;
         hold->active = true;
     }
+    hold->estimate_kept = false; /* the standstill keeps it once its rotor has settled */
     return PMSTEP_OK;
 }
 
@@ -134,6 +135,7 @@ void pmstep_release_vector(pmstep_t *inst)
 {
     if (inst != NULL && inst->hold.active) {
         inst->hold.active = false;
+        inst->hold.estimate_kept = false;
         inst->hold.vector_speed_rad_s = 0.0f;
         inst->current_integral.i_d_error_integral_As = 0.0f;
         inst->current_integral.i_q_error_integral_As = 0.0f;
@@ -220,6 +222,7 @@ void pmstep_standstill_start(pmstep_t *inst)
     const float current_A = inst->cfg->standstill.hold_current_A;
     inst->hold.standstill_engaged = false;
     inst->hold.standstill_settled = false;
+    inst->hold.estimate_kept = false;
     standstill->rest_periods = 0u;
     standstill->keep_cos = 1.0f;
     standstill->keep_sin = 0.0f;
@@ -263,17 +266,21 @@ static void aim_clear_of_phase_axes(float *c, float *s, float min_sin)
     }
 }
 
-/* The rest (c, s) turned with the vector T_L-hat's load angle ahead of it, so that the vector's
- * currents are clear of zero by min_sin (aim_clear_of_phase_axes); the load angle is the one at the
- * rest before the turn (the detent torque's change over the turn is left, a few hundredths of a
- * radian). Unchanged where the load is beyond the vector's pull (pmstep_hold_vector refuses it). */
-static void rest_for_clear_vector(const pmstep_t *inst, float *c, float *s, float min_sin)
+/* The rest (c, s) turned with the vector load_Nm's load angle ahead of it, so that the vector's
+ * currents are clear of zero by PMSTEP_HOLD_PHASE_CLEARANCE_BANDS compensation bands
+ * (aim_clear_of_phase_axes; at most on a diagonal); the load angle is the one at the rest before
+ * the turn (the detent torque's change over the turn is left, a few hundredths of a radian).
+ * Unchanged where the load is beyond the vector's pull (pmstep_hold_vector refuses it). */
+static void rest_for_clear_vector(const pmstep_t *inst, float *c, float *s, float load_Nm)
 {
     const pmstep_law_coeffs_t *law = &inst->law_coeffs;
+    const float current_A = inst->cfg->standstill.hold_current_A;
+    const float clear_sin = PMSTEP_HOLD_PHASE_CLEARANCE_BANDS * inst->cfg->inverter.dead_time_current_band_A
+                            / current_A;
+    const float min_sin = (clear_sin < HOLD_MAX_CLEAR_SIN) ? clear_sin : HOLD_MAX_CLEAR_SIN;
     const pmstep_detent_t detent = pmstep_law_detent(law, *c, *s, 0.0f);
     hold_aim_t aim = {1.0f, 0.0f, 1.0f};
-    if (aim_ahead_of_rotor(law, *c, *s, inst->cfg->standstill.hold_current_A, inst->observer.load_hat_Nm, 0.0f,
-                           &detent, &aim)) {
+    if (aim_ahead_of_rotor(law, *c, *s, current_A, load_Nm, 0.0f, &detent, &aim)) {
         float cos_clear = aim.cos_vector;
         float sin_clear = aim.sin_vector;
         aim_clear_of_phase_axes(&cos_clear, &sin_clear, min_sin);
@@ -281,6 +288,15 @@ static void rest_for_clear_vector(const pmstep_t *inst, float *c, float *s, floa
         pmstep_turn(*c, *s, cos_clear * aim.cos_vector + sin_clear * aim.sin_vector,
                     sin_clear * aim.cos_vector - cos_clear * aim.sin_vector, c, s);
     }
+}
+
+/* A new vector's rest: its drift and motion learnt afresh, the sum leaking over its settling time. */
+static void learn_rest_afresh(pmstep_standstill_t *standstill, const pmstep_vector_hold_t *hold)
+{
+    const uint32_t leak_periods = hold->settle_periods + 1u; /* a settling time, at least a period */
+    standstill->drift_rad = 0.0f;
+    standstill->motion_rad = 0.0f;
+    standstill->motion_leak = 1.0f / (float)leak_periods;
 }
 
 /* Not yet holding: the hold once the zero command is reached and the rotor has been at rest for
@@ -304,8 +320,6 @@ static void standstill_engage(pmstep_t *inst, pmstep_standstill_t *standstill, c
     if (standstill->rest_periods >= standstill->engage_periods) {
         const float current_A = inst->cfg->standstill.hold_current_A;
         const float length = sqrtf(out->cos_hat * out->cos_hat + out->sin_hat * out->sin_hat);
-        const float clear_sin = PMSTEP_HOLD_PHASE_CLEARANCE_BANDS * inst->cfg->inverter.dead_time_current_band_A
-                                / current_A;
         float c = 0.0f;
         float s = 0.0f;
         standstill->rest_periods = 0u;
@@ -314,7 +328,7 @@ static void standstill_engage(pmstep_t *inst, pmstep_standstill_t *standstill, c
             c = out->cos_hat / length;
             s = out->sin_hat / length;
             if (!standstill_turning(inst, standstill, out)) { /* a turning vector's currents cross zero anyway */
-                rest_for_clear_vector(inst, &c, &s, clear_sin < HOLD_MAX_CLEAR_SIN ? clear_sin : HOLD_MAX_CLEAR_SIN);
+                rest_for_clear_vector(inst, &c, &s, inst->observer.load_hat_Nm);
             }
         }
         /* refused (a load beyond the vector's pull, an estimate at the origin): the law holds on */
@@ -326,18 +340,41 @@ static void standstill_engage(pmstep_t *inst, pmstep_standstill_t *standstill, c
         standstill->aim_load_Nm = inst->observer.load_hat_Nm;
         inst->hold.vector_speed_rad_s = vector_speed;
         standstill->vector_rate_rad_s = vector_speed;
-        standstill->drift_rad = 0.0f; /* this vector's drift is learnt afresh */
-        {
-            const uint32_t leak_periods = inst->hold.settle_periods + 1u; /* a settling time, at least a period */
-            standstill->motion_leak = 1.0f / (float)leak_periods;
-        }
+        learn_rest_afresh(standstill, &inst->hold);
     }
 }
 
-/* The turn of this period's estimate off the kept one (electrical rad, small). */
-static float turn_off_kept(const pmstep_standstill_t *standstill, const pmstep_output_t *out)
+/* The flux integrals' estimate of the period: out's, or, where the kept rotor was put out in
+ * its place, the one pmstep_standstill_estimate set aside. */
+typedef struct {
+    float cos_hat;
+    float sin_hat;
+} sensed_angle_t;
+
+static sensed_angle_t sensed_angle(const pmstep_t *inst, const pmstep_output_t *out)
 {
-    return standstill->keep_cos * out->sin_hat - standstill->keep_sin * out->cos_hat;
+    const pmstep_standstill_t *standstill = &inst->scratch.run.standstill;
+    sensed_angle_t sensed = {out->cos_hat, out->sin_hat};
+    if (inst->hold.estimate_kept) {
+        sensed.cos_hat = standstill->sensed_cos;
+        sensed.sin_hat = standstill->sensed_sin;
+    }
+    return sensed;
+}
+
+void pmstep_standstill_estimate(pmstep_t *inst, float *cos_hat, float *sin_hat)
+{
+    pmstep_standstill_t *standstill = &inst->scratch.run.standstill;
+    standstill->sensed_cos = *cos_hat;
+    standstill->sensed_sin = *sin_hat;
+    *cos_hat = standstill->keep_cos;
+    *sin_hat = standstill->keep_sin;
+}
+
+/* The turn of this period's integrals off the kept estimate (electrical rad, small). */
+static float turn_off_kept(const pmstep_standstill_t *standstill, const sensed_angle_t *sensed)
+{
+    return (standstill->keep_cos * sensed->sin_hat) - (standstill->keep_sin * sensed->cos_hat);
 }
 
 /* (J w_v' + F w_v) / k_M (A): the current the vector's own speed profile takes; 0 at rest. */
@@ -416,6 +453,7 @@ static void follow_held_rotor(pmstep_t *inst, pmstep_standstill_t *standstill, c
 /* One period of the standstill's hold: settling, then the kept estimate and the motion sum. */
 static void standstill_hold_period(pmstep_t *inst, pmstep_standstill_t *standstill, const pmstep_output_t *out)
 {
+    const sensed_angle_t sensed = sensed_angle(inst, out);
     const bool turning = standstill_turning(inst, standstill, out);
     const float speed_change = inst->observer.speed_hat_rad_s - inst->hold.vector_speed_rad_s
                                - inst->hold.speed_bias_rad_s;
@@ -424,14 +462,16 @@ static void standstill_hold_period(pmstep_t *inst, pmstep_standstill_t *standsti
         /* Turning: the flux integrals' phase is not the rotor's at low speed (the voltage errors
          * against a back-EMF of the same order), the estimate is the vector's aim throughout. */
         pmstep_angle_set(&inst->angle, &inst->angle_coeffs, standstill->keep_cos, standstill->keep_sin);
+        inst->hold.estimate_kept = true;
     } else if (!inst->hold.standstill_settled) {
+        inst->hold.estimate_kept = false;
         if (standstill->rest_periods >= inst->hold.settle_periods) {
             /* Settled where the vector holds it (the aim: T_L-hat's load angle behind the vector),
              * not where the integrals drifted to while the current stepped up (R and voltage errors
              * times the hold current), unless they put the rotor beyond the motion bound from it (a
              * load T_L-hat did not know). T_L-hat the balance there, w-hat the rest's (its
              * transient from the step is behind), and no first settling time to take. */
-            const float off_aim_rad = turning ? 0.0f : turn_off_kept(standstill, out); /* turning: at the aim */
+            const float off_aim_rad = turning ? 0.0f : turn_off_kept(standstill, &sensed); /* turning: at the aim */
             inst->hold.standstill_settled = true;
             standstill->motion_rad = pmstep_abs(off_aim_rad) > PMSTEP_HOLD_MOTION_BOUND_RAD ? off_aim_rad : 0.0f;
             follow_held_rotor(inst, standstill, out);
@@ -440,27 +480,56 @@ static void standstill_hold_period(pmstep_t *inst, pmstep_standstill_t *standsti
         }
     } else if (pmstep_abs(speed_change) < inst->hold.quiet_band_rad_s) {
         if (standstill->rest_periods <= inst->hold.settle_periods) {
-            standstill->keep_cos = out->cos_hat; /* the rest's first settling time: taken */
-            standstill->keep_sin = out->sin_hat;
+            standstill->keep_cos = sensed.cos_hat; /* the rest's first settling time: taken */
+            standstill->keep_sin = sensed.sin_hat;
             standstill->motion_rad = 0.0f;
+            inst->hold.estimate_kept = false;
             /* the load the vector is aimed for when it turns: the balance where the rotor came to rest */
-            standstill->aim_load_Nm = held_balance_Nm(inst, out->cos_hat, out->sin_hat, out);
+            standstill->aim_load_Nm = held_balance_Nm(inst, sensed.cos_hat, sensed.sin_hat, out);
         } else {
             /* the period's turn of the integrals off the kept estimate less their learnt drift, summed
              * with the leak */
-            const float turn_rad = turn_off_kept(standstill, out);
+            const float turn_rad = turn_off_kept(standstill, &sensed);
             standstill->drift_rad += PMSTEP_HOLD_DRIFT_LEAK_FRACTION * standstill->motion_leak
                                      * (turn_rad - standstill->drift_rad);
             standstill->motion_rad += turn_rad - standstill->drift_rad
                                       - standstill->motion_leak * standstill->motion_rad;
             if (pmstep_abs(standstill->motion_rad) > PMSTEP_HOLD_MOTION_BOUND_RAD) {
                 follow_held_rotor(inst, standstill, out);
+                inst->hold.estimate_kept = false;
             } else {
                 pmstep_angle_set(&inst->angle, &inst->angle_coeffs, standstill->keep_cos, standstill->keep_sin);
+                inst->hold.estimate_kept = true;
             }
         }
     } else {
         standstill->rest_periods = 0u; /* moving: the estimate follows the flux integrals */
+        inst->hold.estimate_kept = false;
+    }
+}
+
+/* The low-speed drive's vector has stopped turning: aimed afresh at its kept rotor for T_L,aim,
+ * clear of the phase axes as an engagement at rest is (the rest it stopped at may put a phase
+ * current in the dead-time band, where the motion sum would read the integrals' drift as
+ * motion), and settled again. A load beyond its pull: released to the law. */
+static void stop_turning(pmstep_t *inst, pmstep_standstill_t *standstill)
+{
+    float c = standstill->keep_cos;
+    float s = standstill->keep_sin;
+    rest_for_clear_vector(inst, &c, &s, standstill->aim_load_Nm);
+    inst->hold.vector_speed_rad_s = 0.0f;
+    standstill->vector_rate_rad_s = 0.0f;
+    if (engage_vector(inst, c, s, inst->hold.current_A, standstill->aim_load_Nm, true) == PMSTEP_OK) {
+        standstill->keep_cos = c;
+        standstill->keep_sin = s;
+        inst->hold.standstill_settled = false;
+        standstill->rest_periods = 0u;
+        learn_rest_afresh(standstill, &inst->hold);
+    } else {
+        inst->observer.load_hat_Nm = standstill->aim_load_Nm; /* the law starts from the aim's */
+        pmstep_release_vector(inst);
+        inst->hold.standstill_engaged = false;
+        standstill->rest_periods = 0u;
     }
 }
 
@@ -476,6 +545,13 @@ void pmstep_standstill_advance(pmstep_t *inst, const pmstep_output_t *out)
     }
     standstill_hold_period(inst, standstill, out);
     if (!standstill_turning(inst, standstill, out)) {
+        /* stopped for good (a reversal only passes through zero) */
+        const bool was_turning = pmstep_abs(inst->hold.vector_speed_rad_s) > 0.0f;
+        const bool zero_command = !(pmstep_abs(inst->speed_ref.target) > 0.0f)
+                                  && !(pmstep_abs(inst->speed_ref.setpoint) > 0.0f);
+        if (was_turning && zero_command) {
+            stop_turning(inst, standstill);
+        }
         inst->hold.vector_speed_rad_s = 0.0f; /* at rest the vector stays where it is */
     } else if (!turn_vector(inst, standstill, out)) {
         pmstep_release_vector(inst); /* a load beyond the turning vector's pull: the law's */

@@ -79,6 +79,9 @@ void pmstep_hold_voltages(pmstep_t *inst, pmstep_observer_input_t *obs_in, pmste
  * speed command's part (ends a hold, except the standstill's for a zero command; re-arms it). */
 void pmstep_standstill_start(pmstep_t *inst);
 void pmstep_standstill_advance(pmstep_t *inst, const pmstep_output_t *out);
+/* Where the standstill keeps its estimate (pmstep_vector_hold_t.estimate_kept): the period's
+ * (cos_hat, sin_hat) from the integrals, kept for the motion sum, replaced by the kept rotor. */
+void pmstep_standstill_estimate(pmstep_t *inst, float *cos_hat, float *sin_hat);
 void pmstep_standstill_command(pmstep_t *inst, float target_rad_s);
 
 #endif /* PMSTEP_INTERNAL_H */

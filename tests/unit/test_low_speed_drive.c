@@ -213,31 +213,91 @@ static void low_speed_drive_hands_over_to_the_law(void **state)
     assert_false(f.inst.hold.active || f.inst.hold.standstill_engaged);
 }
 
-/* The reference at rest: the vector stops where it is (w_v = 0) and the standstill's rule takes
- * the estimate over (the first settling time taken from the integrals, then kept). */
+/* Engaged and turned past its settling, then @p target_rad_s commanded and the period's reference
+ * at zero: the stop's (target 0) or a reversal's passage through zero. */
+static void turned_then_reference_at_zero(paper_run_t *f, pmstep_output_t *out, float target_rad_s)
+{
+    uint32_t n;
+    engaged_turning(f, out);
+    for (n = 0; n < 2u * f->inst.hold.settle_periods; ++n) {
+        pmstep_standstill_advance(&f->inst, out);
+    }
+    assert_true(f->inst.hold.standstill_settled);
+    assert_int_equal(pmstep_set_speed_target(&f->inst, target_rad_s, 100.0f), PMSTEP_OK); /* within the band */
+    assert_true(f->inst.hold.active && f->inst.hold.standstill_engaged);
+    out->speed_ref_rad_s = 0.0f;
+    out->speed_hat_rad_s = 0.0f;
+    f->inst.observer.speed_hat_rad_s = 0.0f;
+    f->inst.hold.speed_bias_rad_s = 0.0f;
+}
+
+/* One period, the vector's aim before it into (@p c, @p s). */
+static void period_after_vector(paper_run_t *f, const pmstep_output_t *out, float *c, float *s)
+{
+    *c = f->inst.hold.cos_vector;
+    *s = f->inst.hold.sin_vector;
+    pmstep_standstill_advance(&f->inst, out);
+}
+
+/* The reference at rest on a zero command: the vector stops (w_v = 0), aimed afresh at its kept
+ * rotor for T_L,aim (no compensation band here: where it stood), and the standstill's rule takes
+ * the estimate over from a new settling (the first settling time taken from the integrals, then
+ * kept). */
 static void low_speed_drive_stops_at_rest(void **state)
 {
     paper_run_t f;
     pmstep_output_t out = turning_output();
     float c;
     float s;
-    uint32_t n;
     (void)state;
-    engaged_turning(&f, &out);
-    for (n = 0; n < 2u * f.inst.hold.settle_periods; ++n) {
-        pmstep_standstill_advance(&f.inst, &out);
-    }
-    c = f.inst.hold.cos_vector;
-    s = f.inst.hold.sin_vector;
-    out.speed_ref_rad_s = 0.0f;
-    out.speed_hat_rad_s = 0.0f;
-    f.inst.observer.speed_hat_rad_s = 0.0f;
-    f.inst.hold.speed_bias_rad_s = 0.0f;
-    for (n = 0; n < 10u; ++n) {
-        pmstep_standstill_advance(&f.inst, &out);
-    }
+    turned_then_reference_at_zero(&f, &out, 0.0f);
+    period_after_vector(&f, &out, &c, &s);
     assert_true(f.inst.hold.active && f.inst.hold.standstill_engaged);
+    assert_false(f.inst.hold.standstill_settled);
+    assert_int_equal(f.inst.scratch.run.standstill.rest_periods, 0u);
     assert_float_equal(f.inst.hold.vector_speed_rad_s, 0.0f, 0.0f);
+    assert_float_equal(f.inst.hold.cos_vector, c, 1e-6f);
+    assert_float_equal(f.inst.hold.sin_vector, s, 1e-6f);
+    assert_float_equal(f.inst.scratch.run.standstill.aim_load_Nm, LOAD_NM, 1e-4f);
+}
+
+/* Stopped with its vector 0.03 rad off phase a's axis (phase b's current 0.2 A, within 25 bands of
+ * 0.02 A): the vector is turned to sin v = 25 x 0.02 / 7.5 (as an engagement at rest is,
+ * pmstep_hold.h) and its kept rotor with it, so that the motion sum does not read the dead-time
+ * band's drift of phase b as motion. */
+static void low_speed_drive_stops_clear_of_the_phase_axes(void **state)
+{
+    paper_run_t f;
+    pmstep_output_t out = turning_output();
+    const float clear_sin = 25.0f * 0.02f / HOLD_A;
+    float vector_rad;
+    float rest_rad;
+    (void)state;
+    turned_then_reference_at_zero(&f, &out, 0.0f);
+    f.cfg.inverter.dead_time_current_band_A = 0.02f;
+    f.inst.scratch.run.standstill.aim_load_Nm = 0.0f;
+    f.inst.scratch.run.standstill.keep_cos = cosf(0.03f);
+    f.inst.scratch.run.standstill.keep_sin = sinf(0.03f);
+    pmstep_standstill_advance(&f.inst, &out);
+    vector_rad = angle_of(f.inst.hold.cos_vector, f.inst.hold.sin_vector);
+    rest_rad = angle_of(f.inst.scratch.run.standstill.keep_cos, f.inst.scratch.run.standstill.keep_sin);
+    assert_float_equal(vector_rad, asinf(clear_sin), 1e-5f);
+    assert_float_equal(rest_rad, vector_rad, 1e-5f); /* no load: the rest under the vector */
+    assert_false(f.inst.hold.standstill_settled);
+}
+
+/* A reversal within the band passes w* = 0 with its target beyond it: the vector keeps its aim and
+ * its settled state (no stop, no re-aim). */
+static void low_speed_drive_passes_through_zero(void **state)
+{
+    paper_run_t f;
+    pmstep_output_t out = turning_output();
+    float c;
+    float s;
+    (void)state;
+    turned_then_reference_at_zero(&f, &out, -SPEED_RAD_S);
+    period_after_vector(&f, &out, &c, &s);
+    assert_true(f.inst.hold.active && f.inst.hold.standstill_settled);
     assert_float_equal(f.inst.hold.cos_vector, c, 0.0f);
     assert_float_equal(f.inst.hold.sin_vector, s, 0.0f);
 }
@@ -267,6 +327,8 @@ int main(void)
         cmocka_unit_test(low_speed_drive_voltage_turns_with_the_vector),
         cmocka_unit_test(low_speed_drive_hands_over_to_the_law),
         cmocka_unit_test(low_speed_drive_stops_at_rest),
+        cmocka_unit_test(low_speed_drive_stops_clear_of_the_phase_axes),
+        cmocka_unit_test(low_speed_drive_passes_through_zero),
         cmocka_unit_test(low_speed_drive_off_without_a_band),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -30,6 +30,10 @@
  * kept while the rotor rests (|w-hat - w-bar| within the quiet band; it is taken during the
  * first settling time of each rest and put back every period after) and follows the flux
  * integrals while it moves: the same rule as the position library's hold (pmstep_position.h).
+ * Where it is kept (and while the low-speed drive turns it) the period's estimate is the kept
+ * rotor itself, not the integrals' reading of it: that reading, a period after the estimate was
+ * put back, carries two current samples' noise (L p / k_M per ampere, 0.84 rad/A on the
+ * 17HS4401), and goes to the motion sum only.
  * A non-zero speed command releases it (a zero one keeps it), as do leaving RUN and
  * pmstep_leave_speed_mode(), by which the position library takes the reference over.
  * A load step on the held rotor moves it at w_n, above the observer's speed bandwidth on a
@@ -56,8 +60,10 @@
  * is taken or followed. The estimate is x-hat throughout (the integrals are not followed while
  * turning); w-bar is the low-passed w-hat - w*; the voltage adds L I p w_f + k_M w* on q, w_f =
  * w* + (d delta / dt) / p the frame's speed with the detent's rate, and is put out in the frame
- * turned on by p w_f T_s (delay + 1/2). At rest (|w*| below 1 % of the quiet band) the vector
- * stops and the standstill's rules above apply. A command beyond w_b releases the vector and the
+ * turned on by p w_f T_s (delay + 1/2). At rest (|w*| below 1 % of the quiet band) on a zero
+ * command the vector stops, aimed afresh at its kept rotor clear of the phase axes as an
+ * engagement at rest is (it may have stopped with a phase current in the dead-time band), and
+ * the standstill's rules above apply from a new settling; a reversal passing w* = 0 turns on. A command beyond w_b releases the vector and the
  * law starts from T_L,aim; so does a load angle beyond PMSTEP_HOLD_MAX_TORQUE_FRACTION.
  */
 #ifndef PMSTEP_HOLD_H
@@ -125,6 +131,7 @@ typedef struct {
     bool standstill_armed;        /**< RUN with a hold current, in speed mode (not the position library's) */
     bool standstill_engaged;      /**< this hold is the standstill's */
     bool standstill_settled;      /**< the held rotor's settling time has passed */
+    bool estimate_kept;           /**< the standstill's kept rotor is the estimate, not the integrals' */
 } pmstep_vector_hold_t;
 
 /** State of the standstill hold in speed mode (part of pmstep_t's RUN scratch). */
@@ -137,6 +144,8 @@ typedef struct {
     float drift_rad;         /**< the integrals' turn per period at rest (R and voltage errors), learnt */
     float aim_load_Nm;       /**< T_L the vector is aimed for (the load angle's), turning or at rest */
     float vector_rate_rad_s; /**< the turning vector's speed, w* + (d delta / dt) / p (rad/s, mechanical) */
+    float sensed_cos;        /**< the flux integrals' estimate of a period whose estimate was kept */
+    float sensed_sin;
     uint32_t engage_periods; /**< PMSTEP_STANDSTILL_ENGAGE_TIME_CONSTANTS / k_w, in periods */
     uint32_t rest_periods;   /**< periods at rest: before the hold, to engage it; in it, since the settling */
 } pmstep_standstill_t;
