@@ -147,9 +147,10 @@ bool pmstep_control_advance(pmstep_t *inst, const pmstep_control_scratch_t *scra
         if (inst->angle_coeffs.correction_gain > 0.0f) {
             pmstep_angle_correct(&inst->angle, &inst->angle_coeffs, out->cos_hat, out->sin_hat);
         }
-        /* speed mode only: a hold's vector sets the angle, and in position mode the holds between
-         * short moves kept more error with it (DESIGN.md section 15) */
-        if ((inst->angle_coeffs.emf_turn_gain > 0.0f) && inst->speed_mode && !inst->hold.active) {
+        /* outside the vector holds, whose vector sets the angle; in the position library's moves
+         * too, where without it the current loop at 0.2/T_s rang at the electrical frequency
+         * (DESIGN.md section 15) */
+        if ((inst->angle_coeffs.emf_turn_gain > 0.0f) && !inst->hold.active) {
             const pmstep_observer_input_t *in = &scratch->observer_input;
             const pmstep_observer_coeffs_t *obs = &inst->observer_coeffs;
             const float err_a = in->i_a_A - inst->observer.i_a_hat_A;

@@ -55,6 +55,10 @@
 /* Robust mode, currents sensed only: the low-speed drive below the speed whose back EMF is this
  * many times the dead time's loss V_bus t_d / T_s (DESIGN.md, "The low-speed drive"). */
 #define LOW_SPEED_EMF_PER_DEAD_TIME_LOSS 2.0f
+/* ... and where the detent torque's frequency 4 p w is at most this fraction of the held rotor's
+ * natural frequency sqrt(p k_M I / J): above, the turning vector drives the rotor near its
+ * resonance (DESIGN.md section 14). */
+#define LOW_SPEED_DETENT_PER_HELD_NATURAL 0.5f
 /* Identification of J and F (pmstep_identify.h): periods with |w*| below this fraction of the top
  * speed stay out of the fit (a hybrid's detent torque does not average out at low speed). */
 #define IDENTIFICATION_MIN_SPEED_OF_TOP 0.2f
@@ -270,6 +274,21 @@ static float magnetising_current(const pmstep_design_input_t *in)
                 MAX_MAGNETISING_PER_RATED_CURRENT * in->rated_current_A);
 }
 
+/* The low-speed drive's band: below the speed whose back EMF is LOW_SPEED_EMF_PER_DEAD_TIME_LOSS
+ * times the dead time's loss, and whose detent frequency 4 p w is LOW_SPEED_DETENT_PER_HELD_NATURAL
+ * of the vector's held natural frequency at rated current (DESIGN.md section 14). */
+static float low_speed_band(const pmstep_design_input_t *in)
+{
+    const pmstep_motor_config_t *m = &in->motor;
+    const float pole_pairs = (float)m->pole_pairs;
+    const float emf_band_rad_s = LOW_SPEED_EMF_PER_DEAD_TIME_LOSS * in->bus_voltage_V * in->dead_time_s
+                                 / (in->period_s * m->torque_constant_Nm_A);
+    const float held_natural_rad_s = sqrtf(pole_pairs * m->torque_constant_Nm_A * in->rated_current_A
+                                           / m->inertia_kgm2);
+    const float resonance_band_rad_s = LOW_SPEED_DETENT_PER_HELD_NATURAL * held_natural_rad_s / (4.0f * pole_pairs);
+    return min2(emf_band_rad_s, resonance_band_rad_s);
+}
+
 static void design_commissioning(const pmstep_design_input_t *in, float window_s, pmstep_config_t *cfg,
                                  pmstep_design_report_t *report)
 {
@@ -319,8 +338,7 @@ static void design_commissioning(const pmstep_design_input_t *in, float window_s
      * in place of the law (asked for: a load step while it turns is not learnt, DESIGN.md
      * section 14). A drive that senses its phase voltages integrates the bridge's own. */
     cfg->standstill.vector_speed_rad_s = (robust && in->low_speed_drive && !in->phase_voltage_sensing)
-                                             ? LOW_SPEED_EMF_PER_DEAD_TIME_LOSS * in->bus_voltage_V * in->dead_time_s
-                                                   / (in->period_s * in->motor.torque_constant_Nm_A)
+                                             ? low_speed_band(in)
                                              : 0.0f;
 }
 
