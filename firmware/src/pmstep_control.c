@@ -72,7 +72,7 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
         pmstep_angle_update(&inst->angle, &inst->angle_coeffs, sample->i_a_A, sample->i_b_A, u_a_V, u_b_V);
     }
     pmstep_angle_estimate(&inst->angle, &inst->angle_coeffs, sample->i_a_A, sample->i_b_A, &cos_hat, &sin_hat);
-    if (inst->hold.estimate_kept) {
+    if (inst->estimate_kept) {
         pmstep_standstill_estimate(inst, &cos_hat, &sin_hat);
     }
     pmstep_park(cos_hat, sin_hat, sample->i_a_A, sample->i_b_A, &i_d, &i_q);

@@ -122,7 +122,7 @@ static pmstep_status_t engage_vector(pmstep_t *inst, float cos_rest, float sin_r
         hold->vector_speed_rad_s = 0.0f;
         hold->active = true;
     }
-    hold->estimate_kept = false; /* the standstill keeps it once its rotor has settled */
+    inst->estimate_kept = false; /* the standstill keeps it once its rotor has settled */
     return PMSTEP_OK;
 }
 
@@ -135,7 +135,7 @@ void pmstep_release_vector(pmstep_t *inst)
 {
     if (inst != NULL && inst->hold.active) {
         inst->hold.active = false;
-        inst->hold.estimate_kept = false;
+        inst->estimate_kept = false;
         inst->hold.vector_speed_rad_s = 0.0f;
         inst->current_integral.i_d_error_integral_As = 0.0f;
         inst->current_integral.i_q_error_integral_As = 0.0f;
@@ -222,7 +222,7 @@ void pmstep_standstill_start(pmstep_t *inst)
     const float current_A = inst->cfg->standstill.hold_current_A;
     inst->hold.standstill_engaged = false;
     inst->hold.standstill_settled = false;
-    inst->hold.estimate_kept = false;
+    inst->estimate_kept = false;
     standstill->rest_periods = 0u;
     standstill->keep_cos = 1.0f;
     standstill->keep_sin = 0.0f;
@@ -345,7 +345,8 @@ static void standstill_engage(pmstep_t *inst, pmstep_standstill_t *standstill, c
 }
 
 /* The flux integrals' estimate of the period: out's, or, where the kept rotor was put out in
- * its place, the one pmstep_standstill_estimate set aside. */
+ * its place, the integrals' own read again at the period's sample (the angle corrections left
+ * them alone but for the drift-free one's radial step, a few 1e-7 rad on a kept unit vector). */
 typedef struct {
     float cos_hat;
     float sin_hat;
@@ -353,20 +354,17 @@ typedef struct {
 
 static sensed_angle_t sensed_angle(const pmstep_t *inst, const pmstep_output_t *out)
 {
-    const pmstep_standstill_t *standstill = &inst->scratch.run.standstill;
     sensed_angle_t sensed = {out->cos_hat, out->sin_hat};
-    if (inst->hold.estimate_kept) {
-        sensed.cos_hat = standstill->sensed_cos;
-        sensed.sin_hat = standstill->sensed_sin;
+    if (inst->estimate_kept) {
+        pmstep_angle_estimate(&inst->angle, &inst->angle_coeffs, inst->angle.i_a_prev_A, inst->angle.i_b_prev_A,
+                              &sensed.cos_hat, &sensed.sin_hat);
     }
     return sensed;
 }
 
-void pmstep_standstill_estimate(pmstep_t *inst, float *cos_hat, float *sin_hat)
+void pmstep_standstill_estimate(const pmstep_t *inst, float *cos_hat, float *sin_hat)
 {
-    pmstep_standstill_t *standstill = &inst->scratch.run.standstill;
-    standstill->sensed_cos = *cos_hat;
-    standstill->sensed_sin = *sin_hat;
+    const pmstep_standstill_t *standstill = &inst->scratch.run.standstill;
     *cos_hat = standstill->keep_cos;
     *sin_hat = standstill->keep_sin;
 }
@@ -462,9 +460,9 @@ static void standstill_hold_period(pmstep_t *inst, pmstep_standstill_t *standsti
         /* Turning: the flux integrals' phase is not the rotor's at low speed (the voltage errors
          * against a back-EMF of the same order), the estimate is the vector's aim throughout. */
         pmstep_angle_set(&inst->angle, &inst->angle_coeffs, standstill->keep_cos, standstill->keep_sin);
-        inst->hold.estimate_kept = true;
+        inst->estimate_kept = true;
     } else if (!inst->hold.standstill_settled) {
-        inst->hold.estimate_kept = false;
+        inst->estimate_kept = false;
         if (standstill->rest_periods >= inst->hold.settle_periods) {
             /* Settled where the vector holds it (the aim: T_L-hat's load angle behind the vector),
              * not where the integrals drifted to while the current stepped up (R and voltage errors
@@ -483,7 +481,7 @@ static void standstill_hold_period(pmstep_t *inst, pmstep_standstill_t *standsti
             standstill->keep_cos = sensed.cos_hat; /* the rest's first settling time: taken */
             standstill->keep_sin = sensed.sin_hat;
             standstill->motion_rad = 0.0f;
-            inst->hold.estimate_kept = false;
+            inst->estimate_kept = false;
             /* the load the vector is aimed for when it turns: the balance where the rotor came to rest */
             standstill->aim_load_Nm = held_balance_Nm(inst, sensed.cos_hat, sensed.sin_hat, out);
         } else {
@@ -496,15 +494,15 @@ static void standstill_hold_period(pmstep_t *inst, pmstep_standstill_t *standsti
                                       - standstill->motion_leak * standstill->motion_rad;
             if (pmstep_abs(standstill->motion_rad) > PMSTEP_HOLD_MOTION_BOUND_RAD) {
                 follow_held_rotor(inst, standstill, out);
-                inst->hold.estimate_kept = false;
+                inst->estimate_kept = false;
             } else {
                 pmstep_angle_set(&inst->angle, &inst->angle_coeffs, standstill->keep_cos, standstill->keep_sin);
-                inst->hold.estimate_kept = true;
+                inst->estimate_kept = true;
             }
         }
     } else {
         standstill->rest_periods = 0u; /* moving: the estimate follows the flux integrals */
-        inst->hold.estimate_kept = false;
+        inst->estimate_kept = false;
     }
 }
 

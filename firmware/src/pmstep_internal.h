@@ -80,8 +80,9 @@ void pmstep_hold_voltages(pmstep_t *inst, pmstep_observer_input_t *obs_in, pmste
 void pmstep_standstill_start(pmstep_t *inst);
 void pmstep_standstill_advance(pmstep_t *inst, const pmstep_output_t *out);
 /* Where the standstill keeps its estimate (pmstep_vector_hold_t.estimate_kept): the period's
- * (cos_hat, sin_hat) from the integrals, kept for the motion sum, replaced by the kept rotor. */
-void pmstep_standstill_estimate(pmstep_t *inst, float *cos_hat, float *sin_hat);
+ * (cos_hat, sin_hat) from the integrals replaced by the kept rotor (the motion sum reads the
+ * integrals again in pmstep_standstill_advance). */
+void pmstep_standstill_estimate(const pmstep_t *inst, float *cos_hat, float *sin_hat);
 void pmstep_standstill_command(pmstep_t *inst, float target_rad_s);
 
 #endif /* PMSTEP_INTERNAL_H */

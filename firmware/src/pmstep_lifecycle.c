@@ -98,6 +98,7 @@ void pmstep_clear_dynamic_state(pmstep_t *inst)
     inst->mode_step = 0u;
     inst->run_started = false;
     inst->speed_mode = false;
+    inst->estimate_kept = false;
     inst->hold.active = false;
     inst->hold.standstill_armed = false;
     inst->hold.standstill_engaged = false;

@@ -131,7 +131,6 @@ typedef struct {
     bool standstill_armed;        /**< RUN with a hold current, in speed mode (not the position library's) */
     bool standstill_engaged;      /**< this hold is the standstill's */
     bool standstill_settled;      /**< the held rotor's settling time has passed */
-    bool estimate_kept;           /**< the standstill's kept rotor is the estimate, not the integrals' */
 } pmstep_vector_hold_t;
 
 /** State of the standstill hold in speed mode (part of pmstep_t's RUN scratch). */
@@ -144,8 +143,6 @@ typedef struct {
     float drift_rad;         /**< the integrals' turn per period at rest (R and voltage errors), learnt */
     float aim_load_Nm;       /**< T_L the vector is aimed for (the load angle's), turning or at rest */
     float vector_rate_rad_s; /**< the turning vector's speed, w* + (d delta / dt) / p (rad/s, mechanical) */
-    float sensed_cos;        /**< the flux integrals' estimate of a period whose estimate was kept */
-    float sensed_sin;
     uint32_t engage_periods; /**< PMSTEP_STANDSTILL_ENGAGE_TIME_CONSTANTS / k_w, in periods */
     uint32_t rest_periods;   /**< periods at rest: before the hold, to engage it; in it, since the settling */
 } pmstep_standstill_t;

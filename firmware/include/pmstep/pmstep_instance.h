@@ -47,6 +47,8 @@ typedef struct {
     uint32_t mode_step;   /**< periods since the alignment started */
     bool run_started;     /**< RUN initialised at t_c */
     bool speed_mode;      /**< RUN takes speed commands, not the position library's loop */
+    bool estimate_kept;   /**< the standstill's kept rotor is the period's estimate, not the integrals'
+                               (pmstep_hold.h; here, in padding, not in the hold's flags: +4 B there) */
 
     /* Controller (6) state and commands. */
     pmstep_ref_t speed_ref;
