@@ -35,6 +35,26 @@ static void sensed_period_voltage(pmstep_t *inst, const pmstep_meas_t *sample, f
                                     *u_b_V - inst->actuator.u_applied_b_V);
 }
 
+/* The standstill's kept rotor in place of the integrals' reading (pmstep_hold.h), and the
+ * observer's inputs that depend on the estimate taken again from it: the Park (written out: a
+ * second caller makes -Os keep pmstep_park out of line) and the detent torque. */
+static void kept_estimate_in(const pmstep_t *inst, const pmstep_meas_t *sample, const pmstep_law_refs_t *refs,
+                             pmstep_observer_input_t *obs_in, float *cos_hat, float *sin_hat, float *i_d, float *i_q)
+{
+    pmstep_detent_t detent;
+    pmstep_standstill_estimate(inst, cos_hat, sin_hat);
+    *i_d = (*cos_hat * sample->i_a_A) + (*sin_hat * sample->i_b_A);
+    *i_q = ((-*sin_hat) * sample->i_a_A) + (*cos_hat * sample->i_b_A);
+    obs_in->cos_hat = *cos_hat;
+    obs_in->sin_hat = *sin_hat;
+    obs_in->i_d_A = *i_d;
+    obs_in->i_q_A = *i_q;
+    detent = pmstep_law_detent(&inst->law_coeffs, *cos_hat, *sin_hat, inst->observer.speed_hat_rad_s);
+    pmstep_law_fade_detent(inst->cfg->gains.detent_fade_speed_rad_s, inst->observer.speed_hat_rad_s,
+                           refs->speed_ref_rate_rad_s2, &detent);
+    obs_in->detent_torque_Nm = detent.torque_Nm;
+}
+
 void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_output_t *out,
                             pmstep_control_scratch_t *scratch)
 {
@@ -72,9 +92,6 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
         pmstep_angle_update(&inst->angle, &inst->angle_coeffs, sample->i_a_A, sample->i_b_A, u_a_V, u_b_V);
     }
     pmstep_angle_estimate(&inst->angle, &inst->angle_coeffs, sample->i_a_A, sample->i_b_A, &cos_hat, &sin_hat);
-    if (inst->estimate_kept) {
-        pmstep_standstill_estimate(inst, &cos_hat, &sin_hat);
-    }
     pmstep_park(cos_hat, sin_hat, sample->i_a_A, sample->i_b_A, &i_d, &i_q);
 
     ref = pmstep_ref_output(&inst->ref_coeffs, &inst->speed_ref);
@@ -105,6 +122,9 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
     obs_in->known_load_Nm = ref.value;
     obs_in->detent_torque_Nm = detent.torque_Nm;
     if (inst->hold.active) { /* a vector hold: its own voltage, the law's speed loop paused */
+        if (inst->estimate_kept) { /* tested in the hold's branch: the law's periods pay nothing for it */
+            kept_estimate_in(inst, sample, &refs, obs_in, &cos_hat, &sin_hat, &i_d, &i_q);
+        }
         i_q_ref = 0.0f;
         pmstep_hold_voltages(inst, obs_in, out);
     } else {

@@ -120,6 +120,7 @@ static pmstep_status_t engage_vector(pmstep_t *inst, float cos_rest, float sin_r
         inst->current_integral.i_q_error_integral_As = 0.0f;
         hold->speed_bias_rad_s = 0.0f;
         hold->vector_speed_rad_s = 0.0f;
+        inst->scratch.run.standstill.vector_rate_rad_s = 0.0f; /* held: the frame does not turn */
         hold->active = true;
     }
     inst->estimate_kept = false; /* the standstill keeps it once its rotor has settled */
@@ -137,6 +138,7 @@ void pmstep_release_vector(pmstep_t *inst)
         inst->hold.active = false;
         inst->estimate_kept = false;
         inst->hold.vector_speed_rad_s = 0.0f;
+        inst->scratch.run.standstill.vector_rate_rad_s = 0.0f;
         inst->current_integral.i_d_error_integral_As = 0.0f;
         inst->current_integral.i_q_error_integral_As = 0.0f;
     }
@@ -166,8 +168,10 @@ void pmstep_hold_voltages(pmstep_t *inst, pmstep_observer_input_t *obs_in, pmste
     const pmstep_law_coeffs_t *law = &inst->law_coeffs;
     const float vector_speed = hold->vector_speed_rad_s;
     const float speed_change = inst->observer.speed_hat_rad_s - vector_speed - hold->speed_bias_rad_s;
-    /* the frame's own speed: the rotor's w_v plus the load angle's rate (the detent torque's) */
-    const float frame_speed = pmstep_abs(vector_speed) > 0.0f ? inst->scratch.run.standstill.vector_rate_rad_s : 0.0f;
+    /* the frame's own speed: the rotor's w_v plus the load angle's rate (the detent torque's); 0
+     * wherever the vector does not turn (every path that stops it zeroes it: no test here, which
+     * every period of a position hold would pay) */
+    const float frame_speed = inst->scratch.run.standstill.vector_rate_rad_s;
     float turn = -hold->damping_s * speed_change;
     float c;
     float s;
@@ -551,6 +555,7 @@ void pmstep_standstill_advance(pmstep_t *inst, const pmstep_output_t *out)
             stop_turning(inst, standstill);
         }
         inst->hold.vector_speed_rad_s = 0.0f; /* at rest the vector stays where it is */
+        standstill->vector_rate_rad_s = 0.0f;
     } else if (!turn_vector(inst, standstill, out)) {
         pmstep_release_vector(inst); /* a load beyond the turning vector's pull: the law's */
         inst->hold.standstill_engaged = false;

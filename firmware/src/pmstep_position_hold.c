@@ -101,6 +101,15 @@ static void correct_aim(pmstep_position_t *pos)
     hold_at_rest(pos, POSITION_HOLD_REAIMED);
 }
 
+/* The kept estimate put back into the core's angle integrals: pmstep_angle_set itself, not
+ * pmstep_set_angle_estimate, whose checks (RUN, finite values) hold here already (a hold runs in
+ * RUN, and the kept estimate is the core's own output) and cost the position-mode period 1.5
+ * instructions on the mean (pil.position_cost). */
+static void put_back_kept_estimate(pmstep_position_t *pos)
+{
+    pmstep_angle_set(&pos->inst->angle, &pos->inst->angle_coeffs, pos->frozen_cos, pos->frozen_sin);
+}
+
 /* An update in a vector hold: settling (after a re-aim, with the turned estimate kept), then the
  * estimate kept while the rotor is at rest (it would drift: nothing observes its phase at zero
  * speed) and followed while the rotor moves;
@@ -115,7 +124,7 @@ void pmstep_position_vector_hold(pmstep_position_t *pos, float position_rad)
     if (pos->hold_stage != POSITION_HOLD_ANCHORED) {
         const bool reaimed = pos->hold_stage == POSITION_HOLD_REAIMED;
         if (reaimed) {
-            (void)pmstep_set_angle_estimate(inst, pos->frozen_cos, pos->frozen_sin);
+            put_back_kept_estimate(pos);
         }
         pos->hold_periods -= PMSTEP_POSITION_DECIMATION;
         if (pos->hold_periods <= 0) {
@@ -132,7 +141,7 @@ void pmstep_position_vector_hold(pmstep_position_t *pos, float position_rad)
             pos->frozen_cos = pos->cos_hat;
             pos->frozen_sin = pos->sin_hat;
         } else {
-            (void)pmstep_set_angle_estimate(inst, pos->frozen_cos, pos->frozen_sin);
+            put_back_kept_estimate(pos);
         }
         if (pos->hold_periods >= keep_after + POSITION_REAIM_PERIODS
             && fabsf(pos->out.position_error_rad) / pos->inv_pole_pairs > POSITION_REAIM_ERROR_RAD) {

@@ -176,8 +176,10 @@ static void low_speed_drive_voltage_turns_with_the_vector(void **state)
     assert_float_equal(out.u_a_V, cosf(act_rad) * u_d_V - sinf(act_rad) * u_q_V, 1e-4f);
     assert_float_equal(out.u_b_V, sinf(act_rad) * u_d_V + cosf(act_rad) * u_q_V, 1e-4f);
     assert_float_equal(angle_of(f.inst.hold.cos_frame, f.inst.hold.sin_frame), act_rad, 1e-6f);
-    /* at rest the same hold is the standstill's: no turn, no rotation terms */
+    /* at rest the same hold is the standstill's: no turn, no rotation terms (the paths that stop
+     * the vector zero its frame's rate with its speed) */
     f.inst.hold.vector_speed_rad_s = 0.0f;
+    f.inst.scratch.run.standstill.vector_rate_rad_s = 0.0f;
     f.inst.observer.speed_hat_rad_s = 0.0f;
     f.inst.hold.speed_bias_rad_s = 0.0f;
     pmstep_hold_voltages(&f.inst, &obs_in, &out);
