@@ -24,7 +24,7 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CORE = ["pmstep_core", "pmstep_lifecycle", "pmstep_config", "pmstep_control", "pmstep_detect", "pmstep_actuate",
         "pmstep_ref", "pmstep_angle", "pmstep_commission", "pmstep_identify", "pmstep_observer", "pmstep_law",
-        "pmstep_hold", "pmstep_presets"]
+        "pmstep_hold", "pmstep_standstill", "pmstep_presets"]
 # Precision: loops of the configuration check unrolled (init evaluates the configuration exactly),
 # init's return states kept apart by status (PMSTEP_OK or not: the instance is set up only on
 # the first), the step's paths kept apart up to 300 states.

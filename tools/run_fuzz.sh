@@ -10,7 +10,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 target=${1:?usage: run_fuzz.sh core|scenario [seconds]}
 seconds=${2:-60}
-core_sources=(firmware/src/pmstep_{core,lifecycle,config,control,detect,actuate,ref,angle,commission,identify,observer,law,hold,presets}.c)
+core_sources=(firmware/src/pmstep_{core,lifecycle,config,control,detect,actuate,ref,angle,commission,identify,observer,law,hold,standstill,presets}.c)
 case $target in
   core) sources='firmware/src/'; harness_sources=("${core_sources[@]}"); libs=(-lm) ;;
   scenario) sources='sil/src/scenario'

@@ -23,7 +23,6 @@ static void start_run(pmstep_t *inst, const pmstep_meas_t *sample)
     pmstep_identify_clear(&inst->scratch.run.identify); /* a re-alignment reopens the window */
     pmstep_standstill_start(inst);
     inst->run_started = true;
-    inst->speed_mode = true;
 }
 
 /* With phase-voltage sensing: the voltage of the period just ended as measured (offsets off), for

@@ -75,11 +75,31 @@ bool pmstep_control_advance(pmstep_t *inst, const pmstep_control_scratch_t *scra
  * damping, the PI current loop's errors in its frame into @p obs_in, the voltage into @p out. */
 void pmstep_hold_voltages(pmstep_t *inst, pmstep_observer_input_t *obs_in, pmstep_output_t *out);
 
-/* Standstill hold in speed mode (pmstep_hold.h): armed at RUN's start, run after each period; a
+/* The vector hold's parts the standstill (pmstep_standstill.c) builds on (pmstep_hold.c). */
+/* Where a vector is aimed: its direction and the cosine of its load angle delta. */
+typedef struct {
+    float cos_vector;
+    float sin_vector;
+    float cos_delta;
+} pmstep_hold_aim_t;
+/* A time in periods as a count, the longest for NaN or anything outside [0, 1e6). */
+uint32_t pmstep_hold_period_count(float periods);
+/* sqrt(p k_M I cos(delta) / J), the held rotor's natural frequency (rad/s), the commissioned model's. */
+float pmstep_hold_natural_rad_s(const pmstep_law_coeffs_t *law, float current_A, float cos_delta);
+/* The vector aimed ahead of the rotor at (c, s) by the load angle of load_Nm + k_M extra_A less
+ * the detent torque; false, @p aim untouched, beyond PMSTEP_HOLD_MAX_TORQUE_FRACTION. */
+bool pmstep_hold_aim_ahead(const pmstep_law_coeffs_t *law, float c, float s, float current_A, float load_Nm,
+                           float extra_A, const pmstep_detent_t *detent, pmstep_hold_aim_t *aim);
+/* pmstep_hold_vector's, with the damping term kept whatever the observer's phase where
+ * @p always_damped (the standstill's). */
+pmstep_status_t pmstep_hold_engage(pmstep_t *inst, float cos_rest, float sin_rest, float current_A, float load_Nm,
+                                   bool always_damped);
+
+/* Standstill hold in speed mode (pmstep_hold.h, pmstep_standstill.c): armed at RUN's start, run after each period; a
  * speed command's part (ends a hold, except the standstill's for a zero command; re-arms it). */
 void pmstep_standstill_start(pmstep_t *inst);
 void pmstep_standstill_advance(pmstep_t *inst, const pmstep_output_t *out);
-/* Where the standstill keeps its estimate (pmstep_vector_hold_t.estimate_kept): the period's
+/* Where the standstill keeps its estimate (pmstep_t.estimate_kept): the period's
  * (cos_hat, sin_hat) from the integrals replaced by the kept rotor (the motion sum reads the
  * integrals again in pmstep_standstill_advance). */
 void pmstep_standstill_estimate(const pmstep_t *inst, float *cos_hat, float *sin_hat);

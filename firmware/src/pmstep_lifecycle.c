@@ -97,7 +97,6 @@ void pmstep_clear_dynamic_state(pmstep_t *inst)
 {
     inst->mode_step = 0u;
     inst->run_started = false;
-    inst->speed_mode = false;
     inst->estimate_kept = false;
     inst->hold.active = false;
     inst->hold.standstill_armed = false;

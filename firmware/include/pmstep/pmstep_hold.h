@@ -63,8 +63,9 @@
  * turned on by p w_f T_s (delay + 1/2). At rest (|w*| below 1 % of the quiet band) on a zero
  * command the vector stops, aimed afresh at its kept rotor clear of the phase axes as an
  * engagement at rest is (it may have stopped with a phase current in the dead-time band), and
- * the standstill's rules above apply from a new settling; a reversal passing w* = 0 turns on. A command beyond w_b releases the vector and the
- * law starts from T_L,aim; so does a load angle beyond PMSTEP_HOLD_MAX_TORQUE_FRACTION.
+ * the standstill's rules above apply from a new settling; a reversal passing w* = 0 turns on.
+ * A command beyond w_b releases the vector and the law starts from T_L,aim; so does a load
+ * angle beyond PMSTEP_HOLD_MAX_TORQUE_FRACTION.
  */
 #ifndef PMSTEP_HOLD_H
 #define PMSTEP_HOLD_H

@@ -46,7 +46,6 @@ typedef struct {
     uint32_t step_count;  /**< periods run since init/reset */
     uint32_t mode_step;   /**< periods since the alignment started */
     bool run_started;     /**< RUN initialised at t_c */
-    bool speed_mode;      /**< RUN takes speed commands, not the position library's loop */
     bool estimate_kept;   /**< the standstill's kept rotor is the period's estimate, not the integrals'
                                (pmstep_hold.h; here, in padding, not in the hold's flags: +4 B there) */
 
