@@ -1,6 +1,8 @@
 /* Angle reconstruction from current integrals, controller (6) (proof of Theorem 3). */
 #include "pmstep/pmstep_angle.h"
 
+#include "pmstep/pmstep_rotation.h"
+
 void pmstep_angle_coeffs_init(pmstep_angle_coeffs_t *coeffs, const pmstep_config_t *cfg,
                               const pmstep_electrical_t *model)
 {
@@ -74,6 +76,30 @@ void pmstep_angle_follow_emf(pmstep_angle_t *angle, const pmstep_angle_coeffs_t 
                        / (speed_hat_rad_s * speed_hat_rad_s + coeffs->emf_corner_squared);
     angle->phi_a -= turn * sin_hat;
     angle->phi_b += turn * cos_hat;
+}
+
+void pmstep_angle_smoother_set(pmstep_angle_smoother_t *smoother, float cos_hat, float sin_hat)
+{
+    smoother->cos_hat = cos_hat;
+    smoother->sin_hat = sin_hat;
+}
+
+void pmstep_angle_smooth(float share, float turn_rad, pmstep_angle_smoother_t *smoother, float *cos_hat,
+                         float *sin_hat)
+{
+    const float turn_squared = turn_rad * turn_rad;
+    float cos_turned;
+    float sin_turned;
+    float off_rad;
+    pmstep_turn(smoother->cos_hat, smoother->sin_hat, 1.0f - (0.5f * turn_squared),
+                turn_rad * (1.0f - ((1.0f / 6.0f) * turn_squared)), &cos_turned, &sin_turned);
+    off_rad = (cos_turned * *sin_hat) - (sin_turned * *cos_hat); /* the reading's turn off the prediction (its sine) */
+    if ((off_rad < PMSTEP_ANGLE_SMOOTHING_GATE_RAD) && (off_rad > -PMSTEP_ANGLE_SMOOTHING_GATE_RAD)) {
+        *cos_hat += share * (cos_turned - *cos_hat);
+        *sin_hat += share * (sin_turned - *sin_hat);
+    }
+    smoother->cos_hat = *cos_hat;
+    smoother->sin_hat = *sin_hat;
 }
 
 void pmstep_angle_set(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs, float cos_hat, float sin_hat)

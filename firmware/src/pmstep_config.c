@@ -59,6 +59,7 @@ static pmstep_status_t validate_signs(const pmstep_config_t *cfg)
         SIGN_RULE(gains.detent_fade_speed_rad_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETENT_FADE_SPEED),
         SIGN_RULE(gains.emf_angle_gain_per_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_EMF_ANGLE_GAIN),
         SIGN_RULE(gains.emf_angle_corner_rad_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_EMF_ANGLE_GAIN),
+        SIGN_RULE(gains.angle_smoothing, SIGN_NON_NEGATIVE, PMSTEP_ERR_ANGLE_SMOOTHING),
         SIGN_RULE(limits.max_phase_current_A, SIGN_POSITIVE, PMSTEP_ERR_MAX_CURRENT),
         SIGN_RULE(limits.min_bus_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_MIN_BUS),
         SIGN_RULE(alignment.s_align_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_ALIGNMENT_VOLTAGE),
@@ -135,6 +136,9 @@ static pmstep_status_t validate_gains(const pmstep_config_t *cfg)
     if ((gains->emf_angle_gain_per_s >= r_over_l + gains->observer_gain_per_s)
         || ((gains->emf_angle_gain_per_s > 0.0f) && !(gains->emf_angle_corner_rad_s > 0.0f))) {
         return PMSTEP_ERR_EMF_ANGLE_GAIN;
+    }
+    if (gains->angle_smoothing >= 1.0f) { /* 1 would never read the integrals again */
+        return PMSTEP_ERR_ANGLE_SMOOTHING;
     }
     {
         /* e'' + K e' + K_I e = 0, K = R/L + K_i: real poles need K_I <= K^2/4. */

@@ -11,6 +11,8 @@ static void start_run(pmstep_t *inst, const pmstep_meas_t *sample)
     pmstep_angle_start(&inst->angle, sample->i_a_A, sample->i_b_A);
     pmstep_angle_set(&inst->angle, &inst->angle_coeffs, inst->commissioning.equilibrium_cos,
                      inst->commissioning.equilibrium_sin); /* c-alignment's equilibrium (1, 0 unless measured) */
+    pmstep_angle_smoother_set(&inst->scratch.run.smoother, inst->commissioning.equilibrium_cos,
+                              inst->commissioning.equilibrium_sin);
     pmstep_observer_start(&inst->observer, sample->i_a_A, sample->i_b_A);
     inst->current_integral.i_d_error_integral_As = 0.0f;
     inst->current_integral.i_q_error_integral_As = 0.0f;
@@ -37,11 +39,13 @@ static void sensed_period_voltage(pmstep_t *inst, const pmstep_meas_t *sample, f
 /* The standstill's kept rotor in place of the integrals' reading (pmstep_hold.h), and the
  * observer's inputs that depend on the estimate taken again from it: the Park (written out: a
  * second caller makes -Os keep pmstep_park out of line) and the detent torque. */
-static void kept_estimate_in(const pmstep_t *inst, const pmstep_meas_t *sample, const pmstep_law_refs_t *refs,
+static void kept_estimate_in(pmstep_t *inst, const pmstep_meas_t *sample, const pmstep_law_refs_t *refs,
                              pmstep_observer_input_t *obs_in, float *cos_hat, float *sin_hat, float *i_d, float *i_q)
 {
     pmstep_detent_t detent;
     pmstep_standstill_estimate(inst, cos_hat, sin_hat);
+    pmstep_angle_smoother_set(&inst->scratch.run.smoother, *cos_hat, *sin_hat); /* the smoothing's next
+                                                                                    prediction starts here */
     *i_d = (*cos_hat * sample->i_a_A) + (*sin_hat * sample->i_b_A);
     *i_q = ((-*sin_hat) * sample->i_a_A) + (*cos_hat * sample->i_b_A);
     obs_in->cos_hat = *cos_hat;
@@ -75,9 +79,12 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
     } else {
         float u_a_V = inst->actuator.u_applied_a_V;
         float u_b_V = inst->actuator.u_applied_b_V;
-        if (inst->actuate_coeffs.sensed) {
+        if (!inst->voltage_corrected) {
+            /* the command is the period's voltage: one test a period here (it was two), which pays
+             * for the angle smoothing's test in the position mode's budget */
+        } else if (inst->actuate_coeffs.sensed) {
             sensed_period_voltage(inst, sample, &u_a_V, &u_b_V);
-        } else if (inst->actuate_coeffs.compensate) { /* the dead time's loss, where the samples fix it */
+        } else { /* compensated: the dead time's loss, where the samples fix it */
             pmstep_period_currents_t currents;
             currents.i_start_a_A = inst->angle.i_a_prev_A;
             currents.i_start_b_A = inst->angle.i_b_prev_A;
@@ -91,6 +98,11 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
         pmstep_angle_update(&inst->angle, &inst->angle_coeffs, sample->i_a_A, sample->i_b_A, u_a_V, u_b_V);
     }
     pmstep_angle_estimate(&inst->angle, &inst->angle_coeffs, sample->i_a_A, sample->i_b_A, &cos_hat, &sin_hat);
+    if (inst->angle_smoothing) { /* DESIGN.md section 16 */
+        pmstep_angle_smooth(inst->cfg->gains.angle_smoothing,
+                            inst->law_coeffs.pole_pairs * inst->cfg->timing.period_s * inst->observer.speed_hat_rad_s,
+                            &inst->scratch.run.smoother, &cos_hat, &sin_hat);
+    }
     pmstep_park(cos_hat, sin_hat, sample->i_a_A, sample->i_b_A, &i_d, &i_q);
 
     ref = pmstep_ref_output(&inst->ref_coeffs, &inst->speed_ref);

@@ -147,6 +147,7 @@ pmstep_status_t pmstep_set_angle_estimate(pmstep_t *inst, float cos_hat, float s
         return PMSTEP_ERR_BAD_COMMAND_VALUE;
     }
     pmstep_angle_set(&inst->angle, &inst->angle_coeffs, cos_hat, sin_hat);
+    pmstep_angle_smoother_set(&inst->scratch.run.smoother, cos_hat, sin_hat); /* and the smoothing's */
     return PMSTEP_OK;
 }
 

@@ -46,6 +46,7 @@ const key_t_ scenario_keys[] = {
     {"controller.gains.detent_fade_speed_rad_s", KEY_FLOAT, OFF(controller.gains.detent_fade_speed_rad_s), -BIG, 0, BIG, 0, "the detent torque's compensation fades as w_f^2 / (w_f^2 + w-hat^2) with the estimated speed (rad/s); 0 = no fade"},
     {"controller.gains.emf_angle_gain_per_s", KEY_FLOAT, OFF(controller.gains.emf_angle_gain_per_s), -BIG, 0, BIG, 0, "K_theta: turns the angle estimate toward the back EMF's direction (the observer's d-axis residual) at this rate (1/s), faded in with the speed; 0 = off"},
     {"controller.gains.emf_angle_corner_rad_s", KEY_FLOAT, OFF(controller.gains.emf_angle_corner_rad_s), -BIG, 0, BIG, 0, "w_theta: the speed at which the back-EMF correction is half on (rad/s)"},
+    {"controller.gains.angle_smoothing", KEY_FLOAT, OFF(controller.gains.angle_smoothing), -BIG, 0, BIG, 0, "a in [0, 1): each period's angle estimate is the previous one turned by p w-hat T_s plus (1 - a) of the flux integrals' reading's difference from it; 0 = the reading itself (the paper's)"},
     {"controller.gains.angle_correction_gain_per_s", KEY_FLOAT, OFF(controller.gains.angle_correction_gain_per_s), -BIG, 0, BIG, 0, "pulls (c-hat, s-hat) onto the unit circle at this rate (1/s); 0 = the paper's open integrals"},
     {"controller.limits.max_phase_current_A", KEY_FLOAT, OFF(controller.limits.max_phase_current_A), -BIG, 0, BIG, 0, "overcurrent trip (A)"},
     {"controller.limits.min_bus_voltage_V", KEY_FLOAT, OFF(controller.limits.min_bus_voltage_V), -BIG, 0, BIG, 0, "undervoltage trip (V)"},

@@ -21,7 +21,7 @@ static const pmstep_status_t all_status_codes[] = {
     PMSTEP_ERR_ADAPT_GAMMA, PMSTEP_ERR_ADAPT_LAMBDA, PMSTEP_ERR_ADAPT_R, PMSTEP_ERR_SAT_KAPPA,
     PMSTEP_ERR_OBSERVER_GAIN_FOR_PERIOD, PMSTEP_ERR_CURRENT_GAIN_FOR_PERIOD, PMSTEP_ERR_REFERENCE_BANDWIDTH,
     PMSTEP_ERR_ANGLE_CORRECTION_GAIN, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN, PMSTEP_ERR_DETENT_FADE_SPEED,
-    PMSTEP_ERR_EMF_ANGLE_GAIN,
+    PMSTEP_ERR_EMF_ANGLE_GAIN, PMSTEP_ERR_ANGLE_SMOOTHING,
     PMSTEP_ERR_MAX_CURRENT, PMSTEP_ERR_MIN_BUS,
     PMSTEP_ERR_BUS_ORDER,
     PMSTEP_ERR_ALIGNMENT_VOLTAGE, PMSTEP_ERR_ALIGNMENT_ABOVE_BUS, PMSTEP_ERR_ALIGNMENT_CURRENT,
@@ -59,6 +59,8 @@ static void emf_gain_at_residual_rate(pmstep_config_t *c)
     c->gains.emf_angle_gain_per_s = 600.0f;
     c->gains.emf_angle_corner_rad_s = 5.0f;
 }
+static void negative_angle_smoothing(pmstep_config_t *c) { c->gains.angle_smoothing = -0.1f; }
+static void angle_smoothing_of_one(pmstep_config_t *c) { c->gains.angle_smoothing = 1.0f; }
 static void bad_l(pmstep_config_t *c) { c->motor.inductance_H = -1e-3f; }
 static void bad_j(pmstep_config_t *c) { c->motor.inertia_kgm2 = 0.0f; }
 static void bad_km(pmstep_config_t *c) { c->motor.torque_constant_Nm_A = 0.0f; }
@@ -137,6 +139,8 @@ static const struct {
     {negative_emf_corner, PMSTEP_ERR_EMF_ANGLE_GAIN},
     {emf_gain_without_corner, PMSTEP_ERR_EMF_ANGLE_GAIN},
     {emf_gain_at_residual_rate, PMSTEP_ERR_EMF_ANGLE_GAIN},
+    {negative_angle_smoothing, PMSTEP_ERR_ANGLE_SMOOTHING},
+    {angle_smoothing_of_one, PMSTEP_ERR_ANGLE_SMOOTHING},
     {negative_lead_in, PMSTEP_ERR_S_LEAD_IN_TIME},
     {lead_in_fills_s_alignment, PMSTEP_ERR_S_LEAD_IN_TIME},
     {current_integral_complex_poles, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN},

@@ -120,6 +120,9 @@ static void every_preset_gets_a_valid_design(void **state)
             } else {
                 assert_true(cfg.gains.emf_angle_gain_per_s == 0.0f && cfg.gains.emf_angle_corner_rad_s == 0.0f);
             }
+            /* Robust: the angle smoothing weighs the turned previous estimate and the reading
+             * equally (DESIGN.md section 16); off in paper mode. */
+            assert_true(cfg.gains.angle_smoothing == (robust != 0 ? 0.5f : 0.0f));
             /* Robust: RUN takes the measured L and k_M. L from the current rise where the rotor stays
              * still over its window (the paper's motor, w_n T_L ~ 0.05), else from the level drops:
              * no rise window for the hybrids (~0.45-0.75), the voltage-bias level on. */

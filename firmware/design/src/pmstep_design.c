@@ -9,6 +9,9 @@
 /* Bandwidths as fractions of the control rate 1/T_s (DESIGN.md, section 2). */
 #define CURRENT_BANDWIDTH_X_PERIOD 0.2f   /* (R/L + K_i) T_s */
 #define OBSERVER_BANDWIDTH_X_PERIOD 0.05f /* w_o T_s: the observer's triple pole */
+/* Robust mode's angle smoothing: the reading and the turned previous estimate weighted equally
+ * (the samples' noise in the estimate x 0.58; DESIGN.md section 16) */
+#define ANGLE_SMOOTHING 0.5f
 #define SPEED_PER_OBSERVER_BANDWIDTH (1.0f / 3.0f) /* k_w = w_o / 3 */
 #define REFERENCE_PER_SPEED_BANDWIDTH 3.0f         /* varpi_0 = 3 k_w */
 #define DRIFT_FREE_PER_OBSERVER_BANDWIDTH (1.0f / 30.0f) /* robust mode's angle correction g = w_o / 30 */
@@ -201,9 +204,11 @@ static void design_gains(const pmstep_design_input_t *in, pmstep_gains_config_t 
                                   + 2.0f * in->bus_voltage_V * in->dead_time_s / in->period_s;
         gains->emf_angle_gain_per_s = EMF_ANGLE_PER_OBSERVER_BANDWIDTH * w_o;
         gains->emf_angle_corner_rad_s = uncertain_V / m->torque_constant_Nm_A;
+        gains->angle_smoothing = ANGLE_SMOOTHING;
     } else {
         gains->emf_angle_gain_per_s = 0.0f;
         gains->emf_angle_corner_rad_s = 0.0f;
+        gains->angle_smoothing = 0.0f;
     }
     gains->detent_fade_speed_rad_s = m->detent_torque_Nm > 0.0f ? DETENT_FADE_PER_CURRENT_BANDWIDTH * current_bandwidth
                                                                        / (4.0f * (float)m->pole_pairs)

@@ -99,6 +99,39 @@ void pmstep_angle_correct(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *co
 void pmstep_angle_follow_emf(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs, float cos_hat,
                              float sin_hat, float i_d_residual_A, float speed_hat_rad_s);
 
+/** The angle smoothing's gate (rad): a reading this far or further off its prediction is taken as
+ *  it is, the prediction having missed a turn (w-hat behind the rotor in a load step: 0.075 rad a
+ *  period on the 17HS4401 stopped by half its holding torque at 34.5 rad/s). The current
+ *  samples' noise in the estimate, L p / k_M times theirs, is a few thousandths of a radian (0.0042
+ *  rad rms on the 17HS4401 at 5 mA), so its largest readings pass unsmoothed as well; a wider
+ *  gate smoothed those and lost the 17HS4401's envelope steps (DESIGN.md section 16). */
+#define PMSTEP_ANGLE_SMOOTHING_GATE_RAD 0.02f
+
+/** The angle smoothing's state (gains.angle_smoothing): the previous period's estimate. */
+typedef struct {
+    float cos_hat;
+    float sin_hat;
+} pmstep_angle_smoother_t;
+
+/** Starts the smoothing from the estimate (@p cos_hat, @p sin_hat). */
+void pmstep_angle_smoother_set(pmstep_angle_smoother_t *smoother, float cos_hat, float sin_hat);
+
+/**
+ * Angle smoothing (gains.angle_smoothing): the estimate becomes the previous one turned by
+ * @p turn_rad, plus (1 - @p share) of this period's reading's difference from it, unless the
+ * reading's turn off that prediction is PMSTEP_ANGLE_SMOOTHING_GATE_RAD or more (the reading
+ * itself); either is kept as the next period's previous one. The current samples' noise in the
+ * estimate goes down by (1 - share) / (1 + share) in power; a speed error w~ turns it
+ * p w~ T_s share / (1 - share) behind.
+ * @param[in]     share     a in (0, 1)
+ * @param[in]     turn_rad  the rotor's turn over the period, p w-hat T_s (electrical rad); (cos, sin)
+ *                          taken to third order: 3.4e-4 rad over at 0.4 rad
+ * @param[in,out] smoother  the previous period's estimate
+ * @param[in,out] cos_hat, sin_hat  this period's reading in, its estimate out
+ */
+void pmstep_angle_smooth(float share, float turn_rad, pmstep_angle_smoother_t *smoother, float *cos_hat,
+                         float *sin_hat);
+
 /** Moves phi1, phi2 (compensations cleared) so that the estimate for the last sampled currents
  *  (those of the last update) is (@p cos_hat, @p sin_hat). */
 void pmstep_angle_set(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs, float cos_hat, float sin_hat);

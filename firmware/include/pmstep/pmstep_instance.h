@@ -32,6 +32,8 @@ typedef struct {
     uint32_t offset_cal_steps;                /**< periods of bridge-off offset calibration */
     bool optional_inputs;                     /**< a load torque or phase voltages to check each period */
     bool angle_corrections;                   /**< the drift-free or the back-EMF angle correction is on */
+    bool angle_smoothing;                     /**< gains.angle_smoothing > 0 */
+    bool voltage_corrected;                   /**< the period's voltage is sensed or dead-time compensated */
     pmstep_detect_coeffs_t detect_coeffs;
     pmstep_actuate_coeffs_t actuate_coeffs;
     pmstep_ref_coeffs_t ref_coeffs;
@@ -65,6 +67,7 @@ typedef struct {
             pmstep_ref_t known_load_filter; /**< T_L* of Remark 1 */
             pmstep_identify_sums_t identify; /**< J and F fit, while the identification window is open */
             pmstep_standstill_t standstill;  /**< standstill hold in speed mode (pmstep_hold.h) */
+            pmstep_angle_smoother_t smoother; /**< the angle smoothing's (gains.angle_smoothing > 0) */
         } run;                            /**< from t_c */
     } scratch;
 

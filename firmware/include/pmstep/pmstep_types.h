@@ -54,6 +54,7 @@ typedef enum {
     PMSTEP_ERR_DETENT_FADE_SPEED = -52,     /**< detent compensation's fade speed < 0 */
     PMSTEP_ERR_EMF_ANGLE_GAIN = -53,        /**< back-EMF angle correction: gain < 0 or not below R/L + K_e, corner
                                                  < 0, or a gain without a corner */
+    PMSTEP_ERR_ANGLE_SMOOTHING = -54,       /**< angle smoothing a < 0 or >= 1 */
     /* limits */
     PMSTEP_ERR_MAX_CURRENT = -60,           /**< max_phase_current_A <= 0 */
     PMSTEP_ERR_MIN_BUS = -61,               /**< min_bus_voltage_V <= 0 */
@@ -221,6 +222,10 @@ typedef struct {
                                      the speed as w-hat^2 / (w-hat^2 + w_theta^2) (pmstep_angle.h). Below R/L + K_e;
                                      0 = off (the paper's estimate) */
     float emf_angle_corner_rad_s; /**< w_theta: the speed at which that correction is half on (> 0 with a gain) */
+    float angle_smoothing; /**< a in [0, 1): each period's estimate is the previous one turned by p w-hat T_s, plus
+                                (1 - a) of the flux integrals' reading's difference from it (the current
+                                samples' noise in the estimate times (1 - a) / (1 + a) in power); 0 = the
+                                reading itself (the paper's) */
 } pmstep_gains_config_t;
 
 /** Protections. */

@@ -40,13 +40,13 @@ extern "C" {
  * then the entries in order.
  */
 #define SIL_RECORD_MAGIC 0x52534D50u /* "PMSR" */
-#define SIL_RECORD_VERSION 13u /* 2: calibration, commissioning, angle, detection; 3: voltage bias; 4: residual;
+#define SIL_RECORD_VERSION 14u /* 2: calibration, commissioning, angle, detection; 3: voltage bias; 4: residual;
                                  5: identification of J and F; 6: phase-voltage sensing; 7: standstill hold;
                                  8: low-speed drive; 9: the compensation's ripple dead zone;
                                  10: detent torque, current integral gain, detent fade;
                                  11: s-alignment's lead-in; 12: the q axis's current integral gain;
-                                 13: the back-EMF angle correction */
-#define SIL_RECORD_CONFIG_WORDS 55u
+                                 13: the back-EMF angle correction; 14: the angle smoothing */
+#define SIL_RECORD_CONFIG_WORDS 56u
 #define SIL_RECORD_TAG_SPEED_TARGET 1u
 #define SIL_RECORD_TAG_PERIOD 2u
 #define SIL_RECORD_TAG_END 3u
@@ -168,6 +168,7 @@ static inline void sil_record_config_from_words(const uint32_t *w, pmstep_config
     c->gains.current_integral_gain_q_per_s2 = sil_record_float(w[52]);
     c->gains.emf_angle_gain_per_s = sil_record_float(w[53]);
     c->gains.emf_angle_corner_rad_s = sil_record_float(w[54]);
+    c->gains.angle_smoothing = sil_record_float(w[55]);
 }
 
 static inline void sil_record_meas_from_words(const uint32_t *w, pmstep_meas_t *m)
@@ -261,6 +262,7 @@ static inline void sil_record_config_to_words(const pmstep_config_t *c, uint32_t
     w[52] = sil_record_bits(c->gains.current_integral_gain_q_per_s2);
     w[53] = sil_record_bits(c->gains.emf_angle_gain_per_s);
     w[54] = sil_record_bits(c->gains.emf_angle_corner_rad_s);
+    w[55] = sil_record_bits(c->gains.angle_smoothing);
 }
 
 static inline void sil_record_meas_to_words(const pmstep_meas_t *m, uint32_t *w)
