@@ -286,8 +286,9 @@ static pmstep_status_t validate_standstill(const pmstep_config_t *cfg)
     if (current_A < 0.0f || (current_A > 0.0f && !(current_A < cfg->limits.max_phase_current_A))) {
         return PMSTEP_ERR_HOLD_CURRENT;
     }
-    if (band_rad_s < 0.0f || (band_rad_s > 0.0f && !(current_A > 0.0f))) {
-        return PMSTEP_ERR_VECTOR_SPEED; /* the low-speed drive turns the hold's vector */
+    if (band_rad_s < 0.0f || (band_rad_s > 0.0f && !(current_A > 0.0f))
+        || (cfg->standstill.stops_only && !(band_rad_s > 0.0f))) {
+        return PMSTEP_ERR_VECTOR_SPEED; /* the low-speed drive turns the hold's vector, in stops or at all */
     }
     return (current_A > 0.0f && cfg->known_load_mode) ? PMSTEP_ERR_STANDSTILL_KNOWN_LOAD : PMSTEP_OK;
 }

@@ -96,9 +96,14 @@ static void learn_rest_afresh(pmstep_standstill_t *standstill, const pmstep_vect
 static void standstill_engage(pmstep_t *inst, pmstep_standstill_t *standstill, const pmstep_output_t *out)
 {
     const pmstep_ref_t *ref = &inst->speed_ref;
-    const float band_rad_s = inst->cfg->standstill.vector_speed_rad_s; /* 0: the standstill only */
+    const bool stops_only = inst->cfg->standstill.stops_only;
+    /* 0: the standstill only; in stops only, the band while the set-point is on its way down */
+    const float band_rad_s = (stops_only && !(pmstep_abs(ref->setpoint) > 0.0f))
+                                 ? 0.0f
+                                 : inst->cfg->standstill.vector_speed_rad_s;
+    const float target_band_rad_s = stops_only ? 0.0f : band_rad_s; /* stops: a zero command */
     const float vector_speed = band_rad_s > 0.0f ? out->speed_ref_rad_s : 0.0f;
-    const bool at_rest = !(pmstep_abs(ref->target) > band_rad_s) && !(pmstep_abs(ref->setpoint) > band_rad_s)
+    const bool at_rest = !(pmstep_abs(ref->target) > target_band_rad_s) && !(pmstep_abs(ref->setpoint) > band_rad_s)
                          && pmstep_abs(out->speed_ref_rad_s)
                                 < PMSTEP_STANDSTILL_REFERENCE_FRACTION * standstill->quiet_band_rad_s + band_rad_s
                          && pmstep_abs(out->speed_hat_rad_s - vector_speed) < standstill->quiet_band_rad_s + band_rad_s;
@@ -353,10 +358,13 @@ void pmstep_standstill_advance(pmstep_t *inst, const pmstep_output_t *out)
 void pmstep_standstill_command(pmstep_t *inst, float target_rad_s)
 {
     const bool in_run = inst->mode == PMSTEP_MODE_RUN && inst->run_started;
-    if (!in_run || pmstep_abs(target_rad_s) > inst->cfg->standstill.vector_speed_rad_s
-        || !inst->hold.standstill_engaged) {
-        if (inst->hold.standstill_engaged && inst->cfg->standstill.vector_speed_rad_s > 0.0f) {
-            inst->observer.load_hat_Nm = inst->scratch.run.standstill.aim_load_Nm; /* the law starts from the aim's */
+    const float target_band_rad_s = inst->cfg->standstill.stops_only ? 0.0f : inst->cfg->standstill.vector_speed_rad_s;
+    if (!in_run || pmstep_abs(target_rad_s) > target_band_rad_s || !inst->hold.standstill_engaged) {
+        /* the low-speed drive's law starts from the aim's T_L; in stops only it keeps the observer's,
+         * as the standstill's own release does (with the aim's, the envelope's steps changed) */
+        if (inst->hold.standstill_engaged && inst->cfg->standstill.vector_speed_rad_s > 0.0f
+            && !inst->cfg->standstill.stops_only) {
+            inst->observer.load_hat_Nm = inst->scratch.run.standstill.aim_load_Nm;
         }
         pmstep_release_vector(inst); /* a speed command ends a hold; a zero one keeps the standstill's */
         inst->hold.standstill_engaged = false;

@@ -70,7 +70,7 @@ const char *pmstep_status_str(pmstep_status_t status)
     case PMSTEP_ERR_POSITION_INTEGRAL_GAIN: return "need 0 <= k_I <= k_theta^2/4";
     case PMSTEP_ERR_HOLD_CURRENT: return "need 0 < hold current < max_phase_current_A and |T_L - T_detent| <= 0.9 k_M I";
     case PMSTEP_ERR_STANDSTILL_KNOWN_LOAD: return "standstill hold not with known_load_mode";
-    case PMSTEP_ERR_VECTOR_SPEED: return "need vector speed >= 0, and a hold current where > 0";
+    case PMSTEP_ERR_VECTOR_SPEED: return "need vector speed >= 0, a hold current where > 0, and > 0 for stops only";
     }
     return "unknown status";
 }

@@ -67,8 +67,8 @@ void print_design(const sil_scenario_t *sc, const pmstep_design_report_t *r, boo
            (double)c->limits.max_bus_voltage_V, (double)c->detection.stall_speed_error_rad_s,
            (double)c->detection.observer_residual_bound_A, (double)c->detection.persistence_s);
     printf("  standstill hold in speed mode: %.3f A (0 = off)\n", (double)c->standstill.hold_current_A);
-    printf("  low-speed drive (the hold's vector turning) below: %.3f rad/s (0 = off)\n",
-           (double)c->standstill.vector_speed_rad_s);
+    printf("  low-speed drive (the hold's vector turning) below: %.3f rad/s (0 = off)%s\n",
+           (double)c->standstill.vector_speed_rad_s, c->standstill.stops_only ? ", in stops only" : "");
     if (robust) {
         printf("  commissioning: offsets %.3f s, windows %.3f s, L window %.5f s, bias level %.2f, "
                "dead time %g s (band %g A, %s), i_d* %.3f A; RUN uses the measured R%s\n",
@@ -146,8 +146,9 @@ int write_c(const char *path, const sil_scenario_t *sc)
             (double)c->detection.angle_magnitude_bound, (double)c->detection.speed_consistency_bound_rad_s,
             (double)c->detection.stall_speed_error_rad_s, (double)c->detection.observer_residual_bound_A,
             (double)c->detection.persistence_s, (unsigned)c->detection.max_realignments);
-    fprintf(f, "    .standstill = {.hold_current_A = %.9gf, .vector_speed_rad_s = %.9gf},\n",
-            (double)c->standstill.hold_current_A, (double)c->standstill.vector_speed_rad_s);
+    fprintf(f, "    .standstill = {.hold_current_A = %.9gf, .vector_speed_rad_s = %.9gf, .stops_only = %s},\n",
+            (double)c->standstill.hold_current_A, (double)c->standstill.vector_speed_rad_s,
+            c->standstill.stops_only ? "true" : "false");
     fprintf(f, "    .known_load_mode = false,\n};\n");
     if (fclose(f) != 0) {
         fprintf(stderr, "pmstep-tune: error writing %s\n", path);

@@ -81,10 +81,11 @@ class AgainstTheFirmwareConsole(unittest.TestCase):
         self.assertEqual(hello["protocol"], 1)
         self.assertEqual(hello["identity"], "pmstep host-drive")
         table = c.list_config()
-        self.assertEqual(len(table), 56)
+        self.assertEqual(len(table), 57)
         names = [e["name"] for e in table]
         self.assertEqual(len(set(names)), len(names))
         self.assertIn("gains.angle_smoothing", names)
+        self.assertIn("standstill.stops_only", names)
         self.assertIn("inverter.phase_voltage_sensing", names)
         self.assertIn("standstill.hold_current_A", names)
         self.assertIn("standstill.vector_speed_rad_s", names)

@@ -111,6 +111,7 @@ static void eva_any_config(pmstep_config_t *cfg)
     cfg->commissioning.use_identified_mechanics = Frama_C_nondet(0, 1) != 0;
     cfg->standstill.hold_current_A = eva_any_finite();
     cfg->standstill.vector_speed_rad_s = eva_any_finite();
+    cfg->standstill.stops_only = Frama_C_nondet(0, 1) != 0;
 }
 
 #endif /* PMSTEP_EVA_CONFIGS_H */

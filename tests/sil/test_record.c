@@ -49,6 +49,7 @@ static void config_round_trips_through_the_words(void **state)
     in.gains.emf_angle_gain_per_s = 1000.0f;
     in.gains.emf_angle_corner_rad_s = 22.5f;
     in.gains.angle_smoothing = 0.5f;
+    in.standstill.stops_only = true;
     sil_record_config_to_words(&in, w);
     sil_record_config_from_words(w, &out);
     assert_memory_equal(&in.motor.resistance_Ohm, &out.motor.resistance_Ohm, sizeof(float));
@@ -81,8 +82,9 @@ static void config_round_trips_through_the_words(void **state)
     assert_true(out.gains.current_integral_gain_q_per_s2 == 6250.0f && w[52] == sil_record_bits(6250.0f));
     assert_true(out.gains.emf_angle_gain_per_s == 1000.0f && w[53] == sil_record_bits(1000.0f));
     assert_true(out.gains.emf_angle_corner_rad_s == 22.5f && w[54] == sil_record_bits(22.5f));
+    assert_true(out.gains.angle_smoothing == 0.5f && w[55] == sil_record_bits(0.5f));
     /* The last word is the last field. */
-    assert_true(out.gains.angle_smoothing == 0.5f && w[SIL_RECORD_CONFIG_WORDS - 1u] == sil_record_bits(0.5f));
+    assert_true(out.standstill.stops_only && w[SIL_RECORD_CONFIG_WORDS - 1u] == 1u);
 }
 
 /* A period's input, the sensed phase voltages included, comes back bit for bit. */

@@ -327,18 +327,23 @@ static void low_speed_drive_below_twice_the_dead_time_loss(void **state)
         assert_true((presets[n].p == 50) == (resonance_band_rad_s < emf_band_rad_s));
         pmstep_config_t cfg;
         pmstep_design_report_t report;
+        /* not asked for: the band, the vector in stops only */
         assert_int_equal(pmstep_design(&in, &cfg, &report), PMSTEP_OK);
-        assert_float_equal(cfg.standstill.vector_speed_rad_s, 0.0f, 0.0f); /* not asked for */
+        assert_float_equal(cfg.standstill.vector_speed_rad_s, expected_rad_s, 1e-5f * expected_rad_s);
+        assert_true(cfg.standstill.stops_only);
         in.low_speed_drive = true;
         ideal.low_speed_drive = true;
         assert_int_equal(pmstep_design(&in, &cfg, &report), PMSTEP_OK);
         assert_float_equal(cfg.standstill.vector_speed_rad_s, expected_rad_s, 1e-5f * expected_rad_s);
+        assert_false(cfg.standstill.stops_only);
         assert_true(cfg.standstill.vector_speed_rad_s < 0.2f * report.top_speed_rad_s);
         in.phase_voltage_sensing = true;
         assert_int_equal(pmstep_design(&in, &cfg, &report), PMSTEP_OK);
         assert_float_equal(cfg.standstill.vector_speed_rad_s, 0.0f, 0.0f);
+        assert_false(cfg.standstill.stops_only);
         assert_int_equal(pmstep_design(&ideal, &cfg, &report), PMSTEP_OK);
         assert_float_equal(cfg.standstill.vector_speed_rad_s, 0.0f, 0.0f);
+        assert_false(cfg.standstill.stops_only);
         assert_false(cfg.inverter.ripple_dead_zone); /* no compensation to shape */
     }
 }

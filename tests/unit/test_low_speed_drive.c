@@ -80,9 +80,11 @@ static void low_speed_drive_validated(void **state)
     cfg.standstill.hold_current_A = 0.0f; /* the drive turns the hold's vector: none to turn */
     assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_ERR_VECTOR_SPEED);
     assert_string_equal(pmstep_status_str(PMSTEP_ERR_VECTOR_SPEED),
-                        "need vector speed >= 0, and a hold current where > 0");
+                        "need vector speed >= 0, a hold current where > 0, and > 0 for stops only");
     cfg.standstill.vector_speed_rad_s = 0.0f;
     assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
+    cfg.standstill.stops_only = true; /* stops only, with no band to turn in */
+    assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_ERR_VECTOR_SPEED);
 }
 
 /* Engaged at w* = 5 rad/s, each period turns the kept rotor by p w* T_s = 1.5e-3 rad and aims the
@@ -320,6 +322,36 @@ static void low_speed_drive_off_without_a_band(void **state)
     assert_false(f.inst.hold.active);
 }
 
+/* Stops only: a command of 5 rad/s within the band is the law's; a zero command with w* still at
+ * 5 rad/s on its way down engages the turning vector; a new non-zero command releases it and
+ * leaves T_L-hat as the observer's (the low-speed drive's law starts from the aim's). */
+static void stops_only_engages_on_the_way_to_a_zero_command(void **state)
+{
+    paper_run_t f;
+    const pmstep_output_t out = turning_output();
+    uint32_t n;
+    (void)state;
+    fixture_with_drive(&f);
+    f.cfg.standstill.stops_only = true;
+    f.inst.observer.load_hat_Nm = LOAD_NM;
+    assert_int_equal(pmstep_set_speed_target(&f.inst, SPEED_RAD_S, 100.0f), PMSTEP_OK);
+    for (n = 0; n < 4u * f.inst.scratch.run.standstill.engage_periods; ++n) {
+        pmstep_standstill_advance(&f.inst, &out);
+    }
+    assert_false(f.inst.hold.active);
+    assert_int_equal(pmstep_set_speed_target(&f.inst, 0.0f, 100.0f), PMSTEP_OK);
+    f.inst.speed_ref.setpoint = 0.5f * SPEED_RAD_S; /* the ramp on its way down (at rest: the standstill's test) */
+    for (n = 0; n < f.inst.scratch.run.standstill.engage_periods; ++n) {
+        pmstep_standstill_advance(&f.inst, &out);
+    }
+    assert_true(f.inst.hold.active && f.inst.hold.standstill_engaged);
+    assert_float_equal(f.inst.hold.vector_speed_rad_s, SPEED_RAD_S, 0.0f);
+    f.inst.observer.load_hat_Nm = -1.0f;
+    assert_int_equal(pmstep_set_speed_target(&f.inst, 0.5f * SPEED_RAD_S, 100.0f), PMSTEP_OK);
+    assert_false(f.inst.hold.active || f.inst.hold.standstill_engaged);
+    assert_float_equal(f.inst.observer.load_hat_Nm, -1.0f, 0.0f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -332,6 +364,7 @@ int main(void)
         cmocka_unit_test(low_speed_drive_stops_clear_of_the_phase_axes),
         cmocka_unit_test(low_speed_drive_passes_through_zero),
         cmocka_unit_test(low_speed_drive_off_without_a_band),
+        cmocka_unit_test(stops_only_engages_on_the_way_to_a_zero_command),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

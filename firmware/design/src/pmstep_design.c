@@ -340,11 +340,13 @@ static void design_commissioning(const pmstep_design_input_t *in, float window_s
     cfg->standstill.hold_current_A = robust ? in->rated_current_A : 0.0f;
     /* Below the speed whose back EMF is of the order of the dead time's loss the flux integrals'
      * phase is off by tenths of a radian: there the hold's vector can turn at the reference speed
-     * in place of the law (asked for: a load step while it turns is not learnt, DESIGN.md
-     * section 14). A drive that senses its phase voltages integrates the bridge's own. */
-    cfg->standstill.vector_speed_rad_s = (robust && in->low_speed_drive && !in->phase_voltage_sensing)
-                                             ? low_speed_band(in)
-                                             : 0.0f;
+     * in place of the law (at every speed in the band where asked for: a load step while it turns
+     * is not learnt, DESIGN.md section 14). A drive that senses its phase voltages integrates the
+     * bridge's own. */
+    cfg->standstill.vector_speed_rad_s = (robust && !in->phase_voltage_sensing) ? low_speed_band(in) : 0.0f;
+    /* Not asked for, the vector takes the stops only: there the law's rotor comes to rest with a
+     * phase current in the dead-time band often enough to cost the estimate 0.05 rad (section 14). */
+    cfg->standstill.stops_only = cfg->standstill.vector_speed_rad_s > 0.0f && !in->low_speed_drive;
 }
 
 static void design_protection(const pmstep_design_input_t *in, pmstep_config_t *cfg, float top_speed_rad_s)

@@ -66,6 +66,12 @@
  * the standstill's rules above apply from a new settling; a reversal passing w* = 0 turns on.
  * A command beyond w_b releases the vector and the law starts from T_L,aim; so does a load
  * angle beyond PMSTEP_HOLD_MAX_TORQUE_FRACTION.
+ *
+ * Stops only (cfg->standstill.stops_only): the same drive, engaged only on a zero command while
+ * the set-point is on its way to it (the band widens the test only then; at rest the standstill's
+ * own test), so that the vector takes the last of a stop, where the law's rotor would come to
+ * rest with a phase current in the dead-time band and its integrals drifting. Any other command
+ * releases it, T_L-hat left as the observer's, and the law drives every speed.
  */
 #ifndef PMSTEP_HOLD_H
 #define PMSTEP_HOLD_H

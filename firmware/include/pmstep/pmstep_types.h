@@ -105,7 +105,8 @@ typedef enum {
                                                  for the load: |T_L - T_detent| above 0.9 k_M I (pmstep_hold.h);
                                                  the standstill hold's current < 0 or not below max_phase_current_A */
     PMSTEP_ERR_STANDSTILL_KNOWN_LOAD = -133, /**< a standstill hold with known_load_mode (a vector hold needs (6)) */
-    PMSTEP_ERR_VECTOR_SPEED = -134           /**< the standstill's low-speed drive: a speed < 0, or > 0 without a
+    PMSTEP_ERR_VECTOR_SPEED = -134           /**< the standstill's low-speed drive: a speed < 0, stops_only without a
+                                                  speed, or > 0 without a
                                                   hold current */
 } pmstep_status_t;
 
@@ -295,6 +296,9 @@ typedef struct {
                                estimate, which drifts). Not with known_load_mode. */
     float vector_speed_rad_s; /**< below this |speed command| (rad/s) the hold's vector turns at the
                                    reference speed in place of the law (pmstep_hold.h); 0 = standstill only */
+    bool stops_only;          /**< with vector_speed_rad_s > 0: the vector turns only on the way to a zero
+                                   command (the last of a stop), the law drives every other speed; false =
+                                   the low-speed drive */
 } pmstep_standstill_config_t;
 
 /** Constant configuration (may live in flash; must outlive the instance). */

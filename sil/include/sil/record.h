@@ -45,8 +45,9 @@ extern "C" {
                                  8: low-speed drive; 9: the compensation's ripple dead zone;
                                  10: detent torque, current integral gain, detent fade;
                                  11: s-alignment's lead-in; 12: the q axis's current integral gain;
-                                 13: the back-EMF angle correction; 14: the angle smoothing */
-#define SIL_RECORD_CONFIG_WORDS 56u
+                                 13: the back-EMF angle correction; 14: the angle smoothing, the
+                                 standstill's stops-only vector */
+#define SIL_RECORD_CONFIG_WORDS 57u
 #define SIL_RECORD_TAG_SPEED_TARGET 1u
 #define SIL_RECORD_TAG_PERIOD 2u
 #define SIL_RECORD_TAG_END 3u
@@ -169,6 +170,7 @@ static inline void sil_record_config_from_words(const uint32_t *w, pmstep_config
     c->gains.emf_angle_gain_per_s = sil_record_float(w[53]);
     c->gains.emf_angle_corner_rad_s = sil_record_float(w[54]);
     c->gains.angle_smoothing = sil_record_float(w[55]);
+    c->standstill.stops_only = w[56] != 0u;
 }
 
 static inline void sil_record_meas_from_words(const uint32_t *w, pmstep_meas_t *m)
@@ -263,6 +265,7 @@ static inline void sil_record_config_to_words(const pmstep_config_t *c, uint32_t
     w[53] = sil_record_bits(c->gains.emf_angle_gain_per_s);
     w[54] = sil_record_bits(c->gains.emf_angle_corner_rad_s);
     w[55] = sil_record_bits(c->gains.angle_smoothing);
+    w[56] = c->standstill.stops_only ? 1u : 0u;
 }
 
 static inline void sil_record_meas_to_words(const pmstep_meas_t *m, uint32_t *w)

@@ -29,7 +29,8 @@ typedef struct {
     float dead_time_s;                    /**< the bridge's dead time (robust mode; 0 = none) */
     bool phase_voltage_sensing;           /**< the drive senses the phase voltages: passed on to
                                                inverter.phase_voltage_sensing (the gains are the same) */
-    bool low_speed_drive;                 /**< robust mode, currents sensed only: the standstill's vector turns
+    bool low_speed_drive;                 /**< robust mode, currents sensed only: the standstill's vector turns at
+                                               every speed of its band, not in stops only (stops_only); it turns
                                                below 2 V_bus t_d / (T_s k_M) (standstill.vector_speed_rad_s) */
     float current_resolution_A;           /**< current measurement resolution (ADC step or noise, whichever is
                                                larger): the dead-time compensation's band (robust mode) */
