@@ -23,6 +23,7 @@ static const size_t fuzz_bool_fields[] = {
     offsetof(pmstep_config_t, commissioning.use_identified_mechanics),
     offsetof(pmstep_config_t, inverter.phase_voltage_sensing),
     offsetof(pmstep_config_t, inverter.ripple_dead_zone),
+    offsetof(pmstep_config_t, standstill.stops_only),
 };
 #define FUZZ_BOOL_FIELDS (sizeof fuzz_bool_fields / sizeof fuzz_bool_fields[0])
 
