@@ -306,20 +306,26 @@ static void low_speed_drive_passes_through_zero(void **state)
     assert_float_equal(f.inst.hold.sin_vector, s, 0.0f);
 }
 
+/* A command of SPEED_RAD_S held for four engage times: nothing engages (the law's). */
+static void command_stays_with_the_law(paper_run_t *f, const pmstep_output_t *out)
+{
+    uint32_t n;
+    assert_int_equal(pmstep_set_speed_target(&f->inst, SPEED_RAD_S, 100.0f), PMSTEP_OK);
+    for (n = 0; n < 4u * f->inst.scratch.run.standstill.engage_periods; ++n) {
+        pmstep_standstill_advance(&f->inst, out);
+    }
+    assert_false(f->inst.hold.active);
+}
+
 /* Without the band (0) a command within 10 rad/s is the law's: nothing engages. */
 static void low_speed_drive_off_without_a_band(void **state)
 {
     paper_run_t f;
     const pmstep_output_t out = turning_output();
-    uint32_t n;
     (void)state;
     fixture_with_drive(&f);
     f.cfg.standstill.vector_speed_rad_s = 0.0f;
-    assert_int_equal(pmstep_set_speed_target(&f.inst, SPEED_RAD_S, 100.0f), PMSTEP_OK);
-    for (n = 0; n < 4u * f.inst.scratch.run.standstill.engage_periods; ++n) {
-        pmstep_standstill_advance(&f.inst, &out);
-    }
-    assert_false(f.inst.hold.active);
+    command_stays_with_the_law(&f, &out);
 }
 
 /* Stops only: a command of 5 rad/s within the band is the law's; a zero command with w* still at
@@ -334,11 +340,7 @@ static void stops_only_engages_on_the_way_to_a_zero_command(void **state)
     fixture_with_drive(&f);
     f.cfg.standstill.stops_only = true;
     f.inst.observer.load_hat_Nm = LOAD_NM;
-    assert_int_equal(pmstep_set_speed_target(&f.inst, SPEED_RAD_S, 100.0f), PMSTEP_OK);
-    for (n = 0; n < 4u * f.inst.scratch.run.standstill.engage_periods; ++n) {
-        pmstep_standstill_advance(&f.inst, &out);
-    }
-    assert_false(f.inst.hold.active);
+    command_stays_with_the_law(&f, &out);
     assert_int_equal(pmstep_set_speed_target(&f.inst, 0.0f, 100.0f), PMSTEP_OK);
     f.inst.speed_ref.setpoint = 0.5f * SPEED_RAD_S; /* the ramp on its way down (at rest: the standstill's test) */
     for (n = 0; n < f.inst.scratch.run.standstill.engage_periods; ++n) {
