@@ -87,12 +87,13 @@ void pmstep_angle_smoother_set(pmstep_angle_smoother_t *smoother, float cos_hat,
 void pmstep_angle_smooth(float share, float turn_rad, pmstep_angle_smoother_t *smoother, float *cos_hat,
                          float *sin_hat)
 {
-    const float turn_squared = turn_rad * turn_rad;
+    float cos_turn;
+    float sin_turn;
     float cos_turned;
     float sin_turned;
     float off_rad;
-    pmstep_turn(smoother->cos_hat, smoother->sin_hat, 1.0f - (0.5f * turn_squared),
-                turn_rad * (1.0f - ((1.0f / 6.0f) * turn_squared)), &cos_turned, &sin_turned);
+    pmstep_small_rotation(turn_rad, &cos_turn, &sin_turn);
+    pmstep_turn(smoother->cos_hat, smoother->sin_hat, cos_turn, sin_turn, &cos_turned, &sin_turned);
     off_rad = (cos_turned * *sin_hat) - (sin_turned * *cos_hat); /* the reading's turn off the prediction (its sine) */
     if ((off_rad < PMSTEP_ANGLE_SMOOTHING_GATE_RAD) && (off_rad > -PMSTEP_ANGLE_SMOOTHING_GATE_RAD)) {
         *cos_hat += share * (cos_turned - *cos_hat);

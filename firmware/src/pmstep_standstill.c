@@ -90,6 +90,13 @@ static void learn_rest_afresh(pmstep_standstill_t *standstill, const pmstep_vect
     standstill->motion_leak = 1.0f / (float)leak_periods;
 }
 
+/* |command| up to which a held vector stays engaged (and may engage): the low-speed drive's band,
+ * 0 in stops only (a zero command) or without the drive. */
+static float command_band_rad_s(const pmstep_t *inst)
+{
+    return inst->cfg->standstill.stops_only ? 0.0f : inst->cfg->standstill.vector_speed_rad_s;
+}
+
 /* Not yet holding: the hold once the zero command is reached and the rotor has been at rest for
  * engage_periods, aimed at the estimate (normalised) ahead by T_L-hat's load angle, the vector
  * and its rest turned clear of the phase axes (rest_for_clear_vector). */
@@ -101,7 +108,7 @@ static void standstill_engage(pmstep_t *inst, pmstep_standstill_t *standstill, c
     const float band_rad_s = (stops_only && !(pmstep_abs(ref->setpoint) > 0.0f))
                                  ? 0.0f
                                  : inst->cfg->standstill.vector_speed_rad_s;
-    const float target_band_rad_s = stops_only ? 0.0f : band_rad_s; /* stops: a zero command */
+    const float target_band_rad_s = command_band_rad_s(inst);
     const float vector_speed = band_rad_s > 0.0f ? out->speed_ref_rad_s : 0.0f;
     const bool at_rest = !(pmstep_abs(ref->target) > target_band_rad_s) && !(pmstep_abs(ref->setpoint) > band_rad_s)
                          && pmstep_abs(out->speed_ref_rad_s)
@@ -358,8 +365,7 @@ void pmstep_standstill_advance(pmstep_t *inst, const pmstep_output_t *out)
 void pmstep_standstill_command(pmstep_t *inst, float target_rad_s)
 {
     const bool in_run = inst->mode == PMSTEP_MODE_RUN && inst->run_started;
-    const float target_band_rad_s = inst->cfg->standstill.stops_only ? 0.0f : inst->cfg->standstill.vector_speed_rad_s;
-    if (!in_run || pmstep_abs(target_rad_s) > target_band_rad_s || !inst->hold.standstill_engaged) {
+    if (!in_run || pmstep_abs(target_rad_s) > command_band_rad_s(inst) || !inst->hold.standstill_engaged) {
         /* the low-speed drive's law starts from the aim's T_L; in stops only it keeps the observer's,
          * as the standstill's own release does (with the aim's, the envelope's steps changed) */
         if (inst->hold.standstill_engaged && inst->cfg->standstill.vector_speed_rad_s > 0.0f

@@ -124,8 +124,8 @@ void pmstep_angle_smoother_set(pmstep_angle_smoother_t *smoother, float cos_hat,
  * estimate goes down by (1 - share) / (1 + share) in power; a speed error w~ turns it
  * p w~ T_s share / (1 - share) behind.
  * @param[in]     share     a in (0, 1)
- * @param[in]     turn_rad  the rotor's turn over the period, p w-hat T_s (electrical rad); (cos, sin)
- *                          taken to third order: 3.4e-4 rad over at 0.4 rad
+ * @param[in]     turn_rad  the rotor's turn over the period, p w-hat T_s (electrical rad)
+ *                          (pmstep_small_rotation: within 1e-5 at 0.4 rad)
  * @param[in,out] smoother  the previous period's estimate
  * @param[in,out] cos_hat, sin_hat  this period's reading in, its estimate out
  */
