@@ -15,9 +15,9 @@
 #define SPEED_PER_OBSERVER_BANDWIDTH (1.0f / 3.0f) /* k_w = w_o / 3 */
 #define REFERENCE_PER_SPEED_BANDWIDTH 3.0f         /* varpi_0 = 3 k_w */
 #define DRIFT_FREE_PER_OBSERVER_BANDWIDTH (1.0f / 30.0f) /* robust mode's angle correction g = w_o / 30 */
-/* Robust mode's back-EMF angle correction: K_theta = w_o, a third of the residual's R/L + K_e (DESIGN.md
- * section 15). */
-#define EMF_ANGLE_PER_OBSERVER_BANDWIDTH 1.0f
+/* Robust mode's back-EMF angle correction: K_theta = 2 w_o, two thirds of the residual's R/L + K_e
+ * (damping 0.61; DESIGN.md section 15). */
+#define EMF_ANGLE_PER_OBSERVER_BANDWIDTH 2.0f
 #define CURRENT_INTEGRAL_PER_BANDWIDTH_SQUARED 0.125f   /* K_I = K^2/8, K = R/L + K_i: PI poles 0.15 K, 0.85 K */
 #define Q_INTEGRAL_SPEED_DIVISOR 5.0f /* K_I,q = K k_w / 5: the q PI's slow pole at k_w / 5 */
 #define STILL_ROTOR_SWING_PHASE 0.1f /* RUN takes the measured L, k_M only if w_n x L window is below this */
@@ -51,9 +51,10 @@
  * period's dead-time volt-seconds move, within [MAGNETISING_PER_RATED_CURRENT,
  * MAX_MAGNETISING_PER_RATED_CURRENT] x I (magnetising_current, DESIGN.md section 8). */
 #define MAGNETISING_PER_DEAD_TIME_CURRENT 25.0f
-/* The cap: I/2 gained nothing on the Monte Carlo over I/4 once the detent compensation fades
- * with the speed, and costs copper and the voltage p w L i_d* (DESIGN.md section 8). */
-#define MAX_MAGNETISING_PER_RATED_CURRENT 0.25f
+/* The cap: 0.35 I with K_theta = 2 w_o lost a third of the AS1050's Monte Carlo failures that I/4 had;
+ * I/2 gained nothing over I/4 once the detent compensation faded with the speed, and costs copper
+ * and the voltage p w L i_d* (DESIGN.md section 8). */
+#define MAX_MAGNETISING_PER_RATED_CURRENT 0.35f
 #define MIN_DEAD_TIME_BAND_A 1e-4f
 /* Robust mode, currents sensed only: the low-speed drive below the speed whose back EMF is this
  * many times the dead time's loss V_bus t_d / T_s (DESIGN.md, "The low-speed drive"). */
@@ -265,7 +266,7 @@ static float design_alignment(const pmstep_design_input_t *in, pmstep_config_t *
 
 /* i_d* of robust mode: I/8, or more where the flux integrals take the compensation's figure for
  * the dead time's loss (no phase-voltage sensing): MAGNETISING_PER_DEAD_TIME_CURRENT times the
- * current one period's dead-time volt-seconds move, 2 V_bus t_d / L, at most I/4 (DESIGN.md
+ * current one period's dead-time volt-seconds move, 2 V_bus t_d / L, at most 0.35 I (DESIGN.md
  * section 8). The faster a light-load phase current passes zero, the fewer periods the integrals
  * take on the compensation's word for the sign of its loss. */
 static float magnetising_current(const pmstep_design_input_t *in)
