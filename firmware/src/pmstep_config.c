@@ -60,6 +60,7 @@ static pmstep_status_t validate_signs(const pmstep_config_t *cfg)
         SIGN_RULE(gains.emf_angle_gain_per_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_EMF_ANGLE_GAIN),
         SIGN_RULE(gains.emf_angle_corner_rad_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_EMF_ANGLE_GAIN),
         SIGN_RULE(gains.angle_smoothing, SIGN_NON_NEGATIVE, PMSTEP_ERR_ANGLE_SMOOTHING),
+        SIGN_RULE(gains.transient_observer_boost, SIGN_NON_NEGATIVE, PMSTEP_ERR_OBSERVER_BOOST),
         SIGN_RULE(limits.max_phase_current_A, SIGN_POSITIVE, PMSTEP_ERR_MAX_CURRENT),
         SIGN_RULE(limits.min_bus_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_MIN_BUS),
         SIGN_RULE(alignment.s_align_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_ALIGNMENT_VOLTAGE),
@@ -139,6 +140,12 @@ static pmstep_status_t validate_gains(const pmstep_config_t *cfg)
     }
     if (gains->angle_smoothing >= 1.0f) { /* 1 would never read the integrals again */
         return PMSTEP_ERR_ANGLE_SMOOTHING;
+    }
+    /* A boost below 1 would slow the observer in the transient; it acts only beyond the residual bound. */
+    if ((gains->transient_observer_boost > 0.0f)
+        && ((gains->transient_observer_boost < 1.0f) || (gains->transient_observer_boost > PMSTEP_OBSERVER_BOOST_MAX)
+            || !(cfg->detection.observer_residual_bound_A > 0.0f))) {
+        return PMSTEP_ERR_OBSERVER_BOOST;
     }
     {
         /* e'' + K e' + K_I e = 0, K = R/L + K_i: real poles need K_I <= K^2/4. */

@@ -147,10 +147,17 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
     scratch->mech_rates = pmstep_observer_mech_rates(&inst->observer, &inst->observer_coeffs, obs_in, known_load);
 
     if (!inst->hold.active) {
-        const float load_rate = known_load ? ref.rate : scratch->mech_rates.load_hat_rate_Nm_s;
-        const float i_q_ref_rate = pmstep_law_iq_ref_rate(&inst->law_coeffs, &refs, speed.slope,
-                                                          scratch->mech_rates.speed_hat_rate_rad_s2,
-                                                          load_rate - detent.rate_Nm_s);
+        float load_rate;
+        float i_q_ref_rate;
+        /* outside the vector holds, whose vector is not the law's (DESIGN.md section 18) */
+        if (inst->robust_corrections && (inst->cfg->gains.transient_observer_boost > 0.0f) && !known_load) {
+            pmstep_observer_boost_in_transient(&inst->observer, &inst->observer_coeffs, obs_in,
+                                               inst->cfg->gains.transient_observer_boost,
+                                               inst->cfg->detection.observer_residual_bound_A, &scratch->mech_rates);
+        }
+        load_rate = known_load ? ref.rate : scratch->mech_rates.load_hat_rate_Nm_s;
+        i_q_ref_rate = pmstep_law_iq_ref_rate(&inst->law_coeffs, &refs, speed.slope,
+                                              scratch->mech_rates.speed_hat_rate_rad_s2, load_rate - detent.rate_Nm_s);
         pmstep_law_voltages(&inst->law_coeffs, &refs, cos_hat, sin_hat, i_d, i_q, inst->observer.speed_hat_rad_s,
                             i_q_ref, i_q_ref_rate, &inst->current_integral, &out->u_a_V, &out->u_b_V);
     }
@@ -174,7 +181,7 @@ bool pmstep_control_advance(pmstep_t *inst, const pmstep_control_scratch_t *scra
 {
     const pmstep_config_t *cfg = inst->cfg;
     const float period_s = cfg->timing.period_s;
-    if (inst->angle_corrections) { /* one test a period where neither is on (the paper's estimate) */
+    if (inst->robust_corrections) { /* one test a period where none is on (the paper's estimate) */
         if (inst->angle_coeffs.correction_gain > 0.0f) {
             pmstep_angle_correct(&inst->angle, &inst->angle_coeffs, out->cos_hat, out->sin_hat);
         }

@@ -35,7 +35,8 @@ static void derive(pmstep_t *inst, const pmstep_config_t *cfg)
     plan->identification_steps = pmstep_periods_in(cfg->commissioning.identification_time_s, period_s);
     inst->offset_cal_steps = pmstep_periods_in(cfg->commissioning.offset_calibration_time_s, period_s);
     inst->optional_inputs = cfg->known_load_mode || cfg->inverter.phase_voltage_sensing;
-    inst->angle_corrections = (cfg->gains.angle_correction_gain_per_s > 0.0f) || (cfg->gains.emf_angle_gain_per_s > 0.0f);
+    inst->robust_corrections = (cfg->gains.angle_correction_gain_per_s > 0.0f) || (cfg->gains.emf_angle_gain_per_s > 0.0f)
+                               || (cfg->gains.transient_observer_boost > 0.0f);
     inst->angle_smoothing = cfg->gains.angle_smoothing > 0.0f;
     pmstep_detect_coeffs_init(&inst->detect_coeffs, cfg);
     pmstep_actuate_coeffs_init(&inst->actuate_coeffs, cfg);

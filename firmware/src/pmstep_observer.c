@@ -72,6 +72,19 @@ pmstep_observer_mech_rates_t pmstep_observer_mech_rates(const pmstep_observer_t 
     return rates;
 }
 
+void pmstep_observer_boost_in_transient(const pmstep_observer_t *obs, const pmstep_observer_coeffs_t *coeffs,
+                                        const pmstep_observer_input_t *in, float boost, float residual_bound_A,
+                                        pmstep_observer_mech_rates_t *rates)
+{
+    /* (6)'s residual s-hat i~_a - c-hat i~_b, the q axis's (with its sign reversed) */
+    const float residual_A = (in->sin_hat * (in->i_a_A - obs->i_a_hat_A)) - (in->cos_hat * (in->i_b_A - obs->i_b_hat_A));
+    if ((residual_A > residual_bound_A) || (residual_A < -residual_bound_A)) {
+        const float eps = coeffs->km_over_l * residual_A;
+        rates->speed_hat_rate_rad_s2 += (boost - 1.0f) * coeffs->speed_injection_gain * eps;
+        rates->load_hat_rate_Nm_s -= ((boost * boost) - 1.0f) * coeffs->load_injection_gain * eps;
+    }
+}
+
 void pmstep_observer_correct_voltage(pmstep_observer_t *obs, const pmstep_observer_coeffs_t *coeffs,
                                      float du_a_V, float du_b_V)
 {

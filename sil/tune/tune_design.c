@@ -54,6 +54,8 @@ void print_design(const sil_scenario_t *sc, const pmstep_design_report_t *r, boo
            (double)c->gains.emf_angle_gain_per_s, (double)c->gains.emf_angle_corner_rad_s);
     printf("  angle smoothing: %g of the turned previous estimate (0 = the flux integrals' reading)\n",
            (double)c->gains.angle_smoothing);
+    printf("  transient observer boost: %g beyond the residual bound %g A (0 = off)\n",
+           (double)c->gains.transient_observer_boost, (double)c->detection.observer_residual_bound_A);
     printf("  detent torque compensated: %g Nm, fading above %.1f rad/s (0 = no fade)\n",
            (double)c->motor.detent_torque_Nm, (double)c->gains.detent_fade_speed_rad_s);
     printf("  alignment: %.3f A (u = %.3f V), lead-in %.2f s, t_s %.2f s, t_c %.2f s; swing %.0f rad/s, "
@@ -110,14 +112,15 @@ int write_c(const char *path, const sil_scenario_t *sc)
                "              .reference_bandwidth_rad_s = %.9gf, .angle_correction_gain_per_s = %.9gf,\n"
                "              .current_integral_gain_per_s2 = %.9gf, .current_integral_gain_q_per_s2 = %.9gf,\n"
                "              .detent_fade_speed_rad_s = %.9gf, .emf_angle_gain_per_s = %.9gf,\n"
-               "              .emf_angle_corner_rad_s = %.9gf, .angle_smoothing = %.9gf},\n",
+               "              .emf_angle_corner_rad_s = %.9gf, .angle_smoothing = %.9gf,\n"
+               "              .transient_observer_boost = %.9gf},\n",
             (double)c->gains.speed_gain_per_s, (double)c->gains.observer_gain_per_s,
             (double)c->gains.current_gain_per_s, (double)c->gains.adapt_gamma, (double)c->gains.adapt_lambda,
             (double)c->gains.adapt_r, (double)c->gains.sat_kappa_rad_s, (double)c->gains.reference_bandwidth_rad_s,
             (double)c->gains.angle_correction_gain_per_s, (double)c->gains.current_integral_gain_per_s2,
             (double)c->gains.current_integral_gain_q_per_s2, (double)c->gains.detent_fade_speed_rad_s,
             (double)c->gains.emf_angle_gain_per_s, (double)c->gains.emf_angle_corner_rad_s,
-            (double)c->gains.angle_smoothing);
+            (double)c->gains.angle_smoothing, (double)c->gains.transient_observer_boost);
     fprintf(f, "    .limits = {.max_phase_current_A = %.9gf, .min_bus_voltage_V = %.9gf, .max_bus_voltage_V = %.9gf},\n",
             (double)c->limits.max_phase_current_A, (double)c->limits.min_bus_voltage_V,
             (double)c->limits.max_bus_voltage_V);

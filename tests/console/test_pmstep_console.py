@@ -81,7 +81,7 @@ class AgainstTheFirmwareConsole(unittest.TestCase):
         self.assertEqual(hello["protocol"], 1)
         self.assertEqual(hello["identity"], "pmstep host-drive")
         table = c.list_config()
-        self.assertEqual(len(table), 57)
+        self.assertEqual(len(table), 58)
         names = [e["name"] for e in table]
         self.assertEqual(len(set(names)), len(names))
         self.assertIn("gains.angle_smoothing", names)

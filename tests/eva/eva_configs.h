@@ -98,6 +98,7 @@ static void eva_any_config(pmstep_config_t *cfg)
     cfg->gains.emf_angle_gain_per_s = eva_any_finite();
     cfg->gains.emf_angle_corner_rad_s = eva_any_finite();
     cfg->gains.angle_smoothing = eva_any_finite();
+    cfg->gains.transient_observer_boost = eva_any_finite();
     cfg->gains.detent_fade_speed_rad_s = eva_any_finite();
     cfg->motor.detent_torque_Nm = eva_any_finite();
     cfg->detection.angle_magnitude_bound = eva_any_finite();

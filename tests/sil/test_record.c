@@ -50,6 +50,7 @@ static void config_round_trips_through_the_words(void **state)
     in.gains.emf_angle_corner_rad_s = 22.5f;
     in.gains.angle_smoothing = 0.5f;
     in.standstill.stops_only = true;
+    in.gains.transient_observer_boost = 3.0f;
     sil_record_config_to_words(&in, w);
     sil_record_config_from_words(w, &out);
     assert_memory_equal(&in.motor.resistance_Ohm, &out.motor.resistance_Ohm, sizeof(float));
@@ -83,8 +84,10 @@ static void config_round_trips_through_the_words(void **state)
     assert_true(out.gains.emf_angle_gain_per_s == 1000.0f && w[53] == sil_record_bits(1000.0f));
     assert_true(out.gains.emf_angle_corner_rad_s == 22.5f && w[54] == sil_record_bits(22.5f));
     assert_true(out.gains.angle_smoothing == 0.5f && w[55] == sil_record_bits(0.5f));
+    assert_true(out.standstill.stops_only && w[56] == 1u);
     /* The last word is the last field. */
-    assert_true(out.standstill.stops_only && w[SIL_RECORD_CONFIG_WORDS - 1u] == 1u);
+    assert_true(out.gains.transient_observer_boost == 3.0f
+                && w[SIL_RECORD_CONFIG_WORDS - 1u] == sil_record_bits(3.0f));
 }
 
 /* A period's input, the sensed phase voltages included, comes back bit for bit. */

@@ -21,7 +21,7 @@ static const pmstep_status_t all_status_codes[] = {
     PMSTEP_ERR_ADAPT_GAMMA, PMSTEP_ERR_ADAPT_LAMBDA, PMSTEP_ERR_ADAPT_R, PMSTEP_ERR_SAT_KAPPA,
     PMSTEP_ERR_OBSERVER_GAIN_FOR_PERIOD, PMSTEP_ERR_CURRENT_GAIN_FOR_PERIOD, PMSTEP_ERR_REFERENCE_BANDWIDTH,
     PMSTEP_ERR_ANGLE_CORRECTION_GAIN, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN, PMSTEP_ERR_DETENT_FADE_SPEED,
-    PMSTEP_ERR_EMF_ANGLE_GAIN, PMSTEP_ERR_ANGLE_SMOOTHING,
+    PMSTEP_ERR_EMF_ANGLE_GAIN, PMSTEP_ERR_ANGLE_SMOOTHING, PMSTEP_ERR_OBSERVER_BOOST,
     PMSTEP_ERR_MAX_CURRENT, PMSTEP_ERR_MIN_BUS,
     PMSTEP_ERR_BUS_ORDER,
     PMSTEP_ERR_ALIGNMENT_VOLTAGE, PMSTEP_ERR_ALIGNMENT_ABOVE_BUS, PMSTEP_ERR_ALIGNMENT_CURRENT,
@@ -61,6 +61,23 @@ static void emf_gain_at_residual_rate(pmstep_config_t *c)
 }
 static void negative_angle_smoothing(pmstep_config_t *c) { c->gains.angle_smoothing = -0.1f; }
 static void angle_smoothing_of_one(pmstep_config_t *c) { c->gains.angle_smoothing = 1.0f; }
+static void negative_observer_boost(pmstep_config_t *c) { c->gains.transient_observer_boost = -1.0f; }
+/* With a residual bound, so that only the boost itself is wrong. */
+static void observer_boost_below_one(pmstep_config_t *c)
+{
+    c->detection.observer_residual_bound_A = 0.3f;
+    c->gains.transient_observer_boost = 0.5f;
+}
+static void observer_boost_above_max(pmstep_config_t *c)
+{
+    c->detection.observer_residual_bound_A = 0.3f;
+    c->gains.transient_observer_boost = 4.5f;
+}
+static void observer_boost_without_bound(pmstep_config_t *c)
+{
+    c->detection.observer_residual_bound_A = 0.0f;
+    c->gains.transient_observer_boost = 3.0f;
+}
 static void bad_l(pmstep_config_t *c) { c->motor.inductance_H = -1e-3f; }
 static void bad_j(pmstep_config_t *c) { c->motor.inertia_kgm2 = 0.0f; }
 static void bad_km(pmstep_config_t *c) { c->motor.torque_constant_Nm_A = 0.0f; }
@@ -141,6 +158,10 @@ static const struct {
     {emf_gain_at_residual_rate, PMSTEP_ERR_EMF_ANGLE_GAIN},
     {negative_angle_smoothing, PMSTEP_ERR_ANGLE_SMOOTHING},
     {angle_smoothing_of_one, PMSTEP_ERR_ANGLE_SMOOTHING},
+    {negative_observer_boost, PMSTEP_ERR_OBSERVER_BOOST},
+    {observer_boost_below_one, PMSTEP_ERR_OBSERVER_BOOST},
+    {observer_boost_above_max, PMSTEP_ERR_OBSERVER_BOOST},
+    {observer_boost_without_bound, PMSTEP_ERR_OBSERVER_BOOST},
     {negative_lead_in, PMSTEP_ERR_S_LEAD_IN_TIME},
     {lead_in_fills_s_alignment, PMSTEP_ERR_S_LEAD_IN_TIME},
     {current_integral_complex_poles, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN},
@@ -228,6 +249,18 @@ static void emf_gain_under_the_residual_rate_is_accepted(void **state)
     assert_int_equal(pmstep_validate_config(&cfg), PMSTEP_OK);
 }
 
+/* The transient observer boost: 1 and the largest, 4, with a residual bound. */
+static void observer_boost_within_range_is_accepted(void **state)
+{
+    pmstep_config_t cfg = pmstep_paper_config();
+    (void)state;
+    cfg.detection.observer_residual_bound_A = 0.3f;
+    cfg.gains.transient_observer_boost = 1.0f;
+    assert_int_equal(pmstep_validate_config(&cfg), PMSTEP_OK);
+    cfg.gains.transient_observer_boost = PMSTEP_OBSERVER_BOOST_MAX;
+    assert_int_equal(pmstep_validate_config(&cfg), PMSTEP_OK);
+}
+
 static void every_validation_code_is_provoked(void **state)
 {
     /* Each configuration code (-10 and below) is the expected result of some case above or
@@ -292,6 +325,7 @@ int main(void)
         cmocka_unit_test(every_invalid_configuration_has_its_code),
         cmocka_unit_test(current_integral_within_its_bound_is_accepted),
         cmocka_unit_test(emf_gain_under_the_residual_rate_is_accepted),
+        cmocka_unit_test(observer_boost_within_range_is_accepted),
         cmocka_unit_test(every_code_has_its_own_text),
         cmocka_unit_test(every_validation_code_is_provoked),
         cmocka_unit_test(condition4_cases_are_on_the_right_side),

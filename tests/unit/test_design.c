@@ -124,6 +124,10 @@ static void every_preset_gets_a_valid_design(void **state)
             /* Robust: the angle smoothing weighs the turned previous estimate and the reading
              * equally (DESIGN.md section 16); off in paper mode. */
             assert_true(cfg.gains.angle_smoothing == (robust != 0 ? 0.5f : 0.0f));
+            /* Robust: the transient observer boost at 3, beyond the designed residual bound (DESIGN.md
+             * section 18); off in paper mode. */
+            assert_true(cfg.gains.transient_observer_boost == (robust != 0 ? 3.0f : 0.0f));
+            assert_true(robust == 0 || cfg.detection.observer_residual_bound_A > 0.0f);
             /* Robust: RUN takes the measured L and k_M. L from the current rise where the rotor stays
              * still over its window (the paper's motor, w_n T_L ~ 0.05), else from the level drops:
              * no rise window for the hybrids (~0.45-0.75), the voltage-bias level on. */

@@ -116,12 +116,71 @@ static void voltage_correction_redoes_the_advance(void **state)
     assert_true(assumed.speed_hat_rad_s == actual.speed_hat_rad_s && assumed.load_hat_Nm == actual.load_hat_Nm);
 }
 
+/* The transient observer boost: within the residual bound the rates stay (6)'s; beyond it the speed
+ * injection is k and the load injection k^2 times (6)'s, the rest of the rates unchanged. Paper motor:
+ * g_w = 10, g_T = 9, k_M/L = 100; estimate at (0.6, 0.8). */
+static void boost_scales_the_injections_beyond_the_residual_bound(void **state)
+{
+    const pmstep_config_t cfg = pmstep_paper_config();
+    const pmstep_electrical_t model = pmstep_configured_electrical(&cfg);
+    const float boost = 3.0f;
+    const float bound_A = 0.3f;
+    pmstep_observer_coeffs_t coeffs;
+    pmstep_observer_t obs;
+    pmstep_observer_input_t in;
+    pmstep_observer_mech_rates_t plain;
+    pmstep_observer_mech_rates_t boosted;
+    float residual_A;
+    float eps;
+    float speed_added;
+    float load_added;
+    (void)state;
+    pmstep_observer_coeffs_init(&coeffs, &cfg, &model);
+    pmstep_observer_start(&obs, 0.3f, 0.9f);
+    obs.speed_hat_rad_s = 8.0f;
+    obs.load_hat_Nm = 1.0f;
+    in.cos_hat = 0.6f;
+    in.sin_hat = 0.8f;
+    in.i_d_err_A = 0.0f;
+    in.i_q_err_A = 0.0f;
+    in.known_load_Nm = 0.0f;
+    in.detent_torque_Nm = 0.0f;
+    /* a residual of 0.2 A along (s-hat, -c-hat): within the bound */
+    in.i_a_A = 0.3f + 0.2f * 0.8f;
+    in.i_b_A = 0.9f - 0.2f * 0.6f;
+    pmstep_park(in.cos_hat, in.sin_hat, in.i_a_A, in.i_b_A, &in.i_d_A, &in.i_q_A);
+    plain = pmstep_observer_mech_rates(&obs, &coeffs, &in, false);
+    boosted = plain;
+    pmstep_observer_boost_in_transient(&obs, &coeffs, &in, boost, bound_A, &boosted);
+    assert_true(boosted.speed_hat_rate_rad_s2 == plain.speed_hat_rate_rad_s2
+                && boosted.load_hat_rate_Nm_s == plain.load_hat_rate_Nm_s);
+    /* 0.5 A, and -0.5 A: beyond it */
+    for (residual_A = -0.5f; residual_A < 1.0f; residual_A += 1.0f) {
+        in.i_a_A = 0.3f + residual_A * 0.8f;
+        in.i_b_A = 0.9f - residual_A * 0.6f;
+        pmstep_park(in.cos_hat, in.sin_hat, in.i_a_A, in.i_b_A, &in.i_d_A, &in.i_q_A);
+        plain = pmstep_observer_mech_rates(&obs, &coeffs, &in, false);
+        boosted = plain;
+        pmstep_observer_boost_in_transient(&obs, &coeffs, &in, boost, bound_A, &boosted);
+        eps = coeffs.km_over_l * residual_A;
+        speed_added = (boost - 1.0f) * coeffs.speed_injection_gain * eps;
+        load_added = -(boost * boost - 1.0f) * coeffs.load_injection_gain * eps;
+        /* to float32 rounding of rates of 10^3-10^4 (a few units in the last place) */
+        assert_float_equal(boosted.speed_hat_rate_rad_s2 - plain.speed_hat_rate_rad_s2, speed_added,
+                           1e-6f * fabsf(speed_added));
+        assert_float_equal(boosted.load_hat_rate_Nm_s - plain.load_hat_rate_Nm_s, load_added,
+                           1e-6f * fabsf(load_added));
+        assert_true(fabsf(boosted.speed_hat_rate_rad_s2 - plain.speed_hat_rate_rad_s2) > 500.0f);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(injection_gains_reduce_to_paper_values_without_friction),
         cmocka_unit_test(observer_converges_on_exact_samples),
         cmocka_unit_test(voltage_correction_redoes_the_advance),
+        cmocka_unit_test(boost_scales_the_injections_beyond_the_residual_bound),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

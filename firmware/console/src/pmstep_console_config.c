@@ -75,6 +75,7 @@ static const pmstep_console_config_entry_t table[] = {
     F32(gains.emf_angle_corner_rad_s),
     F32(gains.angle_smoothing),
     BOOL(standstill.stops_only),
+    F32(gains.transient_observer_boost),
 };
 
 const pmstep_console_config_entry_t *pmstep_console_config_table(uint32_t *count)

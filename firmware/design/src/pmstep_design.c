@@ -12,6 +12,9 @@
 /* Robust mode's angle smoothing: the reading and the turned previous estimate weighted equally
  * (the samples' noise in the estimate x 0.58; DESIGN.md section 16) */
 #define ANGLE_SMOOTHING 0.5f
+/* Robust mode's transient observer boost: beyond the residual bound the observer's mechanical injections
+ * as at 3 w_o (DESIGN.md section 18). */
+#define TRANSIENT_OBSERVER_BOOST 3.0f
 #define SPEED_PER_OBSERVER_BANDWIDTH (1.0f / 3.0f) /* k_w = w_o / 3 */
 #define REFERENCE_PER_SPEED_BANDWIDTH 3.0f         /* varpi_0 = 3 k_w */
 #define DRIFT_FREE_PER_OBSERVER_BANDWIDTH (1.0f / 30.0f) /* robust mode's angle correction g = w_o / 30 */
@@ -206,10 +209,12 @@ static void design_gains(const pmstep_design_input_t *in, pmstep_gains_config_t 
         gains->emf_angle_gain_per_s = EMF_ANGLE_PER_OBSERVER_BANDWIDTH * w_o;
         gains->emf_angle_corner_rad_s = uncertain_V / m->torque_constant_Nm_A;
         gains->angle_smoothing = ANGLE_SMOOTHING;
+        gains->transient_observer_boost = TRANSIENT_OBSERVER_BOOST;
     } else {
         gains->emf_angle_gain_per_s = 0.0f;
         gains->emf_angle_corner_rad_s = 0.0f;
         gains->angle_smoothing = 0.0f;
+        gains->transient_observer_boost = 0.0f;
     }
     gains->detent_fade_speed_rad_s = m->detent_torque_Nm > 0.0f ? DETENT_FADE_PER_CURRENT_BANDWIDTH * current_bandwidth
                                                                        / (4.0f * (float)m->pole_pairs)

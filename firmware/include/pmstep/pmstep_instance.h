@@ -31,7 +31,8 @@ typedef struct {
     pmstep_commission_plan_t commission_plan; /**< alignment timing (t_s, t_c in periods) and windows */
     uint32_t offset_cal_steps;                /**< periods of bridge-off offset calibration */
     bool optional_inputs;                     /**< a load torque or phase voltages to check each period */
-    bool angle_corrections;                   /**< the drift-free or the back-EMF angle correction is on */
+    bool robust_corrections;                  /**< the drift-free or the back-EMF angle correction, or the transient
+                                                   observer boost, is on */
     bool angle_smoothing;                     /**< gains.angle_smoothing > 0 */
     bool voltage_corrected;                   /**< the period's voltage is sensed or dead-time compensated */
     pmstep_detect_coeffs_t detect_coeffs;

@@ -77,6 +77,18 @@ void pmstep_observer_coeffs_init(pmstep_observer_coeffs_t *coeffs, const pmstep_
 /** Starts at t_c: i-hat = i(t_c), w-hat = 0, T_L-hat = 0. */
 void pmstep_observer_start(pmstep_observer_t *obs, float i_a_A, float i_b_A);
 
+/**
+ * The transient observer boost (gains.transient_observer_boost, unknown load): where (6)'s q residual
+ * |s-hat i~_a - c-hat i~_b| is beyond @p residual_bound_A, a load step the observer's bandwidth does not
+ * follow, adds to @p rates the speed injection (@p boost - 1) times over and the load injection
+ * (@p boost^2 - 1) times over, as if the observer's mechanical part ran @p boost times faster while
+ * it lasts (DESIGN.md section 18). The observer's state, @p in and the residual are this period's,
+ * as pmstep_observer_mech_rates took them.
+ */
+void pmstep_observer_boost_in_transient(const pmstep_observer_t *obs, const pmstep_observer_coeffs_t *coeffs,
+                                        const pmstep_observer_input_t *in, float boost, float residual_bound_A,
+                                        pmstep_observer_mech_rates_t *rates);
+
 /** w-hat' and T_L-hat' of (6) (adaptive: known_load = false) or (13) (known_load = true). */
 pmstep_observer_mech_rates_t pmstep_observer_mech_rates(const pmstep_observer_t *obs,
                                                         const pmstep_observer_coeffs_t *coeffs,

@@ -55,6 +55,8 @@ typedef enum {
     PMSTEP_ERR_EMF_ANGLE_GAIN = -53,        /**< back-EMF angle correction: gain < 0 or not below R/L + K_e, corner
                                                  < 0, or a gain without a corner */
     PMSTEP_ERR_ANGLE_SMOOTHING = -54,       /**< angle smoothing a < 0 or >= 1 */
+    PMSTEP_ERR_OBSERVER_BOOST = -55,        /**< transient observer boost k not 0 and not within [1, 4], or k > 0
+                                                 without detection.observer_residual_bound_A */
     /* limits */
     PMSTEP_ERR_MAX_CURRENT = -60,           /**< max_phase_current_A <= 0 */
     PMSTEP_ERR_MIN_BUS = -61,               /**< min_bus_voltage_V <= 0 */
@@ -227,7 +229,16 @@ typedef struct {
                                 (1 - a) of the flux integrals' reading's difference from it (the current
                                 samples' noise in the estimate times (1 - a) / (1 + a) in power); 0 = the
                                 reading itself (the paper's) */
+    float transient_observer_boost; /**< k, 0 or in [1, PMSTEP_OBSERVER_BOOST_MAX]: while the observer's q residual
+                                         is beyond detection.observer_residual_bound_A (a load step faster than the
+                                         observer's bandwidth), its speed injection is k and its load injection
+                                         k^2 times the gains' (unknown load only); 0 = off (the paper's observer) */
 } pmstep_gains_config_t;
+
+/** The largest transient observer boost init accepts. The boost scales the observer's mechanical
+ *  injections as a bandwidth would (k, k^2) but not its current gain: with the designer's triple pole
+ *  the observer stays stable for k < 9 (Routh: (R/L + K_e) k g_w > k^2 g_T), and 4 keeps half of that. */
+#define PMSTEP_OBSERVER_BOOST_MAX 4.0f
 
 /** Protections. */
 typedef struct {
