@@ -80,6 +80,24 @@ static void injection_gains_reduce_to_paper_values_without_friction(void **state
     assert_true(fabs(coeffs.load_injection_gain - 9.0) < 1e-4);
 }
 
+/* The observer started at i-hat = (0.3, 0.9) with w-hat 8 rad/s and T_L-hat 1 N m, and an input at
+ * the estimate (0.6, 0.8) with the samples (i_a, i_b), no current error, load or detent. */
+static void observer_and_input(pmstep_observer_t *obs, pmstep_observer_input_t *in, float i_a_A, float i_b_A)
+{
+    pmstep_observer_start(obs, 0.3f, 0.9f);
+    obs->speed_hat_rad_s = 8.0f;
+    obs->load_hat_Nm = 1.0f;
+    in->i_a_A = i_a_A;
+    in->i_b_A = i_b_A;
+    in->cos_hat = 0.6f;
+    in->sin_hat = 0.8f;
+    pmstep_park(in->cos_hat, in->sin_hat, in->i_a_A, in->i_b_A, &in->i_d_A, &in->i_q_A);
+    in->i_d_err_A = 0.0f;
+    in->i_q_err_A = 0.0f;
+    in->known_load_Nm = 0.0f;
+    in->detent_torque_Nm = 0.0f;
+}
+
 /* An advance with the assumed voltage, corrected by the difference, equals the advance with the
  * actual voltage (to float rounding); the mechanical states do not depend on u in one step. */
 static void voltage_correction_redoes_the_advance(void **state)
@@ -93,19 +111,8 @@ static void voltage_correction_redoes_the_advance(void **state)
     pmstep_observer_mech_rates_t mech;
     (void)state;
     pmstep_observer_coeffs_init(&coeffs, &cfg, &model);
-    pmstep_observer_start(&assumed, 0.3f, 0.9f);
-    assumed.speed_hat_rad_s = 8.0f;
-    assumed.load_hat_Nm = 1.0f;
+    observer_and_input(&assumed, &in, 0.35f, 0.85f);
     actual = assumed;
-    in.i_a_A = 0.35f;
-    in.i_b_A = 0.85f;
-    in.cos_hat = 0.6f;
-    in.sin_hat = 0.8f;
-    pmstep_park(in.cos_hat, in.sin_hat, in.i_a_A, in.i_b_A, &in.i_d_A, &in.i_q_A);
-    in.i_d_err_A = 0.0f;
-    in.i_q_err_A = 0.0f;
-    in.known_load_Nm = 0.0f;
-    in.detent_torque_Nm = 0.0f;
     mech = pmstep_observer_mech_rates(&assumed, &coeffs, &in, false);
     pmstep_observer_advance(&assumed, &coeffs, &in, &mech, 12.0f, -5.0f, cfg.timing.period_s);
     pmstep_observer_advance(&actual, &coeffs, &in, &mech, 12.4f, -5.3f, cfg.timing.period_s);
@@ -136,19 +143,8 @@ static void boost_scales_the_injections_beyond_the_residual_bound(void **state)
     float load_added;
     (void)state;
     pmstep_observer_coeffs_init(&coeffs, &cfg, &model);
-    pmstep_observer_start(&obs, 0.3f, 0.9f);
-    obs.speed_hat_rad_s = 8.0f;
-    obs.load_hat_Nm = 1.0f;
-    in.cos_hat = 0.6f;
-    in.sin_hat = 0.8f;
-    in.i_d_err_A = 0.0f;
-    in.i_q_err_A = 0.0f;
-    in.known_load_Nm = 0.0f;
-    in.detent_torque_Nm = 0.0f;
     /* a residual of 0.2 A along (s-hat, -c-hat): within the bound */
-    in.i_a_A = 0.3f + 0.2f * 0.8f;
-    in.i_b_A = 0.9f - 0.2f * 0.6f;
-    pmstep_park(in.cos_hat, in.sin_hat, in.i_a_A, in.i_b_A, &in.i_d_A, &in.i_q_A);
+    observer_and_input(&obs, &in, 0.3f + 0.2f * 0.8f, 0.9f - 0.2f * 0.6f);
     plain = pmstep_observer_mech_rates(&obs, &coeffs, &in, false);
     boosted = plain;
     pmstep_observer_boost_in_transient(&obs, &coeffs, &in, boost, bound_A, &boosted);
@@ -156,9 +152,7 @@ static void boost_scales_the_injections_beyond_the_residual_bound(void **state)
                 && boosted.load_hat_rate_Nm_s == plain.load_hat_rate_Nm_s);
     /* 0.5 A, and -0.5 A: beyond it */
     for (residual_A = -0.5f; residual_A < 1.0f; residual_A += 1.0f) {
-        in.i_a_A = 0.3f + residual_A * 0.8f;
-        in.i_b_A = 0.9f - residual_A * 0.6f;
-        pmstep_park(in.cos_hat, in.sin_hat, in.i_a_A, in.i_b_A, &in.i_d_A, &in.i_q_A);
+        observer_and_input(&obs, &in, 0.3f + residual_A * 0.8f, 0.9f - residual_A * 0.6f);
         plain = pmstep_observer_mech_rates(&obs, &coeffs, &in, false);
         boosted = plain;
         pmstep_observer_boost_in_transient(&obs, &coeffs, &in, boost, bound_A, &boosted);
