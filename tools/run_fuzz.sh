@@ -42,7 +42,15 @@ build/fuzz/tests/fuzz/fuzz_$target -max_total_time="$seconds" -timeout=10 -rss_l
   -print_final_stats=1 -print_coverage=1 -artifact_prefix=build/fuzz/artifacts-$target/ "$work" >"$log" 2>&1 \
   || status=$?
 if [ $status -ne 0 ]; then
-  grep -v '^COVERED_FUNC\|^UNCOVERED_FUNC' "$log" | tail -40
+  # The report without the coverage dump that -print_coverage appends, then the failing input
+  # itself, so that a run on a machine whose build tree is gone can still be reproduced.
+  grep -v '^\(UN\)\?COVERED_\(FUNC\|PC\|MODULE\)' "$log" | tail -40
+  for artifact in build/fuzz/artifacts-$target/*; do
+    [ -f "$artifact" ] || continue
+    echo "run_fuzz: $artifact ($(wc -c < "$artifact") bytes), base64:"
+    base64 "$artifact" | head -c 16384
+    echo
+  done
   echo "run_fuzz: $target FAILED (exit $status); the input is in build/fuzz/artifacts-$target/"
   exit 1
 fi
