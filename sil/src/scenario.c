@@ -8,13 +8,20 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Whole-string number: no trailing text, finite. */
+double scenario_angle_stored_rad(double degrees)
+{
+    return degrees * PI / 180.0;
+}
+
+/* Whole-string number: no trailing text, finite, 0 or normal. strtod reports a decimal that
+ * underflows as ERANGE; an exact subnormal (hex "0x1p-1074") it takes without a word, and the
+ * printer's decimal of it would then not read back: refused alike. */
 static int parse_number(const char *text, double *value)
 {
     char *end;
     errno = 0;
     *value = strtod(text, &end);
-    if (end == text || errno == ERANGE || !isfinite(*value)) {
+    if (end == text || errno == ERANGE || !isfinite(*value) || (*value != 0.0 && fabs(*value) < DBL_MIN)) {
         return -1;
     }
     while (*end == ' ' || *end == '\t') {
@@ -158,7 +165,8 @@ int sil_scenario_set(sil_scenario_t *sc, const char *key, const char *value, cha
             break;
         }
         if (parse_number(value, &v) != 0) {
-            return fail(err, err_size, "%s: '%s' is not a finite number", key, value);
+            return fail(err, err_size, "%s: '%s' is not a finite number (0 or of magnitude %g to %g)", key, value,
+                        DBL_MIN, DBL_MAX);
         }
         if (!in_range(k, v)) {
             return fail(err, err_size, "%s = %s is out of range: must be %s %g and %s %g (%s)", key, value,
@@ -180,7 +188,7 @@ int sil_scenario_set(sil_scenario_t *sc, const char *key, const char *value, cha
         case KEY_INT: *(int32_t *)(base + k->offset) = (int32_t)v; break;
         case KEY_UINT: *(uint32_t *)(base + k->offset) = (uint32_t)v; break;
         case KEY_ADC_BITS: *(unsigned *)(base + k->offset) = (unsigned)v; break;
-        case KEY_ANGLE_DEG: *(double *)(base + k->offset) = v * PI / 180.0; break;
+        case KEY_ANGLE_DEG: *(double *)(base + k->offset) = scenario_angle_stored_rad(v); break;
         default: break;
         }
         return 0;

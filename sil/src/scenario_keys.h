@@ -37,6 +37,10 @@ static const char *const inverter_model_names[] = {"averaged", "switching"};
 static const char *const integrator_names[] = {"rk4", "exponential"}; /* in plant_integrator_t order */
 static const char *const drive_names[] = {"pmstep", "microstep"};     /* in sil_drive_t order */
 
+/* run.theta0_deg's value as stored (rad): the one conversion the reader applies and the printer
+ * inverts (scenario.c). */
+double scenario_angle_stored_rad(double degrees);
+
 /* The message into @p err; -1, the readers' error return. */
 static inline int fail(char *err, size_t err_size, const char *fmt, ...)
 {

@@ -95,6 +95,13 @@ scenario = {
     "load_table": b"[load]\ntype = table\npoints = 0:0, 1:2, 2:-2\n",
     "sensors": b"[sensors]\nadc_bits = 12\ncurrent_full_scale_a = 10\n",
     "inverter": b"[inverter]\nmodel = switching\ndead_time_s = 1e-6\n[bus]\nripple_v = 100\n",
+    # --print-scenario's text must read back to the same values: at 9 digits the first printed
+    # 0.5 (outside the key's open range), the second two equal times; an exact subnormal was
+    # taken and printed as a decimal that underflows; the angle is stored in radians.
+    "print_open_bound": b"[sensors]\ngain_error_a = 0.4999999999\n",
+    "print_close_times": b"[speed]\npoints = 0:0, 1.0000000001:1, 1.0000000002:2\n",
+    "print_subnormal": b"[motor]\nfriction_Nms_rad = 0x1p-1074\n",
+    "print_angle": b"[run]\ntheta0_deg = 123.45678901234567\n\n--set\nrun.theta0_deg=-999999.99999999988\n",
 }
 
 for folder, seeds in (("core", core), ("scenario", scenario)):
