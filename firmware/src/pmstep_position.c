@@ -122,6 +122,7 @@ pmstep_status_t pmstep_position_init(pmstep_position_t *pos, pmstep_t *inst, con
     pos->cfg = *cfg;
     pos->hold_stage = POSITION_HOLD_NONE;
     pos->hold_periods = 0;
+    pos->reading_turned = false;
     pos->rest_cos = 1.0f;
     pos->rest_sin = 0.0f;
     pos->aim_load_Nm = 0.0f;

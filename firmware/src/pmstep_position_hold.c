@@ -45,6 +45,7 @@ static void hold_at_rest(pmstep_position_t *pos, int32_t stage)
     pos->error_integral_rad_s = 0.0f;
     pos->hold_stage = stage;
     pos->hold_periods = (int32_t)inst->hold.settle_periods;
+    pos->reading_turned = false;
 }
 
 /* The target's direction is the estimate's turned by the error left, p (theta* - theta-hat)
@@ -110,9 +111,43 @@ static void put_back_kept_estimate(pmstep_position_t *pos)
     pmstep_angle_set(&pos->inst->angle, &pos->inst->angle_coeffs, pos->frozen_cos, pos->frozen_sin);
 }
 
+/* Whether the flux integrals' reading is within POSITION_READING_MOTION_BANDS quiet bands' turn
+ * over one update (PMSTEP_POSITION_DECIMATION periods, p w_band N T_s electrical rad a band) of
+ * the estimate last taken or kept. w-hat alone does not tell: a load step swings the held rotor
+ * at the hold's natural frequency, above the observer's bandwidth, and w-hat lags it by more than
+ * a quarter turn (17HS4401 at 1.7 A, 257 Hz: w-hat +0.6 rad/s, within the band, with the rotor at
+ * -8). The reading follows the swing; |c_k s-hat - s_k c-hat| is sin of the turn, the estimate
+ * near unit length. */
+static bool reading_at_rest(const pmstep_position_t *pos, float band_rad_s)
+{
+    const float turn_limit_rad = POSITION_READING_MOTION_BANDS * band_rad_s
+                                 * ((float)PMSTEP_POSITION_DECIMATION * pos->period_s) / pos->inv_pole_pairs;
+    return fabsf((pos->frozen_cos * pos->sin_hat) - (pos->frozen_sin * pos->cos_hat)) < turn_limit_rad;
+}
+
+/* At rest for one more update; after a settling time of it, the estimate is kept (taken then,
+ * not when the rest began: the ring-down's last motion would be lost); POSITION_REAIM_PERIODS
+ * later, if more than POSITION_REAIM_ERROR_RAD from the target, re-aimed. */
+static void one_more_update_at_rest(pmstep_position_t *pos)
+{
+    const int32_t keep_after = (int32_t)pos->inst->hold.settle_periods;
+    pos->hold_periods += PMSTEP_POSITION_DECIMATION;
+    if (pos->hold_periods - PMSTEP_POSITION_DECIMATION < keep_after) {
+        pos->frozen_cos = pos->cos_hat;
+        pos->frozen_sin = pos->sin_hat;
+    } else {
+        put_back_kept_estimate(pos);
+    }
+    if (pos->hold_periods >= keep_after + POSITION_REAIM_PERIODS
+        && fabsf(pos->out.position_error_rad) / pos->inv_pole_pairs > POSITION_REAIM_ERROR_RAD) {
+        correct_aim(pos);
+    }
+}
+
 /* An update in a vector hold: settling (after a re-aim, with the turned estimate kept), then the
  * estimate kept while the rotor is at rest (it would drift: nothing observes its phase at zero
- * speed) and followed while the rotor moves;
+ * speed) and followed while the rotor moves (w-hat beyond the quiet band, or the flux integrals'
+ * reading turned beyond its limit in two updates running: reading_at_rest);
  * after POSITION_REAIM_PERIODS more at rest more than POSITION_REAIM_ERROR_RAD from the target
  * (the aim's load angle off, or the load changed), the aim is corrected (pmstep_position.h). */
 void pmstep_position_vector_hold(pmstep_position_t *pos, float position_rad)
@@ -132,23 +167,24 @@ void pmstep_position_vector_hold(pmstep_position_t *pos, float position_rad)
             pos->hold_periods = reaimed ? (int32_t)inst->hold.settle_periods : 0;
             pos->hold_stage = POSITION_HOLD_ANCHORED;
         }
-    } else if (fabsf(pos->speed_hat_rad_s - inst->hold.speed_bias_rad_s) < inst->hold.quiet_band_rad_s) {
-        /* at rest for one more update; after a settling time of it, the estimate is kept (taken
-         * then, not when the rest began: the ring-down's last motion would be lost) */
-        const int32_t keep_after = (int32_t)inst->hold.settle_periods;
-        pos->hold_periods += PMSTEP_POSITION_DECIMATION;
-        if (pos->hold_periods - PMSTEP_POSITION_DECIMATION < keep_after) {
+    } else {
+        const bool quiet = fabsf(pos->speed_hat_rad_s - inst->hold.speed_bias_rad_s) < inst->hold.quiet_band_rad_s;
+        const bool reading_still = reading_at_rest(pos, inst->hold.quiet_band_rad_s);
+        if (quiet && reading_still) {
+            pos->reading_turned = false;
+            one_more_update_at_rest(pos);
+        } else if (quiet && !pos->reading_turned) {
+            /* turned beyond the limit once: a swing's first update, or the reading's noise at its
+             * rare largest; neither kept nor re-aimed on it */
+            pos->reading_turned = true;
+        } else {
+            /* moving (w-hat, or the reading turned in two updates running): the estimate follows
+             * the flux integrals, the last reading the next one's reference */
+            pos->hold_periods = 0;
+            pos->reading_turned = false;
             pos->frozen_cos = pos->cos_hat;
             pos->frozen_sin = pos->sin_hat;
-        } else {
-            put_back_kept_estimate(pos);
         }
-        if (pos->hold_periods >= keep_after + POSITION_REAIM_PERIODS
-            && fabsf(pos->out.position_error_rad) / pos->inv_pole_pairs > POSITION_REAIM_ERROR_RAD) {
-            correct_aim(pos);
-        }
-    } else {
-        pos->hold_periods = 0; /* moving: the estimate follows the flux integrals */
     }
 }
 

@@ -13,6 +13,12 @@
 #define POSITION_HOLD_REFUSED ((int32_t)4) /* until the next move: the loop holds on the estimate */
 #define POSITION_HOLD_REAIMED ((int32_t)5) /* settling after a re-aim, the estimate kept turned with it */
 
+/* The flux integrals' turn over an update taken for motion in a hold, in quiet bands' turns
+ * (pmstep_position_hold.c, reading_at_rest): at rest their noise is a quarter of one (17HS4401,
+ * realistic chain, rms), their drift in the dead time's zero zone with the vector on a phase axis
+ * 0.7 to 1.1 (AS1050), a load step's swing 4 to 5 (0.11 to 0.16 rad an update on the 17HS4401). */
+#define POSITION_READING_MOTION_BANDS 3.0f
+
 /* An update in position mode with the profile ended and no vector yet: the loop holds
  * POSITION_AIM_WAIT_TIME_CONSTANTS / k_theta, then aims the core's vector at the target (or the
  * stage becomes refused). */

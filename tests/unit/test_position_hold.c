@@ -3,7 +3,9 @@
  * p (theta* - theta-hat), ahead by the load angle of T_L-hat), and the two refusals that leave
  * the position loop holding - a load beyond the vector's pull, a move ending more than 1
  * electrical rad off - until the next move; a re-aim at rest, which turns the kept estimate with
- * the vector; and the T_L-hat a move or a stop from the hold starts with. The rotor is held still by the test (the estimate stays where the test puts it), so the
+ * the vector; the rest told from motion by w-hat and by the flux integrals' reading (a swing
+ * that w-hat misses, one noisy reading); and the T_L-hat a move or a stop from the hold starts
+ * with. The rotor is held still by the test (the estimate stays where the test puts it), so the
  * error a move ends with is chosen exactly. */
 #include <stdarg.h>
 #include <stddef.h>
@@ -196,6 +198,81 @@ static void re_aim_turns_the_kept_estimate_with_the_vector(void **state)
     assert_float_equal(core_estimate(&f), REST_ELECTRICAL_RAD + 0.4, 1e-4);
 }
 
+/* A load step swings the held rotor at the hold's natural frequency, which w-hat does not follow
+ * (here it stays 0): the flux integrals' reading turning by more than
+ * POSITION_READING_MOTION_BANDS quiet bands' turn an update (p w_band N T_s a band) is not rest.
+ * Nothing is re-aimed during the swing, though the rotor is far from the target for longer than
+ * the re-aim's 200 periods; once it rests displaced, the vector is turned by the displacement,
+ * and the kept estimate with it. */
+static void swing_that_w_hat_misses_is_not_rest(void **state)
+{
+    fixture_t f;
+    double turn_limit_rad;
+    double reading_rad = REST_ELECTRICAL_RAD;
+    long n;
+    (void)state;
+    held_after_move(&f, 0.0, 0.0f);
+    turn_limit_rad = POSITION_READING_MOTION_BANDS * (double)f.inst.hold.quiet_band_rad_s * PMSTEP_POSITION_DECIMATION
+                     * (double)f.cfg.timing.period_s * (double)f.cfg.motor.pole_pairs;
+    rest_at(&f, REST_ELECTRICAL_RAD, 4 * (long)f.inst.hold.settle_periods + 2000); /* anchored, estimate kept */
+    assert_int_equal(f.pos.hold_stage, POSITION_HOLD_ANCHORED);
+    /* the rotor swings 0.3 electrical rad off at twice the limit an update, and half back */
+    for (n = 0; reading_rad > REST_ELECTRICAL_RAD - 0.3; ++n) {
+        reading_rad -= 2.0 * turn_limit_rad / PMSTEP_POSITION_DECIMATION;
+        rest_at(&f, reading_rad, 1);
+        assert_int_equal(f.pos.hold_stage, POSITION_HOLD_ANCHORED);
+    }
+    for (; reading_rad < REST_ELECTRICAL_RAD - 0.15; ++n) {
+        reading_rad += 2.0 * turn_limit_rad / PMSTEP_POSITION_DECIMATION;
+        rest_at(&f, reading_rad, 1);
+        assert_int_equal(f.pos.hold_stage, POSITION_HOLD_ANCHORED);
+    }
+    print_message("swing of %ld periods at %.4f electrical rad an update (limit %.4f): no re-aim\n", n,
+                  2.0 * turn_limit_rad, turn_limit_rad);
+    assert_true(n > 200);
+    assert_float_equal(vector_angle(&f), REST_ELECTRICAL_RAD, 1e-4);
+    /* at rest 0.15 short: the re-aim turns the vector and the kept estimate by it */
+    for (n = 0; n < 20000 && f.pos.hold_stage != POSITION_HOLD_REAIMED; ++n) {
+        rest_at(&f, reading_rad, 1);
+    }
+    assert_int_equal(f.pos.hold_stage, POSITION_HOLD_REAIMED);
+    assert_float_equal(vector_angle(&f), REST_ELECTRICAL_RAD + (REST_ELECTRICAL_RAD - reading_rad), 1e-4);
+    assert_float_equal(atan2((double)f.pos.frozen_sin, (double)f.pos.frozen_cos), REST_ELECTRICAL_RAD, 1e-4);
+}
+
+/* One update's reading turned beyond the limit (a swing's first, or noise at its rarest) is
+ * neither rest nor motion: the rest count and the kept estimate go on; two running are motion. */
+static void one_turned_reading_is_not_motion(void **state)
+{
+    fixture_t f;
+    double turn_limit_rad;
+    int32_t periods_before;
+    long n;
+    (void)state;
+    held_after_move(&f, 0.0, 0.0f);
+    turn_limit_rad = POSITION_READING_MOTION_BANDS * (double)f.inst.hold.quiet_band_rad_s * PMSTEP_POSITION_DECIMATION
+                     * (double)f.cfg.timing.period_s * (double)f.cfg.motor.pole_pairs;
+    rest_at(&f, REST_ELECTRICAL_RAD, 4 * (long)f.inst.hold.settle_periods); /* anchored, estimate kept */
+    assert_int_equal(f.pos.hold_stage, POSITION_HOLD_ANCHORED);
+    periods_before = f.pos.hold_periods;
+    assert_true(periods_before > (int32_t)f.inst.hold.settle_periods);
+    for (n = 0; n < 10; ++n) {
+        /* one update's reading 3 limits off, then back at rest */
+        rest_at(&f, REST_ELECTRICAL_RAD + 3.0 * turn_limit_rad, PMSTEP_POSITION_DECIMATION);
+        assert_true(f.pos.reading_turned);
+        rest_at(&f, REST_ELECTRICAL_RAD, PMSTEP_POSITION_DECIMATION);
+        assert_false(f.pos.reading_turned);
+    }
+    assert_int_equal(f.pos.hold_stage, POSITION_HOLD_ANCHORED);
+    assert_int_equal(f.pos.hold_periods, periods_before + 10 * PMSTEP_POSITION_DECIMATION);
+    assert_float_equal(atan2((double)f.pos.frozen_sin, (double)f.pos.frozen_cos), REST_ELECTRICAL_RAD, 1e-5);
+    /* two running: motion, the count starts again from the reading */
+    rest_at(&f, REST_ELECTRICAL_RAD + 3.0 * turn_limit_rad, 2 * PMSTEP_POSITION_DECIMATION);
+    assert_int_equal(f.pos.hold_periods, 0);
+    assert_float_equal(atan2((double)f.pos.frozen_sin, (double)f.pos.frozen_cos),
+                       REST_ELECTRICAL_RAD + 3.0 * turn_limit_rad, 1e-5);
+}
+
 /* Held, the observer balances the vector's torque at the estimated angle: an angle error puts
  * part of the hold current into T_L-hat. A move from the hold gives the law the aim's T_L-hat
  * back; a move from a refused hold (no vector) leaves T_L-hat as the observer has it. */
@@ -234,6 +311,8 @@ int main(void)
         cmocka_unit_test(move_ending_more_than_a_radian_off_is_not_aimed),
         cmocka_unit_test(move_from_the_hold_starts_from_the_aims_load),
         cmocka_unit_test(re_aim_turns_the_kept_estimate_with_the_vector),
+        cmocka_unit_test(swing_that_w_hat_misses_is_not_rest),
+        cmocka_unit_test(one_turned_reading_is_not_motion),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

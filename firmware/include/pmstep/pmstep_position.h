@@ -28,7 +28,9 @@
  * aimed at the target's electrical direction (the estimate turned by p (theta* - theta-hat))
  * ahead by the load angle of T_L-hat (read 2/k_theta after the profile ends, while the loop
  * still holds): no estimate drift moves it. Once the rotor has been at rest (|w-hat - w-bar|
- * within the quiet band) for the held rotor's settling time, the estimate is kept where it was
+ * within the quiet band, and the flux integrals' reading turned by less than three bands' turn
+ * in each update: w-hat lags the swing of a light rotor's hold; DESIGN.md section 12) for the
+ * held rotor's settling time, the estimate is kept where it was
  * then, so it does not drift, and it follows the flux integrals while the rotor moves (a load
  * step). After POSITION_REAIM_PERIODS at rest more than 0.05 electrical rad from the target,
  * the aim is turned by that displacement (the load angle off, or the load changed), and the kept
@@ -130,6 +132,8 @@ typedef struct {
     float frozen_sin;
     int32_t hold_stage;       /**< none, waiting, settling, anchored, refused (until the next move) */
     int32_t hold_periods;     /**< waiting, settling: periods left; anchored: periods at rest */
+    bool reading_turned;      /**< anchored: the last update's reading turned beyond its limit
+                                   (three quiet bands' turn), neither rest nor motion yet */
 } pmstep_position_t;
 
 /**
