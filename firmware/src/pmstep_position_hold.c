@@ -132,14 +132,14 @@ static void one_more_update_at_rest(pmstep_position_t *pos)
 {
     const int32_t keep_after = (int32_t)pos->inst->hold.settle_periods;
     pos->hold_periods += PMSTEP_POSITION_DECIMATION;
-    if (pos->hold_periods - PMSTEP_POSITION_DECIMATION < keep_after) {
+    if ((pos->hold_periods - PMSTEP_POSITION_DECIMATION) < keep_after) {
         pos->frozen_cos = pos->cos_hat;
         pos->frozen_sin = pos->sin_hat;
     } else {
         put_back_kept_estimate(pos);
     }
-    if (pos->hold_periods >= keep_after + POSITION_REAIM_PERIODS
-        && fabsf(pos->out.position_error_rad) / pos->inv_pole_pairs > POSITION_REAIM_ERROR_RAD) {
+    if ((pos->hold_periods >= (keep_after + POSITION_REAIM_PERIODS))
+        && ((fabsf(pos->out.position_error_rad) / pos->inv_pole_pairs) > POSITION_REAIM_ERROR_RAD)) {
         correct_aim(pos);
     }
 }
