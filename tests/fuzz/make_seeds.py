@@ -102,6 +102,8 @@ scenario = {
     "print_close_times": b"[speed]\npoints = 0:0, 1.0000000001:1, 1.0000000002:2\n",
     "print_subnormal": b"[motor]\nfriction_Nms_rad = 0x1p-1074\n",
     "print_angle": b"[run]\ntheta0_deg = 123.45678901234567\n\n--set\nrun.theta0_deg=-999999.99999999988\n",
+    # no decimal of rad * 180 / pi converts back to this one's radians: a neighbouring double does
+    "print_angle_neighbour": b"[run]\ntheta0_deg = 1.0029999999999997\n",
 }
 
 for folder, seeds in (("core", core), ("scenario", scenario)):

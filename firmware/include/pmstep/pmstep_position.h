@@ -28,8 +28,9 @@
  * aimed at the target's electrical direction (the estimate turned by p (theta* - theta-hat))
  * ahead by the load angle of T_L-hat (read 2/k_theta after the profile ends, while the loop
  * still holds): no estimate drift moves it. Once the rotor has been at rest (|w-hat - w-bar|
- * within the quiet band, and the flux integrals' reading turned by less than three bands' turn
- * in each update: w-hat lags the swing of a light rotor's hold; DESIGN.md section 12) for the
+ * within the quiet band, and the flux integrals' reading not turned by more than three bands'
+ * turn in two updates running: w-hat lags the swing of a light rotor's hold; DESIGN.md section
+ * 12; an update with one such turn is neither rest nor motion) for the
  * held rotor's settling time, the estimate is kept where it was
  * then, so it does not drift, and it follows the flux integrals while the rotor moves (a load
  * step). After POSITION_REAIM_PERIODS at rest more than 0.05 electrical rad from the target,
