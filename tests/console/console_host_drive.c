@@ -53,7 +53,8 @@ int main(int argc, char **argv)
     if (pmstep_init(&motor, &cfg) != PMSTEP_OK) {
         return 2;
     }
-    pmstep_console_init(&con, "pmstep host-drive", true);
+    pmstep_console_init(&con, "pmstep host-drive");
+    pmstep_console_attach_simulation(&con);
     if (with_position) {
         pmstep_position_config_t gains;
         if (pmstep_position_design(&cfg, &gains) != PMSTEP_OK || pmstep_position_init(&position, &motor, &gains) != PMSTEP_OK) {

@@ -24,7 +24,7 @@ static pmstep_console_snapshot_t snap;
 static int setup(void **state)
 {
     (void)state;
-    pmstep_console_init(&con, "pmstep 0.1.0 test", false);
+    pmstep_console_init(&con, "pmstep 0.1.0 test");
     cfg = pmstep_console_app_config(50e-6f, 1u);
     assert_int_equal(pmstep_init(&motor, &cfg), PMSTEP_OK);
     memset(&snap, 0, sizeof snap);
@@ -308,6 +308,136 @@ static void test_status_and_telemetry(void **state)
     assert_int_equal(r[n - 1u].n, 41u);
 }
 
+/* Two requests in one receive call (a UART poll reads several bytes): the second, refused as
+ * busy, leaves the waiting one exactly as it was. Each case of the review's finding. */
+static void send_two(uint8_t type1, const void *data1, uint32_t n1, uint8_t type2, const void *data2, uint32_t n2)
+{
+    uint8_t buf[160];
+    uint32_t len = console_test_frame(buf, type1, 1u, data1, n1);
+    len += console_test_frame(buf + len, type2, 2u, data2, n2);
+    pmstep_console_receive(&con, buf, len, 0u);
+}
+
+static void set_config_data(uint8_t *req, uint8_t id, float value)
+{
+    req[0] = id;
+    memcpy(&req[1], &value, 4u);
+}
+
+static uint8_t config_id(const char *name)
+{
+    uint32_t count;
+    const pmstep_console_config_entry_t *t = pmstep_console_config_table(&count);
+    uint32_t id;
+    for (id = 0; id < count; ++id) {
+        if (strcmp(t[id].name, name) == 0) {
+            return (uint8_t)id;
+        }
+    }
+    fail_msg("no configuration value %s", name);
+    return 0u;
+}
+
+static float config_value(const char *name)
+{
+    float v = 0.0f;
+    assert_true(pmstep_console_config_get(&cfg, config_id(name), &v));
+    return v;
+}
+
+static void test_busy_refusal_changes_nothing(void **state)
+{
+    reply_t r[4];
+    uint8_t set[5];
+    uint8_t get[1];
+    const float speed[2] = {10.0f, 50.0f};
+    const float huge_speed[2] = {1e30f, 50.0f};
+    const float id_target = 300.0f;
+    const float trip_before = config_value("limits.max_phase_current_A");
+    const float max_bus_before = config_value("limits.max_bus_voltage_V");
+    (void)state;
+    /* SET_CONFIG of the bus limit, then GET_CONFIG of the current trip: the set applies to the
+     * bus limit, not to the trip the busy GET named. */
+    set_config_data(set, config_id("limits.max_bus_voltage_V"), 55.0f);
+    get[0] = config_id("limits.max_phase_current_A");
+    send_two(PMSTEP_CONSOLE_SET_CONFIG, set, 5u, PMSTEP_CONSOLE_GET_CONFIG, get, 1u);
+    assert_int_equal(replies(r, 4), 1u);
+    assert_int_equal(r[0].data[0], PMSTEP_CONSOLE_GET_CONFIG);
+    assert_int_equal(r[0].data[1], PMSTEP_CONSOLE_ERR_BUSY);
+    step();
+    assert_int_equal(replies(r, 4), 1u);
+    assert_int_equal(r[0].type, PMSTEP_CONSOLE_SET_CONFIG | 0x80u);
+    assert_int_equal(ack_status(&r[0]), PMSTEP_OK);
+    assert_float_equal(config_value("limits.max_phase_current_A"), trip_before, 0.0f);
+    assert_float_equal(config_value("limits.max_bus_voltage_V"), 55.0f, 0.0f);
+    assert_true(max_bus_before != 55.0f);
+    /* SET_CONFIG of the trip, then SPEED_TARGET 1e30: the trip takes the SET's value. */
+    set_config_data(set, config_id("limits.max_phase_current_A"), 10.0f);
+    send_two(PMSTEP_CONSOLE_SET_CONFIG, set, 5u, PMSTEP_CONSOLE_SPEED_TARGET, huge_speed, 8u);
+    assert_int_equal(replies(r, 4), 1u);
+    assert_int_equal(r[0].data[1], PMSTEP_CONSOLE_ERR_BUSY);
+    step();
+    assert_int_equal(replies(r, 4), 1u);
+    assert_int_equal(ack_status(&r[0]), PMSTEP_OK);
+    assert_float_equal(config_value("limits.max_phase_current_A"), 10.0f, 0.0f);
+    /* SPEED_TARGET 10, then ID_TARGET 300: the speed target the core gets is 10 rad/s. */
+    send_request(PMSTEP_CONSOLE_START, 3u, NULL, 0u);
+    step();
+    (void)replies(r, 4);
+    send_two(PMSTEP_CONSOLE_SPEED_TARGET, speed, 8u, PMSTEP_CONSOLE_ID_TARGET, &id_target, 4u);
+    assert_int_equal(replies(r, 4), 1u);
+    assert_int_equal(r[0].data[0], PMSTEP_CONSOLE_ID_TARGET);
+    assert_int_equal(r[0].data[1], PMSTEP_CONSOLE_ERR_BUSY);
+    step();
+    assert_int_equal(replies(r, 4), 1u);
+    assert_int_equal(r[0].type, PMSTEP_CONSOLE_SPEED_TARGET | 0x80u);
+    assert_float_equal(motor.speed_ref.target, 10.0f, 0.0f);
+    assert_float_equal(motor.i_d_ref.target, 0.0f, 0.0f);
+}
+
+/* START applied at a boundary, SET_CONFIG at the next one before any step ran: the snapshot still
+ * reads IDLE, the core does not; the configuration is refused and the start stands. */
+static void test_set_config_after_start_refused(void **state)
+{
+    reply_t r[2];
+    uint8_t set[5];
+    (void)state;
+    send_request(PMSTEP_CONSOLE_START, 1u, NULL, 0u);
+    boundary(); /* applied; no step yet, the snapshot says IDLE */
+    assert_int_equal(replies(r, 2), 1u);
+    assert_int_equal(ack_status(&r[0]), PMSTEP_OK);
+    assert_int_equal(snap.out.mode, PMSTEP_MODE_IDLE);
+    set_config_data(set, config_id("gains.speed_gain_per_s"), 90.0f);
+    send_request(PMSTEP_CONSOLE_SET_CONFIG, 2u, set, 5u);
+    boundary();
+    assert_int_equal(replies(r, 2), 1u);
+    assert_int_equal(r[0].type, 0xFFu);
+    assert_int_equal(r[0].data[1], PMSTEP_CONSOLE_ERR_NOT_STOPPED);
+    assert_float_equal(config_value("gains.speed_gain_per_s"), 100.0f, 0.0f);
+    assert_int_not_equal(pmstep_get_mode(&motor), PMSTEP_MODE_IDLE);
+}
+
+/* In FAULT a configuration change is refused: the fault stays latched until CLEAR_FAULT. */
+static void test_set_config_in_fault_refused(void **state)
+{
+    reply_t r[2];
+    uint8_t set[5];
+    const pmstep_meas_t over = {100.0f, 0.0f, 48.0f, 0.0f, 0.0f, 0.0f};
+    (void)state;
+    send_request(PMSTEP_CONSOLE_START, 1u, NULL, 0u);
+    step();
+    pmstep_step(&motor, &over, &snap.out); /* overcurrent */
+    assert_int_equal(pmstep_get_mode(&motor), PMSTEP_MODE_FAULT);
+    (void)replies(r, 2);
+    set_config_data(set, config_id("gains.speed_gain_per_s"), 90.0f);
+    send_request(PMSTEP_CONSOLE_SET_CONFIG, 2u, set, 5u);
+    boundary();
+    assert_int_equal(replies(r, 2), 1u);
+    assert_int_equal(r[0].data[1], PMSTEP_CONSOLE_ERR_NOT_STOPPED);
+    assert_int_equal(pmstep_get_mode(&motor), PMSTEP_MODE_FAULT);
+    assert_int_equal(motor.fault, PMSTEP_FAULT_OVERCURRENT);
+}
+
 /* Bad input of every kind, seeded: never a command, never a change of the core's instance,
  * every byte accounted for, and the console answers a good request afterwards. */
 static void test_fuzz_never_reaches_core(void **state)
@@ -383,6 +513,9 @@ int main(void)
         cmocka_unit_test_setup(test_command_at_period_boundary, setup),
         cmocka_unit_test_setup(test_errors_answered, setup),
         cmocka_unit_test_setup(test_config_by_name_and_id, setup),
+        cmocka_unit_test_setup(test_busy_refusal_changes_nothing, setup),
+        cmocka_unit_test_setup(test_set_config_after_start_refused, setup),
+        cmocka_unit_test_setup(test_set_config_in_fault_refused, setup),
         cmocka_unit_test_setup(test_status_and_telemetry, setup),
         cmocka_unit_test_setup(test_fuzz_never_reaches_core, setup),
         cmocka_unit_test_setup(test_flood_drops_and_counts, setup),

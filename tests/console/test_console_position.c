@@ -27,7 +27,7 @@ static int setup(void **state)
 {
     pmstep_position_config_t gains;
     (void)state;
-    pmstep_console_init(&con, "pmstep test", false);
+    pmstep_console_init(&con, "pmstep test");
     cfg = pmstep_console_app_config(50e-6f, 1u);
     assert_int_equal(pmstep_init(&motor, &cfg), PMSTEP_OK);
     assert_int_equal(pmstep_position_design(&cfg, &gains), PMSTEP_OK);

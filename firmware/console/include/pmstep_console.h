@@ -22,7 +22,9 @@
  *   0x06 ID_TARGET          target f32               -> ACK (pmstep_set_id_target)
  *   0x07 GET_STATUS         -                        -> STATUS (pmstep_console_encode_status)
  *   0x08 GET_CONFIG         id u8 | 0xFF name        -> id u8, type u8, flags u8, value f32, name
- *   0x09 SET_CONFIG         id u8 | 0xFF, value f32 [, name]  -> ACK (IDLE or FAULT only)
+ *   0x09 SET_CONFIG         id u8 | 0xFF, value f32 [, name]  -> ACK (IDLE only, as the core is at the
+ *                              boundary that applies it: else error NOT_STOPPED; the whole
+ *                              configuration is validated, position gains designed again)
  *   0x0A GET_COMMISSIONING  -                        -> measured u8, offset_samples u32,
  *                              realignments u32, 8 f32 (offsets a/b, R, current scale, L, k_M,
  *                              voltage biases a/b)
@@ -58,7 +60,8 @@
  * Bad input - bytes outside a frame, a length out of range, a frame cut short (no byte for
  * PMSTEP_CONSOLE_TRUNCATION_MS), a wrong CRC - is dropped and counted; a well-framed
  * request that is unknown, of the wrong length, with a non-finite value, or sent while one
- * is still waiting, gets an error reply and is counted. Nothing blocks: a full transmit
+ * is still waiting, gets an error reply and is counted; a refused request changes nothing (it
+ * is parsed into a request of its own and enters the mailbox whole, or not at all). Nothing blocks: a full transmit
  * buffer drops the frame and counts it.
  */
 #ifndef PMSTEP_CONSOLE_H
@@ -131,7 +134,8 @@ typedef struct {
 } pmstep_console_position_reading_t;
 
 /** Applies a position request to @p pos (pmstep_console_position.c, linked only by an image that
- *  attaches position control): @p args as parsed; @p reading filled for GET_POSITION.
+ *  attaches position control): @p args as parsed; @p reading filled for GET_POSITION. @p cmd
+ *  SET_CONFIG: the core's configuration changed, the loop's gains are designed from it again.
  *  @return the pmstep_status_t of the core's call. */
 typedef int32_t (*pmstep_console_position_apply_t)(pmstep_position_t *pos, uint8_t cmd, const float *args,
                                                     pmstep_console_position_reading_t *reading);
@@ -195,7 +199,26 @@ float pmstep_console_config_period_s(const pmstep_config_t *cfg);
 /** The computational delay (periods) of @p cfg. */
 uint32_t pmstep_console_config_delay_periods(const pmstep_config_t *cfg);
 
+/** A request as parsed from its frame: the mailbox takes a whole one when it is accepted, or
+ *  nothing (a refused request, busy included, changes no state). */
 typedef struct {
+    uint8_t cmd;
+    uint8_t seq;
+    uint8_t cfg_id;       /**< GET_CONFIG, SET_CONFIG */
+    float a;              /**< SPEED_TARGET target, ID_TARGET target, SET_CONFIG value */
+    float b;              /**< SPEED_TARGET ramp */
+    uint32_t u;           /**< TELEMETRY decimation */
+    float arg[4];         /**< a position request's values (absent ones 0) */
+} pmstep_console_request_t;
+
+struct pmstep_console;
+
+/** The simulation images' requests (SIM_ADVANCE, SIM_FINISH; pmstep_console_sim.c): answers
+ *  @p type with DATA @p d of @p n bytes. @return 0, or the pmstep_console_error_t to reply. */
+typedef int (*pmstep_console_sim_request_t)(struct pmstep_console *c, uint8_t type, uint8_t seq,
+                                            const uint8_t *d, uint32_t n);
+
+typedef struct pmstep_console {
     /* receiver */
     uint8_t state;
     uint8_t len;
@@ -204,18 +227,12 @@ typedef struct {
     uint32_t last_byte_ms;
     /* mailbox: one command waiting for a period boundary */
     bool pending;
-    uint8_t cmd;
-    uint8_t seq;
-    uint8_t cfg_id;
-    float a;
-    float b;
-    uint32_t u;
-    float arg[4];         /**< a position request's values */
+    pmstep_console_request_t mail;
     /* position control (NULL: none, the position requests are refused) */
     pmstep_position_t *position;
     pmstep_console_position_apply_t position_apply;
-    /* simulation images: periods to run (SIM_ADVANCE) */
-    bool simulation;
+    /* simulation images (NULL: none, the simulation requests are refused): periods to run */
+    pmstep_console_sim_request_t sim_request;
     uint32_t advance_periods;
     uint8_t advance_seq;
     bool advancing;
@@ -232,7 +249,14 @@ typedef struct {
 } pmstep_console_t;
 
 /** A console in its initial state; @p identity is the hello text (must outlive it). */
-void pmstep_console_init(pmstep_console_t *c, const char *identity, bool simulation);
+void pmstep_console_init(pmstep_console_t *c, const char *identity);
+
+/**
+ * Makes @p c a simulation image's console: SIM_ADVANCE and SIM_FINISH are served
+ * (pmstep_console_sim.c, linked only by an image that calls this); elsewhere they get the error
+ * reply PMSTEP_CONSOLE_ERR_NOT_SUPPORTED.
+ */
+void pmstep_console_attach_simulation(pmstep_console_t *c);
 
 /**
  * Attaches position control (@p pos, initialised with pmstep_position_init() on the instance the

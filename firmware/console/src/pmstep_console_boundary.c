@@ -1,6 +1,6 @@
 /*
  * Command and telemetry interface: at a period boundary (see pmstep_console.h): the mailbox's
- * request applied to the core and answered, the telemetry frames, the simulator's advance.
+ * request applied to the core and answered, and the telemetry frames.
  */
 #include "pmstep_console_internal.h"
 
@@ -64,14 +64,15 @@ static void send_position(pmstep_console_t *c, uint8_t seq, int32_t status, cons
 void pmstep_console_boundary(pmstep_console_t *c, pmstep_t *inst, pmstep_config_t *cfg,
                              const pmstep_console_snapshot_t *snap)
 {
-    const uint8_t seq = c->seq;
+    const pmstep_console_request_t *req = &c->mail;
+    const uint8_t seq = req->seq;
     int32_t st = 0;
     if (!c->pending) {
         return;
     }
     c->pending = false;
     c->count.commands_applied++;
-    switch (c->cmd) {
+    switch (req->cmd) {
     case PMSTEP_CONSOLE_START:
         st = (int32_t)pmstep_start(inst);
         break;
@@ -82,24 +83,24 @@ void pmstep_console_boundary(pmstep_console_t *c, pmstep_t *inst, pmstep_config_
         st = (int32_t)pmstep_clear_fault(inst);
         break;
     case PMSTEP_CONSOLE_SPEED_TARGET:
-        st = (int32_t)pmstep_set_speed_target(inst, c->a, c->b);
+        st = (int32_t)pmstep_set_speed_target(inst, req->a, req->b);
         break;
     case PMSTEP_CONSOLE_ID_TARGET:
-        st = (int32_t)pmstep_set_id_target(inst, c->a);
+        st = (int32_t)pmstep_set_id_target(inst, req->a);
         break;
     case PMSTEP_CONSOLE_TELEMETRY:
         /* Frames for the periods that are multiples of the decimation, from the next one on. */
-        c->decimation = c->u;
-        c->next_telemetry = c->u == 0u ? 0u : (snap->period + 1u) - (snap->period + 1u) % c->u + c->u;
+        c->decimation = req->u;
+        c->next_telemetry = req->u == 0u ? 0u : (snap->period + 1u) - (snap->period + 1u) % req->u + req->u;
         break;
     case PMSTEP_CONSOLE_MOVE_TO:
     case PMSTEP_CONSOLE_HOLD:
     case PMSTEP_CONSOLE_SET_POSITION_ZERO:
-        st = c->position_apply(c->position, c->cmd, c->arg, NULL); /* attached: checked at parsing */
+        st = c->position_apply(c->position, req->cmd, req->arg, NULL); /* attached: checked at parsing */
         break;
     case PMSTEP_CONSOLE_GET_POSITION: {
         pmstep_console_position_reading_t r;
-        st = c->position_apply(c->position, c->cmd, c->arg, &r);
+        st = c->position_apply(c->position, req->cmd, req->arg, &r);
         send_position(c, seq, st, snap, &r);
         return;
     }
@@ -107,7 +108,7 @@ void pmstep_console_boundary(pmstep_console_t *c, pmstep_t *inst, pmstep_config_
         send_status(c, seq, snap);
         return;
     case PMSTEP_CONSOLE_GET_CONFIG:
-        send_config(c, seq, cfg, c->cfg_id);
+        send_config(c, seq, cfg, req->cfg_id);
         return;
     case PMSTEP_CONSOLE_GET_COMMISSIONING: {
         pmstep_commissioning_t cm;
@@ -131,14 +132,16 @@ void pmstep_console_boundary(pmstep_console_t *c, pmstep_t *inst, pmstep_config_
     case PMSTEP_CONSOLE_SET_CONFIG: {
         pmstep_config_t trial;
         int err;
-        /* A configuration change re-initialises the core: only with the motor stopped. */
-        if (snap->out.mode != PMSTEP_MODE_IDLE) {
+        /* A configuration change re-initialises the core: only with the motor stopped, as the core
+         * is now (a START applied at an earlier boundary may not have reached a step yet, so the
+         * snapshot's mode cannot tell), and never out of FAULT (only CLEAR_FAULT leaves it). */
+        if (pmstep_get_mode(inst) != PMSTEP_MODE_IDLE) {
             c->count.commands_applied--;
             pmstep_console_send_error(c, PMSTEP_CONSOLE_SET_CONFIG, seq, PMSTEP_CONSOLE_ERR_NOT_STOPPED);
             return;
         }
         trial = *cfg;
-        err = pmstep_console_config_set(&trial, c->cfg_id, c->a);
+        err = pmstep_console_config_set(&trial, req->cfg_id, req->a);
         if (err != 0) {
             c->count.commands_applied--;
             pmstep_console_send_error(c, PMSTEP_CONSOLE_SET_CONFIG, seq, (pmstep_console_error_t)err);
@@ -149,12 +152,15 @@ void pmstep_console_boundary(pmstep_console_t *c, pmstep_t *inst, pmstep_config_
             *cfg = trial;
             st = (int32_t)pmstep_init(inst, cfg);
         }
+        if (st == (int32_t)PMSTEP_OK && c->position_apply != NULL) {
+            st = c->position_apply(c->position, PMSTEP_CONSOLE_SET_CONFIG, req->arg, NULL); /* gains anew */
+        }
         break;
     }
     default:
         break;
     }
-    pmstep_console_send_ack(c, c->cmd, seq, st, snap->period + 1u);
+    pmstep_console_send_ack(c, req->cmd, seq, st, snap->period + 1u);
 }
 
 void pmstep_console_telemetry(pmstep_console_t *c, const pmstep_console_snapshot_t *snap)
@@ -183,30 +189,7 @@ void pmstep_console_telemetry(pmstep_console_t *c, const pmstep_console_snapshot
     pmstep_console_send(c, PMSTEP_CONSOLE_TELEMETRY_FRAME, 0u, w.b, w.n);
 }
 
-uint32_t pmstep_console_advance_request(pmstep_console_t *c)
-{
-    return c->advancing ? c->advance_periods : 0u;
-}
-
-void pmstep_console_advance_done(pmstep_console_t *c, uint32_t period)
-{
-    writer_t w;
-    if (!c->advancing) {
-        return;
-    }
-    c->advancing = false;
-    w.n = 0;
-    put_u16(&w, 0u);
-    put_u32(&w, period);
-    pmstep_console_send(c, PMSTEP_CONSOLE_SIM_ADVANCE | 0x80u, c->advance_seq, w.b, w.n);
-}
-
-bool pmstep_console_finish_requested(const pmstep_console_t *c)
-{
-    return c->finish_requested;
-}
-
 uint8_t pmstep_console_pending_command(const pmstep_console_t *c)
 {
-    return c->pending ? c->cmd : 0u;
+    return c->pending ? c->mail.cmd : 0u;
 }

@@ -21,6 +21,14 @@ static int32_t position_apply(pmstep_position_t *pos, uint8_t cmd, const float *
     case PMSTEP_CONSOLE_SET_POSITION_ZERO:
         st = pmstep_position_set_zero(pos);
         break;
+    case PMSTEP_CONSOLE_SET_CONFIG: { /* the core took a new configuration: the loop's gains from it */
+        pmstep_position_config_t gains;
+        st = pmstep_position_design(pos->inst->cfg, &gains);
+        if (st == PMSTEP_OK) {
+            st = pmstep_position_init(pos, pos->inst, &gains);
+        }
+        break;
+    }
     default: /* GET_POSITION: the present period's estimate and theta* */
         reading->position_rad = 0.0f;
         reading->position_ref_rad = 0.0f;

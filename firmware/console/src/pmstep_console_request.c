@@ -1,12 +1,35 @@
 /*
- * Command and telemetry interface: a request on arrival (see pmstep_console.h). HELLO,
- * GET_COUNTERS and every error are answered at once; any other request is checked and put in
- * the mailbox for the next period boundary (pmstep_console_boundary.c).
- * Every loop is bounded by a frame's length; nothing waits on anything.
+ * Command and telemetry interface: a request on arrival (see pmstep_console.h). A table gives
+ * each request type its DATA length and its parser. HELLO, GET_COUNTERS, the simulation
+ * requests and every error are answered at once; any other request is parsed into a request of
+ * its own and, only once accepted, put whole in the mailbox for the next period boundary
+ * (pmstep_console_boundary.c): a refused request, busy included, changes nothing.
+ * Every loop is bounded by a frame's length or the table's; nothing waits on anything.
  */
 #include "pmstep_console_internal.h"
 
 #include <stddef.h>
+
+/* A parser's outcome besides an error code (pmstep_console_error_t, > 0). */
+#define REQUEST_QUEUE 0     /* accepted: @p req goes to the mailbox */
+#define REQUEST_ANSWERED -1 /* answered at once, nothing for the mailbox */
+
+/* Parses DATA @p d of @p n bytes (its length already within the row's) into @p req.
+ * @return REQUEST_QUEUE, REQUEST_ANSWERED, or the error code to reply. */
+typedef int (*request_parse_t)(pmstep_console_t *c, const uint8_t *d, uint32_t n, pmstep_console_request_t *req);
+
+/* What a request needs of the image before its length is looked at. */
+#define NEEDS_NOTHING 0u
+#define NEEDS_POSITION 1u   /* position control attached, else PMSTEP_CONSOLE_ERR_NO_POSITION */
+#define NEEDS_SIMULATION 2u /* a simulation image, else PMSTEP_CONSOLE_ERR_NOT_SUPPORTED */
+
+typedef struct {
+    uint8_t type;
+    uint8_t needs;
+    uint8_t min_length; /* DATA bytes */
+    uint8_t max_length;
+    request_parse_t parse;
+} request_row_t;
 
 /* The id of the configuration value named by @p n bytes at @p name, or -1. */
 static int32_t config_by_name(const uint8_t *name, uint32_t n)
@@ -27,193 +50,199 @@ static int32_t config_by_name(const uint8_t *name, uint32_t n)
     return -1;
 }
 
-/* A position request's DATA into c->arg (absent values 0): false after an error reply. */
-static bool parse_position(pmstep_console_t *c, uint8_t type, uint8_t seq, const uint8_t *d, uint32_t n)
+static int parse_hello(pmstep_console_t *c, const uint8_t *d, uint32_t n, pmstep_console_request_t *req)
 {
-    uint32_t i;
-    bool length_ok;
-    if (c->position == NULL || c->position_apply == NULL) {
-        pmstep_console_send_error(c, type, seq, PMSTEP_CONSOLE_ERR_NO_POSITION);
-        return false;
-    }
-    if (type == PMSTEP_CONSOLE_MOVE_TO) {
-        length_ok = n == 12u || n == 16u;
-    } else if (type == PMSTEP_CONSOLE_HOLD) {
-        length_ok = n == 0u || n == 4u;
-    } else {
-        length_ok = n == 0u;
-    }
-    if (!length_ok) {
-        pmstep_console_send_error(c, type, seq, PMSTEP_CONSOLE_ERR_BAD_LENGTH);
-        return false;
-    }
-    for (i = 0; i < 4u; ++i) {
-        c->arg[i] = 4u * i < n ? get_f32(d + 4u * i) : 0.0f;
-        if (!is_finite(c->arg[i])) {
-            pmstep_console_send_error(c, type, seq, PMSTEP_CONSOLE_ERR_BAD_VALUE);
-            return false;
-        }
-    }
-    return true;
+    writer_t w;
+    (void)d;
+    (void)n;
+    w.n = 0;
+    put_u8(&w, PMSTEP_CONSOLE_PROTOCOL_VERSION);
+    put_u8(&w, PMSTEP_CONSOLE_MAX_PAYLOAD);
+    put_text(&w, c->identity != NULL ? c->identity : "pmstep", PMSTEP_CONSOLE_MAX_PAYLOAD - 4u);
+    pmstep_console_send(c, (uint8_t)(req->cmd | 0x80u), req->seq, w.b, w.n);
+    return REQUEST_ANSWERED;
 }
 
-/* A request with a good CRC: answered now (HELLO, GET_COUNTERS, errors), or put in the
- * mailbox for the next period boundary. */
+static int parse_counters(pmstep_console_t *c, const uint8_t *d, uint32_t n, pmstep_console_request_t *req)
+{
+    const pmstep_console_counters_t *k = &c->count;
+    const uint32_t values[] = {k->rx_bytes,          k->rx_frames,        k->rx_garbage_bytes, k->rx_bad_length,
+                               k->rx_crc_errors,     k->rx_truncated,     k->rx_error_replies, k->commands_applied,
+                               k->tx_frames,         k->tx_dropped,       k->telemetry_frames};
+    writer_t w;
+    uint32_t i;
+    (void)d;
+    (void)n;
+    w.n = 0;
+    for (i = 0; i < sizeof values / sizeof values[0]; ++i) {
+        put_u32(&w, values[i]);
+    }
+    pmstep_console_send(c, (uint8_t)(req->cmd | 0x80u), req->seq, w.b, w.n);
+    return REQUEST_ANSWERED;
+}
+
+static int parse_simulation(pmstep_console_t *c, const uint8_t *d, uint32_t n, pmstep_console_request_t *req)
+{
+    const int err = c->sim_request(c, req->cmd, req->seq, d, n); /* attached: checked by the row */
+    return err != 0 ? err : REQUEST_ANSWERED;
+}
+
+/* A request without values (its length checked by the row). */
+static int parse_plain(pmstep_console_t *c, const uint8_t *d, uint32_t n, pmstep_console_request_t *req)
+{
+    (void)c;
+    (void)d;
+    (void)n;
+    (void)req;
+    return REQUEST_QUEUE;
+}
+
+static int parse_speed_target(pmstep_console_t *c, const uint8_t *d, uint32_t n, pmstep_console_request_t *req)
+{
+    (void)c;
+    (void)n;
+    req->a = get_f32(d);
+    req->b = get_f32(d + 4);
+    return is_finite(req->a) && is_finite(req->b) ? REQUEST_QUEUE : PMSTEP_CONSOLE_ERR_BAD_VALUE;
+}
+
+static int parse_id_target(pmstep_console_t *c, const uint8_t *d, uint32_t n, pmstep_console_request_t *req)
+{
+    (void)c;
+    (void)n;
+    req->a = get_f32(d);
+    return is_finite(req->a) ? REQUEST_QUEUE : PMSTEP_CONSOLE_ERR_BAD_VALUE;
+}
+
+static int parse_telemetry(pmstep_console_t *c, const uint8_t *d, uint32_t n, pmstep_console_request_t *req)
+{
+    (void)c;
+    (void)n;
+    req->u = get_u32(d);
+    return REQUEST_QUEUE;
+}
+
+/* GET_CONFIG: id, or 0xFF and a name; SET_CONFIG: the same with a value after the id. */
+static int parse_config(pmstep_console_t *c, const uint8_t *d, uint32_t n, pmstep_console_request_t *req)
+{
+    const bool set = req->cmd == PMSTEP_CONSOLE_SET_CONFIG;
+    const uint32_t fixed = set ? 5u : 1u; /* id (+ value) */
+    const bool by_name = d[0] == 0xFFu;
+    uint32_t count;
+    const pmstep_console_config_entry_t *t = pmstep_console_config_table(&count);
+    int32_t id;
+    (void)c;
+    if (by_name ? n == fixed : n != fixed) {
+        return PMSTEP_CONSOLE_ERR_BAD_LENGTH;
+    }
+    id = by_name ? config_by_name(d + fixed, n - fixed) : (int32_t)d[0];
+    if (id < 0 || (uint32_t)id >= count) {
+        return PMSTEP_CONSOLE_ERR_UNKNOWN_CONFIG;
+    }
+    req->cfg_id = (uint8_t)id;
+    if (!set) {
+        return REQUEST_QUEUE;
+    }
+    if ((t[id].flags & PMSTEP_CONSOLE_CFG_READ_ONLY) != 0u) {
+        return PMSTEP_CONSOLE_ERR_READ_ONLY;
+    }
+    req->a = get_f32(d + 1);
+    return is_finite(req->a) ? REQUEST_QUEUE : PMSTEP_CONSOLE_ERR_BAD_VALUE;
+}
+
+/* A position request's values, whole floats only (MOVE_TO 3 or 4, HOLD 0 or 1), absent ones 0. */
+static int parse_position(pmstep_console_t *c, const uint8_t *d, uint32_t n, pmstep_console_request_t *req)
+{
+    uint32_t i;
+    (void)c;
+    if (n % 4u != 0u) {
+        return PMSTEP_CONSOLE_ERR_BAD_LENGTH;
+    }
+    for (i = 0; i < 4u; ++i) {
+        req->arg[i] = 4u * i < n ? get_f32(d + 4u * i) : 0.0f;
+        if (!is_finite(req->arg[i])) {
+            return PMSTEP_CONSOLE_ERR_BAD_VALUE;
+        }
+    }
+    return REQUEST_QUEUE;
+}
+
+#define NAME_ROOM (PMSTEP_CONSOLE_MAX_PAYLOAD - 2u) /* DATA bytes a frame can carry */
+
+static const request_row_t requests[] = {
+    {PMSTEP_CONSOLE_HELLO, NEEDS_NOTHING, 0u, 0u, parse_hello},
+    {PMSTEP_CONSOLE_START, NEEDS_NOTHING, 0u, 0u, parse_plain},
+    {PMSTEP_CONSOLE_STOP, NEEDS_NOTHING, 0u, 0u, parse_plain},
+    {PMSTEP_CONSOLE_CLEAR_FAULT, NEEDS_NOTHING, 0u, 0u, parse_plain},
+    {PMSTEP_CONSOLE_SPEED_TARGET, NEEDS_NOTHING, 8u, 8u, parse_speed_target},
+    {PMSTEP_CONSOLE_ID_TARGET, NEEDS_NOTHING, 4u, 4u, parse_id_target},
+    {PMSTEP_CONSOLE_GET_STATUS, NEEDS_NOTHING, 0u, 0u, parse_plain},
+    {PMSTEP_CONSOLE_GET_CONFIG, NEEDS_NOTHING, 1u, NAME_ROOM, parse_config},
+    {PMSTEP_CONSOLE_SET_CONFIG, NEEDS_NOTHING, 5u, NAME_ROOM, parse_config},
+    {PMSTEP_CONSOLE_GET_COMMISSIONING, NEEDS_NOTHING, 0u, 0u, parse_plain},
+    {PMSTEP_CONSOLE_TELEMETRY, NEEDS_NOTHING, 4u, 4u, parse_telemetry},
+    {PMSTEP_CONSOLE_GET_COUNTERS, NEEDS_NOTHING, 0u, 0u, parse_counters},
+    {PMSTEP_CONSOLE_MOVE_TO, NEEDS_POSITION, 12u, 16u, parse_position},
+    {PMSTEP_CONSOLE_HOLD, NEEDS_POSITION, 0u, 4u, parse_position},
+    {PMSTEP_CONSOLE_GET_POSITION, NEEDS_POSITION, 0u, 0u, parse_position},
+    {PMSTEP_CONSOLE_SET_POSITION_ZERO, NEEDS_POSITION, 0u, 0u, parse_position},
+    {PMSTEP_CONSOLE_SIM_ADVANCE, NEEDS_SIMULATION, 4u, 4u, parse_simulation},
+    {PMSTEP_CONSOLE_SIM_FINISH, NEEDS_SIMULATION, 0u, 0u, parse_simulation},
+};
+
+static const request_row_t *request_row(uint8_t type)
+{
+    uint32_t i;
+    for (i = 0; i < sizeof requests / sizeof requests[0]; ++i) {
+        if (requests[i].type == type) {
+            return &requests[i];
+        }
+    }
+    return NULL;
+}
+
+/* Whether the image has what @p row needs; the error reply otherwise. */
+static int row_available(const pmstep_console_t *c, const request_row_t *row)
+{
+    if (row->needs == NEEDS_POSITION && (c->position == NULL || c->position_apply == NULL)) {
+        return PMSTEP_CONSOLE_ERR_NO_POSITION;
+    }
+    if (row->needs == NEEDS_SIMULATION && c->sim_request == NULL) {
+        return PMSTEP_CONSOLE_ERR_NOT_SUPPORTED;
+    }
+    return REQUEST_QUEUE;
+}
+
+/* A request with a good CRC: answered now (HELLO, GET_COUNTERS, the simulation's, errors), or
+ * put in the mailbox for the next period boundary. */
 void pmstep_console_handle_frame(pmstep_console_t *c)
 {
-    const uint8_t type = c->buf[0];
-    const uint8_t seq = c->buf[1];
     const uint8_t *d = &c->buf[2];
     const uint32_t n = (uint32_t)c->len - 2u;
-    uint32_t count;
+    const request_row_t *row = request_row(c->buf[0]);
+    pmstep_console_request_t req = {0};
+    int outcome;
+    req.cmd = c->buf[0];
+    req.seq = c->buf[1];
     c->count.rx_frames++;
-    switch (type) {
-    case PMSTEP_CONSOLE_HELLO: {
-        writer_t w;
-        if (n != 0u) {
-            pmstep_console_send_error(c, type, seq, PMSTEP_CONSOLE_ERR_BAD_LENGTH);
-            return;
+    if (row == NULL) {
+        outcome = PMSTEP_CONSOLE_ERR_UNKNOWN_COMMAND;
+    } else {
+        outcome = row_available(c, row);
+        if (outcome == REQUEST_QUEUE && (n < row->min_length || n > row->max_length)) {
+            outcome = PMSTEP_CONSOLE_ERR_BAD_LENGTH;
         }
-        w.n = 0;
-        put_u8(&w, PMSTEP_CONSOLE_PROTOCOL_VERSION);
-        put_u8(&w, PMSTEP_CONSOLE_MAX_PAYLOAD);
-        put_text(&w, c->identity != NULL ? c->identity : "pmstep", PMSTEP_CONSOLE_MAX_PAYLOAD - 4u);
-        pmstep_console_send(c, (uint8_t)(type | 0x80u), seq, w.b, w.n);
-        return;
+        if (outcome == REQUEST_QUEUE) {
+            outcome = row->parse(c, d, n, &req);
+        }
     }
-    case PMSTEP_CONSOLE_GET_COUNTERS: {
-        writer_t w;
-        if (n != 0u) {
-            pmstep_console_send_error(c, type, seq, PMSTEP_CONSOLE_ERR_BAD_LENGTH);
-            return;
-        }
-        w.n = 0;
-        put_u32(&w, c->count.rx_bytes);
-        put_u32(&w, c->count.rx_frames);
-        put_u32(&w, c->count.rx_garbage_bytes);
-        put_u32(&w, c->count.rx_bad_length);
-        put_u32(&w, c->count.rx_crc_errors);
-        put_u32(&w, c->count.rx_truncated);
-        put_u32(&w, c->count.rx_error_replies);
-        put_u32(&w, c->count.commands_applied);
-        put_u32(&w, c->count.tx_frames);
-        put_u32(&w, c->count.tx_dropped);
-        put_u32(&w, c->count.telemetry_frames);
-        pmstep_console_send(c, (uint8_t)(type | 0x80u), seq, w.b, w.n);
-        return;
+    if (outcome == REQUEST_QUEUE && c->pending) {
+        outcome = PMSTEP_CONSOLE_ERR_BUSY;
     }
-    case PMSTEP_CONSOLE_SIM_ADVANCE:
-        if (!c->simulation) {
-            pmstep_console_send_error(c, type, seq, PMSTEP_CONSOLE_ERR_NOT_SUPPORTED);
-        } else if (n != 4u) {
-            pmstep_console_send_error(c, type, seq, PMSTEP_CONSOLE_ERR_BAD_LENGTH);
-        } else if (c->advancing) {
-            pmstep_console_send_error(c, type, seq, PMSTEP_CONSOLE_ERR_BUSY);
-        } else if (get_u32(d) == 0u) {
-            pmstep_console_send_error(c, type, seq, PMSTEP_CONSOLE_ERR_BAD_VALUE);
-        } else {
-            c->advance_periods = get_u32(d);
-            c->advance_seq = seq;
-            c->advancing = true;
-        }
-        return;
-    case PMSTEP_CONSOLE_SIM_FINISH:
-        if (!c->simulation) {
-            pmstep_console_send_error(c, type, seq, PMSTEP_CONSOLE_ERR_NOT_SUPPORTED);
-        } else if (n != 0u) {
-            pmstep_console_send_error(c, type, seq, PMSTEP_CONSOLE_ERR_BAD_LENGTH);
-        } else if (c->advancing) {
-            pmstep_console_send_error(c, type, seq, PMSTEP_CONSOLE_ERR_BUSY);
-        } else {
-            c->finish_requested = true;
-            pmstep_console_send_ack(c, type, seq, 0, 0u);
-        }
-        return;
-    case PMSTEP_CONSOLE_START:
-    case PMSTEP_CONSOLE_STOP:
-    case PMSTEP_CONSOLE_CLEAR_FAULT:
-    case PMSTEP_CONSOLE_GET_STATUS:
-    case PMSTEP_CONSOLE_GET_COMMISSIONING:
-        if (n != 0u) {
-            pmstep_console_send_error(c, type, seq, PMSTEP_CONSOLE_ERR_BAD_LENGTH);
-            return;
-        }
-        break;
-    case PMSTEP_CONSOLE_SPEED_TARGET:
-        if (n != 8u) {
-            pmstep_console_send_error(c, type, seq, PMSTEP_CONSOLE_ERR_BAD_LENGTH);
-            return;
-        }
-        c->a = get_f32(d);
-        c->b = get_f32(d + 4);
-        if (!is_finite(c->a) || !is_finite(c->b)) {
-            pmstep_console_send_error(c, type, seq, PMSTEP_CONSOLE_ERR_BAD_VALUE);
-            return;
-        }
-        break;
-    case PMSTEP_CONSOLE_ID_TARGET:
-        if (n != 4u) {
-            pmstep_console_send_error(c, type, seq, PMSTEP_CONSOLE_ERR_BAD_LENGTH);
-            return;
-        }
-        c->a = get_f32(d);
-        if (!is_finite(c->a)) {
-            pmstep_console_send_error(c, type, seq, PMSTEP_CONSOLE_ERR_BAD_VALUE);
-            return;
-        }
-        break;
-    case PMSTEP_CONSOLE_TELEMETRY:
-        if (n != 4u) {
-            pmstep_console_send_error(c, type, seq, PMSTEP_CONSOLE_ERR_BAD_LENGTH);
-            return;
-        }
-        c->u = get_u32(d);
-        break;
-    case PMSTEP_CONSOLE_GET_CONFIG:
-    case PMSTEP_CONSOLE_SET_CONFIG: {
-        const uint32_t fixed = type == PMSTEP_CONSOLE_SET_CONFIG ? 5u : 1u; /* id (+ value) */
-        const pmstep_console_config_entry_t *t = pmstep_console_config_table(&count);
-        int32_t id;
-        if (n < fixed || (d[0] != 0xFFu && n != fixed) || (d[0] == 0xFFu && n == fixed)) {
-            pmstep_console_send_error(c, type, seq, PMSTEP_CONSOLE_ERR_BAD_LENGTH);
-            return;
-        }
-        id = d[0] == 0xFFu ? config_by_name(d + fixed, n - fixed) : (int32_t)d[0];
-        if (id < 0 || (uint32_t)id >= count) {
-            pmstep_console_send_error(c, type, seq, PMSTEP_CONSOLE_ERR_UNKNOWN_CONFIG);
-            return;
-        }
-        c->cfg_id = (uint8_t)id;
-        if (type == PMSTEP_CONSOLE_SET_CONFIG) {
-            c->a = get_f32(d + 1);
-            if ((t[id].flags & PMSTEP_CONSOLE_CFG_READ_ONLY) != 0u) {
-                pmstep_console_send_error(c, type, seq, PMSTEP_CONSOLE_ERR_READ_ONLY);
-                return;
-            }
-            if (!is_finite(c->a)) {
-                pmstep_console_send_error(c, type, seq, PMSTEP_CONSOLE_ERR_BAD_VALUE);
-                return;
-            }
-        }
-        break;
+    if (outcome == REQUEST_QUEUE) {
+        c->mail = req;
+        c->pending = true;
+    } else if (outcome != REQUEST_ANSWERED) {
+        pmstep_console_send_error(c, req.cmd, req.seq, (pmstep_console_error_t)outcome);
     }
-    case PMSTEP_CONSOLE_MOVE_TO:
-    case PMSTEP_CONSOLE_HOLD:
-    case PMSTEP_CONSOLE_GET_POSITION:
-    case PMSTEP_CONSOLE_SET_POSITION_ZERO:
-        if (!parse_position(c, type, seq, d, n)) {
-            return;
-        }
-        break;
-    default:
-        pmstep_console_send_error(c, type, seq, PMSTEP_CONSOLE_ERR_UNKNOWN_COMMAND);
-        return;
-    }
-    if (c->pending) {
-        pmstep_console_send_error(c, type, seq, PMSTEP_CONSOLE_ERR_BUSY);
-        return;
-    }
-    c->cmd = type;
-    c->seq = seq;
-    c->pending = true;
 }

@@ -119,6 +119,12 @@ pmstep_status_t pmstep_set_angle_estimate(pmstep_t *inst, float cos_hat, float s
 /** Runs one control period. Never fails; see pmstep_output_t. */
 void pmstep_step(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out);
 
+/** The mode the instance is in now (the next step runs in it unless a transition is due). */
+static inline pmstep_mode_t pmstep_get_mode(const pmstep_t *inst)
+{
+    return inst->mode;
+}
+
 /** Calibration and commissioning results so far (telemetry; see pmstep_commissioning_t). */
 static inline void pmstep_get_commissioning(const pmstep_t *inst, pmstep_commissioning_t *out)
 {

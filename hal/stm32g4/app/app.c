@@ -94,7 +94,7 @@ int32_t pmstep_app_init(void)
     if (port_st != PMSTEP_STM32G4_OK) {
         return (int32_t)port_st;
     }
-    pmstep_console_init(&console, "pmstep " PMSTEP_VERSION_TEXT " stm32g431", false);
+    pmstep_console_init(&console, "pmstep " PMSTEP_VERSION_TEXT " stm32g431");
     pmstep_console_attach_position(&console, &position);
     pmstep_stm32g4_set_after_step(after_step);
     uart_errors = 0u;

@@ -246,7 +246,8 @@ int main(int argc, char **argv)
     mps2_pil_init(&motor);
     insns_per_tick = mps2_pil_instructions_per_tick(100000u);
     cmsdk_uart_init(16u);
-    pmstep_console_init(&console, "pmstep " PMSTEP_VERSION_TEXT " qemu-mps2-an386", true);
+    pmstep_console_init(&console, "pmstep " PMSTEP_VERSION_TEXT " qemu-mps2-an386");
+    pmstep_console_attach_simulation(&console);
     pmstep_console_attach_position(&console, &position);
     snap.period = UINT32_MAX; /* no step yet */
     systick_last = SYST_CVR;
