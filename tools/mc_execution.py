@@ -7,15 +7,17 @@ that was stopped resumes where it was (see monte_carlo.py for the whole tool).
 What runs on a worker is run_sil(): it gets the case's --set arguments, the scenario file's
 text and the pmstep-sil path (or finds the binary shipped to the worker), runs pmstep-sil in
 a temporary folder of the worker and returns the exit status, the stderr tail and the
-parsed summary.json. The function travels to the workers by value: they need Python with
-dask.distributed and the pmstep-sil binary (and its shared libraries), nothing else of the
-project, and no folder shared with the client.
+parsed summary.json. The function travels in the task graph by value (ByValue): the scheduler,
+which unpickles the graph, and the workers, which run it, need Python with the same
+dask.distributed and, on the workers, the pmstep-sil binary (shipped with --ship-sil) and its
+shared libraries; nothing of the project on their path, and no folder shared with the client.
 """
 import configparser
 import hashlib
 import json
 import math
 import os
+import pickle
 import shlex
 import shutil
 import subprocess
@@ -382,6 +384,34 @@ def make_task(args, seed, base, scenario_text, shipped):
     return task, params
 
 
+class ByValue:
+    """A function that pickles as its own code (cloudpickle, its module registered by value),
+    never as a reference to its module. Distributed pickles a task graph with pickle first,
+    which names a function by module and name (mc_execution.run_sil); the scheduler unpickles
+    the graph, so a scheduler and workers started without this folder on their path would fail
+    with "No module named 'mc_execution'". This pickles as pickle.loads(<cloudpickle of the
+    function>): unpickling it needs cloudpickle (a dependency of distributed) and nothing of
+    these tools, and gives the plain function. One instance in a batch of tasks (Client.map)
+    travels once per batch."""
+
+    def __init__(self, func):
+        import cloudpickle
+
+        cloudpickle.register_pickle_by_value(sys.modules[func.__module__])
+        self.func = func
+        self.__name__ = func.__name__
+        self.payload = cloudpickle.dumps(func)
+
+    def __call__(self, *args, **kwargs):
+        return self.func(*args, **kwargs)
+
+    def __reduce__(self):
+        return pickle.loads, (self.payload,)
+
+
+DASK_BATCH = 1000  # cases per task graph sent to the scheduler (run_sil travels once per graph)
+
+
 def run_threads(args, tasks, on_result):
     """The cases on a pool of args.jobs threads on this machine."""
     import concurrent.futures
@@ -403,15 +433,15 @@ def run_dask(args, tasks, on_result):
     single-threaded worker processes. A worker that dies takes its running cases with it;
     the scheduler runs them again on the others."""
     try:
-        import cloudpickle
         import dask
         from distributed import Client, LocalCluster, as_completed
         from distributed.diagnostics.plugin import UploadFile
     except ImportError as e:
         raise ToolError(f"the Dask engine needs dask.distributed ({e}): install tools/requirements.txt "
                         "(e.g. tools/setup_venv.sh, then run with .venv/bin/python) or pass --engine threads") from None
-    # Workers need nothing of these tools installed: run_sil travels by value.
-    cloudpickle.register_pickle_by_value(sys.modules[__name__])
+    # The scheduler and the workers need nothing of these tools: run_sil travels by value (and
+    # ShipSil below, a class of this module registered by value, too).
+    case = ByValue(run_sil)
     cluster = None
     with dask.config.set(QUIET_DASK):  # the local cluster's processes and this client (an external cluster's are its own)
         if args.scheduler:
@@ -426,7 +456,8 @@ def run_dask(args, tasks, on_result):
 
             client.register_plugin(ShipSil(args.sil, load=False))
         workers = len(client.scheduler_info(n_workers=-1)["workers"]) if args.scheduler else args.jobs
-        futures = [client.submit(run_sil, task, key=f"pmstep-case-{task['seed']}", pure=False) for task in tasks]
+        futures = client.map(case, tasks, key=[f"pmstep-case-{task['seed']}" for task in tasks], pure=False,
+                             batch_size=DASK_BATCH)
         try:
             for future in as_completed(futures):
                 on_result(future.result())

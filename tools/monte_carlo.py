@@ -25,15 +25,17 @@ Engines (--engine): "dask" (default) runs the cases on dask.distributed, by defa
 local cluster of --jobs single-threaded worker processes (default: one per core), or with
 --scheduler ADDRESS on an existing cluster (e.g. tcp://10.0.0.5:8786): start its scheduler
 with `dask scheduler` and a worker per core on each machine with `dask worker ADDRESS
---nthreads 1 --nworkers N`. Each worker runs pmstep-sil at the --sil path, which must then
-exist there (same build on a shared or identical path), or, with --ship-sil, the client
-uploads its pmstep-sil to every worker (also to workers that join later); the workers'
-machines need pmstep-sil's shared libraries (tools/install_deps.sh) and Python with
-tools/requirements.txt. Nothing else is shared: the scenario text travels with each case
-and the results come back to the client. "threads" runs them on --jobs threads here, with
-no Dask. The results of a case do not depend on the engine or the number of workers: its
-seed alone fixes it. A worker that dies takes its running cases with it; the scheduler runs
-them again on the other workers.
+--nthreads 1 --nworkers N`, from any folder and with no PYTHONPATH: the scheduler and the
+workers need only Python of the client's version (3.X) with the dask and distributed that
+tools/requirements.txt pins, nothing of this project (the function a worker runs travels
+by value in each task graph, mc_execution.py). Each worker runs pmstep-sil at the --sil path,
+which must then exist there (same build on a shared or identical path), or, with --ship-sil,
+the client uploads its pmstep-sil to every worker (also to workers that join later); either
+way the workers' machines need pmstep-sil's shared libraries (tools/install_deps.sh). Nothing
+else is shared: the scenario text travels with each case and the results come back to the
+client. "threads" runs them on --jobs threads here, with no Dask. The results of a case do
+not depend on the engine or the number of workers: its seed alone fixes it. A worker that
+dies takes its running cases with it; the scheduler runs them again on the other workers.
 
 Resume: every finished case is kept at once in DIR/cases/<case seed>/result.json; running
 the same command again on the same DIR runs only the cases not finished (a campaign stopped
