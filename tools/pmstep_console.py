@@ -24,6 +24,20 @@ Commands (one per run, or several in the interactive mode):
   interactive                            a prompt for all of the above
 
 Needs pyserial (pinned in tools/requirements.txt); plots need matplotlib (same file).
+
+Every wait is bounded whatever the line does (noise, a flood of sync bytes, a stream of frames, a
+line that takes no bytes): a reply comes within its deadline (2 s; SIM_ADVANCE longer) or the request
+fails. A failure ends a command with one line on stderr, "pmstep_console: error: ...", and an exit
+status by its class (ConsoleError's subclasses; in the interactive mode the shell prints the error
+and goes on, except after a line failure, which ends it):
+  0  done
+  1  the drive answered with an error frame, or the core refused (DeviceError)
+  2  usage (argparse)
+  3  no reply within the deadline (ReplyTimeout)
+  4  a reply too short for its type (MalformedReply)
+  5  the line failed or closed: pty closed, serial port unplugged, socket dropped, write stalled
+     (LinkError)
+  6  the port could not be opened: missing device, refused connection, bad URL (PortOpenError)
 """
 import argparse
 import cmd
@@ -34,6 +48,12 @@ import struct
 import sys
 import time
 
+try:
+    import termios  # a serial port's flush/in_waiting raise termios.error on a line gone away
+    LINK_ERRORS = (OSError, termios.error)  # OSError: pyserial's SerialException among them
+except ImportError:  # Windows
+    LINK_ERRORS = (OSError,)
+
 SYNC = 0xA5
 MAX_PAYLOAD = 64
 
@@ -42,6 +62,12 @@ GET_STATUS, GET_CONFIG, SET_CONFIG, GET_COMMISSIONING, TELEMETRY, GET_COUNTERS =
 MOVE_TO, HOLD, GET_POSITION, SET_POSITION_ZERO = 0x0D, 0x0E, 0x0F, 0x10
 SIM_ADVANCE, SIM_FINISH = 0x40, 0x41
 TELEMETRY_FRAME, ERROR_FRAME = 0x90, 0xFF
+REQUEST_NAMES = {HELLO: "HELLO", START: "START", STOP: "STOP", CLEAR_FAULT: "CLEAR_FAULT",
+                 SPEED_TARGET: "SPEED_TARGET", ID_TARGET: "ID_TARGET", GET_STATUS: "STATUS",
+                 GET_CONFIG: "CONFIG", SET_CONFIG: "SET_CONFIG", GET_COMMISSIONING: "COMMISSIONING",
+                 TELEMETRY: "TELEMETRY", GET_COUNTERS: "COUNTERS", MOVE_TO: "MOVE_TO", HOLD: "HOLD",
+                 GET_POSITION: "POSITION", SET_POSITION_ZERO: "SET_POSITION_ZERO", SIM_ADVANCE: "SIM_ADVANCE",
+                 SIM_FINISH: "SIM_FINISH"}
 
 MODES = {0: "IDLE", 1: "S_ALIGN", 2: "C_ALIGN", 3: "RUN", 4: "FAULT", 5: "OFFSET_CAL"}
 ERRORS = {1: "unknown command", 2: "bad length", 3: "bad value (NaN, Inf or out of range)",
@@ -117,16 +143,94 @@ class Decoder:
             del self.buf[:n + 4]
 
 
-class DeviceError(Exception):
+class ConsoleError(Exception):
+    """A request or the line failed; exit_code: the command line's exit status for it (module
+    docstring)."""
+    exit_code = 1
+
+
+class DeviceError(ConsoleError):
     """The drive answered with an error frame, or the core refused a command."""
+    exit_code = 1
 
 
-def open_endpoint(port, baud=115200, timeout=0.05):
-    import serial  # pyserial, pinned in tools/requirements.txt
-    if port.startswith("tcp:"):
-        host, _, tcp_port = port[4:].rpartition(":")
-        return serial.serial_for_url(f"socket://{host or '127.0.0.1'}:{tcp_port}", timeout=timeout)
-    return serial.serial_for_url(port, baudrate=baud, timeout=timeout)
+class ReplyTimeout(ConsoleError, TimeoutError):
+    """No reply within the deadline (whatever else the line carried meanwhile)."""
+    exit_code = 3
+
+
+class MalformedReply(ConsoleError):
+    """A reply of the right type and sequence number, too short for that type."""
+    exit_code = 4
+
+
+class LinkError(ConsoleError):
+    """The line failed or closed: a read or write raised (pty closed, port unplugged, socket
+    dropped), or a write stalled past the link's write timeout."""
+    exit_code = 5
+
+
+class PortOpenError(LinkError):
+    """The port could not be opened (missing device, refused connection, bad URL, no pyserial)."""
+    exit_code = 6
+
+
+# Reply DATA lengths (pmstep_console.h): fixed layouts, or the fixed part before a text. A longer
+# reply is accepted (fields a later firmware may append); a shorter one is a MalformedReply.
+ACK_BYTES = 6            # status i16, period u32
+HELLO_MIN_BYTES = 2      # protocol u8, max payload u8, text
+STATUS_BYTES = 60        # period u32, mode, fault, port fault, flags u8, fault step u32, 12 f32
+CONFIG_MIN_BYTES = 7     # id, type, flags u8, value f32, name
+COMMISSIONING_BYTES = 41  # measured u8, offset samples u32, realignments u32, 8 f32
+COUNTERS_BYTES = 44      # 11 u32
+POSITION_BYTES = 19      # status i16, period u32, 3 f32, flags u8
+
+
+def check_reply(ftype, data, n_bytes, text=False):
+    """@return @p data, the DATA of the reply to request @p ftype, if it has at least @p n_bytes
+    (@p text: a text follows them); else raises MalformedReply."""
+    if len(data) < n_bytes:
+        name = REQUEST_NAMES.get(ftype, f"0x{ftype:02x}")
+        raise MalformedReply(f"malformed {name} reply: {len(data)} bytes, expected {n_bytes}"
+                             + (" or more" if text else ""))
+    return data
+
+
+def _reason(e):
+    """The cause of a line error in a few words: the innermost OS error's text if there is one
+    (pyserial wraps them), else the exception's own."""
+    inner = e
+    while True:
+        if isinstance(inner, OSError) and inner.strerror and not inner.strerror.startswith("could not"):
+            return inner.strerror
+        nxt = inner.__cause__ or inner.__context__
+        if nxt is None:
+            break
+        inner = nxt
+    if len(getattr(e, "args", ())) == 2 and isinstance(e.args[1], str):  # termios.error (errno, text)
+        return e.args[1]
+    return str(e) or type(e).__name__
+
+
+def open_endpoint(port, baud=115200, timeout=0.05, write_timeout=2.0):
+    """The link to @p port (module docstring); @p timeout bounds a read of one byte, @p
+    write_timeout a write (a line that takes no bytes: LinkError, not a hang). Raises
+    PortOpenError."""
+    try:
+        import serial  # pyserial, pinned in tools/requirements.txt
+    except ImportError as e:
+        raise PortOpenError(f"pyserial is missing ({e}); tools/setup_venv.sh installs tools/requirements.txt") \
+            from e
+    try:
+        if port.startswith("tcp:"):
+            host, _, tcp_port = port[4:].rpartition(":")
+            if not tcp_port.isdigit():
+                raise PortOpenError(f"cannot open port {port}: expected tcp:HOST:PORT or tcp:PORT")
+            return serial.serial_for_url(f"socket://{host or '127.0.0.1'}:{tcp_port}", timeout=timeout,
+                                         write_timeout=write_timeout)
+        return serial.serial_for_url(port, baudrate=baud, timeout=timeout, write_timeout=write_timeout)
+    except (ValueError,) + LINK_ERRORS as e:
+        raise PortOpenError(f"cannot open port {port}: {_reason(e)}") from e
 
 
 class Console:
@@ -154,55 +258,95 @@ class Console:
             return None
         return frame
 
+    def _line_error(self, doing, e):
+        port = getattr(self.link, "port", None)
+        serial = sys.modules.get("serial")
+        if serial is not None and isinstance(e, serial.SerialTimeoutException):
+            reason = f"the line took no bytes for {self.link.write_timeout:g} s"
+        else:
+            reason = _reason(e)
+        return LinkError(f"{port + ': ' if port else ''}the line failed or closed while {doing}: {reason}")
+
+    def _read(self):
+        """What has arrived, or one byte within the link's timeout (b"" if none): a peer that closes
+        right after its last frame (an image that exits) loses nothing. Raises LinkError."""
+        try:
+            return self.link.read(max(1, self.link.in_waiting))
+        except LINK_ERRORS as e:
+            raise self._line_error("reading", e) from e
+
     def pump(self, wait=0.0):
-        """Reads what has arrived (waiting up to @p wait s for something), dispatches telemetry."""
+        """Reads what arrives for @p wait s (at least one read), dispatches telemetry and keeps the
+        other frames in self.pending. Returns at the deadline (plus at most one read) whatever the
+        line does: noise, sync bytes or frames that keep coming do not hold it. Raises LinkError."""
         deadline = time.monotonic() + wait
         while True:
-            # What has arrived, or one byte within the link's timeout: a peer that closes right
-            # after its last frame (an image that exits) loses nothing.
-            data = self.link.read(max(1, self.link.in_waiting))
+            data = self._read()
             if data:
                 for frame in self.decoder.feed(data):
                     kept = self._dispatch(frame)
                     if kept is not None:
                         self.pending.append(kept)
-            if not data and time.monotonic() >= deadline:
+            if time.monotonic() >= deadline:
                 return
 
     def send(self, ftype, data=b""):
-        """Sends a request without waiting; @return its sequence number (for wait_reply)."""
+        """Sends a request without waiting; @return its sequence number (for wait_reply). A write
+        that the line does not take within the link's write timeout raises LinkError. (No flush:
+        the kernel has the bytes once write returns, and tcdrain would wait on the line unbounded.)"""
         self.seq = (self.seq + 1) & 0xFF
-        self.link.write(encode(ftype, self.seq, data))
-        self.link.flush()
+        try:
+            self.link.write(encode(ftype, self.seq, data))
+        except LINK_ERRORS as e:
+            raise self._line_error("writing", e) from e
         return self.seq
 
     def request(self, ftype, data=b"", timeout=None):
         return self.wait_reply(ftype, self.send(ftype, data), timeout)
 
+    def _take_reply(self, ftype, seq):
+        """The DATA of the reply to (@p ftype, @p seq) if it is pending (removed), else None;
+        raises DeviceError for an error reply."""
+        for i, (rtype, rseq, rdata) in enumerate(self.pending):
+            if rseq == seq and rtype in (ftype | 0x80, ERROR_FRAME):
+                del self.pending[i]
+                if rtype == ERROR_FRAME:
+                    code = rdata[1] if len(rdata) > 1 else 0
+                    raise DeviceError(f"request 0x{ftype:02x}: {ERRORS.get(code, f'error {code}')}")
+                return rdata
+        return None
+
     def wait_reply(self, ftype, seq, timeout=None):
-        deadline = time.monotonic() + (self.reply_timeout if timeout is None else timeout)
+        """The DATA of the reply to request (@p ftype, @p seq) within @p timeout s (default
+        self.reply_timeout), else ReplyTimeout, whatever the line carries meanwhile; DeviceError
+        for an error reply, LinkError if the line fails first."""
+        timeout_s = self.reply_timeout if timeout is None else timeout
+        deadline = time.monotonic() + timeout_s
         while True:
-            for i, (rtype, rseq, rdata) in enumerate(self.pending):
-                if rseq == seq and rtype in (ftype | 0x80, ERROR_FRAME):
-                    del self.pending[i]
-                    if rtype == ERROR_FRAME:
-                        code = rdata[1] if len(rdata) > 1 else 0
-                        raise DeviceError(f"request 0x{ftype:02x}: {ERRORS.get(code, f'error {code}')}")
+            rdata = self._take_reply(ftype, seq)
+            if rdata is not None:
+                return rdata
+            now = time.monotonic()
+            if now > deadline:
+                raise ReplyTimeout(f"no reply to request 0x{ftype:02x} (seq {seq}) within {timeout_s:g} s")
+            try:
+                self.pump(min(0.01, deadline - now))
+            except LinkError:
+                rdata = self._take_reply(ftype, seq)  # it came with the line's last bytes
+                if rdata is not None:
                     return rdata
-            if time.monotonic() > deadline:
-                raise TimeoutError(f"no reply to request 0x{ftype:02x} (seq {seq})")
-            self.pump(0.01)
+                raise
 
     def _ack(self, ftype, data=b"", timeout=None):
-        rdata = self.request(ftype, data, timeout)
-        status, period = struct.unpack("<hI", rdata[:6])
+        rdata = check_reply(ftype, self.request(ftype, data, timeout), ACK_BYTES)
+        status, period = struct.unpack_from("<hI", rdata)
         if status != 0:
             raise DeviceError(f"the core refused request 0x{ftype:02x}: status {status}")
         return period
 
     # ---- commands ----
     def hello(self):
-        d = self.request(HELLO)
+        d = check_reply(HELLO, self.request(HELLO), HELLO_MIN_BYTES, text=True)
         return {"protocol": d[0], "max_payload": d[1], "identity": d[2:].decode("ascii", "replace")}
 
     def start(self):
@@ -221,7 +365,7 @@ class Console:
         return self._ack(ID_TARGET, struct.pack("<f", target_a))
 
     def status(self):
-        d = self.request(GET_STATUS)
+        d = check_reply(GET_STATUS, self.request(GET_STATUS), STATUS_BYTES)
         period, mode, fault, port_fault, flags, fault_step = struct.unpack_from("<IBBBBI", d)
         values = struct.unpack_from("<12f", d, 12)
         s = {"period": period, "mode": MODES.get(mode, str(mode)), "fault": fault, "port_fault": port_fault,
@@ -230,10 +374,11 @@ class Console:
         return s
 
     def counters(self):
-        return dict(zip(COUNTER_FIELDS, struct.unpack("<11I", self.request(GET_COUNTERS))))
+        d = check_reply(GET_COUNTERS, self.request(GET_COUNTERS), COUNTERS_BYTES)
+        return dict(zip(COUNTER_FIELDS, struct.unpack_from("<11I", d)))
 
     def commissioning(self):
-        d = self.request(GET_COMMISSIONING)
+        d = check_reply(GET_COMMISSIONING, self.request(GET_COMMISSIONING), COMMISSIONING_BYTES)
         measured, samples, realignments = struct.unpack_from("<BII", d)
         c = {"measured": bool(measured), "offset_samples": samples, "realignments": realignments}
         c.update(zip(COMMISSIONING_FIELDS, struct.unpack_from("<8f", d, 9)))
@@ -247,10 +392,14 @@ class Console:
 
     def get_config(self, key):
         k = self._key(key)
-        d = self.request(GET_CONFIG, k if isinstance(k, bytes) else k[0] + k[1])
-        cid, ctype, flags = d[0], d[1], d[2]
-        (value,) = struct.unpack_from("<f", d, 3)
-        return {"id": cid, "name": d[7:].decode("ascii"), "type": CONFIG_TYPES.get(ctype, "?"),
+        d = check_reply(GET_CONFIG, self.request(GET_CONFIG, k if isinstance(k, bytes) else k[0] + k[1]),
+                        CONFIG_MIN_BYTES, text=True)
+        cid, ctype, flags, value = struct.unpack_from("<BBBf", d)
+        try:
+            name = d[7:].decode("ascii")
+        except UnicodeDecodeError:
+            raise MalformedReply(f"malformed CONFIG reply: the name of value {cid} is not ASCII") from None
+        return {"id": cid, "name": name, "type": CONFIG_TYPES.get(ctype, "?"),
                 "read_only": bool(flags & 1), "value": value}
 
     def set_config(self, key, value):
@@ -282,7 +431,8 @@ class Console:
     def position(self):
         """The present period's estimate and theta* (mechanical rad); status != 0 (e.g. -2: not
         tracked, not in RUN) comes back in the dict with zero positions."""
-        status, period, pos, ref, err, flags = struct.unpack("<hIfffB", self.request(GET_POSITION))
+        d = check_reply(GET_POSITION, self.request(GET_POSITION), POSITION_BYTES)
+        status, period, pos, ref, err, flags = struct.unpack_from("<hIfffB", d)
         p = {"status": status, "period": period, "position_rad": pos, "position_ref_rad": ref,
              "position_error_rad": err}
         p.update({name: bool(flags & bit) for bit, name in POSITION_FLAGS.items()})
@@ -439,10 +589,14 @@ class Shell(cmd.Cmd):
         self.con = con
 
     def default(self, line):
+        """One command; its failure is one "error: ..." line and the shell goes on, except a line
+        failure (LinkError), which ends the shell (main reports it)."""
         try:
             if not run_command(self.con, shlex.split(line)):
                 print(f"unknown command: {line}")
-        except (DeviceError, TimeoutError, ValueError, IndexError, SystemExit) as e:
+        except LinkError:
+            raise
+        except (ConsoleError, ValueError, IndexError, SystemExit) as e:
             print(f"error: {e}")
 
     def do_quit(self, _):
@@ -463,19 +617,24 @@ def main(argv=None):
         return 0
     if not a.port:
         ap.error("--port is required")
-    link = open_endpoint(a.port, a.baud)
-    con = Console(link)
+    link = None
     try:
+        link = open_endpoint(a.port, a.baud)
+        con = Console(link)
         if not a.command or a.command[0] == "interactive":
             Shell(con).cmdloop()
             return 0
         if not run_command(con, a.command):
             ap.error(f"unknown command {a.command[0]}")
-    except (DeviceError, TimeoutError) as e:
-        print(f"pmstep-console: {e}", file=sys.stderr)
-        return 1
+    except ConsoleError as e:  # one line, the exit status of its class (module docstring)
+        print(f"pmstep_console: error: {e}", file=sys.stderr)
+        return e.exit_code
     finally:
-        link.close()
+        if link is not None:
+            try:
+                link.close()
+            except LINK_ERRORS:
+                pass  # the line is gone already: reported above
     return 0
 
 

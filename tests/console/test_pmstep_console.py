@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
-"""Tests of the host console (tools/pmstep_console.py): framing and decoder, and every command
+"""Tests of the host console (tools/pmstep_console.py): framing and decoder, every command
 against the real firmware console (console-host-drive: console + core on a pty), through the
-pty endpoint and the command line.
+pty endpoint and the command line; and the tool against a bad line (a fake peer on the pty's
+master: noise, sync floods, short replies, a line that closes or takes no bytes, a missing port):
+every wait ends by its deadline, every failure is one line and an exit status.
 
 usage: test_pmstep_console.py PATH/TO/console-host-drive
 """
@@ -9,10 +11,15 @@ import contextlib
 import io
 import math
 import os
+import re
+import random
+import select
 import struct
 import subprocess
 import sys
 import tempfile
+import threading
+import time
 import unittest
 from pathlib import Path
 
@@ -20,7 +27,16 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tools"))
 import pmstep_console as pc  # noqa: E402
 
 DRIVE = None
+TOOL = Path(pc.__file__).resolve()
 
+
+
+def firmware_config_entries():
+    """How many configuration values the firmware's table (pmstep_console_config.c) lists."""
+    source = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "firmware", "console", "src",
+                          "pmstep_console_config.c")
+    with open(source, encoding="utf-8") as f:
+        return len(re.findall(r"^\s+(?:F32|U32|I32|BOOL|F32_RO|U32_RO)\(", f.read(), flags=re.M))
 
 class Framing(unittest.TestCase):
     def test_crc_check_value(self):
@@ -81,7 +97,7 @@ class AgainstTheFirmwareConsole(unittest.TestCase):
         self.assertEqual(hello["protocol"], 1)
         self.assertEqual(hello["identity"], "pmstep host-drive")
         table = c.list_config()
-        self.assertEqual(len(table), 58)
+        self.assertEqual(len(table), firmware_config_entries())
         names = [e["name"] for e in table]
         self.assertEqual(len(set(names)), len(names))
         self.assertIn("gains.angle_smoothing", names)
@@ -219,6 +235,229 @@ class AgainstAPositionDrive(AgainstTheFirmwareConsole):
         self.assertEqual(err.getvalue().count("refused request"), 3)
         self.link = pc.open_endpoint(self.slave_name, 115200)
         self.con = pc.Console(self.link)
+
+
+class AgainstABadLine(unittest.TestCase):
+    """The tool on one side of a pty, a fake peer (a thread of this test) on the master. A peer
+    lives at most PEER_LIFETIME_S, then goes quiet: a tool whose wait does not end at its deadline
+    comes back then and fails the timing assertion instead of hanging the run. Timing bounds are
+    generous (the deadline plus seconds): they tell "ended at the deadline" from "ended when the
+    line went quiet", nothing finer."""
+    REPLY_TIMEOUT_S = 0.3
+    WAIT_BOUND_S = 2.0      # a wait of REPLY_TIMEOUT_S must end within this
+    PEER_LIFETIME_S = 6.0   # > WAIT_BOUND_S: a hanging tool is seen as one
+    # The short reply the peer sends to each request, in DATA bytes (the right length in brackets).
+    SHORT_REPLY_BYTES = {pc.HELLO: 1,                # (2 or more)
+                         pc.START: 5,                # ACK (6)
+                         pc.GET_STATUS: 3,           # (60)
+                         pc.GET_CONFIG: 6,           # (7 or more)
+                         pc.GET_COMMISSIONING: 9,    # (41)
+                         pc.GET_COUNTERS: 43,        # (44)
+                         pc.GET_POSITION: 18}        # (19)
+
+    def setUp(self):
+        self.master, self.slave = os.openpty()  # the slave stays open: the master reads no EIO
+        self.slave_name = os.ttyname(self.slave)  # before the tool (a subprocess) opens the pty
+        os.set_blocking(self.master, False)
+        self.master_open = True
+        self.stop = threading.Event()
+        self.peer = None
+        self.link = pc.open_endpoint(self.slave_name, 115200)  # raw mode before the peer writes
+        self.con = pc.Console(self.link, reply_timeout=self.REPLY_TIMEOUT_S)
+
+    def tearDown(self):
+        self.stop.set()
+        if self.peer is not None:
+            self.peer.join(timeout=10)
+        self.link.close()
+        if self.master_open:
+            os.close(self.master)
+        os.close(self.slave)
+
+    # ---- the fake peer ----
+    def start_peer(self, behaviour, *args):
+        self.peer_end = time.monotonic() + self.PEER_LIFETIME_S
+        self.peer = threading.Thread(target=behaviour, args=args, daemon=True)
+        self.peer.start()
+
+    def alive(self):
+        return not self.stop.is_set() and time.monotonic() < self.peer_end
+
+    def write(self, data):
+        """Writes @p data to the master unless the peer's life ends first (a full pty: retried)."""
+        while data and self.alive():
+            try:
+                data = data[os.write(self.master, data):]
+            except BlockingIOError:
+                time.sleep(0.001)
+
+    def requests(self):
+        """The requests the tool sends, as (type, seq), while the peer lives."""
+        decoder = pc.Decoder()
+        while self.alive():
+            if not select.select([self.master], [], [], 0.01)[0]:
+                continue
+            try:
+                data = os.read(self.master, 4096)
+            except BlockingIOError:
+                continue
+            for ftype, seq, _ in decoder.feed(data):
+                yield ftype, seq
+
+    def close_master(self):
+        os.close(self.master)
+        self.master_open = False
+
+    def noise(self, chunk_bytes, interval_s, byte=None):
+        rng = random.Random(57)
+        while self.alive():
+            self.write(bytes([byte]) * chunk_bytes if byte is not None else rng.randbytes(chunk_bytes))
+            time.sleep(interval_s)
+
+    def short_replies(self, close_at_request=None):
+        """Answers each request with a reply of its type and seq, SHORT_REPLY_BYTES long; closes
+        the line 0.2 s after request number @p close_at_request (1: the first) arrives."""
+        for n, (ftype, seq) in enumerate(self.requests(), 1):
+            if n == close_at_request:
+                time.sleep(0.2)
+                self.close_master()
+                return
+            self.write(pc.encode(ftype | 0x80, seq, bytes(self.SHORT_REPLY_BYTES.get(ftype, 0))))
+
+    def drain_after_lifetime(self):
+        """Reads nothing while it lives (the pty fills, the tool's writes stall), then drains."""
+        self.stop.wait(self.PEER_LIFETIME_S)
+        while not self.stop.is_set():
+            try:
+                os.read(self.master, 65536)
+            except BlockingIOError:
+                time.sleep(0.001)
+
+    # ---- every wait ends by its deadline ----
+    def assert_waits_end_at_the_deadline(self):
+        t0 = time.monotonic()
+        with self.assertRaises(TimeoutError):
+            self.con.status()
+        wait_s = time.monotonic() - t0
+        self.assertLess(wait_s, self.WAIT_BOUND_S, "wait_reply ran past its deadline")
+        self.assertGreaterEqual(wait_s, self.REPLY_TIMEOUT_S)
+        t0 = time.monotonic()
+        self.con.pump(self.REPLY_TIMEOUT_S)
+        self.assertLess(time.monotonic() - t0, self.WAIT_BOUND_S, "pump ran past its deadline")
+
+    def test_noise_times_out_at_the_deadline(self):
+        self.start_peer(self.noise, 512, 0.001)  # about 0.5 MB/s of random bytes
+        self.assert_waits_end_at_the_deadline()
+
+    def test_slow_noise_1_byte_per_10_ms_times_out_at_the_deadline(self):
+        self.start_peer(self.noise, 1, 0.010)
+        self.assert_waits_end_at_the_deadline()
+
+    def test_sync_flood_times_out_at_the_deadline(self):
+        self.start_peer(self.noise, 512, 0.001, pc.SYNC)  # 0xA5 0xA5...: a sync, a length out of range
+        self.assert_waits_end_at_the_deadline()
+        self.assertGreater(self.con.decoder.bad, 0)
+
+    # ---- a short reply of the right type and seq: MalformedReply ----
+    def test_short_replies_are_malformed_reply_errors(self):
+        c = self.con
+        self.start_peer(self.short_replies)
+        for call, message in ((c.hello, "HELLO reply: 1 bytes, expected 2 or more"),
+                              (c.start, "START reply: 5 bytes, expected 6"),
+                              (c.status, "STATUS reply: 3 bytes, expected 60"),
+                              (lambda: c.get_config("gains.speed_gain_per_s"),
+                               "CONFIG reply: 6 bytes, expected 7 or more"),
+                              (c.list_config, "CONFIG reply: 6 bytes"),  # not taken for the table's end
+                              (c.commissioning, "COMMISSIONING reply: 9 bytes, expected 41"),
+                              (c.counters, "COUNTERS reply: 43 bytes, expected 44"),
+                              (c.position, "POSITION reply: 18 bytes, expected 19")):
+            with self.subTest(message):
+                with self.assertRaisesRegex(Exception, "^malformed " + message) as raised:
+                    call()
+                self.assertIsInstance(raised.exception, pc.MalformedReply)
+
+    def test_short_reply_on_the_command_line_is_one_line(self):
+        self.start_peer(self.short_replies)
+        self.link.close()
+        err = io.StringIO()
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(err):
+            code = pc.main(["--port", self.slave_name, "status"])
+        self.assertEqual(code, 4)
+        self.assertEqual(err.getvalue().splitlines(),
+                         ["pmstep_console: error: malformed STATUS reply: 3 bytes, expected 60"])
+
+    def test_short_reply_in_the_shell_keeps_the_shell(self):
+        self.start_peer(self.short_replies)
+        out = io.StringIO()
+        shell = pc.Shell(self.con)
+        with contextlib.redirect_stdout(out):
+            self.assertFalse(shell.onecmd("status"))
+            self.assertFalse(shell.onecmd("counters"))
+            self.assertTrue(shell.onecmd("quit"))
+        self.assertEqual(out.getvalue().splitlines(),
+                         ["error: malformed STATUS reply: 3 bytes, expected 60",
+                          "error: malformed COUNTERS reply: 43 bytes, expected 44"])
+
+    # ---- a line that fails: LinkError ----
+    def test_line_closed_mid_wait_is_a_link_error(self):
+        self.con.reply_timeout = 10.0  # the line closes 0.2 s into the wait: long before that
+        self.start_peer(self.short_replies, 1)
+        t0 = time.monotonic()
+        with self.assertRaisesRegex(Exception, "the line failed or closed while reading") as raised:
+            self.con.status()
+        self.assertLess(time.monotonic() - t0, 5.0)
+        self.assertIsInstance(raised.exception, pc.LinkError)
+        with self.assertRaisesRegex(Exception, "the line failed or closed while") as raised:
+            self.con.hello()  # and stays failed, the next request with it
+        self.assertIsInstance(raised.exception, pc.LinkError)
+
+    def run_tool(self, *args, stdin=""):
+        """The command line in a subprocess against the pty: (exit status, stdout, stderr)."""
+        self.link.close()
+        r = subprocess.run([sys.executable, str(TOOL), "--port", self.slave_name, *args], input=stdin,
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=60)
+        return r.returncode, r.stdout, r.stderr
+
+    def test_line_closed_mid_wait_on_the_command_line_is_one_line(self):
+        self.start_peer(self.short_replies, 1)
+        code, _, err = self.run_tool("status")
+        self.assertEqual(code, 5)
+        self.assertEqual(len(err.splitlines()), 1, err)
+        self.assertRegex(err, "^pmstep_console: error: .*the line failed or closed while")
+
+    def test_line_closed_in_the_shell_ends_it(self):
+        """A malformed reply: an error line, the shell goes on; then the line closes: one line on
+        stderr, exit status 5, the commands after it not run."""
+        self.start_peer(self.short_replies, 2)
+        code, out, err = self.run_tool("interactive", stdin="status\nhello\ncounters\n")
+        self.assertEqual(code, 5)
+        self.assertIn("error: malformed STATUS reply: 3 bytes, expected 60", out)
+        self.assertNotIn("COUNTERS", out)
+        self.assertEqual(len(err.splitlines()), 1, err)
+        self.assertRegex(err, "^pmstep_console: error: .*the line failed or closed while")
+
+    def test_line_that_takes_no_bytes_is_a_link_error(self):
+        """Nobody reads the master: the pty fills, a write stalls; the link's write timeout (2 s by
+        default) ends it."""
+        self.start_peer(self.drain_after_lifetime)
+        t0 = time.monotonic()
+        with self.assertRaisesRegex(Exception, "the line took no bytes for 2 s") as raised:
+            for _ in range(100000):  # some 900 kB: far more than a pty holds
+                self.con.send(pc.HELLO)
+        self.assertLess(time.monotonic() - t0, 5.0)
+        self.assertIsInstance(raised.exception, pc.LinkError)
+
+
+class CommandLineFailures(unittest.TestCase):
+    def test_missing_port_is_one_line(self):
+        for port in ("/dev/does-not-exist", "bogus://nowhere"):
+            with self.subTest(port):
+                r = subprocess.run([sys.executable, str(TOOL), "--port", port, "status"], stdout=subprocess.PIPE,
+                                   stderr=subprocess.PIPE, text=True, timeout=60)
+                self.assertEqual(r.returncode, 6)
+                self.assertEqual(r.stdout, "")
+                self.assertEqual(len(r.stderr.splitlines()), 1, r.stderr)
+                self.assertRegex(r.stderr, f"^pmstep_console: error: cannot open port {port}: ")
 
 
 if __name__ == "__main__":
