@@ -19,7 +19,7 @@ static bool duration_ok(float duration_s, float period_s)
 #define SIGN_NON_NEGATIVE 1u /* >= 0 */
 #define SIGN_POSITIVE 2u     /* > 0 */
 typedef struct {
-    unsigned char offset; /* offsetof the float in pmstep_config_t */
+    unsigned char offset; /* offsetof the float in pmstep_config_t (below 256: test_core_config.c) */
     unsigned char sign;   /* SIGN_ANY, SIGN_NON_NEGATIVE or SIGN_POSITIVE */
     signed char status;   /* pmstep_status_t when the sign is wrong */
 } sign_rule_t;
@@ -45,6 +45,7 @@ static pmstep_status_t validate_signs(const pmstep_config_t *cfg)
         SIGN_RULE(motor.torque_constant_Nm_A, SIGN_POSITIVE, PMSTEP_ERR_TORQUE_CONSTANT),
         SIGN_RULE(motor.friction_Nms_rad, SIGN_NON_NEGATIVE, PMSTEP_ERR_FRICTION),
         SIGN_RULE(motor.detent_torque_Nm, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETENT_TORQUE),
+        SIGN_RULE(motor.rated_current_A, SIGN_POSITIVE, PMSTEP_ERR_RATED_CURRENT),
         SIGN_RULE(gains.speed_gain_per_s, SIGN_POSITIVE, PMSTEP_ERR_SPEED_GAIN),
         SIGN_RULE(gains.observer_gain_per_s, SIGN_POSITIVE, PMSTEP_ERR_OBSERVER_GAIN),
         SIGN_RULE(gains.current_gain_per_s, SIGN_POSITIVE, PMSTEP_ERR_CURRENT_GAIN),
@@ -63,6 +64,8 @@ static pmstep_status_t validate_signs(const pmstep_config_t *cfg)
         SIGN_RULE(gains.transient_observer_boost, SIGN_NON_NEGATIVE, PMSTEP_ERR_OBSERVER_BOOST),
         SIGN_RULE(limits.max_phase_current_A, SIGN_POSITIVE, PMSTEP_ERR_MAX_CURRENT),
         SIGN_RULE(limits.min_bus_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_MIN_BUS),
+        SIGN_RULE(limits.current_sense_range_A, SIGN_POSITIVE, PMSTEP_ERR_SENSE_RANGE),
+        SIGN_RULE(limits.bus_sense_range_V, SIGN_POSITIVE, PMSTEP_ERR_SENSE_RANGE),
         SIGN_RULE(alignment.s_align_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_ALIGNMENT_VOLTAGE),
         SIGN_RULE(alignment.c_align_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_ALIGNMENT_VOLTAGE),
         SIGN_RULE(alignment.s_lead_in_time_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_S_LEAD_IN_TIME),
@@ -155,6 +158,26 @@ static pmstep_status_t validate_gains(const pmstep_config_t *cfg)
             || (gains->current_integral_gain_q_per_s2 > largest_integral_per_s2)) {
             return PMSTEP_ERR_CURRENT_INTEGRAL_GAIN;
         }
+    }
+    return PMSTEP_OK;
+}
+
+/* The protections: ordered, and bounded by the motor's rating and by what the drive can measure,
+ * so that no setting switches a trip off. */
+static pmstep_status_t validate_limits(const pmstep_config_t *cfg)
+{
+    const pmstep_limits_config_t *limits = &cfg->limits;
+    if (!(limits->max_bus_voltage_V > limits->min_bus_voltage_V)) {
+        return PMSTEP_ERR_BUS_ORDER;
+    }
+    if (limits->max_phase_current_A > (PMSTEP_MAX_TRIP_PER_RATED_CURRENT * cfg->motor.rated_current_A)) {
+        return PMSTEP_ERR_TRIP_ABOVE_RATED;
+    }
+    if (limits->max_phase_current_A > (PMSTEP_SENSE_RANGE_USABLE_FRACTION * limits->current_sense_range_A)) {
+        return PMSTEP_ERR_TRIP_ABOVE_SENSE_RANGE;
+    }
+    if (limits->max_bus_voltage_V > (PMSTEP_SENSE_RANGE_USABLE_FRACTION * limits->bus_sense_range_V)) {
+        return PMSTEP_ERR_BUS_ABOVE_SENSE_RANGE;
     }
     return PMSTEP_OK;
 }
@@ -315,8 +338,8 @@ pmstep_status_t pmstep_validate_config(const pmstep_config_t *cfg)
     if (status == PMSTEP_OK) {
         status = validate_gains(cfg);
     }
-    if (status == PMSTEP_OK && !(cfg->limits.max_bus_voltage_V > cfg->limits.min_bus_voltage_V)) {
-        status = PMSTEP_ERR_BUS_ORDER;
+    if (status == PMSTEP_OK) {
+        status = validate_limits(cfg);
     }
     if (status == PMSTEP_OK) {
         status = validate_alignment(cfg);

@@ -22,6 +22,7 @@ static void start_run(pmstep_t *inst, const pmstep_meas_t *sample)
     pmstep_ref_set_target(&inst->i_d_ref, i_d_cmd.target, 0.0f);
     pmstep_ref_reset(&inst->scratch.run.known_load_filter, inst->cfg->known_load_mode ? sample->load_torque_Nm : 0.0f);
     pmstep_detect_start(&inst->scratch.run.detector); /* the sums are spent */
+    pmstep_continuity_start(&inst->scratch.run.continuity);
     pmstep_identify_clear(&inst->scratch.run.identify); /* a re-alignment reopens the window */
     pmstep_standstill_start(inst);
     inst->run_started = true;

@@ -9,6 +9,9 @@
  *              fit's sums, at its end J and F (pmstep_identify.c)
  *   supervise  detection every PMSTEP_DETECTION_DECIMATION periods in RUN (pmstep_detect.c)
  *   actuate    dead-time compensation, bus limit, output check, delay (pmstep_actuate.c)
+ *   continuity the windings and the current sensors carry what the voltage asks (pmstep_continuity.c):
+ *              the alignments' peaks, in RUN every PMSTEP_CONTINUITY_DECIMATION periods the bus did not
+ *              limit
  *   advance    observer and references over the coming period (pmstep_control.c) */
 #include "pmstep/pmstep.h"
 #include "pmstep_internal.h"
@@ -309,6 +312,35 @@ static pmstep_compensation_input_t compensation_input(const pmstep_t *inst, cons
     return in;
 }
 
+/* Continuity stage of the alignments (after actuate): the driven phase's peak, and the checks at
+ * the ends of the alignments. A fault here latches (a re-alignment cannot mend a winding). */
+static pmstep_fault_t continuity_align_stage(pmstep_t *inst, const pmstep_meas_t *sample)
+{
+    const pmstep_commission_plan_t *plan = &inst->commission_plan;
+    const bool a_driven = (inst->mode == PMSTEP_MODE_C_ALIGN) || (inst->mode_step < plan->s_lead_in_steps);
+    return pmstep_continuity_align(&inst->scratch.sums.continuity, inst->cfg, a_driven, sample->i_a_A, sample->i_b_A,
+                                   (inst->mode_step + 1u) == plan->s_align_steps,
+                                   (inst->mode_step + 1u) == plan->c_align_end_step);
+}
+
+/* Continuity stage of RUN (after actuate, in a period the bus did not limit, every
+ * PMSTEP_CONTINUITY_DECIMATION periods): the phase currents against what the control asks for, in
+ * the stator frame: a vector hold's vector, or the law's (i_d*, i_q*) turned by the estimate (the
+ * frame in which the current loop tracks them). */
+static pmstep_fault_t continuity_run_stage(pmstep_t *inst, const pmstep_meas_t *sample, const pmstep_output_t *out)
+{
+    float ref_a_A = inst->hold.current_A * inst->hold.cos_frame;
+    float ref_b_A = inst->hold.current_A * inst->hold.sin_frame;
+    if (!inst->hold.active) {
+        ref_a_A = (out->cos_hat * out->i_d_ref_A) - (out->sin_hat * out->i_q_ref_A);
+        ref_b_A = (out->sin_hat * out->i_d_ref_A) + (out->cos_hat * out->i_q_ref_A);
+    }
+    return pmstep_continuity_check(&inst->scratch.run.continuity, &inst->continuity_coeffs, ref_a_A, ref_b_A,
+                                   sample->i_a_A, sample->i_b_A)
+               ? pmstep_continuity_judge(&inst->scratch.run.continuity, inst->cfg)
+               : PMSTEP_FAULT_NONE;
+}
+
 /* The stages after commissioning, in a period with the bridge on. @return a fault to latch,
  * or PMSTEP_FAULT_NONE (also after a detection that re-aligns). */
 static pmstep_fault_t bridge_on_stages(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out)
@@ -346,8 +378,15 @@ static pmstep_fault_t bridge_on_stages(pmstep_t *inst, const pmstep_meas_t *meas
     out->mode = inst->mode;
     out->bridge_enable = true;
     if (inst->mode != PMSTEP_MODE_RUN) {
+        const pmstep_fault_t fault = continuity_align_stage(inst, &sample);
         inst->mode_step++;
-        return PMSTEP_FAULT_NONE;
+        return fault;
+    }
+    if (((inst->step_count % PMSTEP_CONTINUITY_DECIMATION) == 1u) && !out->voltage_limited) {
+        const pmstep_fault_t fault = continuity_run_stage(inst, &sample, out);
+        if (fault != PMSTEP_FAULT_NONE) {
+            return fault;
+        }
     }
     return pmstep_control_advance(inst, &control, meas, out) ? PMSTEP_FAULT_NONE : PMSTEP_FAULT_STATE_NONFINITE;
 }

@@ -39,6 +39,7 @@ static void derive(pmstep_t *inst, const pmstep_config_t *cfg)
                                || (cfg->gains.transient_observer_boost > 0.0f);
     inst->angle_smoothing = cfg->gains.angle_smoothing > 0.0f;
     pmstep_detect_coeffs_init(&inst->detect_coeffs, cfg);
+    pmstep_continuity_coeffs_init(&inst->continuity_coeffs, cfg);
     pmstep_actuate_coeffs_init(&inst->actuate_coeffs, cfg);
     inst->voltage_corrected = inst->actuate_coeffs.sensed || inst->actuate_coeffs.compensate;
 }
@@ -108,6 +109,7 @@ void pmstep_clear_dynamic_state(pmstep_t *inst)
     pmstep_angle_start(&inst->angle, 0.0f, 0.0f);
     pmstep_observer_start(&inst->observer, 0.0f, 0.0f);
     pmstep_actuate_reset(&inst->actuator);
+    memset(&inst->scratch.sums.continuity, 0, sizeof inst->scratch.sums.continuity); /* RUN's state may be there */
 }
 
 void pmstep_reset(pmstep_t *inst)

@@ -39,6 +39,10 @@ const char *pmstep_status_str(pmstep_status_t status)
     case PMSTEP_ERR_MAX_CURRENT: return "current limit must be > 0";
     case PMSTEP_ERR_MIN_BUS: return "min bus must be > 0";
     case PMSTEP_ERR_BUS_ORDER: return "need min bus < max bus";
+    case PMSTEP_ERR_TRIP_ABOVE_RATED: return "overcurrent trip above 3 x the motor's rated current";
+    case PMSTEP_ERR_TRIP_ABOVE_SENSE_RANGE: return "overcurrent trip beyond 95 % of the current sensing's range";
+    case PMSTEP_ERR_BUS_ABOVE_SENSE_RANGE: return "overvoltage trip beyond 95 % of the bus sensing's range";
+    case PMSTEP_ERR_SENSE_RANGE: return "measurement ranges must be > 0";
     case PMSTEP_ERR_ALIGNMENT_VOLTAGE: return "u_cs, u_cc must be > 0";
     case PMSTEP_ERR_ALIGNMENT_ABOVE_BUS: return "u_cs, u_cc above min bus";
     case PMSTEP_ERR_ALIGNMENT_CURRENT: return "alignment u/R >= current limit";
@@ -64,6 +68,7 @@ const char *pmstep_status_str(pmstep_status_t status)
     case PMSTEP_ERR_RATED_CURRENT: return "rated current must be > 0";
     case PMSTEP_ERR_BUS_BELOW_RATED: return "bus too low for R x rated current";
     case PMSTEP_ERR_RATE_TOO_SLOW: return "control rate too slow for R/L or F/J";
+    case PMSTEP_ERR_SENSE_RANGE_BELOW_RATED: return "current sensing cannot read 1.25 x the rated current";
     case PMSTEP_ERR_IDENTIFICATION_WINDOW: return "identification: 0 to 2^24 periods";
     case PMSTEP_ERR_IDENTIFICATION_SPEED: return "identification speed < 0";
     case PMSTEP_ERR_MECHANICS_UNIDENTIFIED: return "identified J, F used without a window";
@@ -92,6 +97,10 @@ const char *pmstep_fault_str(pmstep_fault_t fault)
     case PMSTEP_FAULT_OBSERVER_RESIDUAL: return "OBSERVER_RESIDUAL";
     case PMSTEP_FAULT_PHASE_VOLTAGE_RANGE: return "PHASE_VOLTAGE_RANGE";
     case PMSTEP_FAULT_ALIGNMENT_MOTION: return "ALIGNMENT_MOTION";
+    case PMSTEP_FAULT_OPEN_PHASE_A: return "OPEN_PHASE_A";
+    case PMSTEP_FAULT_OPEN_PHASE_B: return "OPEN_PHASE_B";
+    case PMSTEP_FAULT_CURRENT_STUCK_A: return "CURRENT_STUCK_A";
+    case PMSTEP_FAULT_CURRENT_STUCK_B: return "CURRENT_STUCK_B";
     }
     return "UNKNOWN";
 }

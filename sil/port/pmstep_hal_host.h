@@ -15,6 +15,7 @@
 #define PMSTEP_HAL_HOST_H
 
 #include "pmstep_hal.h"
+#include "sil/faults.h"
 #include "sil/inverter.h"
 #include "sil/plant.h"
 #include "sil/sensors.h"
@@ -30,6 +31,7 @@ typedef struct {
     sil_inverter_config_t inverter;
     sil_bus_config_t bus;
     sil_sensor_config_t sensors;
+    sil_fault_config_t faults;     /**< what fails, and when (sil/faults.h) */
     unsigned long seed;            /**< of the measurement chain's RNG */
 } pmstep_hal_host_setup_t;
 
@@ -37,6 +39,7 @@ typedef struct {
     plant_t *plant;
     sil_inverter_t inverter;
     sil_sensors_t sensors;
+    sil_fault_config_t faults;
     /* The last sample (start of the present period). */
     pmstep_meas_t meas;            /**< what the core was given */
     double bus_V;                  /**< actual bus voltage at the sample */

@@ -172,8 +172,8 @@ static void rk4_substep(plant_t *plant, double t_s, double h, double u_a_V, doub
     const plant_state_t x = plant->x;
     const double p = (double)plant->params.pole_pairs;
     double s0, c0;
-    const bool oa = plant->open_a;
-    const bool ob = plant->open_b;
+    const bool oa = plant->open_a || plant->broken_a;
+    const bool ob = plant->open_b || plant->broken_b;
     plant_state_t k1, k2, k3, k4, y2, y3, y4;
     double s, c;
     plant_sin_cos(plant, &s0, &c0);
@@ -208,7 +208,8 @@ PLANT_INLINE void coupling_at(const plant_params_t *params, const plant_load_t *
                               const plant_state_t *y, double s, double c, plant_state_t *n)
 {
     const double k_m = params->torque_constant_Nm_A;
-    const double load_Nm = load_torque_at(load, t_s, y->omega_rad_s);
+    /* A proportional load is linear in w: it is in A (speed_linear_per_s), integrated exactly. */
+    const double load_Nm = load->kind == PLANT_LOAD_PROPORTIONAL ? 0.0 : load_torque_at(load, t_s, y->omega_rad_s);
     const double emf_per_l = k_m * y->omega_rad_s / params->inductance_H;
     double torque_Nm = k_m * (-y->i_a_A * s + y->i_b_A * c) - load_Nm;
     if (params->detent_torque_Nm != 0.0) {
@@ -275,11 +276,14 @@ static void etd_weights(double lambda, double h, plant_etd_weights_t *w)
     w->w_end = h * (4.0 * phi[2] - phi[1]);
 }
 
-/* The weights for h, R/L and F/J, recomputed only when one of them changes. */
+/* The weights for h, R/L and F/J, recomputed only when one of them changes. A proportional load
+ * c w adds to the friction: (F + c)/J, whatever its size (c T_s / J beyond 2 made RK4 diverge),
+ * and a negative c, a load that drives, grows as it should. */
 static void update_weights(plant_t *plant, double h)
 {
     const double r_over_l = plant->params.resistance_Ohm / plant->params.inductance_H;
-    const double f_over_j = plant->params.friction_Nms_rad / plant->params.inertia_kgm2;
+    const double load_per_speed = plant->load.kind == PLANT_LOAD_PROPORTIONAL ? plant->load.coefficient_Nms_rad : 0.0;
+    const double f_over_j = (plant->params.friction_Nms_rad + load_per_speed) / plant->params.inertia_kgm2;
     if (h != plant->cache_h_s || r_over_l != plant->cache_r_over_l || f_over_j != plant->cache_f_over_j) {
         plant->cache_h_s = h;
         plant->cache_r_over_l = r_over_l;
@@ -328,7 +332,7 @@ PLANT_INLINE void stage_coupling(const plant_t *plant, int k, double t_s, const 
 {
     coupling_at(&plant->params, &plant->load, t_s, y, s, c, n);
     add_extra_torque(plant, k, s, c, n);
-    hold_open(n, plant->open_a, plant->open_b);
+    hold_open(n, plant->open_a || plant->broken_a, plant->open_b || plant->broken_b);
 }
 
 /* Exponential time differencing RK4 on w = y - y* (plant.h). theta has no linear part;
@@ -339,8 +343,8 @@ static void exponential_substep(plant_t *plant, double t_s, double h, double u_a
     const plant_params_t *par = &plant->params;
     const plant_state_t x = plant->x;
     const double p = (double)par->pole_pairs;
-    const bool oa = plant->open_a;
-    const bool ob = plant->open_b;
+    const bool oa = plant->open_a || plant->broken_a;
+    const bool ob = plant->open_b || plant->broken_b;
     const plant_etd_weights_t *wt, *ww, *wa, *wb;
     double star_a, star_b;
     plant_state_t w0, n0, na, nb, nc, ya, yb, yc;

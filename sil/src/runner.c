@@ -158,6 +158,7 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
     hardware.inverter = sc->inverter;
     hardware.bus = sc->bus;
     hardware.sensors = sc->sensors;
+    hardware.faults = sc->faults;
     hardware.seed = sc->seed;
     if (pmstep_hal_host_bind(&plant, &hardware) != 0) {
         pmstep_hal_host_release();

@@ -152,6 +152,25 @@ int sil_scenario_set(sil_scenario_t *sc, const char *key, const char *value, cha
             }
             return fail(err, err_size, "%s: '%s' is not one of pmstep, microstep", key, value);
         }
+        case KEY_PHASES:
+        case KEY_SENSOR_FAULT: {
+            const char *const *names = k->type == KEY_PHASES ? phases_names : sensor_fault_names;
+            const size_t count = k->type == KEY_PHASES ? sizeof phases_names / sizeof phases_names[0]
+                                                       : sizeof sensor_fault_names / sizeof sensor_fault_names[0];
+            size_t j;
+            for (j = 0; j < count; ++j) {
+                if (strcmp(value, names[j]) == 0) {
+                    if (k->type == KEY_PHASES) {
+                        *(sil_phases_t *)(base + k->offset) = (sil_phases_t)j;
+                    } else {
+                        *(sil_sensor_fault_t *)(base + k->offset) = (sil_sensor_fault_t)j;
+                    }
+                    return 0;
+                }
+            }
+            return fail(err, err_size, "%s: '%s' is not one of %s", key, value,
+                        k->type == KEY_PHASES ? "none, a, b, both" : "none, open, stuck");
+        }
         case KEY_BOOL:
             if (strcmp(value, "true") == 0 || strcmp(value, "1") == 0) {
                 *(bool *)(base + k->offset) = true;
@@ -191,6 +210,7 @@ int sil_scenario_set(sil_scenario_t *sc, const char *key, const char *value, cha
         case KEY_ANGLE_DEG: *(double *)(base + k->offset) = scenario_angle_stored_rad(v); break;
         default: break;
         }
+        sil_scenario_sense_ranges(sc);
         return 0;
     }
     return fail(err, err_size, "unknown key '%s' (run with --print-scenario to list the keys)", key);

@@ -27,6 +27,7 @@ const key_t_ scenario_keys[] = {
     {"controller.motor.friction_Nms_rad", KEY_FLOAT, OFF(controller.motor.friction_Nms_rad), -BIG, 0, BIG, 0, "F (Nm s/rad)"},
     {"controller.motor.torque_constant_Nm_A", KEY_FLOAT, OFF(controller.motor.torque_constant_Nm_A), -BIG, 0, BIG, 0, "k_M (Nm/A)"},
     {"controller.motor.pole_pairs", KEY_INT, OFF(controller.motor.pole_pairs), -1000, 0, 1000, 0, "p"},
+    {"controller.motor.rated_current_A", KEY_FLOAT, OFF(controller.motor.rated_current_A), -BIG, 0, BIG, 0, "rated phase current (amplitude) the firmware bounds its overcurrent trip by (A)"},
     {"controller.motor.detent_torque_Nm", KEY_FLOAT, OFF(controller.motor.detent_torque_Nm), -BIG, 0, BIG, 0, "detent torque T_d the observer and the law compensate (Nm); 0 = none (the paper)"},
     {"controller.alignment.s_align_time_s", KEY_FLOAT, OFF(controller.alignment.s_align_time_s), -BIG, 0, BIG, 0, "t_s (s)"},
     {"controller.alignment.s_lead_in_time_s", KEY_FLOAT, OFF(controller.alignment.s_lead_in_time_s), -BIG, 0, BIG, 0, "s-alignment's first part drives (5)'s u_a = u_cc, u_b = 0 (p theta -> 0), away from (3)'s unstable equilibrium (s); 0 = none (the paper's)"},
@@ -136,6 +137,12 @@ const key_t_ scenario_keys[] = {
 
     {"inverter.model", KEY_INVERTER_MODEL, OFF(inverter.model), 0, 0, 0, 0, "averaged | switching"},
     {"inverter.dead_time_s", KEY_DOUBLE, OFF(inverter.dead_time_s), 0, 0, 0.01, 1, "dead time per half-bridge (s), below run.period_s / 4"},
+
+    {"faults.open_phase", KEY_PHASES, OFF(faults.open_phase), 0, 0, 0, 0, "none | a | b | both: the winding(s) open from faults.open_phase_time_s on (a broken wire: no current whatever the bridge applies)"},
+    {"faults.open_phase_time_s", KEY_DOUBLE, OFF(faults.open_phase_time_s), 0, 0, 3600, 0, "when the winding opens (s); 0 = from the start"},
+    {"faults.sensor", KEY_SENSOR_FAULT, OFF(faults.sensor), 0, 0, 0, 0, "none | open | stuck: the current sensor of faults.sensor_phase reads the chain's 0 A (open) or holds its last reading (stuck) from faults.sensor_time_s on"},
+    {"faults.sensor_phase", KEY_PHASES, OFF(faults.sensor_phase), 0, 0, 0, 0, "none | a | b | both: the phase(s) whose current sensor fails"},
+    {"faults.sensor_time_s", KEY_DOUBLE, OFF(faults.sensor_time_s), 0, 0, 3600, 0, "when the sensor fails (s); 0 = from the start"},
 
     {"bus.source_resistance_Ohm", KEY_DOUBLE, OFF(bus.source_resistance_Ohm), 0, 0, 1e6, 0, "sag V_bus = run.bus_voltage_V - R i_bus (Ohm)"},
     {"bus.ripple_V", KEY_DOUBLE, OFF(bus.ripple_V), 0, 0, 1e4, 0, "bus ripple amplitude, ripple_V sin(2 pi ripple_Hz t) (V)"},

@@ -12,7 +12,7 @@
 
 typedef enum { KEY_DOUBLE, KEY_FLOAT, KEY_INT, KEY_UINT, KEY_BOOL, KEY_ANGLE_DEG, KEY_SPEED_POINTS,
                KEY_LOAD_POINTS, KEY_LOAD_KIND, KEY_INVERTER_MODEL, KEY_ADC_BITS, KEY_INTEGRATOR,
-               KEY_DRIVE, KEY_MOVES } key_type_t;
+               KEY_DRIVE, KEY_MOVES, KEY_PHASES, KEY_SENSOR_FAULT } key_type_t;
 
 /* Range of a numeric key: min/max, each inclusive or exclusive. */
 typedef struct {
@@ -36,6 +36,8 @@ static const char *const load_kind_names[] = {"none", "constant", "step", "propo
 static const char *const inverter_model_names[] = {"averaged", "switching"};
 static const char *const integrator_names[] = {"rk4", "exponential"}; /* in plant_integrator_t order */
 static const char *const drive_names[] = {"pmstep", "microstep"};     /* in sil_drive_t order */
+static const char *const phases_names[] = {"none", "a", "b", "both"};  /* in sil_phases_t order */
+static const char *const sensor_fault_names[] = {"none", "open", "stuck"}; /* in sil_sensor_fault_t order */
 
 /* run.theta0_deg's value as stored (rad): the one conversion the reader applies and the printer
  * inverts (scenario.c). */

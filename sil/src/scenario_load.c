@@ -260,6 +260,23 @@ int sil_scenario_check(const sil_scenario_t *sc, char *err, size_t err_size)
             }
         }
     }
+    if (sc->load.kind == PLANT_LOAD_PROPORTIONAL && sc->integrator == PLANT_INTEGRATOR_RK4) {
+        /* RK4 on w' = -(c/J) w: stable for c h / J within 2.78; 2.5 keeps a margin. The exponential
+         * integrator takes the load exactly. */
+        const double h_s = (double)sc->controller.timing.period_s / (double)sc->substeps;
+        const double stiffness = fabs(sc->load.coefficient_Nms_rad) * h_s / sc->motor.inertia_kgm2;
+        if (stiffness > 2.5) {
+            return fail(err, err_size,
+                        "load.coefficient_Nms_rad = %g: |c| h / J = %g with run.integrator = rk4 and a substep of %g s "
+                        "(stable up to 2.5): raise run.substeps to %.0f or use run.integrator = exponential",
+                        sc->load.coefficient_Nms_rad, stiffness, h_s, ceil((double)sc->substeps * stiffness / 2.5));
+        }
+    }
+    if ((sc->faults.sensor != SIL_SENSOR_OK) != (sc->faults.sensor_phase != SIL_PHASES_NONE)) {
+        return fail(err, err_size, "faults.sensor and faults.sensor_phase go together: a failed sensor needs its phase, "
+                                   "a phase needs the failure (got %s on %s)",
+                    sensor_fault_names[sc->faults.sensor], phases_names[sc->faults.sensor_phase]);
+    }
     if (!(sc->bus.ripple_V < sc->bus_voltage_V)) {
         return fail(err, err_size, "bus.ripple_V = %g is not below run.bus_voltage_V = %g: the bus would reach zero",
                     sc->bus.ripple_V, sc->bus_voltage_V);

@@ -126,6 +126,10 @@ void sil_scenario_print(const sil_scenario_t *sc, FILE *file)
         case KEY_INVERTER_MODEL: fprintf(file, "%s\n", inverter_model_names[sc->inverter.model]); break;
         case KEY_INTEGRATOR: fprintf(file, "%s\n", integrator_names[sc->integrator]); break;
         case KEY_DRIVE: fprintf(file, "%s\n", drive_names[sc->drive]); break;
+        case KEY_PHASES: fprintf(file, "%s\n", phases_names[*(const sil_phases_t *)(base + k->offset)]); break;
+        case KEY_SENSOR_FAULT:
+            fprintf(file, "%s\n", sensor_fault_names[*(const sil_sensor_fault_t *)(base + k->offset)]);
+            break;
         case KEY_MOVES:
             if (sc->position_moves > 0) {
                 print_points(file, sc->move_time_s, sc->move_target_rad, sc->position_moves);

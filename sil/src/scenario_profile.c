@@ -45,6 +45,7 @@ void sil_scenario_paper(sil_scenario_t *sc)
     /* Measurement chain, inverter and bus: all ideal. */
     sc->seed = 1u;
     sc->sensors = sil_sensors_ideal();
+    sil_scenario_sense_ranges(sc);
     sc->inverter = sil_inverter_ideal_config();
     sc->bus = sil_bus_ideal_config();
     sc->drive = SIL_DRIVE_PMSTEP;

@@ -17,7 +17,9 @@ void design_input(const sil_scenario_t *sc, bool robust, bool low_speed_drive, p
     in->motor.torque_constant_Nm_A = (float)sc->motor.torque_constant_Nm_A;
     in->motor.pole_pairs = (int32_t)sc->motor.pole_pairs;
     in->motor.detent_torque_Nm = (float)sc->datasheet.detent_torque_Nm; /* the law compensates the datasheet's */
-    in->rated_current_A = (float)sc->datasheet.rated_current_A;
+    in->motor.rated_current_A = (float)sc->datasheet.rated_current_A;
+    in->current_sense_range_A = sc->controller.limits.current_sense_range_A; /* the scenario's sensors */
+    in->bus_sense_range_V = sc->controller.limits.bus_sense_range_V;
     in->bus_voltage_V = (float)sc->bus_voltage_V;
     in->period_s = sc->controller.timing.period_s;
     in->computational_delay_periods = sc->controller.timing.computational_delay_periods;
@@ -96,10 +98,10 @@ int write_c(const char *path, const sil_scenario_t *sc)
     fprintf(f, "#include \"pmstep/pmstep.h\"\n\nconst pmstep_config_t pmstep_designed_config = {\n");
     fprintf(f, "    .motor = {.resistance_Ohm = %.9gf, .inductance_H = %.9gf, .inertia_kgm2 = %.9gf,\n"
                "              .friction_Nms_rad = %.9gf, .torque_constant_Nm_A = %.9gf, .pole_pairs = %d,\n"
-               "              .detent_torque_Nm = %.9gf},\n",
+               "              .detent_torque_Nm = %.9gf, .rated_current_A = %.9gf},\n",
             (double)c->motor.resistance_Ohm, (double)c->motor.inductance_H, (double)c->motor.inertia_kgm2,
             (double)c->motor.friction_Nms_rad, (double)c->motor.torque_constant_Nm_A, (int)c->motor.pole_pairs,
-            (double)c->motor.detent_torque_Nm);
+            (double)c->motor.detent_torque_Nm, (double)c->motor.rated_current_A);
     fprintf(f, "    .timing = {.period_s = %.9gf, .computational_delay_periods = %uu},\n", (double)c->timing.period_s,
             (unsigned)c->timing.computational_delay_periods);
     fprintf(f, "    .alignment = {.s_align_time_s = %.9gf, .s_lead_in_time_s = %.9gf, .c_align_time_s = %.9gf,\n"
@@ -121,9 +123,11 @@ int write_c(const char *path, const sil_scenario_t *sc)
             (double)c->gains.current_integral_gain_q_per_s2, (double)c->gains.detent_fade_speed_rad_s,
             (double)c->gains.emf_angle_gain_per_s, (double)c->gains.emf_angle_corner_rad_s,
             (double)c->gains.angle_smoothing, (double)c->gains.transient_observer_boost);
-    fprintf(f, "    .limits = {.max_phase_current_A = %.9gf, .min_bus_voltage_V = %.9gf, .max_bus_voltage_V = %.9gf},\n",
+    fprintf(f, "    .limits = {.max_phase_current_A = %.9gf, .min_bus_voltage_V = %.9gf, .max_bus_voltage_V = %.9gf,\n"
+               "               .current_sense_range_A = %.9gf, .bus_sense_range_V = %.9gf},\n",
             (double)c->limits.max_phase_current_A, (double)c->limits.min_bus_voltage_V,
-            (double)c->limits.max_bus_voltage_V);
+            (double)c->limits.max_bus_voltage_V, (double)c->limits.current_sense_range_A,
+            (double)c->limits.bus_sense_range_V);
     fprintf(f, "    .commissioning = {.offset_calibration_time_s = %.9gf, .alignment_offset_calibration = %s,\n"
                "                      .steady_state_window_s = %.9gf, .inductance_window_s = %.9gf,\n"
                "                      .use_measured_resistance = %s, .use_measured_inductance = %s,\n"

@@ -49,7 +49,7 @@ int main(int argc, char **argv)
     static pmstep_console_snapshot_t snap; /* zero: no output yet */
     const pmstep_meas_t meas = {0.3f, 0.2f, 48.0f, 0.0f, 0.0f, 0.0f};
     snap.period = UINT32_MAX;                /* no step yet */
-    cfg = pmstep_console_app_config(50e-6f, 1u);
+    cfg = pmstep_console_app_config(50e-6f, 1u, 16.5f, 66.0f);
     if (pmstep_init(&motor, &cfg) != PMSTEP_OK) {
         return 2;
     }

@@ -25,7 +25,7 @@ static int setup(void **state)
 {
     (void)state;
     pmstep_console_init(&con, "pmstep 0.1.0 test");
-    cfg = pmstep_console_app_config(50e-6f, 1u);
+    cfg = pmstep_console_app_config(50e-6f, 1u, 16.5f, 66.0f);
     assert_int_equal(pmstep_init(&motor, &cfg), PMSTEP_OK);
     memset(&snap, 0, sizeof snap);
     snap.period = UINT32_MAX; /* no step yet */

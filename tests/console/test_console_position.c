@@ -28,7 +28,7 @@ static int setup(void **state)
     pmstep_position_config_t gains;
     (void)state;
     pmstep_console_init(&con, "pmstep test");
-    cfg = pmstep_console_app_config(50e-6f, 1u);
+    cfg = pmstep_console_app_config(50e-6f, 1u, 16.5f, 66.0f);
     assert_int_equal(pmstep_init(&motor, &cfg), PMSTEP_OK);
     assert_int_equal(pmstep_position_design(&cfg, &gains), PMSTEP_OK);
     assert_int_equal(pmstep_position_init(&position, &motor, &gains), PMSTEP_OK);

@@ -80,6 +80,8 @@ static void eva_any_config(pmstep_config_t *cfg)
     cfg->limits.max_phase_current_A = eva_any_finite();
     cfg->limits.min_bus_voltage_V = eva_any_finite();
     cfg->limits.max_bus_voltage_V = eva_any_finite();
+    cfg->limits.current_sense_range_A = eva_any_finite();
+    cfg->limits.bus_sense_range_V = eva_any_finite();
     cfg->commissioning.offset_calibration_time_s = eva_any_finite();
     cfg->commissioning.alignment_offset_calibration = Frama_C_nondet(0, 1) != 0;
     cfg->commissioning.steady_state_window_s = eva_any_finite();
@@ -101,6 +103,7 @@ static void eva_any_config(pmstep_config_t *cfg)
     cfg->gains.transient_observer_boost = eva_any_finite();
     cfg->gains.detent_fade_speed_rad_s = eva_any_finite();
     cfg->motor.detent_torque_Nm = eva_any_finite();
+    cfg->motor.rated_current_A = eva_any_finite();
     cfg->detection.angle_magnitude_bound = eva_any_finite();
     cfg->detection.speed_consistency_bound_rad_s = eva_any_finite();
     cfg->detection.stall_speed_error_rad_s = eva_any_finite();

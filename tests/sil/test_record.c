@@ -51,6 +51,9 @@ static void config_round_trips_through_the_words(void **state)
     in.gains.angle_smoothing = 0.5f;
     in.standstill.stops_only = true;
     in.gains.transient_observer_boost = 3.0f;
+    in.motor.rated_current_A = 2.5f;
+    in.limits.current_sense_range_A = 8.25f;
+    in.limits.bus_sense_range_V = 66.5f;
     sil_record_config_to_words(&in, w);
     sil_record_config_from_words(w, &out);
     assert_memory_equal(&in.motor.resistance_Ohm, &out.motor.resistance_Ohm, sizeof(float));
@@ -85,9 +88,11 @@ static void config_round_trips_through_the_words(void **state)
     assert_true(out.gains.emf_angle_corner_rad_s == 22.5f && w[54] == sil_record_bits(22.5f));
     assert_true(out.gains.angle_smoothing == 0.5f && w[55] == sil_record_bits(0.5f));
     assert_true(out.standstill.stops_only && w[56] == 1u);
+    assert_true(out.gains.transient_observer_boost == 3.0f && w[57] == sil_record_bits(3.0f));
+    assert_true(out.motor.rated_current_A == 2.5f && w[58] == sil_record_bits(2.5f));
+    assert_true(out.limits.current_sense_range_A == 8.25f && w[59] == sil_record_bits(8.25f));
     /* The last word is the last field. */
-    assert_true(out.gains.transient_observer_boost == 3.0f
-                && w[SIL_RECORD_CONFIG_WORDS - 1u] == sil_record_bits(3.0f));
+    assert_true(out.limits.bus_sense_range_V == 66.5f && w[SIL_RECORD_CONFIG_WORDS - 1u] == sil_record_bits(66.5f));
 }
 
 /* A period's input, the sensed phase voltages included, comes back bit for bit. */

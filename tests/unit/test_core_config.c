@@ -23,7 +23,8 @@ static const pmstep_status_t all_status_codes[] = {
     PMSTEP_ERR_ANGLE_CORRECTION_GAIN, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN, PMSTEP_ERR_DETENT_FADE_SPEED,
     PMSTEP_ERR_EMF_ANGLE_GAIN, PMSTEP_ERR_ANGLE_SMOOTHING, PMSTEP_ERR_OBSERVER_BOOST,
     PMSTEP_ERR_MAX_CURRENT, PMSTEP_ERR_MIN_BUS,
-    PMSTEP_ERR_BUS_ORDER,
+    PMSTEP_ERR_BUS_ORDER, PMSTEP_ERR_TRIP_ABOVE_RATED, PMSTEP_ERR_TRIP_ABOVE_SENSE_RANGE,
+    PMSTEP_ERR_BUS_ABOVE_SENSE_RANGE, PMSTEP_ERR_SENSE_RANGE,
     PMSTEP_ERR_ALIGNMENT_VOLTAGE, PMSTEP_ERR_ALIGNMENT_ABOVE_BUS, PMSTEP_ERR_ALIGNMENT_CURRENT,
     PMSTEP_ERR_S_ALIGN_TIME, PMSTEP_ERR_C_ALIGN_TIME, PMSTEP_ERR_ALIGNMENT_TOO_LONG, PMSTEP_ERR_ALIGNMENT_CONDITION,
     PMSTEP_ERR_OFFSET_CALIBRATION_TIME, PMSTEP_ERR_STEADY_STATE_WINDOW, PMSTEP_ERR_INDUCTANCE_WINDOW,
@@ -31,6 +32,7 @@ static const pmstep_status_t all_status_codes[] = {
     PMSTEP_ERR_TORQUE_CONSTANT_UNMEASURED, PMSTEP_ERR_VOLTAGE_BIAS_FRACTION, PMSTEP_ERR_VOLTAGE_BIAS_WINDOW,
     PMSTEP_ERR_VOLTAGE_BIAS_SETTLING, PMSTEP_ERR_DEAD_TIME, PMSTEP_ERR_DEAD_TIME_BAND, PMSTEP_ERR_DETECTION_BOUND,
     PMSTEP_ERR_DETECTION_TIME, PMSTEP_ERR_RATED_CURRENT, PMSTEP_ERR_BUS_BELOW_RATED, PMSTEP_ERR_RATE_TOO_SLOW,
+    PMSTEP_ERR_SENSE_RANGE_BELOW_RATED,
     PMSTEP_ERR_IDENTIFICATION_WINDOW, PMSTEP_ERR_IDENTIFICATION_SPEED, PMSTEP_ERR_MECHANICS_UNIDENTIFIED,
     PMSTEP_ERR_POSITION_GAIN, PMSTEP_ERR_POSITION_INTEGRAL_GAIN, PMSTEP_ERR_HOLD_CURRENT, PMSTEP_ERR_STANDSTILL_KNOWN_LOAD};
 
@@ -112,6 +114,23 @@ static void lead_in_fills_s_alignment(pmstep_config_t *c) { c->alignment.s_lead_
 static void bad_bandwidth(pmstep_config_t *c) { c->gains.reference_bandwidth_rad_s = 20000.0f; }
 static void bad_limits(pmstep_config_t *c) { c->limits.max_bus_voltage_V = 20.0f; }
 static void bad_delay(pmstep_config_t *c) { c->timing.computational_delay_periods = 2u; }
+/* The review's values: a trip and an overvoltage limit of 3.4e38 (finite) switched both trips off. */
+static void huge_trip(pmstep_config_t *c) { c->limits.max_phase_current_A = 3.4e38f; }
+static void huge_max_bus(pmstep_config_t *c) { c->limits.max_bus_voltage_V = 3.4e38f; }
+/* Paper: rated 8 A, so the trip may be 24 A at most; with a sensing range of 30 A it is the rating
+ * that refuses 24.5 A. */
+static void trip_above_rated(pmstep_config_t *c)
+{
+    c->limits.current_sense_range_A = 30.0f;
+    c->limits.max_phase_current_A = 24.5f;
+}
+static void zero_rated_current(pmstep_config_t *c) { c->motor.rated_current_A = 0.0f; }
+/* Paper: +/-16.5 A sensed, so a trip up to 15.675 A; 16 A would never see a saturated reading. */
+static void trip_above_sense_range(pmstep_config_t *c) { c->limits.max_phase_current_A = 16.0f; }
+/* Paper: 66 V sensed, so a trip up to 62.7 V. */
+static void max_bus_above_sense_range(pmstep_config_t *c) { c->limits.max_bus_voltage_V = 63.0f; }
+static void zero_current_sense_range(pmstep_config_t *c) { c->limits.current_sense_range_A = 0.0f; }
+static void negative_bus_sense_range(pmstep_config_t *c) { c->limits.bus_sense_range_V = -66.0f; }
 static void nan_param(pmstep_config_t *c) { c->motor.inertia_kgm2 = NAN; }
 /* Found by fuzzing (issue 15): each was accepted and failed only in the step. */
 static void tiny_dead_time_band(pmstep_config_t *c) { c->inverter.dead_time_s = 1e-6f; c->inverter.dead_time_current_band_A = 1e-40f; }
@@ -188,6 +207,14 @@ static const struct {
     {bad_align_time, PMSTEP_ERR_C_ALIGN_TIME},
     {bad_bandwidth, PMSTEP_ERR_REFERENCE_BANDWIDTH},
     {bad_limits, PMSTEP_ERR_BUS_ORDER},
+    {huge_trip, PMSTEP_ERR_TRIP_ABOVE_RATED},
+    {huge_max_bus, PMSTEP_ERR_BUS_ABOVE_SENSE_RANGE},
+    {trip_above_rated, PMSTEP_ERR_TRIP_ABOVE_RATED},
+    {zero_rated_current, PMSTEP_ERR_RATED_CURRENT},
+    {trip_above_sense_range, PMSTEP_ERR_TRIP_ABOVE_SENSE_RANGE},
+    {max_bus_above_sense_range, PMSTEP_ERR_BUS_ABOVE_SENSE_RANGE},
+    {zero_current_sense_range, PMSTEP_ERR_SENSE_RANGE},
+    {negative_bus_sense_range, PMSTEP_ERR_SENSE_RANGE},
     {bad_delay, PMSTEP_ERR_DELAY},
     {nan_param, PMSTEP_ERR_NONFINITE_PARAMETER},
     {tiny_dead_time_band, PMSTEP_ERR_DEAD_TIME_BAND},
@@ -238,6 +265,23 @@ static void current_integral_within_its_bound_is_accepted(void **state)
     assert_int_equal(pmstep_validate_config(&cfg), PMSTEP_OK);
 }
 
+/* The bounds themselves are accepted: a trip of 3 x rated within the sensing, and trips at 95 % of
+ * each range. */
+static void limits_at_their_bounds_are_accepted(void **state)
+{
+    /* The validation's table keeps each float's offset in an unsigned char. */
+    assert_true(offsetof(pmstep_config_t, standstill.vector_speed_rad_s) < 256u);
+    pmstep_config_t cfg = pmstep_paper_config();
+    (void)state;
+    cfg.limits.current_sense_range_A = 30.0f;
+    cfg.limits.max_phase_current_A = PMSTEP_MAX_TRIP_PER_RATED_CURRENT * cfg.motor.rated_current_A;
+    assert_int_equal(pmstep_validate_config(&cfg), PMSTEP_OK);
+    cfg = pmstep_paper_config();
+    cfg.limits.max_phase_current_A = PMSTEP_SENSE_RANGE_USABLE_FRACTION * cfg.limits.current_sense_range_A;
+    cfg.limits.max_bus_voltage_V = PMSTEP_SENSE_RANGE_USABLE_FRACTION * cfg.limits.bus_sense_range_V;
+    assert_int_equal(pmstep_validate_config(&cfg), PMSTEP_OK);
+}
+
 static void emf_gain_under_the_residual_rate_is_accepted(void **state)
 {
     pmstep_config_t cfg = pmstep_paper_config();
@@ -272,7 +316,7 @@ static void every_validation_code_is_provoked(void **state)
         bool found = false;
         size_t k;
         if (code > PMSTEP_ERR_NONFINITE_PARAMETER
-            || (code <= PMSTEP_ERR_RATED_CURRENT && code >= PMSTEP_ERR_RATE_TOO_SLOW)
+            || (code <= PMSTEP_ERR_RATED_CURRENT && code >= PMSTEP_ERR_SENSE_RANGE_BELOW_RATED)
             || code <= PMSTEP_ERR_POSITION_GAIN) {
             continue; /* ok and the command codes: commands_validate_their_values (test_core.c); the
                        * designer's: test_design.c; the position library's: test_position.c */
@@ -324,6 +368,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(every_invalid_configuration_has_its_code),
         cmocka_unit_test(current_integral_within_its_bound_is_accepted),
+        cmocka_unit_test(limits_at_their_bounds_are_accepted),
         cmocka_unit_test(emf_gain_under_the_residual_rate_is_accepted),
         cmocka_unit_test(observer_boost_within_range_is_accepted),
         cmocka_unit_test(every_code_has_its_own_text),

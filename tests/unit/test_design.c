@@ -36,7 +36,9 @@ static pmstep_design_input_t input_of(const motor_data_t *m, bool robust)
     in.motor.torque_constant_Nm_A = m->k_m;
     in.motor.pole_pairs = m->p;
     in.motor.detent_torque_Nm = 0.0f;
-    in.rated_current_A = m->rated_A;
+    in.motor.rated_current_A = m->rated_A;
+    in.current_sense_range_A = 3.0f * m->rated_A;
+    in.bus_sense_range_V = 2.0f * m->bus_V;
     in.bus_voltage_V = m->bus_V;
     in.period_s = 50e-6f;
     in.computational_delay_periods = robust ? 1u : 0u;
@@ -96,9 +98,9 @@ static void every_preset_gets_a_valid_design(void **state)
             assert_true(lhs > rhs);
             assert_true(report.condition_4_margin >= 1.99f);
             /* Alignment current at most the rated current. */
-            assert_true(cfg.alignment.s_align_voltage_V / in.motor.resistance_Ohm <= in.rated_current_A * 1.0001f);
-            assert_true(cfg.alignment.c_align_voltage_V / in.motor.resistance_Ohm <= in.rated_current_A * 1.0001f);
-            assert_true(cfg.limits.max_phase_current_A > in.rated_current_A);
+            assert_true(cfg.alignment.s_align_voltage_V / in.motor.resistance_Ohm <= in.motor.rated_current_A * 1.0001f);
+            assert_true(cfg.alignment.c_align_voltage_V / in.motor.resistance_Ohm <= in.motor.rated_current_A * 1.0001f);
+            assert_true(cfg.limits.max_phase_current_A > in.motor.rated_current_A);
             /* PI current loop: K_I = K^2/8, K = R/L + K_i (poles 0.15 K and 0.85 K, real); on the q
              * axis K k_w / 5, its slow pole a fifth of the speed loop's (DESIGN.md section 2). */
             {
@@ -111,7 +113,7 @@ static void every_preset_gets_a_valid_design(void **state)
              * half on where the back EMF equals R I + 2 V_bus t_d / T_s (DESIGN.md section 15); off in
              * paper mode. */
             if (robust != 0) {
-                const float corner_rad_s = (in.motor.resistance_Ohm * in.rated_current_A
+                const float corner_rad_s = (in.motor.resistance_Ohm * in.motor.rated_current_A
                                             + 2.0f * in.bus_voltage_V * in.dead_time_s / in.period_s)
                                            / in.motor.torque_constant_Nm_A;
                 assert_float_equal(cfg.gains.emf_angle_gain_per_s, 0.1f / in.period_s, 1e-3f);
@@ -141,7 +143,7 @@ static void every_preset_gets_a_valid_design(void **state)
             /* Top speed: the bus takes (R I + k_M w)^2 + (p w L I)^2 = (0.9 V)^2 there. */
             {
                 const double w = (double)report.top_speed_rad_s;
-                const double i = (double)in.rated_current_A;
+                const double i = (double)in.motor.rated_current_A;
                 const double u_q = (double)in.motor.resistance_Ohm * i + (double)in.motor.torque_constant_Nm_A * w;
                 const double u_d = (double)p * w * (double)in.motor.inductance_H * i;
                 assert_true(fabs(sqrt(u_q * u_q + u_d * u_d) - 0.9 * (double)in.bus_voltage_V)
@@ -241,7 +243,7 @@ static void negative_f(pmstep_design_input_t *in) { in->motor.friction_Nms_rad =
 static void zero_p(pmstep_design_input_t *in) { in->motor.pole_pairs = 0; }
 static void nan_r(pmstep_design_input_t *in) { in->motor.resistance_Ohm = NAN; }
 static void inf_j(pmstep_design_input_t *in) { in->motor.inertia_kgm2 = INFINITY; }
-static void zero_rated(pmstep_design_input_t *in) { in->rated_current_A = 0.0f; }
+static void zero_rated(pmstep_design_input_t *in) { in->motor.rated_current_A = 0.0f; }
 static void low_bus(pmstep_design_input_t *in) { in->bus_voltage_V = 2.5f; } /* R I = 2.55 V > 0.9 x 2.5 V */
 static void zero_bus(pmstep_design_input_t *in) { in->bus_voltage_V = 0.0f; }
 static void slow_rate(pmstep_design_input_t *in) { in->period_s = 1e-3f; } /* (R/L) T_s = 0.54 */
@@ -254,6 +256,11 @@ static void heavy_friction(pmstep_design_input_t *in) { in->motor.friction_Nms_r
 static void bad_period(pmstep_design_input_t *in) { in->period_s = 0.1f; }
 static void bad_delay(pmstep_design_input_t *in) { in->computational_delay_periods = 2u; }
 static void long_dead_time(pmstep_design_input_t *in) { in->dead_time_s = 20e-6f; }
+static void no_current_sensing(pmstep_design_input_t *in) { in->current_sense_range_A = 0.0f; }
+/* 17HS4401: 1.7 A rated needs a trip of 2.125 A at least, so 2.2 A of range (2.09 A usable) is short. */
+static void current_sensing_below_rated(pmstep_design_input_t *in) { in->current_sense_range_A = 2.2f; }
+/* 24 V bus: the overvoltage trip must reach 26.4 V, and 27 V of range gives 25.65 V. */
+static void bus_sensing_below_bus(pmstep_design_input_t *in) { in->bus_sense_range_V = 27.0f; }
 
 static void bad_motor_data_gets_a_named_error(void **state)
 {
@@ -270,6 +277,9 @@ static void bad_motor_data_gets_a_named_error(void **state)
         {rate_for_winding, PMSTEP_ERR_RATE_TOO_SLOW}, {heavy_friction, PMSTEP_ERR_RATE_TOO_SLOW},
         {bad_period, PMSTEP_ERR_PERIOD},         {bad_delay, PMSTEP_ERR_DELAY},
         {long_dead_time, PMSTEP_ERR_DEAD_TIME},
+        {no_current_sensing, PMSTEP_ERR_SENSE_RANGE},
+        {current_sensing_below_rated, PMSTEP_ERR_SENSE_RANGE_BELOW_RATED},
+        {bus_sensing_below_bus, PMSTEP_ERR_BUS_ABOVE_SENSE_RANGE},
     };
     size_t n;
     pmstep_config_t cfg;

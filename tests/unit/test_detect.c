@@ -10,14 +10,16 @@
 #include "pmstep/pmstep_instance.h" /* the test sets the flux integrals inside the instance */
 #include "pmstep/pmstep_text.h"
 
-/* Holds the c-aligned state (i_a = 8 A, rotor still) into RUN. */
+/* s-alignment's current in phase b (u_cs / R = 8 A), then holds the c-aligned state (i_a = 8 A,
+ * rotor still) into RUN. */
 static void hold_to_run(pmstep_t *inst, pmstep_output_t *out)
 {
-    const pmstep_meas_t m = {8.0f, 0.0f, 48.0f, 0.0f, 0.0f, 0.0f};
+    const pmstep_meas_t s_aligned = {0.0f, 8.0f, 48.0f, 0.0f, 0.0f, 0.0f};
+    const pmstep_meas_t c_aligned = {8.0f, 0.0f, 48.0f, 0.0f, 0.0f, 0.0f};
     uint32_t k;
     assert_int_equal(pmstep_start(inst), PMSTEP_OK);
     for (k = 0; k <= inst->commission_plan.c_align_end_step; ++k) {
-        pmstep_step(inst, &m, out);
+        pmstep_step(inst, k < inst->commission_plan.s_align_steps ? &s_aligned : &c_aligned, out);
     }
     assert_int_equal(out->mode, PMSTEP_MODE_RUN);
 }

@@ -190,8 +190,10 @@ bool pmstep_console_config_get(const pmstep_config_t *cfg, uint32_t id, float *v
  */
 int pmstep_console_config_set(pmstep_config_t *cfg, uint32_t id, float value);
 
-/** The application's configuration: the paper's, with the port's period and delay. */
-pmstep_config_t pmstep_console_app_config(float period_s, uint32_t computational_delay_periods);
+/** The application's configuration: the paper's, with the port's period, delay and measurement
+ *  ranges (A, V). */
+pmstep_config_t pmstep_console_app_config(float period_s, uint32_t computational_delay_periods,
+                                          float current_sense_range_A, float bus_sense_range_V);
 
 /** The control period (s) of @p cfg. */
 float pmstep_console_config_period_s(const pmstep_config_t *cfg);

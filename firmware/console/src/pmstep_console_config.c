@@ -12,7 +12,8 @@
 #define U32(field) {#field, PMSTEP_CONSOLE_CFG_U32, 0u, (uint16_t)offsetof(pmstep_config_t, field)}
 #define I32(field) {#field, PMSTEP_CONSOLE_CFG_I32, 0u, (uint16_t)offsetof(pmstep_config_t, field)}
 #define BOOL(field) {#field, PMSTEP_CONSOLE_CFG_BOOL, 0u, (uint16_t)offsetof(pmstep_config_t, field)}
-/* Fixed by the port (the carrier and where the duties load): never set from the console. */
+/* Fixed by the port (the carrier and where the duties load, what its sensors read): never set
+ * from the console. */
 #define F32_RO(field) {#field, PMSTEP_CONSOLE_CFG_F32, PMSTEP_CONSOLE_CFG_READ_ONLY, (uint16_t)offsetof(pmstep_config_t, field)}
 #define U32_RO(field) {#field, PMSTEP_CONSOLE_CFG_U32, PMSTEP_CONSOLE_CFG_READ_ONLY, (uint16_t)offsetof(pmstep_config_t, field)}
 
@@ -76,6 +77,9 @@ static const pmstep_console_config_entry_t table[] = {
     F32(gains.angle_smoothing),
     BOOL(standstill.stops_only),
     F32(gains.transient_observer_boost),
+    F32(motor.rated_current_A),
+    F32_RO(limits.current_sense_range_A),
+    F32_RO(limits.bus_sense_range_V),
 };
 
 const pmstep_console_config_entry_t *pmstep_console_config_table(uint32_t *count)
@@ -147,11 +151,14 @@ int pmstep_console_config_set(pmstep_config_t *cfg, uint32_t id, float value)
     }
 }
 
-pmstep_config_t pmstep_console_app_config(float period_s, uint32_t computational_delay_periods)
+pmstep_config_t pmstep_console_app_config(float period_s, uint32_t computational_delay_periods,
+                                          float current_sense_range_A, float bus_sense_range_V)
 {
     pmstep_config_t cfg = pmstep_paper_config();
     cfg.timing.period_s = period_s;
     cfg.timing.computational_delay_periods = computational_delay_periods;
+    cfg.limits.current_sense_range_A = current_sense_range_A;
+    cfg.limits.bus_sense_range_V = bus_sense_range_V;
     return cfg;
 }
 

@@ -35,6 +35,13 @@
 /* Protections. */
 #define USABLE_BUS_FRACTION 0.9f
 #define TRIP_CURRENT_PER_RATED 2.0f
+/* Where the drive's current sensing cannot read twice the rated current, the trip goes down to
+ * what it reads (PMSTEP_SENSE_RANGE_USABLE_FRACTION of its range), but not below this many times the
+ * rated current: a drive that trips at its motor's rating cannot drive it. */
+#define MIN_TRIP_CURRENT_PER_RATED 1.25f
+/* Likewise the overvoltage trip, down to the bus measurement's usable range, but not below this
+ * many times the nominal bus (supply tolerance and regeneration). */
+#define MIN_MAX_BUS_FRACTION 1.1f
 #define MIN_BUS_FRACTION 0.625f
 #define MAX_BUS_FRACTION 1.25f
 /* Detection (DESIGN.md, section 5). */
@@ -100,9 +107,10 @@ static bool finite_input(const pmstep_design_input_t *in)
 {
     const pmstep_motor_config_t *m = &in->motor;
     return isfinite(m->resistance_Ohm) && isfinite(m->inductance_H) && isfinite(m->inertia_kgm2)
-           && isfinite(m->friction_Nms_rad) && isfinite(m->torque_constant_Nm_A) && isfinite(in->rated_current_A)
+           && isfinite(m->friction_Nms_rad) && isfinite(m->torque_constant_Nm_A) && isfinite(in->motor.rated_current_A)
            && isfinite(in->bus_voltage_V) && isfinite(in->period_s) && isfinite(in->dead_time_s)
-           && isfinite(in->current_resolution_A);
+           && isfinite(in->current_resolution_A) && isfinite(in->current_sense_range_A)
+           && isfinite(in->bus_sense_range_V) && isfinite(m->detent_torque_Nm);
 }
 
 static pmstep_status_t check_input(const pmstep_design_input_t *in)
@@ -135,12 +143,22 @@ static pmstep_status_t check_input(const pmstep_design_input_t *in)
     if (in->computational_delay_periods > 1u) {
         return PMSTEP_ERR_DELAY;
     }
-    if (!(in->rated_current_A > 0.0f)) {
+    if (!(in->motor.rated_current_A > 0.0f)) {
         return PMSTEP_ERR_RATED_CURRENT;
     }
     if (!(in->bus_voltage_V > 0.0f)
-        || !(m->resistance_Ohm * in->rated_current_A < USABLE_BUS_FRACTION * in->bus_voltage_V)) {
+        || !(m->resistance_Ohm * in->motor.rated_current_A < USABLE_BUS_FRACTION * in->bus_voltage_V)) {
         return PMSTEP_ERR_BUS_BELOW_RATED;
+    }
+    if (!(in->current_sense_range_A > 0.0f) || !(in->bus_sense_range_V > 0.0f)) {
+        return PMSTEP_ERR_SENSE_RANGE;
+    }
+    if (PMSTEP_SENSE_RANGE_USABLE_FRACTION * in->current_sense_range_A
+        < MIN_TRIP_CURRENT_PER_RATED * in->motor.rated_current_A) {
+        return PMSTEP_ERR_SENSE_RANGE_BELOW_RATED;
+    }
+    if (PMSTEP_SENSE_RANGE_USABLE_FRACTION * in->bus_sense_range_V < MIN_MAX_BUS_FRACTION * in->bus_voltage_V) {
+        return PMSTEP_ERR_BUS_ABOVE_SENSE_RANGE;
     }
     if (!(in->dead_time_s >= 0.0f && 4.0f * in->dead_time_s < in->period_s)) {
         return PMSTEP_ERR_DEAD_TIME;
@@ -160,7 +178,7 @@ static pmstep_status_t check_input(const pmstep_design_input_t *in)
 static float top_speed(const pmstep_design_input_t *in)
 {
     const pmstep_motor_config_t *m = &in->motor;
-    const float i = in->rated_current_A;
+    const float i = in->motor.rated_current_A;
     const float x = (float)m->pole_pairs * m->inductance_H * i;
     const float a = m->torque_constant_Nm_A * m->torque_constant_Nm_A + x * x;
     const float b = 2.0f * m->resistance_Ohm * i * m->torque_constant_Nm_A;
@@ -197,14 +215,14 @@ static void design_gains(const pmstep_design_input_t *in, pmstep_gains_config_t 
     gains->adapt_gamma = b * b / (w_slow * w_slow * w_slow);
     gains->adapt_r = ADAPT_R;
     gains->speed_gain_per_s = speed_gain;
-    gains->sat_kappa_rad_s = KAPPA_CURRENT_FRACTION * in->rated_current_A * m->torque_constant_Nm_A
+    gains->sat_kappa_rad_s = KAPPA_CURRENT_FRACTION * in->motor.rated_current_A * m->torque_constant_Nm_A
                              / (m->inertia_kgm2 * speed_gain);
     gains->reference_bandwidth_rad_s = REFERENCE_PER_SPEED_BANDWIDTH * speed_gain;
     gains->angle_correction_gain_per_s = in->self_commissioning ? DRIFT_FREE_PER_OBSERVER_BANDWIDTH * w_o : 0.0f;
     if (in->self_commissioning) {
         /* Half on where the back EMF equals the voltage the model knows least: the resistive drop at
          * rated current and the dead time's full loss 2 V_bus t_d / T_s. */
-        const float uncertain_V = m->resistance_Ohm * in->rated_current_A
+        const float uncertain_V = m->resistance_Ohm * in->motor.rated_current_A
                                   + 2.0f * in->bus_voltage_V * in->dead_time_s / in->period_s;
         gains->emf_angle_gain_per_s = EMF_ANGLE_PER_OBSERVER_BANDWIDTH * w_o;
         gains->emf_angle_corner_rad_s = uncertain_V / m->torque_constant_Nm_A;
@@ -235,7 +253,7 @@ static float design_alignment(const pmstep_design_input_t *in, pmstep_config_t *
     const float r = m->resistance_Ohm;
     const float l_over_r = m->inductance_H / r;
     const float condition_limit_A = m->torque_constant_Nm_A / (p * m->inductance_H);
-    const float current_A = min2(in->rated_current_A, CONDITION_4_FRACTION * condition_limit_A);
+    const float current_A = min2(in->motor.rated_current_A, CONDITION_4_FRACTION * condition_limit_A);
     const float stiffness = p * m->torque_constant_Nm_A * current_A;
     const float natural = sqrtf(stiffness / m->inertia_kgm2);
     const float lag = natural * l_over_r;
@@ -276,13 +294,13 @@ static float design_alignment(const pmstep_design_input_t *in, pmstep_config_t *
  * take on the compensation's word for the sign of its loss. */
 static float magnetising_current(const pmstep_design_input_t *in)
 {
-    const float floor_A = MAGNETISING_PER_RATED_CURRENT * in->rated_current_A;
+    const float floor_A = MAGNETISING_PER_RATED_CURRENT * in->motor.rated_current_A;
     const float dead_time_current_A = 2.0f * in->bus_voltage_V * in->dead_time_s / in->motor.inductance_H;
     if (in->phase_voltage_sensing) {
         return floor_A;
     }
     return min2(max2(MAGNETISING_PER_DEAD_TIME_CURRENT * dead_time_current_A, floor_A),
-                MAX_MAGNETISING_PER_RATED_CURRENT * in->rated_current_A);
+                MAX_MAGNETISING_PER_RATED_CURRENT * in->motor.rated_current_A);
 }
 
 /* The low-speed drive's band: below the speed whose back EMF is LOW_SPEED_EMF_PER_DEAD_TIME_LOSS
@@ -294,7 +312,7 @@ static float low_speed_band(const pmstep_design_input_t *in)
     const float pole_pairs = (float)m->pole_pairs;
     const float emf_band_rad_s = LOW_SPEED_EMF_PER_DEAD_TIME_LOSS * in->bus_voltage_V * in->dead_time_s
                                  / (in->period_s * m->torque_constant_Nm_A);
-    const float held_natural_rad_s = sqrtf(pole_pairs * m->torque_constant_Nm_A * in->rated_current_A
+    const float held_natural_rad_s = sqrtf(pole_pairs * m->torque_constant_Nm_A * in->motor.rated_current_A
                                            / m->inertia_kgm2);
     const float resonance_band_rad_s = LOW_SPEED_DETENT_PER_HELD_NATURAL * held_natural_rad_s / (4.0f * pole_pairs);
     return min2(emf_band_rad_s, resonance_band_rad_s);
@@ -343,7 +361,7 @@ static void design_commissioning(const pmstep_design_input_t *in, float window_s
     report->magnetising_current_A = robust ? magnetising_current(in) : 0.0f;
     /* Robust mode holds a zero speed command with a vector at rated current (pmstep_hold.h): the
      * estimate would drift there with what is left of the voltage errors. */
-    cfg->standstill.hold_current_A = robust ? in->rated_current_A : 0.0f;
+    cfg->standstill.hold_current_A = robust ? in->motor.rated_current_A : 0.0f;
     /* Below the speed whose back EMF is of the order of the dead time's loss the flux integrals'
      * phase is off by tenths of a radian: there the hold's vector can turn at the reference speed
      * in place of the law (at every speed in the band where asked for: a load step while it turns
@@ -357,9 +375,13 @@ static void design_commissioning(const pmstep_design_input_t *in, float window_s
 
 static void design_protection(const pmstep_design_input_t *in, pmstep_config_t *cfg, float top_speed_rad_s)
 {
-    cfg->limits.max_phase_current_A = TRIP_CURRENT_PER_RATED * in->rated_current_A;
+    const float usable_current_A = PMSTEP_SENSE_RANGE_USABLE_FRACTION * in->current_sense_range_A;
+    const float usable_bus_V = PMSTEP_SENSE_RANGE_USABLE_FRACTION * in->bus_sense_range_V;
+    cfg->limits.current_sense_range_A = in->current_sense_range_A;
+    cfg->limits.bus_sense_range_V = in->bus_sense_range_V;
+    cfg->limits.max_phase_current_A = min2(TRIP_CURRENT_PER_RATED * in->motor.rated_current_A, usable_current_A);
     cfg->limits.min_bus_voltage_V = MIN_BUS_FRACTION * in->bus_voltage_V;
-    cfg->limits.max_bus_voltage_V = MAX_BUS_FRACTION * in->bus_voltage_V;
+    cfg->limits.max_bus_voltage_V = min2(MAX_BUS_FRACTION * in->bus_voltage_V, usable_bus_V);
     cfg->detection.angle_magnitude_bound = ANGLE_MAGNITUDE_BOUND;
     cfg->detection.stall_speed_error_rad_s = STALL_FRACTION_OF_TOP_SPEED * top_speed_rad_s;
     cfg->detection.speed_consistency_bound_rad_s = STALL_FRACTION_OF_TOP_SPEED * top_speed_rad_s;
@@ -367,7 +389,7 @@ static void design_protection(const pmstep_design_input_t *in, pmstep_config_t *
      * prediction (the compensated voltage) can be off by twice the loss 2 V_bus t_d / T (the
      * sign taken the wrong way), which moves that period's current by 4 V_bus t_d / L
      * (DESIGN.md section 5). */
-    cfg->detection.observer_residual_bound_A = RESIDUAL_PER_RATED_CURRENT * in->rated_current_A
+    cfg->detection.observer_residual_bound_A = RESIDUAL_PER_RATED_CURRENT * in->motor.rated_current_A
                                                + 4.0f * in->bus_voltage_V * cfg->inverter.dead_time_s
                                                      / in->motor.inductance_H;
     cfg->detection.persistence_s = PERSISTENCE_S;
@@ -391,7 +413,7 @@ pmstep_status_t pmstep_design(const pmstep_design_input_t *in, pmstep_config_t *
     cfg->known_load_mode = false;
     report->top_speed_rad_s = top_speed(in);
     report->top_electrical_step_rad = (float)in->motor.pole_pairs * report->top_speed_rad_s * in->period_s;
-    report->rated_torque_Nm = in->motor.torque_constant_Nm_A * in->rated_current_A;
+    report->rated_torque_Nm = in->motor.torque_constant_Nm_A * in->motor.rated_current_A;
     design_gains(in, &cfg->gains, report);
     window_s = design_alignment(in, cfg, report);
     design_commissioning(in, window_s, cfg, report);

@@ -55,6 +55,7 @@
 #define PMSTEP_COMMISSION_H
 
 #include "pmstep/pmstep_types.h"
+#include "pmstep/pmstep_continuity.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -124,6 +125,7 @@ typedef struct {
     uint32_t zero_count_a, zero_count_b;
     float zero_voltage_sum_a_V, zero_voltage_sum_b_V; /**< sensed phase voltages with the bridge off (true 0) */
     pmstep_alignment_sums_t alignment;      /**< the alignments' */
+    pmstep_continuity_peaks_t continuity;   /**< the driven phases' peaks (pmstep_continuity.h) */
 } pmstep_commission_sums_t;
 
 void pmstep_commission_clear(pmstep_commission_sums_t *sums);

@@ -17,6 +17,7 @@
 #include "pmstep/pmstep_detect.h"
 #include "pmstep/pmstep_actuate.h"
 #include "pmstep/pmstep_hold.h"
+#include "pmstep/pmstep_continuity.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -36,6 +37,7 @@ typedef struct {
     bool angle_smoothing;                     /**< gains.angle_smoothing > 0 */
     bool voltage_corrected;                   /**< the period's voltage is sensed or dead-time compensated */
     pmstep_detect_coeffs_t detect_coeffs;
+    pmstep_continuity_coeffs_t continuity_coeffs;
     pmstep_actuate_coeffs_t actuate_coeffs;
     pmstep_ref_coeffs_t ref_coeffs;
     pmstep_angle_coeffs_t angle_coeffs;
@@ -69,6 +71,7 @@ typedef struct {
             pmstep_identify_sums_t identify; /**< J and F fit, while the identification window is open */
             pmstep_standstill_t standstill;  /**< standstill hold in speed mode (pmstep_hold.h) */
             pmstep_angle_smoother_t smoother; /**< the angle smoothing's (gains.angle_smoothing > 0) */
+            pmstep_continuity_t continuity;   /**< the windings' and sensors' continuity (pmstep_continuity.h) */
         } run;                            /**< from t_c */
     } scratch;
 

@@ -61,6 +61,14 @@ typedef enum {
     PMSTEP_ERR_MAX_CURRENT = -60,           /**< max_phase_current_A <= 0 */
     PMSTEP_ERR_MIN_BUS = -61,               /**< min_bus_voltage_V <= 0 */
     PMSTEP_ERR_BUS_ORDER = -62,             /**< max_bus_voltage_V <= min_bus_voltage_V */
+    PMSTEP_ERR_TRIP_ABOVE_RATED = -63,      /**< max_phase_current_A above PMSTEP_MAX_TRIP_PER_RATED_CURRENT x
+                                                 motor.rated_current_A */
+    PMSTEP_ERR_TRIP_ABOVE_SENSE_RANGE = -64, /**< max_phase_current_A above PMSTEP_SENSE_RANGE_USABLE_FRACTION x
+                                                 limits.current_sense_range_A: a reading saturated at the sensor's
+                                                 end would never trip */
+    PMSTEP_ERR_BUS_ABOVE_SENSE_RANGE = -65, /**< max_bus_voltage_V above PMSTEP_SENSE_RANGE_USABLE_FRACTION x
+                                                 limits.bus_sense_range_V: the overvoltage trip would never fire */
+    PMSTEP_ERR_SENSE_RANGE = -66,           /**< current_sense_range_A or bus_sense_range_V <= 0 */
     /* alignment */
     PMSTEP_ERR_ALIGNMENT_VOLTAGE = -70,     /**< u_cs or u_cc <= 0 */
     PMSTEP_ERR_ALIGNMENT_ABOVE_BUS = -71,   /**< u_cs or u_cc above the minimum bus voltage */
@@ -91,10 +99,12 @@ typedef enum {
                                                  [PMSTEP_DETECTION_DECIMATION periods (one check),
                                                  PMSTEP_MAX_DURATION_PERIODS periods] */
     /* gain designer (pmstep_design.h): motor data it cannot design for */
-    PMSTEP_ERR_RATED_CURRENT = -110,        /**< rated current <= 0 */
+    PMSTEP_ERR_RATED_CURRENT = -110,        /**< motor.rated_current_A <= 0 */
     PMSTEP_ERR_BUS_BELOW_RATED = -111,      /**< bus voltage <= 0, or R x rated current above the usable bus */
     PMSTEP_ERR_RATE_TOO_SLOW = -112,        /**< control rate too slow for the motor: R/L, or F/J, not well below
                                                  the bandwidths the designer gives the current loop and the observer */
+    PMSTEP_ERR_SENSE_RANGE_BELOW_RATED = -113, /**< the drive's current sensing cannot read the trip the motor
+                                                 needs (1.25 x its rated current) */
     /* commissioning: identification of J and F at the start of RUN (pmstep_identify.h) */
     PMSTEP_ERR_IDENTIFICATION_WINDOW = -120, /**< identification window < 0 or longer than PMSTEP_MAX_DURATION_PERIODS */
     PMSTEP_ERR_IDENTIFICATION_SPEED = -121,  /**< identification's lowest speed < 0 */
@@ -159,8 +169,15 @@ typedef enum {
     PMSTEP_FAULT_PHASE_VOLTAGE_RANGE = 11,  /**< with phase-voltage sensing: a sensed mean phase voltage beyond
                                                  PMSTEP_PHASE_VOLTAGE_RANGE_FACTOR x the measured bus (a mean
                                                  phase voltage cannot exceed the bus: a sensor fault) */
-    PMSTEP_FAULT_ALIGNMENT_MOTION = 12      /**< the rotor still moved in an alignment's steady-state window, in the
+    PMSTEP_FAULT_ALIGNMENT_MOTION = 12,     /**< the rotor still moved in an alignment's steady-state window, in the
                                                  alignments' repeat too (pmstep_commission_finish()) */
+    PMSTEP_FAULT_OPEN_PHASE_A = 13,         /**< phase a carries no current where its voltage (alignment) or its
+                                                 reference (RUN) says it must: an open winding, connector or
+                                                 current sensor (pmstep_continuity.h) */
+    PMSTEP_FAULT_OPEN_PHASE_B = 14,         /**< the same for phase b */
+    PMSTEP_FAULT_CURRENT_STUCK_A = 15,      /**< phase a's reading does not move while its reference does: a
+                                                 stuck current sensor or ADC (pmstep_continuity.h) */
+    PMSTEP_FAULT_CURRENT_STUCK_B = 16       /**< the same for phase b */
 } pmstep_fault_t;
 
 /** A sensed mean phase voltage above this many times the measured bus latches
@@ -178,6 +195,8 @@ typedef struct {
     int32_t pole_pairs;         /**< p >= 1 */
     float detent_torque_Nm;     /**< T_d >= 0: detent (cogging) torque -T_d sin(4 p theta) in the model, not in the
                                      paper's (1); the observer and the law compensate it. 0 = none (the paper) */
+    float rated_current_A;      /**< rated phase current (amplitude) > 0: bounds the overcurrent trip
+                                     (PMSTEP_MAX_TRIP_PER_RATED_CURRENT) */
 } pmstep_motor_config_t;
 
 /** Control period and delay of the drive. */
@@ -240,11 +259,23 @@ typedef struct {
  *  the observer stays stable for k < 9 (Routh: (R/L + K_e) k g_w > k^2 g_T), and 4 keeps half of that. */
 #define PMSTEP_OBSERVER_BOOST_MAX 4.0f
 
-/** Protections. */
+/** The overcurrent trip may be at most this many times the motor's rated current: above, a
+ *  winding carries several times its rating (heat, and the magnets' demagnetisation) before the
+ *  drive reacts. */
+#define PMSTEP_MAX_TRIP_PER_RATED_CURRENT 3.0f
+/** A trip must lie within this fraction of its sensor's range: a reading saturated at the
+ *  sensor's last code (a shorted winding, a failed sensor) then still trips, with room for the
+ *  sensor's gain tolerance and noise. */
+#define PMSTEP_SENSE_RANGE_USABLE_FRACTION 0.95f
+
+/** Protections, and the measurement ranges of the drive that bound them (the port's hardware:
+ *  set by the port, read-only on the console). */
 typedef struct {
     float max_phase_current_A; /**< |i_a|, |i_b| above this -> FAULT_OVERCURRENT */
     float min_bus_voltage_V;   /**< bus below -> FAULT_BUS_UNDERVOLTAGE */
     float max_bus_voltage_V;   /**< bus above -> FAULT_BUS_OVERVOLTAGE */
+    float current_sense_range_A; /**< the phase-current measurement reads up to +/- this (its ADC's full scale) */
+    float bus_sense_range_V;   /**< the bus measurement reads up to this (its divider's full scale) */
 } pmstep_limits_config_t;
 
 /** Remark 2 calibration and self-commissioning (all off in the paper's configuration). */

@@ -72,7 +72,9 @@ int32_t pmstep_app_init(void)
     if (port_st != PMSTEP_STM32G4_OK) {
         return (int32_t)port_st;
     }
-    motor_config = pmstep_console_app_config(pmstep_stm32g4_period_s(&board), 1u); /* duties load one period later */
+    motor_config = pmstep_console_app_config(pmstep_stm32g4_period_s(&board), 1u,
+                                             pmstep_stm32g4_current_sense_range_A(&board),
+                                             pmstep_stm32g4_bus_sense_range_V(&board)); /* duties load one period later */
     st = pmstep_init(&motor, &motor_config);
     if (st != PMSTEP_OK) {
         return -100 + (int32_t)st;

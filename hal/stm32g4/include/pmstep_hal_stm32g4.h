@@ -48,9 +48,12 @@ typedef enum {
     PMSTEP_STM32G4_ERR_PIN_CONFLICT = -10,  /**< two functions on one pin */
     PMSTEP_STM32G4_ERR_PIN_RESERVED = -11,  /**< a pin the board itself uses (VCP, SWD, crystal..) given another function */
     PMSTEP_STM32G4_ERR_UART_CONFIG = -12,   /**< console baud rate outside what LPUART1 can make from its clock */
-    PMSTEP_STM32G4_ERR_UNMEASURED_INPUT = -13 /**< the core's configuration reads an input this board does not
+    PMSTEP_STM32G4_ERR_UNMEASURED_INPUT = -13, /**< the core's configuration reads an input this board does not
                                                    measure: phase voltages (inverter.phase_voltage_sensing) or
                                                    the load torque (known_load_mode) */
+    PMSTEP_STM32G4_ERR_SENSE_RANGE = -14    /**< the core's configuration claims a measurement range (limits.
+                                                 current_sense_range_A, bus_sense_range_V) beyond what this board's
+                                                 ADC reads (pmstep_stm32g4_current_sense_range_A(), _bus_) */
 } pmstep_stm32g4_status_t;
 
 /** Why the port holds the bridge off, independently of the core. */
@@ -222,7 +225,8 @@ pmstep_stm32g4_status_t pmstep_stm32g4_adc_init(const pmstep_stm32g4_config_t *c
 /**
  * The whole port for @p inst (initialised; its configuration must use computational_delay_periods = 1
  * and period_s = pmstep_stm32g4_period_s(), and read neither phase voltages nor a load torque:
- * PMSTEP_STM32G4_ERR_UNMEASURED_INPUT, before any register is touched): GPIO, TIM1, ADC,
+ * PMSTEP_STM32G4_ERR_UNMEASURED_INPUT, nor claim measurement ranges beyond the board's:
+ * PMSTEP_STM32G4_ERR_SENSE_RANGE, before any register is touched): GPIO, TIM1, ADC,
  * interrupts; bridge off.
  * Call after pmstep_stm32g4_clock_init() with the same @p cfg, which must outlive the port.
  */
@@ -230,6 +234,13 @@ pmstep_stm32g4_status_t pmstep_stm32g4_init(const pmstep_stm32g4_config_t *cfg, 
 
 /** Control period (s) that TIM1 runs at: 2 ARR / f_TIM1. 0 if the configuration is invalid. */
 float pmstep_stm32g4_period_s(const pmstep_stm32g4_config_t *cfg);
+
+/** The phase currents the ADC reads (A): +/- the smaller distance from either phase's offset to an
+ *  end code (0 or 4095), times its gain. What the core's limits.current_sense_range_A may be at most. */
+float pmstep_stm32g4_current_sense_range_A(const pmstep_stm32g4_config_t *cfg);
+
+/** The bus voltage the ADC reads at its last code (V). What limits.bus_sense_range_V may be at most. */
+float pmstep_stm32g4_bus_sense_range_V(const pmstep_stm32g4_config_t *cfg);
 
 /** Work run in the control interrupt after each step, with its output (e.g. position control's
  *  pmstep_position_update()). */

@@ -187,6 +187,33 @@ float pmstep_stm32g4_period_s(const pmstep_stm32g4_config_t *cfg)
     return arr == 0u ? 0.0f : (float)(2u * arr) / (float)sysclk_Hz;
 }
 
+#define ADC_LAST_CODE 4095.0f /* 12 bits */
+
+static float abs_f(float x)
+{
+    return x < 0.0f ? -x : x;
+}
+
+/* The magnitude a bipolar channel reads before either end code. */
+static float bipolar_range(float offset_counts, float gain_per_count)
+{
+    const float below = offset_counts;
+    const float above = ADC_LAST_CODE - offset_counts;
+    return (below < above ? below : above) * abs_f(gain_per_count);
+}
+
+float pmstep_stm32g4_current_sense_range_A(const pmstep_stm32g4_config_t *cfg)
+{
+    const float a_A = bipolar_range(cfg->i_a_offset_counts, cfg->i_a_gain_a_per_count);
+    const float b_A = bipolar_range(cfg->i_b_offset_counts, cfg->i_b_gain_a_per_count);
+    return a_A < b_A ? a_A : b_A;
+}
+
+float pmstep_stm32g4_bus_sense_range_V(const pmstep_stm32g4_config_t *cfg)
+{
+    return (ADC_LAST_CODE - cfg->bus_offset_counts) * abs_f(cfg->bus_gain_v_per_count);
+}
+
 static void nvic_enable(uint32_t irq, uint8_t priority)
 {
     stm32g4_nvic_t *const nvic = STM32G4_NVIC;
@@ -205,6 +232,10 @@ pmstep_stm32g4_status_t pmstep_stm32g4_init(const pmstep_stm32g4_config_t *cfg, 
     }
     if (inst->cfg->inverter.phase_voltage_sensing || inst->cfg->known_load_mode) {
         return PMSTEP_STM32G4_ERR_UNMEASURED_INPUT;
+    }
+    if (inst->cfg->limits.current_sense_range_A > pmstep_stm32g4_current_sense_range_A(cfg)
+        || inst->cfg->limits.bus_sense_range_V > pmstep_stm32g4_bus_sense_range_V(cfg)) {
+        return PMSTEP_STM32G4_ERR_SENSE_RANGE;
     }
     sysclk_Hz = pmstep_stm32g4_sysclk_Hz(&cfg->clock);
     if (sysclk_Hz == 0u) {

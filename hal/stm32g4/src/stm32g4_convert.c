@@ -151,6 +151,8 @@ const char *pmstep_stm32g4_status_str(pmstep_stm32g4_status_t status)
         return "console baud rate out of LPUART1's range";
     case PMSTEP_STM32G4_ERR_UNMEASURED_INPUT:
         return "the core reads phase voltages or a load torque, which this board does not measure";
+    case PMSTEP_STM32G4_ERR_SENSE_RANGE:
+        return "the core's measurement ranges exceed what this board's ADC reads";
     }
     return "unknown status";
 }

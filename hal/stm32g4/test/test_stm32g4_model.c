@@ -29,7 +29,9 @@ static int setup(void **state)
     (void)state;
     stm32g4_model_reset();
     board = pmstep_stm32g4_default_config();
-    motor_config = pmstep_console_app_config(pmstep_stm32g4_period_s(&board), 1u);
+    motor_config = pmstep_console_app_config(pmstep_stm32g4_period_s(&board), 1u,
+                                             pmstep_stm32g4_current_sense_range_A(&board),
+                                             pmstep_stm32g4_bus_sense_range_V(&board));
     assert_int_equal(pmstep_init(&motor, &motor_config), PMSTEP_OK);
     return 0;
 }

@@ -110,6 +110,8 @@ static int setup(void **state)
     motor_config = pmstep_paper_config();
     motor_config.timing.period_s = pmstep_stm32g4_period_s(&board);
     motor_config.timing.computational_delay_periods = 1u;
+    motor_config.limits.current_sense_range_A = pmstep_stm32g4_current_sense_range_A(&board);
+    motor_config.limits.bus_sense_range_V = pmstep_stm32g4_bus_sense_range_V(&board);
     assert_int_equal(pmstep_init(&motor, &motor_config), PMSTEP_OK);
     return 0;
 }
@@ -681,6 +683,29 @@ static void test_unmeasured_inputs_refused(void **state)
     assert_int_equal(pmstep_stm32g4_init(&board, &inst), PMSTEP_STM32G4_OK);
 }
 
+/* The measurement ranges follow from the board's offsets and gains (0.1 V/A about 1.65 V: the
+ * smaller side, 2047 counts of 3.3/4096/0.1 A; the bus's 1:20 divider at code 4095), and a core
+ * that claims more than the board reads is refused before any register is touched: its trips
+ * could sit where a saturated reading never reaches them. */
+static void test_sense_ranges_beyond_board_refused(void **state)
+{
+    pmstep_config_t cfg = motor_config;
+    pmstep_t inst;
+    (void)state;
+    fault_input(false);
+    assert_float_equal(pmstep_stm32g4_current_sense_range_A(&board), 2047.0f * 3.3f / 4096.0f / 0.1f, 1e-4f);
+    assert_float_equal(pmstep_stm32g4_bus_sense_range_V(&board), 4095.0f * 3.3f / 4096.0f * 20.0f, 1e-3f);
+    cfg.limits.current_sense_range_A = 16.5f; /* above the board's 16.49 A */
+    assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
+    assert_int_equal(pmstep_stm32g4_init(&board, &inst), PMSTEP_STM32G4_ERR_SENSE_RANGE);
+    cfg = motor_config;
+    cfg.limits.bus_sense_range_V = 66.0f; /* above the board's 65.98 V */
+    assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
+    assert_int_equal(pmstep_stm32g4_init(&board, &inst), PMSTEP_STM32G4_ERR_SENSE_RANGE);
+    assert_int_equal(stm32g4_fake.rcc.AHB2ENR, 0u);
+    assert_int_equal(pmstep_stm32g4_init(&board, &motor), PMSTEP_STM32G4_OK);
+}
+
 /* ---- console UART (LPUART1) and the main loop's access to the last period ---- */
 
 static void test_lpuart(void **state)
@@ -762,6 +787,7 @@ int main(void)
         cmocka_unit_test_setup(test_pin_map_default_board, setup),
         cmocka_unit_test_setup(test_pin_map_conflicts_refused, setup),
         cmocka_unit_test_setup(test_unmeasured_inputs_refused, setup),
+        cmocka_unit_test_setup(test_sense_ranges_beyond_board_refused, setup),
         cmocka_unit_test_setup(test_lpuart, setup),
         cmocka_unit_test_setup(test_hold_and_last_period, setup),
     };

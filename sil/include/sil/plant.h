@@ -118,6 +118,8 @@ typedef struct {
     double trig_angle_rad, trig_sin, trig_cos;
     bool open_a;   /**< phase a open (bridge off, current extinguished): i_a' = 0, i_a held at exactly 0 */
     bool open_b;   /**< same for phase b */
+    bool broken_a; /**< winding a open (a broken wire, faults.open_phase): held at 0 whatever the bridge does */
+    bool broken_b; /**< same for winding b */
 } plant_t;
 
 /** The motor of the paper's Section III.B (no detent torque). */

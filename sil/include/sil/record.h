@@ -40,14 +40,15 @@ extern "C" {
  * then the entries in order.
  */
 #define SIL_RECORD_MAGIC 0x52534D50u /* "PMSR" */
-#define SIL_RECORD_VERSION 15u /* 2: calibration, commissioning, angle, detection; 3: voltage bias; 4: residual;
+#define SIL_RECORD_VERSION 16u /* 2: calibration, commissioning, angle, detection; 3: voltage bias; 4: residual;
                                  5: identification of J and F; 6: phase-voltage sensing; 7: standstill hold;
                                  8: low-speed drive; 9: the compensation's ripple dead zone;
                                  10: detent torque, current integral gain, detent fade;
                                  11: s-alignment's lead-in; 12: the q axis's current integral gain;
                                  13: the back-EMF angle correction; 14: the angle smoothing, the
-                                 standstill's stops-only vector; 15: the transient observer boost */
-#define SIL_RECORD_CONFIG_WORDS 58u
+                                 standstill's stops-only vector; 15: the transient observer boost;
+                                 16: the rated current and the measurement ranges */
+#define SIL_RECORD_CONFIG_WORDS 61u
 #define SIL_RECORD_TAG_SPEED_TARGET 1u
 #define SIL_RECORD_TAG_PERIOD 2u
 #define SIL_RECORD_TAG_END 3u
@@ -172,6 +173,9 @@ static inline void sil_record_config_from_words(const uint32_t *w, pmstep_config
     c->gains.angle_smoothing = sil_record_float(w[55]);
     c->standstill.stops_only = w[56] != 0u;
     c->gains.transient_observer_boost = sil_record_float(w[57]);
+    c->motor.rated_current_A = sil_record_float(w[58]);
+    c->limits.current_sense_range_A = sil_record_float(w[59]);
+    c->limits.bus_sense_range_V = sil_record_float(w[60]);
 }
 
 static inline void sil_record_meas_from_words(const uint32_t *w, pmstep_meas_t *m)
@@ -268,6 +272,9 @@ static inline void sil_record_config_to_words(const pmstep_config_t *c, uint32_t
     w[55] = sil_record_bits(c->gains.angle_smoothing);
     w[56] = c->standstill.stops_only ? 1u : 0u;
     w[57] = sil_record_bits(c->gains.transient_observer_boost);
+    w[58] = sil_record_bits(c->motor.rated_current_A);
+    w[59] = sil_record_bits(c->limits.current_sense_range_A);
+    w[60] = sil_record_bits(c->limits.bus_sense_range_V);
 }
 
 static inline void sil_record_meas_to_words(const pmstep_meas_t *m, uint32_t *w)

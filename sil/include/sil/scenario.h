@@ -15,6 +15,7 @@
 #include "pmstep/pmstep_position.h"
 #include "sil/inverter.h"
 #include "sil/plant.h"
+#include "sil/faults.h"
 #include "sil/sensors.h"
 
 #ifdef __cplusplus
@@ -71,6 +72,7 @@ typedef struct {
     uint32_t seed;                   /**< run.seed: of every random draw of the run (measurement noise) */
     double max_csv_MB;               /**< run.max_csv_MB: largest run.csv a run may write (MB) */
     sil_sensor_config_t sensors;     /**< [sensors]: measurement chain (ideal by default) */
+    sil_fault_config_t faults;       /**< [faults]: an open winding, a failed current sensor (none by default) */
     sil_inverter_config_t inverter;  /**< [inverter]: averaged | switching, dead time */
     sil_bus_config_t bus;            /**< [bus]: source resistance and ripple on run.bus_voltage_V */
     sil_drive_t drive;               /**< run.controller: pmstep | microstep */
@@ -92,6 +94,15 @@ typedef struct {
 
 /** The paper's Section III: t_s = 0.3 s, t_c = 0.6 s, 2 Nm at 0.63 s, theta0 = 30 deg, 2.4 s, 20 kHz. */
 void sil_scenario_paper(sil_scenario_t *sc);
+
+/** The drive's measurement ranges are its sensors': the firmware's limits.current_sense_range_A and
+ *  bus_sense_range_V follow sensors.current_full_scale_A and sensors.bus_full_scale_V (hardware, as
+ *  a port sets them; no key of their own). */
+static inline void sil_scenario_sense_ranges(sil_scenario_t *sc)
+{
+    sc->controller.limits.current_sense_range_A = (float)sc->sensors.current_full_scale_A;
+    sc->controller.limits.bus_sense_range_V = (float)sc->sensors.bus_full_scale_V;
+}
 
 /**
  * The speed command due at @p t_s under the piecewise-linear profile: at the start of

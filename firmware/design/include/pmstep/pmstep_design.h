@@ -19,9 +19,10 @@ extern "C" {
 
 /** What the designer needs to know of the motor and the drive. */
 typedef struct {
-    pmstep_motor_config_t motor;          /**< R, L, J, F, k_M, p (datasheet or measured) */
-    float rated_current_A;                /**< rated phase current (amplitude) */
+    pmstep_motor_config_t motor;          /**< R, L, J, F, k_M, p, detent, rated current (datasheet or measured) */
     float bus_voltage_V;                  /**< nominal DC bus */
+    float current_sense_range_A;          /**< the drive's phase-current measurement reads +/- this */
+    float bus_sense_range_V;              /**< the drive's bus measurement reads up to this */
     float period_s;                       /**< control period T_s */
     uint32_t computational_delay_periods; /**< 0 or 1 */
     bool self_commissioning;              /**< robust mode: Remark 2 offsets and voltage bias, R/L/k_M measured
@@ -61,6 +62,10 @@ typedef struct {
  * @retval PMSTEP_ERR_PERIOD, PMSTEP_ERR_DELAY  bad timing
  * @retval PMSTEP_ERR_RATED_CURRENT        rated current <= 0
  * @retval PMSTEP_ERR_BUS_BELOW_RATED      bus <= 0, or R x rated current above 90 % of it
+ * @retval PMSTEP_ERR_SENSE_RANGE          a sensing range <= 0
+ * @retval PMSTEP_ERR_SENSE_RANGE_BELOW_RATED  the current sensing cannot read 1.25 x the rated current within
+ *                                         PMSTEP_SENSE_RANGE_USABLE_FRACTION of its range
+ * @retval PMSTEP_ERR_BUS_ABOVE_SENSE_RANGE    the bus sensing cannot read 1.1 x the bus likewise
  * @retval PMSTEP_ERR_RATE_TOO_SLOW        R/L or F/J too large for the control period
  * @retval PMSTEP_ERR_DEAD_TIME            dead time < 0 or 4 t_d >= T_s
  * @retval other                           the designed configuration fails pmstep_validate_config()
