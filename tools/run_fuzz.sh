@@ -2,20 +2,24 @@
 # Runs one libFuzzer harness (tests/fuzz) for a bounded time and prints its figures:
 # executions, executions per second, and the edges of firmware/ (core) or sil/src/scenario*.c
 # (scenario) that the run covered (libFuzzer -print_coverage).
-# Usage: tools/run_fuzz.sh core|scenario [seconds=60]
+# Usage: tools/run_fuzz.sh core|scenario|console [seconds=60]
 # Builds the fuzz tree (preset fuzz, clang) first. Exit 77 (skipped) if clang cannot build a
 # libFuzzer binary (install clang and libclang-rt-14-dev: tools/install_deps.sh does).
 # The committed corpus is copied, never written; what the run adds stays in build/fuzz/corpus-<name>.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-target=${1:?usage: run_fuzz.sh core|scenario [seconds]}
+target=${1:?usage: run_fuzz.sh core|scenario|console [seconds]}
 seconds=${2:-60}
-core_sources=(firmware/src/pmstep_{core,lifecycle,config,control,detect,actuate,ref,angle,commission,identify,observer,law,hold,standstill,presets}.c)
+core_sources=(firmware/src/pmstep_{core,lifecycle,config,control,detect,continuity,actuate,ref,angle,commission,identify,observer,law,hold,standstill,presets}.c)
 case $target in
   core) sources='firmware/src/'; harness_sources=("${core_sources[@]}"); libs=(-lm) ;;
   scenario) sources='sil/src/scenario'
     harness_sources=(sil/src/{scenario_keys,scenario,scenario_load,scenario_print,scenario_profile,plant,inverter,inverter_switching,sensors}.c "${core_sources[@]}")
     libs=($(pkg-config --libs inih gsl) -lm) ;;
+  console) sources='firmware/console/src/'
+    harness_sources=(firmware/console/src/pmstep_console{,_request,_boundary,_tx,_config,_position,_sim}.c
+                     firmware/src/pmstep_{position,position_hold,motion}.c "${core_sources[@]}")
+    libs=(-lm) ;;
   *) echo "run_fuzz: unknown fuzzer '$target'" >&2; exit 2 ;;
 esac
 
@@ -78,7 +82,7 @@ fi
 cov=build/fuzz/cov-$target
 rm -rf "$cov" && mkdir -p "$cov"
 clang -std=c99 -D_POSIX_C_SOURCE=200809L -O1 -fprofile-instr-generate -fcoverage-mapping -w \
-  -Ifirmware/include -Isil/include -Itests/fuzz -Itests/include $(pkg-config --cflags inih gsl) \
+  -Ifirmware/include -Ifirmware/console/include -Ifirmware/console/src -Isil/include -Itests/fuzz -Itests/include $(pkg-config --cflags inih gsl) \
   tests/fuzz/fuzz_$target.c tests/fuzz/replay_main.c "${harness_sources[@]}" "${libs[@]}" -o "$cov/replay"
 LLVM_PROFILE_FILE="$cov/replay.profraw" "$cov/replay" "$work" >/dev/null
 "$llvm_profdata" merge -sparse "$cov/replay.profraw" -o "$cov/replay.profdata"

@@ -106,7 +106,58 @@ scenario = {
     "print_angle_neighbour": b"[run]\ntheta0_deg = 1.0029999999999997\n",
 }
 
-for folder, seeds in (("core", core), ("scenario", scenario)):
+# The console's inputs follow the layout described at the top of fuzz_console.c.
+C_RAW, C_FRAME, C_TWO, C_PERIODS, C_SILENCE, C_SPECIAL = range(6)
+HELLO, START, STOP, CLEAR_FAULT, SPEED_TARGET, ID_TARGET, GET_STATUS, GET_CONFIG, SET_CONFIG = range(1, 10)
+TELEMETRY, MOVE_TO, SIM_ADVANCE = 0x0B, 0x0D, 0x40
+TRIP, MAX_BUS = 21, 23  # ids of limits.max_phase_current_A and limits.max_bus_voltage_V (pmstep_console_config.c)
+
+
+def c_frame(ftype, seq=1, data=b""):
+    return bytes([ftype, seq, len(data)]) + data
+
+
+def c_periods(n):
+    return bytes([C_PERIODS]) + struct.pack("<H", n)
+
+
+def set_config(ident, value):
+    return bytes([ident]) + struct.pack("<f", value)
+
+
+console = {
+    # the review's finding: SET_CONFIG max bus then GET_CONFIG of the trip in one receive call
+    "busy_set_then_get": bytes([1, C_TWO]) + c_frame(SET_CONFIG, 1, set_config(MAX_BUS, 60.0))
+    + c_frame(GET_CONFIG, 2, bytes([TRIP])) + c_periods(4),
+    "busy_set_then_speed": bytes([1, C_TWO]) + c_frame(SET_CONFIG, 1, set_config(TRIP, 10.0))
+    + c_frame(SPEED_TARGET, 2, struct.pack("<ff", 1e30, 50.0)) + c_periods(4),
+    # unbounded limits: refused by the validation
+    "huge_limits": bytes([0, C_FRAME]) + c_frame(SET_CONFIG, 1, set_config(TRIP, 3.4e38)) + c_periods(2)
+    + bytes([C_FRAME]) + c_frame(SET_CONFIG, 2, set_config(MAX_BUS, 3.4e38)) + c_periods(2),
+    # START then SET_CONFIG at the next boundary, before a step ran
+    "start_then_set": bytes([0, C_FRAME]) + c_frame(START) + bytes([C_FRAME])
+    + c_frame(SET_CONFIG, 2, set_config(12, 90.0)) + c_periods(3),
+    # into RUN, a speed command, telemetry, a busy ID_TARGET behind it, a stop
+    "run_speed": bytes([1, C_FRAME]) + c_frame(START) + c_periods(1000) + bytes([C_TWO])
+    + c_frame(SPEED_TARGET, 2, struct.pack("<ff", 10.0, 50.0)) + c_frame(ID_TARGET, 3, struct.pack("<f", 300.0))
+    + bytes([C_FRAME]) + c_frame(TELEMETRY, 4, struct.pack("<I", 7)) + c_periods(3000) + bytes([C_FRAME])
+    + c_frame(STOP, 5) + c_periods(10),
+    # a position move, a status, a hold
+    "position_move": bytes([1, C_FRAME]) + c_frame(START) + c_periods(1000) + bytes([C_FRAME])
+    + c_frame(MOVE_TO, 2, struct.pack("<fff", 1.0, 5.0, 50.0)) + c_periods(4000) + bytes([C_FRAME])
+    + c_frame(GET_STATUS, 3) + c_periods(2),
+    # special floats of every typed request, a fault, a refused SET_CONFIG in FAULT, CLEAR_FAULT
+    "specials": bytes([3]) + b"".join(bytes([C_SPECIAL, t, v, 21]) + c_periods(2) for t in range(6) for v in range(16))
+    + bytes([C_FRAME]) + c_frame(START) + c_periods(50) + bytes([C_FRAME]) + c_frame(CLEAR_FAULT) + c_periods(2),
+    # bytes outside frames, a frame cut short, silence
+    "garbage": bytes([0, C_RAW, 12]) + bytes([0xA5, 3, 1, 2, 0xA5, 0xA5, 70, 1, 0, 0xFF, 0x12, 0xA5])
+    + bytes([C_SILENCE, 50, C_FRAME]) + c_frame(HELLO) + c_periods(1),
+    # the simulation requests on a simulation console
+    "simulation": bytes([2, C_FRAME]) + c_frame(SIM_ADVANCE, 1, struct.pack("<I", 5)) + bytes([C_FRAME])
+    + c_frame(SIM_ADVANCE, 2, struct.pack("<I", 5)) + c_periods(2),
+}
+
+for folder, seeds in (("core", core), ("scenario", scenario), ("console", console)):
     path = os.path.join(HERE, "corpus", folder)
     os.makedirs(path, exist_ok=True)
     for name, data in seeds.items():
