@@ -10,7 +10,6 @@ Usage: tools/fault_injection.py --sil build/host-release/sil/pmstep-sil --tune b
 """
 import argparse
 import configparser
-import datetime
 import json
 import os
 import subprocess
@@ -18,6 +17,7 @@ import sys
 import tempfile
 
 import mc_preset
+import report
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -78,14 +78,6 @@ FAULTS = [
     Fault("current sensor gain -30 % (phase a)", lambda m: ["sensors.gain_error_a=-0.3"], must_detect=False,
           note="a gain mismatch robust mode's commissioning measures and corrects; detected where it is not"),
 ]
-
-
-def git_commit():
-    try:
-        return subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
-                              check=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
 
 
 def read_ini(path):
@@ -163,11 +155,7 @@ def passed(result):
 
 
 def report_text(motors, results, argv):
-    lines = ["# Fault injection", "",
-             "Written by `tools/fault_injection.py`; regenerate it, do not edit it.", "",
-             f"- command: `{' '.join(argv)}`",
-             f"- commit: `{git_commit()}`",
-             f"- date: {datetime.date.today().isoformat()}", "",
+    lines = [report.header("Fault injection", "tools/fault_injection.py", argv),
              "Each fault is injected into the SIL's hardware (`[faults]` and other scenario keys) at the start "
              "or, in RUN, in the middle of the first constant-speed segment of the motor's profile. *Latency* "
              "is the time from the injection to the fault the firmware latched; *bridge off* that the run "
@@ -214,10 +202,7 @@ def main(argv=None):
                   + "".join(f"\n  MISSED: {r['fault'].label} ({r['code']})" for r in missed))
     text = report_text(motors, results, argv)
     if args.report:
-        os.makedirs(os.path.dirname(os.path.abspath(args.report)), exist_ok=True)
-        with open(args.report, "w") as f:
-            f.write(text)
-        print(f"fault_injection: wrote {args.report}")
+        print(f"fault_injection: wrote {report.write(args.report, text)}")
     else:
         print(text)
     if args.check and any(not passed(r) for rs in results.values() for r in rs):

@@ -168,8 +168,9 @@ def _run_designer(cmd):
 
 
 def _points_lines(points):
-    """speed.points as an INI value on continuation lines of six points (short lines)."""
-    rows = [", ".join(points[i:i + 6]) for i in range(0, len(points), 6)]
+    """speed.points as an INI value on continuation lines of three points: a point printed at full
+    precision takes up to 49 characters, and the scenario reader takes lines of 197 at most."""
+    rows = [", ".join(points[i:i + 3]) for i in range(0, len(points), 3)]
     return ",\n    ".join(rows)
 
 

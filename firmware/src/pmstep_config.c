@@ -221,21 +221,29 @@ static pmstep_status_t validate_alignment(const pmstep_config_t *cfg)
     return PMSTEP_OK;
 }
 
-/* Remark 2 calibration and commissioning (alignment times already checked). */
+/* Remark 2 calibration and commissioning (alignment times already checked). The windows are
+ * compared with the alignments in whole periods, as the commissioning plan counts them
+ * (pmstep_periods_in()): a difference of two float times can fall a rounding step short of a
+ * window that fits exactly. */
 static pmstep_status_t validate_commissioning(const pmstep_config_t *cfg)
 {
     const pmstep_commissioning_config_t *comm = &cfg->commissioning;
-    const float s_align_s = cfg->alignment.s_align_time_s - cfg->alignment.s_lead_in_time_s; /* (3) proper */
-    const float c_align_s = cfg->alignment.c_align_time_s - cfg->alignment.s_align_time_s;
+    const float period_s = cfg->timing.period_s;
+    const uint32_t s_align_steps = pmstep_periods_in(cfg->alignment.s_align_time_s, period_s)
+                                   - pmstep_periods_in(cfg->alignment.s_lead_in_time_s, period_s); /* (3) proper */
+    const uint32_t c_align_steps = pmstep_periods_in(cfg->alignment.c_align_time_s, period_s)
+                                   - pmstep_periods_in(cfg->alignment.s_align_time_s, period_s);
+    const uint32_t shorter_steps = s_align_steps < c_align_steps ? s_align_steps : c_align_steps;
+    const uint32_t window_steps = pmstep_periods_in(comm->steady_state_window_s, period_s);
     const bool window = comm->steady_state_window_s > 0.0f;
     if (!duration_ok(comm->offset_calibration_time_s, cfg->timing.period_s)) {
         return PMSTEP_ERR_OFFSET_CALIBRATION_TIME;
     }
-    if (comm->steady_state_window_s > 0.5f * s_align_s
-        || comm->steady_state_window_s > 0.5f * c_align_s) {
+    if (!duration_ok(comm->steady_state_window_s, period_s) || (2u * window_steps) > shorter_steps) {
         return PMSTEP_ERR_STEADY_STATE_WINDOW;
     }
-    if (comm->inductance_window_s > 0.5f * s_align_s) {
+    if (!duration_ok(comm->inductance_window_s, period_s)
+        || (2u * pmstep_periods_in(comm->inductance_window_s, period_s)) > s_align_steps) {
         return PMSTEP_ERR_INDUCTANCE_WINDOW;
     }
     /* What is used must be measured: offsets, R and k_M need the windows, L its rise window or the
@@ -259,8 +267,7 @@ static pmstep_status_t validate_commissioning(const pmstep_config_t *cfg)
     if (comm->voltage_bias_level_fraction > 0.0f) {
         /* Two windows (2 W) in the second half of each alignment, and W/2 of settling at the
          * lower level: at least 5 L/R. */
-        if (!window || comm->steady_state_window_s > 0.25f * s_align_s
-            || comm->steady_state_window_s > 0.25f * c_align_s) {
+        if (!window || (4u * window_steps) > shorter_steps) {
             return PMSTEP_ERR_VOLTAGE_BIAS_WINDOW;
         }
         if (comm->steady_state_window_s * cfg->motor.resistance_Ohm < 10.0f * cfg->motor.inductance_H) {

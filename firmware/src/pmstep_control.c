@@ -99,7 +99,7 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
         pmstep_angle_update(&inst->angle, &inst->angle_coeffs, sample->i_a_A, sample->i_b_A, u_a_V, u_b_V);
     }
     pmstep_angle_estimate(&inst->angle, &inst->angle_coeffs, sample->i_a_A, sample->i_b_A, &cos_hat, &sin_hat);
-    if (inst->angle_smoothing) { /* DESIGN.md section 16 */
+    if (inst->angle_smoothing) { /* docs/design/16-angle-smoothing.md */
         pmstep_angle_smooth(inst->cfg->gains.angle_smoothing,
                             inst->law_coeffs.pole_pairs * inst->cfg->timing.period_s * inst->observer.speed_hat_rad_s,
                             &inst->scratch.run.smoother, &cos_hat, &sin_hat);
@@ -150,7 +150,7 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
     if (!inst->hold.active) {
         float load_rate;
         float i_q_ref_rate;
-        /* outside the vector holds, whose vector is not the law's (DESIGN.md section 18) */
+        /* outside the vector holds, whose vector is not the law's (docs/design/18-transient-observer-boost.md) */
         if (inst->robust_corrections && (inst->cfg->gains.transient_observer_boost > 0.0f) && !known_load) {
             pmstep_observer_boost_in_transient(&inst->observer, &inst->observer_coeffs, obs_in,
                                                inst->cfg->gains.transient_observer_boost,
@@ -177,7 +177,7 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
     out->i_q_ref_A = i_q_ref;
 }
 
-bool pmstep_control_advance(pmstep_t *inst, const pmstep_control_scratch_t *scratch, const pmstep_meas_t *meas,
+pmstep_fault_t pmstep_control_advance(pmstep_t *inst, const pmstep_control_scratch_t *scratch, const pmstep_meas_t *meas,
                             const pmstep_output_t *out)
 {
     const pmstep_config_t *cfg = inst->cfg;
@@ -188,7 +188,7 @@ bool pmstep_control_advance(pmstep_t *inst, const pmstep_control_scratch_t *scra
         }
         /* outside the vector holds, whose vector sets the angle; in the position library's moves
          * too, where without it the current loop at 0.2/T_s rang at the electrical frequency
-         * (DESIGN.md section 15) */
+         * (docs/design/15-back-emf-angle-correction.md) */
         if ((inst->angle_coeffs.emf_turn_gain > 0.0f) && !inst->hold.active) {
             const pmstep_observer_input_t *in = &scratch->observer_input;
             const pmstep_observer_coeffs_t *obs = &inst->observer_coeffs;
@@ -229,5 +229,7 @@ bool pmstep_control_advance(pmstep_t *inst, const pmstep_control_scratch_t *scra
     }
     /* The current integrals need no check here: they enter the next voltage, which actuate checks. */
     return pmstep_all_finite6(inst->observer.speed_hat_rad_s, inst->observer.load_hat_Nm, inst->observer.i_a_hat_A,
-                              inst->observer.i_b_hat_A, inst->angle.phi_a, inst->angle.phi_b);
+                              inst->observer.i_b_hat_A, inst->angle.phi_a, inst->angle.phi_b)
+               ? PMSTEP_FAULT_NONE
+               : PMSTEP_FAULT_STATE_NONFINITE;
 }

@@ -243,11 +243,17 @@ static void alignment_stage(const pmstep_t *inst, pmstep_output_t *out)
     }
 }
 
-/* Supervise stage, in RUN: detection every PMSTEP_DETECTION_DECIMATION periods. */
+/* Supervise stage, in RUN, every PMSTEP_DETECTION_DECIMATION periods: the observer's estimates
+ * within what the motor and the bus allow (an estimate beyond is a lost observer, caught before it
+ * runs away to overflow: its injections grow with its own terms), then detection. */
 static pmstep_fault_t supervise_stage(pmstep_t *inst, const pmstep_output_t *out, const pmstep_meas_t *sample)
 {
     if ((inst->step_count % PMSTEP_DETECTION_DECIMATION) != 0u) {
         return PMSTEP_FAULT_NONE;
+    }
+    if ((pmstep_abs(inst->observer.speed_hat_rad_s) > inst->observer_coeffs.speed_bound_rad_s)
+        || (pmstep_abs(inst->observer.load_hat_Nm) > inst->observer_coeffs.load_bound_Nm)) {
+        return PMSTEP_FAULT_ESTIMATE_RANGE;
     }
     return pmstep_detect_check(&inst->scratch.run.detector, &inst->detect_coeffs, &inst->cfg->detection, out, sample);
 }
@@ -388,7 +394,7 @@ static pmstep_fault_t bridge_on_stages(pmstep_t *inst, const pmstep_meas_t *meas
             return fault;
         }
     }
-    return pmstep_control_advance(inst, &control, meas, out) ? PMSTEP_FAULT_NONE : PMSTEP_FAULT_STATE_NONFINITE;
+    return pmstep_control_advance(inst, &control, meas, out);
 }
 
 void pmstep_step(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out)

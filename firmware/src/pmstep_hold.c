@@ -43,7 +43,7 @@ bool pmstep_hold_aim_ahead(const pmstep_law_coeffs_t *law, float c, float s, flo
 /* Whether the observer's speed estimate follows a rotor swinging at w (rad/s) enough in phase for
  * the damping term: Re(w-hat/w) >= PMSTEP_HOLD_MIN_IN_PHASE_SHARE. The estimate is kept at the
  * vector's aim, so the observer's model lacks the swing's restoring torque and sees the rotor's
- * acceleration as a disturbance d: w~ = s (s + a_e) d / P(s) (DESIGN.md, section 3, d entering
+ * acceleration as a disturbance d: w~ = s (s + a_e) d / P(s) (docs/design/03-observer.md, d entering
  * w~'), d = s w, hence w-hat/w = 1 - M/P with P = s^3 + c2 s^2 + c1 s + c0 the observer's
  * characteristic polynomial and M = s^2 (s + a_e) = -w^2 (a_e + j w) at s = j w. Compared
  * without a division: (1 - share) |P|^2 >= Re(M conj P) = -w^2 (a_e Re P + w Im P). */

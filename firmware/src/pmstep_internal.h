@@ -67,8 +67,8 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
 
 /* Advance stage: the drift-free correction, the observer over the coming period with the
  * voltage the bridge applies (inst->actuator), the reference filters.
- * @return false if an internal estimate is no longer finite. */
-bool pmstep_control_advance(pmstep_t *inst, const pmstep_control_scratch_t *scratch, const pmstep_meas_t *meas,
+ * @return PMSTEP_FAULT_STATE_NONFINITE if an internal estimate is no longer finite, else NONE. */
+pmstep_fault_t pmstep_control_advance(pmstep_t *inst, const pmstep_control_scratch_t *scratch, const pmstep_meas_t *meas,
                             const pmstep_output_t *out);
 
 /* Vector hold (pmstep_hold.c), in place of the law's voltage: the vector turned back by the

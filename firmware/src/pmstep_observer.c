@@ -25,6 +25,8 @@ void pmstep_observer_coeffs_init(pmstep_observer_coeffs_t *coeffs, const pmstep_
     coeffs->speed_injection_gain = (2.0f * g * g + r * f * l * j * j) / den;
     coeffs->load_injection_gain = (2.0f * g * g * f + l * j * g + l * j * j * r * f * f) / den;
     coeffs->inv_lambda = 1.0f / l;
+    coeffs->speed_bound_rad_s = PMSTEP_ESTIMATE_RANGE_FACTOR * cfg->limits.max_bus_voltage_V / model->torque_constant_Nm_A;
+    coeffs->load_bound_Nm = PMSTEP_ESTIMATE_RANGE_FACTOR * model->torque_constant_Nm_A * cfg->limits.max_phase_current_A;
     {
         const float half_z = 0.5f * coeffs->r_over_l_per_s * cfg->timing.period_s;
         coeffs->current_decay = (1.0f - half_z) / (1.0f + half_z);

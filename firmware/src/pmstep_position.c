@@ -62,7 +62,7 @@ pmstep_status_t pmstep_position_design(const pmstep_config_t *cfg, pmstep_positi
     }
     pos_cfg->gain_per_s = 0.25f * cfg->gains.speed_gain_per_s;
     pos_cfg->integral_gain_per_s2 = pos_cfg->gain_per_s * pos_cfg->gain_per_s / 8.0f;
-    pos_cfg->hold_current_A = 0.5f * cfg->limits.max_phase_current_A; /* the rated current (DESIGN.md) */
+    pos_cfg->hold_current_A = 0.5f * cfg->limits.max_phase_current_A; /* half the trip (docs/design/12-position-hold.md) */
     return PMSTEP_OK;
 }
 

@@ -69,6 +69,12 @@ const char *pmstep_status_str(pmstep_status_t status)
     case PMSTEP_ERR_BUS_BELOW_RATED: return "bus too low for R x rated current";
     case PMSTEP_ERR_RATE_TOO_SLOW: return "control rate too slow for R/L or F/J";
     case PMSTEP_ERR_SENSE_RANGE_BELOW_RATED: return "current sensing cannot read 1.25 x the rated current";
+    case PMSTEP_ERR_DATASHEET_TORQUE_CONSTANT:
+        return "k_M far from holding torque / (sqrt(2) rated current): check the units of both";
+    case PMSTEP_ERR_DATASHEET_TIME_CONSTANT: return "L/R outside 0.1-20 ms: check the units of R and L";
+    case PMSTEP_ERR_DATASHEET_INERTIA: return "rotor inertia far from what the holding torque gives: check its units";
+    case PMSTEP_ERR_DATASHEET_FLUX_RATIO:
+        return "p L I / k_M outside 0.1-10: the holding torque, the inductance or the current is off";
     case PMSTEP_ERR_IDENTIFICATION_WINDOW: return "identification: 0 to 2^24 periods";
     case PMSTEP_ERR_IDENTIFICATION_SPEED: return "identification speed < 0";
     case PMSTEP_ERR_MECHANICS_UNIDENTIFIED: return "identified J, F used without a window";
@@ -101,6 +107,7 @@ const char *pmstep_fault_str(pmstep_fault_t fault)
     case PMSTEP_FAULT_OPEN_PHASE_B: return "OPEN_PHASE_B";
     case PMSTEP_FAULT_CURRENT_STUCK_A: return "CURRENT_STUCK_A";
     case PMSTEP_FAULT_CURRENT_STUCK_B: return "CURRENT_STUCK_B";
+    case PMSTEP_FAULT_ESTIMATE_RANGE: return "ESTIMATE_RANGE";
     }
     return "UNKNOWN";
 }

@@ -12,14 +12,20 @@
 static void usage(FILE *f)
 {
     fprintf(f,
-            "usage: pmstep-tune --motor FILE [--robust [--low-speed-drive]] [--set section.key=value]...\n"
+            "usage: pmstep-tune (--motor FILE | --motor-db FILE --name NAME) [--robust [--low-speed-drive]]\n"
+            "                   [--force] [--set section.key=value]...\n"
             "                   [--write-ini FILE] [--write-c FILE] [--validate]\n"
             "                   [--told-inertia J] [--told-friction F] [--identify [--max-inertia-error PCT]]\n"
-            "                   [--identify-in-run]\n"
+            "                   [--identify-in-run] [--summary FILE]\n"
             "  --motor      motor preset (sil/scenarios/motors/*.ini): [datasheet], [motor], run.bus_voltage_V;\n"
             "               run.period_s, run.delay_periods, [inverter] and [sensors] are the drive's\n"
             "  --robust     robust mode: Remark 2 calibration, commissioned R/L/k_M, drift-free angle,\n"
             "               dead-time compensation of inverter.dead_time_s\n"
+            "  --motor-db   a motor of a Klipper motor database: its [motor_constants NAME] section (resistance,\n"
+            "               inductance, holding_torque, max_current, steps_per_revolution); J and F, which it\n"
+            "               does not give, are estimated from the holding torque (and J identified in RUN)\n"
+            "  --force      design for data the datasheet check refuses (k_M, L/R or J no stepper has),\n"
+            "               with a warning\n"
             "  --low-speed-drive  robust mode without phase-voltage sensing: below 2 V_bus t_d / (T_s k_M)\n"
             "               the standstill hold's vector turns at the reference speed (a load step there is\n"
             "               not learnt)\n"
@@ -35,7 +41,8 @@ static void usage(FILE *f)
             "               errors against the plant; --validate then validates the second design\n"
             "  --max-inertia-error  with --identify: exit 1 unless J is identified within PCT %% of the plant's\n"
             "  --identify-in-run  the design asks the firmware to identify J and F in each run's first\n"
-            "               window and use them (commissioning.use_identified_mechanics)\n");
+            "               window and use them (commissioning.use_identified_mechanics)\n"
+            "  --summary    the design's status and figures and each validation run's outcome as JSON\n");
 }
 
 int main(int argc, char **argv)
@@ -45,8 +52,13 @@ int main(int argc, char **argv)
     pmstep_design_report_t report;
     pmstep_status_t status;
     const char *motor_path = NULL;
+    const char *motor_db_path = NULL;
+    const char *motor_db_name = NULL;
+    bool force = false;
     const char *ini_path = NULL;
     const char *c_path = NULL;
+    const char *summary_path = NULL;
+    tune_check_t checks[TUNE_CHECKS] = {{0}};
     bool robust = false;
     bool low_speed_drive = false;
     bool run_validation = false;
@@ -66,6 +78,22 @@ int main(int argc, char **argv)
                 fprintf(stderr, "pmstep-tune: %s\n", err);
                 return 2;
             }
+        } else if (strcmp(argv[k], "--motor-db") == 0 && k + 1 < argc) {
+            motor_db_path = argv[++k];
+        } else if (strcmp(argv[k], "--name") == 0 && k + 1 < argc) {
+            motor_db_name = argv[++k];
+            if (motor_db_path == NULL) {
+                fprintf(stderr, "pmstep-tune: --name needs --motor-db before it\n");
+                return 2;
+            }
+            if (load_motor_db(&sc, motor_db_path, motor_db_name, err, sizeof err) != 0) {
+                fprintf(stderr, "pmstep-tune: %s\n", err);
+                return 2;
+            }
+            motor_path = motor_db_path;
+            told_inertia = 0.0; /* the database has none: the designer estimates it */
+        } else if (strcmp(argv[k], "--force") == 0) {
+            force = true;
         } else if (strcmp(argv[k], "--set") == 0 && k + 1 < argc) {
             if (sil_scenario_set_assignment(&sc, argv[++k], err, sizeof err) != 0) {
                 fprintf(stderr, "pmstep-tune: %s\n", err);
@@ -79,6 +107,8 @@ int main(int argc, char **argv)
             ini_path = argv[++k];
         } else if (strcmp(argv[k], "--write-c") == 0 && k + 1 < argc) {
             c_path = argv[++k];
+        } else if (strcmp(argv[k], "--summary") == 0 && k + 1 < argc) {
+            summary_path = argv[++k];
         } else if (strcmp(argv[k], "--validate") == 0) {
             run_validation = true;
         } else if (strcmp(argv[k], "--identify") == 0) {
@@ -110,6 +140,10 @@ int main(int argc, char **argv)
             return 2;
         }
     }
+    if (motor_db_path != NULL && motor_db_name == NULL) {
+        fprintf(stderr, "pmstep-tune: --motor-db needs --name NAME (its [motor_constants NAME] section)\n");
+        return 2;
+    }
     if (motor_path == NULL) {
         usage(stderr);
         return 2;
@@ -123,14 +157,31 @@ int main(int argc, char **argv)
     if (told_friction >= 0.0) {
         in.motor.friction_Nms_rad = (float)told_friction;
     }
+    in.accept_implausible = force;
+    {
+        const pmstep_status_t datasheet = pmstep_design_check_datasheet(&in);
+        if (datasheet != PMSTEP_OK && force) {
+            fprintf(stderr, "pmstep-tune: %s: warning: %s (%d); designing anyway (--force)\n", motor_path,
+                    pmstep_status_str(datasheet), (int)datasheet);
+        }
+    }
     status = pmstep_design(&in, &sc.controller, &report);
     if (status != PMSTEP_OK) {
         fprintf(stderr, "pmstep-tune: %s: cannot design: %s (%d)\n", motor_path, pmstep_status_str(status),
                 (int)status);
+        if (summary_path != NULL) {
+            (void)write_summary(summary_path, motor_path, robust, status, &report, checks, 0);
+        }
         return 1;
     }
     sc.id_target_A = (double)report.magnetising_current_A;
-    (void)pmstep_position_design(&sc.controller, &sc.position); /* position loop (DESIGN.md section 11) */
+    if (report.inertia_estimated) {
+        printf("pmstep-tune: no rotor inertia given: %.3g kg m^2 estimated from the holding torque; the firmware "
+               "identifies J and F in RUN's first window (--identify-in-run)\n",
+               (double)report.inertia_kgm2);
+        identify_in_run = true;
+    }
+    (void)pmstep_position_design(&sc.controller, &sc.position); /* position loop (docs/design/11-position-loop.md) */
     {
         const double top = (double)report.top_speed_rad_s;
         const double levels[] = {0.8 * top, -0.8 * top, 0.05 * top, -0.05 * top, 0.0};
@@ -195,7 +246,7 @@ int main(int argc, char **argv)
             fprintf(stderr, "pmstep-tune: cannot write %s\n", ini_path);
             return 2;
         }
-        fprintf(f, "; Designed by pmstep-tune from %s%s (firmware/design/DESIGN.md).\n", motor_path,
+        fprintf(f, "; Designed by pmstep-tune from %s%s (docs/design).\n", motor_path,
                 robust ? " --robust" : "");
         sil_scenario_print(&sc, f);
         if (fclose(f) != 0) {
@@ -210,5 +261,16 @@ int main(int argc, char **argv)
         }
         printf("pmstep-tune: wrote %s\n", c_path);
     }
-    return run_validation ? validate(&sc, (double)report.top_speed_rad_s, max_inertia_error_pct) : 0;
+    if (run_validation) {
+        const int rc = validate(&sc, (double)report.top_speed_rad_s, max_inertia_error_pct, checks);
+        if (summary_path != NULL && write_summary(summary_path, motor_path, robust, status, &report, checks,
+                                                  TUNE_CHECKS) != 0) {
+            return 2;
+        }
+        return rc;
+    }
+    if (summary_path != NULL && write_summary(summary_path, motor_path, robust, status, &report, checks, 0) != 0) {
+        return 2;
+    }
+    return 0;
 }

@@ -11,6 +11,21 @@
 
 /* ---- tune_validate.c ---- */
 
+/* One run of the validation, for --summary. */
+typedef struct {
+    const char *check;         /* "ramps", "step_50", "step_5" */
+    bool ran;                  /* init accepted the configuration */
+    int fault;                 /* pmstep_fault_t latched, 0 none */
+    double fault_time_s;
+    double angle_error_rad;    /* largest angle-estimate error in RUN after the transients */
+    double speed_error_rad_s;  /* ramps: after the transients; steps: the dip after the load step */
+    double speed_bound_rad_s;  /* the tracking bound (2 % of the top speed) */
+    bool synchronous;          /* no fault, RUN to the end, angle error below SYNC_ANGLE_BOUND_RAD */
+    bool pass;                 /* as --validate judges it */
+} tune_check_t;
+
+#define TUNE_CHECKS 3
+
 /* A speed profile through @p levels (each held PROFILE_HOLD_S), starting 0.1 s after t_c. */
 void set_profile(sil_scenario_t *sc, const double *levels, int n_levels);
 
@@ -18,8 +33,10 @@ void set_profile(sil_scenario_t *sc, const double *levels, int n_levels);
 bool run_ok(const char *what, const sil_summary_t *s, int rc);
 
 /* @p max_inertia_error_pct >= 0: with identification in RUN, the first run must identify J
- * within that many percent of the plant's. @return 0 if every check passed, else 1. */
-int validate(const sil_scenario_t *designed, double top_speed_rad_s, double max_inertia_error_pct);
+ * within that many percent of the plant's. @p checks (TUNE_CHECKS, or NULL) gets each run's outcome.
+ * @return 0 if every check passed, else 1. */
+int validate(const sil_scenario_t *designed, double top_speed_rad_s, double max_inertia_error_pct,
+             tune_check_t *checks);
 
 /* ---- tune_design.c ---- */
 
@@ -30,6 +47,22 @@ void print_design(const sil_scenario_t *sc, const pmstep_design_report_t *r, boo
 
 /* The design as a C99 initialiser of pmstep_config_t. @return 0, or -1 after a message. */
 int write_c(const char *path, const sil_scenario_t *sc);
+
+/* ---- tune_motor_db.c ---- */
+
+/* Friction F where the data gives none: 1.5 % of the holding torque at 60 rad/s (N m s/rad per N m). */
+#define MOTOR_DB_FRICTION_PER_TORQUE (0.015 / 60.0)
+
+/* The motor of section [motor_constants @p name] of the Klipper motor database @p path into @p sc
+ * ([datasheet], [motor] and the name; J and F estimated). @return 0, or -1 with a message in @p err. */
+int load_motor_db(sil_scenario_t *sc, const char *path, const char *name, char *err, size_t err_size);
+
+/* ---- tune_summary.c ---- */
+
+/* --summary: the design's status and figures (@p r read only when @p status is PMSTEP_OK) and the
+ * validation's @p n_checks runs as JSON at @p path. @return 0, or -1 after a message. */
+int write_summary(const char *path, const char *motor_path, bool robust, pmstep_status_t status,
+                  const pmstep_design_report_t *r, const tune_check_t *checks, int n_checks);
 
 /* ---- tune_identify.c ---- */
 

@@ -18,6 +18,7 @@ void design_input(const sil_scenario_t *sc, bool robust, bool low_speed_drive, p
     in->motor.pole_pairs = (int32_t)sc->motor.pole_pairs;
     in->motor.detent_torque_Nm = (float)sc->datasheet.detent_torque_Nm; /* the law compensates the datasheet's */
     in->motor.rated_current_A = (float)sc->datasheet.rated_current_A;
+    in->holding_torque_Nm = (float)sc->datasheet.holding_torque_Nm;
     in->current_sense_range_A = sc->controller.limits.current_sense_range_A; /* the scenario's sensors */
     in->bus_sense_range_V = sc->controller.limits.bus_sense_range_V;
     in->bus_voltage_V = (float)sc->bus_voltage_V;
@@ -94,28 +95,28 @@ int write_c(const char *path, const sil_scenario_t *sc)
         fprintf(stderr, "pmstep-tune: cannot write %s\n", path);
         return -1;
     }
-    fprintf(f, "/* Designed by pmstep-tune for %s (firmware/design/DESIGN.md). */\n", sc->name);
+    fprintf(f, "/* Designed by pmstep-tune for %s (docs/design). */\n", sc->name);
     fprintf(f, "#include \"pmstep/pmstep.h\"\n\nconst pmstep_config_t pmstep_designed_config = {\n");
-    fprintf(f, "    .motor = {.resistance_Ohm = %.9gf, .inductance_H = %.9gf, .inertia_kgm2 = %.9gf,\n"
-               "              .friction_Nms_rad = %.9gf, .torque_constant_Nm_A = %.9gf, .pole_pairs = %d,\n"
-               "              .detent_torque_Nm = %.9gf, .rated_current_A = %.9gf},\n",
+    fprintf(f, "    .motor = {.resistance_Ohm = %#.9gf, .inductance_H = %#.9gf, .inertia_kgm2 = %#.9gf,\n"
+               "              .friction_Nms_rad = %#.9gf, .torque_constant_Nm_A = %#.9gf, .pole_pairs = %d,\n"
+               "              .detent_torque_Nm = %#.9gf, .rated_current_A = %#.9gf},\n",
             (double)c->motor.resistance_Ohm, (double)c->motor.inductance_H, (double)c->motor.inertia_kgm2,
             (double)c->motor.friction_Nms_rad, (double)c->motor.torque_constant_Nm_A, (int)c->motor.pole_pairs,
             (double)c->motor.detent_torque_Nm, (double)c->motor.rated_current_A);
-    fprintf(f, "    .timing = {.period_s = %.9gf, .computational_delay_periods = %uu},\n", (double)c->timing.period_s,
+    fprintf(f, "    .timing = {.period_s = %#.9gf, .computational_delay_periods = %uu},\n", (double)c->timing.period_s,
             (unsigned)c->timing.computational_delay_periods);
-    fprintf(f, "    .alignment = {.s_align_time_s = %.9gf, .s_lead_in_time_s = %.9gf, .c_align_time_s = %.9gf,\n"
-               "                  .s_align_voltage_V = %.9gf, .c_align_voltage_V = %.9gf},\n",
+    fprintf(f, "    .alignment = {.s_align_time_s = %#.9gf, .s_lead_in_time_s = %#.9gf, .c_align_time_s = %#.9gf,\n"
+               "                  .s_align_voltage_V = %#.9gf, .c_align_voltage_V = %#.9gf},\n",
             (double)c->alignment.s_align_time_s, (double)c->alignment.s_lead_in_time_s,
             (double)c->alignment.c_align_time_s, (double)c->alignment.s_align_voltage_V,
             (double)c->alignment.c_align_voltage_V);
-    fprintf(f, "    .gains = {.speed_gain_per_s = %.9gf, .observer_gain_per_s = %.9gf, .current_gain_per_s = %.9gf,\n"
-               "              .adapt_gamma = %.9gf, .adapt_lambda = %.9gf, .adapt_r = %.9gf, .sat_kappa_rad_s = %.9gf,\n"
-               "              .reference_bandwidth_rad_s = %.9gf, .angle_correction_gain_per_s = %.9gf,\n"
-               "              .current_integral_gain_per_s2 = %.9gf, .current_integral_gain_q_per_s2 = %.9gf,\n"
-               "              .detent_fade_speed_rad_s = %.9gf, .emf_angle_gain_per_s = %.9gf,\n"
-               "              .emf_angle_corner_rad_s = %.9gf, .angle_smoothing = %.9gf,\n"
-               "              .transient_observer_boost = %.9gf},\n",
+    fprintf(f, "    .gains = {.speed_gain_per_s = %#.9gf, .observer_gain_per_s = %#.9gf, .current_gain_per_s = %#.9gf,\n"
+               "              .adapt_gamma = %#.9gf, .adapt_lambda = %#.9gf, .adapt_r = %#.9gf, .sat_kappa_rad_s = %#.9gf,\n"
+               "              .reference_bandwidth_rad_s = %#.9gf, .angle_correction_gain_per_s = %#.9gf,\n"
+               "              .current_integral_gain_per_s2 = %#.9gf, .current_integral_gain_q_per_s2 = %#.9gf,\n"
+               "              .detent_fade_speed_rad_s = %#.9gf, .emf_angle_gain_per_s = %#.9gf,\n"
+               "              .emf_angle_corner_rad_s = %#.9gf, .angle_smoothing = %#.9gf,\n"
+               "              .transient_observer_boost = %#.9gf},\n",
             (double)c->gains.speed_gain_per_s, (double)c->gains.observer_gain_per_s,
             (double)c->gains.current_gain_per_s, (double)c->gains.adapt_gamma, (double)c->gains.adapt_lambda,
             (double)c->gains.adapt_r, (double)c->gains.sat_kappa_rad_s, (double)c->gains.reference_bandwidth_rad_s,
@@ -123,16 +124,16 @@ int write_c(const char *path, const sil_scenario_t *sc)
             (double)c->gains.current_integral_gain_q_per_s2, (double)c->gains.detent_fade_speed_rad_s,
             (double)c->gains.emf_angle_gain_per_s, (double)c->gains.emf_angle_corner_rad_s,
             (double)c->gains.angle_smoothing, (double)c->gains.transient_observer_boost);
-    fprintf(f, "    .limits = {.max_phase_current_A = %.9gf, .min_bus_voltage_V = %.9gf, .max_bus_voltage_V = %.9gf,\n"
-               "               .current_sense_range_A = %.9gf, .bus_sense_range_V = %.9gf},\n",
+    fprintf(f, "    .limits = {.max_phase_current_A = %#.9gf, .min_bus_voltage_V = %#.9gf, .max_bus_voltage_V = %#.9gf,\n"
+               "               .current_sense_range_A = %#.9gf, .bus_sense_range_V = %#.9gf},\n",
             (double)c->limits.max_phase_current_A, (double)c->limits.min_bus_voltage_V,
             (double)c->limits.max_bus_voltage_V, (double)c->limits.current_sense_range_A,
             (double)c->limits.bus_sense_range_V);
-    fprintf(f, "    .commissioning = {.offset_calibration_time_s = %.9gf, .alignment_offset_calibration = %s,\n"
-               "                      .steady_state_window_s = %.9gf, .inductance_window_s = %.9gf,\n"
+    fprintf(f, "    .commissioning = {.offset_calibration_time_s = %#.9gf, .alignment_offset_calibration = %s,\n"
+               "                      .steady_state_window_s = %#.9gf, .inductance_window_s = %#.9gf,\n"
                "                      .use_measured_resistance = %s, .use_measured_inductance = %s,\n"
-               "                      .use_measured_torque_constant = %s, .voltage_bias_level_fraction = %.9gf,\n"
-               "                      .identification_time_s = %.9gf, .identification_min_speed_rad_s = %.9gf,\n"
+               "                      .use_measured_torque_constant = %s, .voltage_bias_level_fraction = %#.9gf,\n"
+               "                      .identification_time_s = %#.9gf, .identification_min_speed_rad_s = %#.9gf,\n"
                "                      .use_identified_mechanics = %s},\n",
             (double)c->commissioning.offset_calibration_time_s,
             c->commissioning.alignment_offset_calibration ? "true" : "false",
@@ -143,17 +144,17 @@ int write_c(const char *path, const sil_scenario_t *sc)
             (double)c->commissioning.voltage_bias_level_fraction, (double)c->commissioning.identification_time_s,
             (double)c->commissioning.identification_min_speed_rad_s,
             c->commissioning.use_identified_mechanics ? "true" : "false");
-    fprintf(f, "    .inverter = {.dead_time_s = %.9gf, .dead_time_current_band_A = %.9gf,\n"
+    fprintf(f, "    .inverter = {.dead_time_s = %#.9gf, .dead_time_current_band_A = %#.9gf,\n"
                "                 .phase_voltage_sensing = %s, .ripple_dead_zone = %s},\n",
             (double)c->inverter.dead_time_s, (double)c->inverter.dead_time_current_band_A,
             c->inverter.phase_voltage_sensing ? "true" : "false", c->inverter.ripple_dead_zone ? "true" : "false");
-    fprintf(f, "    .detection = {.angle_magnitude_bound = %.9gf, .speed_consistency_bound_rad_s = %.9gf,\n"
-               "                  .stall_speed_error_rad_s = %.9gf, .observer_residual_bound_A = %.9gf,\n"
-               "                  .persistence_s = %.9gf, .max_realignments = %uu},\n",
+    fprintf(f, "    .detection = {.angle_magnitude_bound = %#.9gf, .speed_consistency_bound_rad_s = %#.9gf,\n"
+               "                  .stall_speed_error_rad_s = %#.9gf, .observer_residual_bound_A = %#.9gf,\n"
+               "                  .persistence_s = %#.9gf, .max_realignments = %uu},\n",
             (double)c->detection.angle_magnitude_bound, (double)c->detection.speed_consistency_bound_rad_s,
             (double)c->detection.stall_speed_error_rad_s, (double)c->detection.observer_residual_bound_A,
             (double)c->detection.persistence_s, (unsigned)c->detection.max_realignments);
-    fprintf(f, "    .standstill = {.hold_current_A = %.9gf, .vector_speed_rad_s = %.9gf, .stops_only = %s},\n",
+    fprintf(f, "    .standstill = {.hold_current_A = %#.9gf, .vector_speed_rad_s = %#.9gf, .stops_only = %s},\n",
             (double)c->standstill.hold_current_A, (double)c->standstill.vector_speed_rad_s,
             c->standstill.stops_only ? "true" : "false");
     fprintf(f, "    .known_load_mode = false,\n};\n");

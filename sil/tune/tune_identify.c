@@ -5,7 +5,7 @@
 #include "pmstep_tune.h"
 
 /* Identification window over the profile +0.8 top, -0.8 top (each held), from t_c; the lowest
- * speed that enters the fit is the designer's (DESIGN.md, section 10). */
+ * speed that enters the fit is the designer's (docs/design/10-inertia-and-friction.md). */
 void set_identification(sil_scenario_t *sc, double top_speed_rad_s, bool use_in_run)
 {
     const double levels[] = {0.8 * top_speed_rad_s, -0.8 * top_speed_rad_s};

@@ -6,7 +6,7 @@
 #include "pmstep/pmstep_text.h"
 #include "pmstep_tune.h"
 
-/* Validation profile (DESIGN.md, section 7): hold, +0.8 top, -0.8 top, +0.05 top, -0.05 top, 0. */
+/* Validation profile (docs/design/09-validation.md): hold, +0.8 top, -0.8 top, +0.05 top, -0.05 top, 0. */
 #define PROFILE_HOLD_S 0.3
 #define RAMP_ACCEL_FRACTION 0.2 /* of the rated acceleration k_M I / J */
 #define MIN_RAMP_S 0.05
@@ -85,7 +85,27 @@ bool run_ok(const char *what, const sil_summary_t *s, int rc)
 
 /* @p max_inertia_error_pct >= 0: with identification in RUN, the first run must identify J
  * within that many percent of the plant's. */
-int validate(const sil_scenario_t *designed, double top_speed_rad_s, double max_inertia_error_pct)
+/* A run's outcome into @p c (NULL: nothing). */
+static void record(tune_check_t *c, const char *check, const sil_summary_t *s, int rc, double speed_error_rad_s,
+                   double bound_rad_s, bool pass)
+{
+    if (c == NULL) {
+        return;
+    }
+    c->check = check;
+    c->ran = rc == 0;
+    c->fault = (int)s->fault;
+    c->fault_time_s = s->fault_time_s;
+    c->angle_error_rad = s->max_angle_error_rad;
+    c->speed_error_rad_s = speed_error_rad_s;
+    c->speed_bound_rad_s = bound_rad_s;
+    c->synchronous = rc == 0 && s->fault == PMSTEP_FAULT_NONE && s->final_mode == PMSTEP_MODE_RUN && !s->nonfinite_seen
+                     && s->max_angle_error_rad < SYNC_ANGLE_BOUND_RAD;
+    c->pass = pass;
+}
+
+int validate(const sil_scenario_t *designed, double top_speed_rad_s, double max_inertia_error_pct,
+             tune_check_t *checks)
 {
     static sil_scenario_t sc;
     sil_summary_t s;
@@ -104,6 +124,7 @@ int validate(const sil_scenario_t *designed, double top_speed_rad_s, double max_
     if (run_ok("ramps to +-80 % and +-5 % of top", &s, rc)) {
         const bool pass = s.max_speed_error_after_settle_rad_s < tracking_bound
                           && s.max_angle_error_rad < ANGLE_BOUND_RAD;
+        record(checks, "ramps", &s, rc, s.max_speed_error_after_settle_rad_s, tracking_bound, pass);
         printf("  %-34s %s: |w - w*| %.3f rad/s (bound %.3f), angle error %.4f rad (bound %.2f)\n",
                "ramps to +-80 % and +-5 % of top", pass ? "pass" : "FAIL", s.max_speed_error_after_settle_rad_s,
                tracking_bound, s.max_angle_error_rad, ANGLE_BOUND_RAD);
@@ -120,6 +141,7 @@ int validate(const sil_scenario_t *designed, double top_speed_rad_s, double max_
         }
         failures += pass ? 0 : 1;
     } else {
+        record(checks, "ramps", &s, rc, s.max_speed_error_after_settle_rad_s, tracking_bound, false);
         ++failures;
     }
     for (k = 0; k < 2; ++k) {
@@ -140,11 +162,15 @@ int validate(const sil_scenario_t *designed, double top_speed_rad_s, double max_
         rc = sil_run(&sc, watch_load, &watch, false, &s);
         if (run_ok(what, &s, rc)) {
             const bool pass = s.max_angle_error_rad < SYNC_ANGLE_BOUND_RAD;
+            record(checks == NULL ? NULL : &checks[1 + k], k == 0 ? "step_50" : "step_5", &s, rc,
+                   watch.max_error_rad_s, tracking_bound, pass);
             printf("  %-34s %s: dip %.2f rad/s, back within %.3f rad/s after %.1f ms, angle error %.4f rad\n", what,
                    pass ? "pass" : "FAIL", watch.max_error_rad_s, tracking_bound,
                    1e3 * (watch.last_above_s - watch.from_s), s.max_angle_error_rad);
             failures += pass ? 0 : 1;
         } else {
+            record(checks == NULL ? NULL : &checks[1 + k], k == 0 ? "step_50" : "step_5", &s, rc,
+                   watch.max_error_rad_s, tracking_bound, false);
             ++failures;
         }
     }

@@ -152,7 +152,7 @@ static void check_output(state_t *st, const pmstep_meas_t *meas)
         CHECK(fuzz_finite(floats[n]), "an output is not finite");
     }
     CHECK((unsigned)o->mode <= (unsigned)PMSTEP_MODE_OFFSET_CAL, "mode out of range");
-    CHECK((unsigned)o->fault <= (unsigned)PMSTEP_FAULT_CURRENT_STUCK_B, "fault out of range");
+    CHECK((unsigned)o->fault <= (unsigned)PMSTEP_FAULT_ESTIMATE_RANGE, "fault out of range");
     CHECK((o->mode == PMSTEP_MODE_FAULT) == (o->fault != PMSTEP_FAULT_NONE), "mode FAULT and fault code disagree");
     if (o->bridge_enable) {
         CHECK(o->mode == PMSTEP_MODE_S_ALIGN || o->mode == PMSTEP_MODE_C_ALIGN || o->mode == PMSTEP_MODE_RUN,

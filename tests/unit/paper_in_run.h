@@ -34,7 +34,7 @@ static inline float paper_estimate_angle(const pmstep_t *inst)
     return atan2f(s, c);
 }
 
-/* Places the observer's poles at a triple pole w_o (rad/s), as the designer does (DESIGN.md,
+/* Places the observer's poles at a triple pole w_o (rad/s), as the designer does (docs/design,
  * section 3): a_e = 3 w_o - F/J, g_w b^2 = 3 w_o^2 - a_e F/J, g_T b^2 / J = w_o^3, b = k_M/L.
  * Returns a_e. */
 static inline double paper_observer_at_triple_pole(pmstep_observer_coeffs_t *obs, double w_o)

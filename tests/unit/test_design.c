@@ -1,5 +1,5 @@
 /* Gain designer (firmware/design): each preset's design meets condition (4) and the rated
- * current, passes validation, places the observer's poles where DESIGN.md says; bad motor data
+ * current, passes validation, places the observer's poles where docs/design says; bad motor data
  * gets its named error. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -47,10 +47,12 @@ static pmstep_design_input_t input_of(const motor_data_t *m, bool robust)
     in.current_resolution_A = robust ? 0.005f : 0.0f;
     in.phase_voltage_sensing = false;
     in.low_speed_drive = false;
+    in.holding_torque_Nm = 0.0f; /* no datasheet check */
+    in.accept_implausible = false;
     return in;
 }
 
-/* DESIGN.md section 5: 0.04 I, plus the dead time's floor 4 V t_d / L in robust mode (on the
+/* docs/design/05-protections-and-detection.md: 0.04 I, plus the dead time's floor 4 V t_d / L in robust mode (on the
  * AS1050 at 48 V and 1 us, 0.2 A + 0.223 A). */
 static void residual_bound_has_the_dead_time_floor(void **state)
 {
@@ -102,7 +104,7 @@ static void every_preset_gets_a_valid_design(void **state)
             assert_true(cfg.alignment.c_align_voltage_V / in.motor.resistance_Ohm <= in.motor.rated_current_A * 1.0001f);
             assert_true(cfg.limits.max_phase_current_A > in.motor.rated_current_A);
             /* PI current loop: K_I = K^2/8, K = R/L + K_i (poles 0.15 K and 0.85 K, real); on the q
-             * axis K k_w / 5, its slow pole a fifth of the speed loop's (DESIGN.md section 2). */
+             * axis K k_w / 5, its slow pole a fifth of the speed loop's (docs/design/02-current-and-speed-loops.md). */
             {
                 const float k = in.motor.resistance_Ohm / in.motor.inductance_H + cfg.gains.current_gain_per_s;
                 assert_float_equal(cfg.gains.current_integral_gain_per_s2, 0.125f * k * k, 1e-3f * k * k);
@@ -110,7 +112,7 @@ static void every_preset_gets_a_valid_design(void **state)
                                    0.2f * k * cfg.gains.speed_gain_per_s, 1e-4f * k * cfg.gains.speed_gain_per_s);
             }
             /* Robust: the back-EMF angle correction at twice the observer's bandwidth w_o = 0.05 / T_s,
-             * half on where the back EMF equals R I + 2 V_bus t_d / T_s (DESIGN.md section 15); off in
+             * half on where the back EMF equals R I + 2 V_bus t_d / T_s (docs/design/15-back-emf-angle-correction.md); off in
              * paper mode. */
             if (robust != 0) {
                 const float corner_rad_s = (in.motor.resistance_Ohm * in.motor.rated_current_A
@@ -124,9 +126,9 @@ static void every_preset_gets_a_valid_design(void **state)
                 assert_true(cfg.gains.emf_angle_gain_per_s == 0.0f && cfg.gains.emf_angle_corner_rad_s == 0.0f);
             }
             /* Robust: the angle smoothing weighs the turned previous estimate and the reading
-             * equally (DESIGN.md section 16); off in paper mode. */
+             * equally (docs/design/16-angle-smoothing.md); off in paper mode. */
             assert_true(cfg.gains.angle_smoothing == (robust != 0 ? 0.5f : 0.0f));
-            /* Robust: the transient observer boost at 3, beyond the designed residual bound (DESIGN.md
+            /* Robust: the transient observer boost at 3, beyond the designed residual bound (docs/design
              * section 18); off in paper mode. */
             assert_true(cfg.gains.transient_observer_boost == (robust != 0 ? 3.0f : 0.0f));
             assert_true(robust == 0 || cfg.detection.observer_residual_bound_A > 0.0f);
@@ -172,7 +174,7 @@ static void detent_compensation_fades_where_the_current_loop_ends(void **state)
     }
 }
 
-/* DESIGN.md section 4: with a detent torque s-alignment leads in for the swing's settling time
+/* docs/design/04-alignment.md: with a detent torque s-alignment leads in for the swing's settling time
  * (rounded up to 10 ms), and its own part and c-alignment stay as designed without one. */
 static void s_alignment_leads_in_where_there_is_a_detent(void **state)
 {
@@ -247,12 +249,10 @@ static void zero_rated(pmstep_design_input_t *in) { in->motor.rated_current_A = 
 static void low_bus(pmstep_design_input_t *in) { in->bus_voltage_V = 2.5f; } /* R I = 2.55 V > 0.9 x 2.5 V */
 static void zero_bus(pmstep_design_input_t *in) { in->bus_voltage_V = 0.0f; }
 static void slow_rate(pmstep_design_input_t *in) { in->period_s = 1e-3f; } /* (R/L) T_s = 0.54 */
-/* (R/L) T_s = 0.085: above 80 % of the current loop's 0.1, below 80 % of the observer's 0.15 */
-/* (R/L) T_s = 0.123: above 80 % of the slower pole, the observer's 3 w_o T_s = 0.15 (the current
- * loop's is 0.2) */
-static void rate_for_winding(pmstep_design_input_t *in) { in->period_s = 2.3e-4f; }
-/* F/J = 1850/s: above 80 % of the observer's 1000 rad/s */
-static void heavy_friction(pmstep_design_input_t *in) { in->motor.friction_Nms_rad = 0.01f; }
+/* (R/L + F/J) T_s = 0.376: beyond the 0.35 the discretisation takes */
+static void rate_for_winding(pmstep_design_input_t *in) { in->period_s = 7e-4f; }
+/* F/J = 7400/s: (R/L + F/J) T_s = 0.40 */
+static void heavy_friction(pmstep_design_input_t *in) { in->motor.friction_Nms_rad = 0.04f; }
 static void bad_period(pmstep_design_input_t *in) { in->period_s = 0.1f; }
 static void bad_delay(pmstep_design_input_t *in) { in->computational_delay_periods = 2u; }
 static void long_dead_time(pmstep_design_input_t *in) { in->dead_time_s = 20e-6f; }
@@ -261,6 +261,69 @@ static void no_current_sensing(pmstep_design_input_t *in) { in->current_sense_ra
 static void current_sensing_below_rated(pmstep_design_input_t *in) { in->current_sense_range_A = 2.2f; }
 /* 24 V bus: the overvoltage trip must reach 26.4 V, and 27 V of range gives 25.65 V. */
 static void bus_sensing_below_bus(pmstep_design_input_t *in) { in->bus_sense_range_V = 27.0f; }
+
+/* The datasheet check (only with a holding torque given): the 17HS4401's 0.40 N m, 1.7 A, 2.8 mH,
+ * 1.5 Ohm, 5.4e-6 kg m^2 pass; a holding torque typed in N cm (40 for 0.40, k_M from it), an L in
+ * uH, a J in g cm^2 or an L that no winding of this magnet has do not; accept_implausible designs
+ * anyway; a J of 0 is estimated from the holding torque and reported so. */
+/* A winding faster than the bandwidths the control rate gives: (R/L) T_s = 0.2 on the 17HS4401 at
+ * 373 us is designed with its current loop at 1.25 R/L and the observer's current pole at 1.25 R/L,
+ * not refused; the result passes init's checks (pmstep_design() validates it). */
+static void fast_winding_gets_a_rate_limited_design(void **state)
+{
+    pmstep_design_input_t in = input_of(&presets[1], false);
+    pmstep_config_t cfg;
+    pmstep_design_report_t report;
+    const float r_over_l = 1.5f / 0.0028f;
+    (void)state;
+    in.period_s = 0.2f / r_over_l;
+    assert_int_equal(pmstep_design(&in, &cfg, &report), PMSTEP_OK);
+    assert_float_equal(report.current_bandwidth_rad_s, 1.25f * r_over_l, 1e-2f);
+    assert_float_equal(3.0f * report.observer_bandwidth_rad_s, 1.25f * (r_over_l + 1e-4f / 5.4e-6f), 1e-1f);
+    assert_true(cfg.gains.current_gain_per_s > 0.0f && cfg.gains.observer_gain_per_s > 0.0f);
+}
+
+static void datasheet_check_names_what_no_stepper_has(void **state)
+{
+    pmstep_config_t cfg;
+    pmstep_design_report_t report;
+    pmstep_design_input_t in;
+    (void)state;
+    in = input_of(&presets[1], false);
+    in.holding_torque_Nm = 0.40f;
+    assert_int_equal(pmstep_design_check_datasheet(&in), PMSTEP_OK);
+    assert_int_equal(pmstep_design(&in, &cfg, &report), PMSTEP_OK);
+    assert_false(report.inertia_estimated);
+    in.holding_torque_Nm = 40.0f; /* k_M still 0.166: 100 x off */
+    assert_int_equal(pmstep_design(&in, &cfg, &report), PMSTEP_ERR_DATASHEET_TORQUE_CONSTANT);
+    in.accept_implausible = true;
+    assert_int_equal(pmstep_design_check_datasheet(&in), PMSTEP_ERR_DATASHEET_TORQUE_CONSTANT);
+    assert_int_equal(pmstep_design(&in, &cfg, &report), PMSTEP_OK);
+    in = input_of(&presets[1], false);
+    in.holding_torque_Nm = 0.40f;
+    in.motor.inductance_H = 2.8e-6f; /* uH typed as mH: L/R 1.9 us */
+    assert_int_equal(pmstep_design(&in, &cfg, &report), PMSTEP_ERR_DATASHEET_TIME_CONSTANT);
+    in = input_of(&presets[1], false);
+    in.holding_torque_Nm = 0.40f;
+    in.motor.inertia_kgm2 = 54.0f * 1e-7f * 1e3f; /* g cm^2 taken for 1e-4 kg m^2 units: 1000 x */
+    assert_int_equal(pmstep_design(&in, &cfg, &report), PMSTEP_ERR_DATASHEET_INERTIA);
+    in = input_of(&presets[1], false);
+    in.holding_torque_Nm = 0.40f;
+    in.motor.inductance_H = 0.3e-3f;  /* p L I / k_M = 50 x 0.3 mH x 1.7 / 0.166 = 0.15 ... */
+    in.motor.resistance_Ohm = 0.15f;  /* (L/R 2 ms) passes; 0.1 mH gives 0.05: refused */
+    assert_int_equal(pmstep_design_check_datasheet(&in), PMSTEP_OK);
+    in.motor.inductance_H = 0.1e-3f;
+    in.motor.resistance_Ohm = 0.05f;
+    assert_int_equal(pmstep_design_check_datasheet(&in), PMSTEP_ERR_DATASHEET_FLUX_RATIO);
+    /* No J: estimated as 2.1e-5 x 0.40^1.5 = 5.3e-6 kg m^2 and reported. */
+    in = input_of(&presets[1], false);
+    in.holding_torque_Nm = 0.40f;
+    in.motor.inertia_kgm2 = 0.0f;
+    assert_int_equal(pmstep_design(&in, &cfg, &report), PMSTEP_OK);
+    assert_true(report.inertia_estimated);
+    assert_float_equal(report.inertia_kgm2, 2.1e-5f * 0.40f * sqrtf(0.40f), 1e-9f);
+    assert_float_equal(cfg.motor.inertia_kgm2, report.inertia_kgm2, 0.0f);
+}
 
 static void bad_motor_data_gets_a_named_error(void **state)
 {
@@ -363,7 +426,7 @@ static void low_speed_drive_below_twice_the_dead_time_loss(void **state)
     }
 }
 
-/* The magnetising current of robust mode (DESIGN.md section 8): 25 times the current one period's
+/* The magnetising current of robust mode (docs/design/08-robust-mode.md): 25 times the current one period's
  * dead-time volt-seconds move, 2 V t_d / L, within [I/8, 0.35 I]; I/8 with phase-voltage sensing
  * (the integrals take the sensed voltage), 0 in the paper's design. At 1 us: the paper motor
  * 25 x 0.016 A = 0.4 A, below its floor of 1 A; 17HS4401 25 x 2 x 24 V x 1 us / 2.8 mH = 0.4286 A and
@@ -407,6 +470,8 @@ int main(void)
         cmocka_unit_test(residual_bound_has_the_dead_time_floor),
         cmocka_unit_test(observer_poles_are_placed),
         cmocka_unit_test(bad_motor_data_gets_a_named_error),
+        cmocka_unit_test(datasheet_check_names_what_no_stepper_has),
+        cmocka_unit_test(fast_winding_gets_a_rate_limited_design),
         cmocka_unit_test(phase_voltage_sensing_is_passed_on),
         cmocka_unit_test(low_speed_drive_below_twice_the_dead_time_loss),
         cmocka_unit_test(magnetising_current_follows_the_dead_time),

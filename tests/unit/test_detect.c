@@ -71,10 +71,51 @@ static void lost_angle_faults_or_realigns_after_the_detection_time(void **state)
     }
 }
 
+/* A speed or load estimate beyond what the bus and the trip allow (4 V_max / k_M = 120 rad/s, 4 k_M
+ * I_trip = 120 N m on the paper's motor) latches ESTIMATE_RANGE at the next check, before the
+ * observer runs away to overflow; within the range nothing happens. */
+static void estimate_out_of_range_faults(void **state)
+{
+    const pmstep_meas_t m = {8.0f, 0.0f, 48.0f, 0.0f, 0.0f, 0.0f};
+    unsigned which;
+    (void)state;
+    for (which = 0; which < 3u; ++which) {
+        pmstep_config_t cfg = pmstep_paper_config();
+        pmstep_t inst;
+        pmstep_output_t out;
+        uint32_t k;
+        cfg.alignment.s_align_time_s = 0.02f;
+        cfg.alignment.c_align_time_s = 0.04f;
+        assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
+        hold_to_run(&inst, &out);
+        assert_float_equal(inst.observer_coeffs.speed_bound_rad_s, 4.0f * 60.0f / 2.0f, 1e-3f);
+        assert_float_equal(inst.observer_coeffs.load_bound_Nm, 4.0f * 2.0f * 15.0f, 1e-3f);
+        for (k = 0; k < 8u && out.mode == PMSTEP_MODE_RUN; ++k) {
+            if (which == 0u) {
+                inst.observer.speed_hat_rad_s = -121.0f;
+            } else if (which == 1u) {
+                inst.observer.load_hat_Nm = 121.0f;
+            } else {
+                inst.observer.speed_hat_rad_s = 100.0f; /* within */
+            }
+            pmstep_step(&inst, &m, &out);
+        }
+        if (which < 2u) {
+            assert_int_equal(out.mode, PMSTEP_MODE_FAULT);
+            assert_int_equal(out.fault, PMSTEP_FAULT_ESTIMATE_RANGE);
+            assert_string_equal(pmstep_fault_str(out.fault), "ESTIMATE_RANGE");
+            assert_false(out.bridge_enable);
+        } else {
+            assert_int_not_equal(out.fault, PMSTEP_FAULT_ESTIMATE_RANGE);
+        }
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(lost_angle_faults_or_realigns_after_the_detection_time),
+        cmocka_unit_test(estimate_out_of_range_faults),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -76,7 +76,7 @@ static void hold_derives_vector_spring_and_damping(void **state)
 }
 
 /* The damping term needs a speed estimate in phase with the swing. With the observer placed at a
- * triple pole w_o (DESIGN.md, section 3) and the estimate kept (no restoring torque in its model),
+ * triple pole w_o (docs/design/03-observer.md) and the estimate kept (no restoring torque in its model),
  * w-hat/w = N(s)/P(s), N = P - s^2 (s + a_e): computed here in complex double, the hold damps
  * (g = 2 zeta p / w_n) where Re(w-hat/w) at w_n is at least 0.5 and not at all below: for the
  * triple pole that is w_n <= w_o (Re exactly 0.5 at w_n = w_o, F = 0). The hybrid presets sit at

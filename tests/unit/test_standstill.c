@@ -79,7 +79,7 @@ static void standstill_engages_after_the_engage_time_at_rest(void **state)
 
 /* The standstill keeps the damping term where the vector hold's rule drops it (w-hat lagging the
  * swing: here the observer's triple pole at w_n / 2, Re(w-hat/w) below 1/2 at w_n): it engages
- * with a step of the vector's current, whose first swing the term shortens (DESIGN.md section 12). */
+ * with a step of the vector's current, whose first swing the term shortens (docs/design/12-position-hold.md). */
 static void standstill_keeps_its_damping_where_the_estimate_lags(void **state)
 {
     paper_run_t f;

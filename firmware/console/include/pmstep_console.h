@@ -34,7 +34,7 @@
  *                                                    -> ACK (pmstep_position_move_to; mechanical
  *                              rad, rad/s, rad/s^2, rad/s^3; j_max absent or 0: a_max varpi_0)
  *   0x0E HOLD               [a_max f32]              -> ACK (pmstep_position_hold; a_max only from
- *                              speed mode, absent = 0: refused there, -7 BAD_COMMAND_VALUE)
+ *                              speed mode, absent = 0: refused there, -3 BAD_COMMAND_VALUE)
  *   0x0F GET_POSITION       -                        -> status i16, period u32, position f32,
  *                              position_ref f32, position_error f32 (rad, mechanical, of that
  *                              period: pmstep_get_position, pmstep_position_reference), flags u8

@@ -1,4 +1,4 @@
-/* Gain designer (pmstep_design.h): the rules of firmware/design/DESIGN.md, one function per group. */
+/* Gain designer (pmstep_design.h): the rules of docs/design, one function per group. */
 #include "pmstep/pmstep_design.h"
 
 #include "pmstep/pmstep.h"
@@ -6,20 +6,25 @@
 #include <math.h> /* sqrtf, isfinite: one FPU instruction / a classification macro, no libm call */
 #include <stddef.h>
 
-/* Bandwidths as fractions of the control rate 1/T_s (DESIGN.md, section 2). */
+/* Bandwidths as fractions of the control rate 1/T_s (docs/design/02-current-and-speed-loops.md). */
 #define CURRENT_BANDWIDTH_X_PERIOD 0.2f   /* (R/L + K_i) T_s */
 #define OBSERVER_BANDWIDTH_X_PERIOD 0.05f /* w_o T_s: the observer's triple pole */
+/* A winding faster than those: the current loop at this many times R/L, the observer's current pole
+ * 3 w_o at this many times R/L + F/J; and the fastest winding designed for, (R/L + F/J) T_s, which
+ * keeps (R/L + K_i) T_s and (R/L + K_e) T_s under the 0.5 init accepts. */
+#define WINDING_RATE_MARGIN 1.25f
+#define MAX_WINDING_RATE_X_PERIOD 0.35f
 /* Robust mode's angle smoothing: the reading and the turned previous estimate weighted equally
- * (the samples' noise in the estimate x 0.58; DESIGN.md section 16) */
+ * (the samples' noise in the estimate x 0.58; docs/design/16-angle-smoothing.md) */
 #define ANGLE_SMOOTHING 0.5f
 /* Robust mode's transient observer boost: beyond the residual bound the observer's mechanical injections
- * as at 3 w_o (DESIGN.md section 18). */
+ * as at 3 w_o (docs/design/18-transient-observer-boost.md). */
 #define TRANSIENT_OBSERVER_BOOST 3.0f
 #define SPEED_PER_OBSERVER_BANDWIDTH (1.0f / 3.0f) /* k_w = w_o / 3 */
 #define REFERENCE_PER_SPEED_BANDWIDTH 3.0f         /* varpi_0 = 3 k_w */
 #define DRIFT_FREE_PER_OBSERVER_BANDWIDTH (1.0f / 30.0f) /* robust mode's angle correction g = w_o / 30 */
 /* Robust mode's back-EMF angle correction: K_theta = 2 w_o, two thirds of the residual's R/L + K_e
- * (damping 0.61; DESIGN.md section 15). */
+ * (damping 0.61; docs/design/15-back-emf-angle-correction.md). */
 #define EMF_ANGLE_PER_OBSERVER_BANDWIDTH 2.0f
 #define CURRENT_INTEGRAL_PER_BANDWIDTH_SQUARED 0.125f   /* K_I = K^2/8, K = R/L + K_i: PI poles 0.15 K, 0.85 K */
 #define Q_INTEGRAL_SPEED_DIVISOR 5.0f /* K_I,q = K k_w / 5: the q PI's slow pole at k_w / 5 */
@@ -44,12 +49,12 @@
 #define MIN_MAX_BUS_FRACTION 1.1f
 #define MIN_BUS_FRACTION 0.625f
 #define MAX_BUS_FRACTION 1.25f
-/* Detection (DESIGN.md, section 5). */
+/* Detection (docs/design/05-protections-and-detection.md). */
 #define ANGLE_MAGNITUDE_BOUND 0.25f
 #define STALL_FRACTION_OF_TOP_SPEED 0.2f
 #define RESIDUAL_PER_RATED_CURRENT 0.04f
 #define PERSISTENCE_S 0.02f
-/* Robust mode's commissioning (DESIGN.md, section 4). */
+/* Robust mode's commissioning (docs/design/08-robust-mode.md; the windows: docs/design/04-alignment.md). */
 #define OFFSET_CALIBRATION_S 0.05f
 #define MIN_STEADY_STATE_WINDOW_S 0.01f
 #define STEADY_STATE_WINDOW_TIME_CONSTANTS 10.0f
@@ -59,27 +64,27 @@
 #define MAGNETISING_PER_RATED_CURRENT 0.125f
 /* Robust mode, currents sensed only: the magnetising current is this many times the current one
  * period's dead-time volt-seconds move, within [MAGNETISING_PER_RATED_CURRENT,
- * MAX_MAGNETISING_PER_RATED_CURRENT] x I (magnetising_current, DESIGN.md section 8). */
+ * MAX_MAGNETISING_PER_RATED_CURRENT] x I (magnetising_current, docs/design/08-robust-mode.md). */
 #define MAGNETISING_PER_DEAD_TIME_CURRENT 25.0f
 /* The cap: 0.35 I with K_theta = 2 w_o lost a third of the AS1050's Monte Carlo failures that I/4 had;
  * I/2 gained nothing over I/4 once the detent compensation faded with the speed, and costs copper
- * and the voltage p w L i_d* (DESIGN.md section 8). */
+ * and the voltage p w L i_d* (docs/design/08-robust-mode.md). */
 #define MAX_MAGNETISING_PER_RATED_CURRENT 0.35f
 #define MIN_DEAD_TIME_BAND_A 1e-4f
 /* Robust mode, currents sensed only: the low-speed drive below the speed whose back EMF is this
- * many times the dead time's loss V_bus t_d / T_s (DESIGN.md, "The low-speed drive"). */
+ * many times the dead time's loss V_bus t_d / T_s (docs/design/14-low-speed-drive.md). */
 #define LOW_SPEED_EMF_PER_DEAD_TIME_LOSS 2.0f
 /* ... and where the detent torque's frequency 4 p w is at most this fraction of the held rotor's
  * natural frequency sqrt(p k_M I / J): above, the turning vector drives the rotor near its
- * resonance (DESIGN.md section 14). */
+ * resonance (docs/design/14-low-speed-drive.md). */
 #define LOW_SPEED_DETENT_PER_HELD_NATURAL 0.5f
 /* Identification of J and F (pmstep_identify.h): periods with |w*| below this fraction of the top
  * speed stay out of the fit (a hybrid's detent torque does not average out at low speed). */
 #define IDENTIFICATION_MIN_SPEED_OF_TOP 0.2f
-/* Paper's r: only matters with F > 0 (DESIGN.md, section 3). */
+/* Paper's r: only matters with F > 0 (docs/design/03-observer.md). */
 #define ADAPT_R 1.0f
 /* The detent torque's compensation fades where its frequency 4 p w-hat is this many current-loop
- * bandwidths (DESIGN.md section 2): calibrated on the Monte Carlo, as section 2 reports. */
+ * bandwidths (docs/design/02-current-and-speed-loops.md): calibrated on the Monte Carlo. */
 #define DETENT_FADE_PER_CURRENT_BANDWIDTH 2.0f
 
 static float max2(float a, float b)
@@ -110,7 +115,58 @@ static bool finite_input(const pmstep_design_input_t *in)
            && isfinite(m->friction_Nms_rad) && isfinite(m->torque_constant_Nm_A) && isfinite(in->motor.rated_current_A)
            && isfinite(in->bus_voltage_V) && isfinite(in->period_s) && isfinite(in->dead_time_s)
            && isfinite(in->current_resolution_A) && isfinite(in->current_sense_range_A)
-           && isfinite(in->bus_sense_range_V) && isfinite(m->detent_torque_Nm);
+           && isfinite(in->bus_sense_range_V) && isfinite(m->detent_torque_Nm) && isfinite(in->holding_torque_Nm);
+}
+
+/* The datasheet check's bounds (pmstep_design_check_datasheet()). */
+#define DATASHEET_KM_RATIO 2.0f
+#define DATASHEET_MIN_TIME_CONSTANT_S 1e-4f
+#define DATASHEET_MAX_TIME_CONSTANT_S 2e-2f
+#define DATASHEET_INERTIA_RATIO 10.0f
+/* p L I / k_M, the winding's flux at rated current over the magnet's, is a property of a frame's
+ * magnetic design (a rewound winding scales L I^2 and k_M I alike): 0.5-3 in stepper datasheets. */
+#define DATASHEET_MIN_FLUX_RATIO 0.1f
+#define DATASHEET_MAX_FLUX_RATIO 10.0f
+
+static float inertia_estimate(float holding_torque_Nm)
+{
+    return PMSTEP_DESIGN_INERTIA_PER_TORQUE * holding_torque_Nm * sqrtf(holding_torque_Nm);
+}
+
+pmstep_status_t pmstep_design_check_datasheet(const pmstep_design_input_t *in)
+{
+    const pmstep_motor_config_t *m;
+    float km_ratio;
+    float time_constant_s;
+    if (in == NULL) {
+        return PMSTEP_ERR_NULL_ARGUMENT;
+    }
+    m = &in->motor;
+    if (!(in->holding_torque_Nm > 0.0f) || !(m->rated_current_A > 0.0f) || !(m->resistance_Ohm > 0.0f)) {
+        return PMSTEP_OK; /* nothing to compare with (the designer's own checks name what is missing) */
+    }
+    km_ratio = m->torque_constant_Nm_A * 1.41421356f * m->rated_current_A / in->holding_torque_Nm;
+    if (!(km_ratio >= 1.0f / DATASHEET_KM_RATIO && km_ratio <= DATASHEET_KM_RATIO)) {
+        return PMSTEP_ERR_DATASHEET_TORQUE_CONSTANT;
+    }
+    time_constant_s = m->inductance_H / m->resistance_Ohm;
+    if (!(time_constant_s >= DATASHEET_MIN_TIME_CONSTANT_S && time_constant_s <= DATASHEET_MAX_TIME_CONSTANT_S)) {
+        return PMSTEP_ERR_DATASHEET_TIME_CONSTANT;
+    }
+    {
+        const float flux_ratio = (float)m->pole_pairs * m->inductance_H * m->rated_current_A
+                                 / (in->holding_torque_Nm / (1.41421356f * m->rated_current_A));
+        if (!(flux_ratio >= DATASHEET_MIN_FLUX_RATIO && flux_ratio <= DATASHEET_MAX_FLUX_RATIO)) {
+            return PMSTEP_ERR_DATASHEET_FLUX_RATIO;
+        }
+    }
+    if (m->inertia_kgm2 > 0.0f) {
+        const float j_ratio = m->inertia_kgm2 / inertia_estimate(in->holding_torque_Nm);
+        if (!(j_ratio >= 1.0f / DATASHEET_INERTIA_RATIO && j_ratio <= DATASHEET_INERTIA_RATIO)) {
+            return PMSTEP_ERR_DATASHEET_INERTIA;
+        }
+    }
+    return PMSTEP_OK;
 }
 
 static pmstep_status_t check_input(const pmstep_design_input_t *in)
@@ -163,18 +219,19 @@ static pmstep_status_t check_input(const pmstep_design_input_t *in)
     if (!(in->dead_time_s >= 0.0f && 4.0f * in->dead_time_s < in->period_s)) {
         return PMSTEP_ERR_DEAD_TIME;
     }
-    /* The current loop's and the observer's poles must lie well beyond the winding's own R/L
-     * (K_i, K_e > 0): R/L at most 80 % of the slower of the two, 0.2/T_s and 3 w_o. The
-     * observer's triple pole must lie beyond the mechanics' F/J (DESIGN.md, 3). */
-    if (!(m->resistance_Ohm / m->inductance_H * in->period_s
-          < 0.8f * min2(CURRENT_BANDWIDTH_X_PERIOD, 3.0f * OBSERVER_BANDWIDTH_X_PERIOD))
-        || !(m->friction_Nms_rad / m->inertia_kgm2 * in->period_s < 0.8f * OBSERVER_BANDWIDTH_X_PERIOD)) {
+    /* The current loop's and the observer's poles lie beyond the winding's own R/L and the
+     * mechanics' F/J (K_i, K_e > 0); where R/L or F/J passes the bandwidths the control rate gives
+     * them, those are raised to WINDING_RATE_MARGIN times it (current_bandwidth(),
+     * observer_bandwidth()), up to what the discretisation takes: (R/L + F/J) T_s at most
+     * MAX_WINDING_RATE_X_PERIOD (docs/design/03-observer.md). */
+    if (!((m->resistance_Ohm / m->inductance_H + m->friction_Nms_rad / m->inertia_kgm2) * in->period_s
+          <= MAX_WINDING_RATE_X_PERIOD)) {
         return PMSTEP_ERR_RATE_TOO_SLOW;
     }
     return PMSTEP_OK;
 }
 
-/* Top speed: (R I + k_M w)^2 + (p w L I)^2 = (0.9 V)^2 at rated current, i_d = 0 (DESIGN.md, 6). */
+/* Top speed: (R I + k_M w)^2 + (p w L I)^2 = (0.9 V)^2 at rated current, i_d = 0 (docs/design/06-top-speed.md). */
 static float top_speed(const pmstep_design_input_t *in)
 {
     const pmstep_motor_config_t *m = &in->motor;
@@ -188,25 +245,25 @@ static float top_speed(const pmstep_design_input_t *in)
 }
 
 /* Current loop, observer (triple pole at -w_o of s^3 + (a_e + F/J) s^2 + (a_e F/J + g_w b^2) s
- * + g_T b^2 / J, b = k_M/L), speed loop and reference filter (DESIGN.md, 2-3). */
+ * + g_T b^2 / J, b = k_M/L), speed loop and reference filter (docs/design/02-current-and-speed-loops.md to 03-observer.md). */
 static void design_gains(const pmstep_design_input_t *in, pmstep_gains_config_t *gains, pmstep_design_report_t *report)
 {
     const pmstep_motor_config_t *m = &in->motor;
     const float r_over_l = m->resistance_Ohm / m->inductance_H;
     const float f_over_j = m->friction_Nms_rad / m->inertia_kgm2;
     const float b = m->torque_constant_Nm_A / m->inductance_H;
-    const float w_o = OBSERVER_BANDWIDTH_X_PERIOD / in->period_s;
+    const float w_o = max2(OBSERVER_BANDWIDTH_X_PERIOD / in->period_s, WINDING_RATE_MARGIN * (r_over_l + f_over_j) / 3.0f);
     const float a_e = 3.0f * w_o - f_over_j;
     const float g_w = (3.0f * w_o * w_o - a_e * f_over_j) / (b * b);
     const float lambda = 2.0f / g_w;
     const float w_slow = w_o - f_over_j; /* > 0: check_input */
     const float speed_gain = SPEED_PER_OBSERVER_BANDWIDTH * w_o;
-    const float current_bandwidth = CURRENT_BANDWIDTH_X_PERIOD / in->period_s;
+    const float current_bandwidth = max2(CURRENT_BANDWIDTH_X_PERIOD / in->period_s, WINDING_RATE_MARGIN * r_over_l);
 
     gains->current_gain_per_s = current_bandwidth - r_over_l;
     gains->current_integral_gain_per_s2 = CURRENT_INTEGRAL_PER_BANDWIDTH_SQUARED * current_bandwidth * current_bandwidth;
     /* The q axis's slow pole K_I,q / K a fifth of the speed loop's k_w: at K^2/8 it sat on k_w (a
-     * limit cycle on the AS1050) or, at this K, upset the position loop's moves (DESIGN.md section 2). */
+     * limit cycle on the AS1050) or, at this K, upset the position loop's moves (docs/design/02-current-and-speed-loops.md). */
     gains->current_integral_gain_q_per_s2 = current_bandwidth * speed_gain / Q_INTEGRAL_SPEED_DIVISOR;
     gains->observer_gain_per_s = a_e - r_over_l;
     gains->adapt_lambda = lambda;
@@ -245,7 +302,7 @@ static void design_gains(const pmstep_design_input_t *in, pmstep_gains_config_t 
 
 /* Alignment voltages from condition (4) and the rated current; times from the swing's decay, and
  * s-alignment's lead-in where a detent torque can hold the rotor on (3)'s unstable equilibrium
- * (DESIGN.md, 4). Returns the steady-state window the robust mode uses (0 in paper mode). */
+ * (docs/design/04-alignment.md). Returns the steady-state window the robust mode uses (0 in paper mode). */
 static float design_alignment(const pmstep_design_input_t *in, pmstep_config_t *cfg, pmstep_design_report_t *report)
 {
     const pmstep_motor_config_t *m = &in->motor;
@@ -289,7 +346,7 @@ static float design_alignment(const pmstep_design_input_t *in, pmstep_config_t *
 
 /* i_d* of robust mode: I/8, or more where the flux integrals take the compensation's figure for
  * the dead time's loss (no phase-voltage sensing): MAGNETISING_PER_DEAD_TIME_CURRENT times the
- * current one period's dead-time volt-seconds move, 2 V_bus t_d / L, at most 0.35 I (DESIGN.md
+ * current one period's dead-time volt-seconds move, 2 V_bus t_d / L, at most 0.35 I (docs/design
  * section 8). The faster a light-load phase current passes zero, the fewer periods the integrals
  * take on the compensation's word for the sign of its loss. */
 static float magnetising_current(const pmstep_design_input_t *in)
@@ -305,7 +362,7 @@ static float magnetising_current(const pmstep_design_input_t *in)
 
 /* The low-speed drive's band: below the speed whose back EMF is LOW_SPEED_EMF_PER_DEAD_TIME_LOSS
  * times the dead time's loss, and whose detent frequency 4 p w is LOW_SPEED_DETENT_PER_HELD_NATURAL
- * of the vector's held natural frequency at rated current (DESIGN.md section 14). */
+ * of the vector's held natural frequency at rated current (docs/design/14-low-speed-drive.md). */
 static float low_speed_band(const pmstep_design_input_t *in)
 {
     const pmstep_motor_config_t *m = &in->motor;
@@ -354,7 +411,7 @@ static void design_commissioning(const pmstep_design_input_t *in, float window_s
     cfg->inverter.phase_voltage_sensing = in->phase_voltage_sensing; /* the drive's, not the design's */
     /* The ports' centred PWM has a ripple: no dead-time loss where it straddles zero. Without
      * phase-voltage sensing the flux integrals take the compensation's figure for the bridge's
-     * voltage, and that is where it counts (DESIGN.md section 8); a sensing drive integrates the
+     * voltage, and that is where it counts (docs/design/08-robust-mode.md); a sensing drive integrates the
      * sensed voltage, and its Monte Carlo gained nothing from it (181 / 194 / 200 / 200 with it,
      * 182 / 195 / 200 / 200 without). */
     cfg->inverter.ripple_dead_zone = robust && !in->phase_voltage_sensing;
@@ -365,7 +422,7 @@ static void design_commissioning(const pmstep_design_input_t *in, float window_s
     /* Below the speed whose back EMF is of the order of the dead time's loss the flux integrals'
      * phase is off by tenths of a radian: there the hold's vector can turn at the reference speed
      * in place of the law (at every speed in the band where asked for: a load step while it turns
-     * is not learnt, DESIGN.md section 14). A drive that senses its phase voltages integrates the
+     * is not learnt, docs/design/14-low-speed-drive.md). A drive that senses its phase voltages integrates the
      * bridge's own. */
     cfg->standstill.vector_speed_rad_s = (robust && !in->phase_voltage_sensing) ? low_speed_band(in) : 0.0f;
     /* Not asked for, the vector takes the stops only: there the law's rotor comes to rest with a
@@ -388,7 +445,7 @@ static void design_protection(const pmstep_design_input_t *in, pmstep_config_t *
     /* Plus the dead time's floor: in a period in which a current crosses zero the observer's
      * prediction (the compensated voltage) can be off by twice the loss 2 V_bus t_d / T (the
      * sign taken the wrong way), which moves that period's current by 4 V_bus t_d / L
-     * (DESIGN.md section 5). */
+     * (docs/design/05-protections-and-detection.md). */
     cfg->detection.observer_residual_bound_A = RESIDUAL_PER_RATED_CURRENT * in->motor.rated_current_A
                                                + 4.0f * in->bus_voltage_V * cfg->inverter.dead_time_s
                                                      / in->motor.inductance_H;
@@ -396,14 +453,29 @@ static void design_protection(const pmstep_design_input_t *in, pmstep_config_t *
     cfg->detection.max_realignments = 0u;
 }
 
-pmstep_status_t pmstep_design(const pmstep_design_input_t *in, pmstep_config_t *cfg, pmstep_design_report_t *report)
+pmstep_status_t pmstep_design(const pmstep_design_input_t *given, pmstep_config_t *cfg, pmstep_design_report_t *report)
 {
     pmstep_status_t status;
     float window_s;
-    if (in == NULL || cfg == NULL || report == NULL) {
+    pmstep_design_input_t estimated;
+    const pmstep_design_input_t *in = given;
+    if (given == NULL || cfg == NULL || report == NULL) {
         return PMSTEP_ERR_NULL_ARGUMENT;
     }
-    status = check_input(in);
+    report->inertia_estimated = false;
+    if (given->motor.inertia_kgm2 == 0.0f && given->holding_torque_Nm > 0.0f) {
+        /* No inertia on the datasheet: the frame's, from the holding torque (to be identified in RUN). */
+        estimated = *given;
+        estimated.motor.inertia_kgm2 = inertia_estimate(given->holding_torque_Nm);
+        report->inertia_estimated = true;
+        in = &estimated;
+    }
+    report->inertia_kgm2 = in->motor.inertia_kgm2;
+    /* Data no stepper has first: a unit typed wrong shows there before it fails a rule below. */
+    status = (!finite_input(in) || in->accept_implausible) ? PMSTEP_OK : pmstep_design_check_datasheet(in);
+    if (status == PMSTEP_OK) {
+        status = check_input(in);
+    }
     if (status != PMSTEP_OK) {
         return status;
     }

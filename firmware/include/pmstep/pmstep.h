@@ -10,6 +10,23 @@
  * protection trip it latches a fault, commands zero voltage and bridge off.
  * One instance drives one motor; the instance's fields are not API.
  */
+/**
+ * @mainpage pmstep C API
+ *
+ * The public headers of the firmware, from their comments (docs/Doxyfile). Names carry their
+ * units (speed_rad_s, current_A, period_s); a function that returns a pmstep_status_t lists
+ * the codes it can return.
+ * - pmstep.h: the control core's lifecycle, commands and readings; pmstep_types.h: its
+ *   configuration, measurements, outputs, status, fault and mode codes;
+ * - pmstep_position.h: sensorless position control on top of the speed controller;
+ * - pmstep_design.h: the gain designer, every setting from a motor's data;
+ * - pmstep_console.h: the command and telemetry interface over a byte stream;
+ * - pmstep_hal.h: the contract between the core and a port.
+ *
+ * The other headers of pmstep/ are the core's stages (angle, observer, law, actuation,
+ * commissioning, detection, ...), public for the tests and for static allocation: their
+ * structures' fields are not API.
+ */
 #ifndef PMSTEP_H
 #define PMSTEP_H
 

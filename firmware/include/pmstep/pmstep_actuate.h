@@ -62,8 +62,12 @@ typedef struct {
 /**
  * Compensates, limits and checks the command in @p out (u_a_V, u_b_V on entry), sets
  * voltage_limited, and advances the delay line.
+ * @param[in,out] actuator   the delay line, advanced by one period on success
+ * @param[in] coeffs         from pmstep_actuate_coeffs_init()
  * @param[in] compensation   read only when coeffs->compensate
  * @param[in] bus_voltage_V  the bus measured this period (finite, > 0)
+ * @param[in,out] out        the command (u_a_V, u_b_V) on entry; the voltages to apply and
+ *                           voltage_limited on return
  * @retval true   @p out holds the finite command to apply, |u| <= bus on each phase
  * @retval false  the command is not finite; the voltages were not advanced (latch a fault; the
  *               compensation's line may have been, and is cleared before the bridge is on again)
@@ -80,7 +84,10 @@ bool pmstep_actuate(pmstep_actuator_t *actuator, const pmstep_actuate_coeffs_t *
  * ripple's extremes: the loss is sign(i) where the current keeps its sign through the ripple
  * (|i| > h) and 0 where the ripple straddles zero. h = V_bus d (1 - d) T_s / (4 L) at duty
  * d = |u| / V_bus: two pulses of d T_s / 2 at (V_bus - u) / L.
+ * @param coeffs  from pmstep_actuate_coeffs_init() (its T_s / (16 L) sets h)
  * @param band_A  the compensation's band (> 0); @param bus_voltage_V  > 0
+ * @param current_A  the phase's reference current i over the period
+ * @param sweep_A  how far the phase current moves about @p current_A over the period
  * @param u_V  the phase's command; 0 for a bridge without ripple (h = 0)
  * @return within [-band_A, band_A]
  */

@@ -72,6 +72,8 @@ void pmstep_angle_start(pmstep_angle_t *angle, float i_a_A, float i_b_A);
 
 /**
  * Integrates phi1, phi2 over the period that just ended.
+ * @param[in,out] angle      the flux integrals
+ * @param[in] coeffs         from pmstep_angle_coeffs_init()
  * @param[in] i_a_A, i_b_A   currents sampled at the end of the period
  * @param[in] u_a_V, u_b_V   voltages applied during the period
  */
@@ -85,6 +87,8 @@ void pmstep_angle_estimate(const pmstep_angle_t *angle, const pmstep_angle_coeff
 /**
  * Drift-free option: moves phi1, phi2 so the next estimate is pulled onto the unit
  * circle (see above). No effect with correction_gain = 0.
+ * @param[in,out] angle         the flux integrals
+ * @param[in] coeffs            from pmstep_angle_coeffs_init()
  * @param[in] cos_hat, sin_hat  the estimate of this period
  */
 void pmstep_angle_correct(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs, float cos_hat, float sin_hat);
@@ -92,6 +96,8 @@ void pmstep_angle_correct(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *co
 /**
  * Back-EMF option: turns the next estimate toward the back EMF's direction (see above). Call it
  * only with emf_turn_gain > 0.
+ * @param[in,out] angle         the flux integrals
+ * @param[in] coeffs            from pmstep_angle_coeffs_init()
  * @param[in] cos_hat, sin_hat  the estimate of this period
  * @param[in] i_d_residual_A    the observer's residual of this sample on cos_hat, sin_hat
  * @param[in] speed_hat_rad_s   the observer's speed
@@ -104,7 +110,7 @@ void pmstep_angle_follow_emf(pmstep_angle_t *angle, const pmstep_angle_coeffs_t 
  *  period on the 17HS4401 stopped by half its holding torque at 34.5 rad/s). The current
  *  samples' noise in the estimate, L p / k_M times theirs, is a few thousandths of a radian (0.0042
  *  rad rms on the 17HS4401 at 5 mA), so its largest readings pass unsmoothed as well; a wider
- *  gate smoothed those and lost the 17HS4401's envelope steps (DESIGN.md section 16). */
+ *  gate smoothed those and lost the 17HS4401's envelope steps (docs/design/16-angle-smoothing.md). */
 #define PMSTEP_ANGLE_SMOOTHING_GATE_RAD 0.02f
 
 /** The angle smoothing's state (gains.angle_smoothing): the previous period's estimate. */

@@ -152,6 +152,10 @@ void pmstep_commission_add_bridge_off(pmstep_commission_sums_t *sums, float i_a_
 
 /**
  * Sample @p sample (< c_align_end_step) of the alignment.
+ * @param[in,out] sums      the running sums the sample is added to
+ * @param[in] plan          when each measurement is taken
+ * @param[in] sample        the sample's index, in samples from the start of s-alignment
+ * @param[in] i_a_A, i_b_A  currents sampled at the end of the period (raw)
  * @param[in] u_a_V, u_b_V  voltage applied over the period that ends at this sample
  * @param[in] u_a_known     @p u_a_V is the voltage the bridge applied to phase a: sensed, or its
  *                          current not beyond the sign threshold negative (see k_M above)

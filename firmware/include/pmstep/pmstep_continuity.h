@@ -94,6 +94,8 @@ void pmstep_continuity_start(pmstep_continuity_t *state);
 /**
  * One alignment period: the driven phase's peak, then at the end of s-alignment phase b's check
  * and at the end of c-alignment phase a's.
+ * @param[in,out] peaks          the driven phases' peaks so far
+ * @param[in] cfg                the configuration: alignment voltages / R set the peak a connected winding reaches
  * @param[in] a_driven           phase a is the driven one (s-alignment's lead-in, c-alignment), else b
  * @param[in] i_a_A, i_b_A       this period's samples (offset-corrected)
  * @param[in] last_s_period      this is the last period of s-alignment

@@ -46,6 +46,9 @@ void pmstep_detect_start(pmstep_detector_t *detector);
 
 /**
  * One check (call every PMSTEP_DETECTION_DECIMATION periods in RUN).
+ * @param[in,out] detector  the detection state, updated by this check
+ * @param[in] coeffs  from pmstep_detect_coeffs_init()
+ * @param[in] cfg     the detection settings (thresholds; which conditions are checked)
  * @param[in] out     this period's output of the control stage: (c-hat, s-hat), w-hat, w*, i-hat
  * @param[in] sample  this period's currents as the observer sees them (offset-corrected)
  * @return the fault of a condition that has persisted (the last one checked if several),

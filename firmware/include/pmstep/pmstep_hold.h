@@ -13,9 +13,9 @@
  *   w_n = sqrt(p k_M I cos(delta) / J);
  * turning the vector back by g (w-hat - w-bar), g = 2 zeta p / w_n, adds the damping 2 zeta w_n
  * where w-hat follows the swing in phase (PMSTEP_HOLD_MIN_IN_PHASE_SHARE; g = 0 where it does
- * not: a rotor light enough that w_n passes the observer's bandwidth, DESIGN.md section 12).
+ * not: a rotor light enough that w_n passes the observer's bandwidth, docs/design/12-position-hold.md).
  * The standstill hold of speed mode keeps g whatever the phase: it engages with a step of the
- * vector's current, whose first swing g still shortens (DESIGN.md section 12).
+ * vector's current, whose first swing g still shortens (docs/design/12-position-hold.md).
  * w-bar is w-hat low-passed at w_n / PMSTEP_HOLD_BIAS_CORNER_RATIO: the speed estimate's bias
  * at rest, which would otherwise turn the vector off the rest for good (g times the bias).
  * The law's PI current loop (pmstep_law_voltages' at zero speed, written out in pmstep_hold.c)

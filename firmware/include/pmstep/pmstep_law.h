@@ -142,7 +142,7 @@ float pmstep_law_iq_ref_rate(const pmstep_law_coeffs_t *coeffs, const pmstep_law
  * (delay + 1/2)) and (u_d, u_q) shortened by 1 - x^2/6, x = p w-hat T_s/2. A voltage held in the
  * stator frame over a period, placed there, drives the currents at the samples as the continuous
  * law's (u_d, u_q) would times 1 + x^2/6 + O(x^3) (steady state of the sampled R-L circuit in the
- * rotor frame; firmware/design/DESIGN.md), so the step stays accurate at p w T_s ~ 0.3 rad.
+ * rotor frame; docs/design), so the step stays accurate at p w T_s ~ 0.3 rad.
  */
 void pmstep_law_voltages(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs,
                          float cos_hat, float sin_hat, float i_d_A, float i_q_A,

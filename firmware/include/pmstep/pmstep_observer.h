@@ -52,7 +52,16 @@ typedef struct {
     float mean_cos_w2;        /**< c2 = -(2/3) h^2, h = p T_s / 2 (per rad/s) */
     float mean_sin_w1;        /**< s1 = h */
     float mean_sin_w3;        /**< s3 = -h^3/3 */
+    float speed_bound_rad_s;  /**< |w-hat| beyond this is no motor's speed: PMSTEP_ESTIMATE_RANGE_FACTOR x the speed
+                                   whose back EMF is the highest bus, max_bus_voltage_V / k_M */
+    float load_bound_Nm;      /**< |T_L-hat| beyond this is no load the drive could be holding:
+                                   PMSTEP_ESTIMATE_RANGE_FACTOR x k_M x max_phase_current_A */
 } pmstep_observer_coeffs_t;
+
+/** How far beyond what the motor and the bus allow the speed and load estimates may go before the
+ *  core takes them for lost (PMSTEP_FAULT_ESTIMATE_RANGE): a loaded rotor can be driven past the
+ *  bus's speed, and an observer's transient overshoots, by less than this. */
+#define PMSTEP_ESTIMATE_RANGE_FACTOR 4.0f
 
 /** Signals the mechanical part of the observer needs at one sample. */
 typedef struct {
@@ -82,7 +91,7 @@ void pmstep_observer_start(pmstep_observer_t *obs, float i_a_A, float i_b_A);
  * |s-hat i~_a - c-hat i~_b| is beyond @p residual_bound_A, a load step the observer's bandwidth does not
  * follow, adds to @p rates the speed injection (@p boost - 1) times over and the load injection
  * (@p boost^2 - 1) times over, as if the observer's mechanical part ran @p boost times faster while
- * it lasts (DESIGN.md section 18). The observer's state, @p in and the residual are this period's,
+ * it lasts (docs/design/18-transient-observer-boost.md). The observer's state, @p in and the residual are this period's,
  * as pmstep_observer_mech_rates took them.
  */
 void pmstep_observer_boost_in_transient(const pmstep_observer_t *obs, const pmstep_observer_coeffs_t *coeffs,

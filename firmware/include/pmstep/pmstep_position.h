@@ -20,7 +20,7 @@
  * go to the speed law (6) as its reference and derivatives. With the speed loop tracking, the
  * position error obeys (s + k_w)(s^2 + k_theta s + k_I) = 0: the loop's poles are set by
  * k_theta and k_I alone, below the speed loop's k_w (validation: k_theta <= k_w/2,
- * k_I <= k_theta^2/4; the designer's rule k_theta = k_w/4, DESIGN.md). At standstill the
+ * k_I <= k_theta^2/4; the designer's rule k_theta = k_w/4, docs/design). At standstill the
  * law's T-hat_L carries the load; k_I takes out what is left of a speed-estimate bias.
  *
  * Vector hold (hold_current_A > 0): when a move's profile has ended, the rotor is held at the
@@ -29,8 +29,8 @@
  * ahead by the load angle of T_L-hat (read 2/k_theta after the profile ends, while the loop
  * still holds): no estimate drift moves it. Once the rotor has been at rest (|w-hat - w-bar|
  * within the quiet band, and the flux integrals' reading not turned by more than three bands'
- * turn in two updates running: w-hat lags the swing of a light rotor's hold; DESIGN.md section
- * 12; an update with one such turn is neither rest nor motion) for the
+ * turn in two updates running: w-hat lags the swing of a light rotor's hold;
+ * docs/design/12-position-hold.md; an update with one such turn is neither rest nor motion) for the
  * held rotor's settling time, the estimate is kept where it was
  * then, so it does not drift, and it follows the flux integrals while the rotor moves (a load
  * step). After POSITION_REAIM_PERIODS at rest more than 0.05 electrical rad from the target,
@@ -47,7 +47,7 @@
  * filter, whose held set-point is solved for so that the filter, run on by pmstep_step() every
  * period, ends the N periods at the w* of the next update (the profile is sampled one update
  * ahead, the feedback moved on by its derivatives): the law keeps a smooth reference whose
- * derivatives are its own, with no step at the updates (DESIGN.md section 11). Cost: the
+ * derivatives are its own, with no step at the updates (docs/design/11-position-loop.md). Cost: the
  * sample-and-hold of the error adds about (N/2) T_s of delay to the one period the loop already
  * acts after the speed law; at the loop's bandwidth k_theta the phase lag is
  * k_theta (N/2 + 1) T_s (paper's motor: 25 rad/s x 5 x 50 us = 6e-3 rad, 0.36 deg), and the
@@ -138,7 +138,7 @@ typedef struct {
 } pmstep_position_t;
 
 /**
- * The designer's rule (DESIGN.md, "Position loop"): k_theta = k_w/4, k_I = k_theta^2/8 (poles
+ * The designer's rule (docs/design/11-position-loop.md): k_theta = k_w/4, k_I = k_theta^2/8 (poles
  * of s^2 + k_theta s + k_I at 0.15 and 0.85 k_theta, both below the speed loop's k_w).
  * @retval PMSTEP_OK, PMSTEP_ERR_NULL_ARGUMENT
  */
@@ -199,6 +199,10 @@ pmstep_status_t pmstep_position_set_zero(pmstep_position_t *pos);
  * Moves to @p target_rad (mechanical, from the zero) by a jerk-limited profile from the present
  * reference (pmstep_motion_plan()); re-targets a move under way. From speed mode the profile
  * starts at theta-hat with the present w* and w*'.
+ * @param pos          the position layer
+ * @param target_rad   where to stop, mechanical rad from the zero
+ * @param v_max_rad_s  speed limit of the profile (> 0)
+ * @param a_max_rad_s2 acceleration limit of the profile (> 0)
  * @param j_max_rad_s3 jerk limit; 0 = a_max times the reference bandwidth varpi_0
  * @retval PMSTEP_OK                     position mode, moving
  * @retval PMSTEP_ERR_NULL_ARGUMENT      @p pos is NULL

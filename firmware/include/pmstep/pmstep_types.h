@@ -105,6 +105,11 @@ typedef enum {
                                                  the bandwidths the designer gives the current loop and the observer */
     PMSTEP_ERR_SENSE_RANGE_BELOW_RATED = -113, /**< the drive's current sensing cannot read the trip the motor
                                                  needs (1.25 x its rated current) */
+    PMSTEP_ERR_DATASHEET_TORQUE_CONSTANT = -114, /**< k_M outside [1/2, 2] x T_H / (sqrt(2) I): no stepper has it */
+    PMSTEP_ERR_DATASHEET_TIME_CONSTANT = -115, /**< L/R outside [0.1, 20] ms: no stepper has it */
+    PMSTEP_ERR_DATASHEET_INERTIA = -116,    /**< J outside [1/10, 10] x its estimate from the holding torque */
+    PMSTEP_ERR_DATASHEET_FLUX_RATIO = -117, /**< p L I / k_M outside [0.1, 10]: the winding's flux at rated current
+                                                 against the magnet's, which no stepper has */
     /* commissioning: identification of J and F at the start of RUN (pmstep_identify.h) */
     PMSTEP_ERR_IDENTIFICATION_WINDOW = -120, /**< identification window < 0 or longer than PMSTEP_MAX_DURATION_PERIODS */
     PMSTEP_ERR_IDENTIFICATION_SPEED = -121,  /**< identification's lowest speed < 0 */
@@ -177,7 +182,9 @@ typedef enum {
     PMSTEP_FAULT_OPEN_PHASE_B = 14,         /**< the same for phase b */
     PMSTEP_FAULT_CURRENT_STUCK_A = 15,      /**< phase a's reading does not move while its reference does: a
                                                  stuck current sensor or ADC (pmstep_continuity.h) */
-    PMSTEP_FAULT_CURRENT_STUCK_B = 16       /**< the same for phase b */
+    PMSTEP_FAULT_CURRENT_STUCK_B = 16,      /**< the same for phase b */
+    PMSTEP_FAULT_ESTIMATE_RANGE = 17        /**< the observer's speed or load estimate left the range the bus and
+                                                 the trip allow (pmstep_observer_coeffs_t): control is lost */
 } pmstep_fault_t;
 
 /** A sensed mean phase voltage above this many times the measured bus latches
@@ -236,7 +243,7 @@ typedef struct {
                                                Where its slow pole K_I,q / K meets the speed loop's k_w, a
                                                large dead time's residual can keep a limit cycle going; the
                                                designer puts it at k_w / 5 (K_I,q = K k_w / 5;
-                                               firmware/design/DESIGN.md section 2) */
+                                               docs/design/02-current-and-speed-loops.md) */
     float detent_fade_speed_rad_s; /**< the detent torque's compensation (law and observer) fades with the
                                         estimated speed as w_f^2 / (w_f^2 + w-hat^2); 0 = no fade */
     float emf_angle_gain_per_s; /**< K_theta: turns the flux integrals' estimate toward the back EMF's direction,

@@ -1,7 +1,7 @@
 /**
  * @file pmstep_design.h
  * @brief Gain designer: every setting of pmstep_config_t from a motor's data, by the rules
- *        derived in firmware/design/DESIGN.md (pole placement on the linearised error
+ *        derived in docs/design (pole placement on the linearised error
  *        dynamics, bandwidths as fractions of the control rate).
  *
  * Portable C99 like the core (no heap, no stdio, float32; sqrtf only), in a library of its
@@ -35,6 +35,11 @@ typedef struct {
                                                below 2 V_bus t_d / (T_s k_M) (standstill.vector_speed_rad_s) */
     float current_resolution_A;           /**< current measurement resolution (ADC step or noise, whichever is
                                                larger): the dead-time compensation's band (robust mode) */
+    float holding_torque_Nm;              /**< the datasheet's holding torque (both phases at rated current); 0 = not
+                                               given. With it, the data is checked for what no stepper has
+                                               (pmstep_design_check_datasheet()), and a rotor inertia of 0 is
+                                               estimated from it (PMSTEP_DESIGN_INERTIA_PER_TORQUE) */
+    bool accept_implausible;              /**< design for data the datasheet check refuses (the caller warns) */
 } pmstep_design_input_t;
 
 /** The design's figures, for people and for the SIL's validation. */
@@ -50,10 +55,30 @@ typedef struct {
     float condition_4_margin;        /**< left side of (4) over its right side (> 1 when (4) holds) */
     float magnetising_current_A;     /**< i_d* the robust mode should run with (0 in paper mode) */
     float rated_torque_Nm;           /**< k_M x rated current (torque of one phase at rated current) */
+    float inertia_kgm2;              /**< the rotor inertia designed for: the input's, or its estimate */
+    bool inertia_estimated;          /**< the input gave no inertia: estimated from the holding torque, to be
+                                          identified in RUN (commissioning.identification_*) */
 } pmstep_design_report_t;
 
+/** Rotor inertia of a stepper from its holding torque T_H, where the datasheet gives none:
+ *  J = PMSTEP_DESIGN_INERTIA_PER_TORQUE x (T_H / 1 N m)^1.5 kg m^2, a fit to NEMA 8-34 datasheets
+ *  (0.4 N m: 5e-6; 1.26 N m: 3e-5; 4.5 N m: 2e-4), within a factor of 2 of most. */
+#define PMSTEP_DESIGN_INERTIA_PER_TORQUE 2.1e-5f
+
 /**
- * Designs every setting of @p cfg for the motor and drive in @p in (see DESIGN.md); the
+ * Checks motor data for what no stepper has (only where the holding torque is given):
+ * @retval PMSTEP_OK
+ * @retval PMSTEP_ERR_DATASHEET_TORQUE_CONSTANT  k_M outside [1/2, 2] x T_H / (sqrt(2) I): the holding torque or the
+ *                                               rated current is off (N cm typed as N m, a per-phase figure)
+ * @retval PMSTEP_ERR_DATASHEET_TIME_CONSTANT    L/R outside [0.1, 20] ms
+ * @retval PMSTEP_ERR_DATASHEET_FLUX_RATIO       p L I / (T_H / (sqrt(2) I)) outside [0.1, 10]: the winding's flux at
+ *                                               rated current against the magnet's (0.5-3 in stepper datasheets)
+ * @retval PMSTEP_ERR_DATASHEET_INERTIA          J outside [1/10, 10] x the estimate from T_H
+ */
+pmstep_status_t pmstep_design_check_datasheet(const pmstep_design_input_t *in);
+
+/**
+ * Designs every setting of @p cfg for the motor and drive in @p in (see docs/design); the
  * result passes pmstep_validate_config().
  * @retval PMSTEP_OK
  * @retval PMSTEP_ERR_NULL_ARGUMENT        a pointer is NULL
@@ -68,6 +93,8 @@ typedef struct {
  * @retval PMSTEP_ERR_BUS_ABOVE_SENSE_RANGE    the bus sensing cannot read 1.1 x the bus likewise
  * @retval PMSTEP_ERR_RATE_TOO_SLOW        R/L or F/J too large for the control period
  * @retval PMSTEP_ERR_DEAD_TIME            dead time < 0 or 4 t_d >= T_s
+ * @retval PMSTEP_ERR_DATASHEET_TORQUE_CONSTANT ... PMSTEP_ERR_DATASHEET_FLUX_RATIO
+ *                                         pmstep_design_check_datasheet(), unless accept_implausible
  * @retval other                           the designed configuration fails pmstep_validate_config()
  */
 pmstep_status_t pmstep_design(const pmstep_design_input_t *in, pmstep_config_t *cfg,
