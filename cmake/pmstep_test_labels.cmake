@@ -12,7 +12,8 @@ function(pmstep_label_tests_here)
            OR test MATCHES "^sil_cli\\.scenario_"
            OR test MATCHES "^hal\\.stm32g4_image"
            OR test MATCHES "^console\\.host_tool$"
-           OR test MATCHES "^fuzz\\.(core|scenario)_run$"
+           OR test MATCHES "^fuzz\\.(core|scenario|console)_run$"
+           OR test MATCHES "^docs\\.quickstart$"
            OR test MATCHES "^eva\\.")
       set(speed slow)
     else()

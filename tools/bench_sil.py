@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Real-time factor of the SIL on the paper scenario (a benchmark that prints figures).
 
-Usage: tools/bench_sil.py [--runs N] [--sil build/host-release/sil/pmstep-sil]
+Usage: tools/bench_sil.py [--runs N] [--sil build/host-release/sil/pmstep-sil] [--report docs/reports/benchmarks.md]
 
 Runs the paper scenario (2.4 s, 20 kHz) without CSV output, N times per setting, and
 prints the median real-time factor (simulated s per wall s; also per CPU s, which a busy
@@ -10,9 +10,12 @@ time (the runner times every 16th period and scales).
 Settings: the default (exponential integrator, one step a period) with the averaged and
 the switching inverter, and the RK4 reference at 25 and 10 steps a period.
 Targets: >= 150x at the default, >= 60x with the switching inverter. Standard library only.
+--report FILE also writes the table as Markdown (command, commit, date, the machine and its load;
+tools/report.py).
 """
 import argparse
 import json
+import os
 import pathlib
 import statistics
 import subprocess
@@ -22,6 +25,7 @@ import tempfile
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tools"))
 from scenario_keys import KEYS  # noqa: E402  (the one place that names the scenario keys)
+import report  # noqa: E402
 
 # (label, --set overrides, target real-time factor or None)
 SETTINGS = [
@@ -40,10 +44,56 @@ def run_once(sil, overrides, out_dir):
     return json.loads((out_dir / "summary.json").read_text())
 
 
+def cpu_model():
+    """The processor's name from /proc/cpuinfo, or None."""
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return None
+
+
+def load_average():
+    try:
+        return os.getloadavg()[0]
+    except (OSError, AttributeError):
+        return None
+
+
+def report_text(rows, runs, machine, argv):
+    """benchmarks.md: @p rows as main() measures them (label, target, rtf, rtf_cpu, per_period_ns,
+    plant_ns, plant_share, firmware_ns, firmware_share, wall_s), @p runs per setting, @p machine
+    (cpu, cores, load_before, load_after)."""
+    def load(v):
+        return "-" if v is None else f"{v:.2f}"
+    lines = [report.header("SIL benchmark", "tools/bench_sil.py", argv),
+             f"The paper scenario (2.4 s simulated at 20 kHz) without CSV output, median of {runs} runs per "
+             f"setting, on {machine['cpu'] or 'an unnamed processor'} ({machine['cores']} cores, shared: load average "
+             f"{load(machine['load_before'])} before the runs, {load(machine['load_after'])} after).", "",
+             "| setting | real-time factor | target | per CPU s | ns per period | plant | firmware | wall |",
+             "|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        target = f"≥ {r['target']:.0f}x" + ("" if r["rtf"] >= r["target"] else " (**below**)") if r["target"] else "-"
+        lines.append(f"| {r['label']} | {r['rtf']:.1f}x | {target} | {r['rtf_cpu']:.1f}x | {r['per_period_ns']:.0f} | "
+                     f"{r['plant_ns']:.0f} ns ({100 * r['plant_share']:.0f} %) | "
+                     f"{r['firmware_ns']:.0f} ns ({100 * r['firmware_share']:.0f} %) | {r['wall_s']:.3f} s |")
+    lines += ["", "Real-time factor: simulated s per wall s of the run's loop (the target's measure); per CPU s: per "
+              "CPU second of the process over the same loop, which leaves out waiting for a core on a shared machine. "
+              "Plant: the inverter model and the integration of (1); firmware: the HAL read, `pmstep_step` and the "
+              "HAL apply (shares of the wall, every 16th period timed and scaled); the rest is the runner: "
+              "set-points, sample, metrics."]
+    return "\n".join(lines) + "\n"
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=7, help="runs per setting (median is reported)")
     parser.add_argument("--sil", default=str(ROOT / "build/host-release/sil/pmstep-sil"))
+    parser.add_argument("--report", metavar="FILE",
+                        help="also write the table as Markdown (docs/reports/benchmarks.md)")
     args = parser.parse_args()
     sil = pathlib.Path(args.sil)
     if not sil.exists():
@@ -56,6 +106,8 @@ def main():
     print(f"{'setting':<38} {'real-time':>10} {'target':>7} {'(CPU)':>8} {'ns/period':>10} {'plant':>14}"
           f" {'firmware':>14} {'wall':>8}")
     failed = []
+    rows = []
+    machine = {"cpu": cpu_model(), "cores": os.cpu_count(), "load_before": load_average()}
     with tempfile.TemporaryDirectory() as tmp:
         for label, overrides, target in SETTINGS:
             summaries = [run_once(sil, overrides, pathlib.Path(tmp)) for _ in range(args.runs)]
@@ -73,12 +125,18 @@ def main():
                   f" {firmware / steps * 1e9:5.0f} ns {100 * firmware / wall:3.0f}% {wall:7.3f}s")
             if target and rtf < target:
                 failed.append(f"{label}: {rtf:.1f}x < {target:.0f}x")
+            rows.append({"label": label, "target": target, "rtf": rtf, "rtf_cpu": rtf_cpu, "per_period_ns": per_period,
+                         "plant_ns": plant / steps * 1e9, "plant_share": plant / wall,
+                         "firmware_ns": firmware / steps * 1e9, "firmware_share": firmware / wall, "wall_s": wall})
+    machine["load_after"] = load_average()
     print("(real-time: simulated s per wall s of the run's loop, the target's measure; CPU: per CPU s of the process"
           " over the same loop, which leaves out waiting for a core on a shared machine. plant: the inverter model and"
           " the integration of (1); firmware: the HAL read, pmstep_step and the HAL apply; the rest is the runner:"
           " set-points, sample, metrics)")
     if failed:
         print("below target: " + "; ".join(failed))
+    if args.report:
+        print(f"bench_sil: wrote {report.write(args.report, report_text(rows, args.runs, machine, sys.argv))}")
 
 
 if __name__ == "__main__":

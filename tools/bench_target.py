@@ -30,9 +30,16 @@ Cycles at 170 MHz, two estimates:
 Footprint: the core library's text + rodata (arm-none-eabi-size), the instance
 sizeof(pmstep_t) printed by the image, the step's stack measured in the image (painted
 stack below the interrupt's SP), and a static bound from -fstack-usage and the call
-graph of the non-LTO library (arm-m4f preset).
+graph of the non-LTO library (arm-m4f preset); the STM32G431 image's flash (text + data)
+and RAM (data + bss) from arm-none-eabi-size on the stm32g431 preset's build.
+
+Report: --report FILE writes these figures as Markdown (command, commit, date; tools/report.py)
+into the section "step" of that page, each beside the budget ctest's pil.cost enforces
+(tests/pil/CMakeLists.txt) and the STM32G431 image's beside hal/stm32g4/check_image.cmake's;
+tools/bench_position_target.py --report writes the section "position" of the same page.
 
 usage: tools/bench_target.py [--no-build] [--branch-penalty P] [--no-pipelining] [--json FILE]
+                             [--report docs/reports/cost.md]
 """
 import argparse
 import collections
@@ -44,6 +51,9 @@ import struct
 import subprocess
 import sys
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import report  # noqa: E402  (the reports' header and sections)
 
 ROOT = Path(__file__).resolve().parent.parent
 PIL = ROOT / "build" / "qemu-pil"
@@ -58,6 +68,16 @@ CONTROL_HZ = 20e3
 IN_WORDS = 6    # SIL_RECORD_IN_WORDS
 OUT_WORDS = 19  # SIL_RECORD_OUT_WORDS
 OUT_MODE = 4    # SIL_RECORD_OUT_MODE
+IMAGE = ROOT / "build" / "stm32g431" / "hal" / "stm32g4" / "pmstep-stm32g431.elf"
+PIL_CMAKE = ROOT / "tests" / "pil" / "CMakeLists.txt"
+IMAGE_CHECK = ROOT / "hal" / "stm32g4" / "check_image.cmake"
+# The cost page (docs/reports/cost.md): this tool's section, then bench_position_target.py's.
+COST_TITLE = "Cost on the target (Cortex-M4F)"
+COST_SECTIONS = ("step", "position")
+COST_WHAT = ("What the control step costs on a Cortex-M4F (QEMU's mps2-an386, the images' flags: `-Os` with "
+             "link-time optimisation) and what the core and the STM32G431 image take, each figure beside the "
+             "budget ctest enforces (`pil.cost`, `pil.position_cost` in tests/pil/CMakeLists.txt; the image's "
+             "fit in hal/stm32g4/check_image.cmake).")
 
 
 def run(cmd, **kw):
@@ -66,7 +86,7 @@ def run(cmd, **kw):
 
 
 def build():
-    for preset in ("qemu-pil", "host-release", "arm-m4f"):
+    for preset in ("qemu-pil", "host-release", "arm-m4f", "stm32g431"):
         run(["cmake", "--preset", preset], cwd=ROOT, stdout=subprocess.DEVNULL)
         run(["cmake", "--build", "--preset", preset], cwd=ROOT, stdout=subprocess.DEVNULL)
 
@@ -264,13 +284,128 @@ def static_stack(root_function="pmstep_step"):
     return total, path, sorted(unknown)
 
 
+# ---- the budgets ctest enforces, read where they are set, and the report ----
+def budgets():
+    """{name: value} of the budgets ctest enforces: pil.cost's MAX_RUN, MAX_STACK, MAX_INSTANCE,
+    MAX_FLASH and pil.position_cost's --max-mean (tests/pil/CMakeLists.txt) as run, stack, instance,
+    flash and position; the STM32G431 image's flash and RAM limits (hal/stm32g4/check_image.cmake)
+    as image_flash and image_ram. A budget not found is None."""
+    out = dict.fromkeys(("run", "stack", "instance", "flash", "position", "image_flash", "image_ram"))
+    try:
+        text = PIL_CMAKE.read_text()
+        for key, value in re.findall(r"-DMAX_(RUN|STACK|INSTANCE|FLASH)=(\d+)", text):
+            out[key.lower()] = int(value)
+        m = re.search(r"bench_position_target\.py[^)]*--max-mean\s+([0-9.]+)", text)
+        if m:
+            out["position"] = float(m.group(1))
+    except OSError:
+        pass
+    try:
+        m = re.search(r"flash GREATER (\d+) OR ram GREATER (\d+)", IMAGE_CHECK.read_text())
+        if m:
+            out["image_flash"], out["image_ram"] = int(m.group(1)), int(m.group(2))
+    except OSError:
+        pass
+    return out
+
+
+def image_sizes(size_output):
+    """(text, data, bss) of the first file in arm-none-eabi-size's Berkeley output, or None."""
+    m = re.search(r"^\s*(\d+)\s+(\d+)\s+(\d+)\s+\d+\s+[0-9a-f]+\s+\S", size_output or "", re.M)
+    return tuple(int(v) for v in m.groups()) if m else None
+
+
+def budget_cell(budget, unit=" B"):
+    return "-" if budget is None else f"{budget}{unit}"
+
+
+def verdict(value, budget):
+    """'within' / 'OVER' of @p value against @p budget ('-' without a budget)."""
+    if budget is None or value is None:
+        return "-"
+    return "within" if value <= budget else "**OVER**"
+
+
+def report_section(r, budget, argv):
+    """The section "step" of the cost page from the figures @p r main() measured (the keys of its
+    --json, plus stack_measured_bytes, static_path, static_unknown, run_mix, image) and @p budget
+    (budgets())."""
+    lines = [report.section_header("Control step: `pmstep_step()` on the paper scenario", "tools/bench_target.py",
+                                   argv),
+             f"{r['qemu']}, arm-none-eabi-gcc {r['gcc']}, `-Os` with link-time optimisation; all {r['periods']} "
+             f"periods of the paper scenario recorded by the host SIL and replayed through the real `pmstep_step()` "
+             f"from the port's control interrupt; outputs "
+             f"{'**bit-identical** to' if r['bit_identical'] else '**DIFFERENT** from'} the host's.", "",
+             "Instructions per step: exact counts of a QEMU plugin (every instruction from the step's entry to its "
+             "return, callees included) and the SysTick estimate under `-icount shift=0` (what `pil.cost` checks). "
+             "Time and CPU load at 170 MHz and 20 kHz, at 1 cycle per instruction and in the Cortex-M4 timing model "
+             f"(ARM DDI 0439B cycle counts, {r['branch_penalty']} cycles per taken branch"
+             f"{', neighbouring loads and stores pipelined' if r['load_store_pipelining'] else ''}, no wait states).",
+             ""]
+    modes = [m for m in ("S_ALIGN", "C_ALIGN", "RUN") if m in r["modes"]]
+    lines += ["| | " + " | ".join(modes) + " |", "|---|" + "---|" * len(modes)]
+
+    def row(label, cell):
+        lines.append(f"| {label} | " + " | ".join(cell(r["modes"][m], m) for m in modes) + " |")
+    row("steps", lambda f, m: str(f["steps"]))
+    row("instructions, exact: min / mean / max",
+        lambda f, m: f"{f['instructions_min']} / {f['instructions_mean']:.1f} / {f['instructions_max']}")
+    row("instructions, SysTick mean" + (f" (budget of RUN: {budget['run']})" if budget["run"] is not None else ""),
+        lambda f, m: f"{f['systick_instructions_mean']:.1f}"
+        + (f" ({verdict(f['systick_instructions_mean'], budget['run'])})" if m == "RUN" else ""))
+    row("1 cycle/instruction: mean time, CPU at 20 kHz (worst step)",
+        lambda f, m: f"{f['instructions_mean'] / CPU_HZ * 1e6:.2f} µs, "
+                     f"{f['instructions_mean'] / CPU_HZ * CONTROL_HZ * 100:.1f} % "
+                     f"({f['instructions_max'] / CPU_HZ * 1e6:.2f} µs, "
+                     f"{f['instructions_max'] / CPU_HZ * CONTROL_HZ * 100:.1f} %)")
+    row("Cortex-M4 timing model: mean cycles, time, CPU at 20 kHz",
+        lambda f, m: f"{f['cycles_model_mean']:.0f}, {f['cycles_model_mean'] / CPU_HZ * 1e6:.2f} µs, "
+                     f"{f['cycles_model_mean'] / CPU_HZ * CONTROL_HZ * 100:.1f} %")
+    row("stack measured in the LTO image" + (f" (budget {budget['stack']} B)" if budget["stack"] is not None else ""),
+        lambda f, m: f"{f['stack_bytes_measured']} B ({verdict(f['stack_bytes_measured'], budget['stack'])})")
+    if r.get("run_mix"):
+        lines += ["", "RUN's instruction mix, per step: " + ", ".join(f"{k} {n:.1f}" for k, n in r["run_mix"]) + "."]
+    lines += ["", "| footprint | measured | budget | |", "|---|---|---|---|",
+              f"| core flash, text + rodata (`libpmstep_core.a`, `-Os`, arm-none-eabi-size --totals) | "
+              f"{r['core_flash_bytes']} B | {budget_cell(budget['flash'])} | "
+              f"{verdict(r['core_flash_bytes'], budget['flash'])} |",
+              f"| instance `sizeof(pmstep_t)` | {r['instance_bytes']} B | "
+              f"{budget_cell(budget['instance'])} | "
+              f"{verdict(r['instance_bytes'], budget['instance'])} |",
+              f"| configuration `sizeof(pmstep_config_t)` (const, may live in flash) | {r['config_bytes']} B | - | - |",
+              f"| stack of `pmstep_step()`, measured in the LTO image (deepest mode) | {r['stack_measured_bytes']} B | "
+              f"{budget_cell(budget['stack'])} | "
+              f"{verdict(r['stack_measured_bytes'], budget['stack'])} |",
+              f"| stack of `pmstep_step()`, static bound (`-fstack-usage` + call graph, non-LTO library) | "
+              f"{r['stack_static_bytes']} B | not checked | - |"]
+    image = r.get("image")
+    if image:
+        text, data, bss = image
+        lines += [f"| STM32G431 image flash, text + data (build/stm32g431, arm-none-eabi-size) | {text + data} B | "
+                  f"{budget_cell(budget['image_flash'])} | "
+                  f"{verdict(text + data, budget['image_flash'])} |",
+                  f"| STM32G431 image RAM, data + bss (the 2 KiB stack reserve apart) | {data + bss} B | "
+                  f"{budget_cell(budget['image_ram'])} | "
+                  f"{verdict(data + bss, budget['image_ram'])} |"]
+    else:
+        lines.append("| STM32G431 image | not built (`cmake --preset stm32g431 && cmake --build --preset "
+                     "stm32g431`) | | |")
+    lines += ["", f"Static bound's deepest path: {' → '.join(r['static_path'])}"
+              + (f"; not counted: {', '.join(r['static_unknown'])} (newlib leaf routines)" if r["static_unknown"]
+                 else "") + "."]
+    return "\n".join(lines) + "\n"
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--no-build", action="store_true", help="use the existing build/qemu-pil, host-release, arm-m4f")
+    ap.add_argument("--no-build", action="store_true", help="use the existing build/qemu-pil, host-release, arm-m4f, stm32g431")
     ap.add_argument("--branch-penalty", type=int, default=2, help="pipeline refill cycles per taken branch (1..3)")
     ap.add_argument("--no-pipelining", action="store_true",
                     help="charge every single load/store 2 cycles (no credit for neighbouring ones)")
     ap.add_argument("--json", help="also write the figures to this JSON file")
+    ap.add_argument("--report", metavar="FILE",
+                    help="also write the figures as Markdown into the section \"step\" of this page "
+                         "(docs/reports/cost.md)")
     ap.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
                     help="override a key of the paper scenario for the recorded run (pmstep-sil --set), e.g. "
                          "controller.commissioning.identification_time_s=1.8 to count RUN with identification")
@@ -329,8 +464,8 @@ def main():
     size = run(["arm-none-eabi-size", "--totals", PIL / "firmware" / "libpmstep_core.a"],
                stdout=subprocess.PIPE, text=True).stdout
     flash = int(re.search(r"^\s*(\d+)\s+(\d+)\s+(\d+)\s+\d+\s+[0-9a-f]+\s+\(TOTALS\)", size, re.M).group(1))
-    image_size = run(["arm-none-eabi-size", ROOT / "build" / "stm32g431" / "hal" / "stm32g4" / "pmstep-stm32g431.elf"],
-                     stdout=subprocess.PIPE, text=True, check=False).stdout
+    image_size = run(["arm-none-eabi-size", IMAGE], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True,
+                     check=False).stdout
     static_total, static_path, static_unknown = static_stack()
     gcc = run(["arm-none-eabi-gcc", "-dumpversion"], stdout=subprocess.PIPE, text=True).stdout.strip()
     qemu_version = run(["qemu-system-arm", "--version"], stdout=subprocess.PIPE, text=True).stdout.splitlines()[0]
@@ -376,13 +511,18 @@ def main():
     if image_size:
         print("  STM32G431 image (build/stm32g431):")
         print("    " + "\n    ".join(image_size.strip().splitlines()))
+    result = {"qemu": qemu_version, "gcc": gcc, "bit_identical": identical, "periods": len(counts),
+              "modes": figures, "core_flash_bytes": flash, "instance_bytes": instance,
+              "config_bytes": config_size, "stack_static_bytes": static_total,
+              "branch_penalty": args.branch_penalty, "load_store_pipelining": not args.no_pipelining}
     if args.json:
-        Path(args.json).write_text(json.dumps({
-            "qemu": qemu_version, "gcc": gcc, "bit_identical": identical, "periods": len(counts),
-            "modes": figures, "core_flash_bytes": flash, "instance_bytes": instance,
-            "config_bytes": config_size, "stack_static_bytes": static_total,
-            "branch_penalty": args.branch_penalty, "load_store_pipelining": not args.no_pipelining},
-            indent=2) + "\n")
+        Path(args.json).write_text(json.dumps(result, indent=2) + "\n")
+    if args.report:
+        result.update({"stack_measured_bytes": max(s for _, s in systick.values()), "static_path": static_path,
+                       "static_unknown": static_unknown, "image": image_sizes(image_size),
+                       "run_mix": [(k, n / len(per_mode["RUN"])) for k, n in top]})
+        print("bench_target: wrote %s" % report.write_section(
+            args.report, COST_TITLE, "step", report_section(result, budgets(), sys.argv), COST_WHAT, COST_SECTIONS))
     return 0 if identical else 1
 
 

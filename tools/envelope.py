@@ -17,7 +17,10 @@ then runs pmstep-sil:
   copper    per-phase RMS current at 50 % of the top speed without load, ours and microstepping
 
   tools/envelope.py --sil build/host-release/sil/pmstep-sil --tune build/host-release/sil/pmstep-tune \\
-      --out out/envelope
+      --out out/envelope [--report docs/reports/envelope.md]
+
+--report FILE also writes the table as Markdown (command, commit, date; tools/report.py) and the
+plot beside it (FILE with .png for .md), shown in the report.
 """
 import argparse
 import csv
@@ -25,6 +28,7 @@ import json
 import math
 import os
 import re
+import shutil
 import subprocess
 import sys
 
@@ -32,6 +36,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 from mc_preset import chain_sets, read_preset as read_preset_file  # noqa: E402
+import report  # noqa: E402
 
 PRESETS = ("paper", "17hs4401", "bj42d29", "as1050")
 ROBUST_CHAINS = ("realistic", "sensed")  # designed with --robust, behind mc_preset.py's chain
@@ -209,8 +214,14 @@ def envelope(args, name, chain):
         row["rms_current_%s_A" % ("microstep" if microstep else "ours")] = s.get("rms_phase_current_A")
     print("%-9s %-9s largest step at 0.5 top: ours %.3f, microstepping %.3f of T_H; rms current ours %.3f A, "
           "microstepping %.3f A" % (name, chain, row["pullout_ours_of_holding"], row["pullout_microstep_of_holding"],
-                                    row["rms_current_ours_A"] or -1, row["rms_current_microstep_A"] or -1), flush=True)
+                                    _or(row["rms_current_ours_A"], -1), _or(row["rms_current_microstep_A"], -1)),
+          flush=True)
     return row
+
+
+def _or(value, missing):
+    """@p value, or @p missing for None (a value of 0 is a value)."""
+    return missing if value is None else value
 
 
 def markdown(rows):
@@ -228,10 +239,35 @@ def markdown(rows):
             return "%.1f, %.0f%s" % (x["dip_rad_s"], x["recovery_ms"], positions)
         lines.append("| %s | %s | %.1f | %s, %.2f, %.4f | %s / %s | %.3f / %.3f | %.3f / %.3f |" % (
             r["preset"], r["chain"], r["top_speed_rad_s"], r["ramps_fault"], r["ramps_speed_error_pct_top"],
-            r["ramps_angle_error_rad"] or float("nan"), step("step_at_0.5"), step("step_at_0.05"),
-            r["pullout_ours_of_holding"], r["pullout_microstep_of_holding"], r["rms_current_ours_A"] or float("nan"),
-            r["rms_current_microstep_A"] or float("nan")))
+            _or(r["ramps_angle_error_rad"], math.nan), step("step_at_0.5"), step("step_at_0.05"),
+            r["pullout_ours_of_holding"], r["pullout_microstep_of_holding"], _or(r["rms_current_ours_A"], math.nan),
+            _or(r["rms_current_microstep_A"], math.nan)))
     return "\n".join(lines) + "\n"
+
+
+def report_text(rows, args, argv, plot_name=None):
+    """The report: what was measured (@p args' presets, chains, duration and --set), markdown(@p rows)
+    and, if @p plot_name, the plot beside it."""
+    what = ("Designer's gains (`pmstep-tune`, no per-motor tuning), 20 kHz, the plant's detent torque on; "
+            "\"realistic\" is sil/scenarios/robust.ini's chain (12-bit ADC over ±3 I, ±20 mA offsets, 5 mA noise, "
+            "one period of delay, 1 µs dead time, switching inverter) with the robust mode, \"sensed\" the same on a "
+            "drive that senses the phase voltages (tools/mc_preset.py). Ramps: %g s of RUN to ±80 %% and ±5 %% of "
+            "the top speed (at least that long: whole rounds of four), each level held %g s; tracking is the "
+            "largest |w-w*| in the holds from %g s after each "
+            "ramp. Steps: half the holding torque T_H stepped on at 50 %% and 5 %% of the top speed (dip and "
+            "recovery, back within 2 %% of the top speed, of the nominal step), and again at %d rotor positions "
+            "over one detent period. Pull-out: the largest step survived at 50 %% of the top speed without a fault "
+            "or a loss of synchronism (bisection, %d steps). Microstepping: the SIL's open-loop baseline at rated "
+            "current." % (args.duration, HOLD_S, SETTLE_S, STEP_POSITIONS, BISECTION_STEPS))
+    if args.set:
+        what += " Every run after the design with " + ", ".join("`--set %s`" % item for item in args.set) + "."
+    # markdown()'s header has |w-w*| unescaped, which splits its cell in a Markdown table: escaped here,
+    # out/.../envelope.md and the printed table left as they are.
+    lines = [report.header("Operating envelope against open-loop microstepping", "tools/envelope.py", argv, what),
+             markdown(rows).replace("max |w-w*|", "max \\|w-w*\\|", 1)]
+    if plot_name:
+        lines += ["![Largest load step survived and RMS phase current, ours and microstepping](%s)" % plot_name, ""]
+    return "\n".join(lines)
 
 
 def plot(rows, path):
@@ -241,7 +277,7 @@ def plot(rows, path):
         import matplotlib.pyplot as plt
     except ImportError:
         print("envelope: matplotlib not installed, no plot", file=sys.stderr)
-        return
+        return None
     labels = ["%s\n%s" % (r["preset"], r["chain"]) for r in rows]
     x = range(len(rows))
     fig, axes = plt.subplots(1, 2, figsize=(12, 4))
@@ -259,6 +295,7 @@ def plot(rows, path):
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     print("envelope: wrote %s" % path)
+    return path
 
 
 def main():
@@ -270,6 +307,8 @@ def main():
     ap.add_argument("--chains", default="ideal,realistic",
                     help="comma-separated: ideal, realistic, sensed (realistic with phase-voltage sensing)")
     ap.add_argument("--duration", type=float, default=20.0, help="RUN time of the ramps run (s)")
+    ap.add_argument("--report", metavar="FILE",
+                    help="also write the table as Markdown here (docs/reports/envelope.md), the plot beside it")
     ap.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
                     help="a pmstep-sil --set applied to every run after the design (e.g. one impairment "
                          "of the chain removed: --set inverter.dead_time_s=0 --set controller.inverter.dead_time_s=0)")
@@ -286,7 +325,17 @@ def main():
     table = markdown(rows)
     open(os.path.join(args.out, "envelope.md"), "w").write(table)
     print(table)
-    plot(rows, os.path.join(args.out, "envelope.png"))
+    png = os.path.join(args.out, "envelope.png")
+    plotted = plot(rows, png)
+    if args.report:
+        picture = None
+        if plotted:  # this run's, not one left in --out
+            picture = os.path.splitext(args.report)[0] + ".png"
+            os.makedirs(os.path.dirname(os.path.abspath(picture)), exist_ok=True)
+            if os.path.abspath(picture) != os.path.abspath(png):
+                shutil.copyfile(png, picture)
+        text = report_text(rows, args, sys.argv, os.path.basename(picture) if picture else None)
+        print("envelope: wrote %s" % report.write(args.report, text))
 
 
 if __name__ == "__main__":

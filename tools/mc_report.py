@@ -1,5 +1,7 @@
 """Monte Carlo campaigns, part 3: the report. Aggregate numbers, the --check verdict,
-report.md with its histograms, cases.csv (see monte_carlo.py for the whole tool)."""
+report.md with its histograms, cases.csv, and the campaign's section of a page of campaigns
+(--report FILE --report-section NAME: docs/reports/monte-carlo.md) (see monte_carlo.py for the
+whole tool)."""
 import csv
 import math
 import os
@@ -10,6 +12,7 @@ from mc_distributions import DURATION_KEY, KEY_PARAMETERS, SEED_KEY, SEED_STRIDE
     distribution_rows, format_value
 from mc_execution import rerun_command
 from mc_outcome import CLASSES, CLASS_TEXT
+import report
 
 WILSON_Z_95 = 1.959963984540054
 WORST_CASES = 10
@@ -319,6 +322,103 @@ def write_report(path, records, agg, args, scenario, version, plots, started_utc
     lines += ["", f"Every case also sets `{SEED_KEY}` to its case seed (the SIL's noise).", ""]
     with open(path, "w") as f:
         f.write("\n".join(lines))
+
+
+# ---- the campaign's section of a page of campaigns (--report FILE --report-section NAME) ----
+PAGE_TITLE = "Monte Carlo campaigns"
+PAGE_WHAT = ("One section per campaign of tools/monte_carlo.py (each with the command that reruns it): random "
+             "plants, sensors, inverters, buses, initial angles and loads drawn per case from its seed. A case is a "
+             "success with no fault, no non-finite value and, after settling, the speed and angle errors within the "
+             "bounds; *detected*: a fault latched (within the latency bound of a loss of control, or a false trip "
+             "without one); *silent*: a loss of control with no fault in time; *out of spec*: a bound exceeded "
+             "without a loss of control or a fault; *crashed*: pmstep-sil failed. The campaign's own report.md "
+             "(histograms, worst cases, distribution table) is in its --out folder.")
+REPORT_OPTIONS = ("--report", "--report-section")
+
+
+def campaign_command(argv, case=None):
+    """@p argv without the --report options (and, with @p case, that case's --case instead of
+    --cases): the command that reruns the campaign, or one case of it."""
+    out, skip = [], False
+    for i, a in enumerate(argv):
+        if skip:
+            skip = False
+            continue
+        name = a.split("=", 1)[0]
+        if name in REPORT_OPTIONS or (case is not None and name == "--cases"):
+            skip = "=" not in a
+            continue
+        out.append(a)
+    return out + (["--case", str(case)] if case is not None else [])
+
+
+def campaign_section(name, records, agg, args, argv):
+    """The section @p name of the page of campaigns: the summary of the campaign (@p records, @p agg
+    as main() builds them, @p args its options) and the command @p argv that reruns it."""
+    n = agg["cases"]
+    counts = agg["counts"]
+    low, high = agg["success_rate_wilson95"]
+    preset = agg.get("preset")
+    subject = f"preset `{preset['preset']}`" if preset else f"`{report.command([args.scenario])}`"
+    lines = [report.section_header(f"{name}: {subject}, {n} cases, seed {args.seed}", "tools/monte_carlo.py",
+                                   campaign_command(argv))]
+    what = [f"Scenario `{report.command([args.scenario])}`"]
+    if preset:
+        what.append(f"designed for `{report.command([preset['preset_file']])}` "
+                    f"(top speed {preset['top_speed_rad_s']:g} rad/s, profile peak {preset['peak_speed_rad_s']:g} "
+                    f"rad/s, load step {preset['load_Nm']:.4g} N m)" if preset["designed"] else
+                    f"with the distributions of `{report.command([preset['preset_file']])}`")
+    bounds = (f"bounds: |w - w*| < {args.speed_bound:.4g} rad/s and angle error < {args.angle_bound:g} rad after "
+              f"settling, a fault within {args.latency_bound:g} s of a loss of control")
+    if getattr(args, "position_bound", None) is not None:
+        bounds += f", every move ending within {args.position_bound:g} electrical rad of its target"
+    what.append(bounds)
+    if args.duration is not None:
+        what.append(f"{args.duration:g} s per case")
+    if agg.get("pmstep_sil_version"):
+        what.append(f"pmstep-sil {agg['pmstep_sil_version']}")
+    ex = agg.get("execution") or {}
+    if ex.get("wall_s") is not None:
+        what.append(f"{ex.get('cases_run')} cases run ({ex.get('cases_resumed')} resumed) in {ex['wall_s']:.0f} s "
+                    f"({ex.get('engine')}, {ex.get('workers')} workers)")
+    lines += ["; ".join(what) + ".", ""]
+    rate = agg["success_rate"]
+    faults = ", ".join(f"{fault} {count}" for fault, count in agg["faults_by_name"].items()) or "none"
+    lat = agg["detection_latency_s"]
+    speed = agg["distributions"]["max_speed_error_rad_s"]
+    angle = agg["distributions"]["max_angle_error_rad"]
+    lines += ["| | |", "|---|---|",
+              f"| success | **{counts['success']} / {n}** = {fmt(100 * rate if rate is not None else None, '.1f')} % "
+              f"(Wilson 95 %: {100 * low:.1f}–{100 * high:.1f} %) |",
+              f"| silent failures | **{counts['silent']}** |",
+              f"| detected (of which false trips) | {counts['detected']} ({agg['false_trips']}) |",
+              f"| out of spec | {counts['out_of_spec']} |",
+              f"| crashed | {counts['crashed']} |",
+              f"| cases with a non-finite value | {agg['nonfinite_cases']} |",
+              f"| faults latched | {faults} |",
+              f"| detection latency, max / median | "
+              + (f"{lat['max'] * 1e3:.3g} / {lat['median'] * 1e3:.3g} ms |" if lat["n"]
+                 else "no detected loss of control |"),
+              f"| max \\|w - w*\\| after settling, p50 / p90 / p99 / max (rad/s) | {fmt(speed['p50'])} / "
+              f"{fmt(speed['p90'])} / {fmt(speed['p99'])} / {fmt(speed['max'])} |",
+              f"| max angle error after settling, p50 / p90 / p99 / max (rad) | {fmt(angle['p50'])} / "
+              f"{fmt(angle['p90'])} / {fmt(angle['p99'])} / {fmt(angle['max'])} |"]
+    by_segment = agg.get("failures_by_segment") or []
+    if by_segment:
+        classes = list(by_segment[0][1])
+        lines += ["", "Failures by the speed profile's segment at their failure time:", "",
+                  "| segment | " + " | ".join(classes) + " |", "|---|" + "---|" * len(classes)]
+        lines += ["| " + segment + " | " + " | ".join(str(row[cls]) for cls in classes) + " |"
+                  for segment, row in by_segment]
+    failed = [r for r in worst_order(records) if r["class"] != "success"]
+    if failed:
+        shown = failed[:WORST_CASES]
+        lines += ["", f"Failed cases ({len(failed)}" + (f", the {len(shown)} worst" if len(failed) > len(shown) else "")
+                  + "): " + ", ".join(f"{r['seed']} ({r['class']}" + (", false trip" if r["false_trip"] else "")
+                                      + ")" for r in shown) + ". Rerun one (with its CSV, for tools/plot_run.py): "
+                  f"`{report.command(campaign_command(argv, shown[0]['seed']))}`, another seed in place of "
+                  f"{shown[0]['seed']}."]
+    return "\n".join(lines) + "\n"
 
 
 # A position scenario's figures (electrical rad; none for a speed scenario).

@@ -75,6 +75,12 @@ and result.json (each run). Each failed case has a failure time (the loss of con
 trip's fault, the exceeded maximum's sample) and the speed profile's segment holding it
 (mc_segments.py); the report and summary.json count the failures by segment.
 
+--report FILE also writes the campaign's summary (success, silent failures, failure classes,
+faults, the command that reruns it; command, commit and date: tools/report.py) as the section
+--report-section NAME (default: the preset's name, or the scenario file's) of the page FILE,
+replacing that section if the page has it, so that one page (docs/reports/monte-carlo.md) holds
+one section per campaign, written by campaigns run in turn.
+
 --check exits with status 1 unless the success rate is >= --min-success (0.99), no case is
 silent, none crashed and none saw a non-finite value. The last line printed is always
 "N passed, N failed" (passed = success cases, failed = all others).
@@ -87,6 +93,7 @@ import argparse
 import datetime
 import json
 import os
+import re
 import shlex
 import sys
 import time
@@ -105,9 +112,10 @@ from mc_segments import (failures_by_segment, label_failures, profile_segments, 
                          speed_points)
 
 FAILURE_CLASSES = ("detected", "silent", "out_of_spec")  # the classes the segment table counts
-from mc_report import (CSV_METRICS, WORST_CASES, aggregate, check_verdict, make_plots,  # noqa: E402,F401
-                       percentile, spans_decades, wilson_interval, worst_order, write_cases_csv,
-                       write_report)
+from mc_report import (CSV_METRICS, PAGE_TITLE, PAGE_WHAT, WORST_CASES, aggregate,  # noqa: E402,F401
+                       campaign_section, check_verdict, make_plots, percentile, spans_decades, wilson_interval,
+                       worst_order, write_cases_csv, write_report)
+import report  # noqa: E402
 
 
 def parse_args(argv):
@@ -159,6 +167,12 @@ def parse_args(argv):
     parser.add_argument("--exclude", action="append", default=[], metavar="KEY",
                         help="leave this row of the distribution table out (the scenario's value stays); "
                              "repeatable, e.g. --exclude controller.inverter.dead_time_s for a firmware without compensation")
+    parser.add_argument("--report", default=None, metavar="FILE",
+                        help="also write the campaign's summary as a section of this Markdown page "
+                             "(docs/reports/monte-carlo.md), replacing the section of the same name")
+    parser.add_argument("--report-section", default=None, metavar="NAME",
+                        help="the section's name for --report (letters, digits, '.', '_', '-'; default: the "
+                             "preset's name, or the scenario file's without .ini)")
     parser.add_argument("--case-timeout", type=float, default=600.0, metavar="SECONDS",
                         help="wall time after which one run counts as crashed (default 600 s)")
     args = parser.parse_args(argv[1:])
@@ -186,6 +200,17 @@ def parse_args(argv):
         parser.error("--duration must be > 0")
     if not 0 <= args.min_success <= 1:
         parser.error("--min-success must be within [0, 1]")
+    if args.report_section is not None and args.report is None:
+        parser.error("--report-section is for --report")
+    if args.report is not None and args.report_section is None:
+        source = args.preset if args.preset is not None and args.scenario is None else args.scenario
+        args.report_section = re.sub(r"[^A-Za-z0-9._-]+", "-", os.path.splitext(os.path.basename(source))[0])
+        if args.preset is not None and args.scenario is None:
+            args.report_section += "".join(suffix for flag, suffix in ((args.phase_voltage_sensing, "-sensed"),
+                                                                       (args.low_speed_drive, "-low-speed-drive"))
+                                           if flag)
+    if args.report_section is not None and not re.fullmatch(r"[A-Za-z0-9._-]+", args.report_section):
+        parser.error("--report-section: letters, digits, '.', '_' and '-' only")
     args.argv = argv
     args.script = argv[0]
     return args
@@ -367,6 +392,10 @@ def main(argv):
               f"{secs('sil_loop_cpu_s_mean')} CPU; firmware {secs('sil_firmware_wall_s_mean')}, "
               f"plant {secs('sil_plant_wall_s_mean')}")
     print(f"report: {os.path.join(args.out, 'report.md')}")
+    if args.report:
+        page = report.write_section(args.report, PAGE_TITLE, args.report_section,
+                                    campaign_section(args.report_section, records, agg, args, args.argv), PAGE_WHAT)
+        print(f"report section {args.report_section}: {page}")
     status = 0
     if args.check:
         if reasons:

@@ -26,6 +26,8 @@ usage: tools/position_acceptance.py [--sil PATH] [--tune PATH] [--motors paper,1
                                     [--chains ideal,realistic] [--moves 50] [--seed 1]
                                     [--hold-s 60] [--out DIR] [--check] [--json FILE]
                                     [--write-scenarios] [--speed-fraction F] [--accel-fraction F]
+                                    [--report docs/reports/position-acceptance.md]
+--report FILE also writes the table as Markdown (command, commit, date; tools/report.py).
 """
 import argparse
 import configparser
@@ -40,6 +42,7 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 # the realistic chain (ADC span sized to the motor) and the speed-mode loss bound scaled to its top speed
 from mc_preset import chain_sets, loss_speed_error, paper_top_speed  # noqa: E402
+import report  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 MOTORS = ["paper", "17hs4401", "bj42d29", "as1050"]
@@ -113,6 +116,47 @@ def run_sil(sil, scenario, sets, out_dir):
     return proc.returncode, summary
 
 
+def _g(value, spec=".3g"):
+    return "-" if value is None or (isinstance(value, float) and math.isnan(value)) else format(value, spec)
+
+
+def report_text(results, args, argv):
+    """The report: the settings of @p args and one row per run of @p results (main()'s --json)."""
+    what = (f"Per motor preset: the `pmstep-tune` design, {args.moves} random moves (seed {args.seed}, targets uniform "
+            f"in ±10 revolutions of where RUN starts, v_max = {args.speed_fraction:g} of the design's top speed, "
+            f"a_max = {args.accel_fraction:g} of k_M I / J, jerk a_max ϖ0; each move given its profile's time plus "
+            f"{SETTLE_S:g} s). Ideal: the ideal measurement chain, the plant's detent torque on. Realistic: "
+            "`pmstep-tune --robust` behind the presets' realistic chain (tools/mc_preset.py: 12-bit ADC over ±3 rated "
+            "current, ±20 mA offsets, 5 mA noise, one period of delay, 1 µs dead time, switching inverter), the "
+            f"plant's R 20 % above the firmware's, the same moves, then {args.hold_s:g} s of hold under 30 % of "
+            "k_M I stepped on. Electrical rad (p × mechanical); \"estimate\" is the largest |p(θ̂ − θ)| over the "
+            "run, \"θ* − θ\" the largest true position error in position mode (moves and hold), drift in "
+            "electrical rad/s over the hold.")
+    lines = [report.header("Position control: acceptance", "tools/position_acceptance.py", argv, what),
+             "| motor | chain | moves (unfinished) | final error max / mean | overshoot | estimate | θ* − θ | "
+             "hold max, drift | simulated | fault | criteria |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in results:
+        pos = r["position"]
+        robust = r["chain"] == "realistic"
+        overshoot = pos.get("max_overshoot_fraction")
+        hold = (f"{_g(pos.get('hold_max_error_electrical_rad'))}, {_g(pos.get('hold_drift_electrical_rad_s'))} /s"
+                if robust else "-")
+        lines.append(f"| {r['motor']} | {r['chain']} | {pos.get('moves', 0)} ({pos.get('unfinished_moves', '-')}) | "
+                     f"{_g(pos.get('max_final_error_electrical_rad'))} / "
+                     f"{_g(pos.get('mean_final_error_electrical_rad'))} | "
+                     f"{_g(None if overshoot is None else 100.0 * overshoot, '.2f')} % | "
+                     f"{_g(pos.get('max_estimate_error_electrical_rad'))} | "
+                     f"{_g(pos.get('max_tracking_error_electrical_rad'))} | {hold} | {r['simulated_s']:.0f} s | "
+                     f"{'none' if r['fault'] == 'NONE' else r['fault']} | {'met' if r['pass'] else '**FAILED**'} |")
+    passed = sum(1 for r in results if r["pass"])
+    lines += ["", f"Criteria: ideal chain, final error < {FINAL_BOUND:g} electrical rad after every move and overshoot "
+              f"< {100 * OVERSHOOT_BOUND:g} % of the move; realistic chain, |θ* − θ| < {HOLD_BOUND:g} electrical rad "
+              "the whole time (moves and hold) and at the end of every move; every run without a fault, every move "
+              f"finished. **{passed} of {len(results)} runs meet them.**"]
+    return "\n".join(lines) + "\n"
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--sil", default=os.path.join(ROOT, "build", "host-release", "sil", "pmstep-sil"))
@@ -129,6 +173,8 @@ def main():
     ap.add_argument("--json", help="also write every run's figures to this file")
     ap.add_argument("--write-scenarios", action="store_true",
                     help="also write each run's whole scenario to OUT/<motor>_<chain>_run.ini")
+    ap.add_argument("--report", metavar="FILE",
+                    help="also write the table as Markdown (docs/reports/position-acceptance.md)")
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
     results = []
@@ -203,6 +249,8 @@ def main():
     if args.json:
         with open(args.json, "w") as f:
             json.dump(results, f, indent=1)
+    if args.report:
+        print(f"position_acceptance: wrote {report.write(args.report, report_text(results, args, sys.argv))}")
     return 1 if (failed and args.check) else 0
 
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""A campaign of tools/monte_carlo.py on a Dask cluster started as the README says, in a plain
+"""A campaign of tools/monte_carlo.py on a Dask cluster started as docs/guides/campaigns-on-dask.md says, in a plain
 environment: a `dask scheduler` process and a `dask worker ... --nthreads 1 --nworkers 2`
 process, started from a temporary folder with nothing but PATH, HOME and TMPDIR in their
 environment (no PYTHONPATH, nothing of the project on their path), then
@@ -43,7 +43,7 @@ def find_sil():
 
 
 def dask_command():
-    """The `dask` command of the Python running this (.venv/bin/dask), as the README runs it."""
+    """The `dask` command of the Python running this (.venv/bin/dask), as the guide runs it."""
     dask = os.path.join(os.path.dirname(sys.executable), "dask")
     return [dask] if os.access(dask, os.X_OK) else [sys.executable, "-m", "dask"]
 
@@ -184,7 +184,7 @@ class PlainCluster(unittest.TestCase):
         return stdout, results
 
     def test_campaign_with_the_binary_shipped(self):
-        """As the README: --ship-sil, the workers get pmstep-sil from the client."""
+        """As the guide: --ship-sil, the workers get pmstep-sil from the client."""
         self.run_campaign("shipped", "--ship-sil")
 
     def test_campaign_with_the_binary_at_its_path(self):

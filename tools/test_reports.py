@@ -1,0 +1,324 @@
+"""Tests of the report writers (python3 -m unittest test_reports): tools/report.py's header and
+sections, and each measuring tool's --report text on fixed figures (bench_target.py,
+bench_position_target.py, bench_sil.py, envelope.py, position_acceptance.py, monte_carlo.py with
+mc_report.py). Standard library only; nothing is measured or run."""
+import argparse
+import contextlib
+import datetime
+import io
+import os
+import re
+import tempfile
+import unittest
+
+import bench_position_target
+import bench_sil
+import bench_target
+import envelope
+import mc_report
+import monte_carlo
+import position_acceptance
+import report
+
+TODAY = datetime.date.today().isoformat()
+
+
+def cells(line):
+    """The cells of a Markdown table row (a '|' escaped as '\\|' is inside a cell)."""
+    return re.split(r"(?<!\\)\|", line.strip())[1:-1]
+
+
+class ReportCase(unittest.TestCase):
+    def assert_header(self, text, command):
+        """@p text names @p command (as run from the repository's root), the commit and today's date."""
+        self.assertIn(f"- command: `{command}`", text)
+        self.assertIn(f"- commit: `{report.commit()}`", text)
+        self.assertRegex(report.commit(), r"^([0-9a-f]{4,}\+?|unknown)$")
+        self.assertIn(f"- date: {TODAY}", text)
+
+    def assert_tables(self, text):
+        """Every Markdown table of @p text has as many cells in each row as in its header."""
+        width = None
+        tables = 0
+        for line in text.splitlines():
+            if line.startswith("|"):
+                if width is None:
+                    width, tables = len(cells(line)), tables + 1
+                self.assertEqual(len(cells(line)), width, line)
+            else:
+                width = None
+        self.assertGreater(tables, 0)
+
+
+class Header(ReportCase):
+    def test_command_commit_date(self):
+        sil = os.path.join(report.ROOT, "build", "host-release", "sil", "pmstep-sil")
+        text = report.header("T", "tools/x.py", ["tools/x.py", "--sil", sil, f"--out={report.ROOT}/out/x",
+                                                  "--note", "two words"], "What.")
+        self.assertTrue(text.startswith("# T\n"))
+        self.assert_header(text, "tools/x.py --sil build/host-release/sil/pmstep-sil --out=out/x --note 'two words'")
+        self.assertIn("What.", text)
+
+    def test_section_header(self):
+        text = report.section_header("S", "tools/y.py", ["tools/y.py", "--cases", "4"])
+        self.assertTrue(text.startswith("## S\n"))
+        self.assert_header(text, "tools/y.py --cases 4")
+
+
+class Sections(ReportCase):
+    def setUp(self):
+        self.dir = tempfile.TemporaryDirectory()
+        self.path = os.path.join(self.dir.name, "sub", "page.md")
+
+    def tearDown(self):
+        self.dir.cleanup()
+
+    def read(self):
+        with open(self.path, encoding="utf-8") as f:
+            return f.read()
+
+    def test_replaced_not_duplicated(self):
+        report.write_section(self.path, "Page", "a", "## A\n\nfirst a\n", "What.")
+        report.write_section(self.path, "Page", "b", "## B\n\nfirst b\n", "What.")
+        report.write_section(self.path, "Page", "a", "## A\n\nsecond a\n", "What.")
+        text = self.read()
+        self.assertEqual(text.count("<!-- section: a -->"), 1)
+        self.assertEqual(text.count("<!-- end of section: a -->"), 1)
+        self.assertEqual(text.count("# Page\n"), 1)
+        self.assertEqual(text.count("What."), 1)
+        self.assertNotIn("first a", text)
+        self.assertIn("second a", text)
+        self.assertIn("first b", text)
+        self.assertEqual([n for n, _ in report.sections(text)], ["a", "b"])  # a keeps its place
+
+    def test_order_and_hand_edits(self):
+        report.write_section(self.path, "Page", "position", "## P\n", order=("step", "position"))
+        with open(self.path, "a", encoding="utf-8") as f:
+            f.write("a line added by hand\n")
+        report.write_section(self.path, "Page", "step", "## S\n| a | b |\n|---|---|\n| 1 | 2 |",
+                             order=("step", "position"))
+        text = self.read()
+        self.assertEqual([n for n, _ in report.sections(text)], ["step", "position"])
+        self.assertNotIn("a line added by hand", text)
+        self.assertIn("| 1 | 2 |\n\n<!-- end of section: step -->", text)  # a blank line ends the table
+
+    def test_bad_name(self):
+        with self.assertRaises(ValueError):
+            report.write_section(self.path, "Page", "two words", "x")
+
+
+# ---- each tool's report on fixed figures ----
+COST = {"qemu": "QEMU emulator version 7.2", "gcc": "12.2.1", "bit_identical": True, "periods": 48000,
+        "modes": {m: {"steps": n, "instructions_min": lo, "instructions_mean": mean, "instructions_max": hi,
+                      "systick_instructions_mean": mean + 1.0, "cycles_model_mean": 2 * mean,
+                      "taken_branches_mean": 10.0, "stack_bytes_measured": stack}
+                  for m, n, lo, mean, hi, stack in (("S_ALIGN", 6000, 302, 306.0, 317, 208),
+                                                     ("C_ALIGN", 6000, 313, 314.0, 319, 208),
+                                                     ("RUN", 36000, 473, 563.1, 1070, 252))},
+        "core_flash_bytes": 18739, "instance_bytes": 812, "config_bytes": 232, "stack_static_bytes": 408,
+        "branch_penalty": 2, "load_store_pipelining": True, "stack_measured_bytes": 252,
+        "static_path": ["pmstep_step", "pmstep_commission_finish"], "static_unknown": ["memset"],
+        "image": (33884, 0, 2976), "run_mix": [("vldr", 128.5)]}
+BUDGETS = {"run": 600, "stack": 256, "instance": 816, "flash": 19456, "position": 615.0, "image_flash": 131072,
+           "image_ram": 30720}
+
+
+class Cost(ReportCase):
+    def test_step_section(self):
+        argv = ["tools/bench_target.py", "--report", "docs/reports/cost.md"]
+        text = bench_target.report_section(COST, BUDGETS, argv)
+        self.assert_header(text, "tools/bench_target.py --report docs/reports/cost.md")
+        self.assert_tables(text)
+        self.assertIn("| 473 / 563.1 / 1070 |", text)
+        self.assertIn("564.1 (within)", text)                       # SysTick mean of RUN against 600
+        self.assertIn("| 18739 B | 19456 B | within |", text)
+        self.assertIn("| 812 B | 816 B | within |", text)
+        self.assertIn("| 33884 B | 131072 B | within |", text)       # text + data
+        self.assertIn("| 2976 B | 30720 B | within |", text)         # data + bss
+        over = dict(COST, instance_bytes=820)
+        self.assertIn("| 820 B | 816 B | **OVER** |", bench_target.report_section(over, BUDGETS, argv))
+        self.assertIn("not built", bench_target.report_section(dict(COST, image=None), BUDGETS, argv))
+
+    def test_budgets_read_where_set(self):
+        budgets = bench_target.budgets()
+        for key in BUDGETS:
+            self.assertIsNotNone(budgets[key], key)
+            self.assertGreater(budgets[key], 0)
+
+    def test_image_sizes(self):
+        out = ("   text\t   data\t    bss\t    dec\t    hex\tfilename\n"
+               "  33884\t      4\t   2976\t  36864\t   9000\tbuild/x.elf\n")
+        self.assertEqual(bench_target.image_sizes(out), (33884, 4, 2976))
+        self.assertIsNone(bench_target.image_sizes(""))
+
+    def test_position_section_and_page(self):
+        figures = {"p": {"label": "RUN, position mode", "periods": 45999, "step": [456, 549.3, 770],
+                         "update": [32, 60.2, 537], "total": [488, 609.5, 1067]}}
+        argv = ["tools/bench_position_target.py", "--max-mean", "615"]
+        text = bench_position_target.report_section(figures, "pil-position: fault NONE", 615.0, 615.0, "3", argv)
+        self.assert_header(text, "tools/bench_position_target.py --max-mean 615")
+        self.assert_tables(text)
+        self.assertIn("| 488 / 609.5 / 1067 |", text)
+        self.assertIn("mean **609.5** instructions, budget 615 (ctest pil.position_cost): within.", text)
+        strict = bench_position_target.report_section(figures, "", 600.0, 615.0, "3", argv)
+        self.assertIn("within; over this run's --max-mean 600", strict)
+        with tempfile.TemporaryDirectory() as d:
+            page = os.path.join(d, "cost.md")
+            for name, body in (("position", text), ("step", bench_target.report_section(COST, BUDGETS, argv)),
+                               ("position", text)):
+                report.write_section(page, bench_target.COST_TITLE, name, body, bench_target.COST_WHAT,
+                                     bench_target.COST_SECTIONS)
+            with open(page) as f:
+                page_text = f.read()
+        self.assertEqual([n for n, _ in report.sections(page_text)], ["step", "position"])
+        self.assertEqual(page_text.count("## Control period with the position loop"), 1)
+
+
+class Benchmarks(ReportCase):
+    def test_table(self):
+        rows = [{"label": "default (exponential x1), averaged", "target": 150.0, "rtf": 343.0, "rtf_cpu": 342.9,
+                 "per_period_ns": 146.0, "plant_ns": 78.0, "plant_share": 0.53, "firmware_ns": 39.0,
+                 "firmware_share": 0.27, "wall_s": 0.007},
+                {"label": "default (exponential x1), switching", "target": 60.0, "rtf": 40.9, "rtf_cpu": 41.0,
+                 "per_period_ns": 1221.0, "plant_ns": 1022.0, "plant_share": 0.84, "firmware_ns": 160.0,
+                 "firmware_share": 0.13, "wall_s": 0.059},
+                {"label": "rk4 x25 (reference), averaged", "target": None, "rtf": 20.2, "rtf_cpu": 20.2,
+                 "per_period_ns": 2475.0, "plant_ns": 2413.0, "plant_share": 0.97, "firmware_ns": 39.0,
+                 "firmware_share": 0.02, "wall_s": 0.119}]
+        machine = {"cpu": "AMD EPYC", "cores": 2, "load_before": 1.0, "load_after": None}
+        text = bench_sil.report_text(rows, 9, machine, ["tools/bench_sil.py", "--runs", "9"])
+        self.assert_header(text, "tools/bench_sil.py --runs 9")
+        self.assert_tables(text)
+        self.assertIn("median of 9 runs", text)
+        self.assertIn("| 343.0x | ≥ 150x | 342.9x | 146 | 78 ns (53 %) | 39 ns (27 %) | 0.007 s |", text)
+        self.assertIn("≥ 60x (**below**)", text)
+        self.assertIn("load average 1.00 before the runs, - after", text)
+
+
+class Envelope(ReportCase):
+    ROW = {"preset": "17hs4401", "chain": "realistic", "top_speed_rad_s": 69.0, "ramps_fault": "NONE",
+           "ramps_speed_error_pct_top": 0.75, "ramps_angle_error_rad": 0.0,
+           "step_at_0.5": {"fault": "NONE", "lost_sync": False, "dip_rad_s": 25.8, "recovery_ms": 17.0,
+                           "survived_positions": 8},
+           "step_at_0.05": {"fault": "STALL", "lost_sync": True, "dip_rad_s": 1.0, "recovery_ms": 1.0,
+                            "survived_positions": 3},
+           "pullout_ours_of_holding": 0.984, "pullout_microstep_of_holding": 0.438, "rms_current_ours_A": 0.0,
+           "rms_current_microstep_A": None}
+
+    def test_table_and_plot(self):
+        args = argparse.Namespace(duration=20.0, set=["inverter.dead_time_s=0"])
+        argv = ["tools/envelope.py", "--out", "out/envelope", "--report", "docs/reports/envelope.md"]
+        text = envelope.report_text([self.ROW], args, argv, "envelope.png")
+        self.assert_header(text, "tools/envelope.py --out out/envelope --report docs/reports/envelope.md")
+        self.assert_tables(text)  # markdown()'s |w-w*| escaped in the report
+        self.assertIn("| 17hs4401 | realistic | 69.0 | NONE, 0.75, 0.0000 | 25.8, 17; 8/8 / STALL, sync lost; 3/8 | "
+                      "0.984 / 0.438 | 0.000 / nan |", text)  # 0 is a value, None is not
+        self.assertIn("![", text)
+        self.assertIn("](envelope.png)", text)
+        self.assertIn("`--set inverter.dead_time_s=0`", text)
+        self.assertNotIn("](", envelope.report_text([self.ROW], args, argv, None))
+        self.assertIn("max |w-w*|", envelope.markdown([self.ROW]))  # the tool's own table as it was
+
+
+class PositionAcceptance(ReportCase):
+    def test_table(self):
+        args = argparse.Namespace(moves=50, seed=1, speed_fraction=0.5, accel_fraction=0.25, hold_s=60.0)
+        pos = {"moves": 50, "unfinished_moves": 0, "max_final_error_electrical_rad": 0.0185,
+               "mean_final_error_electrical_rad": 0.0019, "max_overshoot_fraction": 0.0003,
+               "max_estimate_error_electrical_rad": 0.315, "max_tracking_error_electrical_rad": 0.342,
+               "hold_max_error_electrical_rad": 0.342, "hold_drift_electrical_rad_s": 6.8e-5}
+        results = [{"motor": "paper", "chain": "realistic", "fault": "NONE", "simulated_s": 700.4, "position": pos,
+                    "pass": True},
+                   {"motor": "paper", "chain": "ideal", "fault": "STALL", "simulated_s": 3.0,
+                    "position": {"moves": 3}, "pass": False}]
+        text = position_acceptance.report_text(results, args, ["tools/position_acceptance.py", "--seed", "1"])
+        self.assert_header(text, "tools/position_acceptance.py --seed 1")
+        self.assert_tables(text)
+        self.assertIn("| paper | realistic | 50 (0) | 0.0185 / 0.0019 | 0.03 % | 0.315 | 0.342 | 0.342, 6.8e-05 /s | "
+                      "700 s | none | met |", text)
+        self.assertIn("| paper | ideal | 3 (-) | - / - | - % | - | - | - | 3 s | STALL | **FAILED** |", text)
+        self.assertIn("**1 of 2 runs meet them.**", text)
+
+
+class MonteCarlo(ReportCase):
+    def campaign(self, argv):
+        args = monte_carlo.parse_args(argv)
+        args.speed_bound = 0.5 if args.speed_bound is None else args.speed_bound
+        records = [{"seed": 100000 + k, "class": cls, "false_trip": trip, "fault_name": fault, "reason": "",
+                    "latency_s": latency, "params": {}, "command": ["pmstep-sil"], "stderr_tail": "",
+                    "metrics": {"max_speed_error_rad_s": speed, "max_angle_error_rad": 0.01, "past_settle": True,
+                                "failure_segment": segment}}
+                   for k, (cls, trip, fault, latency, speed, segment) in enumerate((
+                       ("success", False, None, None, 0.1, None),
+                       ("success", False, None, None, 0.2, None),
+                       ("silent", False, None, None, 3.0, "ramp 1"),
+                       ("detected", True, "OVERCURRENT", None, 0.3, "hold 2"),
+                       ("detected", False, "STALL", 0.02, 2.5, "ramp 1")))]
+        agg = mc_report.aggregate(records, args)
+        agg["failures_by_segment"] = monte_carlo.failures_by_segment(records, monte_carlo.FAILURE_CLASSES,
+                                                                     [(0.0, 1.0, "ramp 1"), (1.0, 2.0, "hold 2")])
+        agg.update({"preset": None, "pmstep_sil_version": "pmstep-sil 1.0",
+                    "execution": {"engine": "threads", "workers": 2, "cases_run": 5, "cases_resumed": 0,
+                                  "wall_s": 3.2}})
+        return args, records, agg
+
+    def test_section(self):
+        argv = ["tools/monte_carlo.py", "--sil", "build/host-release/sil/pmstep-sil", "--scenario",
+                "sil/scenarios/robust.ini", "--cases", "5", "--seed", "1", "--out", "out/mc", "--report",
+                "docs/reports/monte-carlo.md", "--report-section", "robust"]
+        args, records, agg = self.campaign(argv)
+        self.assertEqual(args.report_section, "robust")
+        text = mc_report.campaign_section("robust", records, agg, args, argv)
+        rerun = ("tools/monte_carlo.py --sil build/host-release/sil/pmstep-sil --scenario sil/scenarios/robust.ini "
+                 "--cases 5 --seed 1 --out out/mc")
+        self.assert_header(text, rerun)  # the command without --report
+        self.assert_tables(text)
+        self.assertIn("| success | **2 / 5** = 40.0 % (Wilson 95 %:", text)
+        self.assertIn("| silent failures | **1** |", text)
+        self.assertIn("| detected (of which false trips) | 2 (1) |", text)
+        self.assertIn("| faults latched | OVERCURRENT 1, STALL 1 |", text)
+        self.assertIn("| ramp 1 | 1 | 1 | 0 |", text)
+        self.assertIn("100002 (silent)", text)
+        self.assertIn("100003 (detected, false trip)", text)
+        self.assertIn("--out out/mc --case 100002`", text)  # a failed case's rerun, --cases and --report left out
+        self.assertIn("3 s (threads, 2 workers)", text)
+
+    def test_page_of_campaigns(self):
+        argv = ["tools/monte_carlo.py", "--sil", "x", "--scenario", "sil/scenarios/robust.ini", "--out", "o"]
+        args, records, agg = self.campaign(argv)
+        with tempfile.TemporaryDirectory() as d:
+            page = os.path.join(d, "monte-carlo.md")
+            for name in ("paper", "robust", "paper"):
+                report.write_section(page, mc_report.PAGE_TITLE, name,
+                                     mc_report.campaign_section(name, records, agg, args, argv), mc_report.PAGE_WHAT)
+            with open(page) as f:
+                text = f.read()
+        self.assertEqual([n for n, _ in report.sections(text)], ["paper", "robust"])
+        self.assertEqual(text.count("## paper:"), 1)
+        self.assertEqual(text.count("# Monte Carlo campaigns"), 1)
+
+    def test_section_names(self):
+        base = ["tools/monte_carlo.py", "--sil", "x", "--out", "o", "--report", "r.md"]
+        self.assertEqual(monte_carlo.parse_args(base + ["--scenario", "sil/scenarios/robust.ini"]).report_section,
+                         "robust")
+        preset = base + ["--preset", "sil/scenarios/motors/17hs4401.ini"]
+        self.assertEqual(monte_carlo.parse_args(preset).report_section, "17hs4401")
+        self.assertEqual(monte_carlo.parse_args(preset + ["--phase-voltage-sensing"]).report_section,
+                         "17hs4401-sensed")
+        self.assertEqual(monte_carlo.parse_args(preset + ["--scenario", "out/p/as1050_realistic_run.ini"])
+                         .report_section, "as1050_realistic_run")
+        self.assertEqual(monte_carlo.parse_args(preset + ["--report-section", "mine"]).report_section, "mine")
+        self.assertIsNone(monte_carlo.parse_args(base[:5] + ["--scenario", "s.ini"]).report)
+        for bad in (base[:5] + ["--scenario", "s.ini", "--report-section", "x"],  # no --report
+                    preset + ["--report-section", "two words"]):
+            with self.assertRaises(SystemExit), contextlib.redirect_stderr(io.StringIO()):
+                monte_carlo.parse_args(bad)
+
+    def test_campaign_command(self):
+        argv = ["m.py", "--report=r.md", "--cases", "4", "--report-section", "s", "--seed", "1"]
+        self.assertEqual(mc_report.campaign_command(argv), ["m.py", "--cases", "4", "--seed", "1"])
+        self.assertEqual(mc_report.campaign_command(argv, 100003), ["m.py", "--seed", "1", "--case", "100003"])
+
+
+if __name__ == "__main__":
+    unittest.main()
