@@ -18,6 +18,10 @@
 #   mc-position          tools/monte_carlo.py --preset P --scenario (position-acceptance's P_realistic_run.ini)
 #                        --cases 200 --seed 1 --speed-bound 1000 --angle-bound 0.5 --position-bound 0.5,
 #                        P = 17hs4401, bj42d29, as1050          -> docs/reports/monte-carlo.md, "position-P"
+#   fault-injection      tools/fault_injection.py, every fault on paper, 17hs4401, bj42d29, as1050
+#                                                              -> docs/reports/fault-injection.md
+#   motor-sweep          tools/sweep_motors.py, the 500 motors of tools/motor_population.py (seed 2026),
+#                        paper and robust modes             -> docs/reports/motor-sweep.md (+ motor-sweep.png)
 #
 # The campaigns run on a thread pool of 2 (--engine threads --jobs 2; a case's result depends on its
 # seed alone, not on the engine). Outputs of the runs (tables, cases, plots) go to OUT (out/reports);
@@ -34,7 +38,8 @@
 set -uo pipefail
 cd "$(dirname "$0")/.."
 
-STEPS_ALL=(cost position-cost benchmarks envelope position-acceptance mc-presets mc-robust mc-position)
+STEPS_ALL=(cost position-cost benchmarks envelope position-acceptance mc-presets mc-robust mc-position fault-injection
+           motor-sweep)
 MC_PRESETS=(paper 17hs4401 bj42d29 as1050)
 MC_POSITION=(17hs4401 bj42d29 as1050)
 OUT=${OUT:-out/reports}
@@ -137,6 +142,14 @@ for step in "${STEPS[@]}"; do
         campaign "position-$p" "$OUT/mc_position_$p" --preset "sil/scenarios/motors/$p.ini" --scenario "$scenario" \
           --cases 200 --seed 1 --speed-bound 1000 --angle-bound 0.5 --position-bound 0.5
       done ;;
+    fault-injection)
+      need_sil
+      run fault-injection "$REPORTS/fault-injection.md" "$PYTHON" tools/fault_injection.py --sil "$SIL" --tune "$TUNE" \
+        --report "$REPORTS/fault-injection.md" ;;
+    motor-sweep)
+      need_sil
+      run motor-sweep "$REPORTS/motor-sweep.md" "$PYTHON" tools/sweep_motors.py --tune "$TUNE" --jobs 2 \
+        --report "$REPORTS/motor-sweep.md" --plot "$REPORTS/motor-sweep.png" ;;
   esac
 done
 
