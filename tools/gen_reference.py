@@ -130,6 +130,7 @@ FIELD_PHRASES = {
     "commissioning.use_identified_mechanics": ["identified J and F"],
     "inverter.dead_time_s": ["t_d"],
     "standstill.hold_current_A": ["hold current", "standstill hold"],
+    "commissioning.measure_only": ["measure_only"],
     "standstill.vector_speed_rad_s": ["low-speed drive"],
 }
 # Status codes that concern every setting (stated once at the top, not on each row).

@@ -281,6 +281,9 @@ static pmstep_status_t validate_commissioning(const pmstep_config_t *cfg)
     if (comm->use_identified_mechanics && !(comm->identification_time_s > 0.0f)) {
         return PMSTEP_ERR_MECHANICS_UNIDENTIFIED;
     }
+    if (comm->measure_only && !(comm->steady_state_window_s > 0.0f)) {
+        return PMSTEP_ERR_MEASURE_ONLY_WINDOW;
+    }
     return PMSTEP_OK;
 }
 

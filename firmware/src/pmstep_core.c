@@ -189,6 +189,11 @@ static pmstep_fault_t commission_stage(pmstep_t *inst, const pmstep_meas_t *meas
     }
     if (inst->mode == PMSTEP_MODE_RUN) {
         const pmstep_fault_t fault = finish_commissioning(inst, meas);
+        if ((fault == PMSTEP_FAULT_NONE) && inst->cfg->commissioning.measure_only) {
+            pmstep_clear_dynamic_state(inst); /* the commissioning results stay until the next start */
+            inst->mode = PMSTEP_MODE_IDLE;
+            return PMSTEP_FAULT_NONE;
+        }
         if (fault != PMSTEP_FAULT_ALIGNMENT_MOTION
             || inst->commissioning.alignment_repeats >= PMSTEP_ALIGNMENT_MAX_REPEATS) {
             return fault;
@@ -412,6 +417,10 @@ void pmstep_step(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out
     }
     if (fault == PMSTEP_FAULT_NONE) {
         fault = commission_stage(inst, meas);
+        if (inst->mode == PMSTEP_MODE_IDLE) { /* measure_only: the bridge off from t_c */
+            output_off(out, inst);
+            return;
+        }
     }
     if (fault == PMSTEP_FAULT_NONE) {
         fault = bridge_on_stages(inst, meas, out);

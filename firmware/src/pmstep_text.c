@@ -78,6 +78,7 @@ const char *pmstep_status_str(pmstep_status_t status)
     case PMSTEP_ERR_IDENTIFICATION_WINDOW: return "identification: 0 to 2^24 periods";
     case PMSTEP_ERR_IDENTIFICATION_SPEED: return "identification speed < 0";
     case PMSTEP_ERR_MECHANICS_UNIDENTIFIED: return "identified J, F used without a window";
+    case PMSTEP_ERR_MEASURE_ONLY_WINDOW: return "measure-only commissioning without a steady-state window";
     case PMSTEP_ERR_POSITION_GAIN: return "need 0 < k_theta <= k_w/2";
     case PMSTEP_ERR_POSITION_INTEGRAL_GAIN: return "need 0 <= k_I <= k_theta^2/4";
     case PMSTEP_ERR_HOLD_CURRENT: return "need 0 < hold current < max_phase_current_A and |T_L - T_detent| <= 0.9 k_M I";

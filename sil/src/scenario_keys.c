@@ -64,6 +64,7 @@ const key_t_ scenario_keys[] = {
     {"controller.commissioning.identification_time_s", KEY_FLOAT, OFF(controller.commissioning.identification_time_s), -BIG, 0, BIG, 0, "J and F identified over this long from t_c (s); the speed commands must accelerate in it; 0 = off"},
     {"controller.commissioning.identification_min_speed_rad_s", KEY_FLOAT, OFF(controller.commissioning.identification_min_speed_rad_s), -BIG, 0, BIG, 0, "identification uses only periods with |w*| at least this (rad/s)"},
     {"controller.commissioning.use_identified_mechanics", KEY_BOOL, OFF(controller.commissioning.use_identified_mechanics), 0, 0, 1, 0, "RUN uses the identified J and F from the window's end (true/false)"},
+    {"controller.commissioning.measure_only", KEY_BOOL, OFF(controller.commissioning.measure_only), 0, 0, 1, 0, "at t_c the bridge goes off and the motor IDLE, the measured R, L, k_M kept (true/false)"},
     {"controller.inverter.dead_time_s", KEY_FLOAT, OFF(controller.inverter.dead_time_s), -BIG, 0, BIG, 0, "dead time per half-bridge to compensate (s); 0 = none"},
     {"controller.inverter.dead_time_current_band_A", KEY_FLOAT, OFF(controller.inverter.dead_time_current_band_A), -BIG, 0, BIG, 0, "dead-time compensation linear within +/- this current (A)"},
     {"controller.inverter.phase_voltage_sensing", KEY_BOOL, OFF(controller.inverter.phase_voltage_sensing), 0, 0, 1, 0, "the drive senses each phase's mean voltage per period (sensors.phase_voltage_*): RUN's flux integrals and observer use it (true/false)"},

@@ -154,6 +154,11 @@ static void detection_time_below_four_periods_with_detectors_off(pmstep_config_t
 static void negative_identification_window(pmstep_config_t *c) { c->commissioning.identification_time_s = -0.1f; }
 static void negative_identification_speed(pmstep_config_t *c) { c->commissioning.identification_min_speed_rad_s = -1.0f; }
 static void identified_mechanics_without_window(pmstep_config_t *c) { c->commissioning.use_identified_mechanics = true; }
+static void measure_only_without_window(pmstep_config_t *c)
+{
+    c->commissioning.measure_only = true;
+    c->commissioning.steady_state_window_s = 0.0f;
+}
 
 static const struct {
     config_edit_t edit;
@@ -162,6 +167,7 @@ static const struct {
     {negative_identification_window, PMSTEP_ERR_IDENTIFICATION_WINDOW},
     {negative_identification_speed, PMSTEP_ERR_IDENTIFICATION_SPEED},
     {identified_mechanics_without_window, PMSTEP_ERR_MECHANICS_UNIDENTIFIED},
+    {measure_only_without_window, PMSTEP_ERR_MEASURE_ONLY_WINDOW},
     {bad_r, PMSTEP_ERR_RESISTANCE},
     {bad_l, PMSTEP_ERR_INDUCTANCE},
     {bad_j, PMSTEP_ERR_INERTIA},

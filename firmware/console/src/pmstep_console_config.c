@@ -80,6 +80,7 @@ static const pmstep_console_config_entry_t table[] = {
     F32(motor.rated_current_A),
     F32_RO(limits.current_sense_range_A),
     F32_RO(limits.bus_sense_range_V),
+    BOOL(commissioning.measure_only),
 };
 
 const pmstep_console_config_entry_t *pmstep_console_config_table(uint32_t *count)

@@ -57,7 +57,11 @@
 /* Robust mode's commissioning (docs/design/08-robust-mode.md; the windows: docs/design/04-alignment.md). */
 #define OFFSET_CALIBRATION_S 0.05f
 #define MIN_STEADY_STATE_WINDOW_S 0.01f
-#define STEADY_STATE_WINDOW_TIME_CONSTANTS 10.0f
+#define STEADY_STATE_WINDOW_TIME_CONSTANTS 10.0f /* the core's least (pmstep_validate_config()) */
+/* The lower level's step (the voltage bias) decays in the window's first half to the current
+ * resolution: e^-n of it, n time constants, between these (12: float32's resolution of the step). */
+#define SETTLING_MIN_TIME_CONSTANTS 5.0f
+#define SETTLING_MAX_TIME_CONSTANTS 12.0f
 #define INDUCTANCE_WINDOW_PER_TIME_CONSTANT 0.25f
 #define MIN_INDUCTANCE_WINDOW_PERIODS 4.0f
 #define VOLTAGE_BIAS_LEVEL 0.5f
@@ -326,7 +330,17 @@ static float design_alignment(const pmstep_design_input_t *in, pmstep_config_t *
     const float lead_in_s = m->detent_torque_Nm > 0.0f ? round_up_time(settle_s) : 0.0f;
 
     if (in->self_commissioning) {
-        window_s = round_up_time(max2(MIN_STEADY_STATE_WINDOW_S, STEADY_STATE_WINDOW_TIME_CONSTANTS * l_over_r));
+        /* Half a window settles the drop to the lower level, (1 - level) I, to the current resolution:
+         * n time constants with e^-n at or below resolution / step (counted without a logarithm). */
+        const float step_A = (1.0f - VOLTAGE_BIAS_LEVEL) * current_A;
+        float n = SETTLING_MIN_TIME_CONSTANTS;
+        float decay_left = 148.41316f; /* e^5 */
+        while (n < SETTLING_MAX_TIME_CONSTANTS && decay_left * in->current_resolution_A < step_A) {
+            n += 1.0f;
+            decay_left *= 2.7182818f;
+        }
+        window_s = round_up_time(max2(MIN_STEADY_STATE_WINDOW_S,
+                                      max2(STEADY_STATE_WINDOW_TIME_CONSTANTS, 2.0f * n) * l_over_r));
         align_s = max2(settle_s + 2.0f * window_s, 4.0f * window_s);
     }
     align_s = round_up_time(align_s);
@@ -405,6 +419,7 @@ static void design_commissioning(const pmstep_design_input_t *in, float window_s
     c->identification_time_s = 0.0f;
     c->identification_min_speed_rad_s = IDENTIFICATION_MIN_SPEED_OF_TOP * report->top_speed_rad_s;
     c->use_identified_mechanics = false;
+    c->measure_only = false;
     cfg->inverter.dead_time_s = robust ? in->dead_time_s : 0.0f;
     /* The band of the compensation, which the voltage bias uses too. */
     cfg->inverter.dead_time_current_band_A = robust ? max2(in->current_resolution_A, MIN_DEAD_TIME_BAND_A) : 0.0f;

@@ -142,6 +142,12 @@ static inline pmstep_mode_t pmstep_get_mode(const pmstep_t *inst)
     return inst->mode;
 }
 
+/** The fault latched (PMSTEP_FAULT_NONE unless in FAULT). */
+static inline pmstep_fault_t pmstep_get_fault(const pmstep_t *inst)
+{
+    return inst->fault;
+}
+
 /** Calibration and commissioning results so far (telemetry; see pmstep_commissioning_t). */
 static inline void pmstep_get_commissioning(const pmstep_t *inst, pmstep_commissioning_t *out)
 {

@@ -114,6 +114,7 @@ typedef enum {
     PMSTEP_ERR_IDENTIFICATION_WINDOW = -120, /**< identification window < 0 or longer than PMSTEP_MAX_DURATION_PERIODS */
     PMSTEP_ERR_IDENTIFICATION_SPEED = -121,  /**< identification's lowest speed < 0 */
     PMSTEP_ERR_MECHANICS_UNIDENTIFIED = -122, /**< identified J and F used without an identification window */
+    PMSTEP_ERR_MEASURE_ONLY_WINDOW = -123,  /**< measure_only without a steady-state window: it would measure nothing */
     /* position control (pmstep_position.h) */
     PMSTEP_ERR_POSITION_GAIN = -130,        /**< position gain k_theta <= 0, or above k_w/2 (the speed loop's) */
     PMSTEP_ERR_POSITION_INTEGRAL_GAIN = -131, /**< position integral gain k_I < 0, or above k_theta^2/4 (the loop's
@@ -306,6 +307,9 @@ typedef struct {
                                             and the low-speed transients do not average out below it); 0 = all */
     bool use_identified_mechanics;     /**< at the end of the window RUN uses the identified J and F (the observer's
                                             and the law's coefficients; kappa scaled by J/J-identified) */
+    bool measure_only;                 /**< at t_c, once the offsets, R, L and k_M are taken, the bridge goes off and
+                                            the motor IDLE instead of RUN, the results kept until the next start: a
+                                            drive measuring a motor it has no gains for yet (pmstep_calibrate.h) */
 } pmstep_commissioning_config_t;
 
 /** What the controller knows of its inverter: dead-time compensation. */
