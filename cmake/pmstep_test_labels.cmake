@@ -12,6 +12,7 @@ function(pmstep_label_tests_here)
            OR test MATCHES "^sil_cli\\.scenario_"
            OR test MATCHES "^hal\\.stm32g4_image"
            OR test MATCHES "^console\\.host_tool$"
+           OR test MATCHES "^console\\.qemu_store_e2e$"
            OR test MATCHES "^fuzz\\.(core|scenario|console)_run$"
            OR test MATCHES "^docs\\.quickstart$"
            OR test MATCHES "^eva\\.")

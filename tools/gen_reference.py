@@ -52,6 +52,8 @@ CONSOLE_H = "firmware/console/include/pmstep_console.h"
 CONSOLE_CONFIG_C = "firmware/console/src/pmstep_console_config.c"
 CONSOLE_REQUEST_C = "firmware/console/src/pmstep_console_request.c"
 CONSOLE_PY = "tools/pmstep_console.py"
+STORE_H = "firmware/console/include/pmstep_store.h"
+CALIBRATE_H = "firmware/design/include/pmstep/pmstep_calibrate.h"
 STM32G4_H = "hal/stm32g4/include/pmstep_hal_stm32g4.h"
 STM32G4_TEXT_C = "hal/stm32g4/src/stm32g4_convert.c"
 SCENARIO_KEYS_C = "sil/src/scenario_keys.c"
@@ -128,9 +130,9 @@ FIELD_PHRASES = {
     "commissioning.voltage_bias_level_fraction": ["voltage bias", "level drops"],
     "commissioning.identification_time_s": ["identification window"],
     "commissioning.use_identified_mechanics": ["identified J and F"],
+    "commissioning.measure_only": ["measure_only"],
     "inverter.dead_time_s": ["t_d"],
     "standstill.hold_current_A": ["hold current", "standstill hold"],
-    "commissioning.measure_only": ["measure_only"],
     "standstill.vector_speed_rad_s": ["low-speed drive"],
 }
 # Status codes that concern every setting (stated once at the top, not on each row).
@@ -1376,6 +1378,15 @@ def page_codes(ref: Reference) -> str:
     out += enum_table(ref.identification, ref.texts["pmstep_identification_t"], ref, "Text")
     out += ["", f"## Console error replies ({code('pmstep_console_error_t')})", ""]
     out += console_errors_section(ref)
+    out += ["", f"## Stored configuration status codes ({code('pmstep_store_status_t')})", "",
+            f"What a load, save, erase or a record written on the console came to ({code(STORE_H)}); an ACK of "
+            f"{code('CONFIG_APPLY')}, {code('CONFIG_SAVE')} or {code('CONFIG_ERASE')} carries one, and "
+            f"{code('CONFIG_STATUS')} the boot's.", ""]
+    out += enum_table(parse_enum(Source(ref.root, STORE_H), "pmstep_store_status_t"), None, ref, "")
+    out += ["", f"## Self-commissioning status codes ({code('pmstep_calibrate_status_t')})", "",
+            f"Why a calibration ({code(CALIBRATE_H)}) failed: {code('CALIBRATE_STATUS')}'s status; a design the designer "
+            "or the core refused gives its status code above instead.", ""]
+    out += enum_table(parse_enum(Source(ref.root, CALIBRATE_H), "pmstep_calibrate_status_t"), None, ref, "")
     if ref.stm32_status is not None:
         out += ["", f"## STM32G4 port status codes ({code('pmstep_stm32g4_status_t')})", "",
                 f"Returned by the port's set-up calls. Text: {code('pmstep_stm32g4_status_str()')}.", ""]

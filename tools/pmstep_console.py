@@ -23,6 +23,28 @@ Commands (one per run, or several in the interactive mode):
   plot FILE.csv                          plot a telemetry CSV afterwards
   interactive                            a prompt for all of the above
 
+The stored configuration (a drive whose HELLO says it has a store; motor stopped):
+  setup (--motor MOTOR.ini | --motor-db FILE --name NAME) [--robust] [--set SECTION.KEY=VALUE]...
+        [--bus-voltage V] [--tune PMSTEP_TUNE]
+                                         design gains for the motor with pmstep-tune for the board's
+                                         period, delay and sensing ranges, write them as a record,
+                                         apply, read back, compare, save
+  backup FILE.json                       the board's record: identity, format, ids, every value by
+                                         name, the measured values, the raw record (hex)
+  restore FILE.json [--save]             a backup's values by name onto the board's record: write,
+                                         apply, read back, compare (--save: and save)
+  save                                   the configuration in force to flash
+  erase                                  both flash slots erased, the board's defaults in force
+                                         (no motor configured)
+  defaults                               the board's defaults in force, the flash untouched
+  store                                  the store's state: configured, boot outcome, slot, sequence
+  calibrate --current RATED_A [--pole-pairs P] [--paper] [--detent-fraction D] [--timeout S] [--advance N]
+                                         the drive measures R, L, k_M, identifies J, F, designs its gains
+                                         and saves them (p 50 by default: a 1.8 deg stepper; detent 0.05 of
+                                         the holding torque, 0 for a motor without one); progress printed;
+                                         --advance N: a simulation image's N periods per poll
+pmstep-tune: --tune PATH, else $PMSTEP_TUNE, else build/host-release/sil/pmstep-tune of this tree.
+
 Needs pyserial (pinned in tools/requirements.txt); plots need matplotlib (same file).
 
 Every wait is bounded whatever the line does (noise, a flood of sync bytes, a stream of frames, a
@@ -31,8 +53,10 @@ fails. A failure ends a command with one line on stderr, "pmstep_console: error:
 status by its class (ConsoleError's subclasses; in the interactive mode the shell prints the error
 and goes on, except after a line failure, which ends it):
   0  done
-  1  the drive answered with an error frame, or the core refused (DeviceError)
-  2  usage (argparse)
+  1  refused: the drive answered with an error frame, or the core or the store refused (DeviceError);
+     a design, backup or read-back that does not fit the board (ConfigurationRefused)
+  2  usage: a bad argument (argparse), a missing pmstep-tune or file, a file that is no backup
+     (UsageError)
   3  no reply within the deadline (ReplyTimeout)
   4  a reply too short for its type (MalformedReply)
   5  the line failed or closed: pty closed, serial port unplugged, socket dropped, write stalled
@@ -41,12 +65,20 @@ and goes on, except after a line failure, which ends it):
 """
 import argparse
 import cmd
+import configparser
 import csv
+import importlib.util
+import json
 import math
+import os
 import shlex
 import struct
+import subprocess
 import sys
+import tempfile
 import time
+import zlib
+from pathlib import Path
 
 try:
     import termios  # a serial port's flush/in_waiting raise termios.error on a line gone away
@@ -54,26 +86,38 @@ try:
 except ImportError:  # Windows
     LINK_ERRORS = (OSError,)
 
+ROOT = Path(__file__).resolve().parent.parent  # the source tree this tool is part of
+
 SYNC = 0xA5
 MAX_PAYLOAD = 64
+PROTOCOL_VERSION = 2  # HELLO's layout this tool reads; a version 1 drive has no store
 
 HELLO, START, STOP, CLEAR_FAULT, SPEED_TARGET, ID_TARGET = 0x01, 0x02, 0x03, 0x04, 0x05, 0x06
 GET_STATUS, GET_CONFIG, SET_CONFIG, GET_COMMISSIONING, TELEMETRY, GET_COUNTERS = 0x07, 0x08, 0x09, 0x0A, 0x0B, 0x0C
 MOVE_TO, HOLD, GET_POSITION, SET_POSITION_ZERO = 0x0D, 0x0E, 0x0F, 0x10
+CONFIG_READ, CONFIG_WRITE, CONFIG_APPLY, CONFIG_SAVE = 0x11, 0x12, 0x13, 0x14
+CONFIG_ERASE, CONFIG_DEFAULTS, CONFIG_STATUS = 0x15, 0x16, 0x17
+CALIBRATE, CALIBRATE_STATUS = 0x18, 0x19
 SIM_ADVANCE, SIM_FINISH = 0x40, 0x41
 TELEMETRY_FRAME, ERROR_FRAME = 0x90, 0xFF
 REQUEST_NAMES = {HELLO: "HELLO", START: "START", STOP: "STOP", CLEAR_FAULT: "CLEAR_FAULT",
                  SPEED_TARGET: "SPEED_TARGET", ID_TARGET: "ID_TARGET", GET_STATUS: "STATUS",
                  GET_CONFIG: "CONFIG", SET_CONFIG: "SET_CONFIG", GET_COMMISSIONING: "COMMISSIONING",
                  TELEMETRY: "TELEMETRY", GET_COUNTERS: "COUNTERS", MOVE_TO: "MOVE_TO", HOLD: "HOLD",
-                 GET_POSITION: "POSITION", SET_POSITION_ZERO: "SET_POSITION_ZERO", SIM_ADVANCE: "SIM_ADVANCE",
-                 SIM_FINISH: "SIM_FINISH"}
+                 GET_POSITION: "POSITION", SET_POSITION_ZERO: "SET_POSITION_ZERO", CONFIG_READ: "CONFIG_READ",
+                 CONFIG_WRITE: "CONFIG_WRITE", CONFIG_APPLY: "CONFIG_APPLY", CONFIG_SAVE: "CONFIG_SAVE",
+                 CONFIG_ERASE: "CONFIG_ERASE", CONFIG_DEFAULTS: "CONFIG_DEFAULTS", CONFIG_STATUS: "CONFIG_STATUS",
+                 CALIBRATE: "CALIBRATE", CALIBRATE_STATUS: "CALIBRATE_STATUS",
+                 SIM_ADVANCE: "SIM_ADVANCE", SIM_FINISH: "SIM_FINISH"}
 
 MODES = {0: "IDLE", 1: "S_ALIGN", 2: "C_ALIGN", 3: "RUN", 4: "FAULT", 5: "OFFSET_CAL"}
 ERRORS = {1: "unknown command", 2: "bad length", 3: "bad value (NaN, Inf or out of range)",
           4: "unknown configuration value", 5: "read-only value", 6: "refused while the motor runs",
           7: "busy: the previous command has not reached the core yet", 8: "not supported by this image",
-          9: "no position control in this image (speed mode only)"}
+          9: "no position control in this image (speed mode only)", 10: "no motor configured",
+          11: "no stored configuration in this image", 12: "no self-commissioning (CALIBRATE) in this image"}
+ERR_NOT_CONFIGURED = 10
+HELLO_STORE, HELLO_CONFIGURED = 1, 2  # HELLO flags
 POSITION_FLAGS = {1: "tracked", 2: "position_mode", 4: "moving"}
 STATUS_FIELDS = ["speed_ref_rad_s", "speed_hat_rad_s", "load_hat_Nm", "cos_hat", "sin_hat", "i_a_A", "i_b_A",
                  "bus_voltage_V", "u_a_V", "u_b_V", "i_d_A", "i_q_A"]
@@ -84,6 +128,41 @@ COUNTER_FIELDS = ["rx_bytes", "rx_frames", "rx_garbage_bytes", "rx_bad_length", 
 COMMISSIONING_FIELDS = ["offset_a_A", "offset_b_A", "resistance_Ohm", "phase_a_current_scale", "inductance_H",
                         "torque_constant_Nm_A", "voltage_bias_a_V", "voltage_bias_b_V"]
 CONFIG_TYPES = {0: "f32", 1: "u32", 2: "i32", 3: "bool"}
+
+# The record of the stored configuration (firmware/console/include/pmstep_store.h): a header, the
+# configuration table's values (f32 each, in id order), what they were measured with, a CRC-32.
+RECORD_MAGIC = 0x5253504D  # "PMSR"
+RECORD_FORMAT = 1          # the record format this tool reads and writes
+RECORD_HEADER = struct.Struct("<IHHIIIHHII")  # magic, format, header bytes, board id, layout id,
+#                                                sequence, value count, measured count, record bytes, reserved
+MEASURED_FIELDS = ["flags", "offset_a_A", "offset_b_A", "resistance_Ohm", "inductance_H", "torque_constant_Nm_A",
+                   "inertia_kgm2", "friction_Nms_rad"]  # flags u32, then f32 each
+CONFIG_STATUS_BYTES = 23   # configured u8, boot, validation, last i16, slot i8, sequence u32, record bytes u16,
+#                            format u8, layout id u32, board id u32
+CONFIG_READ_MIN_BYTES = 4  # offset u16, total u16, then the bytes
+CALIBRATE_STATUS_BYTES = 28  # stage u8, status i16, fault u8, runs u8, identification u8, save status i16, 5 f32
+CALIBRATE_STAGES = {0: "idle", 1: "measuring", 2: "identifying", 3: "done", 4: "failed"}
+IDENTIFICATION = {0: "off", 1: "running", 2: "done", 3: "friction negative", 4: "poor excitation", 5: "implausible"}
+CALIBRATE_PAPER_MODE = 1  # CALIBRATE flags
+
+# pmstep_store_status_t (pmstep_store.h): C name, a short name, what it means. A test checks this
+# table against the header.
+STORE_CODES = {
+    0: ("PMSTEP_STORE_OK", "ok", "done"),
+    -140: ("PMSTEP_STORE_EMPTY", "empty", "no record in either slot: never saved, or erased"),
+    -141: ("PMSTEP_STORE_ERR_CRC", "bad CRC", "the record's CRC does not match its bytes"),
+    -142: ("PMSTEP_STORE_ERR_FORMAT", "another format", "a record of another firmware"),
+    -143: ("PMSTEP_STORE_ERR_LAYOUT", "another layout", "a record of another firmware's configuration table"),
+    -144: ("PMSTEP_STORE_ERR_BOARD", "another board",
+           "made for another board: its id or its read-only values (period, delay, sensing) differ"),
+    -145: ("PMSTEP_STORE_ERR_LENGTH", "bad length", "the record's length does not match its counts or the bytes"),
+    -146: ("PMSTEP_STORE_ERR_INVALID", "invalid", "a value the configuration cannot take, or one the core refuses"),
+    -147: ("PMSTEP_STORE_ERR_FLASH", "flash error", "the flash reported an error; the previous record stays in force"),
+    -148: ("PMSTEP_STORE_ERR_VERIFY", "verify failed", "the slot read back differs from what was programmed"),
+    -149: ("PMSTEP_STORE_ERR_BRIDGE_ON", "bridge on", "a flash write asked for while the bridge may switch"),
+    -150: ("PMSTEP_STORE_ERR_SLOT_SIZE", "slot too small", "the port's flash slots are smaller than a record"),
+    -151: ("PMSTEP_STORE_ERR_NULL", "no flash", "a NULL argument, or no flash given"),
+}
 
 
 def crc16(data, crc=0xFFFF):
@@ -150,8 +229,26 @@ class ConsoleError(Exception):
 
 
 class DeviceError(ConsoleError):
-    """The drive answered with an error frame, or the core refused a command."""
+    """The drive answered with an error frame (code: its error code, request: the request's type), or
+    the core or the store refused a command (status: the ACK's status)."""
     exit_code = 1
+
+    def __init__(self, message, code=None, request=None, status=None):
+        super().__init__(message)
+        self.code = code
+        self.request = request
+        self.status = status
+
+
+class ConfigurationRefused(DeviceError):
+    """The tool refuses a design or a backup that does not fit the board, or a record read back that
+    differs from the one written."""
+    exit_code = 1
+
+
+class UsageError(ConsoleError):
+    """A bad argument: a missing pmstep-tune or file, a file that is no backup, conflicting options."""
+    exit_code = 2
 
 
 class ReplyTimeout(ConsoleError, TimeoutError):
@@ -178,7 +275,8 @@ class PortOpenError(LinkError):
 # Reply DATA lengths (pmstep_console.h): fixed layouts, or the fixed part before a text. A longer
 # reply is accepted (fields a later firmware may append); a shorter one is a MalformedReply.
 ACK_BYTES = 6            # status i16, period u32
-HELLO_MIN_BYTES = 2      # protocol u8, max payload u8, text
+HELLO_MIN_BYTES = 2      # protocol u8, max payload u8, text (protocol 1)
+HELLO_V2_MIN_BYTES = 4   # protocol u8, max payload u8, record format u8, flags u8, text (protocol 2)
 STATUS_BYTES = 60        # period u32, mode, fault, port fault, flags u8, fault step u32, 12 f32
 CONFIG_MIN_BYTES = 7     # id, type, flags u8, value f32, name
 COMMISSIONING_BYTES = 41  # measured u8, offset samples u32, realignments u32, 8 f32
@@ -275,19 +373,23 @@ class Console:
         except LINK_ERRORS as e:
             raise self._line_error("reading", e) from e
 
-    def pump(self, wait=0.0):
+    def pump(self, wait=0.0, until_frame=False):
         """Reads what arrives for @p wait s (at least one read), dispatches telemetry and keeps the
-        other frames in self.pending. Returns at the deadline (plus at most one read) whatever the
-        line does: noise, sync bytes or frames that keep coming do not hold it. Raises LinkError."""
+        other frames in self.pending; @p until_frame: returns as soon as one is kept (a reply's wait
+        ends when it comes, not a read's timeout later). Returns at the deadline (plus at most one
+        read) whatever the line does: noise, sync bytes or frames that keep coming do not hold it.
+        Raises LinkError."""
         deadline = time.monotonic() + wait
         while True:
             data = self._read()
+            kept_one = False
             if data:
                 for frame in self.decoder.feed(data):
                     kept = self._dispatch(frame)
                     if kept is not None:
                         self.pending.append(kept)
-            if time.monotonic() >= deadline:
+                        kept_one = True
+            if time.monotonic() >= deadline or (until_frame and kept_one):
                 return
 
     def send(self, ftype, data=b""):
@@ -312,7 +414,8 @@ class Console:
                 del self.pending[i]
                 if rtype == ERROR_FRAME:
                     code = rdata[1] if len(rdata) > 1 else 0
-                    raise DeviceError(f"request 0x{ftype:02x}: {ERRORS.get(code, f'error {code}')}")
+                    raise DeviceError(f"request 0x{ftype:02x}: {ERRORS.get(code, f'error {code}')}", code=code,
+                                      request=ftype)
                 return rdata
         return None
 
@@ -330,24 +433,35 @@ class Console:
             if now > deadline:
                 raise ReplyTimeout(f"no reply to request 0x{ftype:02x} (seq {seq}) within {timeout_s:g} s")
             try:
-                self.pump(min(0.01, deadline - now))
+                self.pump(min(0.01, deadline - now), until_frame=True)
             except LinkError:
                 rdata = self._take_reply(ftype, seq)  # it came with the line's last bytes
                 if rdata is not None:
                     return rdata
                 raise
 
-    def _ack(self, ftype, data=b"", timeout=None):
+    def _ack_status(self, ftype, data=b"", timeout=None):
+        """(status, period) of an ACK, whatever the status."""
         rdata = check_reply(ftype, self.request(ftype, data, timeout), ACK_BYTES)
-        status, period = struct.unpack_from("<hI", rdata)
+        return struct.unpack_from("<hI", rdata)
+
+    def _ack(self, ftype, data=b"", timeout=None):
+        status, period = self._ack_status(ftype, data, timeout)
         if status != 0:
-            raise DeviceError(f"the core refused request 0x{ftype:02x}: status {status}")
+            raise DeviceError(f"the core refused request 0x{ftype:02x}: {describe_code(status)}", status=status,
+                              request=ftype)
         return period
 
     # ---- commands ----
     def hello(self):
+        """Protocol version, largest payload, identity text; from protocol 2 also the record format
+        (0: no store), whether a store is attached and whether a motor is configured."""
         d = check_reply(HELLO, self.request(HELLO), HELLO_MIN_BYTES, text=True)
-        return {"protocol": d[0], "max_payload": d[1], "identity": d[2:].decode("ascii", "replace")}
+        if d[0] < 2:
+            return {"protocol": d[0], "max_payload": d[1], "identity": d[2:].decode("ascii", "replace")}
+        d = check_reply(HELLO, d, HELLO_V2_MIN_BYTES, text=True)
+        return {"protocol": d[0], "max_payload": d[1], "record_format": d[2], "store": bool(d[3] & HELLO_STORE),
+                "configured": bool(d[3] & HELLO_CONFIGURED), "identity": d[4:].decode("ascii", "replace")}
 
     def start(self):
         return self._ack(START)
@@ -438,11 +552,654 @@ class Console:
         p.update({name: bool(flags & bit) for bit, name in POSITION_FLAGS.items()})
         return p
 
+    # ---- the stored configuration ----
+    def config_read(self, offset):
+        """(offset, total, bytes) of the record of the configuration in force from @p offset
+        (offset 0 encodes it anew)."""
+        d = check_reply(CONFIG_READ, self.request(CONFIG_READ, struct.pack("<H", offset)), CONFIG_READ_MIN_BYTES)
+        off, total = struct.unpack_from("<HH", d)
+        return off, total, bytes(d[4:])
+
+    def read_record(self):
+        """The whole record of the configuration in force (CONFIG_READ from 0 to its end)."""
+        data = bytearray()
+        total = None
+        while total is None or len(data) < total:
+            off, tot, chunk = self.config_read(len(data))
+            if off != len(data) or (total is not None and tot != total) or not chunk or len(data) + len(chunk) > tot:
+                raise MalformedReply(f"malformed CONFIG_READ reply: offset {off}, total {tot}, {len(chunk)} bytes "
+                                     f"after {len(data)} bytes read")
+            total = tot
+            data += chunk
+        return bytes(data)
+
+    def config_write(self, offset, data):
+        """Stages @p data at @p offset (0 starts a new record); @return the bytes staged."""
+        d = check_reply(CONFIG_WRITE, self.request(CONFIG_WRITE, struct.pack("<H", offset) + bytes(data)), 2)
+        return struct.unpack_from("<H", d)[0]
+
+    def write_record(self, record):
+        """Stages @p record in pieces as long as a frame carries; @return the number of pieces."""
+        piece = MAX_PAYLOAD - 4  # TYPE, SEQ, offset u16
+        pieces = 0
+        for off in range(0, len(record), piece):
+            chunk = record[off:off + piece]
+            staged = self.config_write(off, chunk)
+            if staged != off + len(chunk):
+                raise DeviceError(f"CONFIG_WRITE: the drive staged {staged} bytes, expected {off + len(chunk)}")
+            pieces += 1
+        return pieces
+
+    def config_apply(self):
+        """Puts the staged record in force; raises DeviceError naming the code that refused it."""
+        status, period = self._ack_status(CONFIG_APPLY)
+        if status != 0:
+            raise DeviceError(f"the drive refused the record: {describe_code(status)}; the configuration in force "
+                              "is unchanged", status=status, request=CONFIG_APPLY)
+        return period
+
+    def _store_ack(self, ftype, doing):
+        status, period = self._ack_status(ftype)
+        if status != 0:
+            raise DeviceError(f"{doing} failed: {describe_code(status)}", status=status, request=ftype)
+        return period
+
+    def config_save(self):
+        return self._store_ack(CONFIG_SAVE, "saving")
+
+    def config_erase(self):
+        return self._store_ack(CONFIG_ERASE, "erasing")
+
+    def config_defaults(self):
+        return self._store_ack(CONFIG_DEFAULTS, "putting the board's defaults in force")
+
+    def config_status(self):
+        d = check_reply(CONFIG_STATUS, self.request(CONFIG_STATUS), CONFIG_STATUS_BYTES)
+        (configured, boot, validation, last, slot, sequence, record_bytes, fmt, layout,
+         board) = struct.unpack_from("<BhhhbIHBII", d)
+        return {"configured": bool(configured), "boot_status": boot, "boot_validation": validation,
+                "last_status": last, "slot": slot, "sequence": sequence, "record_bytes": record_bytes,
+                "record_format": fmt, "layout_id": layout, "board_id": board}
+
+    def calibrate(self, rated_current_a, pole_pairs=50, paper_mode=False, detent_fraction=0.05):
+        """Starts self-commissioning; raises DeviceError naming the code that refused it."""
+        data = struct.pack("<fHBf", rated_current_a, pole_pairs, CALIBRATE_PAPER_MODE if paper_mode else 0,
+                           detent_fraction)
+        status, period = self._ack_status(CALIBRATE, data)
+        if status != 0:
+            raise DeviceError(f"the drive refused to calibrate: {describe_code(status)}", status=status,
+                              request=CALIBRATE)
+        return period
+
+    def calibrate_status(self):
+        d = check_reply(CALIBRATE_STATUS, self.request(CALIBRATE_STATUS), CALIBRATE_STATUS_BYTES)
+        stage, status, fault, runs, ident, save, r, l, k, j, f = struct.unpack_from("<BhBBBh5f", d)
+        return {"stage": CALIBRATE_STAGES.get(stage, str(stage)), "status": status, "fault": fault, "runs": runs,
+                "identification": IDENTIFICATION.get(ident, str(ident)), "save_status": save,
+                "resistance_Ohm": r, "inductance_H": l, "torque_constant_Nm_A": k, "inertia_kgm2": j,
+                "friction_Nms_rad": f}
+
     def sim_advance(self, periods, timeout=120.0):
         return self._ack(SIM_ADVANCE, struct.pack("<I", periods), timeout=timeout)
 
     def sim_finish(self):
         return self._ack(SIM_FINISH)
+
+
+# ---- names of status codes ----
+_CORE_CODES = None
+
+
+def core_status_codes():
+    """{value: (name, meaning)} of pmstep_status_t, parsed at run time from the firmware's header
+    with tools/gen_reference.py's parser (the same one the documentation uses), so that no list is
+    copied here; {} when the sources are not next to this tool or do not parse (codes are then printed
+    as numbers)."""
+    global _CORE_CODES
+    if _CORE_CODES is None:
+        _CORE_CODES = {}
+        header = "firmware/include/pmstep/pmstep_types.h"
+        parser = Path(__file__).resolve().parent / "gen_reference.py"
+        if (ROOT / header).is_file() and parser.is_file():
+            try:
+                spec = importlib.util.spec_from_file_location("pmstep_gen_reference", parser)
+                module = importlib.util.module_from_spec(spec)
+                sys.modules[spec.name] = module  # its dataclasses look their module up
+                spec.loader.exec_module(module)
+                values = module.parse_enum(module.Source(ROOT, header), "pmstep_status_t")
+                values += module.parse_enum(module.Source(ROOT, "firmware/design/include/pmstep/pmstep_calibrate.h"),
+                                            "pmstep_calibrate_status_t")
+                _CORE_CODES = {v.value: (v.name, v.doc) for v in values}
+            except Exception:  # noqa: BLE001 - a parser or header of another shape: numbers only
+                _CORE_CODES = {}
+    return _CORE_CODES
+
+
+def describe_code(code):
+    """An ACK status with its name and meaning: a pmstep_store_status_t (-140..-151) or a
+    pmstep_status_t, e.g. "status -22 (PMSTEP_ERR_INERTIA: J <= 0)"; a code without a known name
+    as "status N"."""
+    if code in STORE_CODES and code != 0:
+        name, short, meaning = STORE_CODES[code]
+        return f"status {code} ({name}, {short}: {meaning})"
+    name, meaning = core_status_codes().get(code, (None, ""))
+    if name is None:
+        return f"status {code}"
+    return f"status {code} ({name}" + (f": {meaning})" if meaning else ")")
+
+
+def store_outcome(code):
+    """A store status as the `store` command prints it, e.g. "another format (a record of another
+    firmware; PMSTEP_STORE_ERR_FORMAT)"."""
+    if code in STORE_CODES:
+        name, short, meaning = STORE_CODES[code]
+        return f"{short} ({meaning}; {name})" if code != 0 else f"ok ({name})"
+    return describe_code(code)
+
+
+# ---- the record of the stored configuration ----
+def f32(x):
+    """@p x rounded to float32 (as the drive keeps it); OverflowError beyond float32's range."""
+    return struct.unpack("<f", struct.pack("<f", x))[0]
+
+
+def f32_text(x):
+    """The shortest text that reads back as the float32 @p x."""
+    for digits in range(6, 10):
+        text = f"{x:.{digits}g}"
+        if f32(float(text)) == x:
+            return text
+    return repr(x)
+
+
+class Record:
+    """A record's fields (pmstep_store.h): header, values in table order, measured values."""
+
+    def __init__(self, fmt, board_id, layout_id, sequence, values, measured):
+        self.format = fmt
+        self.board_id = board_id
+        self.layout_id = layout_id
+        self.sequence = sequence
+        self.values = list(values)     # floats (float32 values)
+        self.measured = dict(measured)  # MEASURED_FIELDS: flags int, the others float32 values
+
+    def encode(self):
+        """The record's bytes, CRC included. Every value must be a float32 (f32())."""
+        n = RECORD_HEADER.size + 4 * len(self.values) + 4 * len(MEASURED_FIELDS) + 4
+        body = RECORD_HEADER.pack(RECORD_MAGIC, self.format, RECORD_HEADER.size, self.board_id, self.layout_id,
+                                  self.sequence, len(self.values), len(MEASURED_FIELDS), n, 0)
+        body += struct.pack(f"<{len(self.values)}f", *self.values)
+        body += struct.pack("<I7f", self.measured["flags"], *(self.measured[k] for k in MEASURED_FIELDS[1:]))
+        return body + struct.pack("<I", zlib.crc32(body))
+
+    @classmethod
+    def decode(cls, data):
+        """The fields of the record @p data; MalformedReply if it is none of this tool's format."""
+        if len(data) < RECORD_HEADER.size + 4:
+            raise MalformedReply(f"malformed record: {len(data)} bytes")
+        magic, fmt, header, board, layout, seq, n, m, nbytes, _ = RECORD_HEADER.unpack_from(data)
+        (crc,) = struct.unpack_from("<I", data, len(data) - 4)
+        if magic != RECORD_MAGIC or nbytes != len(data) or zlib.crc32(data[:-4]) != crc:
+            raise MalformedReply("malformed record: bad magic, length or CRC")
+        if fmt != RECORD_FORMAT or header != RECORD_HEADER.size or m != len(MEASURED_FIELDS) \
+                or nbytes != header + 4 * n + 4 * m + 4:
+            raise MalformedReply(f"record format {fmt} ({header}-byte header, {m} measured values): this tool "
+                                 f"reads format {RECORD_FORMAT}; a newer pmstep_console.py is needed")
+        values = struct.unpack_from(f"<{n}f", data, header)
+        flags, *rest = struct.unpack_from("<I7f", data, header + 4 * n)
+        return cls(fmt, board, layout, seq, values, dict(zip(MEASURED_FIELDS, [flags] + rest)))
+
+
+def layout_id(table):
+    """The layout id of a configuration table (pmstep_store_layout_id()): CRC-32 of each name with its
+    NUL and its type byte, in id order."""
+    types = {v: k for k, v in CONFIG_TYPES.items()}
+    crc = 0
+    for e in table:
+        if e["type"] not in types:
+            raise MalformedReply(f"configuration value {e['name']} has a type this tool does not know")
+        crc = zlib.crc32(e["name"].encode("ascii") + b"\0" + bytes([types[e["type"]]]), crc)
+    return crc
+
+
+def typed(entry, value):
+    """A table value as its type gives it: int for u32/i32, bool, float for f32."""
+    if entry["type"] == "bool":
+        return value != 0.0
+    if entry["type"] in ("u32", "i32"):
+        return int(value)
+    return float(f32_text(value))
+
+
+def to_entry_value(entry, value, what):
+    """@p value (a number, or a bool for a boolean entry) as the float32 the record holds for
+    @p entry; ConfigurationRefused naming @p what when the entry cannot take it."""
+    name, kind = entry["name"], entry["type"]
+    if isinstance(value, bool):
+        if kind != "bool":
+            raise ConfigurationRefused(f"{what} {name} = {value}: a boolean for a {kind} value")
+        return 1.0 if value else 0.0
+    if not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ConfigurationRefused(f"{what} {name} = {value!r}: not a finite number")
+    try:
+        v = f32(value)
+    except OverflowError:
+        raise ConfigurationRefused(f"{what} {name} = {value!r}: beyond float32's range") from None
+    if kind == "bool" and v not in (0.0, 1.0):
+        raise ConfigurationRefused(f"{what} {name} = {value!r}: a boolean is 0 or 1 (false or true)")
+    if kind in ("u32", "i32") and (v != math.floor(v) or (kind == "u32" and v < 0)):
+        raise ConfigurationRefused(f"{what} {name} = {value!r}: not a whole number{' >= 0' if kind == 'u32' else ''}")
+    return v
+
+
+class Board:
+    """What a drive with a store holds: HELLO, the record of the configuration in force (raw and
+    decoded) and its configuration table (GET_CONFIG by id: name, type, read-only)."""
+
+    def __init__(self, hello, raw, record, table):
+        self.hello = hello
+        self.raw = raw
+        self.record = record
+        self.table = table
+        self.index = {e["name"]: i for i, e in enumerate(table)}
+
+    def value(self, name):
+        return self.record.values[self.index[name]]
+
+    def typed_values(self, values=None):
+        values = self.record.values if values is None else values
+        return {e["name"]: typed(e, v) for e, v in zip(self.table, values)}
+
+
+def read_board(con):
+    """The board's record and table; DeviceError if the drive has no store. The table read by id must
+    give the record's layout id (else the names would not be the values' own)."""
+    hello = con.hello()
+    if hello["protocol"] < 2 or not hello["store"]:
+        raise DeviceError(f"this drive keeps no stored configuration (protocol {hello['protocol']}"
+                          f"{', no store attached' if hello['protocol'] >= 2 else ''}): {hello['identity']}",
+                          code=11)
+    raw = con.read_record()
+    record = Record.decode(raw)
+    table = [con.get_config(i) for i in range(len(record.values))]
+    if layout_id(table) != record.layout_id:
+        raise MalformedReply(f"the configuration table read by id (layout 0x{layout_id(table):08x}) is not the "
+                             f"record's (layout 0x{record.layout_id:08x})")
+    for e, v in zip(table, record.values):
+        if f32(e["value"]) != v:
+            raise MalformedReply(f"the record and GET_CONFIG disagree on {e['name']}: {v!r} and {e['value']!r}")
+    return Board(hello, raw, record, table)
+
+
+def require_idle(con, doing):
+    """DeviceError unless the motor is IDLE (a record is applied only there): before any work."""
+    mode = con.status()["mode"]
+    if mode != "IDLE":
+        raise DeviceError(f"{doing} needs the motor stopped (IDLE), it is in {mode}: "
+                          f"`{'clear' if mode == 'FAULT' else 'stop'}` first", code=6)
+
+
+def put_record(con, board, record):
+    """Writes @p record in pieces, applies it, reads it back and compares it field by field with what
+    was written. @return (pieces, the record read back). Raises DeviceError for a refusal (its code
+    by name), ConfigurationRefused listing the fields that differ."""
+    data = record.encode()
+    pieces = con.write_record(data)
+    con.config_apply()
+    back = Record.decode(con.read_record())
+    diffs = []
+    for field in ("format", "board_id", "layout_id", "sequence"):
+        if getattr(back, field) != getattr(record, field):
+            diffs.append(f"{field}: written {getattr(record, field)}, read {getattr(back, field)}")
+    if len(back.values) != len(record.values):
+        diffs.append(f"value count: written {len(record.values)}, read {len(back.values)}")
+    for e, w, r in zip(board.table, record.values, back.values):
+        if struct.pack("<f", w) != struct.pack("<f", r):
+            diffs.append(f"{e['name']}: written {f32_text(w)}, read {f32_text(r)}")
+    for k in MEASURED_FIELDS:
+        if struct.pack("<f" if k != "flags" else "<I", record.measured[k]) != \
+                struct.pack("<f" if k != "flags" else "<I", back.measured[k]):
+            diffs.append(f"measured {k}: written {record.measured[k]}, read {back.measured[k]}")
+    if diffs:
+        raise ConfigurationRefused("the record read back differs from the one written:\n  " + "\n  ".join(diffs))
+    return pieces, back
+
+
+def print_stored(con, board, record, save):
+    """Saves (if @p save) and prints the slot, the sequence and every value by name."""
+    if save:
+        con.config_save()
+        st = con.config_status()
+        print(f"saved: slot {st['slot']}, sequence {st['sequence']}")
+    else:
+        print("in force, not saved: `save` stores it (a reset brings back the stored configuration)")
+    for e, v in zip(board.table, record.values):
+        print(f"  {e['name']:44s} = {typed_text(e, v)}" + ("  (read-only)" if e["read_only"] else ""))
+
+
+def typed_text(entry, value):
+    t = typed(entry, value)
+    return ("true" if t else "false") if isinstance(t, bool) else (str(t) if isinstance(t, int) else f32_text(value))
+
+
+# ---- setup: a design of pmstep-tune onto the board's table ----
+# The board's read-only values and the scenario keys that give them to pmstep-tune (sil/src/scenario_keys.c:
+# run.period_s and run.delay_periods are the controller's timing; the sense ranges are the sensors' full
+# scales, sil_scenario_sense_ranges()).
+READ_ONLY_SCENARIO_KEYS = {"timing.period_s": "run.period_s",
+                           "timing.computational_delay_periods": "run.delay_periods",
+                           "limits.current_sense_range_A": "sensors.current_full_scale_A",
+                           "limits.bus_sense_range_V": "sensors.bus_full_scale_V"}
+BUS_VOLTAGE_KEY = "run.bus_voltage_V"
+DEFAULT_TUNE = "build/host-release/sil/pmstep-tune"
+
+
+def find_tune(option):
+    """The pmstep-tune to run: @p option (--tune), else $PMSTEP_TUNE, else DEFAULT_TUNE of this tree."""
+    if option:
+        path, origin = Path(option), "--tune"
+    elif os.environ.get("PMSTEP_TUNE"):
+        path, origin = Path(os.environ["PMSTEP_TUNE"]), "$PMSTEP_TUNE"
+    else:
+        path, origin = ROOT / DEFAULT_TUNE, "the default"
+    if not path.is_file() or not os.access(path, os.X_OK):
+        raise UsageError(f"pmstep-tune not found at {path} ({origin}): build it (cmake --preset host-release && "
+                         f"cmake --build --preset host-release --target pmstep-tune) or give its path with --tune "
+                         f"or $PMSTEP_TUNE")
+    return path
+
+
+def read_design(path):
+    """The designed values of a scenario written by pmstep-tune --write-ini: (by table name, the
+    scenario's keys). [controller.SECTION] KEY is the table's SECTION.KEY, [controller] KEY is KEY."""
+    cp = configparser.ConfigParser(interpolation=None, comment_prefixes=(";", "#"), inline_comment_prefixes=None)
+    cp.optionxform = str  # the names are case-sensitive (resistance_Ohm)
+    try:
+        cp.read(path, encoding="utf-8")
+    except configparser.Error as e:
+        raise ConfigurationRefused(f"pmstep-tune's design {path} does not read: {e}") from e
+    design, keys = {}, {}
+    for section in cp.sections():
+        for key, text in cp.items(section):
+            keys[f"{section}.{key}"] = text
+            if section == "controller" or section.startswith("controller."):
+                prefix = section[len("controller."):] + "." if section != "controller" else ""
+                design[prefix + key] = text
+    return design, keys
+
+
+def design_number(name, text):
+    """A designed value's text as a number (true/false as 1/0)."""
+    if text in ("true", "false"):
+        return 1.0 if text == "true" else 0.0
+    try:
+        return float(text)
+    except ValueError:
+        raise ConfigurationRefused(f"pmstep-tune designed {name} = {text!r}: not a number") from None
+
+
+def preset_bus_voltage(path):
+    """Whether the motor preset @p path gives run.bus_voltage_V (else pmstep-tune's default applies)."""
+    cp = configparser.ConfigParser(interpolation=None, comment_prefixes=(";", "#"), strict=False)
+    cp.optionxform = str
+    try:
+        cp.read(path, encoding="utf-8")
+    except (configparser.Error, UnicodeDecodeError):
+        return False
+    return cp.has_option("run", "bus_voltage_V")
+
+
+def setup(con, a):
+    """The setup command (module docstring): design, map onto the board's table, write, apply, read
+    back, compare, save; prints each step."""
+    if bool(a.motor) == bool(a.motor_db):
+        raise UsageError("setup: give --motor MOTOR.ini, or --motor-db FILE --name NAME")
+    if a.motor_db and not a.name:
+        raise UsageError("setup: --motor-db needs --name NAME (a [motor_constants NAME] section)")
+    for path in filter(None, (a.motor, a.motor_db)):
+        if not Path(path).is_file():
+            raise UsageError(f"setup: {path}: no such file")
+    sets = list(a.set or [])
+    for s in sets:
+        key = s.split("=", 1)[0].strip()
+        if "=" not in s:
+            raise UsageError(f"setup: --set {s}: expected SECTION.KEY=VALUE")
+        if key in READ_ONLY_SCENARIO_KEYS.values():
+            raise UsageError(f"setup: --set {key}: the board's own value (read-only), the design uses the board's")
+        if key == BUS_VOLTAGE_KEY and a.bus_voltage is not None:
+            raise UsageError(f"setup: --bus-voltage and --set {BUS_VOLTAGE_KEY} both given")
+    if a.bus_voltage is not None and not (math.isfinite(a.bus_voltage) and a.bus_voltage > 0):
+        raise UsageError(f"setup: --bus-voltage {a.bus_voltage}: expected a voltage > 0")
+    tune = find_tune(a.tune)
+    board = read_board(con)
+    require_idle(con, "setup")
+    h, r = board.hello, board.record
+    print(f"board: {h['identity']}, record format {r.format}, board id 0x{r.board_id:08x}, layout 0x{r.layout_id:08x}, "
+          f"{len(r.values)} values; {'a motor configured' if h['configured'] else 'no motor configured'}")
+    # The board's read-only values go to pmstep-tune as the scenario's: the design is made for them.
+    board_sets = []
+    for e in board.table:
+        if e["read_only"]:
+            if e["name"] not in READ_ONLY_SCENARIO_KEYS:
+                raise ConfigurationRefused(f"the board's read-only value {e['name']} has no scenario key this tool "
+                                           "knows: a design for it cannot be made (a newer pmstep_console.py?)")
+            v = typed(e, board.value(e["name"]))
+            board_sets.append(f"{READ_ONLY_SCENARIO_KEYS[e['name']]}={v!r}")
+    if a.bus_voltage is not None:
+        sets.append(f"{BUS_VOLTAGE_KEY}={a.bus_voltage!r}")
+    with tempfile.TemporaryDirectory(prefix="pmstep-setup-") as tmp:
+        ini = os.path.join(tmp, "design.ini")
+        argv = [str(tune)] + (["--motor", a.motor] if a.motor else ["--motor-db", a.motor_db, "--name", a.name])
+        argv += ["--robust"] if a.robust else []
+        for s in board_sets + sets:
+            argv += ["--set", s]
+        argv += ["--write-ini", ini]
+        print("design: " + " ".join(shlex.quote(x) for x in argv[:-2]))
+        try:
+            run = subprocess.run(argv, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=300)
+        except (OSError, subprocess.TimeoutExpired) as e:
+            raise UsageError(f"pmstep-tune could not run: {e}") from e
+        for line in run.stdout.splitlines():
+            print(f"  | {line}")
+        if run.returncode != 0:
+            cls = UsageError if run.returncode == 2 else ConfigurationRefused
+            raise cls(f"pmstep-tune refused the design (exit {run.returncode}); nothing written to the board")
+        design, keys = read_design(ini)
+    # The read-only values of the design must be the board's (they were given with --set).
+    for e in board.table:
+        if e["read_only"]:
+            key = READ_ONLY_SCENARIO_KEYS[e["name"]]
+            text = keys.get(key)
+            if text is None or f32(design_number(key, text)) != board.value(e["name"]):
+                raise ConfigurationRefused(f"pmstep-tune designed for {key} = {text}, the board's {e['name']} is "
+                                           f"{f32_text(board.value(e['name']))}")
+    bus_text = keys.get(BUS_VOLTAGE_KEY, "?")
+    if a.bus_voltage is not None:
+        origin = "--bus-voltage"
+    elif any(s.split("=", 1)[0].strip() == BUS_VOLTAGE_KEY for s in sets):
+        origin = f"--set {BUS_VOLTAGE_KEY}"
+    elif a.motor and preset_bus_voltage(a.motor):
+        origin = f"the motor preset's {BUS_VOLTAGE_KEY}"
+    else:
+        origin = "pmstep-tune's default: " + ("the preset gives none" if a.motor else "a motor database gives none")
+    print("designed for the board's " + ", ".join(f"{e['name']} = {typed_text(e, board.value(e['name']))}"
+                                                  for e in board.table if e["read_only"])
+          + f"; bus {bus_text} V ({origin})")
+    # Onto the board's table by name: every value the board can take from the design.
+    values = list(r.values)
+    kept = []
+    for i, e in enumerate(board.table):
+        if e["read_only"]:
+            continue
+        if e["name"] in design:
+            values[i] = to_entry_value(e, design_number(e["name"], design[e["name"]]), "designed")
+        else:
+            kept.append(e["name"])
+    unused = [n for n in design if n not in board.index]
+    if unused:
+        print("designed, not on this board (not written): " + ", ".join(unused))
+    if kept:
+        which = "the board's default" if not h["configured"] else "the value in force"
+        print(f"not in the design, {which} kept: " + ", ".join(
+            f"{n} = {typed_text(board.table[board.index[n]], r.values[board.index[n]])}" for n in kept))
+    # Nothing measured on this motor yet: a design from its data.
+    record = Record(r.format, r.board_id, r.layout_id, 0, values, {k: (0 if k == "flags" else 0.0)
+                                                                   for k in MEASURED_FIELDS})
+    pieces, back = put_record(con, board, record)
+    print(f"record: {len(record.encode())} bytes written in {pieces} pieces, applied, read back equal")
+    print_stored(con, board, back, save=True)
+
+
+# ---- backup and restore ----
+def backup(con):
+    """The board's configuration as a JSON-able dict (the backup file's contents)."""
+    board = read_board(con)
+    r = board.record
+    measured = {k: (v if k == "flags" else float(f32_text(v))) for k, v in r.measured.items()}
+    return {"identity": board.hello["identity"], "protocol": board.hello["protocol"],
+            "configured": board.hello["configured"], "record_format": r.format, "board_id": r.board_id,
+            "layout_id": r.layout_id, "values": board.typed_values(),
+            "read_only": [e["name"] for e in board.table if e["read_only"]], "measured": measured,
+            "record": board.raw.hex()}
+
+
+def load_backup(path):
+    try:
+        with open(path, encoding="utf-8") as f:
+            data = json.load(f)
+    except OSError as e:
+        raise UsageError(f"cannot read {path}: {e.strerror}") from e
+    except ValueError as e:
+        raise UsageError(f"{path} is not JSON: {e}") from e
+    if not isinstance(data, dict) or not isinstance(data.get("values"), dict):
+        raise UsageError(f"{path} is no backup of pmstep_console.py: no \"values\" by name")
+    measured = data.get("measured")
+    if measured is not None and (not isinstance(measured, dict) or set(measured) != set(MEASURED_FIELDS)):
+        raise UsageError(f"{path}: \"measured\" must have the fields {', '.join(MEASURED_FIELDS)}")
+    return data
+
+
+def restore(con, path, save):
+    """The restore command (module docstring)."""
+    data = load_backup(path)
+    board = read_board(con)
+    require_idle(con, "restore")
+    r = board.record
+    unknown = [n for n in data["values"] if n not in board.index]
+    if unknown:
+        raise ConfigurationRefused("the backup has values this board does not: " + ", ".join(unknown)
+                                   + "; nothing written")
+    differ = []
+    for name, v in data["values"].items():
+        e = board.table[board.index[name]]
+        if e["read_only"] and (isinstance(v, bool) or not isinstance(v, (int, float))
+                               or to_entry_value(e, v, "backup") != board.value(name)):
+            differ.append(f"{name} (backup {v}, board {typed_text(e, board.value(name))})")
+    if differ:
+        raise ConfigurationRefused("the backup was made for other read-only values: " + ", ".join(differ)
+                                   + "; nothing written")
+    if data.get("board_id") is not None and data["board_id"] != r.board_id:
+        print(f"note: the backup was made on board id 0x{data['board_id']:08x}, this board is 0x{r.board_id:08x}")
+    values = list(r.values)
+    for name, v in data["values"].items():
+        e = board.table[board.index[name]]
+        if not e["read_only"]:
+            values[board.index[name]] = to_entry_value(e, v, "backup value")
+    missing = [e["name"] for e in board.table if e["name"] not in data["values"]]
+    if missing:
+        print("not in the backup, the value in force kept: " + ", ".join(missing))
+    measured = {k: 0 if k == "flags" else 0.0 for k in MEASURED_FIELDS}
+    if data.get("measured") is not None:
+        for k, v in data["measured"].items():
+            if k == "flags":
+                if isinstance(v, bool) or not isinstance(v, int) or not 0 <= v < 2 ** 32:
+                    raise ConfigurationRefused(f"backup measured flags = {v!r}: not a 32-bit whole number")
+                measured[k] = v
+            else:
+                measured[k] = to_entry_value({"name": k, "type": "f32"}, v, "backup measured")
+    else:
+        print("note: the backup has no measured values: restored as not measured")
+    record = Record(r.format, r.board_id, r.layout_id, 0, values, measured)
+    pieces, back = put_record(con, board, record)
+    print(f"restored {path}: {len(record.encode())} bytes written in {pieces} pieces, applied, read back equal")
+    print_stored(con, board, back, save)
+
+
+FAULTS = {0: "none", 1: "MEASUREMENT_NONFINITE", 2: "OVERCURRENT", 3: "BUS_UNDERVOLTAGE", 4: "BUS_OVERVOLTAGE",
+          5: "STATE_NONFINITE", 6: "ANGLE_MAGNITUDE", 7: "SPEED_INCONSISTENT", 8: "STALL", 9: "COMMISSIONING",
+          10: "OBSERVER_RESIDUAL", 11: "PHASE_VOLTAGE_RANGE", 12: "ALIGNMENT_MOTION", 13: "OPEN_PHASE_A",
+          14: "OPEN_PHASE_B", 15: "CURRENT_STUCK_A", 16: "CURRENT_STUCK_B", 17: "ESTIMATE_RANGE"}
+
+
+def calibrate(con, a):
+    """CALIBRATE, then CALIBRATE_STATUS every half second (a simulation image: --advance periods of its
+    time each) until it is done or failed; the measured motor and the outcome printed."""
+    if a.current is None:
+        raise UsageError("calibrate --current RATED_A [--pole-pairs P] [--paper] [--detent-fraction D] [--timeout S]")
+    require_idle(con, "calibrating")
+    con.calibrate(a.current, a.pole_pairs, a.paper, a.detent_fraction)
+    print(f"calibrating from I = {a.current} A, p = {a.pole_pairs}, detent {a.detent_fraction} of the holding torque, "
+          f"{'paper' if a.paper else 'robust'} mode")
+    deadline = time.monotonic() + a.timeout
+    last = None
+    while True:
+        if a.advance:
+            con.sim_advance(a.advance, timeout=600.0)
+        else:
+            con.pump(0.5)
+        st = con.calibrate_status()
+        line = (f"  {st['stage']:11s} run {st['runs']}: R {st['resistance_Ohm']:.4g} Ohm, L {st['inductance_H']:.4g} H, "
+                f"k_M {st['torque_constant_Nm_A']:.4g} N m/A, J {st['inertia_kgm2']:.4g} kg m^2")
+        if line != last:
+            print(line)
+            last = line
+        if st["stage"] in ("done", "failed"):
+            break
+        if time.monotonic() > deadline:
+            con.stop()
+            raise DeviceError(f"calibration not over after {a.timeout:.0f} s: stopped")
+    if st["stage"] == "failed":
+        fault = f"; the run ended in {FAULTS.get(st['fault'], st['fault'])}" if st["fault"] else ""
+        raise DeviceError(f"calibration failed: {describe_code(st['status'])}{fault}; the board's defaults are in "
+                          "force, no motor configured", status=st["status"], request=CALIBRATE)
+    # The design is saved at the first boundary with the bridge off: wait for the drive to say so.
+    for _ in range(20):
+        if st["save_status"] != 0 or con.config_status()["configured"] and con.config_status()["slot"] >= 0:
+            break
+        if a.advance:
+            con.sim_advance(10, timeout=60.0)
+        else:
+            con.pump(0.1)
+        st = con.calibrate_status()
+    print(f"calibrated: R {st['resistance_Ohm']:.5g} Ohm, L {st['inductance_H']:.5g} H, "
+          f"k_M {st['torque_constant_Nm_A']:.5g} N m/A, J {st['inertia_kgm2']:.5g} kg m^2, "
+          f"F {st['friction_Nms_rad']:.4g} N m s/rad (identification {st['identification']}, {st['runs']} runs)")
+    if st["save_status"] != 0:
+        raise DeviceError(f"the calibrated design is in force but was not saved: {describe_code(st['save_status'])}",
+                          status=st["save_status"], request=CALIBRATE)
+    store = con.config_status()
+    print(f"saved: slot {store['slot']}, sequence {store['sequence']}")
+
+
+def print_store(con):
+    st = con.config_status()
+    print(f"  {'configured':26s} {'yes' if st['configured'] else 'no (START refused until setup or restore)'}")
+    print(f"  {'boot':26s} {store_outcome(st['boot_status'])}")
+    if st["boot_validation"] != 0:
+        print(f"  {'boot refused by the core':26s} {describe_code(st['boot_validation'])}")
+    print(f"  {'last save/erase/apply':26s} {store_outcome(st['last_status'])}")
+    print(f"  {'slot':26s} {st['slot'] if st['slot'] >= 0 else 'none (no valid record)'}")
+    print(f"  {'sequence':26s} {st['sequence']}")
+    print(f"  {'record bytes':26s} {st['record_bytes']}")
+    print(f"  {'record format':26s} {st['record_format']}")
+    print(f"  {'layout id':26s} 0x{st['layout_id']:08x}")
+    print(f"  {'board id':26s} 0x{st['board_id']:08x}")
+
+
+NOT_CONFIGURED_HELP = ("the drive has no motor configured (error 10): configure it first - `setup --motor MOTOR.ini` "
+                       "(or `setup --motor-db FILE --name NAME`) designs, writes and saves one from the motor's data, "
+                       "`restore BACKUP.json --save` brings back a backup, or the drive calibrates the motor itself "
+                       "(CALIBRATE, on images with self-commissioning)")
 
 
 # ---- telemetry to CSV, plots ----
@@ -534,18 +1291,39 @@ def run_command(con, argv):
     p.add_argument("--vmax", type=float, default=5.0)
     p.add_argument("--amax", type=float, default=None)
     p.add_argument("--jmax", type=float, default=0.0)
+    p.add_argument("--motor")
+    p.add_argument("--motor-db")
+    p.add_argument("--name")
+    p.add_argument("--robust", action="store_true")
+    p.add_argument("--set", action="append")
+    p.add_argument("--bus-voltage", type=float)
+    p.add_argument("--tune")
+    p.add_argument("--save", action="store_true")
+    p.add_argument("--current", type=float)
+    p.add_argument("--pole-pairs", type=int, default=50)
+    p.add_argument("--paper", action="store_true")
+    p.add_argument("--detent-fraction", type=float, default=0.05)
+    p.add_argument("--timeout", type=float, default=120.0)
+    p.add_argument("--advance", type=int, default=0)
     a = p.parse_args(argv)
     w = a.what
     if w == "hello":
         print_dict(con.hello())
+    elif w == "start":
+        try:
+            print(f"start: done from period {con.start()}")
+        except DeviceError as e:
+            if e.code == ERR_NOT_CONFIGURED:
+                raise DeviceError(NOT_CONFIGURED_HELP, code=e.code, request=e.request) from None
+            raise
     elif w == "status":
         print_dict(con.status())
     elif w == "counters":
         print_dict(con.counters())
     elif w == "commissioning":
         print_dict(con.commissioning())
-    elif w in ("start", "stop", "clear"):
-        period = {"start": con.start, "stop": con.stop, "clear": con.clear_fault}[w]()
+    elif w in ("stop", "clear"):
+        period = {"stop": con.stop, "clear": con.clear_fault}[w]()
         print(f"{w}: done from period {period}")
     elif w == "speed":
         print(f"speed target {a.args[0]} rad/s at {a.ramp} rad/s^2: from period {con.speed(float(a.args[0]), a.ramp)}")
@@ -554,10 +1332,10 @@ def run_command(con, argv):
     elif w == "config":
         for c in con.list_config():
             ro = " (read-only)" if c["read_only"] else ""
-            print(f"  {c['id']:3d} {c['name']:34s} {c['value']:.7g} {c['type']}{ro}")
+            print(f"  {c['id']:3d} {c['name']:44s} {f32_text(c['value']):15s} {c['type']}{ro}")
     elif w == "get":
         c = con.get_config(a.args[0])
-        print(f"  {c['id']} {c['name']} = {c['value']:.7g} ({c['type']})")
+        print(f"  {c['id']} {c['name']} = {f32_text(c['value'])} ({c['type']})")
     elif w == "set":
         print(f"set {a.args[0]} = {a.args[1]}: done (core re-initialised) at period {con.set_config(a.args[0], a.args[1])}")
     elif w == "move":
@@ -573,6 +1351,46 @@ def run_command(con, argv):
     elif w == "telemetry":
         rows = stream(con, a.decimation, a.seconds, a.csv, a.plot)
         print(f"{len(rows)} telemetry frames" + (f" written to {a.csv}" if a.csv else ""))
+    elif w == "setup":
+        setup(con, a)
+    elif w == "backup":
+        if len(a.args) != 1:
+            raise UsageError("backup FILE.json")
+        data = backup(con)
+        try:
+            with open(a.args[0], "w", encoding="utf-8") as f:
+                json.dump(data, f, indent=1)
+                f.write("\n")
+        except OSError as e:
+            raise UsageError(f"cannot write {a.args[0]}: {e.strerror}") from e
+        print(f"backup of {data['identity']} (board id 0x{data['board_id']:08x}, record format "
+              f"{data['record_format']}, {len(data['values'])} values, "
+              f"{'a motor' if data['configured'] else 'no motor'} configured) written to {a.args[0]}")
+    elif w == "restore":
+        if len(a.args) != 1:
+            raise UsageError("restore FILE.json [--save]")
+        restore(con, a.args[0], a.save)
+    elif w == "save":
+        try:
+            con.config_save()
+        except DeviceError as e:
+            if e.code == ERR_NOT_CONFIGURED:
+                raise DeviceError("nothing to save: " + NOT_CONFIGURED_HELP, code=e.code, request=e.request) from None
+            raise
+        st = con.config_status()
+        print(f"saved: slot {st['slot']}, sequence {st['sequence']}")
+    elif w == "erase":
+        con.config_erase()
+        con.config_defaults()
+        print("erased: both flash slots; the board's defaults in force, no motor configured")
+    elif w == "defaults":
+        con.config_defaults()
+        print("the board's defaults in force, no motor configured; the flash untouched (a reset brings back the "
+              "stored configuration)")
+    elif w == "store":
+        print_store(con)
+    elif w == "calibrate":
+        calibrate(con, a)
     else:
         return False
     return True
@@ -581,7 +1399,9 @@ def run_command(con, argv):
 class Shell(cmd.Cmd):
     intro = "pmstep console: hello, status, start, stop, clear, speed T [--ramp R], id A, config, get K, " \
             "set K V, commissioning, counters, telemetry [--decimation N --seconds S --csv F --plot], " \
-            "move X [--vmax V --amax A --jmax J], hold [--amax A], position, zero, quit"
+            "move X [--vmax V --amax A --jmax J], hold [--amax A], position, zero, setup (--motor F | " \
+            "--motor-db F --name N) [--robust --set K=V --bus-voltage V --tune P], backup F, restore F [--save], " \
+            "save, erase, defaults, store, calibrate --current A [--pole-pairs P --paper --detent-fraction D], quit"
     prompt = "pmstep> "
 
     def __init__(self, con):

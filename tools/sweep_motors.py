@@ -8,7 +8,9 @@ keeps synchronism with no fault; the stricter envelope criteria (tracking within
 speed, angle error within 0.05 rad) are counted apart.
 
 Modes: paper-ideal (the paper's controller, ideal chain) and robust-realistic (the robust design
-behind mc_preset.py's realistic chain); paper-realistic and robust-ideal on request.
+behind mc_preset.py's realistic chain); paper-realistic, robust-ideal and self-commission-realistic
+(the drive's own calibration from the rated current, then its design validated, on the realistic
+chain) on request.
 
 It prints the pass rate and the failure modes per mode, writes results.csv, a report (pass rates
 by frame, steps/rev and bus; the failures and their dimensionless groups) and a plot of where the
@@ -45,6 +47,9 @@ MODES = {
     "robust-realistic": {"robust": True, "realistic": True},
     "paper-realistic": {"robust": False, "realistic": True},
     "robust-ideal": {"robust": True, "realistic": False},
+    # the drive's own calibration (pmstep_calibrate.h) told only the rated current, p and the detent's
+    # presence, then its design validated as the others
+    "self-commission-realistic": {"robust": True, "realistic": True, "self_commission": True},
 }
 NOISE_A = 0.005  # the realistic chain's current noise (mc_preset.REALISTIC_CHAIN)
 
@@ -75,7 +80,9 @@ def run_motor(tune, motor, mode, work):
     if spec["realistic"]:
         for item in mc_preset.chain_sets({"rated_current_A": motor["rated_current_A"]}):
             cmd += ["--set", item]
-    if motor.get("told_inertia_kgm2") is not None:
+    if spec.get("self_commission"):
+        cmd += ["--self-commission", "--detent-fraction", "0.05" if motor.get("detent_torque_Nm", 0.0) > 0.0 else "0"]
+    elif motor.get("told_inertia_kgm2") is not None:
         # a datasheet without J: the designer estimates it from the holding torque and has it identified
         cmd += ["--told-inertia", "0", "--told-friction", f"{motor['told_friction_Nms_rad']:.6g}"]
     started = time.monotonic()
@@ -96,6 +103,10 @@ def outcome(result):
     s = result["summary"]
     if s["design"]["status"] != 0:
         return "refused: " + s["design"]["text"]
+    calibration = s.get("self_commissioning")
+    if calibration is not None and calibration["status"] != 0:
+        fault = f" ({calibration['fault']})" if calibration.get("fault", "NONE") != "NONE" else ""
+        return f"fail: self-commissioning: {calibration['text']}{fault}"
     if s["synchronous"]:
         return "pass"
     for c in s["checks"]:

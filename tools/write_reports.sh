@@ -21,7 +21,9 @@
 #   fault-injection      tools/fault_injection.py, every fault on paper, 17hs4401, bj42d29, as1050
 #                                                              -> docs/reports/fault-injection.md
 #   motor-sweep          tools/sweep_motors.py, the 500 motors of tools/motor_population.py (seed 2026),
-#                        paper and robust modes             -> docs/reports/motor-sweep.md (+ motor-sweep.png)
+#                        paper, robust and self-commissioning modes -> docs/reports/motor-sweep.md (+ .png)
+#   self-commissioning   tools/self_commission.py, every preset on its chain and the realistic one
+#                                                              -> docs/reports/self-commissioning.md
 #
 # The campaigns run on a thread pool of 2 (--engine threads --jobs 2; a case's result depends on its
 # seed alone, not on the engine). Outputs of the runs (tables, cases, plots) go to OUT (out/reports);
@@ -39,7 +41,7 @@ set -uo pipefail
 cd "$(dirname "$0")/.."
 
 STEPS_ALL=(cost position-cost benchmarks envelope position-acceptance mc-presets mc-robust mc-position fault-injection
-           motor-sweep)
+           motor-sweep self-commissioning)
 MC_PRESETS=(paper 17hs4401 bj42d29 as1050)
 MC_POSITION=(17hs4401 bj42d29 as1050)
 OUT=${OUT:-out/reports}
@@ -149,7 +151,12 @@ for step in "${STEPS[@]}"; do
     motor-sweep)
       need_sil
       run motor-sweep "$REPORTS/motor-sweep.md" "$PYTHON" tools/sweep_motors.py --tune "$TUNE" --jobs 2 \
+        --modes paper-ideal,robust-realistic,self-commission-realistic \
         --report "$REPORTS/motor-sweep.md" --plot "$REPORTS/motor-sweep.png" ;;
+    self-commissioning)
+      need_sil
+      run self-commissioning "$REPORTS/self-commissioning.md" "$PYTHON" tools/self_commission.py --tune "$TUNE" \
+        --report "$REPORTS/self-commissioning.md" ;;
   esac
 done
 

@@ -91,6 +91,31 @@ static void command_microstep_speed(sil_microstep_t *drive, const sil_scenario_t
     }
 }
 
+int sil_bind_plant(const sil_scenario_t *sc, plant_t *plant)
+{
+    pmstep_hal_host_setup_t hardware;
+    memset(plant, 0, sizeof *plant);
+    plant->params = sc->motor;
+    plant->load = sc->load;
+    plant->x.theta_rad = sc->theta0_rad;
+    plant->x.omega_rad_s = sc->omega0_rad_s;
+    plant->x.i_a_A = sc->i_a0_A;
+    plant->x.i_b_A = sc->i_b0_A;
+    plant->integrator = sc->integrator;
+    hardware.bus_voltage_V = sc->bus_voltage_V;
+    hardware.delay_periods = sc->controller.timing.computational_delay_periods;
+    hardware.inverter = sc->inverter;
+    hardware.bus = sc->bus;
+    hardware.sensors = sc->sensors;
+    hardware.faults = sc->faults;
+    hardware.seed = sc->seed;
+    if (pmstep_hal_host_bind(plant, &hardware) != 0) {
+        pmstep_hal_host_release();
+        return -3;
+    }
+    return 0;
+}
+
 int sil_run(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user, bool progress, sil_summary_t *s)
 {
     return sil_run_record(sc, on_sample, user, progress, s, NULL);
@@ -110,7 +135,6 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
     const double period_s = (double)cfg->timing.period_s;
     const long steps = sil_periods_in(sc->duration_s, period_s);
     const bool on_terminal = isatty(fileno(stderr)) != 0;
-    pmstep_hal_host_setup_t hardware;
     sil_inverter_t *inverter = pmstep_hal_host_inverter();
     sil_metrics_t metrics;
     plant_t plant;
@@ -145,23 +169,7 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
     sil_position_run_init(&position_run, sc);
     sil_metrics_init(&metrics, sc, s); /* its period counts need a configuration init accepted; clears s */
     s->init_status = PMSTEP_OK;
-    memset(&plant, 0, sizeof plant);
-    plant.params = sc->motor;
-    plant.load = sc->load;
-    plant.x.theta_rad = sc->theta0_rad;
-    plant.x.omega_rad_s = sc->omega0_rad_s;
-    plant.x.i_a_A = sc->i_a0_A;
-    plant.x.i_b_A = sc->i_b0_A;
-    plant.integrator = sc->integrator;
-    hardware.bus_voltage_V = sc->bus_voltage_V;
-    hardware.delay_periods = cfg->timing.computational_delay_periods;
-    hardware.inverter = sc->inverter;
-    hardware.bus = sc->bus;
-    hardware.sensors = sc->sensors;
-    hardware.faults = sc->faults;
-    hardware.seed = sc->seed;
-    if (pmstep_hal_host_bind(&plant, &hardware) != 0) {
-        pmstep_hal_host_release();
+    if (sil_bind_plant(sc, &plant) != 0) {
         return -3;
     }
     if (!microstep) {

@@ -16,7 +16,7 @@ static void usage(FILE *f)
             "                   [--force] [--set section.key=value]...\n"
             "                   [--write-ini FILE] [--write-c FILE] [--validate]\n"
             "                   [--told-inertia J] [--told-friction F] [--identify [--max-inertia-error PCT]]\n"
-            "                   [--identify-in-run] [--summary FILE]\n"
+            "                   [--identify-in-run] [--self-commission [--detent-fraction D]] [--summary FILE]\n"
             "  --motor      motor preset (sil/scenarios/motors/*.ini): [datasheet], [motor], run.bus_voltage_V;\n"
             "               run.period_s, run.delay_periods, [inverter] and [sensors] are the drive's\n"
             "  --robust     robust mode: Remark 2 calibration, commissioned R/L/k_M, drift-free angle,\n"
@@ -42,6 +42,11 @@ static void usage(FILE *f)
             "  --max-inertia-error  with --identify: exit 1 unless J is identified within PCT %% of the plant's\n"
             "  --identify-in-run  the design asks the firmware to identify J and F in each run's first\n"
             "               window and use them (commissioning.use_identified_mechanics)\n"
+            "  --self-commission  run the drive's own calibration (pmstep_calibrate.h) in the SIL on the\n"
+            "               preset's plant, told only the rated current and the pole pairs; print its design\n"
+            "               beside the datasheet's; --validate, --write-ini, --summary then take its design\n"
+            "  --detent-fraction  with --self-commission: the detent torque the user tells, as a fraction of\n"
+            "               the holding torque (default 0.05, a hybrid stepper's; 0 for a motor without one)\n"
             "  --summary    the design's status and figures and each validation run's outcome as JSON\n");
 }
 
@@ -64,6 +69,9 @@ int main(int argc, char **argv)
     bool run_validation = false;
     bool run_identification = false;
     bool identify_in_run = false;
+    bool self_commission = false;
+    double detent_per_holding = (double)PMSTEP_CALIBRATE_DETENT_PER_HOLDING;
+    static tune_calibration_t calibration;
     double told_inertia = -1.0;
     double told_friction = -1.0;
     double max_inertia_error_pct = -1.0;
@@ -115,8 +123,10 @@ int main(int argc, char **argv)
             run_identification = true;
         } else if (strcmp(argv[k], "--identify-in-run") == 0) {
             identify_in_run = true;
+        } else if (strcmp(argv[k], "--self-commission") == 0) {
+            self_commission = true;
         } else if ((strcmp(argv[k], "--told-inertia") == 0 || strcmp(argv[k], "--told-friction") == 0
-                    || strcmp(argv[k], "--max-inertia-error") == 0)
+                    || strcmp(argv[k], "--max-inertia-error") == 0 || strcmp(argv[k], "--detent-fraction") == 0)
                    && k + 1 < argc) {
             char *end = NULL;
             const char *name = argv[k];
@@ -129,6 +139,8 @@ int main(int argc, char **argv)
                 told_inertia = value;
             } else if (strcmp(name, "--told-friction") == 0) {
                 told_friction = value;
+            } else if (strcmp(name, "--detent-fraction") == 0) {
+                detent_per_holding = value;
             } else {
                 max_inertia_error_pct = value;
             }
@@ -170,7 +182,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "pmstep-tune: %s: cannot design: %s (%d)\n", motor_path, pmstep_status_str(status),
                 (int)status);
         if (summary_path != NULL) {
-            (void)write_summary(summary_path, motor_path, robust, status, &report, checks, 0);
+            (void)write_summary(summary_path, motor_path, robust, status, &report, checks, 0, NULL);
         }
         return 1;
     }
@@ -238,6 +250,37 @@ int main(int argc, char **argv)
                (double)sc.controller.commissioning.identification_time_s,
                (double)sc.controller.commissioning.identification_min_speed_rad_s);
     }
+    if (self_commission) {
+        /* The drive's own design, from the rated current and p: it replaces the datasheet's. */
+        static pmstep_calibrate_t cal;
+        static pmstep_config_t drive;
+        const int rc = calibrate_on_drive(&sc, robust, detent_per_holding, &cal, &drive, &calibration.simulated_s);
+        calibration.ran = true;
+        calibration.status = cal.status;
+        calibration.fault = (int)cal.fault;
+        calibration.runs = cal.runs;
+        calibration.datasheet = sc.controller;
+        calibration.datasheet_report = report;
+        calibration.drive = drive;
+        calibration.drive_report = cal.report;
+        if (rc != 0) {
+            if (summary_path != NULL) {
+                (void)write_summary(summary_path, motor_path, robust, status, &report, checks, 0, &calibration);
+            }
+            return rc;
+        }
+        print_calibration(&sc, &calibration.datasheet, &calibration.datasheet_report, &drive, &cal.report);
+        sc.controller = drive;
+        report = cal.report;
+        sc.id_target_A = (double)report.magnetising_current_A;
+        (void)pmstep_position_design(&sc.controller, &sc.position);
+        {
+            const double top = (double)report.top_speed_rad_s;
+            const double levels[] = {0.8 * top, -0.8 * top, 0.05 * top, -0.05 * top, 0.0};
+            set_profile(&sc, levels, 5);
+        }
+        printf("pmstep-tune: the drive's own design replaces the datasheet's from here on\n");
+    }
     printf("  position loop: k_theta %g 1/s, k_I %g 1/s^2; vector hold at %g A\n", (double)sc.position.gain_per_s,
            (double)sc.position.integral_gain_per_s2, (double)sc.position.hold_current_A);
     if (ini_path != NULL) {
@@ -264,12 +307,12 @@ int main(int argc, char **argv)
     if (run_validation) {
         const int rc = validate(&sc, (double)report.top_speed_rad_s, max_inertia_error_pct, checks);
         if (summary_path != NULL && write_summary(summary_path, motor_path, robust, status, &report, checks,
-                                                  TUNE_CHECKS) != 0) {
+                                                  TUNE_CHECKS, &calibration) != 0) {
             return 2;
         }
         return rc;
     }
-    if (summary_path != NULL && write_summary(summary_path, motor_path, robust, status, &report, checks, 0) != 0) {
+    if (summary_path != NULL && write_summary(summary_path, motor_path, robust, status, &report, checks, 0, &calibration) != 0) {
         return 2;
     }
     return 0;

@@ -6,6 +6,7 @@
 
 #include <stdbool.h>
 
+#include "pmstep/pmstep_calibrate.h"
 #include "pmstep/pmstep_design.h"
 #include "sil/runner.h"
 
@@ -57,12 +58,43 @@ int write_c(const char *path, const sil_scenario_t *sc);
  * ([datasheet], [motor] and the name; J and F estimated). @return 0, or -1 with a message in @p err. */
 int load_motor_db(sil_scenario_t *sc, const char *path, const char *name, char *err, size_t err_size);
 
+/* ---- tune_calibrate.c ---- */
+
+/* --self-commission's outcome beside the datasheet design, for --summary. */
+typedef struct {
+    bool ran;
+    int32_t status;                  /* pmstep_calibrate_t::status */
+    int fault;                       /* the fault that ended the last run */
+    unsigned runs;
+    double simulated_s;
+    pmstep_config_t datasheet;       /* the design from the datasheet */
+    pmstep_design_report_t datasheet_report;
+    pmstep_config_t drive;           /* the drive's own design (valid when status is 0) */
+    pmstep_design_report_t drive_report;
+} tune_calibration_t;
+
+/* Runs the drive's calibration in the SIL on @p sc's plant (no load), told the datasheet's rated
+ * current, the pole pairs and the detent torque's fraction of the holding torque; @p cfg gets the configuration in force at its end.
+ * @return 0 when it ended DONE, 1 when it failed (a line says why), 2 on a setup error. */
+int calibrate_on_drive(const sil_scenario_t *sc, bool robust, double detent_per_holding, pmstep_calibrate_t *cal,
+                       pmstep_config_t *cfg, double *simulated_s);
+
+/* A calibration status (pmstep_calibrate_status_t, or a pmstep_status_t) in words. */
+const char *calibrate_status_text(int32_t status);
+
+/* The drive's design against the datasheet's (and the plant's truth) as a table. */
+void print_calibration(const sil_scenario_t *sc, const pmstep_config_t *datasheet,
+                       const pmstep_design_report_t *datasheet_report, const pmstep_config_t *drive,
+                       const pmstep_design_report_t *drive_report);
+
 /* ---- tune_summary.c ---- */
 
-/* --summary: the design's status and figures (@p r read only when @p status is PMSTEP_OK) and the
- * validation's @p n_checks runs as JSON at @p path. @return 0, or -1 after a message. */
+/* --summary: the design's status and figures (@p r read only when @p status is PMSTEP_OK), the
+ * validation's @p n_checks runs and, with @p cal ran, the self-commissioning's, as JSON at @p path.
+ * @return 0, or -1 after a message. */
 int write_summary(const char *path, const char *motor_path, bool robust, pmstep_status_t status,
-                  const pmstep_design_report_t *r, const tune_check_t *checks, int n_checks);
+                  const pmstep_design_report_t *r, const tune_check_t *checks, int n_checks,
+                  const tune_calibration_t *cal);
 
 /* ---- tune_identify.c ---- */
 

@@ -7,8 +7,28 @@
 #include "pmstep/pmstep_text.h"
 #include "pmstep_tune.h"
 
+/* The values a calibration is compared on, of one design. */
+static cJSON *design_values(const pmstep_config_t *c, const pmstep_design_report_t *r)
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddNumberToObject(o, "resistance_Ohm", (double)c->motor.resistance_Ohm);
+    cJSON_AddNumberToObject(o, "inductance_H", (double)c->motor.inductance_H);
+    cJSON_AddNumberToObject(o, "torque_constant_Nm_A", (double)c->motor.torque_constant_Nm_A);
+    cJSON_AddNumberToObject(o, "inertia_kgm2", (double)c->motor.inertia_kgm2);
+    cJSON_AddNumberToObject(o, "friction_Nms_rad", (double)c->motor.friction_Nms_rad);
+    cJSON_AddNumberToObject(o, "top_speed_rad_s", (double)r->top_speed_rad_s);
+    cJSON_AddNumberToObject(o, "current_bandwidth_rad_s", (double)r->current_bandwidth_rad_s);
+    cJSON_AddNumberToObject(o, "observer_bandwidth_rad_s", (double)r->observer_bandwidth_rad_s);
+    cJSON_AddNumberToObject(o, "speed_gain_per_s", (double)c->gains.speed_gain_per_s);
+    cJSON_AddNumberToObject(o, "s_align_voltage_V", (double)c->alignment.s_align_voltage_V);
+    cJSON_AddNumberToObject(o, "c_align_time_s", (double)c->alignment.c_align_time_s);
+    cJSON_AddNumberToObject(o, "max_phase_current_A", (double)c->limits.max_phase_current_A);
+    return o;
+}
+
 int write_summary(const char *path, const char *motor_path, bool robust, pmstep_status_t status,
-                  const pmstep_design_report_t *r, const tune_check_t *checks, int n_checks)
+                  const pmstep_design_report_t *r, const tune_check_t *checks, int n_checks,
+                  const tune_calibration_t *cal)
 {
     cJSON *root = cJSON_CreateObject();
     cJSON *design = cJSON_CreateObject();
@@ -53,6 +73,19 @@ int write_summary(const char *path, const char *motor_path, bool robust, pmstep_
         synchronous = synchronous && c->synchronous;
     }
     cJSON_AddItemToObject(root, "checks", runs);
+    if (cal != NULL && cal->ran) {
+        cJSON *c = cJSON_CreateObject();
+        cJSON_AddNumberToObject(c, "status", (double)cal->status);
+        cJSON_AddStringToObject(c, "text", calibrate_status_text(cal->status));
+        cJSON_AddStringToObject(c, "fault", pmstep_fault_str((pmstep_fault_t)cal->fault));
+        cJSON_AddNumberToObject(c, "runs", (double)cal->runs);
+        cJSON_AddNumberToObject(c, "simulated_s", cal->simulated_s);
+        cJSON_AddItemToObject(c, "datasheet", design_values(&cal->datasheet, &cal->datasheet_report));
+        if (cal->status == PMSTEP_CALIBRATE_OK) {
+            cJSON_AddItemToObject(c, "drive", design_values(&cal->drive, &cal->drive_report));
+        }
+        cJSON_AddItemToObject(root, "self_commissioning", c);
+    }
     cJSON_AddBoolToObject(root, "passed", passed);
     cJSON_AddBoolToObject(root, "synchronous", synchronous);
     text = cJSON_Print(root);

@@ -26,6 +26,20 @@ uint32_t console_test_frame(uint8_t *out, uint8_t type, uint8_t seq, const void 
     return n + 6u;
 }
 
+void console_test_send(struct pmstep_console *con, uint8_t type, uint8_t seq, const void *data, uint32_t n)
+{
+    uint8_t buf[PMSTEP_CONSOLE_MAX_PAYLOAD + 6u];
+    const uint32_t len = console_test_frame(buf, type, seq, data, n);
+    pmstep_console_receive(con, buf, len, 0u);
+}
+
+unsigned console_test_take_replies(struct pmstep_console *con, console_test_reply_t *r, unsigned max)
+{
+    uint8_t tx[PMSTEP_CONSOLE_TX_BYTES];
+    const uint32_t n = pmstep_console_transmit(con, tx, sizeof tx);
+    return console_test_replies(tx, n, r, max);
+}
+
 unsigned console_test_replies(const uint8_t *tx, uint32_t n, console_test_reply_t *r, unsigned max)
 {
     uint32_t i = 0;

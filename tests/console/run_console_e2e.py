@@ -183,7 +183,7 @@ def run_target(a, out, mode, period_s, k_speed, steps):
     log = {}
     try:
         hello = con.hello()
-        assert hello["protocol"] == 1 and hello["identity"].startswith("pmstep "), hello
+        assert hello["protocol"] == 2 and hello["identity"].startswith("pmstep "), hello
         log["hello"] = hello
         p = con.get_config("timing.period_s")
         assert abs(p["value"] - period_s) == 0.0 and p["read_only"], p

@@ -92,7 +92,9 @@ static void test_hello(void **state)
     assert_int_equal(r[0].seq, 7u);
     assert_int_equal(r[0].data[0], PMSTEP_CONSOLE_PROTOCOL_VERSION);
     assert_int_equal(r[0].data[1], PMSTEP_CONSOLE_MAX_PAYLOAD);
-    assert_memory_equal(&r[0].data[2], "pmstep 0.1.0 test", 17u);
+    assert_int_equal(r[0].data[2], 0u); /* no stored configuration */
+    assert_int_equal(r[0].data[3], 2u); /* its own configuration in force: configured */
+    assert_memory_equal(&r[0].data[4], "pmstep 0.1.0 test", 17u);
 }
 
 /* A command waits for the period boundary, then reaches the core; the ACK gives the period. */

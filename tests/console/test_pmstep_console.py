@@ -3,12 +3,17 @@
 against the real firmware console (console-host-drive: console + core on a pty), through the
 pty endpoint and the command line; and the tool against a bad line (a fake peer on the pty's
 master: noise, sync floods, short replies, a line that closes or takes no bytes, a missing port):
-every wait ends by its deadline, every failure is one line and an exit status.
+every wait ends by its deadline, every failure is one line and an exit status. The stored
+configuration against console-host-drive --flash FILE (a reset: the drive killed and started again
+on the same file): setup, backup, erase, restore, refusals, power cuts in a save.
 
-usage: test_pmstep_console.py PATH/TO/console-host-drive
+usage: [PMSTEP_TUNE=PATH/TO/pmstep-tune] test_pmstep_console.py PATH/TO/console-host-drive
+(the tests that run setup need PMSTEP_TUNE, and are skipped without it)
 """
+import configparser
 import contextlib
 import io
+import json
 import math
 import os
 import re
@@ -94,8 +99,12 @@ class AgainstTheFirmwareConsole(unittest.TestCase):
     def test_full_dialogue(self):
         c = self.con
         hello = c.hello()
-        self.assertEqual(hello["protocol"], 1)
+        self.assertEqual(hello["protocol"], pc.PROTOCOL_VERSION)
         self.assertEqual(hello["identity"], "pmstep host-drive")
+        # No store attached: no record format, and the image's own configuration counts as a motor's.
+        self.assertEqual((hello["record_format"], hello["store"], hello["configured"]), (0, False, True))
+        with self.assertRaisesRegex(pc.DeviceError, "no stored configuration in this image"):
+            c.config_status()
         table = c.list_config()
         self.assertEqual(len(table), firmware_config_entries())
         names = [e["name"] for e in table]
@@ -235,6 +244,298 @@ class AgainstAPositionDrive(AgainstTheFirmwareConsole):
         self.assertEqual(err.getvalue().count("refused request"), 3)
         self.link = pc.open_endpoint(self.slave_name, 115200)
         self.con = pc.Console(self.link)
+
+
+REPO = Path(__file__).resolve().parents[2]
+MOTOR = REPO / "sil" / "scenarios" / "motors" / "17hs4401.ini"
+MOTOR_DB = REPO / "tests" / "closed_loop" / "data" / "klipper_motors.cfg"
+TUNE = os.environ.get("PMSTEP_TUNE")  # pmstep-tune of the same build (the CMake test passes it)
+needs_tune = unittest.skipUnless(TUNE and os.access(TUNE, os.X_OK),
+                                 "PMSTEP_TUNE does not name a pmstep-tune binary")
+
+
+class CodeNames(unittest.TestCase):
+    """The host tool's names of status codes: the store's table against its header, the core's from
+    its header at run time."""
+
+    def parse_header_enum(self, header, name):
+        import gen_reference  # tools/, on the path above
+        return {v.value: v.name for v in gen_reference.parse_enum(gen_reference.Source(REPO, header), name)}
+
+    def test_store_codes_match_the_header(self):
+        header = self.parse_header_enum("firmware/console/include/pmstep_store.h", "pmstep_store_status_t")
+        self.assertEqual({code: row[0] for code, row in pc.STORE_CODES.items()}, header)
+
+    def test_console_errors_match_the_header(self):
+        header = self.parse_header_enum("firmware/console/include/pmstep_console.h", "pmstep_console_error_t")
+        self.assertEqual(set(pc.ERRORS), set(header))
+
+    def test_core_codes_named_from_the_header(self):
+        header = self.parse_header_enum("firmware/include/pmstep/pmstep_types.h", "pmstep_status_t")
+        code = next(v for v, n in header.items() if n == "PMSTEP_ERR_INERTIA")
+        self.assertTrue(pc.describe_code(code).startswith(f"status {code} (PMSTEP_ERR_INERTIA: "))
+        self.assertIn("(PMSTEP_STORE_ERR_FORMAT, another format: a record of another firmware)", pc.describe_code(-142))
+        self.assertIn("a record of another firmware", pc.store_outcome(-142))
+        self.assertEqual(pc.describe_code(-9999), "status -9999")  # no name: the number
+
+    def test_record_round_trip(self):
+        rec = pc.Record(pc.RECORD_FORMAT, 0x1234, 0xABCD, 0, [pc.f32(0.1), 2.0, -3.5],
+                        dict(zip(pc.MEASURED_FIELDS, [6] + [pc.f32(0.01 * k) for k in range(7)])))
+        data = rec.encode()
+        self.assertEqual(len(data), 32 + 4 * 3 + 4 * 8 + 4)
+        back = pc.Record.decode(data)
+        self.assertEqual((back.board_id, back.layout_id, back.values, back.measured),
+                         (rec.board_id, rec.layout_id, rec.values, rec.measured))
+        bad = bytearray(data)
+        bad[40] ^= 1
+        with self.assertRaisesRegex(pc.MalformedReply, "CRC"):
+            pc.Record.decode(bytes(bad))
+
+
+class AgainstAStoredConfiguration(unittest.TestCase):
+    """console-host-drive --flash FILE: the stored configuration on a flash kept in a file. A reset of
+    the board is the process killed (a power cut) and started again on the same file; the tool runs
+    as on the command line (pc.main) on the pty's other side."""
+    BOARD_ID = 0x0B0A4D17
+
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.flash = os.path.join(self.tmp.name, "flash.bin")
+        self.master, slave = os.openpty()
+        self.slave_name = os.ttyname(slave)
+        os.close(slave)
+        self.drive = None
+        self.boot()
+
+    def tearDown(self):
+        self.power_off()
+        os.close(self.master)
+        self.tmp.cleanup()
+
+    def power_off(self):
+        """Kills the drive (a power cut: the file holds what its flash holds); @return its exit
+        status and what it wrote on stderr."""
+        if self.drive is None:
+            return None, ""
+        if self.drive.poll() is None:
+            self.drive.kill()
+        _, err = self.drive.communicate(timeout=10)
+        code, self.drive = self.drive.returncode, None
+        return code, err.decode("utf-8", "replace")
+
+    def boot(self, *args):
+        """A reset: the drive started again on the same flash file, the bytes of the old one's line
+        dropped."""
+        self.power_off()
+        os.set_blocking(self.master, False)
+        try:
+            while os.read(self.master, 4096):
+                pass
+        except OSError:  # nothing more (EAGAIN), or the tool's side is not open (EIO)
+            pass
+        self.drive = subprocess.Popen([DRIVE, "--flash", self.flash, "--board-id", hex(self.BOARD_ID), *args],
+                                      stdin=self.master, stdout=self.master, stderr=subprocess.PIPE)
+
+    def cli(self, *args):
+        """The command line against the drive: (exit status, stdout, stderr)."""
+        out, err = io.StringIO(), io.StringIO()
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            try:
+                code = pc.main(["--port", self.slave_name, *args])
+            except SystemExit as e:  # argparse
+                code = e.code
+        return code, out.getvalue(), err.getvalue()
+
+    def ok(self, *args):
+        code, out, err = self.cli(*args)
+        self.assertEqual(code, 0, f"{args}: {out}{err}")
+        return out
+
+    def hello(self):
+        out = self.ok("hello")
+        return {k: v for k, v in re.findall(r"^  (\w+) +(.*)$", out, flags=re.M)}
+
+    def take_backup(self, name):
+        path = os.path.join(self.tmp.name, name)
+        self.ok("backup", path)
+        with open(path, encoding="utf-8") as f:
+            return path, json.load(f)
+
+    def design(self, *motor):
+        """pmstep-tune's design for the board, run here, not by the tool: @p motor (its motor arguments),
+        the board's read-only values (read with `get`) as the scenario's; the [controller.*] values by
+        the table's names."""
+        ini = os.path.join(self.tmp.name, "design.ini")
+        argv = [TUNE, *motor]
+        for name, key in pc.READ_ONLY_SCENARIO_KEYS.items():
+            value = re.search(r"= (\S+) ", self.ok("get", name)).group(1)
+            argv += ["--set", f"{key}={value}"]
+        subprocess.run(argv + ["--write-ini", ini], check=True, stdout=subprocess.DEVNULL)
+        cp = configparser.ConfigParser(interpolation=None)
+        cp.optionxform = str
+        cp.read(ini)
+        out = {}
+        for section in cp.sections():
+            if section.startswith("controller"):
+                for key, text in cp.items(section):
+                    name = (section[len("controller."):] + "." if section != "controller" else "") + key
+                    out[name] = {"true": 1.0, "false": 0.0}.get(text, None)
+                    out[name] = out[name] if out[name] is not None else float(text)
+        return out
+
+    def test_empty_store_refuses_start(self):
+        h = self.hello()
+        self.assertEqual((h["protocol"], h["record_format"], h["store"], h["configured"]),
+                         (str(pc.PROTOCOL_VERSION), str(pc.RECORD_FORMAT), "True", "False"))
+        code, _, err = self.cli("start")
+        self.assertEqual(code, 1)
+        self.assertIn("no motor configured", err)
+        self.assertIn("setup --motor MOTOR.ini", err)
+        self.assertEqual(len(err.splitlines()), 1, err)
+        code, _, err = self.cli("save")
+        self.assertEqual(code, 1)
+        self.assertIn("nothing to save", err)
+        out = self.ok("store")
+        self.assertRegex(out, r"configured +no")
+        self.assertRegex(out, r"boot +empty \(")
+        self.assertRegex(out, r"board id +0x0b0a4d17")
+        with open(self.flash, "rb") as f:  # the absent file became an erased flash
+            self.assertEqual(f.read(), b"\xff" * 4096)
+
+    def test_setup_errors_write_nothing(self):
+        for args, code, message in ((["setup"], 2, "give --motor"),
+                                    (["setup", "--motor", str(MOTOR), "--tune", "/nonexistent/pmstep-tune"], 2,
+                                     "pmstep-tune not found at /nonexistent/pmstep-tune"),
+                                    (["setup", "--motor", str(MOTOR), "--set", "run.period_s=1e-4"], 2,
+                                     "read-only"),
+                                    (["setup", "--motor", "/nonexistent.ini"], 2, "no such file")):
+            with self.subTest(args=args):
+                got, _, err = self.cli(*args)
+                self.assertEqual(got, code, err)
+                self.assertIn(message, err)
+        self.assertRegex(self.ok("store"), r"configured +no")
+
+    @needs_tune
+    def test_setup_reset_backup_erase_restore(self):
+        out = self.ok("setup", "--motor", str(MOTOR))
+        self.assertIn("read back equal", out)
+        self.assertIn("saved: slot 0, sequence 1", out)
+        self.assertIn("bus 24 V (the motor preset's run.bus_voltage_V)", out)
+        design = self.design("--motor", str(MOTOR))
+        self.boot()  # reset
+        h = self.hello()
+        self.assertEqual(h["configured"], "True")
+        self.assertIn(f"motor.resistance_Ohm = {pc.f32_text(pc.f32(design['motor.resistance_Ohm']))} ",
+                      self.ok("get", "motor.resistance_Ohm"))
+        path, saved = self.take_backup("setup.json")
+        # Every value the design gives and the board has is the design's (float32); the rest the board's.
+        for name, value in saved["values"].items():
+            if name in design:
+                self.assertEqual(pc.f32(float(value)), pc.f32(design[name]), name)
+        self.assertRegex(self.ok("store"), r"boot +ok")
+        self.boot("--board-id", hex(self.BOARD_ID + 1))  # the same flash on another board: not loaded
+        self.assertEqual(self.hello()["configured"], "False")
+        self.assertRegex(self.ok("store"), r"boot +another board \(made for another board: ")
+        self.boot()
+        out = self.ok("erase")
+        self.assertIn("no motor configured", out)
+        self.assertEqual(self.cli("start")[0], 1)  # the defaults in force at once
+        self.boot()
+        self.assertEqual(self.hello()["configured"], "False")
+        self.assertRegex(self.ok("store"), r"boot +empty")
+        out = self.ok("restore", path, "--save")
+        self.assertIn("saved: slot 0, sequence 1", out)
+        self.boot()
+        self.assertEqual(self.hello()["configured"], "True")
+        _, again = self.take_backup("again.json")
+        self.assertEqual(again, saved)
+        self.assertIn("start: done", self.ok("start"))
+        link = pc.open_endpoint(self.slave_name)
+        try:
+            pc.Console(link).sim_advance(3)  # the steps of the alignment: the motor runs
+        finally:
+            link.close()
+        code, _, err = self.cli("restore", path)
+        self.assertEqual(code, 1, err)
+        # S_ALIGN, or FAULT: the host drive's constant 48 V bus is above the trip designed for 24 V
+        self.assertRegex(err, r"restore needs the motor stopped \(IDLE\), it is in "
+                              r"(S_ALIGN: `stop`|FAULT: `clear`) first")
+
+    @needs_tune
+    def test_refused_restores_change_nothing(self):
+        self.ok("setup", "--motor", str(MOTOR))
+        path, saved = self.take_backup("setup.json")
+
+        def edited(name, change):
+            data = json.loads(json.dumps(saved))
+            change(data)
+            p = os.path.join(self.tmp.name, name)
+            with open(p, "w", encoding="utf-8") as f:
+                json.dump(data, f)
+            return p
+
+        cases = [(edited("inertia.json", lambda d: d["values"].update({"motor.inertia_kgm2": -1e-5})), 1,
+                  r"refused the record: status -\d+ \(PMSTEP_ERR_INERTIA: "),  # the core's code, by name
+                 (edited("unknown.json", lambda d: d["values"].update({"no.such_value": 1.0})), 1,
+                  r"values this board does not: no\.such_value;"),
+                 (edited("period.json", lambda d: d["values"].update({"timing.period_s": 1e-4})), 1,
+                  r"other read-only values: timing\.period_s \(backup 0\.0001, board "),
+                 (edited("pole_pairs.json", lambda d: d["values"].update({"motor.pole_pairs": 50.5})), 1,
+                  r"motor\.pole_pairs = 50\.5: not a whole number"),
+                 (edited("novalues.json", lambda d: d.pop("values")), 2, r"no \"values\" by name")]
+        for p, code, message in cases:
+            with self.subTest(os.path.basename(p)):
+                got, _, err = self.cli("restore", p, "--save")
+                self.assertEqual(got, code, err)
+                self.assertRegex(err, message)
+                self.assertEqual(len(err.splitlines()), 1, err)
+                self.assertEqual(self.take_backup("now.json")[1], saved)
+        self.boot()
+        self.assertEqual(self.take_backup("after_reset.json")[1], saved)
+        self.assertRegex(self.ok("store"), r"sequence +1\n")
+
+    @needs_tune
+    def test_motor_database_and_a_refused_design(self):
+        out = self.ok("setup", "--motor-db", str(MOTOR_DB), "--name", "ldo-42sth48-2504ah", "--bus-voltage", "36")
+        self.assertIn("bus 36 V (--bus-voltage)", out)
+        self.assertIn("saved: slot 0, sequence 1", out)
+        design = self.design("--motor-db", str(MOTOR_DB), "--name", "ldo-42sth48-2504ah",
+                             "--set", "run.bus_voltage_V=36")
+        self.assertIn(f"limits.max_bus_voltage_V = {pc.f32_text(pc.f32(design['limits.max_bus_voltage_V']))} ",
+                      self.ok("get", "limits.max_bus_voltage_V"))  # the trip designed for 36 V
+        _, before = self.take_backup("before.json")
+        code, out, err = self.cli("setup", "--motor-db", str(MOTOR_DB), "--name", "ncm-as-nm")  # N cm as N m
+        self.assertEqual(code, 1, err)
+        self.assertIn("pmstep-tune refused the design (exit 1); nothing written", err)
+        self.assertEqual(self.take_backup("after.json")[1], before)
+
+    @needs_tune
+    def test_power_cut_in_a_save_keeps_the_previous_record(self):
+        """The drive loses its power in the middle of a save (its own flash operation number N cut
+        half-way, then it exits): after the reset the record saved before is in force. The cut at
+        the save's erase, its first program, one half-way, and the CRC's (the last); then a save
+        without a cut, which the next reset finds."""
+        self.ok("setup", "--motor", str(MOTOR))
+        _, saved = self.take_backup("setup.json")
+        units = (len(saved["record"]) // 2 + 7) // 8  # 8-byte programs of a save, after its erase
+        gain = saved["values"]["gains.speed_gain_per_s"]
+        for cut in (1, 2, 1 + units // 2, 1 + units):
+            with self.subTest(cut=cut):
+                self.boot("--power-cut-after", str(cut))
+                self.ok("set", "gains.speed_gain_per_s", str(gain + 10))
+                code, _, err = self.cli("save")
+                self.assertEqual(code, 3, err)  # no reply: the drive is gone
+                status, drive_err = self.power_off()
+                self.assertEqual(status, 3)
+                self.assertIn(f"power cut in flash operation {cut} ({'erase' if cut == 1 else 'program'}", drive_err)
+                self.boot()
+                self.assertEqual(self.take_backup("after.json")[1], saved)
+                self.assertRegex(self.ok("store"), r"slot +0\n  sequence +1\n")
+        self.boot("--power-cut-after", str(2 + units))  # after the save's last operation
+        self.ok("set", "gains.speed_gain_per_s", str(gain + 10))
+        self.assertIn("saved: slot 1, sequence 2", self.ok("save"))
+        self.boot()
+        self.assertIn(f"= {pc.f32_text(pc.f32(gain + 10))} ", self.ok("get", "gains.speed_gain_per_s"))
 
 
 class AgainstABadLine(unittest.TestCase):

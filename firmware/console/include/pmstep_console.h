@@ -15,8 +15,9 @@
  * Telemetry frames (TYPE 0x90, SEQ 0) come unasked at the chosen decimation.
  *
  * Requests (DATA):
- *   0x01 HELLO              -                        -> protocol version u8, max payload u8, text
- *                                                       "pmstep <version> <port>"
+ *   0x01 HELLO              -                        -> protocol version u8, max payload u8, record
+ *                              format u8 (0: no stored configuration), flags u8 (1 a store attached,
+ *                              2 a motor configured), text "pmstep <version> <port>"
  *   0x02 START, 0x03 STOP, 0x04 CLEAR_FAULT  -       -> ACK: status i16, period u32
  *   0x05 SPEED_TARGET       target f32, ramp f32     -> ACK (pmstep_set_speed_target)
  *   0x06 ID_TARGET          target f32               -> ACK (pmstep_set_id_target)
@@ -41,6 +42,34 @@
  *                              (1 tracked, 2 position mode, 4 moving); status -2 BAD_MODE and
  *                              zeros while not tracked
  *   0x10 SET_POSITION_ZERO  -                        -> ACK (pmstep_position_set_zero)
+ *   0x11 CONFIG_READ        offset u16               -> offset u16, total u16, the bytes of the record
+ *                              of the configuration in force from offset (up to 56; pmstep_store.h's
+ *                              layout, sequence 0); offset 0 encodes it anew
+ *   0x12 CONFIG_WRITE       offset u16, bytes        -> staged u16: bytes of a record staged, in order
+ *                              (offset 0 starts a new one, any other must be the bytes staged so far:
+ *                              else BAD_VALUE); answered at once
+ *   0x13 CONFIG_APPLY       -                        -> ACK (IDLE only: the staged record decoded and
+ *                              validated whole, then in force and the drive configured; status a
+ *                              pmstep_store_status_t, or the pmstep_status_t that refused it)
+ *   0x14 CONFIG_SAVE        -                        -> ACK (IDLE or FAULT, bridge off: the configuration
+ *                              in force and what it was measured with, to flash; pmstep_store_status_t)
+ *   0x15 CONFIG_ERASE       -                        -> ACK (IDLE or FAULT, bridge off: both slots erased;
+ *                              the configuration in force stays until a reset or CONFIG_DEFAULTS)
+ *   0x16 CONFIG_DEFAULTS    -                        -> ACK (IDLE only: the board's configuration with no
+ *                              motor in force, the drive not configured; the flash untouched)
+ *   0x17 CONFIG_STATUS      -                        -> configured u8, boot status i16, boot validation
+ *                              i16, last status i16, slot i8, sequence u32, record bytes u16, format u8,
+ *                              layout id u32, board id u32; answered at once
+ *   0x18 CALIBRATE          rated current f32, pole pairs u16 [, flags u8 [, detent fraction f32]]
+ *                                                    -> ACK (IDLE only: self-commissioning from the rated
+ *                              current, pmstep_calibrate.h; flags 1 = paper mode, else robust; detent
+ *                              fraction of the holding torque, absent = 0.05); its runs follow at the
+ *                              period boundaries; when done, the design is in force, the drive configured
+ *                              and the record saved. STOP cancels it; while it runs, any other request
+ *                              that touches the core gets BUSY
+ *   0x19 CALIBRATE_STATUS   -                        -> stage u8, status i16, fault u8, runs u8,
+ *                              identification u8, save status i16, R f32, L f32, k_M f32, J f32, F f32;
+ *                              answered at once
  *   0x40 SIM_ADVANCE        periods u32              -> (simulation images only) reply when run:
  *                                                       status i16 (0), period u32
  *   0x41 SIM_FINISH         -                        -> (simulation images only) ACK, then the
@@ -50,7 +79,11 @@
  * PMSTEP_ERR_BAD_MODE), and the period from which the command takes effect (the first
  * step that sees it). The position requests 0x0D..0x10 need position control attached
  * (pmstep_console_attach_position); without it (an image in speed mode) they get the error
- * reply PMSTEP_CONSOLE_ERR_NO_POSITION (9). STATUS and TELEMETRY carry the index of the period whose step they
+ * reply PMSTEP_CONSOLE_ERR_NO_POSITION (9). The CONFIG_* requests 0x11..0x17 need the stored
+ * configuration attached (pmstep_console_attach_store), else PMSTEP_CONSOLE_ERR_NO_STORE (11); with it,
+ * START on a drive with no motor configured gets PMSTEP_CONSOLE_ERR_NOT_CONFIGURED (10). CALIBRATE and
+ * CALIBRATE_STATUS need self-commissioning attached too (pmstep_console_attach_calibration), else
+ * PMSTEP_CONSOLE_ERR_NO_CALIBRATION (12). STATUS and TELEMETRY carry the index of the period whose step they
  * report; telemetry comes for the periods that are multiples of the decimation.
  *
  * Timing: pmstep_console_receive() runs in the main loop, never in the control interrupt.
@@ -72,12 +105,14 @@
 
 #include "pmstep/pmstep.h"
 #include "pmstep/pmstep_position.h"
+#include "pmstep_store.h"
+#include "pmstep/pmstep_calibrate.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-#define PMSTEP_CONSOLE_PROTOCOL_VERSION 1u
+#define PMSTEP_CONSOLE_PROTOCOL_VERSION 2u
 #define PMSTEP_CONSOLE_SYNC 0xA5u
 #define PMSTEP_CONSOLE_MAX_PAYLOAD 64u    /**< TYPE + SEQ + DATA */
 #define PMSTEP_CONSOLE_TX_BYTES 1024u     /**< transmit ring */
@@ -101,6 +136,15 @@ typedef enum {
     PMSTEP_CONSOLE_HOLD = 0x0E,
     PMSTEP_CONSOLE_GET_POSITION = 0x0F,
     PMSTEP_CONSOLE_SET_POSITION_ZERO = 0x10,
+    PMSTEP_CONSOLE_CONFIG_READ = 0x11,
+    PMSTEP_CONSOLE_CONFIG_WRITE = 0x12,
+    PMSTEP_CONSOLE_CONFIG_APPLY = 0x13,
+    PMSTEP_CONSOLE_CONFIG_SAVE = 0x14,
+    PMSTEP_CONSOLE_CONFIG_ERASE = 0x15,
+    PMSTEP_CONSOLE_CONFIG_DEFAULTS = 0x16,
+    PMSTEP_CONSOLE_CONFIG_STATUS = 0x17,
+    PMSTEP_CONSOLE_CALIBRATE = 0x18,
+    PMSTEP_CONSOLE_CALIBRATE_STATUS = 0x19,
     PMSTEP_CONSOLE_SIM_ADVANCE = 0x40,
     PMSTEP_CONSOLE_SIM_FINISH = 0x41,
     PMSTEP_CONSOLE_TELEMETRY_FRAME = 0x90,
@@ -117,7 +161,11 @@ typedef enum {
     PMSTEP_CONSOLE_ERR_NOT_STOPPED = 6,    /**< a configuration change while the motor runs */
     PMSTEP_CONSOLE_ERR_BUSY = 7,           /**< the previous command has not reached the core yet */
     PMSTEP_CONSOLE_ERR_NOT_SUPPORTED = 8,  /**< e.g. SIM_ADVANCE on hardware */
-    PMSTEP_CONSOLE_ERR_NO_POSITION = 9     /**< a position request, no position control attached */
+    PMSTEP_CONSOLE_ERR_NO_POSITION = 9,    /**< a position request, no position control attached */
+    PMSTEP_CONSOLE_ERR_NOT_CONFIGURED = 10, /**< START or CONFIG_SAVE with no motor configured: write a
+                                                 record (pmstep_console.py setup) or CALIBRATE first */
+    PMSTEP_CONSOLE_ERR_NO_STORE = 11,      /**< a CONFIG_* or CALIBRATE request, no stored configuration attached */
+    PMSTEP_CONSOLE_ERR_NO_CALIBRATION = 12 /**< CALIBRATE, no self-commissioning attached */
 } pmstep_console_error_t;
 
 /** GET_POSITION flags. */
@@ -211,9 +259,48 @@ typedef struct {
     float b;              /**< SPEED_TARGET ramp */
     uint32_t u;           /**< TELEMETRY decimation */
     float arg[4];         /**< a position request's values (absent ones 0) */
+    uint16_t offset;      /**< CONFIG_READ's byte offset */
 } pmstep_console_request_t;
 
+/**
+ * The stored configuration as the console serves it (pmstep_console_store.c, linked only by an image
+ * that attaches it with pmstep_console_attach_store()): the store on the port's flash, the board's
+ * own configuration, and whether a motor is configured. Until one is - from the store at boot, a
+ * whole record written (CONFIG_WRITE, CONFIG_APPLY) or CALIBRATE - START is refused with
+ * PMSTEP_CONSOLE_ERR_NOT_CONFIGURED, and SET_CONFIG alone does not make the drive configured.
+ */
+typedef struct {
+    pmstep_store_t *store;              /**< the port's flash slots (pmstep_store_init() done) */
+    pmstep_config_t defaults;           /**< the board's configuration with no motor: its read-only values
+                                             (period, delay, sensing ranges) are every record's */
+    pmstep_store_measured_t measured;   /**< what the configuration in force was measured with */
+    bool configured;                    /**< a motor's configuration is in force: START allowed */
+    int16_t boot_status;                /**< pmstep_store_load()'s at boot (pmstep_store_status_t) */
+    int16_t boot_validation;            /**< pmstep_validate_config()'s, when that refused the stored one */
+    int16_t last_status;                /**< the last save's, erase's or apply's status */
+    uint8_t staging[PMSTEP_STORE_RECORD_MAX_BYTES]; /**< CONFIG_WRITE's bytes, in order from 0 */
+    uint32_t staged;                    /**< bytes staged */
+    uint8_t image[PMSTEP_STORE_RECORD_MAX_BYTES];   /**< the record CONFIG_READ serves (encoded at offset 0) */
+    uint32_t image_bytes;
+} pmstep_console_store_t;
+
+/**
+ * At boot, before pmstep_init(): loads the newest record of @p store (pmstep_store_load()) into
+ * @p cfg and marks the drive configured; when there is none, or it is refused (another format, board
+ * or layout, a bad CRC, a configuration the core refuses), @p cfg is @p defaults, the drive is not
+ * configured, and the cause stays in @p cs->boot_status for HELLO and CONFIG_STATUS. Never half
+ * applied. @return the load's status.
+ */
+pmstep_store_status_t pmstep_console_store_boot(pmstep_console_store_t *cs, pmstep_store_t *store,
+                                                const pmstep_config_t *defaults, pmstep_config_t *cfg);
+
 struct pmstep_console;
+
+/** Applies a CONFIG_* request at the period boundary (pmstep_console_store.c, linked only by an image
+ *  that attaches the store): sends its reply. @return false if it was refused (not counted as applied). */
+typedef bool (*pmstep_console_store_apply_t)(struct pmstep_console *c, const pmstep_console_request_t *req,
+                                             pmstep_t *inst, pmstep_config_t *cfg,
+                                             const pmstep_console_snapshot_t *snap);
 
 /** The simulation images' requests (SIM_ADVANCE, SIM_FINISH; pmstep_console_sim.c): answers
  *  @p type with DATA @p d of @p n bytes. @return 0, or the pmstep_console_error_t to reply. */
@@ -235,6 +322,14 @@ typedef struct pmstep_console {
     pmstep_console_position_apply_t position_apply;
     /* simulation images (NULL: none, the simulation requests are refused): periods to run */
     pmstep_console_sim_request_t sim_request;
+    /* stored configuration (NULL: none; the image's configuration is then the one in force) */
+    pmstep_console_store_t *store;
+    pmstep_console_store_apply_t store_apply;
+    /* self-commissioning (NULL: none; CALIBRATE refused) */
+    pmstep_calibrate_t *calibration;
+    pmstep_console_store_apply_t calibration_apply; /**< CALIBRATE at the boundary, and each boundary while it runs */
+    int16_t calibration_save_status;                /**< the store's status of the calibrated design's save */
+    bool calibrating;                               /**< a calibration runs, or its design waits to be saved */
     uint32_t advance_periods;
     uint8_t advance_seq;
     bool advancing;
@@ -267,13 +362,28 @@ void pmstep_console_attach_simulation(pmstep_console_t *c);
  */
 void pmstep_console_attach_position(pmstep_console_t *c, pmstep_position_t *pos);
 
+/**
+ * Attaches the stored configuration (@p cs, filled by pmstep_console_store_boot()): the CONFIG_*
+ * requests then reach it, and START needs a configured motor. Saves and erases run at the period
+ * boundary, with the motor IDLE or in FAULT and the bridge off; the flash may take tens of
+ * milliseconds there (the control interrupt held off all that time, as the flash stalls the core).
+ */
+void pmstep_console_attach_store(pmstep_console_t *c, pmstep_console_store_t *cs);
+
+/**
+ * Attaches self-commissioning (@p cal; the stored configuration must be attached too): CALIBRATE starts it,
+ * and while it runs pmstep_console_pending() is true, so that the application calls
+ * pmstep_console_boundary() at every period boundary, where its runs advance.
+ */
+void pmstep_console_attach_calibration(pmstep_console_t *c, pmstep_calibrate_t *cal);
+
 /** Feeds received bytes (main loop). @p now_ms: a millisecond clock, for the truncation timeout. */
 void pmstep_console_receive(pmstep_console_t *c, const uint8_t *data, uint32_t n, uint32_t now_ms);
 
 /** Drops a frame that has been silent for PMSTEP_CONSOLE_TRUNCATION_MS (main loop). */
 void pmstep_console_poll(pmstep_console_t *c, uint32_t now_ms);
 
-/** Whether a command waits for the next period boundary. */
+/** Whether the console needs the next period boundary: a command waits, or a calibration runs. */
 bool pmstep_console_pending(const pmstep_console_t *c);
 
 /**

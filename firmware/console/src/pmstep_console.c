@@ -21,7 +21,7 @@ void pmstep_console_init(pmstep_console_t *c, const char *identity)
 
 bool pmstep_console_pending(const pmstep_console_t *c)
 {
-    return c->pending;
+    return c->pending || c->calibrating;
 }
 
 void pmstep_console_receive(pmstep_console_t *c, const uint8_t *data, uint32_t n, uint32_t now_ms)

@@ -61,21 +61,61 @@ static void send_position(pmstep_console_t *c, uint8_t seq, int32_t status, cons
     pmstep_console_send(c, PMSTEP_CONSOLE_GET_POSITION | 0x80u, seq, w.b, w.n);
 }
 
+/* What a request may do while a calibration runs: read, or STOP it (the calibration's); the rest would
+ * reach a core the calibration drives. */
+static bool allowed_while_calibrating(uint8_t cmd)
+{
+    return cmd == PMSTEP_CONSOLE_GET_STATUS || cmd == PMSTEP_CONSOLE_GET_CONFIG || cmd == PMSTEP_CONSOLE_GET_COMMISSIONING
+           || cmd == PMSTEP_CONSOLE_TELEMETRY || cmd == PMSTEP_CONSOLE_GET_POSITION || cmd == PMSTEP_CONSOLE_CONFIG_READ;
+}
+
 void pmstep_console_boundary(pmstep_console_t *c, pmstep_t *inst, pmstep_config_t *cfg,
                              const pmstep_console_snapshot_t *snap)
 {
     const pmstep_console_request_t *req = &c->mail;
     const uint8_t seq = req->seq;
     int32_t st = 0;
+    if (c->calibrating) {
+        (void)c->calibration_apply(c, NULL, inst, cfg, snap); /* its runs advance at every boundary */
+    }
     if (!c->pending) {
         return;
     }
     c->pending = false;
     c->count.commands_applied++;
+    if (c->calibrating && !allowed_while_calibrating(req->cmd)) {
+        if (req->cmd != PMSTEP_CONSOLE_STOP || !c->calibration_apply(c, req, inst, cfg, snap)) {
+            c->count.commands_applied--;
+            if (req->cmd != PMSTEP_CONSOLE_STOP) {
+                pmstep_console_send_error(c, req->cmd, seq, PMSTEP_CONSOLE_ERR_BUSY);
+            }
+        }
+        return;
+    }
     switch (req->cmd) {
     case PMSTEP_CONSOLE_START:
+        if (c->store != NULL && !c->store->configured) {
+            /* No motor's configuration in force: the board's defaults are no motor's to drive. */
+            c->count.commands_applied--;
+            pmstep_console_send_error(c, PMSTEP_CONSOLE_START, seq, PMSTEP_CONSOLE_ERR_NOT_CONFIGURED);
+            return;
+        }
         st = (int32_t)pmstep_start(inst);
         break;
+    case PMSTEP_CONSOLE_CALIBRATE:
+        if (!c->calibration_apply(c, req, inst, cfg, snap)) { /* attached: checked at parsing; it replies */
+            c->count.commands_applied--;
+        }
+        return;
+    case PMSTEP_CONSOLE_CONFIG_READ:
+    case PMSTEP_CONSOLE_CONFIG_APPLY:
+    case PMSTEP_CONSOLE_CONFIG_SAVE:
+    case PMSTEP_CONSOLE_CONFIG_ERASE:
+    case PMSTEP_CONSOLE_CONFIG_DEFAULTS:
+        if (!c->store_apply(c, req, inst, cfg, snap)) { /* attached: checked at parsing; it replies */
+            c->count.commands_applied--;
+        }
+        return;
     case PMSTEP_CONSOLE_STOP:
         st = (int32_t)pmstep_stop(inst);
         break;

@@ -81,4 +81,11 @@ void pmstep_console_send_ack(pmstep_console_t *c, uint8_t type, uint8_t seq, int
  * mailbox for the next period boundary. */
 void pmstep_console_handle_frame(pmstep_console_t *c);
 
+/* ---- stored configuration (pmstep_console_store.c) ---- */
+
+/* @p next in force: *cfg = *next, the core initialised on it, position gains designed anew.
+ * @return pmstep_init()'s (or the position design's) status. */
+int32_t pmstep_console_put_in_force(pmstep_console_t *c, pmstep_t *inst, pmstep_config_t *cfg,
+                                    const pmstep_config_t *next);
+
 #endif /* PMSTEP_CONSOLE_INTERNAL_H */

@@ -22,6 +22,8 @@ typedef int (*request_parse_t)(pmstep_console_t *c, const uint8_t *d, uint32_t n
 #define NEEDS_NOTHING 0u
 #define NEEDS_POSITION 1u   /* position control attached, else PMSTEP_CONSOLE_ERR_NO_POSITION */
 #define NEEDS_SIMULATION 2u /* a simulation image, else PMSTEP_CONSOLE_ERR_NOT_SUPPORTED */
+#define NEEDS_STORE 3u      /* the stored configuration attached, else PMSTEP_CONSOLE_ERR_NO_STORE */
+#define NEEDS_CALIBRATION 4u /* the store and self-commissioning attached, else _NO_STORE / _NO_CALIBRATION */
 
 typedef struct {
     uint8_t type;
@@ -58,7 +60,9 @@ static int parse_hello(pmstep_console_t *c, const uint8_t *d, uint32_t n, pmstep
     w.n = 0;
     put_u8(&w, PMSTEP_CONSOLE_PROTOCOL_VERSION);
     put_u8(&w, PMSTEP_CONSOLE_MAX_PAYLOAD);
-    put_text(&w, c->identity != NULL ? c->identity : "pmstep", PMSTEP_CONSOLE_MAX_PAYLOAD - 4u);
+    put_u8(&w, c->store != NULL ? PMSTEP_STORE_FORMAT_VERSION : 0u);
+    put_u8(&w, (c->store != NULL ? 1u : 0u) | (c->store == NULL || c->store->configured ? 2u : 0u));
+    put_text(&w, c->identity != NULL ? c->identity : "pmstep", PMSTEP_CONSOLE_MAX_PAYLOAD - 6u);
     pmstep_console_send(c, (uint8_t)(req->cmd | 0x80u), req->seq, w.b, w.n);
     return REQUEST_ANSWERED;
 }
@@ -167,6 +171,94 @@ static int parse_position(pmstep_console_t *c, const uint8_t *d, uint32_t n, pms
     return REQUEST_QUEUE;
 }
 
+/* CONFIG_READ: the offset to read from. */
+static int parse_config_read(pmstep_console_t *c, const uint8_t *d, uint32_t n, pmstep_console_request_t *req)
+{
+    (void)c;
+    (void)n;
+    req->offset = (uint16_t)(d[0] | ((uint32_t)d[1] << 8));
+    return req->offset < PMSTEP_STORE_RECORD_MAX_BYTES ? REQUEST_QUEUE : PMSTEP_CONSOLE_ERR_BAD_VALUE;
+}
+
+/* CONFIG_WRITE: bytes of a record into the staging buffer, in order; answered at once. Refused while
+ * a CONFIG_APPLY waits to decode the buffer. */
+static int parse_config_write(pmstep_console_t *c, const uint8_t *d, uint32_t n, pmstep_console_request_t *req)
+{
+    pmstep_console_store_t *cs = c->store;
+    const uint32_t offset = (uint32_t)d[0] | ((uint32_t)d[1] << 8);
+    const uint32_t count = n - 2u;
+    writer_t w;
+    if (c->pending && c->mail.cmd == PMSTEP_CONSOLE_CONFIG_APPLY) {
+        return PMSTEP_CONSOLE_ERR_BUSY;
+    }
+    if ((offset != 0u && offset != cs->staged) || offset + count > sizeof cs->staging) {
+        return PMSTEP_CONSOLE_ERR_BAD_VALUE;
+    }
+    memcpy(&cs->staging[offset], d + 2, count);
+    cs->staged = offset + count;
+    w.n = 0;
+    put_u16(&w, cs->staged);
+    pmstep_console_send(c, (uint8_t)(req->cmd | 0x80u), req->seq, w.b, w.n);
+    return REQUEST_ANSWERED;
+}
+
+static int parse_config_status(pmstep_console_t *c, const uint8_t *d, uint32_t n, pmstep_console_request_t *req)
+{
+    const pmstep_console_store_t *cs = c->store;
+    writer_t w;
+    (void)d;
+    (void)n;
+    w.n = 0;
+    put_u8(&w, cs->configured ? 1u : 0u);
+    put_u16(&w, (uint32_t)(uint16_t)cs->boot_status);
+    put_u16(&w, (uint32_t)(uint16_t)cs->boot_validation);
+    put_u16(&w, (uint32_t)(uint16_t)cs->last_status);
+    put_u8(&w, (uint32_t)(uint8_t)(int8_t)cs->store->slot);
+    put_u32(&w, cs->store->sequence);
+    put_u16(&w, pmstep_store_record_bytes());
+    put_u8(&w, PMSTEP_STORE_FORMAT_VERSION);
+    put_u32(&w, pmstep_store_layout_id());
+    put_u32(&w, cs->store->board_id);
+    pmstep_console_send(c, (uint8_t)(req->cmd | 0x80u), req->seq, w.b, w.n);
+    return REQUEST_ANSWERED;
+}
+
+/* CALIBRATE: rated current f32, pole pairs u16 [, flags u8 [, detent fraction f32]]. */
+static int parse_calibrate(pmstep_console_t *c, const uint8_t *d, uint32_t n, pmstep_console_request_t *req)
+{
+    (void)c;
+    if (n != 6u && n != 7u && n != 11u) {
+        return PMSTEP_CONSOLE_ERR_BAD_LENGTH;
+    }
+    req->a = get_f32(d);
+    req->u = (uint32_t)d[4] | ((uint32_t)d[5] << 8);
+    req->arg[0] = n >= 7u ? (float)d[6] : 0.0f;
+    req->b = n == 11u ? get_f32(d + 7) : PMSTEP_CALIBRATE_DETENT_PER_HOLDING;
+    return is_finite(req->a) && is_finite(req->b) ? REQUEST_QUEUE : PMSTEP_CONSOLE_ERR_BAD_VALUE;
+}
+
+static int parse_calibrate_status(pmstep_console_t *c, const uint8_t *d, uint32_t n, pmstep_console_request_t *req)
+{
+    const pmstep_calibrate_t *cal = c->calibration;
+    writer_t w;
+    (void)d;
+    (void)n;
+    w.n = 0;
+    put_u8(&w, (uint32_t)cal->stage);
+    put_u16(&w, (uint32_t)(uint16_t)(int16_t)cal->status);
+    put_u8(&w, (uint32_t)cal->fault);
+    put_u8(&w, cal->runs < 255u ? cal->runs : 255u);
+    put_u8(&w, (uint32_t)cal->identification);
+    put_u16(&w, (uint32_t)(uint16_t)c->calibration_save_status);
+    put_f32(&w, cal->resistance_Ohm);
+    put_f32(&w, cal->inductance_H);
+    put_f32(&w, cal->torque_constant_Nm_A);
+    put_f32(&w, cal->inertia_kgm2);
+    put_f32(&w, cal->friction_Nms_rad);
+    pmstep_console_send(c, (uint8_t)(req->cmd | 0x80u), req->seq, w.b, w.n);
+    return REQUEST_ANSWERED;
+}
+
 #define NAME_ROOM (PMSTEP_CONSOLE_MAX_PAYLOAD - 2u) /* DATA bytes a frame can carry */
 
 static const request_row_t requests[] = {
@@ -186,6 +278,15 @@ static const request_row_t requests[] = {
     {PMSTEP_CONSOLE_HOLD, NEEDS_POSITION, 0u, 4u, parse_position},
     {PMSTEP_CONSOLE_GET_POSITION, NEEDS_POSITION, 0u, 0u, parse_position},
     {PMSTEP_CONSOLE_SET_POSITION_ZERO, NEEDS_POSITION, 0u, 0u, parse_position},
+    {PMSTEP_CONSOLE_CONFIG_READ, NEEDS_STORE, 2u, 2u, parse_config_read},
+    {PMSTEP_CONSOLE_CONFIG_WRITE, NEEDS_STORE, 3u, NAME_ROOM, parse_config_write},
+    {PMSTEP_CONSOLE_CONFIG_APPLY, NEEDS_STORE, 0u, 0u, parse_plain},
+    {PMSTEP_CONSOLE_CONFIG_SAVE, NEEDS_STORE, 0u, 0u, parse_plain},
+    {PMSTEP_CONSOLE_CONFIG_ERASE, NEEDS_STORE, 0u, 0u, parse_plain},
+    {PMSTEP_CONSOLE_CONFIG_DEFAULTS, NEEDS_STORE, 0u, 0u, parse_plain},
+    {PMSTEP_CONSOLE_CONFIG_STATUS, NEEDS_STORE, 0u, 0u, parse_config_status},
+    {PMSTEP_CONSOLE_CALIBRATE, NEEDS_CALIBRATION, 6u, 11u, parse_calibrate},
+    {PMSTEP_CONSOLE_CALIBRATE_STATUS, NEEDS_CALIBRATION, 0u, 0u, parse_calibrate_status},
     {PMSTEP_CONSOLE_SIM_ADVANCE, NEEDS_SIMULATION, 4u, 4u, parse_simulation},
     {PMSTEP_CONSOLE_SIM_FINISH, NEEDS_SIMULATION, 0u, 0u, parse_simulation},
 };
@@ -209,6 +310,12 @@ static int row_available(const pmstep_console_t *c, const request_row_t *row)
     }
     if (row->needs == NEEDS_SIMULATION && c->sim_request == NULL) {
         return PMSTEP_CONSOLE_ERR_NOT_SUPPORTED;
+    }
+    if ((row->needs == NEEDS_STORE || row->needs == NEEDS_CALIBRATION) && (c->store == NULL || c->store_apply == NULL)) {
+        return PMSTEP_CONSOLE_ERR_NO_STORE;
+    }
+    if (row->needs == NEEDS_CALIBRATION && (c->calibration == NULL || c->calibration_apply == NULL)) {
+        return PMSTEP_CONSOLE_ERR_NO_CALIBRATION;
     }
     return REQUEST_QUEUE;
 }

@@ -13,12 +13,21 @@
 #include <stdio.h>
 
 #include "sil/metrics.h"
+#include "sil/plant.h"
 #include "sil/record.h"
 #include "sil/scenario.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
+
+/**
+ * @p plant at @p sc's initial state, and the host port (pmstep_hal_host.h) bound to it with @p sc's
+ * bridge, bus, measurement chain and faults, as sil_run() does before its first period; the load is
+ * @p sc's (a caller may change it before the first period). @return 0, or -3 when the measurement
+ * chain's random number generator could not be allocated (the port released).
+ */
+int sil_bind_plant(const sil_scenario_t *sc, plant_t *plant);
 
 /**
  * Runs @p sc. @p on_sample may be NULL. @p progress prints a progress line to

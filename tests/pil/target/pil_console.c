@@ -11,6 +11,17 @@
  *
  * usage (semihosting command line):
  *   pil-console [--duration S] [--substeps N] [--summary FILE] [--cost FILE]
+ *               [--flash FILE [--board-id N] [--power-cut-after N]] [--no-load]
+ * --flash: the board's stored configuration (pmstep_store.h) and self-commissioning attached, on a
+ * flash of two 2 KiB slots kept in FILE on the host (read at boot, every erase and program written
+ * through at once): the image boots from the newest valid record, or with no motor configured. A
+ * restart of QEMU with the same FILE is a reset of the board. --power-cut-after N: the N-th erase or
+ * 8-byte program is cut half-way (half its bytes written) and the image stops at once, as a board
+ * losing its supply (exit status 5). What this proves: the firmware's store, console and
+ * self-commissioning across resets and cut saves, run by the real core on the emulated Cortex-M4;
+ * not the STM32G4's flash controller (its driver is tested on hal/stm32g4's behavioural model).
+ * --no-load: the plant without the scenario's load torque (a motor free on its shaft, as it is
+ * calibrated).
  * Position control (pmstep_position) is attached to the console: pmstep_position_update() runs
  * after every step (in the main loop, after the control interrupt), and MOVE_TO, HOLD,
  * GET_POSITION, SET_POSITION_ZERO reach it; in speed mode it changes nothing of the run.
@@ -42,6 +53,9 @@
 static pmstep_t motor;
 static pmstep_config_t config; /* outlives the instance, as pmstep_init() requires */
 static pmstep_console_t console;
+static pmstep_store_t store;
+static pmstep_console_store_t stored;
+static pmstep_calibrate_t calibration;
 static pmstep_position_t position;
 static const char *const mode_names[MPS2_PIL_MODES] = {"IDLE", "S_ALIGN", "C_ALIGN", "RUN", "FAULT"};
 
@@ -85,6 +99,113 @@ static void flush_uart(void)
     for (guard = 0; guard < 1000000u && (tx_pos != tx_len || console.tx_head != console.tx_tail); ++guard) {
         service_uart();
     }
+}
+
+/* ---- the board's flash: two slots in a host file (semihosting) ---- */
+
+#define SLOT_BYTES 2048u
+
+static struct {
+    FILE *file;
+    long cut_after;    /* operations left before the power cut; 0: none planned */
+} flash;
+
+static int32_t flash_io(uint32_t slot, uint32_t offset, void *data, uint32_t n, bool write)
+{
+    if (slot > 1u || offset + n > SLOT_BYTES || fseek(flash.file, (long)(slot * SLOT_BYTES + offset), SEEK_SET) != 0) {
+        return -1;
+    }
+    if (write) {
+        return fwrite(data, 1u, n, flash.file) == n && fflush(flash.file) == 0 ? 0 : -2;
+    }
+    return fread(data, 1u, n, flash.file) == n ? 0 : -2;
+}
+
+/* An erase or a program about to happen: the one the plan cuts leaves its @p n bytes with only part
+ * of their bits programmed (a program turns 1s to 0s: half of them still 1), then the board loses its
+ * supply. */
+static void maybe_cut(uint32_t slot, uint32_t offset, const uint8_t *data, uint32_t n)
+{
+    if (flash.cut_after > 0 && --flash.cut_after == 0) {
+        uint8_t partial[256];
+        uint32_t k;
+        n = n < sizeof partial ? n : (uint32_t)sizeof partial;
+        for (k = 0; k < n; ++k) {
+            partial[k] = (uint8_t)(data[k] | 0x55u);
+        }
+        (void)flash_io(slot, offset, partial, n, true);
+        fclose(flash.file);
+        fprintf(stderr, "pil-console: power cut in a flash write (slot %u, offset %u)\n", (unsigned)slot,
+                (unsigned)offset);
+        exit(5);
+    }
+}
+
+static int32_t flash_erase(void *ctx, uint32_t slot)
+{
+    uint8_t ff[256];
+    uint32_t off;
+    (void)ctx;
+    memset(ff, 0xFF, sizeof ff);
+    maybe_cut(slot, 0u, ff, sizeof ff); /* a cut erase: the slot's first bytes erased, the rest as it was */
+    for (off = 0; off < SLOT_BYTES; off += sizeof ff) {
+        if (flash_io(slot, off, ff, sizeof ff, true) != 0) {
+            return -2;
+        }
+    }
+    return 0;
+}
+
+static int32_t flash_program(void *ctx, uint32_t slot, uint32_t offset, const uint8_t *data, uint32_t n)
+{
+    uint8_t was[PMSTEP_STORE_PROGRAM_UNIT];
+    uint32_t k;
+    (void)ctx;
+    for (k = 0; k < n; k += PMSTEP_STORE_PROGRAM_UNIT) {
+        uint32_t b;
+        if (flash_io(slot, offset + k, was, sizeof was, false) != 0) {
+            return -2;
+        }
+        for (b = 0; b < sizeof was; ++b) {
+            if (was[b] != 0xFFu) {
+                return -3; /* NOR flash: a unit is programmed once after its erase */
+            }
+        }
+        maybe_cut(slot, offset + k, &data[k], PMSTEP_STORE_PROGRAM_UNIT);
+        if (flash_io(slot, offset + k, (void *)(uintptr_t)&data[k], PMSTEP_STORE_PROGRAM_UNIT, true) != 0) {
+            return -2;
+        }
+    }
+    return 0;
+}
+
+static int32_t flash_read(void *ctx, uint32_t slot, uint32_t offset, uint8_t *data, uint32_t n)
+{
+    (void)ctx;
+    return flash_io(slot, offset, data, n, false);
+}
+
+static const pmstep_store_flash_t flash_ops = {SLOT_BYTES, flash_erase, flash_program, flash_read, NULL};
+
+/* Opens the flash file, made erased (0xFF) where it is shorter than two slots. @return 0 or -1. */
+static int flash_open(const char *path)
+{
+    long size;
+    flash.file = fopen(path, "r+b");
+    if (flash.file == NULL) {
+        flash.file = fopen(path, "w+b");
+    }
+    if (flash.file == NULL || fseek(flash.file, 0, SEEK_END) != 0) {
+        return -1;
+    }
+    size = ftell(flash.file);
+    while (size >= 0 && size < (long)(2u * SLOT_BYTES)) {
+        if (fputc(0xFF, flash.file) == EOF) {
+            return -1;
+        }
+        ++size;
+    }
+    return fflush(flash.file) == 0 ? 0 : -1;
 }
 
 /* ---- the closed loop (as pil_closed_loop.c) ---- */
@@ -186,6 +307,9 @@ int main(int argc, char **argv)
     static pmstep_console_snapshot_t snap;
     const char *summary_path = NULL;
     const char *cost_path = NULL;
+    const char *flash_path = NULL;
+    bool no_load = false;
+    uint32_t board_id = 0x4D505332u; /* "MPS2" */
     double insns_per_tick;
     pmstep_status_t st;
     long steps;
@@ -204,8 +328,17 @@ int main(int argc, char **argv)
             summary_path = argv[++i];
         } else if (strcmp(argv[i], "--cost") == 0 && i + 1 < argc) {
             cost_path = argv[++i];
+        } else if (strcmp(argv[i], "--flash") == 0 && i + 1 < argc) {
+            flash_path = argv[++i];
+        } else if (strcmp(argv[i], "--board-id") == 0 && i + 1 < argc) {
+            board_id = (uint32_t)strtoul(argv[++i], NULL, 0);
+        } else if (strcmp(argv[i], "--power-cut-after") == 0 && i + 1 < argc) {
+            flash.cut_after = strtol(argv[++i], NULL, 0);
+        } else if (strcmp(argv[i], "--no-load") == 0) {
+            no_load = true;
         } else {
-            fprintf(stderr, "usage: pil-console [--duration S] [--substeps N] [--summary FILE] [--cost FILE]\n");
+            fprintf(stderr, "usage: pil-console [--duration S] [--substeps N] [--summary FILE] [--cost FILE]\n"
+                            "                   [--flash FILE [--board-id N] [--power-cut-after N]] [--no-load]\n");
             return 2;
         }
     }
@@ -214,6 +347,19 @@ int main(int argc, char **argv)
         return 2;
     }
     config = L.sc.controller;
+    if (flash_path != NULL) {
+        /* The board with its flash: the stored record, or no motor configured. */
+        const pmstep_config_t defaults = L.sc.controller;
+        pmstep_store_status_t boot;
+        if (flash_open(flash_path) != 0 || pmstep_store_init(&store, &flash_ops, board_id) != PMSTEP_STORE_OK) {
+            fprintf(stderr, "pil-console: cannot use '%s' as the flash\n", flash_path);
+            return 2;
+        }
+        boot = pmstep_console_store_boot(&stored, &store, &defaults, &config);
+        fprintf(stderr, "pil-console: stored configuration: %s (%d)\n",
+                boot == PMSTEP_STORE_OK ? "in force" : "none in force, no motor configured", (int)boot);
+    }
+    L.sc.controller = config; /* the metrics' windows from the configuration in force */
     st = pmstep_init(&motor, &config);
     if (st != PMSTEP_OK) {
         fprintf(stderr, "pil-console: pmstep_init: %s\n", pmstep_status_str(st));
@@ -234,6 +380,9 @@ int main(int argc, char **argv)
     memset(&L.plant, 0, sizeof L.plant);
     L.plant.params = L.sc.motor;
     L.plant.load = L.sc.load;
+    if (no_load) {
+        L.plant.load.kind = PLANT_LOAD_NONE;
+    }
     L.plant.x.theta_rad = L.sc.theta0_rad;
     L.plant.x.omega_rad_s = L.sc.omega0_rad_s;
     L.plant.x.i_a_A = L.sc.i_a0_A;
@@ -249,6 +398,10 @@ int main(int argc, char **argv)
     pmstep_console_init(&console, "pmstep " PMSTEP_VERSION_TEXT " qemu-mps2-an386");
     pmstep_console_attach_simulation(&console);
     pmstep_console_attach_position(&console, &position);
+    if (flash_path != NULL) {
+        pmstep_console_attach_store(&console, &stored);
+        pmstep_console_attach_calibration(&console, &calibration);
+    }
     snap.period = UINT32_MAX; /* no step yet */
     systick_last = SYST_CVR;
 
