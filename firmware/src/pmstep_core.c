@@ -415,7 +415,8 @@ void pmstep_step(pmstep_t *inst, const pmstep_meas_t *meas, pmstep_output_t *out
         offset_calibration_stage(inst, meas, out);
         return;
     }
-    if (fault == PMSTEP_FAULT_NONE) {
+    if (fault == PMSTEP_FAULT_NONE && inst->mode != PMSTEP_MODE_RUN) {
+        /* Only the alignments time modes and measure: once in RUN the stage has nothing to do. */
         fault = commission_stage(inst, meas);
         if (inst->mode == PMSTEP_MODE_IDLE) { /* measure_only: the bridge off from t_c */
             output_off(out, inst);
