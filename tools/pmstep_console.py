@@ -131,7 +131,7 @@ CONFIG_TYPES = {0: "f32", 1: "u32", 2: "i32", 3: "bool"}
 
 # The record of the stored configuration (firmware/console/include/pmstep_store.h): a header, the
 # configuration table's values (f32 each, in id order), what they were measured with, a CRC-32.
-RECORD_MAGIC = 0x5253504D  # "PMSR"
+RECORD_MAGIC = 0x52534D50  # "PMSR" in memory order (little-endian)
 RECORD_FORMAT = 1          # the record format this tool reads and writes
 RECORD_HEADER = struct.Struct("<IHHIIIHHII")  # magic, format, header bytes, board id, layout id,
 #                                                sequence, value count, measured count, record bytes, reserved

@@ -1,7 +1,9 @@
 # Checks the STM32G431 image the build produced: .elf, .bin and .map exist; the vector
 # table at the start of the .bin holds the initial stack pointer (top of the 32 KiB
-# SRAM), the reset handler, and the ADC1_2 (IRQ 18) and TIM1_BRK (IRQ 24) handlers, each
-# with the Thumb bit; flash and RAM use fit the part. Prints the size.
+# SRAM), the reset handler, the NMI handler (the flash's ECC errors of the stored
+# configuration), and the ADC1_2 (IRQ 18) and TIM1_BRK (IRQ 24) handlers, each with the
+# Thumb bit; flash and RAM use fit the part; the image ends below 0x0801F000, the stored
+# configuration's two pages (62, 63), and no symbol lies in them. Prints the size.
 # Usage: cmake -DIMAGE_DIR= -DNM= -DSIZE= -P check_image.cmake
 cmake_minimum_required(VERSION 3.20)
 foreach(var IMAGE_DIR NM SIZE)
@@ -51,7 +53,7 @@ vector_word(0 sp)
 if(NOT sp STREQUAL "20008000")
   list(APPEND failed "initial SP 0x${sp}, expected 0x20008000 (end of SRAM)")
 endif()
-foreach(entry "1;Reset_Handler" "34;ADC1_2_IRQHandler" "40;TIM1_BRK_TIM15_IRQHandler")
+foreach(entry "1;Reset_Handler" "2;NMI_Handler" "34;ADC1_2_IRQHandler" "40;TIM1_BRK_TIM15_IRQHandler")
   list(GET entry 0 index)
   list(GET entry 1 name)
   vector_word(${index} word)
@@ -72,6 +74,25 @@ math(EXPR flash "${CMAKE_MATCH_1} + ${CMAKE_MATCH_2}")
 math(EXPR ram "${CMAKE_MATCH_2} + ${CMAKE_MATCH_3}")
 if(flash GREATER 131072 OR ram GREATER 30720) # 128 KiB flash; 32 KiB SRAM less the 2 KiB stack reserve
   list(APPEND failed "image does not fit: ${flash} B flash, ${ram} B RAM")
+endif()
+
+# The stored configuration's pages: the .bin (from 0x08000000, where the vector table is) must end
+# below them, and no symbol of the image may lie in them.
+set(store_start 134344704) # 0x0801F000
+set(store_end 134348800)   # 0x08020000
+file(SIZE ${IMAGE_DIR}/pmstep-stm32g431.bin bin_bytes)
+math(EXPR image_end "134217728 + ${bin_bytes}") # 0x08000000 + the .bin's length
+math(EXPR image_end_hex "${image_end}" OUTPUT_FORMAT HEXADECIMAL)
+if(image_end GREATER store_start)
+  list(APPEND failed "image ends at ${image_end_hex}, inside the stored configuration's pages (from 0x0801F000)")
+else()
+  math(EXPR spare "${store_start} - ${image_end}")
+  message(STATUS "image ends at ${image_end_hex}: ${spare} B below the stored configuration's pages (0x0801F000)")
+endif()
+string(REGEX MATCHALL "(^|\n)0801f[0-9a-f][0-9a-f][0-9a-f] [^\n]*" in_store "${symbols}")
+if(in_store)
+  string(STRIP "${in_store}" in_store)
+  list(APPEND failed "symbols in the stored configuration's pages: ${in_store}")
 endif()
 if(failed)
   string(REPLACE ";" "\n  " failed "${failed}")

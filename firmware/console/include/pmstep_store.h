@@ -49,7 +49,7 @@
 extern "C" {
 #endif
 
-#define PMSTEP_STORE_MAGIC 0x5253504Du     /**< "PMSR" in memory order */
+#define PMSTEP_STORE_MAGIC 0x52534D50u     /**< "PMSR" in memory order (little-endian) */
 #define PMSTEP_STORE_FORMAT_VERSION 1u
 #define PMSTEP_STORE_HEADER_BYTES 32u
 #define PMSTEP_STORE_MAX_VALUES 96u        /**< configuration table entries a record can hold */

@@ -1,6 +1,7 @@
 /*
- * The STM32G431 application (see main.c and app.h): the port, the core and the console, and one
- * turn of the main loop. The control step itself runs in the port's ADC interrupt.
+ * The STM32G431 application (see main.c and app.h): the port, the stored configuration, the core
+ * and the console, and one turn of the main loop. The control step itself runs in the port's ADC
+ * interrupt.
  */
 #include "app.h"
 
@@ -16,6 +17,8 @@ static pmstep_t motor;
 static pmstep_config_t motor_config;       /* must outlive the instance */
 static pmstep_stm32g4_config_t board;      /* must outlive the port */
 static pmstep_console_t console;
+static pmstep_store_t store;               /* the port's two flash pages (stm32g4_flash.c) */
+static pmstep_console_store_t console_store; /* the configuration in force, as the console serves it */
 static pmstep_position_t position;         /* sensorless position control on the same instance */
 static pmstep_position_output_t position_out;
 static uint32_t uart_errors;
@@ -65,6 +68,8 @@ int32_t pmstep_app_init(void)
 {
     pmstep_status_t st;
     pmstep_stm32g4_status_t port_st;
+    pmstep_store_status_t store_st;
+    pmstep_config_t defaults;
     uint32_t sysclk_Hz;
 
     board = pmstep_stm32g4_default_config();
@@ -72,9 +77,17 @@ int32_t pmstep_app_init(void)
     if (port_st != PMSTEP_STM32G4_OK) {
         return (int32_t)port_st;
     }
-    motor_config = pmstep_console_app_config(pmstep_stm32g4_period_s(&board), 1u,
-                                             pmstep_stm32g4_current_sense_range_A(&board),
-                                             pmstep_stm32g4_bus_sense_range_V(&board)); /* duties load one period later */
+    /* The board's own configuration (duties load one period later: one period of delay). Then the
+     * newest record of the flash over it, if there is one and it is accepted whole; otherwise the
+     * board's, the drive not configured until a record is written or CALIBRATE runs (START refused). */
+    defaults = pmstep_console_app_config(pmstep_stm32g4_period_s(&board), 1u,
+                                         pmstep_stm32g4_current_sense_range_A(&board),
+                                         pmstep_stm32g4_bus_sense_range_V(&board));
+    store_st = pmstep_store_init(&store, pmstep_stm32g4_store_flash(), pmstep_stm32g4_board_id());
+    if (store_st != PMSTEP_STORE_OK) {
+        return -300 + (int32_t)store_st;
+    }
+    (void)pmstep_console_store_boot(&console_store, &store, &defaults, &motor_config); /* its cause kept there */
     st = pmstep_init(&motor, &motor_config);
     if (st != PMSTEP_OK) {
         return -100 + (int32_t)st;
@@ -98,6 +111,7 @@ int32_t pmstep_app_init(void)
     }
     pmstep_console_init(&console, "pmstep " PMSTEP_VERSION_TEXT " stm32g431");
     pmstep_console_attach_position(&console, &position);
+    pmstep_console_attach_store(&console, &console_store); /* saves at the period boundary, bridge off */
     pmstep_stm32g4_set_after_step(after_step);
     uart_errors = 0u;
     tx_len = 0u;

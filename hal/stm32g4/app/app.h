@@ -13,11 +13,15 @@ extern "C" {
 #endif
 
 /**
- * Clock to 170 MHz, the core (paper configuration, the port's period, one period of delay), the
- * port (bridge off, motor IDLE), position control (pmstep_position, updated in the control
- * interrupt after each step, its commands on the console), the console on LPUART1, then TIM1 started.
+ * Clock to 170 MHz, the stored configuration (the newest record of the flash's two pages,
+ * pmstep_console_store_boot(); with none, or one refused, the board's configuration and the drive
+ * not configured: START is refused until a record is written or CALIBRATE runs), the core (the
+ * port's period, one period of delay), the port (bridge off, motor IDLE), position control
+ * (pmstep_position, updated in the control interrupt after each step, its commands on the console),
+ * the console on LPUART1 with the stored configuration attached (CONFIG_* requests; saves at a period
+ * boundary, bridge off), then TIM1 started.
  * @return 0, or the failing step's status: a pmstep_stm32g4_status_t, -100 + a pmstep_status_t (pmstep_init),
- *         or -200 + a pmstep_status_t (pmstep_position_init).
+ *         -200 + a pmstep_status_t (pmstep_position_init), or -300 + a pmstep_store_status_t (pmstep_store_init).
  */
 int32_t pmstep_app_init(void);
 

@@ -28,12 +28,14 @@
 #include <stdint.h>
 
 #include "pmstep_hal.h"
+#include "pmstep_store.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-/** Status of the port's set-up calls: 0 = ok, negative = one named cause. */
+/** Status of the port's set-up calls and of the stored configuration's flash (pmstep_stm32g4_store_flash(),
+ *  -15 .. -28; the FLASH_SR flags named as in RM0440 §3.7.5): 0 = ok, negative = one named cause. */
 typedef enum {
     PMSTEP_STM32G4_OK = 0,
     PMSTEP_STM32G4_ERR_NULL_ARGUMENT = -1,
@@ -51,9 +53,27 @@ typedef enum {
     PMSTEP_STM32G4_ERR_UNMEASURED_INPUT = -13, /**< the core's configuration reads an input this board does not
                                                    measure: phase voltages (inverter.phase_voltage_sensing) or
                                                    the load torque (known_load_mode) */
-    PMSTEP_STM32G4_ERR_SENSE_RANGE = -14    /**< the core's configuration claims a measurement range (limits.
+    PMSTEP_STM32G4_ERR_SENSE_RANGE = -14,   /**< the core's configuration claims a measurement range (limits.
                                                  current_sense_range_A, bus_sense_range_V) beyond what this board's
                                                  ADC reads (pmstep_stm32g4_current_sense_range_A(), _bus_) */
+    PMSTEP_STM32G4_ERR_FLASH_RANGE = -15,   /**< a slot other than 0 or 1, bytes beyond the slot, or a program not
+                                                 in whole double words (8-byte offset and length) */
+    PMSTEP_STM32G4_ERR_FLASH_LOCKED = -16,  /**< FLASH_CR still locked after the key sequence (a wrong key written
+                                                 earlier locks it until the next reset) */
+    PMSTEP_STM32G4_ERR_FLASH_TIMEOUT = -17, /**< FLASH_SR.BSY did not clear */
+    PMSTEP_STM32G4_ERR_FLASH_PROGERR = -18, /**< programming a double word that was not erased */
+    PMSTEP_STM32G4_ERR_FLASH_WRPERR = -19,  /**< the page is write-protected (option bytes WRP, PCROP) */
+    PMSTEP_STM32G4_ERR_FLASH_PGAERR = -20,  /**< program alignment: the two words not in one double word */
+    PMSTEP_STM32G4_ERR_FLASH_SIZERR = -21,  /**< a program write that was not a 32-bit word */
+    PMSTEP_STM32G4_ERR_FLASH_PGSERR = -22,  /**< programming sequence: a write without PG, an erase with PG, or an
+                                                 operation started while an error flag was set */
+    PMSTEP_STM32G4_ERR_FLASH_MISERR = -23,  /**< fast programming data miss (fast programming is not used) */
+    PMSTEP_STM32G4_ERR_FLASH_FASTERR = -24, /**< fast programming error (fast programming is not used) */
+    PMSTEP_STM32G4_ERR_FLASH_OPERR = -25,   /**< an operation failed (reported with ERRIE only, not used) */
+    PMSTEP_STM32G4_ERR_FLASH_RDERR = -26,   /**< a PCROP read error (reported with RDERRIE only, not used) */
+    PMSTEP_STM32G4_ERR_FLASH_OPTVERR = -27, /**< the option bytes failed their check at load */
+    PMSTEP_STM32G4_ERR_FLASH_ECC = -28      /**< a read met an uncorrectable ECC error (two or more bits wrong in a
+                                                 double word: one cut short by a power loss) */
 } pmstep_stm32g4_status_t;
 
 /** Why the port holds the bridge off, independently of the core. */
@@ -288,6 +308,52 @@ void pmstep_stm32g4_release_control(void);
  * converted again from the ADC data registers, the port's fault.
  */
 void pmstep_stm32g4_last_period(pmstep_output_t *out, pmstep_meas_t *meas, uint8_t *port_fault);
+
+/* ---- stored configuration: the flash (stm32g4_flash.c) ---- */
+
+/** The two slots of the stored configuration: the last two pages of the STM32G431xB's flash,
+ *  page 62 (slot 0) and page 63 (slot 1), which the linker script keeps free of code and data. */
+#define PMSTEP_STM32G4_STORE_ADDR 0x0801F000u
+#define PMSTEP_STM32G4_STORE_FIRST_PAGE 62u
+#define PMSTEP_STM32G4_STORE_SLOTS 2u
+
+/** The text whose CRC-32 is the board id (pmstep_stm32g4_board_id()): the controller board, its power
+ *  stage and sensing as pmstep_stm32g4_default_config() describes them. A port for another board
+ *  or sensing names it otherwise, so that a record made for one is refused by the other
+ *  (PMSTEP_STORE_ERR_BOARD). */
+#define PMSTEP_STM32G4_BOARD_NAME "pmstep stm32g431 NUCLEO-G431RB dual full-bridge 0.1V/A 1:20"
+
+/**
+ * The flash the stored configuration (pmstep_store.h) lives in on this port: slots of one page
+ * (2 KiB) each at PMSTEP_STM32G4_STORE_ADDR. Each operation unlocks FLASH_CR, clears error flags
+ * left from before, runs, waits for BSY with a bound and locks FLASH_CR again; it returns 0 or a
+ * negative pmstep_stm32g4_status_t:
+ *   erase:   a page erase (RM0440 §3.3.6); 22 ms typical (DS12589), the CPU stalls on any flash read
+ *            meanwhile (a single bank); then the data cache is reset.
+ *   program: double words (§3.3.7 standard programming, 82 us each typical), each checked.
+ *   read:    PMSTEP_STM32G4_ERR_FLASH_ECC if a double word read has an uncorrectable ECC error
+ *            (FLASH_ECCR.ECCD with its address in the slots; the NMI it raises is taken by
+ *            pmstep_stm32g4_flash_ecc_nmi()).
+ * Codes: _RANGE, _LOCKED, _TIMEOUT, one per FLASH_SR error flag (_PROGERR .. _OPTVERR), _ECC.
+ * Main loop only (never from an interrupt), bridge off: the store's caller sees to that.
+ */
+const pmstep_store_flash_t *pmstep_stm32g4_store_flash(void);
+
+/** The board id of the stored configuration's records: CRC-32 (ISO-HDLC, pmstep_store_crc32()) of the
+ *  bytes of PMSTEP_STM32G4_BOARD_NAME, without its NUL. */
+uint32_t pmstep_stm32g4_board_id(void);
+
+/**
+ * The NMI's flash part (NMI_Handler calls it first): a double ECC error (FLASH_ECCR.ECCD) of a read
+ * inside the stored configuration's pages is the store's to report: ECCD is cleared, the error
+ * counted for the read in progress (which then returns PMSTEP_STM32G4_ERR_FLASH_ECC), and the
+ * handler returns. @return true if it was such an error; false for any other cause (an ECC error in
+ * code or constants, in the system flash, or not a flash error at all): the NMI stays fatal.
+ */
+bool pmstep_stm32g4_flash_ecc_nmi(void);
+
+/** Double ECC errors in the stored configuration's pages since reset (taken by the NMI or seen by a read). */
+uint32_t pmstep_stm32g4_flash_ecc_errors(void);
 
 /** ADC1 and ADC2 interrupt: the control period. */
 void ADC1_2_IRQHandler(void);

@@ -145,15 +145,97 @@ STM32G4_STATIC_ASSERT(offsetof(stm32g4_pwr_t, CR5) == 0x80, pwr_cr5);
  * FLASH interface: RM0440 §3.7 "FLASH registers", base 0x4002 2000
  * ------------------------------------------------------------------------- */
 typedef struct {
-    volatile uint32_t ACR; /* 0x00 access control */
+    volatile uint32_t ACR;      /* 0x00 access control */
+    volatile uint32_t PDKEYR;   /* 0x04 power-down key */
+    volatile uint32_t KEYR;     /* 0x08 key: unlocks FLASH_CR (write-only) */
+    volatile uint32_t OPTKEYR;  /* 0x0C option key */
+    volatile uint32_t SR;       /* 0x10 status */
+    volatile uint32_t CR;       /* 0x14 control */
+    volatile uint32_t ECCR;     /* 0x18 ECC */
+    uint32_t reserved0;         /* 0x1C */
+    volatile uint32_t OPTR;     /* 0x20 option */
+    volatile uint32_t PCROP1SR; /* 0x24 PCROP area start */
+    volatile uint32_t PCROP1ER; /* 0x28 PCROP area end */
+    volatile uint32_t WRP1AR;   /* 0x2C write protection area A */
+    volatile uint32_t WRP1BR;   /* 0x30 write protection area B */
 } stm32g4_flash_t;
-/* FLASH_ACR (§3.7.1): LATENCY[3:0], PRFTEN 8, ICEN 9, DCEN 10. Wait states (§3.3.3, Table 9
+STM32G4_STATIC_ASSERT(offsetof(stm32g4_flash_t, KEYR) == 0x08, flash_keyr);
+STM32G4_STATIC_ASSERT(offsetof(stm32g4_flash_t, SR) == 0x10, flash_sr);
+STM32G4_STATIC_ASSERT(offsetof(stm32g4_flash_t, CR) == 0x14, flash_cr);
+STM32G4_STATIC_ASSERT(offsetof(stm32g4_flash_t, ECCR) == 0x18, flash_eccr);
+STM32G4_STATIC_ASSERT(offsetof(stm32g4_flash_t, OPTR) == 0x20, flash_optr);
+STM32G4_STATIC_ASSERT(offsetof(stm32g4_flash_t, WRP1BR) == 0x30, flash_wrp1br);
+/* FLASH_ACR (§3.7.1): LATENCY[3:0], PRFTEN 8, ICEN 9, DCEN 10, ICRST 11, DCRST 12 (a cache reset
+ * bit can be written only while that cache is disabled). Wait states (§3.3.3, Table 9
  * "Number of wait states according to CPU clock (HCLK) frequency"): range 1 boost mode one per
  * 34 MHz of HCLK (4 WS up to 170 MHz), range 1 normal mode one per 30 MHz (up to 150 MHz). */
 #define FLASH_ACR_LATENCY_MASK 0xFu
 #define FLASH_ACR_PRFTEN STM32G4_BIT(8)
 #define FLASH_ACR_ICEN STM32G4_BIT(9)
 #define FLASH_ACR_DCEN STM32G4_BIT(10)
+#define FLASH_ACR_ICRST STM32G4_BIT(11)
+#define FLASH_ACR_DCRST STM32G4_BIT(12)
+/* FLASH_KEYR (§3.7.3): KEY1 then KEY2 clears FLASH_CR.LOCK; any other sequence locks FLASH_CR
+ * until the next reset (§3.3.5 "Flash program and erase operations", unlocking). */
+#define FLASH_KEY1 0x45670123u
+#define FLASH_KEY2 0xCDEF89ABu
+/* FLASH_SR (§3.7.5): EOP 0 (only with EOPIE), OPERR 1 (only with ERRIE), PROGERR 3, WRPERR 4,
+ * PGAERR 5, SIZERR 6, PGSERR 7, MISERR 8, FASTERR 9, RDERR 14 (only with RDERRIE), OPTVERR 15,
+ * each cleared by writing 1; BSY 16 (read-only: an operation runs). */
+#define FLASH_SR_EOP STM32G4_BIT(0)
+#define FLASH_SR_OPERR STM32G4_BIT(1)
+#define FLASH_SR_PROGERR STM32G4_BIT(3)
+#define FLASH_SR_WRPERR STM32G4_BIT(4)
+#define FLASH_SR_PGAERR STM32G4_BIT(5)
+#define FLASH_SR_SIZERR STM32G4_BIT(6)
+#define FLASH_SR_PGSERR STM32G4_BIT(7)
+#define FLASH_SR_MISERR STM32G4_BIT(8)
+#define FLASH_SR_FASTERR STM32G4_BIT(9)
+#define FLASH_SR_RDERR STM32G4_BIT(14)
+#define FLASH_SR_OPTVERR STM32G4_BIT(15)
+#define FLASH_SR_BSY STM32G4_BIT(16)
+#define FLASH_SR_ERRORS (FLASH_SR_OPERR | FLASH_SR_PROGERR | FLASH_SR_WRPERR | FLASH_SR_PGAERR | FLASH_SR_SIZERR \
+                         | FLASH_SR_PGSERR | FLASH_SR_MISERR | FLASH_SR_FASTERR | FLASH_SR_RDERR | FLASH_SR_OPTVERR)
+/* The flags of a programming error: while one is set, the next program or erase start is refused
+ * with PGSERR (§3.7.5 PGSERR; §3.3.6, §3.3.7 step "check and clear all error programming flags"). */
+#define FLASH_SR_PROGRAMMING_ERRORS (FLASH_SR_PROGERR | FLASH_SR_WRPERR | FLASH_SR_PGAERR | FLASH_SR_SIZERR \
+                                     | FLASH_SR_PGSERR | FLASH_SR_MISERR | FLASH_SR_FASTERR)
+/* FLASH_CR (§3.7.6, reset value 0xC000 0000): PG 0, PER 1, MER1 2, PNB[8:3] (the page of a page
+ * erase; 6 bits on the category 2 devices, 64 pages), STRT 16 (starts an erase; cleared by
+ * hardware when BSY clears), OPTSTRT 17, FSTPG 18, EOPIE 24, ERRIE 25, RDERRIE 26, OBL_LAUNCH 27,
+ * SEC_PROT1 28, OPTLOCK 30, LOCK 31 (set by software, cleared only by the key sequence). */
+#define FLASH_CR_PG STM32G4_BIT(0)
+#define FLASH_CR_PER STM32G4_BIT(1)
+#define FLASH_CR_MER1 STM32G4_BIT(2)
+#define FLASH_CR_PNB_POS 3u
+#define FLASH_CR_PNB_MASK (0x3Fu << FLASH_CR_PNB_POS)
+#define FLASH_CR_STRT STM32G4_BIT(16)
+#define FLASH_CR_OPTSTRT STM32G4_BIT(17)
+#define FLASH_CR_FSTPG STM32G4_BIT(18)
+#define FLASH_CR_EOPIE STM32G4_BIT(24)
+#define FLASH_CR_ERRIE STM32G4_BIT(25)
+#define FLASH_CR_RDERRIE STM32G4_BIT(26)
+#define FLASH_CR_OPTLOCK STM32G4_BIT(30)
+#define FLASH_CR_LOCK STM32G4_BIT(31)
+/* FLASH_ECCR (§3.7.7): ADDR_ECC[17:0] (byte offset from the start of the flash of the double
+ * word that failed), SYSF_ECC 22 (the failure is in the system flash), ECCIE 24, ECCC 30 (a
+ * single error corrected), ECCD 31 (a double error detected: raises the NMI); ECCC and ECCD are
+ * cleared by writing 1, and a new failure is recorded only while both are clear (§3.3.2 "Error
+ * code correction (ECC)"). */
+#define FLASH_ECCR_ADDR_ECC_MASK 0x3FFFFu
+#define FLASH_ECCR_SYSF_ECC STM32G4_BIT(22)
+#define FLASH_ECCR_ECCIE STM32G4_BIT(24)
+#define FLASH_ECCR_ECCC STM32G4_BIT(30)
+#define FLASH_ECCR_ECCD STM32G4_BIT(31)
+/* The main flash of the STM32G431xB (§3.3.1 "Flash memory organization", category 2 devices): one
+ * bank of 128 KiB at 0x0800 0000, 64 pages of 2 KiB, rows of 64-bit double words (each with 8
+ * ECC bits), programmed one double word at a time (§3.3.7 "Flash main memory programming
+ * sequences", standard programming). */
+#define STM32G4_FLASH_MEM_BASE 0x08000000u
+#define STM32G4_FLASH_MEM_BYTES 0x20000u
+#define STM32G4_FLASH_PAGE_BYTES 2048u
+#define STM32G4_FLASH_PAGES 64u
+#define STM32G4_FLASH_DOUBLE_WORD_BYTES 8u
 
 /* ---------------------------------------------------------------------------
  * GPIO: RM0440 §9.4 "GPIO registers", GPIOA 0x4800 0000, one port per 0x400 (A..G)
@@ -492,6 +574,17 @@ uint32_t stm32g4_fake_lpuart_rdr(void);
 void stm32g4_fake_lpuart_tdr(uint32_t byte);
 #define STM32G4_LPUART_READ_RDR(u) ((void)(u), stm32g4_fake_lpuart_rdr())
 #define STM32G4_LPUART_WRITE_TDR(u, b) ((void)(u), stm32g4_fake_lpuart_tdr(b))
+/** FLASH: a write of a register with side effects (a key, a flag cleared by writing 1, a start
+ *  bit) and the flash memory array. Plain RAM would not show two keys written in a row, would
+ *  keep a flag "cleared" by writing 1, and has no flash behind the addresses; the model sees each
+ *  access through these. @p offset: the register's offset in stm32g4_flash_t. */
+void stm32g4_fake_flash_reg_write(uint32_t offset, uint32_t value);
+uint32_t stm32g4_fake_flash_read32(uint32_t addr);
+void stm32g4_fake_flash_write32(uint32_t addr, uint32_t value);
+#define STM32G4_FLASH_REG_WRITE(reg, v) stm32g4_fake_flash_reg_write((uint32_t)offsetof(stm32g4_flash_t, reg), (v))
+#define STM32G4_FLASH_MEM_READ32(addr) stm32g4_fake_flash_read32(addr)
+#define STM32G4_FLASH_MEM_WRITE32(addr, v) stm32g4_fake_flash_write32((addr), (v))
+#define STM32G4_INSTRUCTION_BARRIER() ((void)0)
 #else
 #define STM32G4_RCC ((stm32g4_rcc_t *)STM32G4_RCC_BASE)
 #define STM32G4_PWR ((stm32g4_pwr_t *)STM32G4_PWR_BASE)
@@ -509,6 +602,11 @@ void stm32g4_fake_lpuart_tdr(uint32_t byte);
 #define STM32G4_WAIT_HOOK() ((void)0)
 #define STM32G4_LPUART_READ_RDR(u) ((u)->RDR)
 #define STM32G4_LPUART_WRITE_TDR(u, b) ((u)->TDR = (b))
+#define STM32G4_FLASH_REG_WRITE(reg, v) (STM32G4_FLASH->reg = (v))
+#define STM32G4_FLASH_MEM_READ32(addr) (*(volatile const uint32_t *)(uintptr_t)(addr))
+#define STM32G4_FLASH_MEM_WRITE32(addr, v) (*(volatile uint32_t *)(uintptr_t)(addr) = (v))
+/* ISB (ARMv7-M A7.7.37): the instructions before it complete before those after it start. */
+#define STM32G4_INSTRUCTION_BARRIER() __asm volatile("isb" ::: "memory")
 #endif
 
 #ifdef __cplusplus

@@ -1,11 +1,13 @@
 /*
  * Start-up of the STM32G431: vector table (RM0440 §14.3, Table 97: 16 Cortex-M4
  * system entries, then interrupts 0..101), reset handler (data copy, bss clear,
- * FPU access, VTOR), default handler. Handlers are weak: the port and the
- * application define the ones they use.
+ * FPU access, VTOR), NMI handler, default handler. The other handlers are weak: the port
+ * and the application define the ones they use.
  */
+#include <stdbool.h>
 #include <stdint.h>
 
+#include "pmstep_hal_stm32g4.h"
 #include "stm32g4_regs.h"
 
 extern uint32_t _sidata, _sdata, _edata, _sbss, _ebss, _estack;
@@ -13,7 +15,7 @@ extern int main(void);
 
 void Reset_Handler(void);
 void Default_Handler(void);
-void NMI_Handler(void) __attribute__((weak, alias("Default_Handler")));
+void NMI_Handler(void);
 void HardFault_Handler(void) __attribute__((weak, alias("Default_Handler")));
 void MemManage_Handler(void) __attribute__((weak, alias("Default_Handler")));
 void BusFault_Handler(void) __attribute__((weak, alias("Default_Handler")));
@@ -55,6 +57,20 @@ __attribute__((section(".isr_vector"), used)) const vector_table_t stm32g431_vec
 
 void Default_Handler(void)
 {
+    for (;;) {
+    }
+}
+
+/* NMI: a double ECC error of the flash raises it (RM0440 §3.3.2 "Error code correction (ECC)",
+ * FLASH_ECCR.ECCD). One in the stored configuration's pages (a double word cut short by a power
+ * loss) is the store's to report: the flash driver clears it and the read that met it returns an
+ * error; the handler returns to that read. Any other cause (an ECC error in code or constants, the
+ * clock security system, ...) stays fatal: the CPU stops here. */
+void NMI_Handler(void)
+{
+    if (pmstep_stm32g4_flash_ecc_nmi()) {
+        return;
+    }
     for (;;) {
     }
 }

@@ -153,6 +153,34 @@ const char *pmstep_stm32g4_status_str(pmstep_stm32g4_status_t status)
         return "the core reads phase voltages or a load torque, which this board does not measure";
     case PMSTEP_STM32G4_ERR_SENSE_RANGE:
         return "the core's measurement ranges exceed what this board's ADC reads";
+    case PMSTEP_STM32G4_ERR_FLASH_RANGE:
+        return "flash slot, offset or length out of range";
+    case PMSTEP_STM32G4_ERR_FLASH_LOCKED:
+        return "flash control register stayed locked (a wrong key locks it until reset)";
+    case PMSTEP_STM32G4_ERR_FLASH_TIMEOUT:
+        return "flash operation timed out (BSY stayed set)";
+    case PMSTEP_STM32G4_ERR_FLASH_PROGERR:
+        return "flash PROGERR: double word not erased before programming";
+    case PMSTEP_STM32G4_ERR_FLASH_WRPERR:
+        return "flash WRPERR: page write-protected";
+    case PMSTEP_STM32G4_ERR_FLASH_PGAERR:
+        return "flash PGAERR: program alignment";
+    case PMSTEP_STM32G4_ERR_FLASH_SIZERR:
+        return "flash SIZERR: program write not a word";
+    case PMSTEP_STM32G4_ERR_FLASH_PGSERR:
+        return "flash PGSERR: programming sequence";
+    case PMSTEP_STM32G4_ERR_FLASH_MISERR:
+        return "flash MISERR: fast programming data miss";
+    case PMSTEP_STM32G4_ERR_FLASH_FASTERR:
+        return "flash FASTERR: fast programming error";
+    case PMSTEP_STM32G4_ERR_FLASH_OPERR:
+        return "flash OPERR: operation error";
+    case PMSTEP_STM32G4_ERR_FLASH_RDERR:
+        return "flash RDERR: PCROP read error";
+    case PMSTEP_STM32G4_ERR_FLASH_OPTVERR:
+        return "flash OPTVERR: option bytes invalid";
+    case PMSTEP_STM32G4_ERR_FLASH_ECC:
+        return "flash uncorrectable ECC error on read";
     }
     return "unknown status";
 }

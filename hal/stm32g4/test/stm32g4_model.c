@@ -52,6 +52,7 @@ void stm32g4_model_reset(void)
     stm32g4_fake.adc2.ISR = STM32G4_MODEL_ISR_MARK;
     M.bkin_pin_high = true;
     M.aden_guard_polls = 1u;
+    stm32g4_model_flash_reset(); /* the controller; the flash array keeps its contents */
 }
 
 static stm32g4_adc_t *adc_block(unsigned a)
@@ -293,9 +294,14 @@ void stm32g4_model_sync(void)
     tim_sync();
 }
 
-/* The driver's bounded wait loops call this once per poll. */
+/* The driver's bounded wait loops call this once per poll. While the flash is busy only the flash
+ * driver polls (the main loop waits in it, the control interrupt held off): only the flash advances. */
 void stm32g4_fake_wait_hook(void)
 {
+    if (stm32g4_model_flash_busy()) {
+        stm32g4_model_flash_poll();
+        return;
+    }
     stm32g4_model_sync();
     clock_poll();
     adc_poll(0u);
@@ -652,6 +658,7 @@ void stm32g4_model_run(uint64_t ticks)
         adc_tick(0u);
         adc_tick(1u);
         TIM->SR = M.sr;
+        stm32g4_model_flash_advance(1u);
         interrupts();
     }
 }

@@ -15,7 +15,8 @@
  * Each rule in stm32g4_model.c cites the section of the reference manual (ST RM0440,
  * "STM32G4 Series advanced Arm-based 32-bit MCUs") it models, numbered as in the revision the
  * port's register header follows (Rev 8), with the section's title where other revisions number
- * it differently. Not modelled: prescaler
+ * it differently. The flash controller and the flash array are modelled in stm32g4_model_flash.c
+ * (see "Flash" below). Not modelled: prescaler
  * other than 0, input capture, break filter and break 2, OCxREF clear, combined/asymmetric
  * PWM modes, the injected queue (JQDIS = 1 is assumed), regular conversions.
  */
@@ -129,6 +130,96 @@ void stm32g4_model_pin_in(unsigned port, unsigned pin, bool high);
 
 /** The level an output pin of a GPIO port drives (ODR after BSRR), port 0 = A. */
 bool stm32g4_model_pin_out(unsigned port, unsigned pin);
+
+/* ---------------------------------------------------------------------------
+ * Flash (stm32g4_model_flash.c): the FLASH controller's key, status, control and ECC registers
+ * and the 128 KiB main array with its ECC state per double word, from RM0440 chapter 3. The
+ * driver's register writes with side effects and every access to the array come through
+ * stm32g4_fake_flash_reg_write(), stm32g4_fake_flash_read32() and _write32() (stm32g4_regs.h).
+ * The array lives outside stm32g4_model_reset(): a reset is a power cycle of the chip, and the
+ * flash keeps its contents (stm32g4_model_flash_erase_all() gives a fresh part).
+ * ------------------------------------------------------------------------- */
+
+/** 64-bit program time t_PROG, 81.7 us typical (DS12589 "Flash memory characteristics"), in
+ *  ticks of 170 MHz (13 889). */
+#define STM32G4_MODEL_FLASH_PROGRAM_TICKS 13889u
+/** Page (2 KiB) erase time t_ERASE, 22.02 ms typical (DS12589), in ticks of 170 MHz. */
+#define STM32G4_MODEL_FLASH_ERASE_TICKS 3743400u
+/** Model ticks per second (the ticks are SYSCLK cycles at 170 MHz). */
+#define STM32G4_MODEL_TICKS_PER_S 170000000u
+/** Double words per page. */
+#define STM32G4_MODEL_FLASH_PAGE_DW (STM32G4_FLASH_PAGE_BYTES / STM32G4_FLASH_DOUBLE_WORD_BYTES)
+
+typedef struct {
+    /* ---- inputs the test drives (stm32g4_model_reset() sets them to the values said) ---- */
+    uint32_t poll_ticks;      /**< ticks one driver poll of FLASH_SR lasts, while the flash is busy (170: 1 us) */
+    uint32_t cut_at_step;     /**< the power is cut in the middle of this program or erase step, counted
+                                   from 1 since the reset (0: no cut) */
+    uint32_t cut_erase_dw;    /**< an erase cut short has erased this many double words of its page
+                                   before the cut (STM32G4_MODEL_FLASH_PAGE_DW / 2) */
+    uint32_t inject_step;     /**< this program or erase step ends with inject_flags and changes nothing (0: none) */
+    uint32_t inject_flags;    /**< FLASH_SR error flags of the injected failure (FLASH_SR_PROGERR) */
+    bool stuck_busy;          /**< an operation once started never ends (BSY stays set) */
+
+    /* ---- the controller (RM0440 §3.3.5 .. §3.3.7) ---- */
+    uint32_t sr;              /**< FLASH_SR's flags as the hardware holds them (BSY apart) */
+    unsigned key_step;        /**< 1: KEY1 written, KEY2 expected */
+    bool key_error;           /**< a wrong key sequence: FLASH_CR locked until the reset */
+    bool latched;             /**< the first word of a double word is latched */
+    uint32_t latch_addr;
+    uint32_t latch_word;
+    unsigned op;              /**< the operation running: 0 none, 1 page erase, 2 program */
+    uint32_t op_index;        /**< its page, or its double word's index in the array */
+    uint32_t op_data[2];      /**< the double word being programmed */
+    uint64_t op_left;         /**< ticks until it ends */
+    bool powered;             /**< false from a power cut until the reset */
+
+    /* ---- counted since the reset ---- */
+    uint32_t steps;           /**< program and erase steps started (the power cut's count) */
+    uint32_t erases;          /**< page erases completed */
+    uint32_t programs;        /**< double words programmed */
+    uint64_t busy_ticks;      /**< ticks with BSY set */
+    uint32_t bus_errors;      /**< wrong-key bus errors (the hardware raises a hard fault) */
+    uint32_t nmis;            /**< NMIs raised by ECCD */
+    uint32_t nmis_fatal;      /**< of those, the ones the port's handler did not take (the CPU would hang) */
+    uint32_t dcache_resets;   /**< FLASH_ACR.DCRST written 1 while the data cache was disabled */
+    uint32_t stalled_reads;   /**< array reads that waited for a running operation */
+} stm32g4_model_flash_t;
+
+extern stm32g4_model_flash_t stm32g4_model_flash;
+
+/** The controller to its reset state (FLASH_CR locked, no flag; stm32g4_model_reset() calls it);
+ *  the array is kept, as through a power cycle. */
+void stm32g4_model_flash_reset(void);
+
+/** A fresh part: every byte of the array 0xFF, no double word with an ECC error. */
+void stm32g4_model_flash_erase_all(void);
+
+/** The array's byte at @p addr (0x0800 0000 ..), for a test to look at without a CPU read. */
+const uint8_t *stm32g4_model_flash_bytes(uint32_t addr);
+
+/** Makes the double word at @p addr read with an uncorrectable ECC error (until erased). */
+void stm32g4_model_flash_set_ecc_error(uint32_t addr);
+
+/** Whether the double word at @p addr reads with an uncorrectable ECC error. */
+bool stm32g4_model_flash_ecc_error(uint32_t addr);
+
+/** A CPU write of @p bytes (1, 2 or 4) to the flash memory at @p addr (the driver's word writes
+ *  come through stm32g4_fake_flash_write32()). */
+void stm32g4_model_flash_write(uint32_t addr, uint32_t value, uint32_t bytes);
+
+/** A CPU 32-bit read of the flash memory at @p addr (waits for a running operation, records and
+ *  raises an ECC double error). */
+uint32_t stm32g4_model_flash_read(uint32_t addr);
+
+/** Whether an operation runs (FLASH_SR.BSY). */
+bool stm32g4_model_flash_busy(void);
+
+/** @p ticks of time for the flash (stm32g4_model_run() gives it each tick). */
+void stm32g4_model_flash_advance(uint64_t ticks);
+
+/** One driver poll of FLASH_SR (the wait hook calls it): poll_ticks of time for the flash. */
+void stm32g4_model_flash_poll(void);
 
 #ifdef __cplusplus
 }

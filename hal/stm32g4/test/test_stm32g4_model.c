@@ -28,6 +28,7 @@ static int setup(void **state)
 {
     (void)state;
     stm32g4_model_reset();
+    stm32g4_model_flash_erase_all(); /* a fresh part: no stored configuration */
     board = pmstep_stm32g4_default_config();
     motor_config = pmstep_console_app_config(pmstep_stm32g4_period_s(&board), 1u,
                                              pmstep_stm32g4_current_sense_range_A(&board),
@@ -797,7 +798,39 @@ static void turns(void)
     }
 }
 
-static void test_app_console_on_the_model(void **state)
+/* HELLO's flags (pmstep_console.h): 1 a stored configuration attached, 2 a motor configured. */
+#define HELLO_STORE 1u
+#define HELLO_CONFIGURED 2u
+
+/* A record of @p cfg saved in the flash (through the port's driver, on the model's flash), as a
+ * configuration written over the console and saved would leave it. */
+static void store_record(const pmstep_config_t *cfg)
+{
+    pmstep_store_t store;
+    pmstep_store_record_t rec;
+    memset(&rec, 0, sizeof rec);
+    rec.config = *cfg;
+    assert_int_equal(pmstep_store_init(&store, pmstep_stm32g4_store_flash(), pmstep_stm32g4_board_id()), PMSTEP_STORE_OK);
+    assert_int_equal(pmstep_store_save(&store, &rec, true), PMSTEP_STORE_OK);
+}
+
+/* HELLO: its text and flags. */
+static void check_hello(uint8_t seq, uint8_t flags)
+{
+    uint8_t d[64];
+    int n;
+    host_send(PMSTEP_CONSOLE_HELLO, seq, NULL, 0u);
+    turns();
+    n = host_receive(0x81u, d);
+    assert_true(n > 4);
+    assert_int_equal(d[2], PMSTEP_STORE_FORMAT_VERSION);
+    assert_int_equal(d[3], flags);
+    assert_memory_equal(&d[4], "pmstep " PMSTEP_VERSION_TEXT " stm32g431", strlen("pmstep  stm32g431") + strlen(PMSTEP_VERSION_TEXT));
+}
+
+/* A fresh part: the application boots with the board's configuration, not configured; START is
+ * refused (error reply NOT_CONFIGURED) and the bridge stays off. */
+static void test_app_boots_unconfigured_with_empty_flash(void **state)
 {
     const uint32_t arr = arr_of_board();
     uint8_t d[64];
@@ -806,13 +839,39 @@ static void test_app_console_on_the_model(void **state)
     stm32g4_model_pin_in(board.fault_pin.port, board.fault_pin.pin, !board.fault_active_high);
     analog(0.0f, 0.0f, 48.0f);
     assert_int_equal(pmstep_app_init(), 0);
+    assert_int_equal(stm32g4_model_flash.steps, 0u); /* booting only reads the flash */
+    uart_cursor = 0u;
+    check_hello(1u, HELLO_STORE);
+    host_send(PMSTEP_CONSOLE_START, 2u, NULL, 0u);
+    turns();
+    app_run(arr, 2u);
+    n = host_receive(PMSTEP_CONSOLE_ERROR_FRAME, d);
+    assert_int_equal(n, 2);
+    assert_int_equal(d[0], PMSTEP_CONSOLE_START);
+    assert_int_equal(d[1], PMSTEP_CONSOLE_ERR_NOT_CONFIGURED);
+    app_run(arr, 20u);
+    assert_false(pmstep_stm32g4_bridge_on());
+    host_send(PMSTEP_CONSOLE_GET_STATUS, 3u, NULL, 0u);
+    turns();
+    n = host_receive(0x87u, d);
+    assert_int_equal(n, 60);
+    assert_int_equal(d[4], PMSTEP_MODE_IDLE);
+}
+
+static void test_app_console_on_the_model(void **state)
+{
+    const uint32_t arr = arr_of_board();
+    uint8_t d[64];
+    int n;
+    (void)state;
+    store_record(&motor_config); /* the paper's motor, configured from the flash at boot */
+    stm32g4_model_reset();        /* a power cycle: the flash keeps it */
+    stm32g4_model_pin_in(board.fault_pin.port, board.fault_pin.pin, !board.fault_active_high);
+    analog(0.0f, 0.0f, 48.0f);
+    assert_int_equal(pmstep_app_init(), 0);
     uart_cursor = 0u;
     /* Hello, answered in the main loop. */
-    host_send(PMSTEP_CONSOLE_HELLO, 1u, NULL, 0u);
-    turns();
-    n = host_receive(0x81u, d);
-    assert_true(n > 2);
-    assert_memory_equal(&d[2], "pmstep " PMSTEP_VERSION_TEXT " stm32g431", strlen("pmstep  stm32g431") + strlen(PMSTEP_VERSION_TEXT));
+    check_hello(1u, HELLO_STORE | HELLO_CONFIGURED);
     /* IDLE: the bridge stays off while periods run. */
     app_run(arr, 10u);
     assert_false(pmstep_stm32g4_bridge_on());
@@ -905,6 +964,7 @@ int main(void)
         cmocka_unit_test_setup(test_port_duties_follow_commanded_voltages, setup),
         cmocka_unit_test_setup(test_port_break_turns_bridge_off, setup),
         cmocka_unit_test_setup(test_port_firmware_fault_turns_bridge_off, setup),
+        cmocka_unit_test_setup(test_app_boots_unconfigured_with_empty_flash, setup),
         cmocka_unit_test_setup(test_app_console_on_the_model, setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
