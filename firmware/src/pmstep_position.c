@@ -1,5 +1,6 @@
 /* Sensorless position control on the speed controller (pmstep_position.h). */
 #include "pmstep/pmstep_position.h"
+#include "pmstep/pmstep_stepdir.h"
 #include "pmstep_position_internal.h"
 
 #include <math.h> /* fabsf: one instruction, no libm call */
@@ -119,6 +120,7 @@ pmstep_status_t pmstep_position_init(pmstep_position_t *pos, pmstep_t *inst, con
         return PMSTEP_ERR_HOLD_CURRENT;
     }
     pos->inst = inst;
+    pos->steps = NULL;
     pos->cfg = *cfg;
     pos->hold_stage = POSITION_HOLD_NONE;
     pos->hold_periods = 0;
@@ -170,36 +172,51 @@ static void put_speed_reference(pmstep_position_t *pos, float speed, float rate,
     pmstep_ref_place(ref, speed + (end_speed - speed - free_change) * pos->hold_inv_gain, speed, diff12, diff23);
 }
 
-/* Position mode, an update after period k: the profile's sample for period k+1 (pos->now, taken
- * one update ahead) and the loop on the estimate moved on to k+1; the speed reference it puts
- * serves periods k+1 .. k+N and ends where the next update's will begin: the profile's speed at
- * k+N+1 (pos->ahead, sampled now) plus the feedback terms moved on by their derivatives
+/* The loop on the estimate moved on to period k+1, against @p ref, the reference for period k+1; the
+ * speed reference it puts serves periods k+1 .. k+N and ends where the next update's will begin: the
+ * reference's speed at k+N+1 (@p ahead_speed) plus the feedback terms moved on by their derivatives
  * (k_theta e + k_I z)(t + N T_s) ~ value + N T_s rate + (N T_s)^2/2 accel. z integrates the error
  * sampled every N T_s. */
-static void position_loop(pmstep_position_t *pos, float position_rad)
+static inline void loop_output(pmstep_position_t *pos, float position_rad, const pmstep_motion_sample_t *ref,
+                               float ahead_speed, bool running)
 {
     const float k_p = pos->cfg.gain_per_s;
     const float k_i = pos->cfg.integral_gain_per_s2;
     const float step_s = pos->motion.period_s;
-    const pmstep_motion_sample_t ref = pos->ahead; /* the sample for period k+1 */
-    const bool running = !pmstep_motion_finished(&pos->motion);
     const float predicted_rad = position_rad + pos->period_s * pos->speed_hat_rad_s;
-    const float error_rad = ref.position - predicted_rad;
-    const float speed_error = ref.speed - pos->speed_hat_rad_s;
+    const float error_rad = ref->position - predicted_rad;
+    const float speed_error = ref->speed - pos->speed_hat_rad_s;
     float feedback;
     float feedback_rate;
     float feedback_accel;
-    pos->now = ref;
-    pos->ahead = pmstep_motion_next(&pos->motion); /* the sample for period k+N+1 */
     pos->error_integral_rad_s += step_s * error_rad;
     feedback = k_p * error_rad + k_i * pos->error_integral_rad_s;
     feedback_rate = k_p * speed_error + k_i * error_rad;
     feedback_accel = (k_i - k_p * k_p) * speed_error;
-    put_speed_reference(pos, ref.speed + feedback, ref.accel + feedback_rate, ref.jerk + feedback_accel,
-                        pos->ahead.speed + feedback + step_s * (feedback_rate + 0.5f * step_s * feedback_accel));
+    put_speed_reference(pos, ref->speed + feedback, ref->accel + feedback_rate, ref->jerk + feedback_accel,
+                        ahead_speed + feedback + step_s * (feedback_rate + 0.5f * step_s * feedback_accel));
     pos->out.moving = running;
-    pos->out.position_ref_rad = ref.position;
+    pos->out.position_ref_rad = ref->position;
     pos->out.position_error_rad = error_rad;
+}
+
+/* Position mode on a move, an update after period k: the profile's sample for period k+1 (taken one
+ * update ahead) and the one for period k+N+1 (sampled now). */
+static void position_loop(pmstep_position_t *pos, float position_rad)
+{
+    const bool running = !pmstep_motion_finished(&pos->motion);
+    pos->now = pos->ahead;
+    pos->ahead = pmstep_motion_next(&pos->motion);
+    loop_output(pos, position_rad, &pos->now, pos->ahead.speed, running);
+}
+
+/* Position mode on a STEP/DIR input, an update after period k: the count's tracker (updated with
+ * period k's count) moved on to period k+1 and to period k+N+1. */
+static void follow_loop(pmstep_position_t *pos, float position_rad)
+{
+    pos->now = pmstep_stepdir_predict(pos->steps, pos->period_s);
+    pos->ahead = pmstep_stepdir_predict(pos->steps, pos->period_s + pos->motion.period_s);
+    loop_output(pos, position_rad, &pos->now, pos->ahead.speed, pos->steps->moving);
 }
 
 void pmstep_position_step(pmstep_position_t *pos, const pmstep_meas_t *meas, pmstep_output_t *out,
@@ -207,6 +224,15 @@ void pmstep_position_step(pmstep_position_t *pos, const pmstep_meas_t *meas, pms
 {
     pmstep_step(pos->inst, meas, out);
     pmstep_position_update(pos, out, pos_out);
+}
+
+/* The loop no longer follows a STEP/DIR input (a move, a stop, a speed command, leaving RUN). */
+static void stop_following(pmstep_position_t *pos)
+{
+    if (pos->steps != NULL) {
+        pos->steps->following = false;
+        pos->steps = NULL;
+    }
 }
 
 /* Leaving RUN (stop, fault, re-alignment): the position is lost. Leaving position mode this way,
@@ -218,6 +244,7 @@ POSITION_OUT_OF_LINE static void lose_position(pmstep_position_t *pos)
         pmstep_ref_reset(&pos->inst->speed_ref, 0.0f);
     }
     pos->hold_stage = POSITION_HOLD_NONE; /* the core ended its hold on leaving RUN */
+    stop_following(pos);
     pos->out.tracked = false;
     pos->out.position_mode = false;
     pos->out.moving = false;
@@ -249,12 +276,23 @@ POSITION_OUT_OF_LINE static void update(pmstep_position_t *pos)
         pos->out.position_mode = false;
         pos->out.moving = false;
         pos->hold_stage = POSITION_HOLD_NONE; /* the command released the core's hold */
+        stop_following(pos);
+    }
+    if (pos->steps != NULL) {
+        pmstep_stepdir_track(pos->steps); /* every update, the hold's included: it sees the next step */
+        if (pos->steps->moving && pmstep_position_vector_held(pos)) {
+            pmstep_position_release_hold(pos);
+        }
     }
     if (pos->out.position_mode) {
         if (pmstep_position_vector_held(pos)) {
             pmstep_position_vector_hold(pos, position_rad);
         } else {
-            position_loop(pos, position_rad);
+            if (pos->steps != NULL) {
+                follow_loop(pos, position_rad);
+            } else {
+                position_loop(pos, position_rad);
+            }
             if (!pos->out.moving && pos->hold_stage != POSITION_HOLD_REFUSED && pos->cfg.hold_current_A > 0.0f) {
                 pmstep_position_wait_and_aim(pos, position_rad);
             }
@@ -339,6 +377,10 @@ pmstep_status_t pmstep_position_set_zero(pmstep_position_t *pos)
     pos->turns = 0;
     pos->zero_rad = pmstep_atan2_poly(pos->sin_hat, pos->cos_hat);
     pmstep_motion_shift(&pos->motion, -position_rad);
+    if (pos->steps != NULL) {
+        pos->steps->origin_rad -= position_rad;
+        pos->steps->position_rad -= position_rad;
+    }
     pos->now.position -= position_rad;
     pos->ahead.position -= position_rad;
     pos->out.position_rad -= position_rad;
@@ -407,6 +449,7 @@ pmstep_status_t pmstep_position_move_to(pmstep_position_t *pos, float target_rad
         return PMSTEP_ERR_BAD_COMMAND_VALUE; /* NaN fails every compare; Inf - Inf is NaN */
     }
     pmstep_position_release_hold(pos);
+    stop_following(pos);
     start = profile_start(pos);
     pmstep_motion_plan(&pos->motion, start.position, start.speed, start.accel, target_rad, v_max_rad_s, a_max_rad_s2,
                        (j_max_rad_s3 > 0.0f) ? j_max_rad_s3 : (a_max_rad_s2 / pos->inv_bandwidth_s));
@@ -431,8 +474,31 @@ pmstep_status_t pmstep_position_hold(pmstep_position_t *pos, float a_max_rad_s2)
         pos->motion.j_max = a_max_rad_s2 / pos->inv_bandwidth_s;
     }
     pmstep_position_release_hold(pos);
+    stop_following(pos);
     start = profile_start(pos);
     pmstep_motion_stop(&pos->motion, &start);
     enter_position_mode(pos);
+    return PMSTEP_OK;
+}
+
+pmstep_status_t pmstep_position_follow_steps(pmstep_position_t *pos, struct pmstep_stepdir *sd)
+{
+    pmstep_motion_sample_t start;
+    if (pos == NULL || sd == NULL) {
+        return PMSTEP_ERR_NULL_ARGUMENT;
+    }
+    if (!pos->out.tracked) {
+        return PMSTEP_ERR_BAD_MODE;
+    }
+    pmstep_position_release_hold(pos);
+    start = profile_start(pos);
+    stop_following(pos);
+    pmstep_motion_reset(&pos->motion, start.position, pos->motion.period_s); /* no move left to resume */
+    pmstep_stepdir_start(sd, &start);
+    pos->steps = sd;
+    enter_position_mode(pos);
+    pos->ahead = start;
+    pos->now = start;
+    pos->out.moving = true;
     return PMSTEP_OK;
 }

@@ -33,4 +33,17 @@ void pmstep_position_vector_hold(pmstep_position_t *pos, float position_rad);
 /* Ends a vector hold (a move, a stop); the stage returns to none. */
 void pmstep_position_release_hold(pmstep_position_t *pos);
 
+/* ---- STEP/DIR (pmstep_stepdir.c), run from the position loop ---- */
+struct pmstep_stepdir;
+
+/* The loop starts following the count at @p start (its reference for the next period): the count's
+ * origin is put there, so theta* does not jump. */
+void pmstep_stepdir_start(struct pmstep_stepdir *sd, const pmstep_motion_sample_t *start);
+
+/* An update: the tracker predicted over T and corrected by the count; at rest after stop_time_s. */
+void pmstep_stepdir_track(struct pmstep_stepdir *sd);
+
+/* The tracker's state moved on by @p ahead_s at constant acceleration. */
+pmstep_motion_sample_t pmstep_stepdir_predict(const struct pmstep_stepdir *sd, float ahead_s);
+
 #endif /* PMSTEP_POSITION_INTERNAL_H */

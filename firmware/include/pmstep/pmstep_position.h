@@ -100,9 +100,13 @@ typedef struct {
     bool moving;              /**< the profile is still running (false: holding theta*) */
 } pmstep_position_output_t;
 
+struct pmstep_stepdir;
+
 /** State of the position control of one pmstep_t (allocate it statically next to it). */
 typedef struct {
     pmstep_t *inst;
+    struct pmstep_stepdir *steps; /**< the STEP/DIR input the loop follows (pmstep_position_follow_steps()),
+                                       NULL: the motion profile */
     pmstep_position_config_t cfg;
     float inv_pole_pairs;     /**< 1/p */
     float period_s;           /**< T_s */
@@ -220,6 +224,17 @@ pmstep_status_t pmstep_position_move_to(pmstep_position_t *pos, float target_rad
  *         PMSTEP_ERR_BAD_COMMAND_VALUE (from speed mode: a_max not finite or not > 0)
  */
 pmstep_status_t pmstep_position_hold(pmstep_position_t *pos, float a_max_rad_s2);
+
+/**
+ * Position mode on the STEP/DIR input @p sd (pmstep_stepdir.h, initialised for this motor and period):
+ * from the next period the loop's reference is the step count's tracker, started where the present
+ * reference is (no jump: step count 0 is there). At rest (no step for stop_time_s) the vector hold
+ * takes over as at a move's end; the next step releases it. pmstep_position_move_to(),
+ * pmstep_position_hold() or a speed command end it, as does leaving RUN.
+ * @retval PMSTEP_OK, PMSTEP_ERR_NULL_ARGUMENT
+ * @retval PMSTEP_ERR_BAD_MODE  not tracked (not in RUN)
+ */
+pmstep_status_t pmstep_position_follow_steps(pmstep_position_t *pos, struct pmstep_stepdir *sd);
 
 #ifdef __cplusplus
 }

@@ -123,9 +123,14 @@ typedef enum {
                                                  for the load: |T_L - T_detent| above 0.9 k_M I (pmstep_hold.h);
                                                  the standstill hold's current < 0 or not below max_phase_current_A */
     PMSTEP_ERR_STANDSTILL_KNOWN_LOAD = -133, /**< a standstill hold with known_load_mode (a vector hold needs (6)) */
-    PMSTEP_ERR_VECTOR_SPEED = -134           /**< the standstill's low-speed drive: a speed < 0, stops_only without a
+    PMSTEP_ERR_VECTOR_SPEED = -134,          /**< the standstill's low-speed drive: a speed < 0, stops_only without a
                                                   speed, or > 0 without a
                                                   hold current */
+    /* STEP/DIR input (pmstep_stepdir.h) */
+    PMSTEP_ERR_STEPDIR_MICROSTEPS = -135,   /**< microsteps per full step not within 1..PMSTEP_STEPDIR_MAX_MICROSTEPS */
+    PMSTEP_ERR_STEPDIR_TRACKING = -136,     /**< the step tracker's bandwidth not > 0, or above 4 / (N T_s) */
+    PMSTEP_ERR_STEPDIR_LIMIT = -137         /**< the following-error limit or the stop time not > 0, or a DIAG pulse
+                                                 of 0 periods */
 } pmstep_status_t;
 
 /** Shortest and longest control period accepted (s): 1 MHz down to 100 Hz. */
