@@ -8,7 +8,15 @@
 
 /* Bandwidths as fractions of the control rate 1/T_s (docs/design/02-current-and-speed-loops.md). */
 #define CURRENT_BANDWIDTH_X_PERIOD 0.2f   /* (R/L + K_i) T_s */
-#define OBSERVER_BANDWIDTH_X_PERIOD 0.05f /* w_o T_s: the observer's triple pole */
+/* The observer's triple pole w_o: at least OBSERVER_BANDWIDTH_X_PERIOD / T_s, raised to
+ * OBSERVER_HALF_RESPONSE / t_step, t_step the time the rated torque takes to turn the told rotor by
+ * one full step (a triple pole's step response is half way at w_o t = 2.674: half a load step is
+ * estimated before it has slipped the rotor a full step), up to MAX_OBSERVER_BANDWIDTH_X_PERIOD / T_s
+ * (3 w_o T_s = 0.3 within the forward-Euler observer's 0.5; docs/design/03-observer.md). */
+#define OBSERVER_BANDWIDTH_X_PERIOD 0.05f
+#define MAX_OBSERVER_BANDWIDTH_X_PERIOD 0.1f
+#define OBSERVER_HALF_RESPONSE 2.674f
+#define DESIGN_PI 3.14159265f
 /* A winding faster than those: the current loop at this many times R/L, the observer's current pole
  * 3 w_o at this many times R/L + F/J; and the fastest winding designed for, (R/L + F/J) T_s, which
  * keeps (R/L + K_i) T_s and (R/L + K_e) T_s under the 0.5 init accepts. */
@@ -248,6 +256,18 @@ static float top_speed(const pmstep_design_input_t *in)
     return (-b + sqrtf(b * b - 4.0f * a * c)) / (2.0f * a);
 }
 
+/* The observer's bandwidth from the control rate and the rotor's full-step time under the rated
+ * torque, t_step = sqrt(2 (pi / (2 p)) J / (k_M I)) (OBSERVER_HALF_RESPONSE). */
+static float observer_bandwidth(const pmstep_design_input_t *in)
+{
+    const pmstep_motor_config_t *m = &in->motor;
+    const float rated_torque_Nm = m->torque_constant_Nm_A * in->motor.rated_current_A;
+    const float step_time_s = sqrtf(DESIGN_PI * m->inertia_kgm2 / ((float)m->pole_pairs * rated_torque_Nm));
+    const float w_step = OBSERVER_HALF_RESPONSE / step_time_s;
+    return min2(max2(OBSERVER_BANDWIDTH_X_PERIOD, w_step * in->period_s), MAX_OBSERVER_BANDWIDTH_X_PERIOD)
+           / in->period_s;
+}
+
 /* Current loop, observer (triple pole at -w_o of s^3 + (a_e + F/J) s^2 + (a_e F/J + g_w b^2) s
  * + g_T b^2 / J, b = k_M/L), speed loop and reference filter (docs/design/02-current-and-speed-loops.md to 03-observer.md). */
 static void design_gains(const pmstep_design_input_t *in, pmstep_gains_config_t *gains, pmstep_design_report_t *report)
@@ -256,7 +276,11 @@ static void design_gains(const pmstep_design_input_t *in, pmstep_gains_config_t 
     const float r_over_l = m->resistance_Ohm / m->inductance_H;
     const float f_over_j = m->friction_Nms_rad / m->inertia_kgm2;
     const float b = m->torque_constant_Nm_A / m->inductance_H;
-    const float w_o = max2(OBSERVER_BANDWIDTH_X_PERIOD / in->period_s, WINDING_RATE_MARGIN * (r_over_l + f_over_j) / 3.0f);
+    const float w_winding = WINDING_RATE_MARGIN * (r_over_l + f_over_j) / 3.0f;
+    const float w_o = max2(observer_bandwidth(in), w_winding);
+    /* The angle's corrections against the current samples' noise: at the rate's bandwidth, not raised
+     * for the load (docs/design/15-back-emf-angle-correction.md). */
+    const float w_angle = max2(OBSERVER_BANDWIDTH_X_PERIOD / in->period_s, w_winding);
     const float a_e = 3.0f * w_o - f_over_j;
     const float g_w = (3.0f * w_o * w_o - a_e * f_over_j) / (b * b);
     const float lambda = 2.0f / g_w;
@@ -279,13 +303,13 @@ static void design_gains(const pmstep_design_input_t *in, pmstep_gains_config_t 
     gains->sat_kappa_rad_s = KAPPA_CURRENT_FRACTION * in->motor.rated_current_A * m->torque_constant_Nm_A
                              / (m->inertia_kgm2 * speed_gain);
     gains->reference_bandwidth_rad_s = REFERENCE_PER_SPEED_BANDWIDTH * speed_gain;
-    gains->angle_correction_gain_per_s = in->self_commissioning ? DRIFT_FREE_PER_OBSERVER_BANDWIDTH * w_o : 0.0f;
+    gains->angle_correction_gain_per_s = in->self_commissioning ? DRIFT_FREE_PER_OBSERVER_BANDWIDTH * w_angle : 0.0f;
     if (in->self_commissioning) {
         /* Half on where the back EMF equals the voltage the model knows least: the resistive drop at
          * rated current and the dead time's full loss 2 V_bus t_d / T_s. */
         const float uncertain_V = m->resistance_Ohm * in->motor.rated_current_A
                                   + 2.0f * in->bus_voltage_V * in->dead_time_s / in->period_s;
-        gains->emf_angle_gain_per_s = EMF_ANGLE_PER_OBSERVER_BANDWIDTH * w_o;
+        gains->emf_angle_gain_per_s = EMF_ANGLE_PER_OBSERVER_BANDWIDTH * w_angle;
         gains->emf_angle_corner_rad_s = uncertain_V / m->torque_constant_Nm_A;
         gains->angle_smoothing = ANGLE_SMOOTHING;
         gains->transient_observer_boost = TRANSIENT_OBSERVER_BOOST;
