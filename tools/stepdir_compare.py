@@ -313,8 +313,7 @@ def plot(rows, path, motor, case):
 def summary_text(rows):
     """One paragraph of the figures: the checked cases' verdicts, the largest errors of both drives."""
     pm = [r for r in rows if r["checked"]]
-    parts = [f"pmstep, checked cases: {sum(1 for r in pm if not r['failures'])} of {len(pm)} runs kept every step "
-             "without DIAG"]
+    parts = [f"pmstep, checked cases: {sum(1 for r in pm if not r['failures'])} of {len(pm)} runs met the verdict"]
     for drive, name in (("pmstep", "pmstep"), ("microstep", "open-loop microstepping")):
         for checked in (True, False):
             rs = [r for r in rows if r["drive"] == drive and (r["case"] in CHECKED) == checked]
@@ -330,7 +329,7 @@ def summary_text(rows):
 
 def report_text(rows, args, argv, picture):
     what = ("Per public preset, pmstep-tune's design (ideal measurement chain, the plant's detent torque on) and "
-            "three step streams from the SIL's step generator (`position.source = stepdir`), each into the firmware "
+            "the step streams below from the SIL's step generator (`position.source = stepdir`), each into the firmware "
             "following the count (`pmstep_stepdir.h`, the designer's tracker and DIAG limit of one full step) and "
             "into open-loop microstepping at rated current (`run.controller = microstep`) on the same plant: "
             f"**moves** (S-curves at ½ the top speed and min(¼ k_M I / J, {A_AXIS:g} rad/s²), reversals, dwells), "
