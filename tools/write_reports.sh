@@ -24,6 +24,8 @@
 #                        paper, robust and self-commissioning modes -> docs/reports/motor-sweep.md (+ .png)
 #   self-commissioning   tools/self_commission.py, every preset on its chain and the realistic one
 #                                                              -> docs/reports/self-commissioning.md
+#   step-dir             tools/stepdir_compare.py, every preset, pmstep and open-loop microstepping on the
+#                        same step streams                     -> docs/reports/step-dir.md (+ step-dir.png)
 #
 # The campaigns run on a thread pool of 2 (--engine threads --jobs 2; a case's result depends on its
 # seed alone, not on the engine). Outputs of the runs (tables, cases, plots) go to OUT (out/reports);
@@ -41,7 +43,7 @@ set -uo pipefail
 cd "$(dirname "$0")/.."
 
 STEPS_ALL=(cost position-cost benchmarks envelope position-acceptance mc-presets mc-robust mc-position fault-injection
-           motor-sweep self-commissioning)
+           motor-sweep self-commissioning step-dir)
 MC_PRESETS=(paper 17hs4401 bj42d29 as1050)
 MC_POSITION=(17hs4401 bj42d29 as1050)
 OUT=${OUT:-out/reports}
@@ -157,6 +159,11 @@ for step in "${STEPS[@]}"; do
       need_sil
       run self-commissioning "$REPORTS/self-commissioning.md" "$PYTHON" tools/self_commission.py --tune "$TUNE" \
         --report "$REPORTS/self-commissioning.md" ;;
+    step-dir)
+      need_sil
+      rm -rf "$OUT/stepdir_compare"
+      run step-dir "$REPORTS/step-dir.md" "$PYTHON" tools/stepdir_compare.py --sil "$SIL" --tune "$TUNE" \
+        --out "$OUT/stepdir_compare" --report "$REPORTS/step-dir.md" ;;
   esac
 done
 

@@ -54,6 +54,10 @@ static bool write_row(const sil_sample_t *x, void *user)
          * (from the c-alignment equilibrium). */
         fprintf(csv->file, ",%.9g,%.9g,%.9g", x->position_reference_rad, x->position_estimate_rad, x->position_rad);
     }
+    if (x->stepdir) {
+        /* A STEP/DIR scenario's: the generator's count, the following error (full steps), DIAG. */
+        fprintf(csv->file, ",%ld,%.9g,%d", (long)x->step_count, x->step_error_full_steps, x->diag ? 1 : 0);
+    }
     fputc('\n', csv->file);
     return true;
 }
@@ -77,6 +81,33 @@ static void add_position_json(cJSON *root, const sil_summary_t *s)
     cJSON_AddNumberToObject(position, "hold_max_estimate_error_electrical_rad", p->hold_max_estimate_error_rad);
     cJSON_AddNumberToObject(position, "hold_drift_electrical_rad_s", p->hold_drift_rad_s);
     cJSON_AddItemToObject(root, "position", position);
+}
+
+/* A STEP/DIR scenario's figures (sil_stepdir_summary_t; errors in full steps, pi / (2 p) mechanical rad). */
+static void add_stepdir_json(cJSON *root, const sil_scenario_t *sc, const sil_summary_t *s)
+{
+    const sil_stepdir_summary_t *d = &s->stepdir;
+    cJSON *stepdir = cJSON_CreateObject();
+    cJSON_AddNumberToObject(stepdir, "microsteps", (double)d->microsteps);
+    cJSON_AddStringToObject(stepdir, "diag_mode", sc->stepdir_diag_mode == PMSTEP_DIAG_PULSE ? "pulse" : "level");
+    cJSON_AddNumberToObject(stepdir, "moves", d->moves);
+    cJSON_AddNumberToObject(stepdir, "first_move_s", d->first_move_s);
+    cJSON_AddNumberToObject(stepdir, "last_move_end_s", d->last_move_end_s);
+    cJSON_AddNumberToObject(stepdir, "peak_speed_rad_s", d->peak_speed_rad_s);
+    cJSON_AddNumberToObject(stepdir, "following_start_s", d->following_start_s);
+    cJSON_AddNumberToObject(stepdir, "following_end_s", d->following_end_s);
+    cJSON_AddNumberToObject(stepdir, "generator_steps", (double)d->generator_steps);
+    cJSON_AddNumberToObject(stepdir, "drive_steps", (double)d->drive_steps);
+    cJSON_AddNumberToObject(stepdir, "max_error_moving_full_steps", d->max_error_moving_full_steps);
+    cJSON_AddNumberToObject(stepdir, "rms_error_moving_full_steps", d->rms_error_moving_full_steps);
+    cJSON_AddNumberToObject(stepdir, "max_error_full_steps", d->max_error_full_steps);
+    cJSON_AddNumberToObject(stepdir, "rms_error_full_steps", d->rms_error_full_steps);
+    cJSON_AddNumberToObject(stepdir, "final_error_full_steps", d->final_error_full_steps);
+    cJSON_AddNumberToObject(stepdir, "lost_full_steps", (double)d->lost_full_steps);
+    cJSON_AddNumberToObject(stepdir, "error_beyond_full_step_s", d->error_beyond_full_step_s);
+    cJSON_AddNumberToObject(stepdir, "diag_periods", (double)d->diag_periods);
+    cJSON_AddNumberToObject(stepdir, "diag_first_s", d->diag_first_s);
+    cJSON_AddItemToObject(root, "stepdir", stepdir);
 }
 
 /* The [sensors], [inverter] and [bus] settings and what the ADC clipped. */
@@ -227,8 +258,11 @@ static cJSON *summary_json(const sil_scenario_t *sc, const sil_summary_t *s)
     cJSON_AddStringToObject(root, "final_mode", pmstep_mode_str(s->final_mode));
     add_robustness_json(root, s);
     add_baseline_json(root, sc, s);
-    if (sc->position_moves > 0) {
+    if (sc->position_moves > 0 && sc->drive == SIL_DRIVE_PMSTEP) {
         add_position_json(root, s);
+    }
+    if (sc->position_moves > 0 && sc->position_source == SIL_SOURCE_STEPDIR) {
+        add_stepdir_json(root, sc, s);
     }
 
     cJSON_AddNumberToObject(fault, "code", (double)s->fault);
@@ -284,6 +318,7 @@ int main(int argc, char **argv)
     FILE *record = NULL;
     int run_status;
     bool write_csv = true, quiet = false, print_only = false;
+    bool stepdir; /* a STEP/DIR scenario: its columns, figures and line */
     csv_ctx_t csv = {NULL, 1};
     cJSON *json;
     char *text;
@@ -359,6 +394,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "pmstep-sil: %s\n", err);
         return 2;
     }
+    stepdir = sc.position_moves > 0 && sc.position_source == SIL_SOURCE_STEPDIR;
     if (sc.drive == SIL_DRIVE_MICROSTEP && record_path != NULL) {
         fprintf(stderr, "pmstep-sil: --record needs run.controller = pmstep (the microstep baseline has no firmware to replay)\n");
         return 2;
@@ -366,7 +402,8 @@ int main(int argc, char **argv)
     if (write_csv) {
         /* Refuse a run whose time series would fill the disk, before it starts. */
         const double rows = sc.duration_s / (double)sc.controller.timing.period_s / (double)sc.decimation;
-        const double csv_MB = rows * (SIL_CSV_ROW_MAX_BYTES + (sc.position_moves > 0 ? 48.0 : 0.0)) / 1e6;
+        const double csv_MB = rows * (SIL_CSV_ROW_MAX_BYTES + (sc.position_moves > 0 ? 48.0 : 0.0)
+                                      + (stepdir ? 32.0 : 0.0)) / 1e6;
         if (csv_MB > sc.max_csv_MB) {
             fprintf(stderr,
                     "pmstep-sil: run.csv would take up to %.0f MB (%.0f rows), more than run.max_csv_MB = %g: raise "
@@ -392,8 +429,10 @@ int main(int argc, char **argv)
         csv.decimation = sc.decimation;
         fprintf(csv.file, "t_s,theta_rad,omega_rad_s,omega_ref_rad_s,i_a_A,i_b_A,u_a_V,u_b_V,cos_hat,sin_hat,"
                           "cos_ptheta,sin_ptheta,omega_hat_rad_s,load_hat_Nm,load_Nm,mode,fault,"
-                          "i_a_meas_A,i_b_meas_A,bus_voltage_V,bus_voltage_meas_V%s\n",
-                sc.position_moves > 0 ? ",position_ref_rad,position_hat_rad,position_rad" : "");
+                          "i_a_meas_A,i_b_meas_A,bus_voltage_V,bus_voltage_meas_V%s%s\n",
+                sc.position_moves > 0 && sc.drive == SIL_DRIVE_PMSTEP ? ",position_ref_rad,position_hat_rad,position_rad"
+                                                                      : "",
+                stepdir ? ",step_count,step_error_full_steps,diag" : "");
     }
     if (record_path != NULL && sc.position_moves > 0) {
         fprintf(stderr, "pmstep-sil: --record replays pmstep_step alone: not for a position scenario (position.points)\n");
@@ -476,6 +515,18 @@ int main(int argc, char **argv)
     }
     cJSON_free(text);
     cJSON_Delete(json);
+    if (stepdir && !quiet) {
+        const sil_stepdir_summary_t *d = &summary.stepdir;
+        fprintf(stderr, "pmstep-sil: STEP/DIR: %ld microsteps put out, %ld counted; following error max %.3f full steps "
+                        "(%.3f while moving), final %+.3f",
+                (long)d->generator_steps, (long)d->drive_steps, d->max_error_full_steps, d->max_error_moving_full_steps,
+                d->final_error_full_steps);
+        if (d->diag_first_s >= 0.0) {
+            fprintf(stderr, "; DIAG asserted at t = %.6f s (%ld periods)\n", d->diag_first_s, d->diag_periods);
+        } else {
+            fprintf(stderr, "; DIAG %s\n", sc.drive == SIL_DRIVE_MICROSTEP ? "none (open loop)" : "never asserted");
+        }
+    }
     if (summary.loss_of_synchronism) {
         fprintf(stderr, "pmstep-sil: LOSS OF SYNCHRONISM at t = %.6f s (%s)\n", summary.loss_of_synchronism_time_s,
                 sc.drive == SIL_DRIVE_MICROSTEP ? "load angle beyond pi" : "angle-estimate error above run.loss_angle_error_rad");

@@ -24,6 +24,20 @@ void sil_microstep_set_speed_target(sil_microstep_t *drive, double target_rad_s,
     drive->moving = true;
 }
 
+void sil_microstep_set_angle(sil_microstep_t *drive, double angle_ref_rad)
+{
+    if (drive->angle_mode) {
+        /* mechanical: the angle is electrical */
+        drive->speed_ref_rad_s = (angle_ref_rad - drive->angle_ref_rad) / (drive->period_s * drive->pole_pairs);
+    } else {
+        drive->speed_ref_rad_s = 0.0;
+    }
+    drive->target_rad_s = drive->speed_ref_rad_s; /* no ramp left running: the telemetry's rate is 0 */
+    drive->angle_ref_rad = angle_ref_rad;
+    drive->angle_mode = true;
+    drive->moving = true;
+}
+
 /* omega* over [t_k, t_k + T_s]: a ramp towards the target that stops there. Returns the
  * integral of omega* over the period (rad) and leaves omega*(t_k + T_s). */
 static double advance_reference(sil_microstep_t *drive)
@@ -79,5 +93,7 @@ void sil_microstep_step(sil_microstep_t *drive, const pmstep_meas_t *meas, pmste
     }
     out->i_a_hat_A = (float)i_a_ref;
     out->i_b_hat_A = (float)i_b_ref;
-    drive->angle_ref_rad = angle + drive->pole_pairs * advance_reference(drive);
+    if (!drive->angle_mode) {
+        drive->angle_ref_rad = angle + drive->pole_pairs * advance_reference(drive);
+    }
 }

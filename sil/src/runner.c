@@ -12,6 +12,7 @@
 #include "pmstep_hal_host.h"
 #include "sil/microstep.h"
 #include "sil/position_run.h"
+#include "sil/stepdir_run.h"
 
 /* The firmware and plant shares are timed on every SIL_TIMING_STRIDE-th period only (three
  * clock reads there, none elsewhere) and scaled to the run: a clock read costs about as
@@ -126,8 +127,11 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
 {
     static pmstep_t inst; /* as on the MCU: one static instance */
     static pmstep_position_t pos; /* a position scenario's position control of inst */
+    static sil_stepdir_run_t stepdir_run; /* a STEP/DIR scenario's generator and input (large: static) */
     const bool microstep = sc->drive == SIL_DRIVE_MICROSTEP;
     const bool positional = !microstep && sc->position_moves > 0;
+    /* position.source = stepdir: the drive (either) follows the step generator's count */
+    const bool stepdir = sc->position_moves > 0 && sc->position_source == SIL_SOURCE_STEPDIR;
     sil_position_run_t position_run;
     pmstep_position_output_t pos_out;
     sil_microstep_t drive;
@@ -168,7 +172,10 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
     memset(&pos_out, 0, sizeof pos_out);
     sil_position_run_init(&position_run, sc);
     sil_metrics_init(&metrics, sc, s); /* its period counts need a configuration init accepted; clears s */
-    s->init_status = PMSTEP_OK;
+    s->init_status = stepdir ? sil_stepdir_run_init(&stepdir_run, sc, !microstep, s) : PMSTEP_OK;
+    if (s->init_status != PMSTEP_OK) {
+        return -1;
+    }
     if (sil_bind_plant(sc, &plant) != 0) {
         return -3;
     }
@@ -206,7 +213,9 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
         } else {
             command_speed(&inst, sc, t_s, &next_segment, rec);
         }
-        if (positional) {
+        if (stepdir) {
+            sil_stepdir_run_command(&stepdir_run, t_s, positional ? &pos : NULL, microstep ? &drive : NULL, s);
+        } else if (positional) {
             sil_position_run_command(&position_run, &pos, t_s, s);
         }
         sample.theta_rad = plant.x.theta_rad;
@@ -226,7 +235,13 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
             sil_microstep_step(&drive, &meas, &out);
         } else {
             sample.angle_ref_rad = 0.0;
-            if (positional) {
+            if (stepdir) {
+                /* the port's order: the step, the step counter read, the position update, DIAG */
+                pmstep_step(&inst, &meas, &out);
+                sil_stepdir_run_count(&stepdir_run);
+                pmstep_position_update(&pos, &out, &pos_out);
+                sil_stepdir_run_diag(&stepdir_run, out.mode, &pos_out);
+            } else if (positional) {
                 pmstep_position_step(&pos, &meas, &out, &pos_out);
             } else {
                 pmstep_step(&inst, &meas, &out);
@@ -260,9 +275,16 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
         sample.position_estimate_rad = 0.0;
         sample.position_reference_rad = 0.0;
         sample.position_updated = false;
+        sample.stepdir = false;
+        sample.step_count = 0;
+        sample.step_error_full_steps = 0.0;
+        sample.diag = false;
         if (positional) {
             sample.position = &pos_out;
             sil_position_run_sample(&position_run, &pos, &sample, s);
+        }
+        if (stepdir) {
+            sil_stepdir_run_sample(&stepdir_run, &sample, s);
         }
         sil_metrics_add(&metrics, &sample, s);
 
@@ -289,6 +311,9 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
     sil_metrics_finish(&metrics, s);
     if (positional) {
         sil_position_run_finish(&position_run, s);
+    }
+    if (stepdir) {
+        sil_stepdir_run_finish(&stepdir_run, s);
     }
     s->inverter_limited_periods = (long)inverter->limited_periods;
     pmstep_hal_host_release();

@@ -152,6 +152,25 @@ int sil_scenario_set(sil_scenario_t *sc, const char *key, const char *value, cha
             }
             return fail(err, err_size, "%s: '%s' is not one of pmstep, microstep", key, value);
         }
+        case KEY_POSITION_SOURCE:
+        case KEY_DIAG_MODE: {
+            const bool source = k->type == KEY_POSITION_SOURCE;
+            const char *const *names = source ? position_source_names : diag_mode_names;
+            const size_t count = source ? sizeof position_source_names / sizeof position_source_names[0]
+                                        : sizeof diag_mode_names / sizeof diag_mode_names[0];
+            size_t j;
+            for (j = 0; j < count; ++j) {
+                if (strcmp(value, names[j]) == 0) {
+                    if (source) {
+                        *(sil_position_source_t *)(base + k->offset) = (sil_position_source_t)j;
+                    } else {
+                        *(pmstep_diag_mode_t *)(base + k->offset) = (pmstep_diag_mode_t)j;
+                    }
+                    return 0;
+                }
+            }
+            return fail(err, err_size, "%s: '%s' is not one of %s", key, value, source ? "move, stepdir" : "level, pulse");
+        }
         case KEY_PHASES:
         case KEY_SENSOR_FAULT: {
             const char *const *names = k->type == KEY_PHASES ? phases_names : sensor_fault_names;

@@ -12,7 +12,8 @@
 
 typedef enum { KEY_DOUBLE, KEY_FLOAT, KEY_INT, KEY_UINT, KEY_BOOL, KEY_ANGLE_DEG, KEY_SPEED_POINTS,
                KEY_LOAD_POINTS, KEY_LOAD_KIND, KEY_INVERTER_MODEL, KEY_ADC_BITS, KEY_INTEGRATOR,
-               KEY_DRIVE, KEY_MOVES, KEY_PHASES, KEY_SENSOR_FAULT } key_type_t;
+               KEY_DRIVE, KEY_MOVES, KEY_PHASES, KEY_SENSOR_FAULT, KEY_POSITION_SOURCE,
+               KEY_DIAG_MODE } key_type_t;
 
 /* Range of a numeric key: min/max, each inclusive or exclusive. */
 typedef struct {
@@ -38,6 +39,8 @@ static const char *const integrator_names[] = {"rk4", "exponential"}; /* in plan
 static const char *const drive_names[] = {"pmstep", "microstep"};     /* in sil_drive_t order */
 static const char *const phases_names[] = {"none", "a", "b", "both"};  /* in sil_phases_t order */
 static const char *const sensor_fault_names[] = {"none", "open", "stuck"}; /* in sil_sensor_fault_t order */
+static const char *const position_source_names[] = {"move", "stepdir"}; /* in sil_position_source_t order */
+static const char *const diag_mode_names[] = {"level", "pulse"}; /* in pmstep_diag_mode_t order */
 
 /* run.theta0_deg's value as stored (rad): the one conversion the reader applies and the printer
  * inverts (scenario.c). */

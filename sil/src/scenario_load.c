@@ -239,8 +239,19 @@ int sil_scenario_check(const sil_scenario_t *sc, char *err, size_t err_size)
         const double run_start_s = (double)sc->controller.commissioning.offset_calibration_time_s
                                    + (double)sc->controller.alignment.c_align_time_s;
         int n;
-        if (sc->drive != SIL_DRIVE_PMSTEP) {
-            return fail(err, err_size, "position.points: moves need run.controller = pmstep");
+        if (sc->drive != SIL_DRIVE_PMSTEP && sc->position_source != SIL_SOURCE_STEPDIR) {
+            return fail(err, err_size, "position.points: moves need run.controller = pmstep, or position.source = "
+                                       "stepdir (a step count the microstep baseline follows too)");
+        }
+        if (sc->position_source == SIL_SOURCE_STEPDIR) {
+            /* The port's 16-bit counter is read once a period: it must turn by less than half its range. */
+            const double microstep_rad = 2.0 * PI / (4.0 * (double)sc->motor.pole_pairs * (double)sc->stepdir_microsteps);
+            const double per_period = sc->move_speed_rad_s * (double)sc->controller.timing.period_s / microstep_rad;
+            if (!(per_period < 32767.0)) {
+                return fail(err, err_size, "position.v_max_rad_s = %g with stepdir.microsteps = %u: %.0f microsteps a "
+                            "period, more than the 16-bit step counter's half turn (32767)", sc->move_speed_rad_s,
+                            (unsigned)sc->stepdir_microsteps, per_period);
+            }
         }
         for (n = 0; n < sc->speed_points; ++n) {
             if (sc->speed_value_rad_s[n] != 0.0) {
@@ -259,6 +270,9 @@ int sil_scenario_check(const sil_scenario_t *sc, char *err, size_t err_size)
                             (double)PMSTEP_POSITION_MAX_ELECTRICAL_RAD);
             }
         }
+    }
+    if (sc->position_source == SIL_SOURCE_STEPDIR && sc->position_moves == 0) {
+        return fail(err, err_size, "position.source = stepdir needs position.points (the moves the step generator plans)");
     }
     if (sc->load.kind == PLANT_LOAD_PROPORTIONAL && sc->integrator == PLANT_INTEGRATOR_RK4) {
         /* RK4 on w' = -(c/J) w: stable for c h / J within 2.78; 2.5 keeps a margin. The exponential

@@ -54,11 +54,18 @@ void sil_scenario_paper(sil_scenario_t *sc)
     sc->move_speed_rad_s = 5.0;
     sc->move_accel_rad_s2 = 50.0;
     sc->position.hold_current_A = -1.0f; /* the designer's */
+    /* Moves planned by the drive; a STEP/DIR input at 16 microsteps (a printer board's usual), DIAG as a level. */
+    sc->position_source = SIL_SOURCE_MOVE;
+    sc->stepdir_microsteps = 16u;
+    sc->stepdir_diag_mode = PMSTEP_DIAG_LEVEL;
 }
 
 double sil_scenario_hold_end_s(const sil_scenario_t *sc)
 {
     int k;
+    if (sc->position_source == SIL_SOURCE_STEPDIR && sc->position_moves > 0) {
+        return sc->move_time_s[0];
+    }
     for (k = 0; k + 1 < sc->speed_points; ++k) {
         if (sc->speed_value_rad_s[k + 1] != sc->speed_value_rad_s[k]) {
             return sc->speed_time_s[k];

@@ -35,6 +35,11 @@ typedef struct {
     double position_estimate_rad;    /**< position scenario, tracked: theta-hat of this period (pmstep_get_position) */
     double position_reference_rad;   /**< theta* of this period (pmstep_position_reference) */
     bool position_updated;           /**< this period ran the position update (the output's values are its own) */
+    bool stepdir;                    /**< a STEP/DIR scenario (position.source = stepdir): the three below are set */
+    int32_t step_count;              /**< the step generator's count at t_k (microsteps, signed) */
+    double step_error_full_steps;    /**< count q - theta (the plant's, from the c-alignment's equilibrium) in full
+                                          steps pi / (2 p); 0 until the drive follows the count */
+    bool diag;                       /**< DIAG after this period (pmstep_stepdir_diag(); false for the baseline) */
 } sil_sample_t;
 
 /** Position scenario (issue 13): the moves and the hold, judged on the true position (electrical rad: p times
@@ -55,6 +60,31 @@ typedef struct {
     double hold_max_estimate_error_rad;    /**< max |theta-hat - theta| p over it */
     double hold_drift_rad_s;               /**< least-squares slope of (theta - theta*) p over it (electrical rad/s) */
 } sil_position_summary_t;
+
+/** A STEP/DIR scenario (issue 53, position.source = stepdir): the drive against the count the step generator put
+ *  out. Errors in full steps, pi / (2 p) mechanical rad, signed count q - theta (theta the plant's from the
+ *  c-alignment's equilibrium, where count 0 is: positive when the rotor lags a forward move). Both drives. */
+typedef struct {
+    uint32_t microsteps;                   /**< stepdir.microsteps */
+    int moves;                             /**< moves planned */
+    double first_move_s;                   /**< the first move's start */
+    double last_move_end_s;                /**< the last move's end (queued moves included) */
+    double peak_speed_rad_s;               /**< the largest |speed| the moves reach (mechanical) */
+    double following_start_s;              /**< when the drive began following the count (-1: never) */
+    double following_end_s;                /**< when the firmware stopped following (left RUN), -1 if it did not */
+    int32_t generator_steps;               /**< the generator's count at the end (microsteps) */
+    int32_t drive_steps;                   /**< the drive's count at the end (pmstep_stepdir_t::steps; the baseline's
+                                                is the generator's) */
+    double max_error_moving_full_steps;    /**< max |error| while a move runs */
+    double rms_error_moving_full_steps;    /**< RMS of the error while a move runs */
+    double max_error_full_steps;           /**< max |error| from the start of following to the end */
+    double rms_error_full_steps;           /**< RMS over the same */
+    double final_error_full_steps;         /**< the error at the last period (after the last move) */
+    int32_t lost_full_steps;               /**< final_error_full_steps rounded: full steps lost (+: behind) */
+    double error_beyond_full_step_s;       /**< the first period with |error| above one full step, -1 if none */
+    long diag_periods;                     /**< periods DIAG was asserted (pmstep only) */
+    double diag_first_s;                   /**< the first of them, -1 if none */
+} sil_stepdir_summary_t;
 
 /** Called once per period; return false to stop the run early. */
 typedef bool (*sil_sample_fn)(const sil_sample_t *sample, void *user);
@@ -106,6 +136,7 @@ typedef struct {
                                                 angle-estimate error above run.loss_angle_error_rad in RUN */
     double loss_of_synchronism_time_s;     /**< its first sample, -1 if none */
     sil_position_summary_t position;       /**< position scenario only (zero otherwise) */
+    sil_stepdir_summary_t stepdir;         /**< STEP/DIR scenario only (zero otherwise) */
 } sil_summary_t;
 
 /** Running sums behind the summary. */

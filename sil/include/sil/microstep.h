@@ -10,6 +10,10 @@
  * omega*(t), and the commanded electrical angle theta_e* = p * integral of omega* dt
  * (0 before the first ramp: the power-on hold that aligns the rotor to p theta = 0 mod 2 pi).
  *
+ * Or, following a STEP/DIR count (position.source = stepdir), the angle itself each period:
+ * theta_e* = p n q for a count n of microsteps q (sil_microstep_set_angle()), and omega* its change
+ * over the last period (what a drive that sees only the steps knows of the speed).
+ *
  * Set-points i_a* = I cos theta_e*, i_b* = I sin theta_e*, I = datasheet.rated_current_A,
  * so the torque is k_M I sin(theta_e* - p theta) and the pull-out torque k_M I.
  *
@@ -47,7 +51,8 @@ typedef struct {
     double target_rad_s;      /**< where the ramp goes */
     double ramp_rate_rad_s2;  /**< its slope (> 0; <= 0: a step) */
     double angle_ref_rad;     /**< theta_e*(t_k), electrical, unwrapped */
-    bool moving;              /**< a speed command has been issued: the hold is over */
+    bool moving;              /**< a speed command or an angle has been given: the hold is over */
+    bool angle_mode;          /**< following an angle (sil_microstep_set_angle()), not a speed profile */
 } sil_microstep_t;
 
 /** Settings from @p sc (T_s, datasheet.rated_current_A, controller.motor R, L, p); reference 0. */
@@ -57,12 +62,18 @@ void sil_microstep_init(sil_microstep_t *drive, const sil_scenario_t *sc);
  *  reference to @p target_rad_s at @p ramp_rate_rad_s2. */
 void sil_microstep_set_speed_target(sil_microstep_t *drive, double target_rad_s, double ramp_rate_rad_s2);
 
+/** Angle mode: theta_e* = @p angle_ref_rad (electrical, unwrapped) from the present sample t_k on, and
+ *  omega* its change since the last call over T_s (0 at the first: the hold before it is at rest).
+ *  The speed profile's commands are not followed any more. */
+void sil_microstep_set_angle(sil_microstep_t *drive, double angle_ref_rad);
+
 /**
  * One control period: the phase voltages from the sample @p meas at t_k into @p out
  * (u_a_V, u_b_V, bridge_enable, voltage_limited; the telemetry of the CSV: cos_hat, sin_hat
  * = cos, sin theta_e*; speed_ref_rad_s = omega*; speed_ref_rate_rad_s2; i_a_hat_A, i_b_hat_A
  * = i_a*, i_b*; mode C_ALIGN during the hold, RUN after; the rest 0), then advances the
- * reference to t_k + T_s (theta_e* integrated exactly over the ramp).
+ * reference to t_k + T_s (theta_e* integrated exactly over the ramp; in angle mode the next
+ * sil_microstep_set_angle() gives it).
  */
 void sil_microstep_step(sil_microstep_t *drive, const pmstep_meas_t *meas, pmstep_output_t *out);
 

@@ -13,6 +13,7 @@
 
 #include "pmstep/pmstep.h"
 #include "pmstep/pmstep_position.h"
+#include "pmstep/pmstep_stepdir.h"
 #include "sil/inverter.h"
 #include "sil/plant.h"
 #include "sil/faults.h"
@@ -37,6 +38,13 @@ typedef struct {
     double holding_torque_Nm; /**< datasheet.holding_torque_Nm: holding torque with both phases at rated current */
     double detent_torque_Nm;  /**< datasheet.detent_torque_Nm: unpowered detent torque (0 = not given) */
 } sil_datasheet_t;
+
+/** position.source: what a position scenario's points become. */
+typedef enum {
+    SIL_SOURCE_MOVE = 0,    /**< each point a pmstep_position_move_to() at its time (the drive plans the move) */
+    SIL_SOURCE_STEPDIR = 1  /**< the SIL's step generator (sil/step_generator.h) plans each move as a motion
+                                 controller does; the drive follows its STEP/DIR count (pmstep_stepdir.h) */
+} sil_position_source_t;
 
 /** run.controller: what drives the plant. */
 typedef enum {
@@ -86,10 +94,19 @@ typedef struct {
     double move_target_rad[SIL_POSITION_MOVES_MAX];
     double move_speed_rad_s;               /**< position.v_max_rad_s of every move */
     double move_accel_rad_s2;              /**< position.a_max_rad_s2 */
-    double move_jerk_rad_s3;               /**< position.j_max_rad_s3 (0 = a_max varpi_0) */
+    double move_jerk_rad_s3;               /**< position.j_max_rad_s3 (source move: 0 = a_max varpi_0; source
+                                                stepdir: 0 = no jerk limit, a trapezoid) */
     double hold_start_s;                   /**< position.hold_start_s: the hold window's start (0 = none) */
     pmstep_position_config_t position;     /**< [controller.position]: gain_per_s 0 = the designer's rule
                                                 (pmstep_position_design) for both gains */
+    /* A STEP/DIR scenario (issue 53): position.source = stepdir. The points are planned by the SIL's step
+     * generator; the firmware follows the count (pmstep_position_follow_steps()), or with run.controller =
+     * microstep the open-loop baseline turns its current vector with it. */
+    sil_position_source_t position_source; /**< position.source: move | stepdir */
+    uint32_t stepdir_microsteps;           /**< stepdir.microsteps: m per full step, 1 to 256 */
+    pmstep_diag_mode_t stepdir_diag_mode;  /**< stepdir.diag_mode: level | pulse */
+    float stepdir_tracking_bandwidth_rad_s; /**< stepdir.tracking_bandwidth_rad_s: the step tracker's w_t (0 = the
+                                                 designer's, pmstep_stepdir_design()) */
 } sil_scenario_t;
 
 /** The paper's Section III: t_s = 0.3 s, t_c = 0.6 s, 2 Nm at 0.63 s, theta0 = 30 deg, 2.4 s, 20 kHz. */
@@ -115,8 +132,9 @@ int sil_scenario_speed_command(const sil_scenario_t *sc, double t_s, int *next_s
 
 /**
  * End of the hold (s): the start of the first segment of the speed profile that changes the
- * speed, or run.duration_s if the speed never changes. The microstep drive holds
- * theta_e* = 0 until the runner issues that segment's command.
+ * speed, or run.duration_s if the speed never changes; in a STEP/DIR scenario (position.source =
+ * stepdir with points) the first point's time, where the microstep drive starts following the count.
+ * The microstep drive holds theta_e* = 0 until then.
  */
 double sil_scenario_hold_end_s(const sil_scenario_t *sc);
 
