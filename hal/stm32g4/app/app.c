@@ -13,6 +13,16 @@
 #define PMSTEP_VERSION_TEXT "0.0.0"
 #endif
 
+/* STEP/DIR mode (a build with -DPMSTEP_STM32G4_STEPDIR=1, CMake option PMSTEP_STM32G4_STEPDIR): the
+ * port's STEP/DIR/EN input and DIAG output enabled; in RUN the position loop follows the step count.
+ * Off by default: the drive is commanded from the console only, and STEP pulses move nothing. */
+#ifndef PMSTEP_STM32G4_STEPDIR
+#define PMSTEP_STM32G4_STEPDIR 0
+#endif
+#if PMSTEP_STM32G4_STEPDIR
+#include "pmstep/pmstep_stepdir.h"
+#endif
+
 static pmstep_t motor;
 static pmstep_config_t motor_config;       /* must outlive the instance */
 static pmstep_stm32g4_config_t board;      /* must outlive the port */
@@ -21,6 +31,10 @@ static pmstep_store_t store;               /* the port's two flash pages (stm32g
 static pmstep_console_store_t console_store; /* the configuration in force, as the console serves it */
 static pmstep_position_t position;         /* sensorless position control on the same instance */
 static pmstep_position_output_t position_out;
+#if PMSTEP_STM32G4_STEPDIR
+static pmstep_stepdir_t stepdir;           /* the step count, fed by the control interrupt */
+static bool stepdir_was_tracked;           /* RUN at the last period: following starts on entering RUN */
+#endif
 static uint32_t uart_errors;
 static uint8_t tx[64];
 static uint32_t tx_len;
@@ -51,12 +65,40 @@ static void clock_update(void)
     clk.rem_period %= clk.cycles_per_period;
 }
 
+#if PMSTEP_STM32G4_STEPDIR
+/* The step tracker for the configuration in force (the console may have changed it since boot), at the
+ * counter's present value: nothing counted yet. */
+static pmstep_status_t stepdir_start(void)
+{
+    pmstep_stepdir_config_t sd;
+    pmstep_status_t st = pmstep_stepdir_design(&motor_config, board.step_input.microsteps, &sd);
+    if (st == PMSTEP_OK) {
+        st = pmstep_stepdir_init(&stepdir, &sd, motor_config.motor.pole_pairs, motor_config.timing.period_s,
+                                 (uint16_t)pmstep_stm32g4_step_counter());
+    }
+    return st;
+}
+
+/* Once a period, after the step: the count (TIM4 read once), the position loop, then following from
+ * the period RUN begins (the reference starts where the motor is: no jump), and DIAG. */
+static void after_step(const pmstep_output_t *out)
+{
+    pmstep_stepdir_count(&stepdir, pmstep_stm32g4_step_counter());
+    pmstep_position_update(&position, out, &position_out);
+    if (position_out.tracked && !stepdir_was_tracked && stepdir_start() == PMSTEP_OK) {
+        (void)pmstep_position_follow_steps(&position, &stepdir);
+    }
+    stepdir_was_tracked = position_out.tracked;
+    pmstep_stm32g4_set_diag(pmstep_stepdir_diag(&stepdir, out->mode, position_out.position_rad, position_out.tracked));
+}
+#else
 /* In the control interrupt, after each step: the turn count and, every N-th period, the position
  * loop (pmstep_position.h). */
 static void after_step(const pmstep_output_t *out)
 {
     pmstep_position_update(&position, out, &position_out);
 }
+#endif
 
 static void snapshot(pmstep_console_snapshot_t *snap)
 {
@@ -73,6 +115,7 @@ int32_t pmstep_app_init(void)
     uint32_t sysclk_Hz;
 
     board = pmstep_stm32g4_default_config();
+    board.step_input.enabled = PMSTEP_STM32G4_STEPDIR != 0;
     port_st = pmstep_stm32g4_clock_init(&board.clock);
     if (port_st != PMSTEP_STM32G4_OK) {
         return (int32_t)port_st;
@@ -104,6 +147,13 @@ int32_t pmstep_app_init(void)
     if (port_st != PMSTEP_STM32G4_OK) {
         return (int32_t)port_st;
     }
+#if PMSTEP_STM32G4_STEPDIR
+    st = stepdir_start();
+    if (st != PMSTEP_OK) {
+        return -400 + (int32_t)st;
+    }
+    stepdir_was_tracked = false;
+#endif
     sysclk_Hz = pmstep_stm32g4_sysclk_Hz(&board.clock);
     port_st = pmstep_stm32g4_lpuart_init(&board, sysclk_Hz); /* PCLK1 = SYSCLK */
     if (port_st != PMSTEP_STM32G4_OK) {
@@ -155,4 +205,13 @@ void pmstep_app_poll(void)
 uint32_t pmstep_app_uart_errors(void)
 {
     return uart_errors;
+}
+
+int32_t pmstep_app_step_count(void)
+{
+#if PMSTEP_STM32G4_STEPDIR
+    return stepdir.steps;
+#else
+    return 0;
+#endif
 }

@@ -72,8 +72,13 @@ typedef enum {
     PMSTEP_STM32G4_ERR_FLASH_OPERR = -25,   /**< an operation failed (reported with ERRIE only, not used) */
     PMSTEP_STM32G4_ERR_FLASH_RDERR = -26,   /**< a PCROP read error (reported with RDERRIE only, not used) */
     PMSTEP_STM32G4_ERR_FLASH_OPTVERR = -27, /**< the option bytes failed their check at load */
-    PMSTEP_STM32G4_ERR_FLASH_ECC = -28      /**< a read met an uncorrectable ECC error (two or more bits wrong in a
+    PMSTEP_STM32G4_ERR_FLASH_ECC = -28,     /**< a read met an uncorrectable ECC error (two or more bits wrong in a
                                                  double word: one cut short by a power loss) */
+    PMSTEP_STM32G4_ERR_STEP_MICROSTEPS = -29, /**< STEP/DIR input: microsteps per full step not within 1..256 */
+    PMSTEP_STM32G4_ERR_STEP_PULSE = -30,    /**< STEP/DIR input: the shortest STEP pulse is under 3 timer clocks
+                                                 (18 ns at 170 MHz), shorter than TIM4's input stage sees for sure */
+    PMSTEP_STM32G4_ERR_STEP_PIN = -31       /**< STEP/DIR input: STEP not on a TIM4_CH2 pin or DIR not on a TIM4_CH1 pin
+                                                 with its alternate function (PB7/PA12, PB6/PA11) */
 } pmstep_stm32g4_status_t;
 
 /** Why the port holds the bridge off, independently of the core. */
@@ -89,6 +94,35 @@ typedef struct {
     uint8_t pin;
     uint8_t af;
 } pmstep_stm32g4_pin_t;
+
+/**
+ * STEP/DIR/EN input and DIAG output, as a TMC stepper driver has them (a drop-in for one: the
+ * controller's step generator, e.g. Klipper or Marlin, drives the motor). Off by default.
+ *
+ * STEP and DIR go to TIM4 in encoder mode "clock plus direction, x1" (RM0440 §29.4, SMS = 1011):
+ * STEP on TIM4_CH2 (tim_ti2, counted on its rising edges), DIR on TIM4_CH1 (tim_ti1, up while
+ * high). The counter is the step count, 16 bits wrapping at 0xFFFF; the control interrupt reads it
+ * once a period (pmstep_stm32g4_step_counter(), for pmstep_stepdir_count()). Both inputs pass the
+ * same digital filter (TIMx_CCMR1 ICxF), chosen from step_min_pulse_ns (pmstep_stm32g4_step_filter()):
+ * a STEP high or low time of that length always passes, a glitch much shorter never does; DIR is
+ * delayed as much as STEP, so the controller's DIR-to-STEP set-up time is kept.
+ *
+ * EN (a GPIO input, pulled to its disabled level) gates the bridge: while it reads disabled the
+ * bridge is off by the port's one path (MOE = 0, gate-driver enable off, duties 50 %) and the core
+ * stopped, as for a port fault but without latching one. DIAG (an open-drain GPIO output, with
+ * the pin's pull-up) is driven from pmstep_stepdir_diag() through pmstep_stm32g4_set_diag().
+ */
+typedef struct {
+    bool enabled;                      /**< false: none of these pins is touched, no timer runs, EN gates nothing */
+    pmstep_stm32g4_pin_t step_pin;     /**< TIM4_CH2: PB7 (AF2) or PA12 (AF10) */
+    pmstep_stm32g4_pin_t dir_pin;      /**< TIM4_CH1: PB6 (AF2) or PA11 (AF10) */
+    pmstep_stm32g4_pin_t enable_pin;   /**< EN, GPIO input */
+    bool enable_active_high;           /**< false: the drive is enabled while EN is low (a TMC driver's EN) */
+    pmstep_stm32g4_pin_t diag_pin;     /**< DIAG, open-drain GPIO output */
+    bool diag_active_high;             /**< true: DIAG released (pulled high) while asserted (a TMC2209's DIAG) */
+    uint32_t microsteps;               /**< microsteps per full step, 1..256 (the controller's setting) */
+    uint32_t step_min_pulse_ns;        /**< the shortest STEP high or low time the controller makes */
+} pmstep_stm32g4_step_input_t;
 
 /** One use of a pin: what it does on the drive, the MCU signal (with an ADC channel number
  *  appended when @p channel is not 0), and the pin. */
@@ -157,12 +191,18 @@ typedef struct {
     pmstep_stm32g4_pin_t console_rx;  /**< LPUART1_RX */
     uint32_t console_baud;            /**< e.g. 115200 */
 
+    /* STEP/DIR/EN input and DIAG output on TIM4 and three GPIOs (step_input.enabled: off by default) */
+    pmstep_stm32g4_step_input_t step_input;
+
     /** The controller board whose own pins the drive must keep off (NULL: none checked). */
     const pmstep_stm32g4_board_t *board;
 } pmstep_stm32g4_config_t;
 
+/** The most pins a configuration uses (the STEP/DIR input's four included). */
+#define PMSTEP_STM32G4_PIN_USES_MAX 20u
+
 /** Every pin @p cfg uses, with its function, into @p out (up to @p max). @return the count
- *  (18 for a complete configuration), or 0 if @p cfg is NULL. */
+ *  (16 for a complete configuration, 20 with the STEP/DIR input enabled), or 0 if @p cfg is NULL. */
 uint32_t pmstep_stm32g4_pin_map(const pmstep_stm32g4_config_t *cfg, pmstep_stm32g4_pin_use_t *out, uint32_t max);
 
 /**
@@ -225,6 +265,24 @@ uint32_t pmstep_stm32g4_flash_latency(uint32_t hclk_Hz);
 /** TIM1 ARR for a centre-aligned carrier: round(f_TIM / (2 f_pwm)); 0 when outside 2..65535. */
 uint32_t pmstep_stm32g4_pwm_arr(uint32_t tim_clock_Hz, uint32_t pwm_frequency_Hz);
 
+/** The shortest STEP pulse the default configuration expects (ns): a TMC2209's minimum STEP high and
+ *  low time t_SH, t_SL (100 ns), and Klipper's step_pulse_duration for TMC drivers. */
+#define PMSTEP_STM32G4_STEP_MIN_PULSE_NS 100u
+
+/**
+ * TIMx_CCMR1 ICxF for the STEP/DIR inputs at @p tim_clock_Hz (CKD = 0, f_DTS = f_CK_INT): the longest
+ * filter (N samples at f_SAMPLING, RM0440 §29.5.7) whose span N / f_SAMPLING is at most the shortest
+ * pulse less 2 clocks (the input synchroniser's uncertainty), so that every pulse of @p min_pulse_ns
+ * passes. 100 ns at 170 MHz: 17 clocks, code 0100 (6 samples at 85 MHz, 12 clocks = 71 ns).
+ * @retval PMSTEP_STM32G4_OK, PMSTEP_STM32G4_ERR_NULL_ARGUMENT
+ * @retval PMSTEP_STM32G4_ERR_STEP_PULSE  the pulse spans fewer than 3 clocks
+ */
+pmstep_stm32g4_status_t pmstep_stm32g4_step_filter(uint32_t min_pulse_ns, uint32_t tim_clock_Hz, uint8_t *icf);
+
+/** The span of filter code @p icf in timer clocks (N times the sampling period; CKD = 0): a level
+ *  held this long always passes, one held at most (N - 1) sampling periods never does. */
+uint32_t pmstep_stm32g4_step_filter_ticks(uint8_t icf);
+
 /** Text for a status code. */
 const char *pmstep_stm32g4_status_str(pmstep_stm32g4_status_t status);
 
@@ -239,6 +297,16 @@ pmstep_stm32g4_status_t pmstep_stm32g4_gpio_init(const pmstep_stm32g4_config_t *
 /** TIM1: centre-aligned PWM, dead time, break, ADC trigger; outputs off (MOE = 0), counter stopped. */
 pmstep_stm32g4_status_t pmstep_stm32g4_pwm_init(const pmstep_stm32g4_config_t *cfg, uint32_t tim_clock_Hz);
 
+/**
+ * The STEP/DIR input (cfg->step_input; nothing when not enabled): checks it, then the EN input (pulled
+ * to its disabled level), the DIAG output (open drain, deasserted), the STEP and DIR pins (TIM4_CH2,
+ * TIM4_CH1, pulled down) and TIM4 in encoder mode clock plus direction x1, ARR = 0xFFFF, the filter
+ * of step_min_pulse_ns, CNT = 0, counting (CEN = 1). pmstep_stm32g4_init() calls it.
+ * @retval PMSTEP_STM32G4_OK, PMSTEP_STM32G4_ERR_NULL_ARGUMENT, PMSTEP_STM32G4_ERR_PIN
+ * @retval PMSTEP_STM32G4_ERR_STEP_MICROSTEPS, PMSTEP_STM32G4_ERR_STEP_PULSE, PMSTEP_STM32G4_ERR_STEP_PIN
+ */
+pmstep_stm32g4_status_t pmstep_stm32g4_step_input_init(const pmstep_stm32g4_config_t *cfg, uint32_t tim_clock_Hz);
+
 /** ADC1/ADC2: power-up, calibration, injected sequences on TIM1_TRGO2, JEOS interrupt of ADC1. */
 pmstep_stm32g4_status_t pmstep_stm32g4_adc_init(const pmstep_stm32g4_config_t *cfg);
 
@@ -246,8 +314,8 @@ pmstep_stm32g4_status_t pmstep_stm32g4_adc_init(const pmstep_stm32g4_config_t *c
  * The whole port for @p inst (initialised; its configuration must use computational_delay_periods = 1
  * and period_s = pmstep_stm32g4_period_s(), and read neither phase voltages nor a load torque:
  * PMSTEP_STM32G4_ERR_UNMEASURED_INPUT, nor claim measurement ranges beyond the board's:
- * PMSTEP_STM32G4_ERR_SENSE_RANGE, before any register is touched): GPIO, TIM1, ADC,
- * interrupts; bridge off.
+ * PMSTEP_STM32G4_ERR_SENSE_RANGE, before any register is touched): GPIO, TIM1, ADC, the STEP/DIR
+ * input when enabled (pmstep_stm32g4_step_input_init()), interrupts; bridge off.
  * Call after pmstep_stm32g4_clock_init() with the same @p cfg, which must outlive the port.
  */
 pmstep_stm32g4_status_t pmstep_stm32g4_init(const pmstep_stm32g4_config_t *cfg, pmstep_t *inst);
@@ -280,6 +348,16 @@ bool pmstep_stm32g4_clear_fault(void);
 
 /** Whether the port has the bridge switching (MOE set and driver enabled). */
 bool pmstep_stm32g4_bridge_on(void);
+
+/** The STEP/DIR input's counter (TIM4_CNT, 16 bits): read it once a period in the control interrupt
+ *  (the after-step hook) for pmstep_stepdir_count(). 0 when the input is not enabled. */
+uint32_t pmstep_stm32g4_step_counter(void);
+
+/** Whether EN reads enabled (always true when the STEP/DIR input is not enabled: nothing gates). */
+bool pmstep_stm32g4_step_enabled(void);
+
+/** Drives DIAG (open drain): @p asserted at diag_active_high's level. Nothing when the input is off. */
+void pmstep_stm32g4_set_diag(bool asserted);
 
 /** Longest control interrupt so far, in CPU cycles (DWT cycle counter). */
 uint32_t pmstep_stm32g4_isr_cycles_max(void);

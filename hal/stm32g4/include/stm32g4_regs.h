@@ -109,7 +109,8 @@ STM32G4_STATIC_ASSERT(offsetof(stm32g4_rcc_t, CCIPR2) == 0x9C, rcc_ccipr2);
 /* RCC_AHB2ENR (§7.4.15): GPIOxEN bits 0..6, ADC12EN 13 */
 #define RCC_AHB2ENR_GPIOAEN_POS 0u
 #define RCC_AHB2ENR_ADC12EN STM32G4_BIT(13)
-/* RCC_APB1ENR1 (§7.4.17): PWREN 28 */
+/* RCC_APB1ENR1 (§7.4.17): TIM4EN 2, PWREN 28 */
+#define RCC_APB1ENR1_TIM4EN STM32G4_BIT(2)
 #define RCC_APB1ENR1_PWREN STM32G4_BIT(28)
 /* RCC_APB2ENR (§7.4.19): SYSCFGEN 0, TIM1EN 11 */
 #define RCC_APB2ENR_SYSCFGEN STM32G4_BIT(0)
@@ -255,6 +256,7 @@ typedef struct {
 STM32G4_STATIC_ASSERT(offsetof(stm32g4_gpio_t, BSRR) == 0x18, gpio_bsrr);
 STM32G4_STATIC_ASSERT(offsetof(stm32g4_gpio_t, AFR) == 0x20, gpio_afr);
 STM32G4_STATIC_ASSERT(offsetof(stm32g4_gpio_t, BRR) == 0x28, gpio_brr);
+/* GPIOx_OTYPER (§9.4.2): 1 = open drain (the output drives low or lets the line go) */
 #define GPIO_MODE_INPUT 0u
 #define GPIO_MODE_OUTPUT 1u
 #define GPIO_MODE_AF 2u
@@ -348,6 +350,48 @@ STM32G4_STATIC_ASSERT(offsetof(stm32g4_tim_t, DCR) == 0x3DC, tim_dcr);
 /* TIMx_AF1 (§28.6.25): BKINE 0 (BKIN pin input enable, 1 at reset), BKINP 9 (BKIN polarity) */
 #define TIM_AF1_BKINE STM32G4_BIT(0)
 #define TIM_AF1_BKINP STM32G4_BIT(9)
+
+/* ---------------------------------------------------------------------------
+ * TIM4, general-purpose 16-bit timer: RM0440 chapter 29 "General-purpose timers
+ * (TIM2/TIM3/TIM4/TIM5)", registers §29.5, base 0x4000 0800 (APB1). Same register layout as
+ * TIM1 (stm32g4_tim_t; RCR, BDTR, CCR5, CCR6, CCMR3 and DTR2 are reserved on it). The STEP/DIR
+ * input counts with it.
+ * ------------------------------------------------------------------------- */
+/* TIMx_CR1 (§29.5.1): DIR 4 (read-only in encoder mode: the last count's direction), CKD[9:8]
+ * (t_DTS = t_CK_INT << CKD; 00 here) */
+#define TIM_CR1_DIR STM32G4_BIT(4)
+#define TIM_CR1_CKD_POS 8u
+#define TIM_CR1_CKD_MASK (3u << TIM_CR1_CKD_POS)
+/* TIMx_SMCR (§29.5.3): SMS[3:0] at bits 16, 2, 1, 0. 1010: encoder mode, clock plus direction, x2
+ * (both edges of tim_ti2fp2 counted); 1011: clock plus direction, x1 (one edge of tim_ti2fp2, the
+ * one CC2P selects); the direction from the level of tim_ti1fp1 (CC1P = 0: up while tim_ti1 is
+ * high). §29.4 "Encoder interface mode", "Clock plus direction encoder mode". */
+#define TIM_SMCR_SMS_LOW_MASK 7u
+#define TIM_SMCR_SMS_BIT3 STM32G4_BIT(16)
+#define TIM_SMCR_SMS_MASK (TIM_SMCR_SMS_LOW_MASK | TIM_SMCR_SMS_BIT3)
+#define TIM_SMCR_SMS_CLOCK_DIR_X2 (TIM_SMCR_SMS_BIT3 | 2u)
+#define TIM_SMCR_SMS_CLOCK_DIR_X1 (TIM_SMCR_SMS_BIT3 | 3u)
+/* TIMx_CCMR1 input capture mode (§29.5.7): CC1S[1:0] (01: IC1 on tim_ti1), IC1PSC[3:2], IC1F[7:4];
+ * CC2S[9:8] (01: IC2 on tim_ti2), IC2PSC[11:10], IC2F[15:12]. ICxF: the digital filter, an edge
+ * passes after N consecutive samples at the new level, sampled at f_SAMPLING:
+ * 0000 none (f_DTS, N = 1); 0001..0011 f_CK_INT, N = 2, 4, 8; 0100/0101 f_DTS/2, N = 6/8;
+ * 0110/0111 f_DTS/4, N = 6/8; 1000/1001 f_DTS/8, N = 6/8; 1010..1100 f_DTS/16, N = 5, 6, 8;
+ * 1101..1111 f_DTS/32, N = 5, 6, 8. */
+#define TIM_CCMR1_CC1S_POS 0u
+#define TIM_CCMR1_IC1F_POS 4u
+#define TIM_CCMR1_CC2S_POS 8u
+#define TIM_CCMR1_IC2F_POS 12u
+#define TIM_CCMR_CCS_MASK 3u
+#define TIM_CCMR_CCS_INPUT_TI 1u
+#define TIM_CCMR_ICF_MASK 0xFu
+/* TIMx_CCER (§29.5.11): CC1E 0, CC1P 1, CC1NP 3, CC2E 4, CC2P 5, CC2NP 7 */
+#define TIM_CCER_CC1P STM32G4_BIT(1)
+#define TIM_CCER_CC1NP STM32G4_BIT(3)
+#define TIM_CCER_CC2P STM32G4_BIT(5)
+#define TIM_CCER_CC2NP STM32G4_BIT(7)
+/* TIMx_TISEL (§29.5.25): TI1SEL[3:0], TI2SEL[11:8]; 0000 = the TIMx_CHx pin */
+#define TIM_TISEL_TI1SEL_MASK 0xFu
+#define TIM_TISEL_TI2SEL_MASK (0xFu << 8)
 
 /* ---------------------------------------------------------------------------
  * ADC1/ADC2: RM0440 §21.7 "ADC registers (for each ADC)", ADC1 0x5000 0000, ADC2 0x5000 0100;
@@ -516,6 +560,7 @@ typedef struct {
 #define STM32G4_IRQ_COUNT 102u
 
 /* Base addresses (RM0440 Table 4) */
+#define STM32G4_TIM4_BASE 0x40000800u
 #define STM32G4_PWR_BASE 0x40007000u
 #define STM32G4_LPUART1_BASE 0x40008000u
 #define STM32G4_TIM1_BASE 0x40012C00u
@@ -539,6 +584,7 @@ typedef struct {
     stm32g4_flash_t flash;
     stm32g4_gpio_t gpio[STM32G4_GPIO_PORTS];
     stm32g4_tim_t tim1;
+    stm32g4_tim_t tim4;
     stm32g4_adc_t adc1;
     stm32g4_adc_t adc2;
     stm32g4_adc_common_t adc12;
@@ -559,6 +605,7 @@ stm32g4_gpio_t *stm32g4_fake_gpio(uint32_t port);
 #define STM32G4_FLASH (&stm32g4_fake.flash)
 #define STM32G4_GPIO(port) stm32g4_fake_gpio((uint32_t)(port))
 #define STM32G4_TIM1 (&stm32g4_fake.tim1)
+#define STM32G4_TIM4 (&stm32g4_fake.tim4)
 #define STM32G4_ADC1 (&stm32g4_fake.adc1)
 #define STM32G4_ADC2 (&stm32g4_fake.adc2)
 #define STM32G4_ADC12 (&stm32g4_fake.adc12)
@@ -591,6 +638,7 @@ void stm32g4_fake_flash_write32(uint32_t addr, uint32_t value);
 #define STM32G4_FLASH ((stm32g4_flash_t *)STM32G4_FLASH_R_BASE)
 #define STM32G4_GPIO(port) ((stm32g4_gpio_t *)(STM32G4_GPIOA_BASE + STM32G4_GPIO_STRIDE * (uint32_t)(port)))
 #define STM32G4_TIM1 ((stm32g4_tim_t *)STM32G4_TIM1_BASE)
+#define STM32G4_TIM4 ((stm32g4_tim_t *)STM32G4_TIM4_BASE)
 #define STM32G4_ADC1 ((stm32g4_adc_t *)STM32G4_ADC1_BASE)
 #define STM32G4_ADC2 ((stm32g4_adc_t *)STM32G4_ADC2_BASE)
 #define STM32G4_ADC12 ((stm32g4_adc_common_t *)STM32G4_ADC12_COMMON_BASE)

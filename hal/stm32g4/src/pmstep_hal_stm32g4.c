@@ -18,6 +18,7 @@ static struct {
     float bus_voltage_V;  /* this period's sample, for the duties */
     pmstep_output_t out;
     volatile pmstep_stm32g4_fault_t fault;
+    volatile bool step_disabled; /* the STEP/DIR input's EN read disabled at this period's start */
     volatile bool bridge_on;
     volatile uint32_t isr_cycles_max;
     pmstep_stm32g4_after_step_t after_step;
@@ -28,6 +29,18 @@ static bool fault_input_asserted(void)
     const pmstep_stm32g4_config_t *cfg = port.cfg;
     const bool high = (STM32G4_GPIO(cfg->fault_pin.port)->IDR & STM32G4_BIT(cfg->fault_pin.pin)) != 0u;
     return high == cfg->fault_active_high;
+}
+
+/* EN of the STEP/DIR input (true when the input is not enabled: nothing gates the bridge). */
+static bool step_enable_asserted(void)
+{
+    const pmstep_stm32g4_step_input_t *in = &port.cfg->step_input;
+    bool high;
+    if (!in->enabled) {
+        return true;
+    }
+    high = (STM32G4_GPIO(in->enable_pin.port)->IDR & STM32G4_BIT(in->enable_pin.pin)) != 0u;
+    return high == in->enable_active_high;
 }
 
 static void enable_pin(bool on)
@@ -76,6 +89,7 @@ void pmstep_hal_read_measurements(pmstep_meas_t *meas)
     meas->phase_voltage_a_V = 0.0f; /* no phase-voltage sensing (refused at init) */
     meas->phase_voltage_b_V = 0.0f;
     port.bus_voltage_V = meas->bus_voltage_V;
+    port.step_disabled = !step_enable_asserted();
     if (fault_input_asserted()) {
         latch_fault(PMSTEP_STM32G4_FAULT_INPUT);
     }
@@ -87,8 +101,8 @@ void pmstep_hal_apply_output(const pmstep_output_t *out)
     stm32g4_tim_t *const tim = STM32G4_TIM1;
     float d_plus;
     float d_minus;
-    if (port.fault != PMSTEP_STM32G4_FAULT_NONE || !out->bridge_enable) {
-        bridge_off();
+    if (port.fault != PMSTEP_STM32G4_FAULT_NONE || port.step_disabled || !out->bridge_enable) {
+        bridge_off(); /* the one way off, for EN too: never one bridge on and one off */
         return;
     }
     /* Preloaded: these take effect at the next update event (the next carrier peak). */
@@ -103,10 +117,10 @@ void pmstep_hal_apply_output(const pmstep_output_t *out)
     }
 }
 
-/* The core stops (IDLE) after a port fault, unless it is already off. */
+/* The core stops (IDLE) after a port fault or while EN holds the bridge off, unless it is already off. */
 static void stop_core_on_port_fault(void)
 {
-    if (port.fault != PMSTEP_STM32G4_FAULT_NONE && port.out.mode != PMSTEP_MODE_IDLE
+    if ((port.fault != PMSTEP_STM32G4_FAULT_NONE || port.step_disabled) && port.out.mode != PMSTEP_MODE_IDLE
         && port.out.mode != PMSTEP_MODE_FAULT) {
         (void)pmstep_stop(port.inst);
         port.out.mode = PMSTEP_MODE_IDLE;
@@ -168,6 +182,31 @@ bool pmstep_stm32g4_clear_fault(void)
 bool pmstep_stm32g4_bridge_on(void)
 {
     return port.bridge_on;
+}
+
+uint32_t pmstep_stm32g4_step_counter(void)
+{
+    if (port.cfg == NULL || !port.cfg->step_input.enabled) {
+        return 0u;
+    }
+    return STM32G4_TIM4->CNT & 0xFFFFu;
+}
+
+bool pmstep_stm32g4_step_enabled(void)
+{
+    return port.cfg == NULL || step_enable_asserted();
+}
+
+void pmstep_stm32g4_set_diag(bool asserted)
+{
+    const pmstep_stm32g4_step_input_t *in;
+    if (port.cfg == NULL || !port.cfg->step_input.enabled) {
+        return;
+    }
+    in = &port.cfg->step_input;
+    /* Open drain: a 1 in ODR releases the line (the pull-up takes it high), a 0 pulls it low. */
+    STM32G4_GPIO(in->diag_pin.port)->BSRR = asserted == in->diag_active_high ? STM32G4_BIT(in->diag_pin.pin)
+                                                                            : STM32G4_BIT(16u + in->diag_pin.pin);
 }
 
 uint32_t pmstep_stm32g4_isr_cycles_max(void)
@@ -244,6 +283,7 @@ pmstep_stm32g4_status_t pmstep_stm32g4_init(const pmstep_stm32g4_config_t *cfg, 
     port.cfg = cfg;
     port.inst = NULL; /* no control period until everything is set up */
     port.fault = PMSTEP_STM32G4_FAULT_NONE;
+    port.step_disabled = cfg->step_input.enabled; /* off until the first period reads EN */
     port.bridge_on = false;
     port.isr_cycles_max = 0u;
     port.arr = pmstep_stm32g4_pwm_arr(sysclk_Hz, cfg->pwm_frequency_Hz);
@@ -254,6 +294,9 @@ pmstep_stm32g4_status_t pmstep_stm32g4_init(const pmstep_stm32g4_config_t *cfg, 
     }
     if (st == PMSTEP_STM32G4_OK) {
         st = pmstep_stm32g4_pwm_init(cfg, sysclk_Hz); /* TIM1 runs at PCLK2 = SYSCLK */
+    }
+    if (st == PMSTEP_STM32G4_OK) {
+        st = pmstep_stm32g4_step_input_init(cfg, sysclk_Hz); /* TIM4 runs at PCLK1 = SYSCLK */
     }
     if (st == PMSTEP_STM32G4_OK) {
         st = pmstep_stm32g4_adc_init(cfg);

@@ -78,6 +78,18 @@ pmstep_stm32g4_config_t pmstep_stm32g4_default_config(void)
     c.console_tx = (pmstep_stm32g4_pin_t){PA, 2u, 12u}; /* LPUART1_TX AF12: the ST-LINK VCP */
     c.console_rx = (pmstep_stm32g4_pin_t){PA, 3u, 12u}; /* LPUART1_RX AF12 */
     c.console_baud = 115200u;
+    /* STEP/DIR input, off unless the application enables it: TIM4 on PB6/PB7 (AF2, DS12589), EN and
+     * DIAG on PC8/PC9, free on the NUCLEO and away from the power stage's pins. Polarities of a
+     * TMC2209: EN enables while low, DIAG high when asserted. */
+    c.step_input.enabled = false;
+    c.step_input.step_pin = (pmstep_stm32g4_pin_t){PB, 7u, 2u}; /* TIM4_CH2 AF2 */
+    c.step_input.dir_pin = (pmstep_stm32g4_pin_t){PB, 6u, 2u};  /* TIM4_CH1 AF2 */
+    c.step_input.enable_pin = (pmstep_stm32g4_pin_t){PC, 8u, 0u};
+    c.step_input.enable_active_high = false;
+    c.step_input.diag_pin = (pmstep_stm32g4_pin_t){PC, 9u, 0u};
+    c.step_input.diag_active_high = true;
+    c.step_input.microsteps = 16u;
+    c.step_input.step_min_pulse_ns = PMSTEP_STM32G4_STEP_MIN_PULSE_NS;
     c.board = &pmstep_stm32g4_board_nucleo_g431rb;
     return c;
 }
@@ -90,7 +102,7 @@ uint32_t pmstep_stm32g4_pin_map(const pmstep_stm32g4_config_t *cfg, pmstep_stm32
                                           "phase b- low side"};
     static const char *const high_sig[4] = {"TIM1_CH1", "TIM1_CH2", "TIM1_CH3", "TIM1_CH4"};
     static const char *const low_sig[4] = {"TIM1_CH1N", "TIM1_CH2N", "TIM1_CH3N", "TIM1_CH4N"};
-    pmstep_stm32g4_pin_use_t all[18];
+    pmstep_stm32g4_pin_use_t all[PMSTEP_STM32G4_PIN_USES_MAX];
     uint32_t n = 0u;
     uint32_t k;
     if (cfg == NULL) {
@@ -108,6 +120,12 @@ uint32_t pmstep_stm32g4_pin_map(const pmstep_stm32g4_config_t *cfg, pmstep_stm32
     all[n++] = (pmstep_stm32g4_pin_use_t){"gate driver fault", "GPIO input", 0u, cfg->fault_pin};
     all[n++] = (pmstep_stm32g4_pin_use_t){"console TX", "LPUART1_TX", 0u, cfg->console_tx};
     all[n++] = (pmstep_stm32g4_pin_use_t){"console RX", "LPUART1_RX", 0u, cfg->console_rx};
+    if (cfg->step_input.enabled) {
+        all[n++] = (pmstep_stm32g4_pin_use_t){"STEP input", "TIM4_CH2", 0u, cfg->step_input.step_pin};
+        all[n++] = (pmstep_stm32g4_pin_use_t){"DIR input", "TIM4_CH1", 0u, cfg->step_input.dir_pin};
+        all[n++] = (pmstep_stm32g4_pin_use_t){"EN input (bridge gate)", "GPIO input", 0u, cfg->step_input.enable_pin};
+        all[n++] = (pmstep_stm32g4_pin_use_t){"DIAG output", "GPIO open drain", 0u, cfg->step_input.diag_pin};
+    }
     for (k = 0; k < n && k < max && out != NULL; ++k) {
         out[k] = all[k];
     }
@@ -130,14 +148,14 @@ static bool same_text(const char *a, const char *b)
 
 pmstep_stm32g4_status_t pmstep_stm32g4_check_pins(const pmstep_stm32g4_config_t *cfg)
 {
-    pmstep_stm32g4_pin_use_t map[18];
+    pmstep_stm32g4_pin_use_t map[PMSTEP_STM32G4_PIN_USES_MAX];
     uint32_t n;
     uint32_t i;
     uint32_t j;
     if (cfg == NULL) {
         return PMSTEP_STM32G4_ERR_NULL_ARGUMENT;
     }
-    n = pmstep_stm32g4_pin_map(cfg, map, 18u);
+    n = pmstep_stm32g4_pin_map(cfg, map, PMSTEP_STM32G4_PIN_USES_MAX);
     for (i = 0; i < n; ++i) {
         if (map[i].pin.port >= 7u || map[i].pin.pin >= 16u || map[i].pin.af >= 16u) {
             return PMSTEP_STM32G4_ERR_PIN;

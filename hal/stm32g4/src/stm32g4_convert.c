@@ -120,6 +120,38 @@ uint32_t pmstep_stm32g4_pwm_arr(uint32_t tim_clock_Hz, uint32_t pwm_frequency_Hz
     return (arr < 2u || arr > 65535u) ? 0u : (uint32_t)arr;
 }
 
+/* TIMx_CCMR1 ICxF (RM0440 §29.5.7) with CKD = 0: sampling period in timer clocks and samples N. */
+static const uint8_t filter_period_ticks[16] = {1u, 1u, 1u, 1u, 2u, 2u, 4u, 4u, 8u, 8u, 16u, 16u, 16u, 32u, 32u, 32u};
+static const uint8_t filter_samples[16] = {1u, 2u, 4u, 8u, 6u, 8u, 6u, 8u, 6u, 8u, 5u, 6u, 8u, 5u, 6u, 8u};
+#define STEP_SYNC_MARGIN_TICKS 2u /* the input synchroniser: an edge is seen up to 2 clocks late */
+
+uint32_t pmstep_stm32g4_step_filter_ticks(uint8_t icf)
+{
+    const uint32_t k = icf & 0xFu;
+    return (uint32_t)filter_period_ticks[k] * (uint32_t)filter_samples[k];
+}
+
+pmstep_stm32g4_status_t pmstep_stm32g4_step_filter(uint32_t min_pulse_ns, uint32_t tim_clock_Hz, uint8_t *icf)
+{
+    uint64_t pulse_ticks;
+    uint8_t k;
+    if (icf == NULL) {
+        return PMSTEP_STM32G4_ERR_NULL_ARGUMENT;
+    }
+    pulse_ticks = (uint64_t)min_pulse_ns * tim_clock_Hz / 1000000000u;
+    if (pulse_ticks < 1u + STEP_SYNC_MARGIN_TICKS) {
+        return PMSTEP_STM32G4_ERR_STEP_PULSE;
+    }
+    /* The spans grow with the code: the last one that fits. */
+    *icf = 0u;
+    for (k = 1u; k < 16u; ++k) {
+        if ((uint64_t)pmstep_stm32g4_step_filter_ticks(k) + STEP_SYNC_MARGIN_TICKS <= pulse_ticks) {
+            *icf = k;
+        }
+    }
+    return PMSTEP_STM32G4_OK;
+}
+
 const char *pmstep_stm32g4_status_str(pmstep_stm32g4_status_t status)
 {
     switch (status) {
@@ -181,6 +213,12 @@ const char *pmstep_stm32g4_status_str(pmstep_stm32g4_status_t status)
         return "flash OPTVERR: option bytes invalid";
     case PMSTEP_STM32G4_ERR_FLASH_ECC:
         return "flash uncorrectable ECC error on read";
+    case PMSTEP_STM32G4_ERR_STEP_MICROSTEPS:
+        return "STEP/DIR microsteps per full step not within 1..256";
+    case PMSTEP_STM32G4_ERR_STEP_PULSE:
+        return "STEP/DIR minimum pulse shorter than 3 timer clocks";
+    case PMSTEP_STM32G4_ERR_STEP_PIN:
+        return "STEP not on a TIM4_CH2 pin or DIR not on a TIM4_CH1 pin";
     }
     return "unknown status";
 }

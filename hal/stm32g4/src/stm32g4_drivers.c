@@ -115,7 +115,9 @@ static void port_clock_on(uint8_t port)
     (void)STM32G4_RCC->AHB2ENR; /* the enable takes effect before the port is written */
 }
 
-static void pin_configure(const pmstep_stm32g4_pin_t *p, uint32_t mode, uint32_t pull)
+/* The pin's mode (MODER last, so it takes its function with the rest already set), pull, output
+ * type (§9.4.2 OTYPER: push-pull, or open drain) and alternate function. */
+static void pin_configure_type(const pmstep_stm32g4_pin_t *p, uint32_t mode, uint32_t pull, bool open_drain)
 {
     stm32g4_gpio_t *gpio;
     const uint32_t shift2 = 2u * p->pin;
@@ -126,9 +128,18 @@ static void pin_configure(const pmstep_stm32g4_pin_t *p, uint32_t mode, uint32_t
         gpio->AFR[p->pin / 8u] = (gpio->AFR[p->pin / 8u] & ~(0xFu << shift4)) | ((uint32_t)p->af << shift4);
         gpio->OSPEEDR = (gpio->OSPEEDR & ~(3u << shift2)) | (GPIO_SPEED_VERY_HIGH << shift2);
     }
-    gpio->OTYPER &= ~STM32G4_BIT(p->pin); /* push-pull */
+    if (open_drain) {
+        gpio->OTYPER |= STM32G4_BIT(p->pin);
+    } else {
+        gpio->OTYPER &= ~STM32G4_BIT(p->pin);
+    }
     gpio->PUPDR = (gpio->PUPDR & ~(3u << shift2)) | (pull << shift2);
     gpio->MODER = (gpio->MODER & ~(3u << shift2)) | (mode << shift2);
+}
+
+static void pin_configure(const pmstep_stm32g4_pin_t *p, uint32_t mode, uint32_t pull)
+{
+    pin_configure_type(p, mode, pull, false);
 }
 
 /* Drives the enable pin to its inactive level (driver off). */
@@ -247,6 +258,93 @@ pmstep_stm32g4_status_t pmstep_stm32g4_pwm_init(const pmstep_stm32g4_config_t *c
     tim->EGR = TIM_EGR_UG;
     tim->SR = 0u;
     tim->DIER = TIM_DIER_BIE;
+    return PMSTEP_STM32G4_OK;
+}
+
+/* ---- STEP/DIR input: TIM4 in encoder mode, RM0440 chapter 29 "General-purpose timers (TIM2/TIM3/
+ * TIM4/TIM5)": §29.4 "Encoder interface mode" (clock plus direction), §29.4 "Input filter"
+ * (TIMx_CCMR1 ICxF), registers §29.5 ----
+ *
+ * Why the encoder mode "clock plus direction" (SMS = 1011) rather than external clock mode 1 with
+ * DIR on TIMx_CR1.DIR: in external clock mode the direction is a register bit software must copy
+ * from the DIR pin, late by an interrupt's latency, so a STEP edge right after a DIR change counts
+ * the wrong way; in the encoder mode the timer takes each STEP edge's direction from the DIR pin's
+ * level (tim_ti1fp1) at that edge, in hardware, with DIR and STEP through the same filter. x1
+ * counts each STEP pulse once (x2, SMS = 1010, would count both edges: a TMC driver's "dedge").
+ * Timers with the mode on the STM32G431: TIM1, TIM8, TIM2, TIM3, TIM4; TIM1 makes the PWM, TIM2 and
+ * TIM3's channel pins are the ADC inputs, the break input and the gate-driver enable here, TIM8 is
+ * kept for a second axis: TIM4 on PB6/PB7. */
+static bool tim4_channel_pin(const pmstep_stm32g4_pin_t *p, uint8_t channel)
+{
+    /* DS12589 alternate functions: TIM4_CH1 on PB6 (AF2) and PA11 (AF10), TIM4_CH2 on PB7 (AF2) and
+     * PA12 (AF10) (the LQFP64 has no PD12/PD13). */
+    const uint8_t port_a = 0u;
+    const uint8_t port_b = 1u;
+    const uint8_t pin_b = channel == 1u ? 6u : 7u;
+    const uint8_t pin_a = channel == 1u ? 11u : 12u;
+    return (p->port == port_b && p->pin == pin_b && p->af == 2u) || (p->port == port_a && p->pin == pin_a && p->af == 10u);
+}
+
+pmstep_stm32g4_status_t pmstep_stm32g4_step_input_init(const pmstep_stm32g4_config_t *cfg, uint32_t tim_clock_Hz)
+{
+    stm32g4_tim_t *const tim = STM32G4_TIM4;
+    const pmstep_stm32g4_step_input_t *in;
+    pmstep_stm32g4_status_t st;
+    uint8_t icf;
+    if (cfg == NULL) {
+        return PMSTEP_STM32G4_ERR_NULL_ARGUMENT;
+    }
+    in = &cfg->step_input;
+    if (!in->enabled) {
+        return PMSTEP_STM32G4_OK;
+    }
+    if (in->microsteps < 1u || in->microsteps > 256u) {
+        return PMSTEP_STM32G4_ERR_STEP_MICROSTEPS;
+    }
+    st = pmstep_stm32g4_step_filter(in->step_min_pulse_ns, tim_clock_Hz, &icf);
+    if (st != PMSTEP_STM32G4_OK) {
+        return st;
+    }
+    if (!pin_valid(&in->step_pin) || !pin_valid(&in->dir_pin) || !pin_valid(&in->enable_pin)
+        || !pin_valid(&in->diag_pin)) {
+        return PMSTEP_STM32G4_ERR_PIN;
+    }
+    if (!tim4_channel_pin(&in->step_pin, 2u) || !tim4_channel_pin(&in->dir_pin, 1u)) {
+        return PMSTEP_STM32G4_ERR_STEP_PIN;
+    }
+
+    /* EN: an input pulled to its disabled level, so an open line keeps the bridge off. */
+    pin_configure(&in->enable_pin, GPIO_MODE_INPUT, in->enable_active_high ? GPIO_PULL_DOWN : GPIO_PULL_UP);
+    /* DIAG: deasserted in ODR first (active high: pulled low; active low: released), then an
+     * open-drain output with the pin's pull-up (a line nobody else pulls reads high). */
+    port_clock_on(in->diag_pin.port);
+    STM32G4_GPIO(in->diag_pin.port)->BSRR = in->diag_active_high ? STM32G4_BIT(16u + in->diag_pin.pin)
+                                                                 : STM32G4_BIT(in->diag_pin.pin);
+    pin_configure_type(&in->diag_pin, GPIO_MODE_OUTPUT, GPIO_PULL_UP, true);
+    /* STEP and DIR: TIM4's inputs, pulled down (an open STEP line counts nothing). */
+    pin_configure(&in->step_pin, GPIO_MODE_AF, GPIO_PULL_DOWN);
+    pin_configure(&in->dir_pin, GPIO_MODE_AF, GPIO_PULL_DOWN);
+
+    STM32G4_RCC->APB1ENR1 |= RCC_APB1ENR1_TIM4EN; /* §7.4.17; TIM4 runs at PCLK1 = SYSCLK */
+    (void)STM32G4_RCC->APB1ENR1;
+    tim->CR1 = 0u;  /* counter stopped; CKD = 00: t_DTS = t_CK_INT, the filter's base (§29.5.1) */
+    tim->SMCR = 0u; /* slave mode off while the inputs are set up (§29.5.3) */
+    tim->DIER = 0u; /* no interrupt: the count is read each control period */
+    /* CC1P = CC2P = 0 (§29.5.11): counts up while DIR is high, on STEP's rising edges; CCxNP = 0 as
+     * the encoder mode wants; CCxE = 0, no capture. */
+    tim->CCER = 0u;
+    /* IC1 on tim_ti1 (DIR), IC2 on tim_ti2 (STEP), the same filter on both so DIR keeps its set-up
+     * time to STEP (§29.5.7); input prescalers 0. */
+    tim->CCMR1 = (TIM_CCMR_CCS_INPUT_TI << TIM_CCMR1_CC1S_POS) | ((uint32_t)icf << TIM_CCMR1_IC1F_POS)
+                 | (TIM_CCMR_CCS_INPUT_TI << TIM_CCMR1_CC2S_POS) | ((uint32_t)icf << TIM_CCMR1_IC2F_POS);
+    tim->TISEL = 0u; /* tim_ti1, tim_ti2 from the TIM4_CH1, TIM4_CH2 pins (§29.5.25) */
+    tim->PSC = 0u;
+    tim->ARR = 0xFFFFu; /* the whole 16 bits: the count wraps 0xFFFF <-> 0, which the core unwraps */
+    tim->EGR = TIM_EGR_UG; /* PSC and ARR loaded, the counter to 0 (§29.5.6) */
+    tim->SR = 0u;
+    tim->CNT = 0u;
+    tim->SMCR = TIM_SMCR_SMS_CLOCK_DIR_X1; /* §29.5.3 SMS = 1011 */
+    tim->CR1 = TIM_CR1_CEN;
     return PMSTEP_STM32G4_OK;
 }
 

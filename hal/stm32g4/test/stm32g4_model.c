@@ -17,9 +17,8 @@ stm32g4_model_t stm32g4_model;
 #define M stm32g4_model
 #define TIM (&stm32g4_fake.tim1)
 
-/* TIMx_CR1 DIR (bit 4); CR2 OISx at 8 + 2(x-1), OISxN at 9 + 2(x-1); CCER CCxP at 4(x-1) + 1,
+/* TIMx_CR1 DIR (bit 4, stm32g4_regs.h); CR2 OISx at 8 + 2(x-1), OISxN at 9 + 2(x-1); CCER CCxP at 4(x-1) + 1,
  * CCxNP at 4(x-1) + 3; CCMR OCxM[3] at bit 16 (+8); MMS2 code 0010 = update. */
-#define TIM_CR1_DIR STM32G4_BIT(4)
 #define MMS2_UPDATE 2u
 #define ADC_CLOCK_DIVIDER 4u /* CKMODE = 11: HCLK / 4; TIM1 runs at HCLK here */
 
@@ -53,6 +52,7 @@ void stm32g4_model_reset(void)
     M.bkin_pin_high = true;
     M.aden_guard_polls = 1u;
     stm32g4_model_flash_reset(); /* the controller; the flash array keeps its contents */
+    stm32g4_model_tim4_reset();
 }
 
 static stm32g4_adc_t *adc_block(unsigned a)
@@ -87,6 +87,16 @@ static void gpio_sync(void)
             g->ODR &= ~(g->BRR & 0xFFFFu);
             g->BRR = 0u;
         }
+        /* §9.3.1, §9.3.9: an input nobody drives reads its pull (up 1, down 0; none: 0 here). */
+        if (M.gpio_floating[p] != 0u) {
+            unsigned pin;
+            for (pin = 0; pin < 16u; ++pin) {
+                if ((M.gpio_floating[p] & STM32G4_BIT(pin)) != 0u) {
+                    const uint32_t pull = (g->PUPDR >> (2u * pin)) & 3u;
+                    g->IDR = pull == GPIO_PULL_UP ? (g->IDR | STM32G4_BIT(pin)) : (g->IDR & ~STM32G4_BIT(pin));
+                }
+            }
+        }
         memcpy(&M.gpio_seen[p], g, sizeof *g);
     }
 }
@@ -99,6 +109,7 @@ stm32g4_gpio_t *stm32g4_fake_gpio(uint32_t port)
 
 void stm32g4_model_pin_in(unsigned port, unsigned pin, bool high)
 {
+    M.gpio_floating[port] &= ~STM32G4_BIT(pin);
     gpio_sync();
     if (high) {
         stm32g4_fake.gpio[port].IDR |= STM32G4_BIT(pin);
@@ -112,6 +123,49 @@ bool stm32g4_model_pin_out(unsigned port, unsigned pin)
 {
     gpio_sync();
     return (stm32g4_fake.gpio[port].ODR & STM32G4_BIT(pin)) != 0u;
+}
+
+void stm32g4_model_pin_float(unsigned port, unsigned pin)
+{
+    M.gpio_floating[port] |= STM32G4_BIT(pin);
+    gpio_sync();
+}
+
+/* §9.3.7, §9.4.1, §9.4.2: an output pin (MODER 01) drives ODR push-pull (OTYPER 0); open drain
+ * (OTYPER 1) drives a 0 and lets the line go for a 1: then a pull-up (the pin's own, PUPDR 01, or
+ * one outside) takes it high, and with none it floats. */
+bool stm32g4_model_pin_drives_high(unsigned port, unsigned pin)
+{
+    const stm32g4_gpio_t *g;
+    gpio_sync();
+    g = &stm32g4_fake.gpio[port];
+    return ((g->MODER >> (2u * pin)) & 3u) == GPIO_MODE_OUTPUT && (g->OTYPER & STM32G4_BIT(pin)) == 0u
+           && (g->ODR & STM32G4_BIT(pin)) != 0u;
+}
+
+bool stm32g4_model_pin_drives_low(unsigned port, unsigned pin)
+{
+    const stm32g4_gpio_t *g;
+    gpio_sync();
+    g = &stm32g4_fake.gpio[port];
+    return ((g->MODER >> (2u * pin)) & 3u) == GPIO_MODE_OUTPUT && (g->ODR & STM32G4_BIT(pin)) == 0u;
+}
+
+bool stm32g4_model_pin_level(unsigned port, unsigned pin, bool external_pull_up)
+{
+    const stm32g4_gpio_t *g;
+    gpio_sync();
+    g = &stm32g4_fake.gpio[port];
+    if (((g->MODER >> (2u * pin)) & 3u) != GPIO_MODE_OUTPUT) {
+        return (g->IDR & STM32G4_BIT(pin)) != 0u;
+    }
+    if (stm32g4_model_pin_drives_high(port, pin)) {
+        return true;
+    }
+    if (stm32g4_model_pin_drives_low(port, pin)) {
+        return false;
+    }
+    return external_pull_up || ((g->PUPDR >> (2u * pin)) & 3u) == GPIO_PULL_UP; /* released */
 }
 
 /* ---------------------------------------------------------------------------
@@ -658,6 +712,7 @@ void stm32g4_model_run(uint64_t ticks)
         adc_tick(0u);
         adc_tick(1u);
         TIM->SR = M.sr;
+        stm32g4_model_tim4_tick();
         stm32g4_model_flash_advance(1u);
         interrupts();
     }

@@ -16,7 +16,7 @@
  * "STM32G4 Series advanced Arm-based 32-bit MCUs") it models, numbered as in the revision the
  * port's register header follows (Rev 8), with the section's title where other revisions number
  * it differently. The flash controller and the flash array are modelled in stm32g4_model_flash.c
- * (see "Flash" below). Not modelled: prescaler
+ * (see "Flash" below), TIM4 as the STEP/DIR counter in stm32g4_model_tim4.c (see "TIM4"). Not modelled: prescaler
  * other than 0, input capture, break filter and break 2, OCxREF clear, combined/asymmetric
  * PWM modes, the injected queue (JQDIS = 1 is assumed), regular conversions.
  */
@@ -87,6 +87,7 @@ typedef struct {
 
     /* ---- GPIO ---- */
     stm32g4_gpio_t gpio_seen[STM32G4_GPIO_PORTS]; /**< register values the model last accepted */
+    uint32_t gpio_floating[STM32G4_GPIO_PORTS]; /**< inputs nobody drives: IDR reads the pin's pull */
     unsigned unclocked_writes;  /**< writes to a GPIO port whose clock was off (lost) */
 
     /* ---- LPUART1 (the console): bytes from the host, bytes sent ---- */
@@ -130,6 +131,52 @@ void stm32g4_model_pin_in(unsigned port, unsigned pin, bool high);
 
 /** The level an output pin of a GPIO port drives (ODR after BSRR), port 0 = A. */
 bool stm32g4_model_pin_out(unsigned port, unsigned pin);
+
+/** Leaves an input pin undriven (a line left open): IDR reads its pull, 0 without one, until
+ *  stm32g4_model_pin_in() drives it again. */
+void stm32g4_model_pin_float(unsigned port, unsigned pin);
+
+/** Whether an output pin drives its line high (push-pull with a 1; never an open-drain pin). */
+bool stm32g4_model_pin_drives_high(unsigned port, unsigned pin);
+
+/** Whether an output pin pulls its line low (a 0 in ODR, push-pull or open drain). */
+bool stm32g4_model_pin_drives_low(unsigned port, unsigned pin);
+
+/** The line's level: an input's IDR; an output's drive; a released open-drain line high if the pin's
+ *  pull-up or @p external_pull_up holds it (low otherwise: floating, read as low here). */
+bool stm32g4_model_pin_level(unsigned port, unsigned pin, bool external_pull_up);
+
+/* ---------------------------------------------------------------------------
+ * TIM4 (stm32g4_model_tim4.c): the STEP/DIR counter, from RM0440 chapter 29 "General-purpose timers
+ * (TIM2/TIM3/TIM4/TIM5)". Its inputs are the pins the test drives with stm32g4_model_pin_in(): tim_ti1
+ * from TIM4_CH1 (PB6 AF2 or PA11 AF10), tim_ti2 from TIM4_CH2 (PB7 AF2 or PA12 AF10), each only
+ * while the pin is in that alternate function (0 otherwise). Modelled: the input filter (ICxF, CKD),
+ * the polarity (CCxP), the encoder modes clock plus direction x2 and x1 (SMS 1010, 1011) and the
+ * internal clock (SMS 0000, PSC 0), CEN, ARR wrap both ways with UIF, UG, CNT written by software,
+ * CR1.DIR. Not modelled: the other slave and encoder modes (no count), the prescalers, captures,
+ * compare outputs, TISEL other than 0 (no input), the index, interrupts and DMA.
+ * ------------------------------------------------------------------------- */
+
+typedef struct {
+    uint32_t cnt;             /**< the counter (what CNT reads) */
+    uint32_t cnt_written;     /**< CNT as the model last left it: another value is a software write */
+    uint32_t sr;              /**< TIM4_SR as the hardware holds it */
+    bool ti_filtered[2];      /**< tim_ti1, tim_ti2 after the filter (before the polarity) */
+    uint32_t ti_run[2];       /**< consecutive samples at the other level */
+    bool ti2fp2_prev;         /**< tim_ti2fp2 at the last tick */
+    uint64_t counted_up;      /**< counts up and down since the reset */
+    uint64_t counted_down;
+    uint64_t wraps;           /**< overflows and underflows */
+    uint64_t filtered_edges;  /**< STEP edges the filter passed (both directions of the level) */
+} stm32g4_model_tim4_t;
+
+extern stm32g4_model_tim4_t stm32g4_model_tim4;
+
+/** TIM4's registers and state to their reset values (stm32g4_model_reset() calls it). */
+void stm32g4_model_tim4_reset(void);
+
+/** One TIM4 clock tick (stm32g4_model_run() gives it each tick: TIM4 runs at PCLK1 = SYSCLK). */
+void stm32g4_model_tim4_tick(void);
 
 /* ---------------------------------------------------------------------------
  * Flash (stm32g4_model_flash.c): the FLASH controller's key, status, control and ECC registers

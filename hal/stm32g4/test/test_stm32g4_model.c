@@ -840,6 +840,19 @@ static void test_app_boots_unconfigured_with_empty_flash(void **state)
     analog(0.0f, 0.0f, 48.0f);
     assert_int_equal(pmstep_app_init(), 0);
     assert_int_equal(stm32g4_model_flash.steps, 0u); /* booting only reads the flash */
+    /* The default build has no STEP/DIR mode: TIM4 never clocked, its pins and EN/DIAG's untouched
+     * (analog, their reset state), STEP pulses count nothing. */
+    assert_int_equal(stm32g4_fake.rcc.APB1ENR1 & RCC_APB1ENR1_TIM4EN, 0u);
+    assert_int_equal((stm32g4_fake.gpio[board.step_input.step_pin.port].MODER >> (2u * board.step_input.step_pin.pin)) & 3u,
+                     GPIO_MODE_ANALOG);
+    assert_int_equal((stm32g4_fake.gpio[board.step_input.enable_pin.port].MODER >> (2u * board.step_input.enable_pin.pin)) & 3u,
+                     GPIO_MODE_ANALOG);
+    stm32g4_model_pin_in(board.step_input.step_pin.port, board.step_input.step_pin.pin, true);
+    stm32g4_model_run(100u);
+    stm32g4_model_pin_in(board.step_input.step_pin.port, board.step_input.step_pin.pin, false);
+    stm32g4_model_run(100u);
+    assert_int_equal(stm32g4_fake.tim4.CNT, 0u);
+    assert_int_equal(pmstep_app_step_count(), 0);
     uart_cursor = 0u;
     check_hello(1u, HELLO_STORE);
     host_send(PMSTEP_CONSOLE_START, 2u, NULL, 0u);
