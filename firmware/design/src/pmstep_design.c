@@ -8,7 +8,7 @@
 
 /* Bandwidths as fractions of the control rate 1/T_s (docs/design/02-current-and-speed-loops.md). */
 #define CURRENT_BANDWIDTH_X_PERIOD 0.2f   /* (R/L + K_i) T_s */
-/* The observer's triple pole w_o: at least OBSERVER_BANDWIDTH_X_PERIOD / T_s, raised to
+/* The observer's triple pole w_o: at least OBSERVER_BANDWIDTH_X_PERIOD / T_s; in paper mode raised to
  * OBSERVER_HALF_RESPONSE / t_step, t_step the time the rated torque takes to turn the told rotor by
  * one full step (a triple pole's step response is half way at w_o t = 2.674: half a load step is
  * estimated before it has slipped the rotor a full step), up to MAX_OBSERVER_BANDWIDTH_X_PERIOD / T_s
@@ -264,6 +264,12 @@ static float observer_bandwidth(const pmstep_design_input_t *in)
     const float rated_torque_Nm = m->torque_constant_Nm_A * in->motor.rated_current_A;
     const float step_time_s = sqrtf(DESIGN_PI * m->inertia_kgm2 / ((float)m->pole_pairs * rated_torque_Nm));
     const float w_step = OBSERVER_HALF_RESPONSE / step_time_s;
+    if (in->self_commissioning) {
+        /* Robust mode answers a load step with its transient observer boost (3 w_o beyond the
+         * residual bound) and holds its standstills on a vector aimed by T_L-hat: it keeps the rate's
+         * bandwidth (raised, its standstill hold's entry jolted the BJ42D29 over the tracking bound). */
+        return OBSERVER_BANDWIDTH_X_PERIOD / in->period_s;
+    }
     return min2(max2(OBSERVER_BANDWIDTH_X_PERIOD, w_step * in->period_s), MAX_OBSERVER_BANDWIDTH_X_PERIOD)
            / in->period_s;
 }
@@ -276,11 +282,7 @@ static void design_gains(const pmstep_design_input_t *in, pmstep_gains_config_t 
     const float r_over_l = m->resistance_Ohm / m->inductance_H;
     const float f_over_j = m->friction_Nms_rad / m->inertia_kgm2;
     const float b = m->torque_constant_Nm_A / m->inductance_H;
-    const float w_winding = WINDING_RATE_MARGIN * (r_over_l + f_over_j) / 3.0f;
-    const float w_o = max2(observer_bandwidth(in), w_winding);
-    /* The angle's corrections against the current samples' noise: at the rate's bandwidth, not raised
-     * for the load (docs/design/15-back-emf-angle-correction.md). */
-    const float w_angle = max2(OBSERVER_BANDWIDTH_X_PERIOD / in->period_s, w_winding);
+    const float w_o = max2(observer_bandwidth(in), WINDING_RATE_MARGIN * (r_over_l + f_over_j) / 3.0f);
     const float a_e = 3.0f * w_o - f_over_j;
     const float g_w = (3.0f * w_o * w_o - a_e * f_over_j) / (b * b);
     const float lambda = 2.0f / g_w;
@@ -303,13 +305,13 @@ static void design_gains(const pmstep_design_input_t *in, pmstep_gains_config_t 
     gains->sat_kappa_rad_s = KAPPA_CURRENT_FRACTION * in->motor.rated_current_A * m->torque_constant_Nm_A
                              / (m->inertia_kgm2 * speed_gain);
     gains->reference_bandwidth_rad_s = REFERENCE_PER_SPEED_BANDWIDTH * speed_gain;
-    gains->angle_correction_gain_per_s = in->self_commissioning ? DRIFT_FREE_PER_OBSERVER_BANDWIDTH * w_angle : 0.0f;
+    gains->angle_correction_gain_per_s = in->self_commissioning ? DRIFT_FREE_PER_OBSERVER_BANDWIDTH * w_o : 0.0f;
     if (in->self_commissioning) {
         /* Half on where the back EMF equals the voltage the model knows least: the resistive drop at
          * rated current and the dead time's full loss 2 V_bus t_d / T_s. */
         const float uncertain_V = m->resistance_Ohm * in->motor.rated_current_A
                                   + 2.0f * in->bus_voltage_V * in->dead_time_s / in->period_s;
-        gains->emf_angle_gain_per_s = EMF_ANGLE_PER_OBSERVER_BANDWIDTH * w_angle;
+        gains->emf_angle_gain_per_s = EMF_ANGLE_PER_OBSERVER_BANDWIDTH * w_o;
         gains->emf_angle_corner_rad_s = uncertain_V / m->torque_constant_Nm_A;
         gains->angle_smoothing = ANGLE_SMOOTHING;
         gains->transient_observer_boost = TRANSIENT_OBSERVER_BOOST;
