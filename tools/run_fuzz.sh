@@ -10,18 +10,13 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 target=${1:?usage: run_fuzz.sh core|scenario|console [seconds]}
 seconds=${2:-60}
-core_sources=(firmware/src/pmstep_{core,lifecycle,config,control,detect,continuity,actuate,ref,angle,commission,identify,observer,law,hold,standstill,presets}.c)
 case $target in
-  core) sources='firmware/src/'; harness_sources=("${core_sources[@]}"); libs=(-lm) ;;
-  scenario) sources='sil/src/scenario'
-    harness_sources=(sil/src/{scenario_keys,scenario,scenario_load,scenario_print,scenario_profile,plant,inverter,inverter_switching,sensors}.c "${core_sources[@]}")
-    libs=($(pkg-config --libs inih gsl) -lm) ;;
-  console) sources='firmware/console/src/'
-    harness_sources=(firmware/console/src/pmstep_console{,_request,_boundary,_tx,_config,_position,_sim}.c
-                     firmware/src/pmstep_{position,position_hold,motion}.c "${core_sources[@]}")
-    libs=(-lm) ;;
+  core) prefix=firmware/src/ ;;
+  scenario) prefix=sil/src/scenario ;;
+  console) prefix=firmware/console/src/ ;;
   *) echo "run_fuzz: unknown fuzzer '$target'" >&2; exit 2 ;;
 esac
+sources=("$prefix"*.c) # what the figures count: the fuzzed module's own sources
 
 probe=$(mktemp -d)
 trap 'rm -rf "$probe"' EXIT
@@ -61,7 +56,7 @@ fi
 execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log")
 rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log")
 # COVERED_FUNC: hits: H edges: c/t name file:line  (UNCOVERED_FUNC: no edges reached)
-read -r covered total functions reached < <(awk -v src="$sources" '
+read -r covered total functions reached < <(awk -v src="$prefix" '
   /^(COVERED|UNCOVERED)_FUNC:/ && index($0, src) {
     split($0, f, "edges: "); split(f[2], e, "[/ ]");
     c += e[1]; t += e[2]; n++; if ($1 == "COVERED_FUNC:") r++
@@ -69,7 +64,7 @@ read -r covered total functions reached < <(awk -v src="$sources" '
   END { printf "%d %d %d %d\n", c, t, n, r }' "$log")
 corpus=$(ls "$work" | wc -l)
 echo "run_fuzz: $target: $execs executions in $seconds s ($rate/s), corpus $corpus inputs, no invariant broken;" \
-     "functions of ${sources}* reached: $reached of $functions"
+     "functions of ${prefix}* reached: $reached of $functions"
 
 # Line coverage of the final corpus (source-based, llvm-cov): the harness rebuilt without
 # sanitizers (their checks are not source lines) and the replay driver.
@@ -79,18 +74,15 @@ if [ -z "$llvm_cov" ] || [ -z "$llvm_profdata" ]; then
   echo "run_fuzz: llvm-cov not found: no line coverage"
   exit 0
 fi
-cov=build/fuzz/cov-$target
-rm -rf "$cov" && mkdir -p "$cov"
-clang -std=c99 -D_POSIX_C_SOURCE=200809L -O1 -fprofile-instr-generate -fcoverage-mapping -w \
-  -Ifirmware/include -Ifirmware/console/include -Ifirmware/console/src -Isil/include -Itests/fuzz -Itests/include $(pkg-config --cflags inih gsl) \
-  tests/fuzz/fuzz_$target.c tests/fuzz/replay_main.c "${harness_sources[@]}" "${libs[@]}" -o "$cov/replay"
-LLVM_PROFILE_FILE="$cov/replay.profraw" "$cov/replay" "$work" >/dev/null
-"$llvm_profdata" merge -sparse "$cov/replay.profraw" -o "$cov/replay.profdata"
-report_files=()
-for f in "${harness_sources[@]}"; do
-  case $f in "$sources"*) report_files+=("$f") ;; esac
-done
-"$llvm_cov" report "$cov/replay" -instr-profile="$cov/replay.profdata" "${report_files[@]}" > "$cov/report.txt"
+cov=build/fuzz-cov
+cmake -S . -B "$cov" -G Ninja -DCMAKE_C_COMPILER=clang -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DPMSTEP_FUZZ=ON -DPMSTEP_FUZZ_COVERAGE=ON >/dev/null
+cmake --build "$cov" --target "fuzz_${target}_replay" >/dev/null
+rm -f "$cov/replay-$target.profraw"
+LLVM_PROFILE_FILE="$cov/replay-$target.profraw" "$cov/tests/fuzz/fuzz_${target}_replay" "$work" >/dev/null
+"$llvm_profdata" merge -sparse "$cov/replay-$target.profraw" -o "$cov/replay-$target.profdata"
+"$llvm_cov" report "$cov/tests/fuzz/fuzz_${target}_replay" -instr-profile="$cov/replay-$target.profdata" "${sources[@]}" \
+  > "$cov/report-$target.txt"
 awk -v t="$target" '$1 == "TOTAL" {
   printf "run_fuzz: %s: line coverage of the final corpus: %s of lines (%s missed of %s), regions %s, branches %s\n",
-         t, $10, $9, $8, $4, $13 }' "$cov/report.txt"
+         t, $10, $9, $8, $4, $13 }' "$cov/report-$target.txt"
