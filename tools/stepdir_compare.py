@@ -62,6 +62,7 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import report  # noqa: E402
+from position_acceptance import read_preset  # noqa: E402  (the preset's rated current, k_M, J, p)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 MOTORS = ["paper", "17hs4401", "bj42d29", "as1050"]
@@ -74,15 +75,6 @@ TAIL_S = 0.4            # after the last move's end, at rest, to the end of the 
 THETA0_ELECTRICAL_DEG = 30.0
 JERK_TIME_S = 0.02      # the moves case's S-curve: the acceleration reached in 20 ms
 A_AXIS = 1000.0         # rad/s^2: a printer axis (6400 mm/s^2 on a 40 mm pulley's turn)
-
-
-def read_preset(path):
-    ini = configparser.ConfigParser(inline_comment_prefixes=(";",))
-    ini.read(path)
-    return {"rated_A": float(ini["datasheet"]["rated_current_A"]),
-            "k_M": float(ini["motor"]["torque_constant_Nm_A"]),
-            "J": float(ini["motor"]["inertia_kgm2"]),
-            "p": int(ini["motor"]["pole_pairs"])}
 
 
 def design(tune, motor_ini, ini_out):
