@@ -28,6 +28,7 @@ usage: run_store_e2e.py --qemu Q --image ELF --sil PMSTEP_SIL --tune PMSTEP_TUNE
                         --out DIR
 """
 import argparse
+import atexit
 import json
 import math
 import os
@@ -51,6 +52,17 @@ PAPER_MOTOR = {"resistance_Ohm": 3.0, "inductance_H": 0.006, "torque_constant_Nm
                "friction_Nms_rad": 0.0}
 
 
+BOARDS = []  # every QEMU started, so that none outlives this script when a step fails
+
+
+@atexit.register
+def _stop_boards():
+    for board in BOARDS:
+        if board.qemu.poll() is None:
+            board.qemu.kill()
+            board.qemu.wait()
+
+
 class Board:
     """One boot of the image: QEMU with the flash file, the console connected."""
 
@@ -67,6 +79,7 @@ class Board:
         self.cmd = [a.qemu, "-M", "mps2-an386", "-cpu", "cortex-m4", "-nographic", "-monitor", "none", "-serial",
                     f"tcp:127.0.0.1:{self.port},server=on,wait=on", "-semihosting-config", semi, "-kernel", a.image]
         self.qemu = subprocess.Popen(self.cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        BOARDS.append(self)
         self.link = None
         for _ in range(200):
             try:
