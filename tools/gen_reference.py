@@ -200,6 +200,19 @@ class Source:
             raise GenError(f"{where}expected one line matching {pattern!r}, found {len(hits)}")
         return hits[0]
 
+    def table_rows(self, opening: str, table: str) -> tuple[int, list[tuple[int, str]]]:
+        """An initialiser's rows: the line matching @p opening, then (index, line) of each line up to
+        its closing "};" that is neither blank nor a plain comment; GenError if it is not closed."""
+        start, _ = self.find_one(opening)
+        rows = []
+        for i in range(start + 1, len(self.lines)):
+            line = self.lines[i]
+            if line.strip() == "};":
+                return start, rows
+            if line.strip() and not PLAIN_COMMENT.match(line):
+                rows.append((i, line))
+        raise self.error(start, f"{table} not closed")
+
 
 # ---------------------------------------------------------------------------------------------------
 # C pieces
@@ -644,22 +657,14 @@ def parse_console_table(src: Source) -> list[tuple[str, str, bool, int]]:
             macros[m.group(1)] = (m.group(2), m.group(3) != "0u")
         elif line.startswith("#define") and "(field)" in line:
             raise src.error(i, "entry macro not understood")
-    start, _ = src.find_one(r"^static const pmstep_console_config_entry_t table\[\] = \{\s*$")
+    start, lines = src.table_rows(r"^static const pmstep_console_config_entry_t table\[\] = \{\s*$", "table[]")
     rows = []
-    i = start + 1
-    while True:
-        if i >= len(src.lines):
-            raise src.error(start, "table[] not closed")
-        line = src.lines[i]
-        if line.strip() == "};":
-            break
-        if line.strip() and not PLAIN_COMMENT.match(line):
-            m = re.match(r"^\s*(\w+)\(([\w.]+)\),\s*$", line)
-            if not m or m.group(1) not in macros:
-                raise src.error(i, f"table[] line not understood: {line.strip()!r}")
-            ctype, read_only = macros[m.group(1)]
-            rows.append((m.group(2), ctype, read_only, i + 1))
-        i += 1
+    for i, line in lines:
+        m = re.match(r"^\s*(\w+)\(([\w.]+)\),\s*$", line)
+        if not m or m.group(1) not in macros:
+            raise src.error(i, f"table[] line not understood: {line.strip()!r}")
+        ctype, read_only = macros[m.group(1)]
+        rows.append((m.group(2), ctype, read_only, i + 1))
     if not rows:
         raise src.error(start, "table[] is empty")
     return rows
@@ -667,23 +672,15 @@ def parse_console_table(src: Source) -> list[tuple[str, str, bool, int]]:
 
 def parse_sign_rules(src: Source) -> list[tuple[str, str, str, int]]:
     """sign_rules[] of pmstep_config.c: (field path, SIGN_*, status code, line)."""
-    start, _ = src.find_one(r"^\s*static const sign_rule_t sign_rules\[\] = \{\s*$")
+    _, lines = src.table_rows(r"^\s*static const sign_rule_t sign_rules\[\] = \{\s*$", "sign_rules[]")
     rows = []
-    i = start + 1
-    while True:
-        if i >= len(src.lines):
-            raise src.error(start, "sign_rules[] not closed")
-        line = src.lines[i]
-        if line.strip() == "};":
-            break
-        if line.strip() and not PLAIN_COMMENT.match(line):
-            m = re.match(r"^\s*SIGN_RULE\(([\w.]+), (SIGN_\w+), (PMSTEP_\w+)\),\s*(?:/\*.*\*/\s*)?$", line)
-            if not m:
-                raise src.error(i, f"sign_rules[] line not understood: {line.strip()!r}")
-            if m.group(2) not in SIGNS:
-                raise src.error(i, f"sign {m.group(2)} not known to the generator")
-            rows.append((m.group(1), m.group(2), m.group(3), i + 1))
-        i += 1
+    for i, line in lines:
+        m = re.match(r"^\s*SIGN_RULE\(([\w.]+), (SIGN_\w+), (PMSTEP_\w+)\),\s*(?:/\*.*\*/\s*)?$", line)
+        if not m:
+            raise src.error(i, f"sign_rules[] line not understood: {line.strip()!r}")
+        if m.group(2) not in SIGNS:
+            raise src.error(i, f"sign {m.group(2)} not known to the generator")
+        rows.append((m.group(1), m.group(2), m.group(3), i + 1))
     return rows
 
 
@@ -942,35 +939,27 @@ def parse_console(console_h: Source, request_c: Source, types: list[EnumValue]) 
     before = paragraphs(console_h, first, list_start)
     after = paragraphs(console_h, list_end, comment_end)
     macros = {**defines(console_h), **defines(request_c)}
-    start, _ = request_c.find_one(r"^static const request_row_t requests\[\] = \{\s*$")
+    start, lines = request_c.table_rows(r"^static const request_row_t requests\[\] = \{\s*$", "requests[]")
     by_name = {v.name: v for v in types}
     requests = []
-    i = start + 1
-    while True:
-        if i >= len(request_c.lines):
-            raise request_c.error(start, "requests[] not closed")
-        line = request_c.lines[i]
-        if line.strip() == "};":
-            break
-        if line.strip() and not PLAIN_COMMENT.match(line):
-            m = re.match(r"^\s*\{(PMSTEP_CONSOLE_\w+), (NEEDS_\w+), (\w+), (\w+), (\w+)\},\s*$", line)
-            if not m:
-                raise request_c.error(i, f"requests[] line not understood: {line.strip()!r}")
-            if m.group(1) not in by_name:
-                raise request_c.error(i, f"{m.group(1)} is not a value of pmstep_console_type_t")
-            if m.group(2) not in macros:
-                raise request_c.error(i, f"{m.group(2)} is not defined")
-            name = m.group(1).removeprefix("PMSTEP_CONSOLE_")
-            if name not in listed:
-                raise request_c.error(i, f"{name} is in requests[] but not in the \"Requests (DATA):\" list of "
-                                         f"{console_h.name}")
-            lo, hi = c_int(m.group(3), macros, request_c, i), c_int(m.group(4), macros, request_c, i)
-            if lo > hi:
-                raise request_c.error(i, f"{name}: DATA length {lo} > {hi}")
-            data, reply = listed[name]
-            requests.append(Request(by_name[m.group(1)].value, name, m.group(2), macros[m.group(2)][1],
-                                    lo, hi, data, reply))
-        i += 1
+    for i, line in lines:
+        m = re.match(r"^\s*\{(PMSTEP_CONSOLE_\w+), (NEEDS_\w+), (\w+), (\w+), (\w+)\},\s*$", line)
+        if not m:
+            raise request_c.error(i, f"requests[] line not understood: {line.strip()!r}")
+        if m.group(1) not in by_name:
+            raise request_c.error(i, f"{m.group(1)} is not a value of pmstep_console_type_t")
+        if m.group(2) not in macros:
+            raise request_c.error(i, f"{m.group(2)} is not defined")
+        name = m.group(1).removeprefix("PMSTEP_CONSOLE_")
+        if name not in listed:
+            raise request_c.error(i, f"{name} is in requests[] but not in the \"Requests (DATA):\" list of "
+                                     f"{console_h.name}")
+        lo, hi = c_int(m.group(3), macros, request_c, i), c_int(m.group(4), macros, request_c, i)
+        if lo > hi:
+            raise request_c.error(i, f"{name}: DATA length {lo} > {hi}")
+        data, reply = listed[name]
+        requests.append(Request(by_name[m.group(1)].value, name, m.group(2), macros[m.group(2)][1],
+                                lo, hi, data, reply))
     in_table = {r.name for r in requests}
     if len(in_table) != len(requests):
         raise request_c.error(start, "requests[] has a type twice")
@@ -1083,33 +1072,25 @@ def parse_scenario(keys_c: Source, keys_h: Source) -> Scenario:
     number = r"(-?(?:BIG|[\d.]+(?:[eE][-+]?\d+)?))"
     row = re.compile(rf'^\s*\{{{STRING}, (KEY_[A-Z_]+), (?:OFF\([\w.]+\)|0), {number}, ([01]), {number}, ([01]), '
                      rf'{STRING}\}},\s*$')
-    start, _ = keys_c.find_one(r"^const key_t_ scenario_keys\[\] = \{\s*$")
+    start, lines = keys_c.table_rows(r"^const key_t_ scenario_keys\[\] = \{\s*$", "scenario_keys[]")
     keys = []
-    i = start + 1
-    while True:
-        if i >= len(keys_c.lines):
-            raise keys_c.error(start, "scenario_keys[] not closed")
-        line = keys_c.lines[i]
-        if line.strip() == "};":
-            break
-        if line.strip() and not PLAIN_COMMENT.match(line):
-            r = row.match(line)
-            if not r:
-                raise keys_c.error(i, f"scenario_keys[] line not understood: {line.strip()[:80]!r}")
-            if r.group(2) not in key_types:
-                raise keys_c.error(i, f"{r.group(2)} is not a value of key_type_t")
+    for i, line in lines:
+        r = row.match(line)
+        if not r:
+            raise keys_c.error(i, f"scenario_keys[] line not understood: {line.strip()[:80]!r}")
+        if r.group(2) not in key_types:
+            raise keys_c.error(i, f"{r.group(2)} is not a value of key_type_t")
 
-            def value(s: str) -> float:
-                neg = s.startswith("-")
-                v = float(macros["BIG"]) if s.lstrip("-") == "BIG" else float(s.lstrip("-"))
-                return -v if neg else v
+        def value(s: str) -> float:
+            neg = s.startswith("-")
+            v = float(macros["BIG"]) if s.lstrip("-") == "BIG" else float(s.lstrip("-"))
+            return -v if neg else v
 
-            name = c_string(keys_c, i, r.group(1))
-            if not re.fullmatch(r"[a-z_0-9]+(\.[a-z_0-9]+)*\.[A-Za-z_0-9]+", name):
-                raise keys_c.error(i, f"key {name!r} is not section.key")
-            keys.append(ScenarioKey(name, r.group(2), value(r.group(3)), r.group(4) == "1", value(r.group(5)),
-                                    r.group(6) == "1", c_string(keys_c, i, r.group(7)), i + 1))
-        i += 1
+        name = c_string(keys_c, i, r.group(1))
+        if not re.fullmatch(r"[a-z_0-9]+(\.[a-z_0-9]+)*\.[A-Za-z_0-9]+", name):
+            raise keys_c.error(i, f"key {name!r} is not section.key")
+        keys.append(ScenarioKey(name, r.group(2), value(r.group(3)), r.group(4) == "1", value(r.group(5)),
+                                r.group(6) == "1", c_string(keys_c, i, r.group(7)), i + 1))
     names = [k.name for k in keys]
     if len(set(names)) != len(names):
         raise keys_c.error(start, "scenario_keys[] has a key twice")

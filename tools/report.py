@@ -42,8 +42,14 @@ def command(argv):
 def header(title, tool, argv, what=""):
     """The report's first lines: @p title, the @p tool that wrote it, @p argv, commit and date, and
     @p what (a paragraph on what the figures are)."""
-    lines = [f"# {title}", "",
-             f"Written by `{tool}`; regenerate it with the command below, never edit it by hand.", "",
+    return _provenance(f"# {title}",
+                       f"Written by `{tool}`; regenerate it with the command below, never edit it by hand.",
+                       argv, what)
+
+
+def _provenance(heading, written_by, argv, what):
+    """@p heading, @p written_by, then the command, commit and date, and @p what."""
+    lines = [heading, "", written_by, "",
              f"- command: `{command(argv)}`",
              f"- commit: `{commit()}`",
              f"- date: {datetime.date.today().isoformat()}", ""]
@@ -67,14 +73,7 @@ _SECTION = re.compile(r"^<!-- section: ([A-Za-z0-9._-]+) -->\n(.*?)^<!-- end of 
 def section_header(heading, tool, argv, what="", level=2):
     """A section's first lines, as header() gives a page's: @p heading, the @p tool, @p argv,
     commit and date, and @p what."""
-    lines = [f"{'#' * level} {heading}", "",
-             f"Written by `{tool}`:", "",
-             f"- command: `{command(argv)}`",
-             f"- commit: `{commit()}`",
-             f"- date: {datetime.date.today().isoformat()}", ""]
-    if what:
-        lines += [what, ""]
-    return "\n".join(lines)
+    return _provenance(f"{'#' * level} {heading}", f"Written by `{tool}`:", argv, what)
 
 
 def page_header(title, what=""):

@@ -215,13 +215,19 @@ def plot(path, results):
     fig.savefig(path, dpi=90)
 
 
+def mode_counts(results, mode):
+    """A mode's runs, and of them: passed, meeting the envelope criteria, with STATE_NONFINITE."""
+    rs = [r for r in results if r["mode"] == mode]
+    passed = sum(outcome(r) == "pass" for r in rs)
+    envelope = sum(bool(r["summary"]["passed"]) for r in rs)
+    nonfinite = sum(any(c["fault"] == "STATE_NONFINITE" for c in r["summary"]["checks"]) for r in rs)
+    return rs, passed, envelope, nonfinite
+
+
 def summary_lines(results, modes):
     lines = []
     for mode in modes:
-        rs = [r for r in results if r["mode"] == mode]
-        passed = sum(outcome(r) == "pass" for r in rs)
-        envelope = sum(bool(r["summary"]["passed"]) for r in rs)
-        nonfinite = sum(any(c["fault"] == "STATE_NONFINITE" for c in r["summary"]["checks"]) for r in rs)
+        rs, passed, envelope, nonfinite = mode_counts(results, mode)
         lines.append(f"{mode}: {passed} of {len(rs)} pass ({100.0 * passed / max(1, len(rs)):.1f} %); "
                      f"envelope criteria {envelope}; STATE_NONFINITE in {nonfinite}")
         modes_seen = collections.Counter(outcome(r) for r in rs if outcome(r) != "pass")
@@ -240,10 +246,7 @@ def report_text(results, modes, argv, seconds, jobs, population_note):
            f"{len(results)} runs in {seconds:.0f} s on {jobs} workers.", ""]
     out += ["## Pass rates", "", "| mode | motors | pass | % | envelope | STATE_NONFINITE |", "|---|---|---|---|---|---|"]
     for mode in modes:
-        rs = [r for r in results if r["mode"] == mode]
-        passed = sum(outcome(r) == "pass" for r in rs)
-        envelope = sum(bool(r["summary"]["passed"]) for r in rs)
-        nonfinite = sum(any(c["fault"] == "STATE_NONFINITE" for c in r["summary"]["checks"]) for r in rs)
+        rs, passed, envelope, nonfinite = mode_counts(results, mode)
         out.append(f"| {mode} | {len(rs)} | {passed} | {100.0 * passed / max(1, len(rs)):.1f} | {envelope} | "
                    f"{nonfinite} |")
     for title, key in (("frame", lambda r: r["motor"]["frame"]), ("steps/rev", lambda r: 4 * r["motor"]["pole_pairs"]),

@@ -266,8 +266,8 @@ static float observer_bandwidth(const pmstep_design_input_t *in)
     const float w_step = OBSERVER_HALF_RESPONSE / step_time_s;
     if (in->self_commissioning) {
         /* Robust mode answers a load step with its transient observer boost (3 w_o beyond the
-         * residual bound) and holds its standstills on a vector aimed by T_L-hat: it keeps the rate's
-         * bandwidth (raised, its standstill hold's entry jolted the BJ42D29 over the tracking bound). */
+         * residual bound) and aims its standstill hold by T_L-hat, into which a raised observer passes
+         * more of the samples' noise: it keeps the rate's bandwidth. */
         return OBSERVER_BANDWIDTH_X_PERIOD / in->period_s;
     }
     return min2(max2(OBSERVER_BANDWIDTH_X_PERIOD, w_step * in->period_s), MAX_OBSERVER_BANDWIDTH_X_PERIOD)
