@@ -234,12 +234,14 @@ static pmstep_status_t validate_commissioning(const pmstep_config_t *cfg)
     const uint32_t c_align_steps = pmstep_periods_in(cfg->alignment.c_align_time_s, period_s)
                                    - pmstep_periods_in(cfg->alignment.s_align_time_s, period_s);
     const uint32_t shorter_steps = s_align_steps < c_align_steps ? s_align_steps : c_align_steps;
-    const uint32_t window_steps = pmstep_periods_in(comm->steady_state_window_s, period_s);
     const bool window = comm->steady_state_window_s > 0.0f;
     if (!duration_ok(comm->offset_calibration_time_s, cfg->timing.period_s)) {
         return PMSTEP_ERR_OFFSET_CALIBRATION_TIME;
     }
-    if (!duration_ok(comm->steady_state_window_s, period_s) || (2u * window_steps) > shorter_steps) {
+    /* Each window counted in periods only once duration_ok() has bounded it (the conversion of a
+     * larger float to uint32_t is undefined). */
+    if (!duration_ok(comm->steady_state_window_s, period_s)
+        || (2u * pmstep_periods_in(comm->steady_state_window_s, period_s)) > shorter_steps) {
         return PMSTEP_ERR_STEADY_STATE_WINDOW;
     }
     if (!duration_ok(comm->inductance_window_s, period_s)
@@ -267,7 +269,7 @@ static pmstep_status_t validate_commissioning(const pmstep_config_t *cfg)
     if (comm->voltage_bias_level_fraction > 0.0f) {
         /* Two windows (2 W) in the second half of each alignment, and W/2 of settling at the
          * lower level: at least 5 L/R. */
-        if (!window || (4u * window_steps) > shorter_steps) {
+        if (!window || (4u * pmstep_periods_in(comm->steady_state_window_s, period_s)) > shorter_steps) {
             return PMSTEP_ERR_VOLTAGE_BIAS_WINDOW;
         }
         if (comm->steady_state_window_s * cfg->motor.resistance_Ohm < 10.0f * cfg->motor.inductance_H) {

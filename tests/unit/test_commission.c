@@ -87,6 +87,8 @@ static void bias_window_too_short(pmstep_config_t *c) { c->commissioning.voltage
 static void bias_window_too_long(pmstep_config_t *c) { c->commissioning.voltage_bias_level_fraction = 0.5f; c->inverter.dead_time_current_band_A = 0.05f; c->commissioning.steady_state_window_s = 0.015f; }
 static void bias_fraction_one(pmstep_config_t *c) { c->commissioning.voltage_bias_level_fraction = 1.0f; c->inverter.dead_time_current_band_A = 0.05f; }
 static void long_window(pmstep_config_t *c) { c->commissioning.steady_state_window_s = 0.021f; }
+/* A window no period count holds: refused before it is counted in periods. */
+static void huge_window(pmstep_config_t *c) { c->commissioning.steady_state_window_s = 1e30f; }
 static void long_rise(pmstep_config_t *c) { c->commissioning.inductance_window_s = 0.021f; }
 static void negative_offset_time(pmstep_config_t *c) { c->commissioning.offset_calibration_time_s = -1e-3f; }
 static void use_unmeasured_l(pmstep_config_t *c) { c->commissioning.inductance_window_s = 0.0f; c->commissioning.use_measured_inductance = true; }
@@ -108,6 +110,7 @@ static void calibration_settings_are_validated(void **state)
     } cases[] = {
         {no_window, PMSTEP_ERR_ALIGNMENT_OFFSETS_UNMEASURED},
         {long_window, PMSTEP_ERR_STEADY_STATE_WINDOW},
+        {huge_window, PMSTEP_ERR_STEADY_STATE_WINDOW},
         {long_rise, PMSTEP_ERR_INDUCTANCE_WINDOW},
         {negative_offset_time, PMSTEP_ERR_OFFSET_CALIBRATION_TIME},
         {use_unmeasured_l, PMSTEP_ERR_INDUCTANCE_UNMEASURED},
