@@ -161,7 +161,7 @@ def _run_designer(cmd):
         raise ToolError(f"cannot run {cmd[0]}: {e}") from None
     if proc.returncode != 0:
         raise ToolError(f"{' '.join(cmd)} failed (status {proc.returncode}):\n{proc.stderr.strip()}")
-    top = re.search(r"V\): ([0-9.eE+-]+) rad/s", proc.stdout)
+    top = re.search(r"top speed: ([0-9.eE+-]+) rad/s", proc.stdout)
     if top is None:
         raise ToolError(f"cannot read the top speed from the output of {' '.join(cmd)}:\n{proc.stdout}")
     return float(top.group(1))

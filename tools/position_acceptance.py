@@ -69,7 +69,7 @@ def design(tune, motor_ini, ini_out, robust, sets):
     for s in sets:
         cmd += ["--set", s]
     out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
-    top = float(re.search(r"top speed at the bus[^:]*: ([0-9.]+) rad/s", out).group(1))
+    top = float(re.search(r"top speed: ([0-9.eE+-]+) rad/s", out).group(1))
     varpi = float(re.search(r"varpi_0 ([0-9.e+-]+) rad/s", out).group(1))
     k_theta = float(re.search(r"position loop: k_theta ([0-9.e+-]+)", out).group(1))
     return top, varpi, k_theta

@@ -8,7 +8,7 @@ chain, the plant's detent torque on); then every motion below is planned by the 
 pmstep-sil on the same scenario, the firmware (its STEP/DIR input, pmstep_stepdir.h with the designer's
 settings, following the count once tracked in RUN) and the open-loop microstepping baseline at rated
 current (run.controller = microstep, its electrical angle the count's). Motions, per motor (v_top: the
-design's top speed at the bus; a_ref = k_M I / J, the rated torque's acceleration of the bare rotor;
+design's top speed; a_ref = k_M I / J, the rated torque's acceleration of the bare rotor;
 A_AXIS = 1000 rad/s^2, a printer axis's acceleration: 6400 mm/s^2 on a 40 mm belt pulley's turn):
 
   moves       S-curves (jerk: the acceleration reached in 20 ms) at v_max = 1/2 v_top, a_max = min(a_ref / 4,
@@ -82,7 +82,7 @@ def design(tune, motor_ini, ini_out):
     tracker's w_t) and the stall detection's bound."""
     out = subprocess.run([tune, "--motor", motor_ini, "--write-ini", ini_out], check=True, capture_output=True,
                          text=True).stdout
-    top = float(re.search(r"top speed at the bus[^:]*: ([0-9.]+) rad/s", out).group(1))
+    top = float(re.search(r"top speed: ([0-9.eE+-]+) rad/s", out).group(1))
     ini = configparser.ConfigParser(inline_comment_prefixes=(";",))
     ini.read(ini_out)
     run_start = float(ini["controller.commissioning"]["offset_calibration_time_s"]) + float(

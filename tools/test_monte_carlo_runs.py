@@ -31,7 +31,7 @@ FAKE_TUNE = textwrap.dedent('''\
     args = sys.argv[1:]
     assert "--robust" in args and "--motor" in args
     top = 9.6 if args[args.index("--motor") + 1].endswith("paper.ini") else 69.0
-    print(f"  top speed at the bus (rated current, 90 % of 24 V): {top} rad/s (659 rpm)")
+    print(f"  top speed: {top} rad/s (659 rpm), p w T_s = 0.173 rad; the bus's")
     print("  alignment: 0.594 A (u = 0.891 V), t_s 0.09 s, t_c 0.18 s; swing 957 rad/s")
     if "--write-ini" not in args:
         sys.exit(0)

@@ -40,9 +40,12 @@ void print_design(const sil_scenario_t *sc, const pmstep_design_report_t *r, boo
     const pmstep_config_t *c = &sc->controller;
     printf("pmstep-tune: %s, %s mode, T_s = %g s, delay %u\n", sc->name, robust ? "robust" : "paper",
            (double)c->timing.period_s, (unsigned)c->timing.computational_delay_periods);
-    printf("  top speed at the bus (rated current, 90 %% of %g V): %.1f rad/s (%.0f rpm), p w T_s = %.3f rad\n",
-           sc->bus_voltage_V, (double)r->top_speed_rad_s, (double)r->top_speed_rad_s * 60.0 / (2.0 * M_PI),
-           (double)r->top_electrical_step_rad);
+    printf("  top speed: %.1f rad/s (%.0f rpm), p w T_s = %.3f rad; the %s's (bus: rated current in 90 %% of %g V at "
+           "%.1f rad/s; control rate: %.2f rad per period at %.1f rad/s)\n",
+           (double)r->top_speed_rad_s, (double)r->top_speed_rad_s * 60.0 / (2.0 * M_PI),
+           (double)r->top_electrical_step_rad, r->bus_speed_rad_s <= r->rate_speed_rad_s ? "bus" : "control rate",
+           sc->bus_voltage_V, (double)r->bus_speed_rad_s, (double)PMSTEP_DESIGN_MAX_ELECTRICAL_STEP_RAD,
+           (double)r->rate_speed_rad_s);
     printf("  bandwidths: current %.0f rad/s, observer %.0f rad/s (triple pole), speed %.0f rad/s\n",
            (double)r->current_bandwidth_rad_s, (double)r->observer_bandwidth_rad_s,
            (double)r->speed_bandwidth_rad_s);

@@ -45,6 +45,8 @@ int write_summary(const char *path, const char *motor_path, bool robust, pmstep_
     if (status == PMSTEP_OK) {
         cJSON_AddNumberToObject(design, "top_speed_rad_s", (double)r->top_speed_rad_s);
         cJSON_AddNumberToObject(design, "top_electrical_step_rad", (double)r->top_electrical_step_rad);
+        cJSON_AddNumberToObject(design, "bus_speed_rad_s", (double)r->bus_speed_rad_s);
+        cJSON_AddNumberToObject(design, "rate_speed_rad_s", (double)r->rate_speed_rad_s);
         cJSON_AddNumberToObject(design, "current_bandwidth_rad_s", (double)r->current_bandwidth_rad_s);
         cJSON_AddNumberToObject(design, "observer_bandwidth_rad_s", (double)r->observer_bandwidth_rad_s);
         cJSON_AddNumberToObject(design, "speed_bandwidth_rad_s", (double)r->speed_bandwidth_rad_s);

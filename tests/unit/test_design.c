@@ -142,9 +142,12 @@ static void every_preset_gets_a_valid_design(void **state)
                 assert_true(report.alignment_frequency_rad_s * cfg.commissioning.inductance_window_s < 0.1f);
                 assert_true(cfg.commissioning.voltage_bias_level_fraction > 0.0f);
             }
-            /* Top speed: the bus takes (R I + k_M w)^2 + (p w L I)^2 = (0.9 V)^2 there. */
+            /* Top speed: the bus's, where (R I + k_M w)^2 + (p w L I)^2 = (0.9 V)^2, within the
+             * control rate's 0.4 electrical rad per period (no preset reaches it). */
+            assert_true(report.top_speed_rad_s == report.bus_speed_rad_s);
+            assert_true((float)p * report.top_speed_rad_s * in.period_s <= 0.4f);
             {
-                const double w = (double)report.top_speed_rad_s;
+                const double w = (double)report.bus_speed_rad_s;
                 const double i = (double)in.motor.rated_current_A;
                 const double u_q = (double)in.motor.resistance_Ohm * i + (double)in.motor.torque_constant_Nm_A * w;
                 const double u_d = (double)p * w * (double)in.motor.inductance_H * i;
@@ -283,6 +286,33 @@ static void fast_winding_gets_a_rate_limited_design(void **state)
     assert_true(3.0f * report.observer_bandwidth_rad_s >= 1.25f * (r_over_l + 1e-4f / 5.4e-6f) - 1e-1f);
     assert_true(report.observer_bandwidth_rad_s <= 0.1f / in.period_s + 1e-2f);
     assert_true(cfg.gains.current_gain_per_s > 0.0f && cfg.gains.observer_gain_per_s > 0.0f);
+}
+
+/* A NEMA 11 (R 2.08 Ohm, L 0.739 mH, k_M 0.0442 N m/A, 0.711 A, p = 50) on 48 V: the bus would
+ * take it to 816 rad/s, 2.04 electrical rad per period at 20 kHz; its top speed is the control
+ * rate's 0.4 rad per period, 160 rad/s, and the stall bound follows it. */
+static void top_speed_within_the_control_rate(void **state)
+{
+    const motor_data_t nema11 = {"nema11", 2.08f, 0.000739f, 3.6e-7f, 1.1e-5f, 0.0442f, 50, 0.711f, 48.0f};
+    int robust;
+    (void)state;
+    for (robust = 0; robust < 2; ++robust) {
+        pmstep_design_input_t in = input_of(&nema11, robust != 0);
+        pmstep_config_t cfg;
+        pmstep_design_report_t report;
+        assert_int_equal(pmstep_design(&in, &cfg, &report), PMSTEP_OK);
+        assert_float_equal(report.bus_speed_rad_s, 816.0f, 1.0f);
+        assert_float_equal(report.rate_speed_rad_s, 0.4f / (50.0f * 50e-6f), 1e-3f);
+        assert_true(report.top_speed_rad_s == report.rate_speed_rad_s);
+        assert_float_equal(report.top_electrical_step_rad, 0.4f, 1e-6f);
+        assert_float_equal(cfg.detection.stall_speed_error_rad_s, 0.2f * 160.0f, 1e-3f);
+        /* at 6 V the bus's 79 rad/s is below the rate's */
+        in.bus_voltage_V = 6.0f;
+        in.bus_sense_range_V = 12.0f;
+        assert_int_equal(pmstep_design(&in, &cfg, &report), PMSTEP_OK);
+        assert_true(report.top_speed_rad_s == report.bus_speed_rad_s);
+        assert_float_equal(report.bus_speed_rad_s, 79.0f, 1.0f);
+    }
 }
 
 /* Paper mode: the observer's bandwidth from the rotor's full-step time under the rated torque,
@@ -506,6 +536,7 @@ int main(void)
         cmocka_unit_test(bad_motor_data_gets_a_named_error),
         cmocka_unit_test(datasheet_check_names_what_no_stepper_has),
         cmocka_unit_test(fast_winding_gets_a_rate_limited_design),
+        cmocka_unit_test(top_speed_within_the_control_rate),
         cmocka_unit_test(observer_follows_the_full_step_time),
         cmocka_unit_test(phase_voltage_sensing_is_passed_on),
         cmocka_unit_test(low_speed_drive_below_twice_the_dead_time_loss),

@@ -243,8 +243,9 @@ static pmstep_status_t check_input(const pmstep_design_input_t *in)
     return PMSTEP_OK;
 }
 
-/* Top speed: (R I + k_M w)^2 + (p w L I)^2 = (0.9 V)^2 at rated current, i_d = 0 (docs/design/06-top-speed.md). */
-static float top_speed(const pmstep_design_input_t *in)
+/* The bus's speed: (R I + k_M w)^2 + (p w L I)^2 = (0.9 V)^2 at rated current, i_d = 0
+ * (docs/design/06-top-speed.md). */
+static float bus_speed(const pmstep_design_input_t *in)
 {
     const pmstep_motor_config_t *m = &in->motor;
     const float i = in->motor.rated_current_A;
@@ -524,7 +525,11 @@ pmstep_status_t pmstep_design(const pmstep_design_input_t *given, pmstep_config_
     cfg->timing.period_s = in->period_s;
     cfg->timing.computational_delay_periods = in->computational_delay_periods;
     cfg->known_load_mode = false;
-    report->top_speed_rad_s = top_speed(in);
+    /* The top speed: the bus's, or the control rate's where the rotor turns more than
+     * PMSTEP_DESIGN_MAX_ELECTRICAL_STEP_RAD per period before the bus runs out. */
+    report->bus_speed_rad_s = bus_speed(in);
+    report->rate_speed_rad_s = PMSTEP_DESIGN_MAX_ELECTRICAL_STEP_RAD / ((float)in->motor.pole_pairs * in->period_s);
+    report->top_speed_rad_s = min2(report->bus_speed_rad_s, report->rate_speed_rad_s);
     report->top_electrical_step_rad = (float)in->motor.pole_pairs * report->top_speed_rad_s * in->period_s;
     report->rated_torque_Nm = in->motor.torque_constant_Nm_A * in->motor.rated_current_A;
     design_gains(in, &cfg->gains, report);

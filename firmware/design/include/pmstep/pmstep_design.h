@@ -44,7 +44,10 @@ typedef struct {
 
 /** The design's figures, for people and for the SIL's validation. */
 typedef struct {
-    float top_speed_rad_s;           /**< speed at which rated current takes 90 % of the bus (i_d = 0) */
+    float top_speed_rad_s;           /**< the lower of bus_speed_rad_s and rate_speed_rad_s */
+    float bus_speed_rad_s;           /**< speed at which rated current takes 90 % of the bus (i_d = 0) */
+    float rate_speed_rad_s;          /**< speed at which the rotor turns PMSTEP_DESIGN_MAX_ELECTRICAL_STEP_RAD per
+                                          period */
     float top_electrical_step_rad;   /**< p x top speed x T_s: electrical angle turned per period at top speed */
     float current_bandwidth_rad_s;   /**< R/L + K_i: pole of the current error */
     float observer_bandwidth_rad_s;  /**< w_o: triple pole of the linearised speed/load observer */
@@ -59,6 +62,11 @@ typedef struct {
     bool inertia_estimated;          /**< the input gave no inertia: estimated from the holding torque, to be
                                           identified in RUN (commissioning.identification_*) */
 } pmstep_design_report_t;
+
+/** The top speed turns the rotor at most this electrical angle per period: the speed-consistency
+ *  check turns its estimate over PMSTEP_DETECTION_DECIMATION = 4 periods by pmstep_small_rotation(),
+ *  whose polynomials stay within 0.023 of cos and sin up to 1.6 rad (docs/design/06-top-speed.md). */
+#define PMSTEP_DESIGN_MAX_ELECTRICAL_STEP_RAD 0.4f
 
 /** Rotor inertia of a stepper from its holding torque T_H, where the datasheet gives none:
  *  J = PMSTEP_DESIGN_INERTIA_PER_TORQUE x (T_H / 1 N m)^1.5 kg m^2, a fit to NEMA 8-34 datasheets
