@@ -506,9 +506,11 @@ pmstep_status_t pmstep_design(const pmstep_design_input_t *given, pmstep_config_
     }
     report->inertia_estimated = false;
     if (given->motor.inertia_kgm2 == 0.0f && given->holding_torque_Nm > 0.0f) {
-        /* No inertia on the datasheet: the frame's, from the holding torque (to be identified in RUN). */
+        /* No inertia on the datasheet: the frame's, from the holding torque (to be identified in RUN).
+         * Paper mode takes the top of the estimate's range (docs/design/10-inertia-and-friction.md). */
         estimated = *given;
-        estimated.motor.inertia_kgm2 = inertia_estimate(given->holding_torque_Nm);
+        estimated.motor.inertia_kgm2 = (given->self_commissioning ? 1.0f : PMSTEP_DESIGN_INERTIA_ESTIMATE_SPREAD)
+                                       * inertia_estimate(given->holding_torque_Nm);
         report->inertia_estimated = true;
         in = &estimated;
     }

@@ -72,6 +72,10 @@ typedef struct {
  *  J = PMSTEP_DESIGN_INERTIA_PER_TORQUE x (T_H / 1 N m)^1.5 kg m^2, a fit to NEMA 8-34 datasheets
  *  (0.4 N m: 5e-6; 1.26 N m: 3e-5; 4.5 N m: 2e-4), within a factor of 2 of most. */
 #define PMSTEP_DESIGN_INERTIA_PER_TORQUE 2.1e-5f
+/** Paper mode designs for this many times the estimate, the top of its range: its observer and
+ *  speed loop ride out a rotor 4 times lighter than designed for, not one 2 times heavier
+ *  (docs/design/10-inertia-and-friction.md). Robust mode takes the estimate itself. */
+#define PMSTEP_DESIGN_INERTIA_ESTIMATE_SPREAD 2.0f
 
 /**
  * Checks motor data for what no stepper has (only where the holding torque is given):
