@@ -10,7 +10,10 @@ Pages (in --out, default docs/reference of this tree):
                        the C type, the unit (the name's suffix: UNIT_SUFFIXES), the meaning (the field's
                        doc comment) and the range init validates: the sign of sign_rules[]
                        (firmware/src/pmstep_config.c) and every status code of init whose cause (its doc
-                       comment in pmstep_status_t) names the field (FIELD_PHRASES).
+                       comment in pmstep_status_t) names the field (FIELD_PHRASES). Then the STEP/DIR
+                       settings the console stores with them (pmstep_stepdir_settings_t of
+                       firmware/console/include/pmstep_store.h, the table's stepdir.* entries), with the
+                       codes pmstep_console_stepdir_validate() refuses each with.
   codes.md             pmstep_status_t, pmstep_fault_t, pmstep_mode_t, pmstep_identification_t with
                        their texts (firmware/src/pmstep_text.c) and causes; the console's error reply
                        codes (with the host tool's texts, tools/pmstep_console.py ERRORS); the STM32G4
@@ -77,6 +80,7 @@ UNIT_SUFFIXES = {
     "_Nms_rad": "Nm s/rad",
     "_Hz": "Hz",
     "_periods": "control periods",
+    "_full_steps": "full steps",
 }
 # Numeric fields whose name carries no unit suffix (a plain number, or a coefficient whose unit its
 # meaning states). Any other numeric field without a known suffix raises: a new unit is added to
@@ -91,6 +95,8 @@ UNSUFFIXED_FIELDS = {
     "commissioning.voltage_bias_level_fraction",
     "detection.angle_magnitude_bound",
     "detection.max_realignments",
+    "stepdir.microsteps",
+    "stepdir.diag_mode",
 }
 
 # How the causes of the status codes (their doc comments) name a setting besides its own name
@@ -646,15 +652,19 @@ def parse_config_fields(types_h: Source) -> list[ConfigGroup]:
 
 
 def parse_console_table(src: Source) -> list[tuple[str, str, bool, int]]:
-    """table[] of pmstep_console_config.c: (field path, console type, read-only, line) by id."""
+    """table[] of pmstep_console_config.c: (field path, console type, read-only, line) by id. The STEP/DIR
+    settings' entries (pmstep_stepdir_settings_t, PMSTEP_CONSOLE_CFG_STEPDIR) have the path stepdir.<field>."""
     macros = {}
     for i, line in enumerate(src.lines):
         m = re.match(r"^#define (\w+)\(field\) \{#field, PMSTEP_CONSOLE_CFG_(\w+), (0u|PMSTEP_CONSOLE_CFG_READ_ONLY), "
                      r"\(uint16_t\)offsetof\(pmstep_config_t, field\)\}\s*$", line)
-        if m:
-            if m.group(2) not in CONSOLE_TYPES:
-                raise src.error(i, f"console entry type {m.group(2)} not known to the generator")
-            macros[m.group(1)] = (m.group(2), m.group(3) != "0u")
+        sd = re.match(r'^#define (\w+)\(field\) \{"stepdir\." #field, PMSTEP_CONSOLE_CFG_(\w+), '
+                      r"PMSTEP_CONSOLE_CFG_STEPDIR, \(uint16_t\)offsetof\(pmstep_stepdir_settings_t, field\)\}\s*$", line)
+        if m or sd:
+            kind = (m or sd).group(2)
+            if kind not in CONSOLE_TYPES:
+                raise src.error(i, f"console entry type {kind} not known to the generator")
+            macros[(m or sd).group(1)] = (kind, m is not None and m.group(3) != "0u", "stepdir." if sd else "")
         elif line.startswith("#define") and "(field)" in line:
             raise src.error(i, "entry macro not understood")
     start, lines = src.table_rows(r"^static const pmstep_console_config_entry_t table\[\] = \{\s*$", "table[]")
@@ -663,11 +673,52 @@ def parse_console_table(src: Source) -> list[tuple[str, str, bool, int]]:
         m = re.match(r"^\s*(\w+)\(([\w.]+)\),\s*$", line)
         if not m or m.group(1) not in macros:
             raise src.error(i, f"table[] line not understood: {line.strip()!r}")
-        ctype, read_only = macros[m.group(1)]
-        rows.append((m.group(2), ctype, read_only, i + 1))
+        ctype, read_only, prefix = macros[m.group(1)]
+        rows.append((prefix + m.group(2), ctype, read_only, i + 1))
     if not rows:
         raise src.error(start, "table[] is empty")
     return rows
+
+
+STEPDIR_STRUCT = "pmstep_stepdir_settings_t"
+STEPDIR_VALIDATE = "pmstep_console_stepdir_validate"
+
+
+def parse_stepdir_group(store_h: Source) -> ConfigGroup:
+    """The STEP/DIR settings (pmstep_stepdir_settings_t of pmstep_store.h) as the group stepdir."""
+    members, doc = parse_struct(store_h, STEPDIR_STRUCT)
+    fields = []
+    for m in members:
+        if m.ctype not in CONSOLE_TYPES.values():
+            raise GenError(f"{store_h.name}:{m.line}: stepdir.{m.name}: type {m.ctype} not known to the generator")
+        fields.append(ConfigField(f"stepdir.{m.name}", "stepdir", m.ctype, m.doc, m.line))
+    return ConfigGroup("stepdir", STEPDIR_STRUCT, doc, fields)
+
+
+def parse_stepdir_rules(src: Source, group: ConfigGroup, status_names: set[str]) -> None:
+    """The codes pmstep_console_stepdir_validate() (pmstep_console_config.c) refuses each STEP/DIR setting
+    with: every `if (...) { return CODE; }` of its body, the settings its condition reads (sd->field);
+    into the fields' codes, in the checks' order."""
+    start, _ = src.find_one(rf"^pmstep_status_t {STEPDIR_VALIDATE}\(")
+    end = next((i for i in range(start, len(src.lines)) if src.lines[i] == "}"), None)
+    if end is None:
+        raise src.error(start, f"{STEPDIR_VALIDATE}() not closed")
+    body = "\n".join(src.lines[start:end])
+    fields = {f.path.split(".", 1)[1]: f for f in group.fields}
+    checked = 0
+    for m in re.finditer(r"if \((.*?)\) \{\s*return (\w+);\s*\}", body, re.S):
+        names = re.findall(r"\bsd->(\w+)", m.group(1))
+        code_name = m.group(2)
+        if code_name not in status_names:
+            raise src.error(start, f"{STEPDIR_VALIDATE}() returns {code_name}, not a value of pmstep_status_t")
+        for n in names:
+            if n not in fields:
+                raise src.error(start, f"{STEPDIR_VALIDATE}() reads sd->{n}, not a field of {STEPDIR_STRUCT}")
+            if code_name not in fields[n].codes:
+                fields[n].codes.append(code_name)
+        checked += bool(names)
+    if not checked:
+        raise src.error(start, f"{STEPDIR_VALIDATE}(): no check of a setting understood")
 
 
 def parse_sign_rules(src: Source) -> list[tuple[str, str, str, int]]:
@@ -734,7 +785,8 @@ def link_config(ref_groups: list[ConfigGroup], console_rows, sign_rules, status:
     seen = set()
     for cid, (path, ctype, read_only, line) in enumerate(console_rows):
         if path not in fields:
-            raise GenError(f"{console_c.name}:{line}: table[] names {path}, not a field of pmstep_config_t")
+            struct = STEPDIR_STRUCT if path.startswith("stepdir.") else "pmstep_config_t"
+            raise GenError(f"{console_c.name}:{line}: table[] names {path}, not a field of {struct}")
         if path in seen:
             raise GenError(f"{console_c.name}:{line}: table[] names {path} twice")
         seen.add(path)
@@ -764,6 +816,8 @@ def link_config(ref_groups: list[ConfigGroup], console_rows, sign_rules, status:
                 raise GenError(f"{config_c.name}:{line}: a sign rule that refuses with PMSTEP_OK")
             f.sign, f.sign_code = SIGNS[sign], code_name
     for f in fields.values():
+        if f.group == "stepdir":   # checked by pmstep_console_stepdir_validate(), not by init
+            continue
         if f.ctype == "float" and f.sign is None:
             notes.append(f"{f.path} is a float setting outside sign_rules[] ({config_c.name}): init does not "
                          "check that it is finite")
@@ -805,6 +859,10 @@ def link_config(ref_groups: list[ConfigGroup], console_rows, sign_rules, status:
         raise GenError("FIELD_PHRASES in tools/gen_reference.py: no cause of a status code init returns uses "
                        + ", ".join(repr(p) for p in stale) + " any more: remove or update it")
     for f in fields.values():
+        if f.group == "stepdir":   # its codes are pmstep_console_stepdir_validate()'s (parse_stepdir_rules)
+            for c in f.codes:
+                code_fields.setdefault(c, []).append(f.path)
+            continue
         codes = {c for c in considered if f.path in code_fields[c]}
         if f.sign_code:
             codes.add(f.sign_code)
@@ -1177,7 +1235,7 @@ def load(root: Path = ROOT, sil: Path | None = None) -> Reference:
         if len({v.value for v in values}) != len(values):
             raise GenError(f"{types_h.name}: two names share a value in an enum")
 
-    groups = parse_config_fields(types_h)
+    groups = parse_config_fields(types_h) + [parse_stepdir_group(Source(root, STORE_H))]
     for g in groups:
         for f in g.fields:
             unit_of(f.path, f.ctype)   # raises on an unknown suffix
@@ -1190,6 +1248,7 @@ def load(root: Path = ROOT, sil: Path | None = None) -> Reference:
     if unknown:
         raise GenError(f"{config_c.name}: {', '.join(unknown)} not values of pmstep_status_t")
     init_codes = [v.name for v in status if v.name in returned]
+    parse_stepdir_rules(console_c, groups[-1], names)
     code_fields = link_config(groups, console_rows, sign_rules, status, init_codes, notes, types_h, console_c,
                               config_c)
     constants = numeric_constants(types_h)
@@ -1272,11 +1331,13 @@ def config_row(ref: Reference, f: ConfigField) -> list[str]:
 
 def page_configuration(ref: Reference) -> str:
     out = ["# Configuration", ""]
-    out += generated_banner([TYPES_H, CONSOLE_CONFIG_C, CONFIG_C])
-    exposed = sum(1 for f in ref.fields() if f.console_id is not None)
+    out += generated_banner([TYPES_H, STORE_H, CONSOLE_CONFIG_C, CONFIG_C])
+    core = [f for f in ref.fields() if f.group != "stepdir"]
+    exposed = sum(1 for f in core if f.console_id is not None)
     out += [
-        f"Every setting of {code('pmstep_config_t')}, grouped by its sub-structures. "
-        f"The console exposes {exposed} of the {len(ref.fields())} settings; "
+        f"Every setting of {code('pmstep_config_t')}, grouped by its sub-structures, then the "
+        f"[STEP/DIR settings](#stepdir) the console keeps and stores with them. "
+        f"The console exposes {exposed} of the {len(core)} settings of {code('pmstep_config_t')}; "
         "**Id** is its position in the console's table (GET\\_CONFIG / SET\\_CONFIG by id or by name, "
         "the name being the setting's path), `-` where the console does not expose the setting. "
         "A read-only setting is fixed by the port (its hardware) and refused by SET\\_CONFIG. "
@@ -1294,12 +1355,19 @@ def page_configuration(ref: Reference) -> str:
         title = g.name if g.name else "Top level"
         out += [f"## {title}", ""]
         struct = f"{code(g.struct)}" + (f": {esc(g.doc)}" if g.doc else "")
-        if g.name:
+        if g.name == "stepdir":
+            out += [f"Not part of {code('pmstep_config_t')}: the STEP/DIR settings, a {struct}", "",
+                    "The console reads and writes them by name (`stepdir.` and the field) as the settings "
+                    "above, with the motor stopped; a record holds them with the rest. **Range** is what "
+                    f"{code(STEPDIR_VALIDATE + '()')} accepts (SET\_CONFIG's ACK and a record's check give "
+                    "its code); the core does not read them.", ""]
+        elif g.name:
             out += [f"{code(g.name)} is a {struct}", ""]
         else:
             out += [f"Members of {code('pmstep_config_t')} itself.", ""]
         rows = [config_row(ref, f) for f in g.fields]
-        out += table(["Id", "Setting", "Type", "Unit", "Console", "Meaning", "Range (init)"], rows)
+        last = "Range" if g.name == "stepdir" else "Range (init)"
+        out += table(["Id", "Setting", "Type", "Unit", "Console", "Meaning", last], rows)
         out.append("")
     return "\n".join(out)
 
@@ -1340,7 +1408,8 @@ def page_codes(ref: Reference) -> str:
         f"## Status codes ({code('pmstep_status_t')})",
         "",
         f"Returned by every fallible call: 0 ok, negative a cause. Text: {code('pmstep_status_str()')}. "
-        f"**Settings**: for the codes {code('pmstep_init()')} returns, the settings the cause names "
+        f"**Settings**: for the codes {code('pmstep_init()')} returns, the settings the cause names; for "
+        f"the STEP/DIR codes, the STEP/DIR settings {code(STEPDIR_VALIDATE + '()')} refuses with them "
         "(see [Configuration](configuration.md)).",
         "",
     ]

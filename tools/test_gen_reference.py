@@ -57,6 +57,11 @@ def section(page, heading):
     return page[start:] if end < 0 else page[start:end]
 
 
+def block_struct(text, name):
+    """The body of `typedef struct { ... } name;` in @p text."""
+    return re.search(r"typedef struct \{\n((?:(?!typedef struct).)*?)\n\} " + name + ";", text, re.S).group(1)
+
+
 def block(text, opening):
     """The lines of a C table from the line matching @p opening to its '};'."""
     lines = text.split("\n")
@@ -115,8 +120,12 @@ class RealSources(unittest.TestCase):
         text = read(gen.CONSOLE_CONFIG_C)
         console = [line for line in block(text, r"^static const pmstep_console_config_entry_t table\[\]")
                    if re.match(r"^\s+\w+\([\w.]+\),\s*$", line)]
-        console_names = {re.search(r"\(([\w.]+)\)", line).group(1) for line in console}
+        def entry_name(line):   # the STEP/DIR settings' entries (SD_*) are named stepdir.<field>
+            return ("stepdir." if re.match(r"^\s+SD_", line) else "") + re.search(r"\(([\w.]+)\)", line).group(1)
+        console_names = {entry_name(line) for line in console}
         fields = [f.path for g in gen.parse_config_fields(gen.Source(ROOT, gen.TYPES_H)) for f in g.fields]
+        fields += ["stepdir." + m.group(1) for m in re.finditer(
+            r"^\s+(?:uint32_t|bool|float) (\w+);", block_struct(read(gen.STORE_H), "pmstep_stepdir_settings_t"), re.M)]
         unexposed = [f for f in fields if f not in console_names]
         rows = self.configuration_rows()
         self.assertEqual(len(rows), len(console) + len(unexposed))
@@ -127,7 +136,7 @@ class RealSources(unittest.TestCase):
                 self.assertEqual(r["Console"], "not exposed")
         # ids are the table's positions
         for cid, line in enumerate(console):
-            name = re.search(r"\(([\w.]+)\)", line).group(1)
+            name = entry_name(line)
             row = next(r for r in rows if r["Setting"].startswith(f"`{name}`"))
             self.assertEqual(row["Id"], str(cid), name)
             self.assertEqual(row["Console"], "read-only" if "_RO(" in line else "read/write", name)
@@ -170,7 +179,30 @@ class RealSources(unittest.TestCase):
         # grouped by sub-structure, in pmstep_config_t's order, the top level last
         headings = re.findall(r"^## (.+)$", self.pages["configuration.md"], re.M)
         self.assertEqual(headings, ["motor", "timing", "alignment", "gains", "limits", "commissioning", "inverter",
-                                    "detection", "standstill", "Top level"])
+                                    "detection", "standstill", "Top level", "stepdir"])
+
+    def test_stepdir_rows(self):
+        """The STEP/DIR settings after the core's, each with the codes pmstep_console_stepdir_validate()
+        refuses it with."""
+        r = self.row("stepdir.microsteps")
+        self.assertEqual((r["Type"], r["Unit"], r["Console"]), ("`uint32_t`", "-", "read/write"))
+        self.assertTrue(r["Range"].startswith("[`PMSTEP_ERR_STEPDIR_MICROSTEPS`](codes.md#pmstep_err_stepdir_microsteps)"),
+                        r["Range"])
+        r = self.row("stepdir.diag_mode")
+        self.assertIn("PMSTEP_ERR_STEPDIR_DIAG_MODE", r["Range"])
+        self.assertNotIn("PMSTEP_ERR_STEPDIR_MICROSTEPS", r["Range"])
+        r = self.row("stepdir.following_error_limit_full_steps")
+        self.assertEqual((r["Type"], r["Unit"]), ("`float`", "full steps"))
+        self.assertTrue(r["Range"].startswith("[`PMSTEP_ERR_STEPDIR_LIMIT`]"), r["Range"])
+        for name in ("stepdir.invert_direction", "stepdir.enable_active_high", "stepdir.diag_active_high"):
+            self.assertEqual(self.row(name)["Range"], "any")
+        # the console's ids follow the core's: the table's last entries
+        ids = sorted(int(self.row(n)["Id"]) for n in ("stepdir.microsteps", "stepdir.following_error_limit_full_steps"))
+        self.assertEqual(ids[1] - ids[0], 5)
+        # the codes page names the setting of each STEP/DIR code
+        codes = self.pages["codes.md"]
+        line = next(x for x in codes.split("\n") if "`PMSTEP_ERR_STEPDIR_DIAG_MODE`" in x and x.startswith("| -138"))
+        self.assertIn("configuration.md#cfg-stepdir-diag_mode", line)
 
     def test_every_status_code_once_with_its_text(self):
         types_h = read(gen.TYPES_H)
@@ -290,7 +322,7 @@ class BrokenSources(unittest.TestCase):
     """The generator on a copy of the sources with one change: it must raise, naming the file."""
 
     FILES = [gen.TYPES_H, gen.CONFIG_C, gen.TEXT_C, gen.CONSOLE_H, gen.CONSOLE_CONFIG_C, gen.CONSOLE_REQUEST_C,
-             gen.CONSOLE_PY, gen.STM32G4_H, gen.STM32G4_TEXT_C, gen.SCENARIO_KEYS_C, gen.SCENARIO_KEYS_H]
+             gen.CONSOLE_PY, gen.STORE_H, gen.STM32G4_H, gen.STM32G4_TEXT_C, gen.SCENARIO_KEYS_C, gen.SCENARIO_KEYS_H]
 
     def setUp(self):
         self.tmp = tempfile.TemporaryDirectory()
@@ -342,6 +374,19 @@ class BrokenSources(unittest.TestCase):
     def test_console_entry_naming_no_field(self):
         self.edit(gen.CONSOLE_CONFIG_C, r"\bF32\(motor\.detent_torque_Nm\)", "F32(motor.detent_Nm)")
         self.assert_fails(f"{gen.CONSOLE_CONFIG_C}:", "motor.detent_Nm", "not a field of pmstep_config_t")
+
+    def test_stepdir_entry_naming_no_field(self):
+        self.edit(gen.CONSOLE_CONFIG_C, r"\bSD_U32\(microsteps\)", "SD_U32(microstep_count)")
+        self.assert_fails(f"{gen.CONSOLE_CONFIG_C}:", "stepdir.microstep_count",
+                          "not a field of pmstep_stepdir_settings_t")
+
+    def test_stepdir_check_of_no_field(self):
+        self.edit(gen.CONSOLE_CONFIG_C, r"sd->diag_mode != \(uint32_t\)PMSTEP_DIAG_LEVEL", "sd->mode != 0u")
+        self.assert_fails(f"{gen.CONSOLE_CONFIG_C}:", "sd->mode", "pmstep_stepdir_settings_t")
+
+    def test_stepdir_check_with_unknown_code(self):
+        self.edit(gen.CONSOLE_CONFIG_C, r"return PMSTEP_ERR_STEPDIR_DIAG_MODE;", "return PMSTEP_ERR_STEPDIR_MODE;")
+        self.assert_fails(f"{gen.CONSOLE_CONFIG_C}:", "PMSTEP_ERR_STEPDIR_MODE", "not a value of pmstep_status_t")
 
     def test_new_field_with_unknown_unit(self):
         self.edit(gen.TYPES_H, r"^(\s*)float dead_time_s;", r"\1float gate_charge_nC; /**< new */\n\1float dead_time_s;")

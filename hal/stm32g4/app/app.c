@@ -15,7 +15,9 @@
 
 /* STEP/DIR mode (a build with -DPMSTEP_STM32G4_STEPDIR=1, CMake option PMSTEP_STM32G4_STEPDIR): the
  * port's STEP/DIR/EN input and DIAG output enabled; in RUN the position loop follows the step count.
- * Off by default: the drive is commanded from the console only, and STEP pulses move nothing. */
+ * Its settings (microsteps, DIR's sense, EN's and DIAG's polarities, DIAG's mode, the following-error
+ * limit) are the console's stepdir.* values, stored with the configuration. Off by default: the
+ * drive is commanded from the console only, and STEP pulses move nothing. */
 #ifndef PMSTEP_STM32G4_STEPDIR
 #define PMSTEP_STM32G4_STEPDIR 0
 #endif
@@ -66,12 +68,12 @@ static void clock_update(void)
 }
 
 #if PMSTEP_STM32G4_STEPDIR
-/* The step tracker for the configuration in force (the console may have changed it since boot), at the
- * counter's present value: nothing counted yet. */
+/* The step tracker for the configuration and STEP/DIR settings in force (the console may have changed
+ * them since boot), at the counter's present value: nothing counted yet. */
 static pmstep_status_t stepdir_start(void)
 {
     pmstep_stepdir_config_t sd;
-    pmstep_status_t st = pmstep_stepdir_design(&motor_config, board.step_input.microsteps, &sd);
+    pmstep_status_t st = pmstep_console_stepdir_config(&motor_config, &console.stepdir, &sd);
     if (st == PMSTEP_OK) {
         st = pmstep_stepdir_init(&stepdir, &sd, motor_config.motor.pole_pairs, motor_config.timing.period_s,
                                  (uint16_t)pmstep_stm32g4_step_counter());
@@ -90,6 +92,18 @@ static void after_step(const pmstep_output_t *out)
     }
     stepdir_was_tracked = position_out.tracked;
     pmstep_stm32g4_set_diag(pmstep_stepdir_diag(&stepdir, out->mode, position_out.position_rad, position_out.tracked));
+}
+
+/* The STEP/DIR settings in force onto the port's input (the control interrupt held): EN's and DIAG's
+ * polarities at once; the microsteps, DIR's sense, DIAG's mode and limit when following next starts. */
+static void stepdir_settings_to_port(void)
+{
+    const pmstep_stepdir_settings_t *s = &console.stepdir;
+    board.step_input.microsteps = s->microsteps;
+    if (s->enable_active_high != board.step_input.enable_active_high
+        || s->diag_active_high != board.step_input.diag_active_high) {
+        pmstep_stm32g4_step_polarity(&board, s->enable_active_high, s->diag_active_high);
+    }
 }
 #else
 /* In the control interrupt, after each step: the turn count and, every N-th period, the position
@@ -143,6 +157,15 @@ int32_t pmstep_app_init(void)
             return -200 + (int32_t)st;
         }
     }
+    pmstep_console_init(&console, "pmstep " PMSTEP_VERSION_TEXT " stm32g431");
+    pmstep_console_attach_position(&console, &position);
+    pmstep_console_attach_store(&console, &console_store); /* saves at the period boundary, bridge off */
+#if PMSTEP_STM32G4_STEPDIR
+    /* The stored STEP/DIR settings (or the defaults) onto the input before the port sets it up. */
+    board.step_input.microsteps = console.stepdir.microsteps;
+    board.step_input.enable_active_high = console.stepdir.enable_active_high;
+    board.step_input.diag_active_high = console.stepdir.diag_active_high;
+#endif
     port_st = pmstep_stm32g4_init(&board, &motor);
     if (port_st != PMSTEP_STM32G4_OK) {
         return (int32_t)port_st;
@@ -159,9 +182,6 @@ int32_t pmstep_app_init(void)
     if (port_st != PMSTEP_STM32G4_OK) {
         return (int32_t)port_st;
     }
-    pmstep_console_init(&console, "pmstep " PMSTEP_VERSION_TEXT " stm32g431");
-    pmstep_console_attach_position(&console, &position);
-    pmstep_console_attach_store(&console, &console_store); /* saves at the period boundary, bridge off */
     pmstep_stm32g4_set_after_step(after_step);
     uart_errors = 0u;
     tx_len = 0u;
@@ -192,6 +212,9 @@ void pmstep_app_poll(void)
             (void)pmstep_stm32g4_clear_fault(); /* the port's latch too (break, driver fault input) */
         }
         pmstep_console_boundary(&console, &motor, &motor_config, &snap);
+#if PMSTEP_STM32G4_STEPDIR
+        stepdir_settings_to_port();
+#endif
         pmstep_stm32g4_release_control();
         pmstep_console_telemetry(&console, &snap);
     }
