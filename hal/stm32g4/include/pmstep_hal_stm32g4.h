@@ -109,7 +109,8 @@ typedef struct {
  *
  * EN (a GPIO input, pulled to its disabled level) gates the bridge: while it reads disabled the
  * bridge is off by the port's one path (MOE = 0, gate-driver enable off, duties 50 %) and the core
- * stopped, as for a port fault but without latching one. DIAG (an open-drain GPIO output, with
+ * stopped, as for a port fault but without latching one. Starting the drive on EN's assertion, and
+ * clearing a fault on its release, is the application's (app.c), from pmstep_stm32g4_step_enabled(). DIAG (an open-drain GPIO output, with
  * the pin's pull-up) is driven from pmstep_stepdir_diag() through pmstep_stm32g4_set_diag().
  */
 typedef struct {
