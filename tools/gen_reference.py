@@ -24,6 +24,12 @@ Pages (in --out, default docs/reference of this tree):
   scenario-keys.md     every key of the SIL's scenario (scenario_keys[] of sil/src/scenario_keys.c) by
                        section, with the value names of the enumerated keys (sil/src/scenario_keys.h).
 
+Tables in hand-written pages (--docs, default docs/ of this tree), each between its two markers
+(PAGE_TABLES), written again in place:
+  getting-started/nucleo-g431rb.md, stm32g4-stepdir-pins: the STEP/DIR input's pins of the STM32G4
+                       port's default drive: the STEP/DIR rows of pmstep_stm32g4_pin_map() and the pins
+                       pmstep_stm32g4_default_config() gives them (hal/stm32g4/src/stm32g4_board.c).
+
 --sil PATH: a pmstep-sil binary. Its --print-scenario output must list the same keys, in the same
 order and with the same help, as the parsed table (else the binary is stale or the parser wrong),
 and the scenario-keys page gains a column with the built-in paper scenario's values.
@@ -59,6 +65,7 @@ STORE_H = "firmware/console/include/pmstep_store.h"
 CALIBRATE_H = "firmware/design/include/pmstep/pmstep_calibrate.h"
 STM32G4_H = "hal/stm32g4/include/pmstep_hal_stm32g4.h"
 STM32G4_TEXT_C = "hal/stm32g4/src/stm32g4_convert.c"
+STM32G4_BOARD_C = "hal/stm32g4/src/stm32g4_board.c"
 SCENARIO_KEYS_C = "sil/src/scenario_keys.c"
 SCENARIO_KEYS_H = "sil/src/scenario_keys.h"
 
@@ -1588,6 +1595,124 @@ PAGES = {
 }
 
 
+# ---------------------------------------------------------------------------------------------------
+# Tables in hand-written pages
+# ---------------------------------------------------------------------------------------------------
+
+@dataclass
+class PinUse:
+    function: str     # "STEP input"
+    signal: str       # "TIM4_CH2", "GPIO input"
+    field: str        # the member of step_input: step_pin
+    pin: str          # PB7
+    af: int
+    line: int
+
+
+def parse_stepdir_pins(board_c: Source) -> list[PinUse]:
+    """The STEP/DIR rows of pmstep_stm32g4_pin_map() (`all[n++] = (pmstep_stm32g4_pin_use_t){"FUNCTION",
+    "SIGNAL", 0u, cfg->step_input.FIELD};`, in order) with the pins pmstep_stm32g4_default_config() gives
+    those fields (`c.step_input.FIELD = (pmstep_stm32g4_pin_t){PORT, PIN, AF};`)."""
+    ports = {}
+    for i, line in enumerate(board_c.lines):
+        m = re.match(r"^#define (P[A-G]) (\d+)u\s*$", line)
+        if m:
+            ports[m.group(1)] = int(m.group(2))
+    defaults = {}
+    for i, line in enumerate(board_c.lines):
+        m = re.match(r"^\s*c\.step_input\.(\w+_pin) = \(pmstep_stm32g4_pin_t\)\{(P[A-G]), (\d+)u, (\d+)u\};", line)
+        if m:
+            if m.group(2) not in ports:
+                raise board_c.error(i, f"port {m.group(2)} not defined")
+            defaults[m.group(1)] = (f"{m.group(2)}{int(m.group(3))}", int(m.group(4)))
+        elif re.match(r"^\s*c\.step_input\.\w+_pin = ", line):
+            raise board_c.error(i, f"step_input pin line not understood: {line.strip()!r}")
+    rows = []
+    for i, line in enumerate(board_c.lines):
+        if "cfg->step_input." not in line or "pmstep_stm32g4_pin_use_t" not in line:
+            continue
+        m = re.match(r'^\s*all\[n\+\+\] = \(pmstep_stm32g4_pin_use_t\)\{"([^"]+)", "([^"]+)", 0u, '
+                     r"cfg->step_input\.(\w+)\};\s*$", line)
+        if not m:
+            raise board_c.error(i, f"STEP/DIR pin map row not understood: {line.strip()!r}")
+        if m.group(3) not in defaults:
+            raise board_c.error(i, f"step_input.{m.group(3)} has no pin in pmstep_stm32g4_default_config()")
+        pin, af = defaults[m.group(3)]
+        rows.append(PinUse(m.group(1), m.group(2), m.group(3), pin, af, i + 1))
+    if not rows:
+        raise GenError(f"{board_c.name}: no STEP/DIR row (cfg->step_input.*) in pmstep_stm32g4_pin_map()")
+    return rows
+
+
+def pin_mode(use: PinUse) -> str:
+    """The pin's mode as the pin table prints it (hal/stm32g4/tools/print_pin_map.c): its alternate function,
+    or the GPIO's direction."""
+    gpio = {"GPIO input": "input", "GPIO output": "output", "GPIO open drain": "open drain"}
+    if use.signal.startswith("GPIO"):
+        if use.signal not in gpio:
+            raise GenError(f"{STM32G4_BOARD_C}:{use.line}: GPIO signal {use.signal!r} not known to the generator")
+        return gpio[use.signal]
+    return f"AF{use.af}"
+
+
+def table_stm32g4_stepdir_pins(root: Path) -> list[str]:
+    rows = [[esc(u.function), u.pin, esc(u.signal), pin_mode(u), code(f"step_input.{u.field}")]
+            for u in parse_stepdir_pins(Source(root, STM32G4_BOARD_C))]
+    return table(["Signal", "Pin", "MCU signal", "Mode", "Pin setting"], rows)
+
+
+# page (relative to --docs) -> table name -> (what it is written from, renderer)
+PAGE_TABLES = {
+    "getting-started/nucleo-g431rb.md": {
+        "stm32g4-stepdir-pins": ([STM32G4_BOARD_C], table_stm32g4_stepdir_pins),
+    },
+}
+
+
+def table_markers(name: str, sources: list[str]) -> tuple[str, str]:
+    begin = (f"<!-- Generated by tools/gen_reference.py ({name}) from {', '.join(sources)}: do not edit down to "
+             "the end marker; edit the sources and run it again. -->")
+    return begin, f"<!-- End of the table generated by tools/gen_reference.py ({name}). -->"
+
+
+def fill_tables(text: str, page: str, root: Path) -> str:
+    """@p text (the page @p page) with each of its PAGE_TABLES written again between its markers."""
+    for name, (sources, render) in PAGE_TABLES[page].items():
+        begin, end = table_markers(name, sources)
+        if text.count(begin) != 1 or text.count(end) != 1:
+            raise GenError(f"{page}: the markers of the generated table {name} must be there once each:\n  {begin}\n"
+                           f"  {end}")
+        head, rest = text.split(begin, 1)
+        if end not in rest:
+            raise GenError(f"{page}: the end marker of the generated table {name} comes before its start")
+        tail = rest.split(end, 1)[1]
+        text = head + begin + "\n\n" + "\n".join(render(root)) + "\n\n" + end + tail
+    return text
+
+
+def render_page_tables(root: Path, docs_dir: Path) -> dict[Path, tuple[str, str]]:
+    """Each page of PAGE_TABLES in @p docs_dir: (its text, its text with the tables written again)."""
+    texts = {}
+    for page in PAGE_TABLES:
+        path = docs_dir / page
+        try:
+            old = path.read_text(encoding="utf-8")
+        except OSError as e:
+            raise GenError(f"{path}: cannot read: {e}") from e
+        texts[path] = (old, fill_tables(old, page, root))
+    return texts
+
+
+def write_page_tables(texts: dict[Path, tuple[str, str]]) -> list[Path]:
+    """Writes the pages render_page_tables() gave, each only if it changes."""
+    written = []
+    for path, (old, new) in texts.items():
+        if new != old:
+            path.write_text(new, encoding="utf-8")
+            written.append(path)
+    return written
+
+
 def write_pages(ref: Reference, out_dir: Path) -> list[Path]:
     texts = {name: render(ref) for name, render in PAGES.items()}   # all rendered before any is written
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -1604,13 +1729,17 @@ def main(argv: list[str] | None = None) -> int:
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--out", type=Path, default=ROOT / "docs" / "reference",
                         help="folder of the pages (default: docs/reference of this tree)")
+    parser.add_argument("--docs", type=Path, default=ROOT / "docs",
+                        help="folder of the hand-written pages with generated tables (default: docs/ of this tree)")
     parser.add_argument("--sil", type=Path, default=None,
                         help="a pmstep-sil binary: cross-check the scenario keys against its --print-scenario "
                              "and add the paper scenario's values")
     args = parser.parse_args(argv)
     try:
         ref = load(ROOT, args.sil)
+        page_tables = render_page_tables(ROOT, args.docs)   # before any page is written
         written = write_pages(ref, args.out)
+        tables = write_page_tables(page_tables)
     except GenError as e:
         print(f"gen_reference: error: {e}", file=sys.stderr)
         return 1
@@ -1618,6 +1747,8 @@ def main(argv: list[str] | None = None) -> int:
         note(n)
     for path in written:
         print(f"gen_reference: wrote {rel(path)}")
+    for path in tables:
+        print(f"gen_reference: wrote the generated tables of {rel(path)}")
     return 0
 
 

@@ -75,11 +75,16 @@ class RealSources(unittest.TestCase):
     def setUpClass(cls):
         cls.tmp = tempfile.TemporaryDirectory()
         cls.out = Path(cls.tmp.name) / "reference"
-        run = subprocess.run([sys.executable, str(GEN), "--out", str(cls.out)], capture_output=True, text=True,
-                             timeout=120)
+        cls.docs = Path(cls.tmp.name) / "docs"   # copies of the pages with generated tables
+        for page in gen.PAGE_TABLES:
+            (cls.docs / page).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy(ROOT / "docs" / page, cls.docs / page)
+        run = subprocess.run([sys.executable, str(GEN), "--out", str(cls.out), "--docs", str(cls.docs)],
+                             capture_output=True, text=True, timeout=120)
         if run.returncode != 0:
             raise AssertionError(f"gen_reference.py failed:\n{run.stdout}\n{run.stderr}")
         cls.pages = {p.name: p.read_text(encoding="utf-8") for p in cls.out.glob("*.md")}
+        cls.tabled = {page: (cls.docs / page).read_text(encoding="utf-8") for page in gen.PAGE_TABLES}
 
     @classmethod
     def tearDownClass(cls):
@@ -91,6 +96,30 @@ class RealSources(unittest.TestCase):
             self.assertTrue(page.startswith("# "), name)
             self.assertIn("Generated page", page, name)
             self.assertIn("Do not edit", page, name)
+
+    def test_stepdir_pin_table(self):
+        """The NUCLEO page's STEP/DIR pin table: one row per STEP/DIR row of pmstep_stm32g4_pin_map(), in its
+        order, with the pin pmstep_stm32g4_default_config() gives it, between its markers."""
+        board = read(gen.STM32G4_BOARD_C)
+        uses = re.findall(r'\{"([^"]+)", "([^"]+)", 0u, cfg->step_input\.(\w+)\}', board)
+        self.assertEqual(len(uses), 4)
+        pins = {f: f"P{p[1]}{n}" for f, p, n in re.findall(r"c\.step_input\.(\w+) = \(pmstep_stm32g4_pin_t\)\{(P[A-G]), (\d+)u",
+                                                             board)}
+        page = self.tabled["getting-started/nucleo-g431rb.md"]
+        begin, end = gen.table_markers("stm32g4-stepdir-pins", [gen.STM32G4_BOARD_C])
+        between = page.split(begin, 1)[1].split(end, 1)[0]
+        [(header, rows)] = tables(between)
+        self.assertEqual(header, ["Signal", "Pin", "MCU signal", "Mode", "Pin setting"])
+        self.assertEqual([(r[0], r[1], r[2].replace("\\_", "_"), r[4]) for r in rows],
+                         [(f, pins[field], sig, f"`step_input.{field}`") for f, sig, field in uses])
+        self.assertEqual([r[3] for r in rows], ["AF2", "AF2", "input", "open drain"])
+        self.assertIn("| STEP input | PB7 |", between)
+
+    def test_committed_pages_have_their_tables_current(self):
+        """The committed pages hold what the generator writes: nobody edited a generated table by hand,
+        and the sources did not change since it last ran."""
+        for page, text in self.tabled.items():
+            self.assertEqual(read(f"docs/{page}"), text, f"docs/{page}: run tools/gen_reference.py")
 
     def test_tables_are_well_formed(self):
         for name, page in self.pages.items():
@@ -322,7 +351,7 @@ class BrokenSources(unittest.TestCase):
     """The generator on a copy of the sources with one change: it must raise, naming the file."""
 
     FILES = [gen.TYPES_H, gen.CONFIG_C, gen.TEXT_C, gen.CONSOLE_H, gen.CONSOLE_CONFIG_C, gen.CONSOLE_REQUEST_C,
-             gen.CONSOLE_PY, gen.STORE_H, gen.STM32G4_H, gen.STM32G4_TEXT_C, gen.SCENARIO_KEYS_C, gen.SCENARIO_KEYS_H]
+             gen.CONSOLE_PY, gen.STORE_H, gen.STM32G4_H, gen.STM32G4_BOARD_C, "docs/getting-started/nucleo-g431rb.md", gen.STM32G4_TEXT_C, gen.SCENARIO_KEYS_C, gen.SCENARIO_KEYS_H]
 
     def setUp(self):
         self.tmp = tempfile.TemporaryDirectory()
@@ -374,6 +403,28 @@ class BrokenSources(unittest.TestCase):
     def test_console_entry_naming_no_field(self):
         self.edit(gen.CONSOLE_CONFIG_C, r"\bF32\(motor\.detent_torque_Nm\)", "F32(motor.detent_Nm)")
         self.assert_fails(f"{gen.CONSOLE_CONFIG_C}:", "motor.detent_Nm", "not a field of pmstep_config_t")
+
+    def assert_tables_fail(self, *fragments):
+        with self.assertRaises(gen.GenError) as ctx:
+            gen.render_page_tables(self.root, self.root / "docs")
+        for fragment in fragments:
+            self.assertIn(fragment, str(ctx.exception))
+
+    def test_page_tables_of_the_copy(self):
+        texts = gen.render_page_tables(self.root, self.root / "docs")
+        self.assertEqual({p.relative_to(self.root / "docs").as_posix() for p in texts}, set(gen.PAGE_TABLES))
+
+    def test_pin_map_row_shape_change(self):
+        self.edit(gen.STM32G4_BOARD_C, r'(\{"DIR input", "TIM4_CH1", 0u, cfg->step_input\.dir_pin)\}', r"\1, 1}")
+        self.assert_tables_fail(f"{gen.STM32G4_BOARD_C}:", "STEP/DIR pin map row not understood")
+
+    def test_pin_map_row_without_default_pin(self):
+        self.edit(gen.STM32G4_BOARD_C, r"^\s*c\.step_input\.diag_pin = .*\n", "")
+        self.assert_tables_fail(f"{gen.STM32G4_BOARD_C}:", "step_input.diag_pin has no pin")
+
+    def test_table_marker_missing(self):
+        self.edit("docs/getting-started/nucleo-g431rb.md", r"^<!-- End of the table generated .*-->\n", "")
+        self.assert_tables_fail("nucleo-g431rb.md", "stm32g4-stepdir-pins", "markers")
 
     def test_stepdir_entry_naming_no_field(self):
         self.edit(gen.CONSOLE_CONFIG_C, r"\bSD_U32\(microsteps\)", "SD_U32(microstep_count)")
