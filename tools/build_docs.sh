@@ -2,7 +2,8 @@
 # Builds the documentation site into build/site, in one command:
 #   1. tools/gen_reference.py writes the reference pages generated from the code's tables
 #      (docs/reference/configuration.md, codes.md, console-protocol.md, scenario-keys.md; not
-#      committed, see .gitignore);
+#      committed, see .gitignore), and the tables it generates inside committed pages between
+#      their markers (the NUCLEO page's STEP/DIR pins; rewritten only when the code changed them);
 #   2. Doxygen (docs/Doxyfile) writes the C API reference of the public headers into docs/api/
 #      (generated, in .gitignore), which mkdocs copies into the site as api/; any Doxygen warning
 #      fails the build;

@@ -10,7 +10,10 @@ Pages (in --out, default docs/reference of this tree):
                        the C type, the unit (the name's suffix: UNIT_SUFFIXES), the meaning (the field's
                        doc comment) and the range init validates: the sign of sign_rules[]
                        (firmware/src/pmstep_config.c) and every status code of init whose cause (its doc
-                       comment in pmstep_status_t) names the field (FIELD_PHRASES).
+                       comment in pmstep_status_t) names the field (FIELD_PHRASES). Then the STEP/DIR
+                       settings the console stores with them (pmstep_stepdir_settings_t of
+                       firmware/console/include/pmstep_store.h, the table's stepdir.* entries), with the
+                       codes pmstep_console_stepdir_validate() refuses each with.
   codes.md             pmstep_status_t, pmstep_fault_t, pmstep_mode_t, pmstep_identification_t with
                        their texts (firmware/src/pmstep_text.c) and causes; the console's error reply
                        codes (with the host tool's texts, tools/pmstep_console.py ERRORS); the STM32G4
@@ -20,6 +23,12 @@ Pages (in --out, default docs/reference of this tree):
                        joined with the header's "Requests (DATA):" list, and the error reply codes.
   scenario-keys.md     every key of the SIL's scenario (scenario_keys[] of sil/src/scenario_keys.c) by
                        section, with the value names of the enumerated keys (sil/src/scenario_keys.h).
+
+Tables in hand-written pages (--docs, default docs/ of this tree), each between its two markers
+(PAGE_TABLES), written again in place:
+  getting-started/nucleo-g431rb.md, stm32g4-stepdir-pins: the STEP/DIR input's pins of the STM32G4
+                       port's default drive: the STEP/DIR rows of pmstep_stm32g4_pin_map() and the pins
+                       pmstep_stm32g4_default_config() gives them (hal/stm32g4/src/stm32g4_board.c).
 
 --sil PATH: a pmstep-sil binary. Its --print-scenario output must list the same keys, in the same
 order and with the same help, as the parsed table (else the binary is stale or the parser wrong),
@@ -56,6 +65,7 @@ STORE_H = "firmware/console/include/pmstep_store.h"
 CALIBRATE_H = "firmware/design/include/pmstep/pmstep_calibrate.h"
 STM32G4_H = "hal/stm32g4/include/pmstep_hal_stm32g4.h"
 STM32G4_TEXT_C = "hal/stm32g4/src/stm32g4_convert.c"
+STM32G4_BOARD_C = "hal/stm32g4/src/stm32g4_board.c"
 SCENARIO_KEYS_C = "sil/src/scenario_keys.c"
 SCENARIO_KEYS_H = "sil/src/scenario_keys.h"
 
@@ -77,6 +87,7 @@ UNIT_SUFFIXES = {
     "_Nms_rad": "Nm s/rad",
     "_Hz": "Hz",
     "_periods": "control periods",
+    "_full_steps": "full steps",
 }
 # Numeric fields whose name carries no unit suffix (a plain number, or a coefficient whose unit its
 # meaning states). Any other numeric field without a known suffix raises: a new unit is added to
@@ -91,6 +102,8 @@ UNSUFFIXED_FIELDS = {
     "commissioning.voltage_bias_level_fraction",
     "detection.angle_magnitude_bound",
     "detection.max_realignments",
+    "stepdir.microsteps",
+    "stepdir.diag_mode",
 }
 
 # How the causes of the status codes (their doc comments) name a setting besides its own name
@@ -646,15 +659,19 @@ def parse_config_fields(types_h: Source) -> list[ConfigGroup]:
 
 
 def parse_console_table(src: Source) -> list[tuple[str, str, bool, int]]:
-    """table[] of pmstep_console_config.c: (field path, console type, read-only, line) by id."""
+    """table[] of pmstep_console_config.c: (field path, console type, read-only, line) by id. The STEP/DIR
+    settings' entries (pmstep_stepdir_settings_t, PMSTEP_CONSOLE_CFG_STEPDIR) have the path stepdir.<field>."""
     macros = {}
     for i, line in enumerate(src.lines):
         m = re.match(r"^#define (\w+)\(field\) \{#field, PMSTEP_CONSOLE_CFG_(\w+), (0u|PMSTEP_CONSOLE_CFG_READ_ONLY), "
                      r"\(uint16_t\)offsetof\(pmstep_config_t, field\)\}\s*$", line)
-        if m:
-            if m.group(2) not in CONSOLE_TYPES:
-                raise src.error(i, f"console entry type {m.group(2)} not known to the generator")
-            macros[m.group(1)] = (m.group(2), m.group(3) != "0u")
+        sd = re.match(r'^#define (\w+)\(field\) \{"stepdir\." #field, PMSTEP_CONSOLE_CFG_(\w+), '
+                      r"PMSTEP_CONSOLE_CFG_STEPDIR, \(uint16_t\)offsetof\(pmstep_stepdir_settings_t, field\)\}\s*$", line)
+        if m or sd:
+            kind = (m or sd).group(2)
+            if kind not in CONSOLE_TYPES:
+                raise src.error(i, f"console entry type {kind} not known to the generator")
+            macros[(m or sd).group(1)] = (kind, m is not None and m.group(3) != "0u", "stepdir." if sd else "")
         elif line.startswith("#define") and "(field)" in line:
             raise src.error(i, "entry macro not understood")
     start, lines = src.table_rows(r"^static const pmstep_console_config_entry_t table\[\] = \{\s*$", "table[]")
@@ -663,11 +680,52 @@ def parse_console_table(src: Source) -> list[tuple[str, str, bool, int]]:
         m = re.match(r"^\s*(\w+)\(([\w.]+)\),\s*$", line)
         if not m or m.group(1) not in macros:
             raise src.error(i, f"table[] line not understood: {line.strip()!r}")
-        ctype, read_only = macros[m.group(1)]
-        rows.append((m.group(2), ctype, read_only, i + 1))
+        ctype, read_only, prefix = macros[m.group(1)]
+        rows.append((prefix + m.group(2), ctype, read_only, i + 1))
     if not rows:
         raise src.error(start, "table[] is empty")
     return rows
+
+
+STEPDIR_STRUCT = "pmstep_stepdir_settings_t"
+STEPDIR_VALIDATE = "pmstep_console_stepdir_validate"
+
+
+def parse_stepdir_group(store_h: Source) -> ConfigGroup:
+    """The STEP/DIR settings (pmstep_stepdir_settings_t of pmstep_store.h) as the group stepdir."""
+    members, doc = parse_struct(store_h, STEPDIR_STRUCT)
+    fields = []
+    for m in members:
+        if m.ctype not in CONSOLE_TYPES.values():
+            raise GenError(f"{store_h.name}:{m.line}: stepdir.{m.name}: type {m.ctype} not known to the generator")
+        fields.append(ConfigField(f"stepdir.{m.name}", "stepdir", m.ctype, m.doc, m.line))
+    return ConfigGroup("stepdir", STEPDIR_STRUCT, doc, fields)
+
+
+def parse_stepdir_rules(src: Source, group: ConfigGroup, status_names: set[str]) -> None:
+    """The codes pmstep_console_stepdir_validate() (pmstep_console_config.c) refuses each STEP/DIR setting
+    with: every `if (...) { return CODE; }` of its body, the settings its condition reads (sd->field);
+    into the fields' codes, in the checks' order."""
+    start, _ = src.find_one(rf"^pmstep_status_t {STEPDIR_VALIDATE}\(")
+    end = next((i for i in range(start, len(src.lines)) if src.lines[i] == "}"), None)
+    if end is None:
+        raise src.error(start, f"{STEPDIR_VALIDATE}() not closed")
+    body = "\n".join(src.lines[start:end])
+    fields = {f.path.split(".", 1)[1]: f for f in group.fields}
+    checked = 0
+    for m in re.finditer(r"if \((.*?)\) \{\s*return (\w+);\s*\}", body, re.S):
+        names = re.findall(r"\bsd->(\w+)", m.group(1))
+        code_name = m.group(2)
+        if code_name not in status_names:
+            raise src.error(start, f"{STEPDIR_VALIDATE}() returns {code_name}, not a value of pmstep_status_t")
+        for n in names:
+            if n not in fields:
+                raise src.error(start, f"{STEPDIR_VALIDATE}() reads sd->{n}, not a field of {STEPDIR_STRUCT}")
+            if code_name not in fields[n].codes:
+                fields[n].codes.append(code_name)
+        checked += bool(names)
+    if not checked:
+        raise src.error(start, f"{STEPDIR_VALIDATE}(): no check of a setting understood")
 
 
 def parse_sign_rules(src: Source) -> list[tuple[str, str, str, int]]:
@@ -734,7 +792,8 @@ def link_config(ref_groups: list[ConfigGroup], console_rows, sign_rules, status:
     seen = set()
     for cid, (path, ctype, read_only, line) in enumerate(console_rows):
         if path not in fields:
-            raise GenError(f"{console_c.name}:{line}: table[] names {path}, not a field of pmstep_config_t")
+            struct = STEPDIR_STRUCT if path.startswith("stepdir.") else "pmstep_config_t"
+            raise GenError(f"{console_c.name}:{line}: table[] names {path}, not a field of {struct}")
         if path in seen:
             raise GenError(f"{console_c.name}:{line}: table[] names {path} twice")
         seen.add(path)
@@ -764,6 +823,8 @@ def link_config(ref_groups: list[ConfigGroup], console_rows, sign_rules, status:
                 raise GenError(f"{config_c.name}:{line}: a sign rule that refuses with PMSTEP_OK")
             f.sign, f.sign_code = SIGNS[sign], code_name
     for f in fields.values():
+        if f.group == "stepdir":   # checked by pmstep_console_stepdir_validate(), not by init
+            continue
         if f.ctype == "float" and f.sign is None:
             notes.append(f"{f.path} is a float setting outside sign_rules[] ({config_c.name}): init does not "
                          "check that it is finite")
@@ -805,6 +866,10 @@ def link_config(ref_groups: list[ConfigGroup], console_rows, sign_rules, status:
         raise GenError("FIELD_PHRASES in tools/gen_reference.py: no cause of a status code init returns uses "
                        + ", ".join(repr(p) for p in stale) + " any more: remove or update it")
     for f in fields.values():
+        if f.group == "stepdir":   # its codes are pmstep_console_stepdir_validate()'s (parse_stepdir_rules)
+            for c in f.codes:
+                code_fields.setdefault(c, []).append(f.path)
+            continue
         codes = {c for c in considered if f.path in code_fields[c]}
         if f.sign_code:
             codes.add(f.sign_code)
@@ -1177,7 +1242,7 @@ def load(root: Path = ROOT, sil: Path | None = None) -> Reference:
         if len({v.value for v in values}) != len(values):
             raise GenError(f"{types_h.name}: two names share a value in an enum")
 
-    groups = parse_config_fields(types_h)
+    groups = parse_config_fields(types_h) + [parse_stepdir_group(Source(root, STORE_H))]
     for g in groups:
         for f in g.fields:
             unit_of(f.path, f.ctype)   # raises on an unknown suffix
@@ -1190,6 +1255,7 @@ def load(root: Path = ROOT, sil: Path | None = None) -> Reference:
     if unknown:
         raise GenError(f"{config_c.name}: {', '.join(unknown)} not values of pmstep_status_t")
     init_codes = [v.name for v in status if v.name in returned]
+    parse_stepdir_rules(console_c, groups[-1], names)
     code_fields = link_config(groups, console_rows, sign_rules, status, init_codes, notes, types_h, console_c,
                               config_c)
     constants = numeric_constants(types_h)
@@ -1272,11 +1338,13 @@ def config_row(ref: Reference, f: ConfigField) -> list[str]:
 
 def page_configuration(ref: Reference) -> str:
     out = ["# Configuration", ""]
-    out += generated_banner([TYPES_H, CONSOLE_CONFIG_C, CONFIG_C])
-    exposed = sum(1 for f in ref.fields() if f.console_id is not None)
+    out += generated_banner([TYPES_H, STORE_H, CONSOLE_CONFIG_C, CONFIG_C])
+    core = [f for f in ref.fields() if f.group != "stepdir"]
+    exposed = sum(1 for f in core if f.console_id is not None)
     out += [
-        f"Every setting of {code('pmstep_config_t')}, grouped by its sub-structures. "
-        f"The console exposes {exposed} of the {len(ref.fields())} settings; "
+        f"Every setting of {code('pmstep_config_t')}, grouped by its sub-structures, then the "
+        f"[STEP/DIR settings](#stepdir) the console keeps and stores with them. "
+        f"The console exposes {exposed} of the {len(core)} settings of {code('pmstep_config_t')}; "
         "**Id** is its position in the console's table (GET\\_CONFIG / SET\\_CONFIG by id or by name, "
         "the name being the setting's path), `-` where the console does not expose the setting. "
         "A read-only setting is fixed by the port (its hardware) and refused by SET\\_CONFIG. "
@@ -1294,12 +1362,19 @@ def page_configuration(ref: Reference) -> str:
         title = g.name if g.name else "Top level"
         out += [f"## {title}", ""]
         struct = f"{code(g.struct)}" + (f": {esc(g.doc)}" if g.doc else "")
-        if g.name:
+        if g.name == "stepdir":
+            out += [f"Not part of {code('pmstep_config_t')}: the STEP/DIR settings, a {struct}", "",
+                    "The console reads and writes them by name (`stepdir.` and the field) as the settings "
+                    "above, with the motor stopped; a record holds them with the rest. **Range** is what "
+                    f"{code(STEPDIR_VALIDATE + '()')} accepts (SET\_CONFIG's ACK and a record's check give "
+                    "its code); the core does not read them.", ""]
+        elif g.name:
             out += [f"{code(g.name)} is a {struct}", ""]
         else:
             out += [f"Members of {code('pmstep_config_t')} itself.", ""]
         rows = [config_row(ref, f) for f in g.fields]
-        out += table(["Id", "Setting", "Type", "Unit", "Console", "Meaning", "Range (init)"], rows)
+        last = "Range" if g.name == "stepdir" else "Range (init)"
+        out += table(["Id", "Setting", "Type", "Unit", "Console", "Meaning", last], rows)
         out.append("")
     return "\n".join(out)
 
@@ -1340,7 +1415,8 @@ def page_codes(ref: Reference) -> str:
         f"## Status codes ({code('pmstep_status_t')})",
         "",
         f"Returned by every fallible call: 0 ok, negative a cause. Text: {code('pmstep_status_str()')}. "
-        f"**Settings**: for the codes {code('pmstep_init()')} returns, the settings the cause names "
+        f"**Settings**: for the codes {code('pmstep_init()')} returns, the settings the cause names; for "
+        f"the STEP/DIR codes, the STEP/DIR settings {code(STEPDIR_VALIDATE + '()')} refuses with them "
         "(see [Configuration](configuration.md)).",
         "",
     ]
@@ -1519,6 +1595,124 @@ PAGES = {
 }
 
 
+# ---------------------------------------------------------------------------------------------------
+# Tables in hand-written pages
+# ---------------------------------------------------------------------------------------------------
+
+@dataclass
+class PinUse:
+    function: str     # "STEP input"
+    signal: str       # "TIM4_CH2", "GPIO input"
+    field: str        # the member of step_input: step_pin
+    pin: str          # PB7
+    af: int
+    line: int
+
+
+def parse_stepdir_pins(board_c: Source) -> list[PinUse]:
+    """The STEP/DIR rows of pmstep_stm32g4_pin_map() (`all[n++] = (pmstep_stm32g4_pin_use_t){"FUNCTION",
+    "SIGNAL", 0u, cfg->step_input.FIELD};`, in order) with the pins pmstep_stm32g4_default_config() gives
+    those fields (`c.step_input.FIELD = (pmstep_stm32g4_pin_t){PORT, PIN, AF};`)."""
+    ports = {}
+    for i, line in enumerate(board_c.lines):
+        m = re.match(r"^#define (P[A-G]) (\d+)u\s*$", line)
+        if m:
+            ports[m.group(1)] = int(m.group(2))
+    defaults = {}
+    for i, line in enumerate(board_c.lines):
+        m = re.match(r"^\s*c\.step_input\.(\w+_pin) = \(pmstep_stm32g4_pin_t\)\{(P[A-G]), (\d+)u, (\d+)u\};", line)
+        if m:
+            if m.group(2) not in ports:
+                raise board_c.error(i, f"port {m.group(2)} not defined")
+            defaults[m.group(1)] = (f"{m.group(2)}{int(m.group(3))}", int(m.group(4)))
+        elif re.match(r"^\s*c\.step_input\.\w+_pin = ", line):
+            raise board_c.error(i, f"step_input pin line not understood: {line.strip()!r}")
+    rows = []
+    for i, line in enumerate(board_c.lines):
+        if "cfg->step_input." not in line or "pmstep_stm32g4_pin_use_t" not in line:
+            continue
+        m = re.match(r'^\s*all\[n\+\+\] = \(pmstep_stm32g4_pin_use_t\)\{"([^"]+)", "([^"]+)", 0u, '
+                     r"cfg->step_input\.(\w+)\};\s*$", line)
+        if not m:
+            raise board_c.error(i, f"STEP/DIR pin map row not understood: {line.strip()!r}")
+        if m.group(3) not in defaults:
+            raise board_c.error(i, f"step_input.{m.group(3)} has no pin in pmstep_stm32g4_default_config()")
+        pin, af = defaults[m.group(3)]
+        rows.append(PinUse(m.group(1), m.group(2), m.group(3), pin, af, i + 1))
+    if not rows:
+        raise GenError(f"{board_c.name}: no STEP/DIR row (cfg->step_input.*) in pmstep_stm32g4_pin_map()")
+    return rows
+
+
+def pin_mode(use: PinUse) -> str:
+    """The pin's mode as the pin table prints it (hal/stm32g4/tools/print_pin_map.c): its alternate function,
+    or the GPIO's direction."""
+    gpio = {"GPIO input": "input", "GPIO output": "output", "GPIO open drain": "open drain"}
+    if use.signal.startswith("GPIO"):
+        if use.signal not in gpio:
+            raise GenError(f"{STM32G4_BOARD_C}:{use.line}: GPIO signal {use.signal!r} not known to the generator")
+        return gpio[use.signal]
+    return f"AF{use.af}"
+
+
+def table_stm32g4_stepdir_pins(root: Path) -> list[str]:
+    rows = [[esc(u.function), u.pin, esc(u.signal), pin_mode(u), code(f"step_input.{u.field}")]
+            for u in parse_stepdir_pins(Source(root, STM32G4_BOARD_C))]
+    return table(["Signal", "Pin", "MCU signal", "Mode", "Pin setting"], rows)
+
+
+# page (relative to --docs) -> table name -> (what it is written from, renderer)
+PAGE_TABLES = {
+    "getting-started/nucleo-g431rb.md": {
+        "stm32g4-stepdir-pins": ([STM32G4_BOARD_C], table_stm32g4_stepdir_pins),
+    },
+}
+
+
+def table_markers(name: str, sources: list[str]) -> tuple[str, str]:
+    begin = (f"<!-- Generated by tools/gen_reference.py ({name}) from {', '.join(sources)}: do not edit down to "
+             "the end marker; edit the sources and run it again. -->")
+    return begin, f"<!-- End of the table generated by tools/gen_reference.py ({name}). -->"
+
+
+def fill_tables(text: str, page: str, root: Path) -> str:
+    """@p text (the page @p page) with each of its PAGE_TABLES written again between its markers."""
+    for name, (sources, render) in PAGE_TABLES[page].items():
+        begin, end = table_markers(name, sources)
+        if text.count(begin) != 1 or text.count(end) != 1:
+            raise GenError(f"{page}: the markers of the generated table {name} must be there once each:\n  {begin}\n"
+                           f"  {end}")
+        head, rest = text.split(begin, 1)
+        if end not in rest:
+            raise GenError(f"{page}: the end marker of the generated table {name} comes before its start")
+        tail = rest.split(end, 1)[1]
+        text = head + begin + "\n\n" + "\n".join(render(root)) + "\n\n" + end + tail
+    return text
+
+
+def render_page_tables(root: Path, docs_dir: Path) -> dict[Path, tuple[str, str]]:
+    """Each page of PAGE_TABLES in @p docs_dir: (its text, its text with the tables written again)."""
+    texts = {}
+    for page in PAGE_TABLES:
+        path = docs_dir / page
+        try:
+            old = path.read_text(encoding="utf-8")
+        except OSError as e:
+            raise GenError(f"{path}: cannot read: {e}") from e
+        texts[path] = (old, fill_tables(old, page, root))
+    return texts
+
+
+def write_page_tables(texts: dict[Path, tuple[str, str]]) -> list[Path]:
+    """Writes the pages render_page_tables() gave, each only if it changes."""
+    written = []
+    for path, (old, new) in texts.items():
+        if new != old:
+            path.write_text(new, encoding="utf-8")
+            written.append(path)
+    return written
+
+
 def write_pages(ref: Reference, out_dir: Path) -> list[Path]:
     texts = {name: render(ref) for name, render in PAGES.items()}   # all rendered before any is written
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -1535,13 +1729,17 @@ def main(argv: list[str] | None = None) -> int:
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--out", type=Path, default=ROOT / "docs" / "reference",
                         help="folder of the pages (default: docs/reference of this tree)")
+    parser.add_argument("--docs", type=Path, default=ROOT / "docs",
+                        help="folder of the hand-written pages with generated tables (default: docs/ of this tree)")
     parser.add_argument("--sil", type=Path, default=None,
                         help="a pmstep-sil binary: cross-check the scenario keys against its --print-scenario "
                              "and add the paper scenario's values")
     args = parser.parse_args(argv)
     try:
         ref = load(ROOT, args.sil)
+        page_tables = render_page_tables(ROOT, args.docs)   # before any page is written
         written = write_pages(ref, args.out)
+        tables = write_page_tables(page_tables)
     except GenError as e:
         print(f"gen_reference: error: {e}", file=sys.stderr)
         return 1
@@ -1549,6 +1747,8 @@ def main(argv: list[str] | None = None) -> int:
         note(n)
     for path in written:
         print(f"gen_reference: wrote {rel(path)}")
+    for path in tables:
+        print(f"gen_reference: wrote the generated tables of {rel(path)}")
     return 0
 
 

@@ -57,6 +57,11 @@ def section(page, heading):
     return page[start:] if end < 0 else page[start:end]
 
 
+def block_struct(text, name):
+    """The body of `typedef struct { ... } name;` in @p text."""
+    return re.search(r"typedef struct \{\n((?:(?!typedef struct).)*?)\n\} " + name + ";", text, re.S).group(1)
+
+
 def block(text, opening):
     """The lines of a C table from the line matching @p opening to its '};'."""
     lines = text.split("\n")
@@ -70,11 +75,16 @@ class RealSources(unittest.TestCase):
     def setUpClass(cls):
         cls.tmp = tempfile.TemporaryDirectory()
         cls.out = Path(cls.tmp.name) / "reference"
-        run = subprocess.run([sys.executable, str(GEN), "--out", str(cls.out)], capture_output=True, text=True,
-                             timeout=120)
+        cls.docs = Path(cls.tmp.name) / "docs"   # copies of the pages with generated tables
+        for page in gen.PAGE_TABLES:
+            (cls.docs / page).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy(ROOT / "docs" / page, cls.docs / page)
+        run = subprocess.run([sys.executable, str(GEN), "--out", str(cls.out), "--docs", str(cls.docs)],
+                             capture_output=True, text=True, timeout=120)
         if run.returncode != 0:
             raise AssertionError(f"gen_reference.py failed:\n{run.stdout}\n{run.stderr}")
         cls.pages = {p.name: p.read_text(encoding="utf-8") for p in cls.out.glob("*.md")}
+        cls.tabled = {page: (cls.docs / page).read_text(encoding="utf-8") for page in gen.PAGE_TABLES}
 
     @classmethod
     def tearDownClass(cls):
@@ -86,6 +96,30 @@ class RealSources(unittest.TestCase):
             self.assertTrue(page.startswith("# "), name)
             self.assertIn("Generated page", page, name)
             self.assertIn("Do not edit", page, name)
+
+    def test_stepdir_pin_table(self):
+        """The NUCLEO page's STEP/DIR pin table: one row per STEP/DIR row of pmstep_stm32g4_pin_map(), in its
+        order, with the pin pmstep_stm32g4_default_config() gives it, between its markers."""
+        board = read(gen.STM32G4_BOARD_C)
+        uses = re.findall(r'\{"([^"]+)", "([^"]+)", 0u, cfg->step_input\.(\w+)\}', board)
+        self.assertEqual(len(uses), 4)
+        pins = {f: f"P{p[1]}{n}" for f, p, n in re.findall(r"c\.step_input\.(\w+) = \(pmstep_stm32g4_pin_t\)\{(P[A-G]), (\d+)u",
+                                                             board)}
+        page = self.tabled["getting-started/nucleo-g431rb.md"]
+        begin, end = gen.table_markers("stm32g4-stepdir-pins", [gen.STM32G4_BOARD_C])
+        between = page.split(begin, 1)[1].split(end, 1)[0]
+        [(header, rows)] = tables(between)
+        self.assertEqual(header, ["Signal", "Pin", "MCU signal", "Mode", "Pin setting"])
+        self.assertEqual([(r[0], r[1], r[2].replace("\\_", "_"), r[4]) for r in rows],
+                         [(f, pins[field], sig, f"`step_input.{field}`") for f, sig, field in uses])
+        self.assertEqual([r[3] for r in rows], ["AF2", "AF2", "input", "open drain"])
+        self.assertIn("| STEP input | PB7 |", between)
+
+    def test_committed_pages_have_their_tables_current(self):
+        """The committed pages hold what the generator writes: nobody edited a generated table by hand,
+        and the sources did not change since it last ran."""
+        for page, text in self.tabled.items():
+            self.assertEqual(read(f"docs/{page}"), text, f"docs/{page}: run tools/gen_reference.py")
 
     def test_tables_are_well_formed(self):
         for name, page in self.pages.items():
@@ -115,8 +149,12 @@ class RealSources(unittest.TestCase):
         text = read(gen.CONSOLE_CONFIG_C)
         console = [line for line in block(text, r"^static const pmstep_console_config_entry_t table\[\]")
                    if re.match(r"^\s+\w+\([\w.]+\),\s*$", line)]
-        console_names = {re.search(r"\(([\w.]+)\)", line).group(1) for line in console}
+        def entry_name(line):   # the STEP/DIR settings' entries (SD_*) are named stepdir.<field>
+            return ("stepdir." if re.match(r"^\s+SD_", line) else "") + re.search(r"\(([\w.]+)\)", line).group(1)
+        console_names = {entry_name(line) for line in console}
         fields = [f.path for g in gen.parse_config_fields(gen.Source(ROOT, gen.TYPES_H)) for f in g.fields]
+        fields += ["stepdir." + m.group(1) for m in re.finditer(
+            r"^\s+(?:uint32_t|bool|float) (\w+);", block_struct(read(gen.STORE_H), "pmstep_stepdir_settings_t"), re.M)]
         unexposed = [f for f in fields if f not in console_names]
         rows = self.configuration_rows()
         self.assertEqual(len(rows), len(console) + len(unexposed))
@@ -127,7 +165,7 @@ class RealSources(unittest.TestCase):
                 self.assertEqual(r["Console"], "not exposed")
         # ids are the table's positions
         for cid, line in enumerate(console):
-            name = re.search(r"\(([\w.]+)\)", line).group(1)
+            name = entry_name(line)
             row = next(r for r in rows if r["Setting"].startswith(f"`{name}`"))
             self.assertEqual(row["Id"], str(cid), name)
             self.assertEqual(row["Console"], "read-only" if "_RO(" in line else "read/write", name)
@@ -170,7 +208,30 @@ class RealSources(unittest.TestCase):
         # grouped by sub-structure, in pmstep_config_t's order, the top level last
         headings = re.findall(r"^## (.+)$", self.pages["configuration.md"], re.M)
         self.assertEqual(headings, ["motor", "timing", "alignment", "gains", "limits", "commissioning", "inverter",
-                                    "detection", "standstill", "Top level"])
+                                    "detection", "standstill", "Top level", "stepdir"])
+
+    def test_stepdir_rows(self):
+        """The STEP/DIR settings after the core's, each with the codes pmstep_console_stepdir_validate()
+        refuses it with."""
+        r = self.row("stepdir.microsteps")
+        self.assertEqual((r["Type"], r["Unit"], r["Console"]), ("`uint32_t`", "-", "read/write"))
+        self.assertTrue(r["Range"].startswith("[`PMSTEP_ERR_STEPDIR_MICROSTEPS`](codes.md#pmstep_err_stepdir_microsteps)"),
+                        r["Range"])
+        r = self.row("stepdir.diag_mode")
+        self.assertIn("PMSTEP_ERR_STEPDIR_DIAG_MODE", r["Range"])
+        self.assertNotIn("PMSTEP_ERR_STEPDIR_MICROSTEPS", r["Range"])
+        r = self.row("stepdir.following_error_limit_full_steps")
+        self.assertEqual((r["Type"], r["Unit"]), ("`float`", "full steps"))
+        self.assertTrue(r["Range"].startswith("[`PMSTEP_ERR_STEPDIR_LIMIT`]"), r["Range"])
+        for name in ("stepdir.invert_direction", "stepdir.enable_active_high", "stepdir.diag_active_high"):
+            self.assertEqual(self.row(name)["Range"], "any")
+        # the console's ids follow the core's: the table's last entries
+        ids = sorted(int(self.row(n)["Id"]) for n in ("stepdir.microsteps", "stepdir.following_error_limit_full_steps"))
+        self.assertEqual(ids[1] - ids[0], 5)
+        # the codes page names the setting of each STEP/DIR code
+        codes = self.pages["codes.md"]
+        line = next(x for x in codes.split("\n") if "`PMSTEP_ERR_STEPDIR_DIAG_MODE`" in x and x.startswith("| -138"))
+        self.assertIn("configuration.md#cfg-stepdir-diag_mode", line)
 
     def test_every_status_code_once_with_its_text(self):
         types_h = read(gen.TYPES_H)
@@ -290,7 +351,7 @@ class BrokenSources(unittest.TestCase):
     """The generator on a copy of the sources with one change: it must raise, naming the file."""
 
     FILES = [gen.TYPES_H, gen.CONFIG_C, gen.TEXT_C, gen.CONSOLE_H, gen.CONSOLE_CONFIG_C, gen.CONSOLE_REQUEST_C,
-             gen.CONSOLE_PY, gen.STM32G4_H, gen.STM32G4_TEXT_C, gen.SCENARIO_KEYS_C, gen.SCENARIO_KEYS_H]
+             gen.CONSOLE_PY, gen.STORE_H, gen.STM32G4_H, gen.STM32G4_BOARD_C, "docs/getting-started/nucleo-g431rb.md", gen.STM32G4_TEXT_C, gen.SCENARIO_KEYS_C, gen.SCENARIO_KEYS_H]
 
     def setUp(self):
         self.tmp = tempfile.TemporaryDirectory()
@@ -342,6 +403,41 @@ class BrokenSources(unittest.TestCase):
     def test_console_entry_naming_no_field(self):
         self.edit(gen.CONSOLE_CONFIG_C, r"\bF32\(motor\.detent_torque_Nm\)", "F32(motor.detent_Nm)")
         self.assert_fails(f"{gen.CONSOLE_CONFIG_C}:", "motor.detent_Nm", "not a field of pmstep_config_t")
+
+    def assert_tables_fail(self, *fragments):
+        with self.assertRaises(gen.GenError) as ctx:
+            gen.render_page_tables(self.root, self.root / "docs")
+        for fragment in fragments:
+            self.assertIn(fragment, str(ctx.exception))
+
+    def test_page_tables_of_the_copy(self):
+        texts = gen.render_page_tables(self.root, self.root / "docs")
+        self.assertEqual({p.relative_to(self.root / "docs").as_posix() for p in texts}, set(gen.PAGE_TABLES))
+
+    def test_pin_map_row_shape_change(self):
+        self.edit(gen.STM32G4_BOARD_C, r'(\{"DIR input", "TIM4_CH1", 0u, cfg->step_input\.dir_pin)\}', r"\1, 1}")
+        self.assert_tables_fail(f"{gen.STM32G4_BOARD_C}:", "STEP/DIR pin map row not understood")
+
+    def test_pin_map_row_without_default_pin(self):
+        self.edit(gen.STM32G4_BOARD_C, r"^\s*c\.step_input\.diag_pin = .*\n", "")
+        self.assert_tables_fail(f"{gen.STM32G4_BOARD_C}:", "step_input.diag_pin has no pin")
+
+    def test_table_marker_missing(self):
+        self.edit("docs/getting-started/nucleo-g431rb.md", r"^<!-- End of the table generated .*-->\n", "")
+        self.assert_tables_fail("nucleo-g431rb.md", "stm32g4-stepdir-pins", "markers")
+
+    def test_stepdir_entry_naming_no_field(self):
+        self.edit(gen.CONSOLE_CONFIG_C, r"\bSD_U32\(microsteps\)", "SD_U32(microstep_count)")
+        self.assert_fails(f"{gen.CONSOLE_CONFIG_C}:", "stepdir.microstep_count",
+                          "not a field of pmstep_stepdir_settings_t")
+
+    def test_stepdir_check_of_no_field(self):
+        self.edit(gen.CONSOLE_CONFIG_C, r"sd->diag_mode != \(uint32_t\)PMSTEP_DIAG_LEVEL", "sd->mode != 0u")
+        self.assert_fails(f"{gen.CONSOLE_CONFIG_C}:", "sd->mode", "pmstep_stepdir_settings_t")
+
+    def test_stepdir_check_with_unknown_code(self):
+        self.edit(gen.CONSOLE_CONFIG_C, r"return PMSTEP_ERR_STEPDIR_DIAG_MODE;", "return PMSTEP_ERR_STEPDIR_MODE;")
+        self.assert_fails(f"{gen.CONSOLE_CONFIG_C}:", "PMSTEP_ERR_STEPDIR_MODE", "not a value of pmstep_status_t")
 
     def test_new_field_with_unknown_unit(self):
         self.edit(gen.TYPES_H, r"^(\s*)float dead_time_s;", r"\1float gate_charge_nC; /**< new */\n\1float dead_time_s;")

@@ -189,20 +189,22 @@ static void test_config_by_name_and_id(void **state)
         uint32_t j;
         float v;
         pmstep_config_t copy = cfg;
+        pmstep_stepdir_settings_t sd = con.stepdir;
         for (j = id + 1u; j < count; ++j) {
             assert_string_not_equal(t[id].name, t[j].name);
         }
-        assert_true(pmstep_console_config_get(&cfg, id, &v));
+        assert_true(pmstep_console_config_get(&cfg, &con.stepdir, id, &v));
         if ((t[id].flags & PMSTEP_CONSOLE_CFG_READ_ONLY) == 0u) {
-            assert_int_equal(pmstep_console_config_set(&copy, id, v), 0);
+            assert_int_equal(pmstep_console_config_set(&copy, &sd, id, v), 0);
             assert_memory_equal(&copy, &cfg, sizeof cfg);
+            assert_memory_equal(&sd, &con.stepdir, sizeof sd);
         } else {
-            assert_int_equal(pmstep_console_config_set(&copy, id, v), PMSTEP_CONSOLE_ERR_READ_ONLY);
+            assert_int_equal(pmstep_console_config_set(&copy, &sd, id, v), PMSTEP_CONSOLE_ERR_READ_ONLY);
         }
     }
     {
         float v;
-        assert_false(pmstep_console_config_get(&cfg, count, &v)); /* past the table */
+        assert_false(pmstep_console_config_get(&cfg, &con.stepdir, count, &v)); /* past the table */
     }
     /* Get by name. */
     req[0] = 0xFFu;
@@ -223,7 +225,7 @@ static void test_config_by_name_and_id(void **state)
     assert_int_equal(ack_status(&r[0]), PMSTEP_OK);
     {
         float v = 0.0f;
-        assert_true(pmstep_console_config_get(&cfg, 12u, &v)); /* gains.speed_gain_per_s */
+        assert_true(pmstep_console_config_get(&cfg, &con.stepdir, 12u, &v)); /* gains.speed_gain_per_s */
         assert_float_equal(v, 120.0f, 0.0f);
     }
     /* A value the core's validation refuses: its status, and the configuration unchanged. */
@@ -236,7 +238,7 @@ static void test_config_by_name_and_id(void **state)
         assert_int_equal(replies(r, 2), 1u);
         assert_int_equal(ack_status(&r[0]), PMSTEP_ERR_RESISTANCE);
         float ohm = 0.0f;
-        assert_true(pmstep_console_config_get(&cfg, 0u, &ohm)); /* motor.resistance_Ohm */
+        assert_true(pmstep_console_config_get(&cfg, &con.stepdir, 0u, &ohm)); /* motor.resistance_Ohm */
         assert_float_equal(ohm, 3.0f, 0.0f);
     }
     /* Read-only (the port's period), unknown name, non-integer integer. */
@@ -269,7 +271,7 @@ static void test_config_by_name_and_id(void **state)
         assert_int_equal(r[0].type, 0xFFu);
         assert_int_equal(r[0].data[1], PMSTEP_CONSOLE_ERR_NOT_STOPPED);
         float g = 0.0f;
-        assert_true(pmstep_console_config_get(&cfg, 12u, &g)); /* gains.speed_gain_per_s */
+        assert_true(pmstep_console_config_get(&cfg, &con.stepdir, 12u, &g)); /* gains.speed_gain_per_s */
         assert_float_equal(g, 120.0f, 0.0f);
     }
 }
@@ -343,7 +345,7 @@ static uint8_t config_id(const char *name)
 static float config_value(const char *name)
 {
     float v = 0.0f;
-    assert_true(pmstep_console_config_get(&cfg, config_id(name), &v));
+    assert_true(pmstep_console_config_get(&cfg, &con.stepdir, config_id(name), &v));
     return v;
 }
 

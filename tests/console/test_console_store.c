@@ -106,6 +106,7 @@ static uint32_t motor_record(uint8_t *out, uint32_t board_id, float inertia_kgm2
     pmstep_store_record_t rec;
     memset(&rec, 0, sizeof rec);
     rec.config = defaults;
+    rec.stepdir = pmstep_console_stepdir_defaults();
     rec.config.motor.inertia_kgm2 = inertia_kgm2;
     rec.measured.flags = PMSTEP_STORE_MEASURED_RESISTANCE;
     rec.measured.resistance_Ohm = 2.0f;
@@ -318,6 +319,182 @@ static void test_defaults_and_erase(void **state)
     assert_false(cs.configured);
 }
 
+/* SET_CONFIG of a STEP/DIR setting by name: the ACK's status and the value in force after it. */
+static int16_t set_by_name(const char *name, float value)
+{
+    uint8_t d[64];
+    const uint32_t k = (uint32_t)strlen(name);
+    reply_t r;
+    d[0] = 0xFFu;
+    memcpy(&d[1], &value, 4u);
+    memcpy(&d[5], name, k);
+    r = request(PMSTEP_CONSOLE_SET_CONFIG, d, 5u + k);
+    if (r.type == PMSTEP_CONSOLE_ERROR_FRAME) {
+        return (int16_t)(1000 + r.data[1]); /* an error reply: 1000 + its code */
+    }
+    assert_int_equal(r.type, PMSTEP_CONSOLE_SET_CONFIG | 0x80u);
+    return console_test_i16(r.data);
+}
+
+/* GET_CONFIG by name: the value, and flags in @p flags. */
+static float get_by_name(const char *name, uint8_t *flags)
+{
+    uint8_t d[64];
+    const uint32_t k = (uint32_t)strlen(name);
+    reply_t r;
+    d[0] = 0xFFu;
+    memcpy(&d[1], name, k);
+    r = request(PMSTEP_CONSOLE_GET_CONFIG, d, 1u + k);
+    assert_int_equal(r.type, PMSTEP_CONSOLE_GET_CONFIG | 0x80u);
+    assert_memory_equal(&r.data[7], name, k);
+    *flags = r.data[2];
+    return console_test_f32(&r.data[3]);
+}
+
+/* The STEP/DIR settings over the console: read with their flag, each out-of-range value refused with its
+ * own code and nothing changed, the rest in force at once, saved with the motor's record and in force
+ * again after a reset; CONFIG_DEFAULTS brings back the defaults. */
+static void test_stepdir_settings_set_saved_and_booted(void **state)
+{
+    uint8_t b[PMSTEP_STORE_RECORD_MAX_BYTES];
+    const uint32_t n = motor_record(b, BOARD_ID, 0.02f);
+    const pmstep_stepdir_settings_t defaults_sd = pmstep_console_stepdir_defaults();
+    const pmstep_config_t before = cfg;
+    uint8_t flags = 0u;
+    (void)state;
+    assert_memory_equal(&con.stepdir, &defaults_sd, sizeof defaults_sd);
+    assert_true(get_by_name("stepdir.microsteps", &flags) == 16.0f);
+    assert_int_equal(flags, PMSTEP_CONSOLE_CFG_STEPDIR);
+    assert_true(get_by_name("stepdir.following_error_limit_full_steps", &flags) == 1.0f);
+    assert_true(get_by_name("stepdir.enable_active_high", &flags) == 0.0f);
+    assert_true(get_by_name("stepdir.diag_active_high", &flags) == 1.0f);
+    /* Refused by cause, never clamped; the settings in force unchanged. */
+    assert_int_equal(set_by_name("stepdir.microsteps", 0.0f), PMSTEP_ERR_STEPDIR_MICROSTEPS);
+    assert_int_equal(set_by_name("stepdir.microsteps", 257.0f), PMSTEP_ERR_STEPDIR_MICROSTEPS);
+    assert_int_equal(set_by_name("stepdir.diag_mode", 2.0f), PMSTEP_ERR_STEPDIR_DIAG_MODE);
+    assert_int_equal(set_by_name("stepdir.following_error_limit_full_steps", 0.0f), PMSTEP_ERR_STEPDIR_LIMIT);
+    assert_int_equal(set_by_name("stepdir.following_error_limit_full_steps", -0.5f), PMSTEP_ERR_STEPDIR_LIMIT);
+    assert_int_equal(set_by_name("stepdir.microsteps", 12.5f), 1000 + PMSTEP_CONSOLE_ERR_BAD_VALUE);
+    assert_int_equal(set_by_name("stepdir.invert_direction", 2.0f), 1000 + PMSTEP_CONSOLE_ERR_BAD_VALUE);
+    assert_memory_equal(&con.stepdir, &defaults_sd, sizeof defaults_sd);
+    /* Accepted: in force at once; the core's configuration untouched. */
+    assert_int_equal(set_by_name("stepdir.microsteps", 256.0f), PMSTEP_OK);
+    assert_int_equal(set_by_name("stepdir.microsteps", 1.0f), PMSTEP_OK);
+    assert_int_equal(set_by_name("stepdir.microsteps", 32.0f), PMSTEP_OK);
+    assert_int_equal(set_by_name("stepdir.invert_direction", 1.0f), PMSTEP_OK);
+    assert_int_equal(set_by_name("stepdir.enable_active_high", 1.0f), PMSTEP_OK);
+    assert_int_equal(set_by_name("stepdir.diag_active_high", 0.0f), PMSTEP_OK);
+    assert_int_equal(set_by_name("stepdir.diag_mode", 1.0f), PMSTEP_OK);
+    assert_int_equal(set_by_name("stepdir.following_error_limit_full_steps", 1.5f), PMSTEP_OK);
+    assert_memory_equal(&cfg, &before, sizeof cfg);
+    assert_int_equal(con.stepdir.microsteps, 32u);
+    assert_true(con.stepdir.invert_direction && con.stepdir.enable_active_high && !con.stepdir.diag_active_high);
+    assert_int_equal(con.stepdir.diag_mode, PMSTEP_DIAG_PULSE);
+    assert_true(con.stepdir.following_error_limit_full_steps == 1.5f);
+    /* A motor's record applied: its STEP/DIR settings (the defaults, as motor_record() writes them) in
+     * force, then ours again, saved. */
+    write_record(b, n, 58u);
+    assert_int_equal(ack(PMSTEP_CONSOLE_CONFIG_APPLY), 0);
+    assert_memory_equal(&con.stepdir, &defaults_sd, sizeof defaults_sd);
+    assert_int_equal(set_by_name("stepdir.microsteps", 32.0f), PMSTEP_OK);
+    assert_int_equal(set_by_name("stepdir.enable_active_high", 1.0f), PMSTEP_OK);
+    assert_int_equal(set_by_name("stepdir.diag_mode", 1.0f), PMSTEP_OK);
+    assert_int_equal(ack(PMSTEP_CONSOLE_CONFIG_SAVE), PMSTEP_STORE_OK);
+    assert_int_equal(boot(), PMSTEP_STORE_OK);
+    assert_true(cs.configured);
+    assert_int_equal(con.stepdir.microsteps, 32u);
+    assert_true(con.stepdir.enable_active_high);
+    assert_int_equal(con.stepdir.diag_mode, PMSTEP_DIAG_PULSE);
+    assert_true(get_by_name("stepdir.microsteps", &flags) == 32.0f);
+    /* Refused while the motor runs, as every setting. */
+    assert_int_equal(ack(PMSTEP_CONSOLE_START), PMSTEP_OK);
+    step();
+    assert_int_equal(set_by_name("stepdir.microsteps", 64.0f), 1000 + PMSTEP_CONSOLE_ERR_NOT_STOPPED);
+    assert_int_equal(con.stepdir.microsteps, 32u);
+    assert_int_equal(ack(PMSTEP_CONSOLE_STOP), PMSTEP_OK);
+    step();
+    assert_int_equal(ack(PMSTEP_CONSOLE_CONFIG_DEFAULTS), PMSTEP_OK);
+    assert_memory_equal(&con.stepdir, &defaults_sd, sizeof defaults_sd);
+}
+
+/* The step tracker's settings from the STEP/DIR settings: the designer's with ours over them, the limit
+ * in full steps of this motor. */
+static void test_stepdir_tracker_settings(void **state)
+{
+    pmstep_stepdir_settings_t sd = pmstep_console_stepdir_defaults();
+    pmstep_stepdir_config_t designed;
+    pmstep_stepdir_config_t got;
+    const float full_step_rad = 1.5707963f / (float)cfg.motor.pole_pairs;
+    (void)state;
+    sd.microsteps = 64u;
+    sd.invert_direction = true;
+    sd.diag_mode = 1u;
+    sd.following_error_limit_full_steps = 2.0f;
+    assert_int_equal(pmstep_stepdir_design(&cfg, 64u, &designed), PMSTEP_OK);
+    assert_int_equal(pmstep_console_stepdir_config(&cfg, &sd, &got), PMSTEP_OK);
+    assert_int_equal(got.microsteps, 64u);
+    assert_true(got.invert_direction);
+    assert_int_equal(got.diag_mode, PMSTEP_DIAG_PULSE);
+    assert_float_equal(got.following_error_limit_rad, 2.0f * full_step_rad, 1e-6f * full_step_rad);
+    assert_true(got.tracking_bandwidth_rad_s == designed.tracking_bandwidth_rad_s);
+    assert_true(got.stop_time_s == designed.stop_time_s);
+    assert_int_equal(got.diag_pulse_periods, designed.diag_pulse_periods);
+    sd.microsteps = 300u;
+    memset(&got, 0xAB, sizeof got);
+    designed = got;
+    assert_int_equal(pmstep_console_stepdir_config(&cfg, &sd, &got), PMSTEP_ERR_STEPDIR_MICROSTEPS);
+    assert_memory_equal(&got, &designed, sizeof got); /* untouched */
+    assert_int_equal(pmstep_console_stepdir_validate(NULL), PMSTEP_ERR_NULL_ARGUMENT);
+}
+
+/* A record of the firmware before the STEP/DIR settings (another layout) at boot: refused by name, the
+ * board's defaults and the default STEP/DIR settings in force, not configured. */
+static void test_boot_record_before_stepdir_settings(void **state)
+{
+    uint8_t b[PMSTEP_STORE_RECORD_MAX_BYTES];
+    uint32_t n = motor_record(b, BOARD_ID, 0.02f);
+    const pmstep_stepdir_settings_t defaults_sd = pmstep_console_stepdir_defaults();
+    uint32_t count;
+    const pmstep_console_config_entry_t *t = pmstep_console_config_table(&count);
+    uint32_t old = 0u;
+    uint32_t layout = 0u;
+    uint32_t off;
+    reply_t r;
+    (void)state;
+    while (old < count && !pmstep_console_config_is_stepdir(old)) {
+        const uint8_t type = t[old].type;
+        layout = pmstep_store_crc32(layout, (const uint8_t *)t[old].name, (uint32_t)strlen(t[old].name) + 1u);
+        layout = pmstep_store_crc32(layout, &type, 1u);
+        ++old;
+    }
+    /* The values of the older table, the measured values moved up over the STEP/DIR ones. */
+    memmove(&b[32u + 4u * old], &b[32u + 4u * count], 4u * PMSTEP_STORE_MEASURED_VALUES);
+    n -= 4u * (count - old);
+    memcpy(&b[12], &layout, 4u); /* little-endian host and record */
+    b[20] = (uint8_t)old;
+    b[21] = 0u;
+    memcpy(&b[24], &n, 4u);
+    b[16] = 1u; /* sequence 1, as a save writes it */
+    {
+        const uint32_t crc = pmstep_store_crc32(0u, b, n - 4u);
+        memcpy(&b[n - 4u], &crc, 4u);
+    }
+    assert_int_equal(flash.ops.erase(flash.ops.ctx, 0u), 0);
+    for (off = 0; off < ((n + 7u) & ~7u); off += 8u) {
+        assert_int_equal(flash.ops.program(flash.ops.ctx, 0u, off, &b[off], 8u), 0);
+    }
+    con.stepdir.microsteps = 99u; /* whatever the console held before the reset */
+    assert_int_equal(boot(), PMSTEP_STORE_ERR_LAYOUT);
+    assert_false(cs.configured);
+    assert_memory_equal(&cfg, &defaults, sizeof cfg);
+    assert_memory_equal(&con.stepdir, &defaults_sd, sizeof defaults_sd);
+    send_request(PMSTEP_CONSOLE_CONFIG_STATUS, NULL, 0u);
+    assert_int_equal(replies(&r, 1), 1u);
+    assert_int_equal(console_test_i16(&r.data[1]), PMSTEP_STORE_ERR_LAYOUT);
+    r = request(PMSTEP_CONSOLE_START, NULL, 0u);
+    assert_int_equal(error_code(&r, PMSTEP_CONSOLE_START), PMSTEP_CONSOLE_ERR_NOT_CONFIGURED);
+}
+
 /* A power cut in the middle of a save through the console: after the reset the record saved before
  * is in force. Over every operation of the save. */
 static void test_power_cut_in_console_save(void **state)
@@ -370,6 +547,9 @@ int main(void)
         cmocka_unit_test_setup(test_not_while_running, setup),
         cmocka_unit_test_setup(test_defaults_and_erase, setup),
         cmocka_unit_test_setup(test_power_cut_in_console_save, setup),
+        cmocka_unit_test_setup(test_stepdir_settings_set_saved_and_booted, setup),
+        cmocka_unit_test_setup(test_stepdir_tracker_settings, setup),
+        cmocka_unit_test_setup(test_boot_record_before_stepdir_settings, setup),
         cmocka_unit_test_setup(test_no_store_attached, setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -41,7 +41,7 @@ def firmware_config_entries():
     source = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "firmware", "console", "src",
                           "pmstep_console_config.c")
     with open(source, encoding="utf-8") as f:
-        return len(re.findall(r"^\s+(?:F32|U32|I32|BOOL|F32_RO|U32_RO)\(", f.read(), flags=re.M))
+        return len(re.findall(r"^\s+(?:F32|U32|I32|BOOL|F32_RO|U32_RO|SD_F32|SD_U32|SD_BOOL)\(", f.read(), flags=re.M))
 
 class Framing(unittest.TestCase):
     def test_crc_check_value(self):
@@ -124,6 +124,21 @@ class AgainstTheFirmwareConsole(unittest.TestCase):
             c.get_config("no_such_value")
         with self.assertRaisesRegex(pc.DeviceError, "status -20"):  # PMSTEP_ERR_RESISTANCE
             c.set_config("motor.resistance_Ohm", -1.0)
+        # The STEP/DIR settings: by name like the rest, each value out of range refused with its own code.
+        for name in ("stepdir.microsteps", "stepdir.invert_direction", "stepdir.enable_active_high",
+                     "stepdir.diag_active_high", "stepdir.diag_mode", "stepdir.following_error_limit_full_steps"):
+            self.assertIn(name, names)
+        self.assertEqual(c.get_config("stepdir.microsteps")["value"], 16.0)
+        for name, value, code in (("stepdir.microsteps", 0, r"status -135 \(PMSTEP_ERR_STEPDIR_MICROSTEPS"),
+                                  ("stepdir.microsteps", 257, r"status -135 \(PMSTEP_ERR_STEPDIR_MICROSTEPS"),
+                                  ("stepdir.diag_mode", 2, r"status -138 \(PMSTEP_ERR_STEPDIR_DIAG_MODE"),
+                                  ("stepdir.following_error_limit_full_steps", 0.0,
+                                   r"status -137 \(PMSTEP_ERR_STEPDIR_LIMIT")):
+            with self.subTest(name=name, value=value), self.assertRaisesRegex(pc.DeviceError, code):
+                c.set_config(name, value)
+        self.assertEqual(c.get_config("stepdir.microsteps")["value"], 16.0)
+        c.set_config("stepdir.microsteps", 64)
+        self.assertEqual(c.get_config("stepdir.microsteps")["value"], 64.0)
         self.assertEqual(c.status()["mode"], "IDLE")
         c.id_target(0.0)
         c.set_telemetry(10)
@@ -460,6 +475,40 @@ class AgainstAStoredConfiguration(unittest.TestCase):
         # S_ALIGN, or FAULT: the host drive's constant 48 V bus is above the trip designed for 24 V
         self.assertRegex(err, r"restore needs the motor stopped \(IDLE\), it is in "
                               r"(S_ALIGN: `stop`|FAULT: `clear`) first")
+
+    @needs_tune
+    def test_stepdir_settings_saved_backed_up_and_restored(self):
+        self.ok("setup", "--motor", str(MOTOR))
+        self.ok("set", "stepdir.microsteps", "32")
+        self.ok("set", "stepdir.enable_active_high", "1")
+        self.ok("set", "stepdir.following_error_limit_full_steps", "1.5")
+        code, _, err = self.cli("set", "stepdir.microsteps", "300")
+        self.assertEqual(code, 1, err)
+        self.assertIn("PMSTEP_ERR_STEPDIR_MICROSTEPS", err)
+        self.ok("save")
+        self.boot()  # reset: the saved STEP/DIR settings in force again
+        self.assertIn("stepdir.microsteps = 32 ", self.ok("get", "stepdir.microsteps"))
+        self.assertIn("stepdir.enable_active_high = 1 ", self.ok("get", "stepdir.enable_active_high"))
+        path, saved = self.take_backup("stepdir.json")
+        self.assertEqual(saved["values"]["stepdir.microsteps"], 32)
+        self.assertIs(saved["values"]["stepdir.enable_active_high"], True)
+        self.assertEqual(saved["values"]["stepdir.following_error_limit_full_steps"], 1.5)
+        # A backup of the firmware before the STEP/DIR settings (no stepdir.* values) restores here: the
+        # STEP/DIR settings in force are kept, and said so.
+        older = dict(saved, values={k: v for k, v in saved["values"].items() if not k.startswith("stepdir.")})
+        old_path = os.path.join(self.tmp.name, "before-stepdir.json")
+        with open(old_path, "w", encoding="utf-8") as f:
+            json.dump(older, f)
+        self.ok("defaults")
+        out = self.ok("restore", old_path, "--save")
+        self.assertRegex(out, r"not in the backup, the value in force kept: stepdir\.microsteps, "
+                              r"stepdir\.invert_direction, ")
+        self.boot()
+        self.assertEqual(self.hello()["configured"], "True")
+        self.assertIn("stepdir.microsteps = 16 ", self.ok("get", "stepdir.microsteps"))
+        self.ok("restore", path, "--save")
+        self.boot()
+        self.assertIn("stepdir.microsteps = 32 ", self.ok("get", "stepdir.microsteps"))
 
     @needs_tune
     def test_refused_restores_change_nothing(self):

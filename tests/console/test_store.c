@@ -37,6 +37,7 @@ static pmstep_store_record_t record_with(float mark)
     pmstep_store_record_t rec;
     memset(&rec, 0, sizeof rec);
     rec.config = board;
+    rec.stepdir = pmstep_console_stepdir_defaults();
     rec.config.motor.inertia_kgm2 = 0.01f * mark;
     rec.measured.flags = PMSTEP_STORE_MEASURED_RESISTANCE | PMSTEP_STORE_MEASURED_MECHANICS;
     rec.measured.resistance_Ohm = 2.1f;
@@ -60,9 +61,9 @@ static void test_crc32_check_value(void **state)
     assert_int_equal(pmstep_store_crc32(0u, (const uint8_t *)"123456789", 9u), 0xCBF43926u);
 }
 
-/* Every byte of pmstep_config_t is a value of the table, or padding after a boolean: a field the
- * table lacks would not be stored. */
-static void test_table_covers_every_field(void **state)
+/* Every byte of @p bytes-long struct is a value of the table's entries with (@p flags & STEPDIR) equal
+ * to @p stepdir, or padding after a boolean: a field the table lacks would not be stored. */
+static void check_covered(uint8_t stepdir, size_t bytes, const char *what)
 {
     uint32_t count;
     const pmstep_console_config_entry_t *t = pmstep_console_config_table(&count);
@@ -70,23 +71,41 @@ static void test_table_covers_every_field(void **state)
     bool after_bool[sizeof(pmstep_config_t)] = {false};
     uint32_t id;
     size_t i;
-    (void)state;
-    assert_true(count <= PMSTEP_STORE_MAX_VALUES);
+    assert_true(bytes <= sizeof covered);
     for (id = 0; id < count; ++id) {
         const size_t size = t[id].type == PMSTEP_CONSOLE_CFG_BOOL ? sizeof(bool) : 4u;
+        if ((t[id].flags & PMSTEP_CONSOLE_CFG_STEPDIR) != stepdir) {
+            continue;
+        }
+        assert_true(t[id].offset + size <= bytes);
         for (i = 0; i < size; ++i) {
             covered[t[id].offset + i] = 1u;
         }
         if (t[id].type == PMSTEP_CONSOLE_CFG_BOOL) {
-            for (i = t[id].offset + sizeof(bool); i < sizeof(pmstep_config_t) && i % 4u != 0u; ++i) {
+            for (i = t[id].offset + sizeof(bool); i < bytes && i % 4u != 0u; ++i) {
                 after_bool[i] = true;
             }
         }
     }
-    for (i = 0; i < sizeof(pmstep_config_t); ++i) {
+    for (i = 0; i < bytes; ++i) {
         if (!covered[i] && !after_bool[i]) {
-            fail_msg("byte %zu of pmstep_config_t is in no entry of the configuration table", i);
+            fail_msg("byte %zu of %s is in no entry of the configuration table", i, what);
         }
+    }
+}
+
+static void test_table_covers_every_field(void **state)
+{
+    uint32_t count;
+    uint32_t id;
+    const pmstep_console_config_entry_t *t = pmstep_console_config_table(&count);
+    (void)state;
+    assert_true(count <= PMSTEP_STORE_MAX_VALUES);
+    check_covered(0u, sizeof(pmstep_config_t), "pmstep_config_t");
+    check_covered(PMSTEP_CONSOLE_CFG_STEPDIR, sizeof(pmstep_stepdir_settings_t), "pmstep_stepdir_settings_t");
+    /* The STEP/DIR settings are named stepdir.*, and only they. */
+    for (id = 0; id < count; ++id) {
+        assert_int_equal(strncmp(t[id].name, "stepdir.", 8u) == 0, pmstep_console_config_is_stepdir(id));
     }
 }
 
@@ -105,14 +124,15 @@ static void test_round_trip(void **state)
     assert_int_equal(pmstep_store_decode(b, n, BOARD_ID, &board, &back, NULL, &seq), PMSTEP_STORE_OK);
     assert_int_equal(seq, 7u);
     assert_memory_equal(&back.measured, &rec.measured, sizeof rec.measured);
+    assert_memory_equal(&back.stepdir, &rec.stepdir, sizeof rec.stepdir);
     assert_true(back.config.motor.inertia_kgm2 == 0.01f * 1.7f);
     {
         uint32_t id;
         for (id = 0; id < count; ++id) {
             float x = 0.0f;
             float y = 1.0f;
-            (void)pmstep_console_config_get(&rec.config, id, &x);
-            (void)pmstep_console_config_get(&back.config, id, &y);
+            (void)pmstep_console_config_get(&rec.config, &rec.stepdir, id, &x);
+            (void)pmstep_console_config_get(&back.config, &back.stepdir, id, &y);
             assert_true(x == y);
         }
     }
@@ -187,6 +207,163 @@ static void test_refusals(void **state)
     assert_int_equal(pmstep_store_decode(good, n - 4u, BOARD_ID, &board, &out, NULL, NULL), PMSTEP_STORE_ERR_LENGTH);
     assert_int_equal(pmstep_store_decode(good, 16u, BOARD_ID, &board, &out, NULL, NULL), PMSTEP_STORE_ERR_LENGTH);
     assert_memory_equal(&out, &untouched, sizeof out);
+}
+
+/* The id of the table's entry @p name. */
+static uint32_t entry(const char *name)
+{
+    uint32_t count;
+    const pmstep_console_config_entry_t *t = pmstep_console_config_table(&count);
+    uint32_t id;
+    for (id = 0; id < count; ++id) {
+        if (strcmp(t[id].name, name) == 0) {
+            return id;
+        }
+    }
+    fail_msg("no configuration entry %s", name);
+    return 0u;
+}
+
+/* STEP/DIR settings other than the defaults, every one of them, saved and loaded after a reset. */
+static void test_stepdir_settings_saved(void **state)
+{
+    pmstep_store_record_t rec = record_with(1.0f);
+    pmstep_store_record_t out;
+    (void)state;
+    rec.stepdir.microsteps = 256u;
+    rec.stepdir.invert_direction = true;
+    rec.stepdir.enable_active_high = true;
+    rec.stepdir.diag_active_high = false;
+    rec.stepdir.diag_mode = 1u;
+    rec.stepdir.following_error_limit_full_steps = 2.5f;
+    assert_int_equal(pmstep_store_save(&store, &rec, true), PMSTEP_STORE_OK);
+    assert_int_equal(pmstep_store_init(&store, &flash.ops, BOARD_ID), PMSTEP_STORE_OK);
+    memset(&out, 0, sizeof out);
+    assert_int_equal(pmstep_store_load(&store, &board, &out, NULL), PMSTEP_STORE_OK);
+    assert_int_equal(out.stepdir.microsteps, 256u);
+    assert_true(out.stepdir.invert_direction);
+    assert_true(out.stepdir.enable_active_high);
+    assert_false(out.stepdir.diag_active_high);
+    assert_int_equal(out.stepdir.diag_mode, PMSTEP_DIAG_PULSE);
+    assert_true(out.stepdir.following_error_limit_full_steps == 2.5f);
+}
+
+/* A record with a STEP/DIR value out of range: refused whole with the cause's own code, never clamped. */
+static void test_stepdir_settings_refused_by_cause(void **state)
+{
+    static const struct {
+        const char *name;
+        float value;
+        pmstep_status_t why;
+    } bad[] = {
+        {"stepdir.microsteps", 0.0f, PMSTEP_ERR_STEPDIR_MICROSTEPS},
+        {"stepdir.microsteps", 257.0f, PMSTEP_ERR_STEPDIR_MICROSTEPS},
+        {"stepdir.microsteps", 1024.0f, PMSTEP_ERR_STEPDIR_MICROSTEPS},
+        {"stepdir.diag_mode", 2.0f, PMSTEP_ERR_STEPDIR_DIAG_MODE},
+        {"stepdir.following_error_limit_full_steps", 0.0f, PMSTEP_ERR_STEPDIR_LIMIT},
+        {"stepdir.following_error_limit_full_steps", -1.0f, PMSTEP_ERR_STEPDIR_LIMIT},
+    };
+    uint8_t good[PMSTEP_STORE_RECORD_MAX_BYTES];
+    uint8_t b[PMSTEP_STORE_RECORD_MAX_BYTES];
+    const pmstep_store_record_t rec = record_with(1.0f);
+    const uint32_t n = pmstep_store_encode(&rec, BOARD_ID, 1u, good);
+    pmstep_store_record_t out;
+    pmstep_store_record_t untouched;
+    size_t k;
+    (void)state;
+    memset(&out, 0xAB, sizeof out);
+    untouched = out;
+    for (k = 0; k < sizeof bad / sizeof bad[0]; ++k) {
+        pmstep_status_t why = PMSTEP_OK;
+        memcpy(b, good, n);
+        memcpy(&b[32u + 4u * entry(bad[k].name)], &bad[k].value, 4u);
+        rewrite_crc(b, n);
+        assert_int_equal(pmstep_store_decode(b, n, BOARD_ID, &board, &out, &why, NULL), PMSTEP_STORE_ERR_INVALID);
+        assert_int_equal(why, bad[k].why);
+    }
+    {
+        /* Not a whole number, and a boolean that is neither: the value's type refuses it. */
+        const float half = 0.5f;
+        pmstep_status_t why = PMSTEP_ERR_NULL_ARGUMENT;
+        memcpy(b, good, n);
+        memcpy(&b[32u + 4u * entry("stepdir.microsteps")], &half, 4u);
+        rewrite_crc(b, n);
+        assert_int_equal(pmstep_store_decode(b, n, BOARD_ID, &board, &out, &why, NULL), PMSTEP_STORE_ERR_INVALID);
+        assert_int_equal(why, PMSTEP_OK);
+        memcpy(b, good, n);
+        memcpy(&b[32u + 4u * entry("stepdir.invert_direction")], &half, 4u);
+        rewrite_crc(b, n);
+        assert_int_equal(pmstep_store_decode(b, n, BOARD_ID, &board, &out, NULL, NULL), PMSTEP_STORE_ERR_INVALID);
+    }
+    assert_memory_equal(&out, &untouched, sizeof out);
+}
+
+/* A record as the firmware before the STEP/DIR settings wrote it: the same format, its table's entries
+ * only (those that are not stepdir.*, in order), that table's layout id. */
+static uint32_t record_before_stepdir(const pmstep_store_record_t *rec, uint32_t sequence, uint8_t *out)
+{
+    uint32_t count;
+    const pmstep_console_config_entry_t *t = pmstep_console_config_table(&count);
+    uint32_t old = 0u;
+    uint32_t layout = 0u;
+    uint8_t full[PMSTEP_STORE_RECORD_MAX_BYTES];
+    uint32_t n;
+    uint32_t id;
+    (void)pmstep_store_encode(rec, BOARD_ID, sequence, full);
+    for (id = 0; id < count && !pmstep_console_config_is_stepdir(id); ++id) {
+        const uint8_t type = t[id].type;
+        layout = pmstep_store_crc32(layout, (const uint8_t *)t[id].name, (uint32_t)strlen(t[id].name) + 1u);
+        layout = pmstep_store_crc32(layout, &type, 1u);
+        ++old;
+    }
+    for (; id < count; ++id) {
+        assert_true(pmstep_console_config_is_stepdir(id)); /* appended after every older entry */
+    }
+    n = 32u + 4u * old + 4u * PMSTEP_STORE_MEASURED_VALUES + 4u;
+    memcpy(out, full, 32u);
+    memcpy(&out[32], &full[32], 4u * old);                                                  /* the values */
+    memcpy(&out[32u + 4u * old], &full[32u + 4u * count], 4u * PMSTEP_STORE_MEASURED_VALUES); /* measured */
+    out[12] = (uint8_t)layout;
+    out[13] = (uint8_t)(layout >> 8);
+    out[14] = (uint8_t)(layout >> 16);
+    out[15] = (uint8_t)(layout >> 24);
+    out[20] = (uint8_t)old;
+    out[21] = (uint8_t)(old >> 8);
+    out[24] = (uint8_t)n;
+    out[25] = (uint8_t)(n >> 8);
+    out[26] = 0u;
+    out[27] = 0u;
+    rewrite_crc(out, n);
+    return n;
+}
+
+/* A record of the firmware before the STEP/DIR settings is refused by name (another layout), as the
+ * newest record at boot too: the store never reads it in part, and a save of this firmware's record
+ * goes to the other slot and is in force after a reset. */
+static void test_record_before_stepdir_settings_refused(void **state)
+{
+    const pmstep_store_record_t rec = record_with(1.0f);
+    pmstep_store_record_t out;
+    uint8_t b[PMSTEP_STORE_RECORD_MAX_BYTES];
+    uint32_t n;
+    uint32_t off;
+    (void)state;
+    memset(b, 0xFF, sizeof b);
+    n = record_before_stepdir(&rec, 1u, b);
+    assert_int_equal(n, pmstep_store_record_bytes() - 4u * 6u); /* six STEP/DIR values fewer */
+    assert_int_equal(pmstep_store_decode(b, n, BOARD_ID, &board, &out, NULL, NULL), PMSTEP_STORE_ERR_LAYOUT);
+    assert_int_equal(flash.ops.erase(flash.ops.ctx, 0u), 0);
+    for (off = 0; off < ((n + 7u) & ~7u); off += 8u) {
+        assert_int_equal(flash.ops.program(flash.ops.ctx, 0u, off, &b[off], 8u), 0);
+    }
+    assert_int_equal(pmstep_store_init(&store, &flash.ops, BOARD_ID), PMSTEP_STORE_OK);
+    assert_int_equal(pmstep_store_load(&store, &board, &out, NULL), PMSTEP_STORE_ERR_LAYOUT);
+    assert_int_equal(store.slot, 0);
+    assert_int_equal(pmstep_store_save(&store, &rec, true), PMSTEP_STORE_OK);
+    assert_int_equal(store.slot, 1);
+    assert_int_equal(pmstep_store_init(&store, &flash.ops, BOARD_ID), PMSTEP_STORE_OK);
+    assert_int_equal(pmstep_store_load(&store, &board, &out, NULL), PMSTEP_STORE_OK);
+    assert_memory_equal(&out.stepdir, &rec.stepdir, sizeof rec.stepdir);
 }
 
 static void test_empty_store(void **state)
@@ -387,6 +564,9 @@ int main(void)
         cmocka_unit_test(test_table_covers_every_field),
         cmocka_unit_test_setup(test_round_trip, setup),
         cmocka_unit_test_setup(test_refusals, setup),
+        cmocka_unit_test_setup(test_stepdir_settings_saved, setup),
+        cmocka_unit_test_setup(test_stepdir_settings_refused_by_cause, setup),
+        cmocka_unit_test_setup(test_record_before_stepdir_settings_refused, setup),
         cmocka_unit_test_setup(test_empty_store, setup),
         cmocka_unit_test_setup(test_saves_alternate_slots, setup),
         cmocka_unit_test_setup(test_power_cut_at_every_save_step, setup),

@@ -51,6 +51,9 @@ static void settings_refused_by_cause(void **state)
     c = designed(16u);
     c.microsteps = 300u;
     assert_int_equal(pmstep_stepdir_init(&sd, &c, POLE_PAIRS, PERIOD_S, 0u), PMSTEP_ERR_STEPDIR_MICROSTEPS);
+    c = designed(16u);
+    c.diag_mode = (pmstep_diag_mode_t)2;
+    assert_int_equal(pmstep_stepdir_init(&sd, &c, POLE_PAIRS, PERIOD_S, 0u), PMSTEP_ERR_STEPDIR_DIAG_MODE);
 }
 
 /* The 16-bit counter wraps; a difference is signed; DIR's sense can be reversed. */

@@ -22,10 +22,13 @@
  *   0x05 SPEED_TARGET       target f32, ramp f32     -> ACK (pmstep_set_speed_target)
  *   0x06 ID_TARGET          target f32               -> ACK (pmstep_set_id_target)
  *   0x07 GET_STATUS         -                        -> STATUS (pmstep_console_encode_status)
- *   0x08 GET_CONFIG         id u8 | 0xFF name        -> id u8, type u8, flags u8, value f32, name
+ *   0x08 GET_CONFIG         id u8 | 0xFF name        -> id u8, type u8, flags u8 (1 read-only, 2 a STEP/DIR
+ *                              setting), value f32, name
  *   0x09 SET_CONFIG         id u8 | 0xFF, value f32 [, name]  -> ACK (IDLE only, as the core is at the
  *                              boundary that applies it: else error NOT_STOPPED; the whole
- *                              configuration is validated, position gains designed again)
+ *                              configuration is validated, position gains designed again; a STEP/DIR
+ *                              setting is validated with the others, pmstep_console_stepdir_validate(),
+ *                              and the core left as it is)
  *   0x0A GET_COMMISSIONING  -                        -> measured u8, offset_samples u32,
  *                              realignments u32, 8 f32 (offsets a/b, R, current scale, L, k_M,
  *                              voltage biases a/b)
@@ -56,7 +59,8 @@
  *   0x15 CONFIG_ERASE       -                        -> ACK (IDLE or FAULT, bridge off: both slots erased;
  *                              the configuration in force stays until a reset or CONFIG_DEFAULTS)
  *   0x16 CONFIG_DEFAULTS    -                        -> ACK (IDLE only: the board's configuration with no
- *                              motor in force, the drive not configured; the flash untouched)
+ *                              motor and the default STEP/DIR settings in force, the drive not configured;
+ *                              the flash untouched)
  *   0x17 CONFIG_STATUS      -                        -> configured u8, boot status i16, boot validation
  *                              i16, last status i16, slot i8, sequence u32, record bytes u16, format u8,
  *                              layout id u32, board id u32; answered at once
@@ -105,6 +109,7 @@
 
 #include "pmstep/pmstep.h"
 #include "pmstep/pmstep_position.h"
+#include "pmstep/pmstep_stepdir.h"
 #include "pmstep_store.h"
 #include "pmstep/pmstep_calibrate.h"
 
@@ -216,8 +221,8 @@ typedef struct {
 typedef struct {
     const char *name;
     uint8_t type;    /**< PMSTEP_CONSOLE_CFG_F32, _U32, _I32, _BOOL */
-    uint8_t flags;   /**< PMSTEP_CONSOLE_CFG_READ_ONLY */
-    uint16_t offset; /**< in pmstep_config_t */
+    uint8_t flags;   /**< PMSTEP_CONSOLE_CFG_READ_ONLY, PMSTEP_CONSOLE_CFG_STEPDIR */
+    uint16_t offset; /**< in pmstep_config_t; with PMSTEP_CONSOLE_CFG_STEPDIR in pmstep_stepdir_settings_t */
 } pmstep_console_config_entry_t;
 
 #define PMSTEP_CONSOLE_CFG_F32 0u
@@ -225,18 +230,50 @@ typedef struct {
 #define PMSTEP_CONSOLE_CFG_I32 2u
 #define PMSTEP_CONSOLE_CFG_BOOL 3u
 #define PMSTEP_CONSOLE_CFG_READ_ONLY 1u
+#define PMSTEP_CONSOLE_CFG_STEPDIR 2u  /**< a STEP/DIR setting (pmstep_stepdir_settings_t), named stepdir.* */
 
 /** The table of configuration values: @p count gets its length. */
 const pmstep_console_config_entry_t *pmstep_console_config_table(uint32_t *count);
 
-/** Reads entry @p id of @p cfg as a float. @return false if @p id is out of the table. */
-bool pmstep_console_config_get(const pmstep_config_t *cfg, uint32_t id, float *value);
+/** Reads entry @p id of @p cfg or, for a STEP/DIR setting, of @p sd, as a float. @return false if @p id
+ *  is out of the table. */
+bool pmstep_console_config_get(const pmstep_config_t *cfg, const pmstep_stepdir_settings_t *sd, uint32_t id,
+                               float *value);
 
 /**
- * Writes entry @p id of @p cfg (integers and booleans must be given exactly, e.g. 1.0).
+ * Writes entry @p id of @p cfg or, for a STEP/DIR setting, of @p sd (integers and booleans must be
+ * given exactly, e.g. 1.0). Only the type is checked here: the ranges by pmstep_validate_config() and
+ * pmstep_console_stepdir_validate().
  * @return 0, or PMSTEP_CONSOLE_ERR_UNKNOWN_CONFIG / _READ_ONLY / _BAD_VALUE.
  */
-int pmstep_console_config_set(pmstep_config_t *cfg, uint32_t id, float value);
+int pmstep_console_config_set(pmstep_config_t *cfg, pmstep_stepdir_settings_t *sd, uint32_t id, float value);
+
+/** Whether entry @p id is a STEP/DIR setting (false beyond the table). */
+bool pmstep_console_config_is_stepdir(uint32_t id);
+
+/** The STEP/DIR settings of a drive that was never given any, a TMC driver's conventions: 16
+ *  microsteps, DIR not inverted, EN active low, DIAG active high in level mode, a following-error
+ *  limit of one full step (the designer's). */
+pmstep_stepdir_settings_t pmstep_console_stepdir_defaults(void);
+
+/**
+ * Checks STEP/DIR settings, refused by cause, never clamped:
+ * @retval PMSTEP_OK, PMSTEP_ERR_NULL_ARGUMENT
+ * @retval PMSTEP_ERR_STEPDIR_MICROSTEPS  microsteps not within 1..PMSTEP_STEPDIR_MAX_MICROSTEPS
+ * @retval PMSTEP_ERR_STEPDIR_DIAG_MODE   diag_mode neither PMSTEP_DIAG_LEVEL nor PMSTEP_DIAG_PULSE
+ * @retval PMSTEP_ERR_STEPDIR_LIMIT       following_error_limit_full_steps not > 0 (or not finite)
+ */
+pmstep_status_t pmstep_console_stepdir_validate(const pmstep_stepdir_settings_t *sd);
+
+/**
+ * The step tracker's settings for the motor of @p cfg from the STEP/DIR settings @p sd: the
+ * designer's (pmstep_stepdir_design()) with sd's microsteps, direction, DIAG mode and following-error
+ * limit (full steps times pi / (2 p)).
+ * @return pmstep_console_stepdir_validate()'s or pmstep_stepdir_design()'s status; @p out written on
+ *         PMSTEP_OK only.
+ */
+pmstep_status_t pmstep_console_stepdir_config(const pmstep_config_t *cfg, const pmstep_stepdir_settings_t *sd,
+                                              pmstep_stepdir_config_t *out);
 
 /** The application's configuration: the paper's, with the port's period, delay and measurement
  *  ranges (A, V). */
@@ -278,6 +315,8 @@ typedef struct {
     int16_t boot_status;                /**< pmstep_store_load()'s at boot (pmstep_store_status_t) */
     int16_t boot_validation;            /**< pmstep_validate_config()'s, when that refused the stored one */
     int16_t last_status;                /**< the last save's, erase's or apply's status */
+    pmstep_stepdir_settings_t boot_stepdir; /**< the STEP/DIR settings of the record loaded at boot (the defaults
+                                             when none was): pmstep_console_attach_store() puts them in force */
     uint8_t staging[PMSTEP_STORE_RECORD_MAX_BYTES]; /**< CONFIG_WRITE's bytes, in order from 0 */
     uint32_t staged;                    /**< bytes staged */
     uint8_t image[PMSTEP_STORE_RECORD_MAX_BYTES];   /**< the record CONFIG_READ serves (encoded at offset 0) */
@@ -286,10 +325,11 @@ typedef struct {
 
 /**
  * At boot, before pmstep_init(): loads the newest record of @p store (pmstep_store_load()) into
- * @p cfg and marks the drive configured; when there is none, or it is refused (another format, board
- * or layout, a bad CRC, a configuration the core refuses), @p cfg is @p defaults, the drive is not
- * configured, and the cause stays in @p cs->boot_status for HELLO and CONFIG_STATUS. Never half
- * applied. @return the load's status.
+ * @p cfg (its STEP/DIR settings into @p cs->boot_stepdir) and marks the drive configured; when there
+ * is none, or it is refused (another format, board or layout, a bad CRC, a configuration the core
+ * refuses, STEP/DIR settings out of range), @p cfg is @p defaults, the STEP/DIR settings
+ * pmstep_console_stepdir_defaults(), the drive is not configured, and the cause stays in
+ * @p cs->boot_status for HELLO and CONFIG_STATUS. Never half applied. @return the load's status.
  */
 pmstep_store_status_t pmstep_console_store_boot(pmstep_console_store_t *cs, pmstep_store_t *store,
                                                 const pmstep_config_t *defaults, pmstep_config_t *cfg);
@@ -317,6 +357,9 @@ typedef struct pmstep_console {
     /* mailbox: one command waiting for a period boundary */
     bool pending;
     pmstep_console_request_t mail;
+    /* the STEP/DIR settings in force (GET_CONFIG and SET_CONFIG of stepdir.*, the records read and saved):
+     * an image in STEP/DIR mode reads them from here */
+    pmstep_stepdir_settings_t stepdir;
     /* position control (NULL: none, the position requests are refused) */
     pmstep_position_t *position;
     pmstep_console_position_apply_t position_apply;
@@ -345,7 +388,8 @@ typedef struct pmstep_console {
     pmstep_console_counters_t count;
 } pmstep_console_t;
 
-/** A console in its initial state; @p identity is the hello text (must outlive it). */
+/** A console in its initial state, the STEP/DIR settings pmstep_console_stepdir_defaults(); @p identity is
+ *  the hello text (must outlive it). */
 void pmstep_console_init(pmstep_console_t *c, const char *identity);
 
 /**
@@ -363,8 +407,9 @@ void pmstep_console_attach_simulation(pmstep_console_t *c);
 void pmstep_console_attach_position(pmstep_console_t *c, pmstep_position_t *pos);
 
 /**
- * Attaches the stored configuration (@p cs, filled by pmstep_console_store_boot()): the CONFIG_*
- * requests then reach it, and START needs a configured motor. Saves and erases run at the period
+ * Attaches the stored configuration (@p cs, filled by pmstep_console_store_boot()): the STEP/DIR
+ * settings loaded at boot are put in force (c->stepdir), the CONFIG_* requests then reach it, and
+ * START needs a configured motor. Saves and erases run at the period
  * boundary, with the motor IDLE or in FAULT and the bridge off; the flash may take tens of
  * milliseconds there (the control interrupt held off all that time, as the flash stalls the core).
  */

@@ -1,10 +1,10 @@
 /**
  * @file pmstep_store.h
- * @brief The drive's stored configuration: a record of the whole pmstep_config_t (every value of
- *        the console's configuration table, by id) and of what commissioning measured, with a
- *        format version, the board's id, the table's layout id and a CRC-32, kept in two flash
- *        slots written alternately. C99, no heap, no stdio; portable (a port gives it its flash
- *        through pmstep_store_flash_t).
+ * @brief The drive's stored configuration: a record of the whole pmstep_config_t and of the STEP/DIR
+ *        settings (every value of the console's configuration table, by id) and of what commissioning
+ *        measured, with a format version, the board's id, the table's layout id and a CRC-32, kept in
+ *        two flash slots written alternately. C99, no heap, no stdio; portable (a port gives it its
+ *        flash through pmstep_store_flash_t).
  *
  * Record (little-endian, PMSTEP_STORE_HEADER_BYTES of header, then the values, then the CRC):
  *
@@ -20,7 +20,8 @@
  *         24     4  record bytes (header + 4 n + 4 m + 4)
  *         28     4  reserved, 0
  *         32   4 n  the configuration's values, f32 each, in table order (integers and booleans as
- *                   exact floats, as GET_CONFIG reads them)
+ *                   exact floats, as GET_CONFIG reads them): the core's configuration and the STEP/DIR
+ *                   settings (pmstep_stepdir_settings_t, the table's stepdir.* entries)
  *     32+4n    4 m  what the configuration was measured with: flags u32 (PMSTEP_STORE_MEASURED_*),
  *                   then offsets a/b (A), R (Ohm), L (H), k_M (N m/A), J (kg m^2), F (N m s/rad), f32
  *    32+4n+4m    4  CRC-32 (ISO-HDLC: reflected 0x04C11DB7, initial and final XOR 0xFFFFFFFF) of every
@@ -29,7 +30,10 @@
  * The same bytes travel on the console (CONFIG_READ, CONFIG_WRITE; sequence 0 there) and in the
  * flash slots. A record is accepted only whole: the right magic, format version and layout id, the
  * board's id, a good CRC, the read-only values (period, delay, sensing ranges) equal to the board's,
- * and pmstep_validate_config() passing; otherwise its status names why and nothing is applied.
+ * pmstep_validate_config() and pmstep_console_stepdir_validate() passing; otherwise its status names
+ * why and nothing is applied. The layout id covers every entry of the table: a record of a firmware
+ * whose table had other entries, or fewer (one from before the STEP/DIR settings), is refused with
+ * PMSTEP_STORE_ERR_LAYOUT, never read in part.
  *
  * Slots: a save erases the slot that does not hold the newest valid record and programs the new one
  * there, CRC last; the newest valid record is the one of the higher sequence. A power cut at any
@@ -78,10 +82,30 @@ typedef struct {
     float friction_Nms_rad;
 } pmstep_store_measured_t;
 
+/**
+ * The STEP/DIR input's settings a drive keeps with its configuration (the console's table entries
+ * stepdir.*, PMSTEP_CONSOLE_CFG_STEPDIR), as a TMC driver keeps its own: what an image in STEP/DIR
+ * mode applies to its step tracker (pmstep_console_stepdir_config()) and to its EN and DIAG pins.
+ * Checked by pmstep_console_stepdir_validate(); pmstep_console_stepdir_defaults() gives a TMC
+ * driver's conventions.
+ */
+typedef struct {
+    uint32_t microsteps;                    /**< microsteps per full step, 1..PMSTEP_STEPDIR_MAX_MICROSTEPS: the
+                                                 controller's setting for this axis */
+    bool invert_direction;                  /**< DIR's sense reversed (counts down while DIR is high) */
+    bool enable_active_high;                /**< EN enables the drive while high; false: while low (a TMC driver's
+                                                 EN) */
+    bool diag_active_high;                  /**< DIAG high while asserted (a TMC2209's DIAG); false: low */
+    uint32_t diag_mode;                     /**< DIAG's mode: PMSTEP_DIAG_LEVEL (0) or PMSTEP_DIAG_PULSE (1) */
+    float following_error_limit_full_steps; /**< DIAG beyond this following error, in full steps of the motor
+                                                 (pi / (2 p) mechanical rad each; > 0, the designer's 1) */
+} pmstep_stepdir_settings_t;
+
 /** A record's contents. */
 typedef struct {
     pmstep_config_t config;
     pmstep_store_measured_t measured;
+    pmstep_stepdir_settings_t stepdir;
 } pmstep_store_record_t;
 
 /** Outcomes: one per cause. Disjoint from pmstep_status_t's codes, so that an ACK's status names
@@ -95,7 +119,8 @@ typedef enum {
     PMSTEP_STORE_ERR_BOARD = -144,     /**< a record of another board: its id or its read-only values differ */
     PMSTEP_STORE_ERR_LENGTH = -145,    /**< the record's length does not match its counts or the bytes given */
     PMSTEP_STORE_ERR_INVALID = -146,   /**< a value the configuration cannot take (an integer or boolean not
-                                            exact), or a configuration pmstep_validate_config() refuses */
+                                            exact), or a configuration pmstep_validate_config() or
+                                            pmstep_console_stepdir_validate() refuses */
     PMSTEP_STORE_ERR_FLASH = -147,     /**< the flash reported an error (erase, program, or an uncorrectable
                                             read); the previous record stays in force */
     PMSTEP_STORE_ERR_VERIFY = -148,    /**< the slot read back differs from what was programmed */
@@ -151,8 +176,10 @@ uint32_t pmstep_store_encode(const pmstep_store_record_t *rec, uint32_t board_id
 /**
  * Decodes the record of @p n bytes at @p in, made for @p board_id, into @p rec: every value over
  * @p board (the board's own configuration), whose read-only values the record's must equal; then
- * validates the configuration. @p rec is written only when the whole record is accepted.
- * @param validation if not NULL: pmstep_validate_config()'s status when that is what refused it.
+ * validates the configuration and the STEP/DIR settings. @p rec is written only when the whole record
+ * is accepted.
+ * @param validation if not NULL: pmstep_validate_config()'s or pmstep_console_stepdir_validate()'s
+ *        status when that is what refused it.
  * @param sequence if not NULL: the record's sequence.
  */
 pmstep_store_status_t pmstep_store_decode(const uint8_t *in, uint32_t n, uint32_t board_id,

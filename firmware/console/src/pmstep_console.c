@@ -16,6 +16,7 @@ enum { RX_SYNC, RX_LEN, RX_PAYLOAD, RX_CRC0, RX_CRC1 };
 void pmstep_console_init(pmstep_console_t *c, const char *identity)
 {
     memset(c, 0, sizeof *c);
+    c->stepdir = pmstep_console_stepdir_defaults();
     c->identity = identity;
 }
 

@@ -37,7 +37,7 @@ static void send_config(pmstep_console_t *c, uint8_t seq, const pmstep_config_t 
     const pmstep_console_config_entry_t *t = pmstep_console_config_table(&count);
     writer_t w;
     float value = 0.0f;
-    (void)pmstep_console_config_get(cfg, id, &value);
+    (void)pmstep_console_config_get(cfg, &c->stepdir, id, &value);
     w.n = 0;
     put_u8(&w, id);
     put_u8(&w, t[id].type);
@@ -171,6 +171,7 @@ void pmstep_console_boundary(pmstep_console_t *c, pmstep_t *inst, pmstep_config_
     }
     case PMSTEP_CONSOLE_SET_CONFIG: {
         pmstep_config_t trial;
+        pmstep_stepdir_settings_t stepdir = c->stepdir;
         int err;
         /* A configuration change re-initialises the core: only with the motor stopped, as the core
          * is now (a START applied at an earlier boundary may not have reached a step yet, so the
@@ -181,11 +182,20 @@ void pmstep_console_boundary(pmstep_console_t *c, pmstep_t *inst, pmstep_config_
             return;
         }
         trial = *cfg;
-        err = pmstep_console_config_set(&trial, req->cfg_id, req->a);
+        err = pmstep_console_config_set(&trial, &stepdir, req->cfg_id, req->a);
         if (err != 0) {
             c->count.commands_applied--;
             pmstep_console_send_error(c, PMSTEP_CONSOLE_SET_CONFIG, seq, (pmstep_console_error_t)err);
             return;
+        }
+        if (pmstep_console_config_is_stepdir(req->cfg_id)) {
+            /* The STEP/DIR input's: checked whole, in force when accepted; the core is not touched (the
+             * image applies them when it next starts following). */
+            st = (int32_t)pmstep_console_stepdir_validate(&stepdir);
+            if (st == (int32_t)PMSTEP_OK) {
+                c->stepdir = stepdir;
+            }
+            break;
         }
         st = (int32_t)pmstep_validate_config(&trial);
         if (st == (int32_t)PMSTEP_OK) {

@@ -47,6 +47,7 @@ static void adopt_design(pmstep_console_t *c, pmstep_t *inst, pmstep_config_t *c
     }
     rec.config = *cfg;
     rec.measured = cs->measured;
+    rec.stepdir = c->stepdir;
     c->calibration_save_status = (int16_t)pmstep_store_save(cs->store, &rec, true);
     cs->last_status = c->calibration_save_status;
     c->calibrating = false;

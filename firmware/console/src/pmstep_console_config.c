@@ -1,7 +1,8 @@
 /*
- * The configuration values the console reads and writes by name or id, the application's
- * configuration, and the two values the images read (period, delay). The only file of the
- * console, the applications and their tests that names fields of pmstep_config_t: a change of
+ * The configuration values the console reads and writes by name or id (the core's configuration
+ * and the STEP/DIR settings), the application's configuration, the two values the images read
+ * (period, delay), and the STEP/DIR settings' defaults, checks and tracker settings. The only file of
+ * the console, the applications and their tests that names fields of pmstep_config_t: a change of
  * the core's configuration layout is an edit of this file alone.
  */
 #include <stddef.h>
@@ -16,6 +17,10 @@
  * from the console. */
 #define F32_RO(field) {#field, PMSTEP_CONSOLE_CFG_F32, PMSTEP_CONSOLE_CFG_READ_ONLY, (uint16_t)offsetof(pmstep_config_t, field)}
 #define U32_RO(field) {#field, PMSTEP_CONSOLE_CFG_U32, PMSTEP_CONSOLE_CFG_READ_ONLY, (uint16_t)offsetof(pmstep_config_t, field)}
+/* The STEP/DIR settings (pmstep_stepdir_settings_t), named stepdir.<field>. */
+#define SD_F32(field) {"stepdir." #field, PMSTEP_CONSOLE_CFG_F32, PMSTEP_CONSOLE_CFG_STEPDIR, (uint16_t)offsetof(pmstep_stepdir_settings_t, field)}
+#define SD_U32(field) {"stepdir." #field, PMSTEP_CONSOLE_CFG_U32, PMSTEP_CONSOLE_CFG_STEPDIR, (uint16_t)offsetof(pmstep_stepdir_settings_t, field)}
+#define SD_BOOL(field) {"stepdir." #field, PMSTEP_CONSOLE_CFG_BOOL, PMSTEP_CONSOLE_CFG_STEPDIR, (uint16_t)offsetof(pmstep_stepdir_settings_t, field)}
 
 /* Ids are the positions in this table: append, never reorder. */
 static const pmstep_console_config_entry_t table[] = {
@@ -81,7 +86,15 @@ static const pmstep_console_config_entry_t table[] = {
     F32_RO(limits.current_sense_range_A),
     F32_RO(limits.bus_sense_range_V),
     BOOL(commissioning.measure_only),
+    SD_U32(microsteps),
+    SD_BOOL(invert_direction),
+    SD_BOOL(enable_active_high),
+    SD_BOOL(diag_active_high),
+    SD_U32(diag_mode),
+    SD_F32(following_error_limit_full_steps),
 };
+
+#define HALF_PI 1.5707963f
 
 const pmstep_console_config_entry_t *pmstep_console_config_table(uint32_t *count)
 {
@@ -91,12 +104,19 @@ const pmstep_console_config_entry_t *pmstep_console_config_table(uint32_t *count
     return table;
 }
 
-bool pmstep_console_config_get(const pmstep_config_t *cfg, uint32_t id, float *value)
+bool pmstep_console_config_is_stepdir(uint32_t id)
 {
-    const unsigned char *base = (const unsigned char *)cfg;
+    return id < sizeof table / sizeof table[0] && (table[id].flags & PMSTEP_CONSOLE_CFG_STEPDIR) != 0u;
+}
+
+bool pmstep_console_config_get(const pmstep_config_t *cfg, const pmstep_stepdir_settings_t *sd, uint32_t id,
+                               float *value)
+{
+    const unsigned char *base;
     if (id >= sizeof table / sizeof table[0]) {
         return false;
     }
+    base = pmstep_console_config_is_stepdir(id) ? (const unsigned char *)sd : (const unsigned char *)cfg;
     switch (table[id].type) {
     case PMSTEP_CONSOLE_CFG_F32:
         *value = *(const float *)(const void *)(base + table[id].offset);
@@ -114,12 +134,13 @@ bool pmstep_console_config_get(const pmstep_config_t *cfg, uint32_t id, float *v
     return true;
 }
 
-int pmstep_console_config_set(pmstep_config_t *cfg, uint32_t id, float value)
+int pmstep_console_config_set(pmstep_config_t *cfg, pmstep_stepdir_settings_t *sd, uint32_t id, float value)
 {
-    unsigned char *base = (unsigned char *)cfg;
+    unsigned char *base;
     if (id >= sizeof table / sizeof table[0]) {
         return PMSTEP_CONSOLE_ERR_UNKNOWN_CONFIG;
     }
+    base = pmstep_console_config_is_stepdir(id) ? (unsigned char *)sd : (unsigned char *)cfg;
     if ((table[id].flags & PMSTEP_CONSOLE_CFG_READ_ONLY) != 0u) {
         return PMSTEP_CONSOLE_ERR_READ_ONLY;
     }
@@ -171,4 +192,56 @@ float pmstep_console_config_period_s(const pmstep_config_t *cfg)
 uint32_t pmstep_console_config_delay_periods(const pmstep_config_t *cfg)
 {
     return cfg->timing.computational_delay_periods;
+}
+
+pmstep_stepdir_settings_t pmstep_console_stepdir_defaults(void)
+{
+    pmstep_stepdir_settings_t sd;
+    sd.microsteps = 16u;
+    sd.invert_direction = false;
+    sd.enable_active_high = false;
+    sd.diag_active_high = true;
+    sd.diag_mode = (uint32_t)PMSTEP_DIAG_LEVEL;
+    sd.following_error_limit_full_steps = 1.0f;
+    return sd;
+}
+
+pmstep_status_t pmstep_console_stepdir_validate(const pmstep_stepdir_settings_t *sd)
+{
+    if (sd == NULL) {
+        return PMSTEP_ERR_NULL_ARGUMENT;
+    }
+    if (sd->microsteps < 1u || sd->microsteps > PMSTEP_STEPDIR_MAX_MICROSTEPS) {
+        return PMSTEP_ERR_STEPDIR_MICROSTEPS;
+    }
+    if (sd->diag_mode != (uint32_t)PMSTEP_DIAG_LEVEL && sd->diag_mode != (uint32_t)PMSTEP_DIAG_PULSE) {
+        return PMSTEP_ERR_STEPDIR_DIAG_MODE;
+    }
+    if (!(sd->following_error_limit_full_steps > 0.0f)
+        || (sd->following_error_limit_full_steps - sd->following_error_limit_full_steps) != 0.0f) {
+        return PMSTEP_ERR_STEPDIR_LIMIT;
+    }
+    return PMSTEP_OK;
+}
+
+pmstep_status_t pmstep_console_stepdir_config(const pmstep_config_t *cfg, const pmstep_stepdir_settings_t *sd,
+                                              pmstep_stepdir_config_t *out)
+{
+    pmstep_stepdir_config_t c;
+    pmstep_status_t st;
+    if (cfg == NULL || out == NULL) {
+        return PMSTEP_ERR_NULL_ARGUMENT;
+    }
+    st = pmstep_console_stepdir_validate(sd);
+    if (st == PMSTEP_OK) {
+        st = pmstep_stepdir_design(cfg, sd->microsteps, &c);
+    }
+    if (st != PMSTEP_OK) {
+        return st;
+    }
+    c.invert_direction = sd->invert_direction;
+    c.diag_mode = sd->diag_mode == (uint32_t)PMSTEP_DIAG_PULSE ? PMSTEP_DIAG_PULSE : PMSTEP_DIAG_LEVEL;
+    c.following_error_limit_rad = sd->following_error_limit_full_steps * HALF_PI / (float)cfg->motor.pole_pairs;
+    *out = c;
+    return PMSTEP_OK;
 }

@@ -22,12 +22,14 @@ pmstep_store_status_t pmstep_console_store_boot(pmstep_console_store_t *cs, pmst
     memset(cs, 0, sizeof *cs);
     cs->store = store;
     cs->defaults = *defaults;
+    cs->boot_stepdir = pmstep_console_stepdir_defaults();
     st = pmstep_store_load(store, defaults, &rec, &why);
     cs->boot_status = (int16_t)st;
     cs->boot_validation = (int16_t)why;
     if (st == PMSTEP_STORE_OK) {
         *cfg = rec.config;
         cs->measured = rec.measured;
+        cs->boot_stepdir = rec.stepdir;
         cs->configured = true;
     } else {
         *cfg = *defaults; /* nothing of a refused record */
@@ -87,6 +89,7 @@ static bool send_record(pmstep_console_t *c, const pmstep_console_request_t *req
         pmstep_store_record_t rec;
         rec.config = *cfg;
         rec.measured = measured_now(inst, &cs->measured);
+        rec.stepdir = c->stepdir;
         cs->image_bytes = pmstep_store_encode(&rec, cs->store->board_id, 0u, cs->image);
     }
     if (req->offset >= cs->image_bytes) {
@@ -120,6 +123,7 @@ static int32_t apply_staged(pmstep_console_t *c, pmstep_t *inst, pmstep_config_t
     init = pmstep_console_put_in_force(c, inst, cfg, &rec.config);
     cs->configured = init == (int32_t)PMSTEP_OK;
     cs->measured = rec.measured;
+    c->stepdir = rec.stepdir; /* validated with the rest by the decode */
     cs->image_bytes = 0u;
     return init;
 }
@@ -153,6 +157,7 @@ static bool store_apply(pmstep_console_t *c, const pmstep_console_request_t *req
         }
         rec.config = *cfg;
         rec.measured = measured_now(inst, &cs->measured);
+        rec.stepdir = c->stepdir;
         st = (int32_t)pmstep_store_save(cs->store, &rec, bridge_off);
         if (st == (int32_t)PMSTEP_STORE_OK) {
             cs->measured = rec.measured;
@@ -164,6 +169,7 @@ static bool store_apply(pmstep_console_t *c, const pmstep_console_request_t *req
         break;
     default: /* PMSTEP_CONSOLE_CONFIG_DEFAULTS */
         st = pmstep_console_put_in_force(c, inst, cfg, &cs->defaults);
+        c->stepdir = pmstep_console_stepdir_defaults();
         cs->configured = false;
         memset(&cs->measured, 0, sizeof cs->measured);
         cs->image_bytes = 0u;
@@ -178,4 +184,5 @@ void pmstep_console_attach_store(pmstep_console_t *c, pmstep_console_store_t *cs
 {
     c->store = cs;
     c->store_apply = store_apply;
+    c->stepdir = cs->boot_stepdir;
 }

@@ -127,7 +127,7 @@ uint32_t pmstep_store_encode(const pmstep_store_record_t *rec, uint32_t board_id
     put32(out + OFF_RESERVED, 0u);
     for (id = 0; id < count; ++id) {
         float value = 0.0f;
-        (void)pmstep_console_config_get(&rec->config, id, &value);
+        (void)pmstep_console_config_get(&rec->config, &rec->stepdir, id, &value);
         put_float(p, value);
         p += 4;
     }
@@ -195,16 +195,17 @@ pmstep_store_status_t pmstep_store_decode(const uint8_t *in, uint32_t n, uint32_
         return st;
     }
     trial.config = *board;
+    trial.stepdir = pmstep_console_stepdir_defaults(); /* every one of them is in the record */
     for (id = 0; id < count; ++id) {
         const float value = get_float(p);
         p += 4;
         if ((t[id].flags & PMSTEP_CONSOLE_CFG_READ_ONLY) != 0u) {
             float own = 0.0f;
-            (void)pmstep_console_config_get(board, id, &own);
+            (void)pmstep_console_config_get(board, &trial.stepdir, id, &own);
             if (value != own) {
                 return PMSTEP_STORE_ERR_BOARD; /* made for another period, delay or sensing */
             }
-        } else if (pmstep_console_config_set(&trial.config, id, value) != 0) {
+        } else if (pmstep_console_config_set(&trial.config, &trial.stepdir, id, value) != 0) {
             return PMSTEP_STORE_ERR_INVALID;
         }
     }
@@ -222,6 +223,9 @@ pmstep_store_status_t pmstep_store_decode(const uint8_t *in, uint32_t n, uint32_
     trial.measured.inertia_kgm2 = measured[5];
     trial.measured.friction_Nms_rad = measured[6];
     valid = pmstep_validate_config(&trial.config);
+    if (valid == PMSTEP_OK) {
+        valid = pmstep_console_stepdir_validate(&trial.stepdir);
+    }
     if (valid != PMSTEP_OK) {
         if (validation != NULL) {
             *validation = valid;

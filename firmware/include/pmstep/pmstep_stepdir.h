@@ -100,6 +100,7 @@ pmstep_status_t pmstep_stepdir_design(const pmstep_config_t *cfg, uint32_t micro
  * @retval PMSTEP_ERR_STEPDIR_MICROSTEPS  microsteps not within 1..256
  * @retval PMSTEP_ERR_STEPDIR_TRACKING    w_t not > 0, or w_t T above 4 (the tracker's poles at e^-4)
  * @retval PMSTEP_ERR_STEPDIR_LIMIT       the following-error limit or the stop time not > 0, or a pulse of 0
+ * @retval PMSTEP_ERR_STEPDIR_DIAG_MODE   diag_mode neither PMSTEP_DIAG_LEVEL nor PMSTEP_DIAG_PULSE
  */
 pmstep_status_t pmstep_stepdir_init(pmstep_stepdir_t *sd, const pmstep_stepdir_config_t *cfg, int32_t pole_pairs,
                                     float period_s, uint16_t counter);

@@ -129,8 +129,9 @@ typedef enum {
     /* STEP/DIR input (pmstep_stepdir.h) */
     PMSTEP_ERR_STEPDIR_MICROSTEPS = -135,   /**< microsteps per full step not within 1..PMSTEP_STEPDIR_MAX_MICROSTEPS */
     PMSTEP_ERR_STEPDIR_TRACKING = -136,     /**< the step tracker's bandwidth not > 0, or above 4 / (N T_s) */
-    PMSTEP_ERR_STEPDIR_LIMIT = -137         /**< the following-error limit or the stop time not > 0, or a DIAG pulse
+    PMSTEP_ERR_STEPDIR_LIMIT = -137,        /**< the following-error limit or the stop time not > 0, or a DIAG pulse
                                                  of 0 periods */
+    PMSTEP_ERR_STEPDIR_DIAG_MODE = -138     /**< DIAG's mode neither PMSTEP_DIAG_LEVEL (0) nor PMSTEP_DIAG_PULSE (1) */
 } pmstep_status_t;
 
 /** Shortest and longest control period accepted (s): 1 MHz down to 100 Hz. */

@@ -14,8 +14,10 @@
 #endif
 
 /* STEP/DIR mode (a build with -DPMSTEP_STM32G4_STEPDIR=1, CMake option PMSTEP_STM32G4_STEPDIR): the
- * port's STEP/DIR/EN input and DIAG output enabled; in RUN the position loop follows the step count.
- * Off by default: the drive is commanded from the console only, and STEP pulses move nothing. */
+ * port's STEP/DIR/EN input and DIAG output enabled; EN starts and releases the drive (follow_enable());
+ * in RUN the position loop follows the step count. Its settings (microsteps, DIR's sense, EN's and DIAG's polarities, DIAG's mode, the following-error
+ * limit) are the console's stepdir.* values, stored with the configuration. Off by default: the
+ * drive is commanded from the console only, and STEP pulses move nothing. */
 #ifndef PMSTEP_STM32G4_STEPDIR
 #define PMSTEP_STM32G4_STEPDIR 0
 #endif
@@ -34,6 +36,7 @@ static pmstep_position_output_t position_out;
 #if PMSTEP_STM32G4_STEPDIR
 static pmstep_stepdir_t stepdir;           /* the step count, fed by the control interrupt */
 static bool stepdir_was_tracked;           /* RUN at the last period: following starts on entering RUN */
+static bool en_was_enabled;                /* EN at the last period: its edges start and release the drive */
 #endif
 static uint32_t uart_errors;
 static uint8_t tx[64];
@@ -66,12 +69,12 @@ static void clock_update(void)
 }
 
 #if PMSTEP_STM32G4_STEPDIR
-/* The step tracker for the configuration in force (the console may have changed it since boot), at the
- * counter's present value: nothing counted yet. */
+/* The step tracker for the configuration and STEP/DIR settings in force (the console may have changed
+ * them since boot), at the counter's present value: nothing counted yet. */
 static pmstep_status_t stepdir_start(void)
 {
     pmstep_stepdir_config_t sd;
-    pmstep_status_t st = pmstep_stepdir_design(&motor_config, board.step_input.microsteps, &sd);
+    pmstep_status_t st = pmstep_console_stepdir_config(&motor_config, &console.stepdir, &sd);
     if (st == PMSTEP_OK) {
         st = pmstep_stepdir_init(&stepdir, &sd, motor_config.motor.pole_pairs, motor_config.timing.period_s,
                                  (uint16_t)pmstep_stm32g4_step_counter());
@@ -79,17 +82,57 @@ static pmstep_status_t stepdir_start(void)
     return st;
 }
 
-/* Once a period, after the step: the count (TIM4 read once), the position loop, then following from
- * the period RUN begins (the reference starts where the motor is: no jump), and DIAG. */
+/* EN as a TMC driver's, between two steps (the core's calls land at this period boundary):
+ * - asserted (an edge, or asserted at boot): a configured drive that is IDLE starts - the alignments
+ *   (its commissioning), then RUN following the steps; what was counted while disabled is dropped;
+ * - released: the port has the bridge off and the core stopped (IDLE) from this period on, as it
+ *   gates every period EN reads disabled; a fault latched meanwhile is cleared (the core's, and the
+ *   port's once its input is released), so the drive waits in IDLE, DIAG deasserted, for EN again.
+ * Edges only: a console STOP, or a fault, with EN held asserted stays so until EN is toggled (or the
+ * console starts it). Not while a calibration runs (it drives the core itself). */
+static void follow_enable(void)
+{
+    const bool enabled = pmstep_stm32g4_step_enabled();
+    if (enabled && !en_was_enabled) {
+        if (console_store.configured && !console.calibrating && pmstep_get_mode(&motor) == PMSTEP_MODE_IDLE
+            && pmstep_stm32g4_fault() == PMSTEP_STM32G4_FAULT_NONE) {
+            (void)stepdir_start();
+            (void)pmstep_start(&motor);
+        }
+    } else if (!enabled && en_was_enabled && !console.calibrating) {
+        if (pmstep_get_mode(&motor) == PMSTEP_MODE_FAULT) {
+            (void)pmstep_clear_fault(&motor);
+        }
+        (void)pmstep_stm32g4_clear_fault();
+    }
+    en_was_enabled = enabled;
+}
+
+/* Once a period, after the step: the count (TIM4 read once), the position loop, EN's edges, then
+ * following from the period RUN begins (the reference starts where the motor is: no jump), and DIAG. */
 static void after_step(const pmstep_output_t *out)
 {
     pmstep_stepdir_count(&stepdir, pmstep_stm32g4_step_counter());
     pmstep_position_update(&position, out, &position_out);
+    follow_enable();
     if (position_out.tracked && !stepdir_was_tracked && stepdir_start() == PMSTEP_OK) {
         (void)pmstep_position_follow_steps(&position, &stepdir);
     }
     stepdir_was_tracked = position_out.tracked;
     pmstep_stm32g4_set_diag(pmstep_stepdir_diag(&stepdir, out->mode, position_out.position_rad, position_out.tracked));
+}
+
+/* The STEP/DIR settings in force onto the port's input (the control interrupt held): EN's and DIAG's
+ * polarities at once; the microsteps, DIR's sense, DIAG's mode and limit when following next starts. */
+static void stepdir_settings_to_port(void)
+{
+    const pmstep_stepdir_settings_t *s = &console.stepdir;
+    board.step_input.microsteps = s->microsteps;
+    if (s->enable_active_high != board.step_input.enable_active_high
+        || s->diag_active_high != board.step_input.diag_active_high) {
+        pmstep_stm32g4_step_polarity(&board, s->enable_active_high, s->diag_active_high);
+        en_was_enabled = pmstep_stm32g4_step_enabled(); /* a new polarity is no edge: EN starts nothing */
+    }
 }
 #else
 /* In the control interrupt, after each step: the turn count and, every N-th period, the position
@@ -143,6 +186,15 @@ int32_t pmstep_app_init(void)
             return -200 + (int32_t)st;
         }
     }
+    pmstep_console_init(&console, "pmstep " PMSTEP_VERSION_TEXT " stm32g431");
+    pmstep_console_attach_position(&console, &position);
+    pmstep_console_attach_store(&console, &console_store); /* saves at the period boundary, bridge off */
+#if PMSTEP_STM32G4_STEPDIR
+    /* The stored STEP/DIR settings (or the defaults) onto the input before the port sets it up. */
+    board.step_input.microsteps = console.stepdir.microsteps;
+    board.step_input.enable_active_high = console.stepdir.enable_active_high;
+    board.step_input.diag_active_high = console.stepdir.diag_active_high;
+#endif
     port_st = pmstep_stm32g4_init(&board, &motor);
     if (port_st != PMSTEP_STM32G4_OK) {
         return (int32_t)port_st;
@@ -153,15 +205,13 @@ int32_t pmstep_app_init(void)
         return -400 + (int32_t)st;
     }
     stepdir_was_tracked = false;
+    en_was_enabled = false; /* EN asserted at boot starts a configured drive */
 #endif
     sysclk_Hz = pmstep_stm32g4_sysclk_Hz(&board.clock);
     port_st = pmstep_stm32g4_lpuart_init(&board, sysclk_Hz); /* PCLK1 = SYSCLK */
     if (port_st != PMSTEP_STM32G4_OK) {
         return (int32_t)port_st;
     }
-    pmstep_console_init(&console, "pmstep " PMSTEP_VERSION_TEXT " stm32g431");
-    pmstep_console_attach_position(&console, &position);
-    pmstep_console_attach_store(&console, &console_store); /* saves at the period boundary, bridge off */
     pmstep_stm32g4_set_after_step(after_step);
     uart_errors = 0u;
     tx_len = 0u;
@@ -192,6 +242,9 @@ void pmstep_app_poll(void)
             (void)pmstep_stm32g4_clear_fault(); /* the port's latch too (break, driver fault input) */
         }
         pmstep_console_boundary(&console, &motor, &motor_config, &snap);
+#if PMSTEP_STM32G4_STEPDIR
+        stepdir_settings_to_port();
+#endif
         pmstep_stm32g4_release_control();
         pmstep_console_telemetry(&console, &snap);
     }

@@ -109,7 +109,8 @@ typedef struct {
  *
  * EN (a GPIO input, pulled to its disabled level) gates the bridge: while it reads disabled the
  * bridge is off by the port's one path (MOE = 0, gate-driver enable off, duties 50 %) and the core
- * stopped, as for a port fault but without latching one. DIAG (an open-drain GPIO output, with
+ * stopped, as for a port fault but without latching one. Starting the drive on EN's assertion, and
+ * clearing a fault on its release, is the application's (app.c), from pmstep_stm32g4_step_enabled(). DIAG (an open-drain GPIO output, with
  * the pin's pull-up) is driven from pmstep_stepdir_diag() through pmstep_stm32g4_set_diag().
  */
 typedef struct {
@@ -306,6 +307,14 @@ pmstep_stm32g4_status_t pmstep_stm32g4_pwm_init(const pmstep_stm32g4_config_t *c
  * @retval PMSTEP_STM32G4_ERR_STEP_MICROSTEPS, PMSTEP_STM32G4_ERR_STEP_PULSE, PMSTEP_STM32G4_ERR_STEP_PIN
  */
 pmstep_stm32g4_status_t pmstep_stm32g4_step_input_init(const pmstep_stm32g4_config_t *cfg, uint32_t tim_clock_Hz);
+
+/**
+ * Sets the STEP/DIR input's EN and DIAG polarities of @p cfg (the configuration the port runs on) to
+ * @p enable_active_high and @p diag_active_high, and when the input is enabled and set up, its pins
+ * to match at once: EN pulled to its disabled level, DIAG deasserted (the next period drives it).
+ * From the main loop with the control interrupt held (pmstep_stm32g4_hold_control()).
+ */
+void pmstep_stm32g4_step_polarity(pmstep_stm32g4_config_t *cfg, bool enable_active_high, bool diag_active_high);
 
 /** ADC1/ADC2: power-up, calibration, injected sequences on TIM1_TRGO2, JEOS interrupt of ADC1. */
 pmstep_stm32g4_status_t pmstep_stm32g4_adc_init(const pmstep_stm32g4_config_t *cfg);

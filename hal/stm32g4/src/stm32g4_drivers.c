@@ -348,6 +348,24 @@ pmstep_stm32g4_status_t pmstep_stm32g4_step_input_init(const pmstep_stm32g4_conf
     return PMSTEP_STM32G4_OK;
 }
 
+void pmstep_stm32g4_step_polarity(pmstep_stm32g4_config_t *cfg, bool enable_active_high, bool diag_active_high)
+{
+    pmstep_stm32g4_step_input_t *in;
+    if (cfg == NULL) {
+        return;
+    }
+    in = &cfg->step_input;
+    in->enable_active_high = enable_active_high;
+    in->diag_active_high = diag_active_high;
+    if (!in->enabled) {
+        return;
+    }
+    /* As at set-up: EN pulled to its (new) disabled level, DIAG deasserted at its (new) level. */
+    pin_configure(&in->enable_pin, GPIO_MODE_INPUT, enable_active_high ? GPIO_PULL_DOWN : GPIO_PULL_UP);
+    STM32G4_GPIO(in->diag_pin.port)->BSRR = diag_active_high ? STM32G4_BIT(16u + in->diag_pin.pin)
+                                                             : STM32G4_BIT(in->diag_pin.pin);
+}
+
 /* ---- ADC1/ADC2: RM0440 §21.4.6 (regulator), §21.4.8 (calibration), §21.4.9 (enable),
  * §21.4.21 (injected conversions) ---- */
 static void adc_cr_set(stm32g4_adc_t *adc, uint32_t bits)

@@ -379,6 +379,7 @@ static pmstep_store_record_t record_with(float mark)
     pmstep_store_record_t rec;
     memset(&rec, 0, sizeof rec);
     rec.config = board;
+    rec.stepdir = pmstep_console_stepdir_defaults();
     rec.config.motor.inertia_kgm2 = 0.01f * mark;
     rec.measured.flags = PMSTEP_STORE_MEASURED_RESISTANCE;
     rec.measured.resistance_Ohm = 1.0f + mark;

@@ -810,6 +810,7 @@ static void store_record(const pmstep_config_t *cfg)
     pmstep_store_record_t rec;
     memset(&rec, 0, sizeof rec);
     rec.config = *cfg;
+    rec.stepdir = pmstep_console_stepdir_defaults();
     assert_int_equal(pmstep_store_init(&store, pmstep_stm32g4_store_flash(), pmstep_stm32g4_board_id()), PMSTEP_STORE_OK);
     assert_int_equal(pmstep_store_save(&store, &rec, true), PMSTEP_STORE_OK);
 }
