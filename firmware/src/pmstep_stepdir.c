@@ -77,7 +77,7 @@ pmstep_status_t pmstep_stepdir_init(pmstep_stepdir_t *sd, const pmstep_stepdir_c
         || (cfg->stop_time_s - cfg->stop_time_s) != 0.0f) {
         return PMSTEP_ERR_STEPDIR_LIMIT;
     }
-    if (cfg->diag_mode != PMSTEP_DIAG_LEVEL && cfg->diag_mode != PMSTEP_DIAG_PULSE) {
+    if ((cfg->diag_mode != PMSTEP_DIAG_LEVEL) && (cfg->diag_mode != PMSTEP_DIAG_PULSE)) {
         return PMSTEP_ERR_STEPDIR_DIAG_MODE;
     }
     sd->cfg = *cfg;

@@ -187,6 +187,8 @@ def main():
     for e in b_table:
         if e["read_only"]:
             continue  # the board's read-only values: the paper scenario's own
+        if e["name"].startswith("stepdir."):
+            continue  # the STEP/DIR input's settings: the console's, not the core configuration the SIL runs
         sets += ["--set", f"controller.{e['name']}={scenario_value(e['type'], after[e['name']])}"]
     subprocess.run([a.sil, "--quiet", "--no-csv", "--out", str(out / "sil"), "--set", f"run.duration_s={RUN_DURATION_S}",
                     "--set", f"run.substeps={SUBSTEPS}"] + sets, check=True)

@@ -21,6 +21,7 @@ static const size_t fuzz_bool_fields[] = {
     offsetof(pmstep_config_t, commissioning.use_measured_inductance),
     offsetof(pmstep_config_t, commissioning.use_measured_torque_constant),
     offsetof(pmstep_config_t, commissioning.use_identified_mechanics),
+    offsetof(pmstep_config_t, commissioning.measure_only),
     offsetof(pmstep_config_t, inverter.phase_voltage_sensing),
     offsetof(pmstep_config_t, inverter.ripple_dead_zone),
     offsetof(pmstep_config_t, standstill.stops_only),
