@@ -26,6 +26,8 @@
 #                                                              -> docs/reports/self-commissioning.md
 #   step-dir             tools/stepdir_compare.py, every preset, pmstep and open-loop microstepping on the
 #                        same step streams                     -> docs/reports/step-dir.md (+ step-dir.png)
+#   homing               tools/homing_sweep.py, every preset, ideal and realistic chains, homing speeds from
+#                        0.1 % to 50 % of the top speed         -> docs/reports/homing.md
 #
 # The campaigns run on a thread pool of 2 (--engine threads --jobs 2; a case's result depends on its
 # seed alone, not on the engine). Outputs of the runs (tables, cases, plots) go to OUT (out/reports);
@@ -43,7 +45,7 @@ set -uo pipefail
 cd "$(dirname "$0")/.."
 
 STEPS_ALL=(cost position-cost benchmarks envelope position-acceptance mc-presets mc-robust mc-position fault-injection
-           motor-sweep self-commissioning step-dir)
+           motor-sweep self-commissioning step-dir homing)
 MC_PRESETS=(paper 17hs4401 bj42d29 as1050)
 MC_POSITION=(17hs4401 bj42d29 as1050)
 OUT=${OUT:-out/reports}
@@ -164,6 +166,11 @@ for step in "${STEPS[@]}"; do
       rm -rf "$OUT/stepdir_compare"
       run step-dir "$REPORTS/step-dir.md" "$PYTHON" tools/stepdir_compare.py --sil "$SIL" --tune "$TUNE" \
         --out "$OUT/stepdir_compare" --report "$REPORTS/step-dir.md" ;;
+    homing)
+      need_sil
+      rm -rf "$OUT/homing_sweep"
+      run homing "$REPORTS/homing.md" "$PYTHON" tools/homing_sweep.py --sil "$SIL" --tune "$TUNE" \
+        --out "$OUT/homing_sweep" --report "$REPORTS/homing.md" ;;
   esac
 done
 

@@ -481,6 +481,26 @@ pmstep_status_t pmstep_position_hold(pmstep_position_t *pos, float a_max_rad_s2)
     return PMSTEP_OK;
 }
 
+pmstep_status_t pmstep_position_rest_here(pmstep_position_t *pos)
+{
+    pmstep_motion_sample_t start;
+    if (pos == NULL) {
+        return PMSTEP_ERR_NULL_ARGUMENT;
+    }
+    if (!pos->out.tracked) {
+        return PMSTEP_ERR_BAD_MODE;
+    }
+    pmstep_position_release_hold(pos);
+    stop_following(pos);
+    /* the speed channel at rest and position mode entered afresh: the loop's integral at 0 */
+    pmstep_ref_reset(&pos->inst->speed_ref, 0.0f);
+    pos->out.position_mode = false;
+    start = profile_start(pos);
+    pmstep_motion_reset(&pos->motion, start.position, pos->motion.period_s);
+    enter_position_mode(pos);
+    return PMSTEP_OK;
+}
+
 pmstep_status_t pmstep_position_follow_steps(pmstep_position_t *pos, struct pmstep_stepdir *sd)
 {
     pmstep_motion_sample_t start;

@@ -110,6 +110,38 @@ static void add_stepdir_json(cJSON *root, const sil_scenario_t *sc, const sil_su
     cJSON_AddItemToObject(root, "stepdir", stepdir);
 }
 
+static const char *homing_state_name(pmstep_homing_state_t state)
+{
+    static const char *const names[] = {"idle", "seeking", "backing_off", "done", "not_found", "aborted"};
+    return (unsigned)state < sizeof names / sizeof names[0] ? names[state] : "unknown";
+}
+
+static void add_homing_json(cJSON *root, const sil_summary_t *s)
+{
+    const sil_homing_summary_t *h = &s->homing;
+    cJSON *homing = cJSON_CreateObject();
+    cJSON_AddNumberToObject(homing, "speed_rad_s", (double)h->config.speed_rad_s);
+    cJSON_AddNumberToObject(homing, "accel_rad_s2", (double)h->config.accel_rad_s2);
+    cJSON_AddNumberToObject(homing, "max_travel_rad", (double)h->config.max_travel_rad);
+    cJSON_AddNumberToObject(homing, "stall_current_a", (double)h->config.stall_current_A);
+    cJSON_AddNumberToObject(homing, "stall_error_rad", (double)h->config.stall_error_rad);
+    cJSON_AddNumberToObject(homing, "back_off_rad", (double)h->config.back_off_rad);
+    cJSON_AddNumberToObject(homing, "start_status", (double)h->start_status);
+    cJSON_AddStringToObject(homing, "state", homing_state_name(h->state));
+    cJSON_AddNumberToObject(homing, "start_s", h->start_s);
+    cJSON_AddNumberToObject(homing, "contact_s", h->contact_s);
+    cJSON_AddNumberToObject(homing, "found_s", h->found_s);
+    cJSON_AddNumberToObject(homing, "done_s", h->done_s);
+    cJSON_AddStringToObject(homing, "found_by", h->by_current ? "current" : "following_error");
+    cJSON_AddNumberToObject(homing, "zero_rad", h->zero_rad);
+    cJSON_AddNumberToObject(homing, "stop_error_full_steps", h->stop_error_full_steps);
+    cJSON_AddNumberToObject(homing, "contact_peak_current_a", h->contact_peak_current_A);
+    cJSON_AddNumberToObject(homing, "seek_peak_stop_torque_nm", h->seek_peak_stop_torque_Nm);
+    cJSON_AddNumberToObject(homing, "final_from_stop_full_steps", h->final_from_stop_full_steps);
+    cJSON_AddNumberToObject(homing, "final_position_error_full_steps", h->final_position_error_full_steps);
+    cJSON_AddItemToObject(root, "homing", homing);
+}
+
 /* The [sensors], [inverter] and [bus] settings and what the ADC clipped. */
 static cJSON *measurement_chain_json(const sil_scenario_t *sc)
 {
@@ -263,6 +295,9 @@ static cJSON *summary_json(const sil_scenario_t *sc, const sil_summary_t *s)
     }
     if (sc->position_moves > 0 && sc->position_source == SIL_SOURCE_STEPDIR) {
         add_stepdir_json(root, sc, s);
+    }
+    if (sc->position_moves > 0 && sc->position_source == SIL_SOURCE_HOMING) {
+        add_homing_json(root, s);
     }
 
     cJSON_AddNumberToObject(fault, "code", (double)s->fault);

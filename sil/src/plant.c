@@ -24,6 +24,10 @@ plant_params_t plant_paper_params(void)
     p.torque_constant_Nm_A = 2.0;
     p.pole_pairs = 6;
     p.detent_torque_Nm = 0.0;
+    p.stop_side = 0;
+    p.stop_position_rad = 0.0;
+    p.stop_stiffness_Nm_rad = 0.0;
+    p.stop_damping_Nms_rad = 0.0;
     return p;
 }
 
@@ -81,6 +85,18 @@ static double detent_torque(const plant_params_t *params, double s, double c)
     return -params->detent_torque_Nm * 4.0 * s * c * (c * c - s * s);
 }
 
+double plant_stop_torque(const plant_params_t *params, double theta_rad, double omega_rad_s)
+{
+    const double side = (double)params->stop_side;
+    const double depth_rad = side * (theta_rad - params->stop_position_rad);
+    double push_Nm;
+    if (params->stop_side == 0 || depth_rad <= 0.0) {
+        return 0.0;
+    }
+    push_Nm = params->stop_stiffness_Nm_rad * depth_rad + params->stop_damping_Nms_rad * side * omega_rad_s;
+    return push_Nm > 0.0 ? -side * push_Nm : 0.0;
+}
+
 /* (1) with sin p theta and cos p theta given. The detent term is added only when T_d != 0, so
  * T_d = 0 leaves every result bit for bit as it was without it. */
 static void derivative_at(const plant_params_t *params, const plant_load_t *load, double t_s, const plant_state_t *x,
@@ -94,6 +110,9 @@ static void derivative_at(const plant_params_t *params, const plant_load_t *load
 
     if (params->detent_torque_Nm != 0.0) {
         torque_Nm += detent_torque(params, s, c);
+    }
+    if (params->stop_side != 0) {
+        torque_Nm += plant_stop_torque(params, x->theta_rad, x->omega_rad_s);
     }
     dx->theta_rad = x->omega_rad_s;
     dx->omega_rad_s = inv_j * torque_Nm;
@@ -214,6 +233,9 @@ PLANT_INLINE void coupling_at(const plant_params_t *params, const plant_load_t *
     double torque_Nm = k_m * (-y->i_a_A * s + y->i_b_A * c) - load_Nm;
     if (params->detent_torque_Nm != 0.0) {
         torque_Nm += detent_torque(params, s, c); /* T_d = 0: bit for bit as without the term */
+    }
+    if (params->stop_side != 0) {
+        torque_Nm += plant_stop_torque(params, y->theta_rad, y->omega_rad_s); /* none: bit for bit as without it */
     }
     n->theta_rad = y->omega_rad_s;
     n->omega_rad_s = torque_Nm / params->inertia_kgm2;

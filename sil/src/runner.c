@@ -11,6 +11,7 @@
 
 #include "pmstep_hal_host.h"
 #include "sil/microstep.h"
+#include "sil/homing_run.h"
 #include "sil/position_run.h"
 #include "sil/stepdir_run.h"
 
@@ -132,7 +133,10 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
     const bool positional = !microstep && sc->position_moves > 0;
     /* position.source = stepdir: the drive (either) follows the step generator's count */
     const bool stepdir = sc->position_moves > 0 && sc->position_source == SIL_SOURCE_STEPDIR;
+    /* position.source = homing: the drive homes against the plant's stop */
+    const bool homing = positional && sc->position_source == SIL_SOURCE_HOMING;
     sil_position_run_t position_run;
+    sil_homing_run_t homing_run;
     pmstep_position_output_t pos_out;
     sil_microstep_t drive;
     const pmstep_config_t *cfg = &sc->controller;
@@ -173,6 +177,9 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
     sil_position_run_init(&position_run, sc);
     sil_metrics_init(&metrics, sc, s); /* its period counts need a configuration init accepted; clears s */
     s->init_status = stepdir ? sil_stepdir_run_init(&stepdir_run, sc, !microstep, s) : PMSTEP_OK;
+    if (homing) {
+        sil_homing_run_init(&homing_run, sc, s);
+    }
     if (s->init_status != PMSTEP_OK) {
         return -1;
     }
@@ -215,6 +222,8 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
         }
         if (stepdir) {
             sil_stepdir_run_command(&stepdir_run, t_s, positional ? &pos : NULL, microstep ? &drive : NULL, s);
+        } else if (homing) {
+            sil_homing_run_command(&homing_run, &pos, t_s, s);
         } else if (positional) {
             sil_position_run_command(&position_run, &pos, t_s, s);
         }
@@ -243,6 +252,9 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
                 sil_stepdir_run_diag(&stepdir_run, out.mode, &pos_out);
             } else if (positional) {
                 pmstep_position_step(&pos, &meas, &out, &pos_out);
+                if (homing) {
+                    sil_homing_run_update(&homing_run, &pos, &out, &pos_out);
+                }
             } else {
                 pmstep_step(&inst, &meas, &out);
             }
@@ -282,6 +294,9 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
         if (positional) {
             sample.position = &pos_out;
             sil_position_run_sample(&position_run, &pos, &sample, s);
+            if (homing && position_run.origin_set) {
+                sil_homing_run_sample(&homing_run, &sample, &plant.params, position_run.origin_rad, s);
+            }
         }
         if (stepdir) {
             sil_stepdir_run_sample(&stepdir_run, &sample, s);

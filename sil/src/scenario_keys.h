@@ -39,7 +39,7 @@ static const char *const integrator_names[] = {"rk4", "exponential"}; /* in plan
 static const char *const drive_names[] = {"pmstep", "microstep"};     /* in sil_drive_t order */
 static const char *const phases_names[] = {"none", "a", "b", "both"};  /* in sil_phases_t order */
 static const char *const sensor_fault_names[] = {"none", "open", "stuck"}; /* in sil_sensor_fault_t order */
-static const char *const position_source_names[] = {"move", "stepdir"}; /* in sil_position_source_t order */
+static const char *const position_source_names[] = {"move", "stepdir", "homing"}; /* in sil_position_source_t order */
 static const char *const diag_mode_names[] = {"level", "pulse"}; /* in pmstep_diag_mode_t order */
 
 /* run.theta0_deg's value as stored (rad): the one conversion the reader applies and the printer

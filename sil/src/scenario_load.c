@@ -274,6 +274,30 @@ int sil_scenario_check(const sil_scenario_t *sc, char *err, size_t err_size)
     if (sc->position_source == SIL_SOURCE_STEPDIR && sc->position_moves == 0) {
         return fail(err, err_size, "position.source = stepdir needs position.points (the moves the step generator plans)");
     }
+    if (sc->position_source == SIL_SOURCE_HOMING && sc->position_moves != 1) {
+        return fail(err, err_size, "position.source = homing needs one position point t:theta (homing starts at t toward "
+                                   "theta's sign, |theta| its largest travel); got %d", sc->position_moves);
+    }
+    if (sc->motor.stop_side != 0) {
+        /* the rotor on the stop's spring: sqrt(k_s / J) h within 1 keeps the integrator's step well inside its
+         * stability (RK4: 2.8) */
+        const double h_s = (double)sc->controller.timing.period_s / (double)sc->substeps;
+        const double phase = sqrt(sc->motor.stop_stiffness_Nm_rad / sc->motor.inertia_kgm2) * h_s;
+        if (!(sc->motor.stop_stiffness_Nm_rad > 0.0)) {
+            return fail(err, err_size, "motor.stop_side = %d needs motor.stop_stiffness_Nm_rad > 0", sc->motor.stop_side);
+        }
+        if (!((double)sc->motor.stop_side * (sc->theta0_rad - sc->motor.stop_position_rad) < 0.0)) {
+            return fail(err, err_size, "motor.stop_position_rad = %g with motor.stop_side = %d: the rotor would start "
+                                       "at or beyond the stop (run.theta0_deg = %g)", sc->motor.stop_position_rad,
+                        sc->motor.stop_side, sc->theta0_rad * 180.0 / PI);
+        }
+        if (phase > 1.0) {
+            return fail(err, err_size,
+                        "motor.stop_stiffness_Nm_rad = %g: sqrt(k_s / J) h = %g with a substep of %g s (at most 1): raise "
+                        "run.substeps to %.0f", sc->motor.stop_stiffness_Nm_rad, phase, h_s,
+                        ceil((double)sc->substeps * phase));
+        }
+    }
     if (sc->load.kind == PLANT_LOAD_PROPORTIONAL && sc->integrator == PLANT_INTEGRATOR_RK4) {
         /* RK4 on w' = -(c/J) w: stable for c h / J within 2.78; 2.5 keeps a margin. The exponential
          * integrator takes the load exactly. */

@@ -58,6 +58,9 @@ void sil_scenario_paper(sil_scenario_t *sc)
     sc->position_source = SIL_SOURCE_MOVE;
     sc->stepdir_microsteps = 16u;
     sc->stepdir_diag_mode = PMSTEP_DIAG_LEVEL;
+    sc->homing_speed_rad_s = 0.0;
+    sc->homing_stall_current_A = 0.0;
+    sc->homing_back_off_rad = -1.0;
 }
 
 double sil_scenario_hold_end_s(const sil_scenario_t *sc)

@@ -226,6 +226,13 @@ pmstep_status_t pmstep_position_move_to(pmstep_position_t *pos, float target_rad
 pmstep_status_t pmstep_position_hold(pmstep_position_t *pos, float a_max_rad_s2);
 
 /**
+ * Puts the reference at rest on theta-hat now: speed 0, the loop's integral at 0 (a stop or an
+ * obstacle found: the loop stops pushing toward where the reference had gone). Position mode, not moving.
+ * @retval PMSTEP_OK, PMSTEP_ERR_NULL_ARGUMENT, PMSTEP_ERR_BAD_MODE (not tracked)
+ */
+pmstep_status_t pmstep_position_rest_here(pmstep_position_t *pos);
+
+/**
  * Position mode on the STEP/DIR input @p sd (pmstep_stepdir.h, initialised for this motor and period):
  * from the next period the loop's reference is the step count's tracker, started where the present
  * reference is (no jump: step count 0 is there). At rest (no step for stop_time_s) the vector hold

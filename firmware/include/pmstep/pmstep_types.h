@@ -131,7 +131,11 @@ typedef enum {
     PMSTEP_ERR_STEPDIR_TRACKING = -136,     /**< the step tracker's bandwidth not > 0, or above 4 / (N T_s) */
     PMSTEP_ERR_STEPDIR_LIMIT = -137,        /**< the following-error limit or the stop time not > 0, or a DIAG pulse
                                                  of 0 periods */
-    PMSTEP_ERR_STEPDIR_DIAG_MODE = -138     /**< DIAG's mode neither PMSTEP_DIAG_LEVEL (0) nor PMSTEP_DIAG_PULSE (1) */
+    PMSTEP_ERR_STEPDIR_DIAG_MODE = -138,    /**< DIAG's mode neither PMSTEP_DIAG_LEVEL (0) nor PMSTEP_DIAG_PULSE (1) */
+    /* homing (pmstep_homing.h) */
+    PMSTEP_ERR_HOMING = -139                /**< a homing speed, acceleration, travel or stall error not > 0, a back-off
+                                                 < 0, a stall current not in (0, max_phase_current_A), or a direction
+                                                 other than +1 or -1 */
 } pmstep_status_t;
 
 /** Shortest and longest control period accepted (s): 1 MHz down to 100 Hz. */

@@ -10,6 +10,7 @@
 #include <stdbool.h>
 
 #include "pmstep/pmstep.h"
+#include "pmstep/pmstep_homing.h"
 #include "sil/scenario.h"
 
 #ifdef __cplusplus
@@ -86,6 +87,24 @@ typedef struct {
     double diag_first_s;                   /**< the first of them, -1 if none */
 } sil_stepdir_summary_t;
 
+/** A homing scenario's figures (sil/homing_run.h), on the plant's truth. Full steps: pi / (2 p). */
+typedef struct {
+    pmstep_homing_config_t config;          /**< the settings it ran with */
+    pmstep_status_t start_status;           /**< pmstep_homing_start()'s */
+    pmstep_homing_state_t state;            /**< at the end of the run */
+    double start_s;                         /**< homing started */
+    double contact_s;                       /**< the rotor first met the stop, -1 if never */
+    double found_s;                         /**< the drive found it (or stopped seeking), -1 if never */
+    double done_s;                          /**< backed off, -1 if never */
+    bool by_current;                        /**< found by the current test (else by the following error) */
+    double zero_rad;                        /**< the stop the drive found, in its frame before the zero */
+    double stop_error_full_steps;           /**< that stop less where the rotor meets the stop */
+    double contact_peak_current_A;          /**< largest |phase current| from the rotor's contact to the find */
+    double seek_peak_stop_torque_Nm;        /**< largest push of the stop on the rotor while seeking */
+    double final_from_stop_full_steps;      /**< the rotor's true distance from the stop at the end */
+    double final_position_error_full_steps; /**< the drive's position (from its zero) less that distance */
+} sil_homing_summary_t;
+
 /** Called once per period; return false to stop the run early. */
 typedef bool (*sil_sample_fn)(const sil_sample_t *sample, void *user);
 
@@ -137,6 +156,7 @@ typedef struct {
     double loss_of_synchronism_time_s;     /**< its first sample, -1 if none */
     sil_position_summary_t position;       /**< position scenario only (zero otherwise) */
     sil_stepdir_summary_t stepdir;         /**< STEP/DIR scenario only (zero otherwise) */
+    sil_homing_summary_t homing;           /**< homing scenario only (zero otherwise) */
 } sil_summary_t;
 
 /** Running sums behind the summary. */

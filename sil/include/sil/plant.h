@@ -33,7 +33,19 @@ typedef struct {
     double torque_constant_Nm_A;/**< k_M */
     int pole_pairs;                 /**< p */
     double detent_torque_Nm;        /**< T_d >= 0: detent torque amplitude, -T_d sin 4 p theta (0 = none) */
+    /* A hard stop (plant_stop_torque()): a one-sided spring and damper the rotor meets at stop_position_rad. */
+    int stop_side;                  /**< 0: none; +1: it blocks motion above stop_position_rad; -1: below */
+    double stop_position_rad;       /**< where the rotor meets it (mechanical rad, the plant's theta) */
+    double stop_stiffness_Nm_rad;   /**< k_s > 0: its torque per rad pressed into it */
+    double stop_damping_Nms_rad;    /**< c_s >= 0: its damping while in contact */
 } plant_params_t;
+
+/**
+ * The hard stop's torque on the rotor at (@p theta_rad, @p omega_rad_s): with d = side (theta - stop)
+ * the depth pressed in, -side max(0, k_s d + c_s side omega) for d > 0, else 0. It pushes the
+ * rotor out and never pulls it in (the damper lets go as the spring does).
+ */
+double plant_stop_torque(const plant_params_t *params, double theta_rad, double omega_rad_s);
 
 /** Load torque T_L(t, omega). */
 typedef enum {

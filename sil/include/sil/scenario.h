@@ -42,8 +42,10 @@ typedef struct {
 /** position.source: what a position scenario's points become. */
 typedef enum {
     SIL_SOURCE_MOVE = 0,    /**< each point a pmstep_position_move_to() at its time (the drive plans the move) */
-    SIL_SOURCE_STEPDIR = 1  /**< the SIL's step generator (sil/step_generator.h) plans each move as a motion
+    SIL_SOURCE_STEPDIR = 1, /**< the SIL's step generator (sil/step_generator.h) plans each move as a motion
                                  controller does; the drive follows its STEP/DIR count (pmstep_stepdir.h) */
+    SIL_SOURCE_HOMING = 2   /**< the first point starts homing (pmstep_homing.h) toward its sign, its
+                                 magnitude the largest travel (sil/homing_run.h) */
 } sil_position_source_t;
 
 /** run.controller: what drives the plant. */
@@ -107,6 +109,10 @@ typedef struct {
     pmstep_diag_mode_t stepdir_diag_mode;  /**< stepdir.diag_mode: level | pulse */
     float stepdir_tracking_bandwidth_rad_s; /**< stepdir.tracking_bandwidth_rad_s: the step tracker's w_t (0 = the
                                                  designer's, pmstep_stepdir_design()) */
+    /* position.source = homing: the designer's settings (pmstep_homing_design()) unless given here. */
+    double homing_speed_rad_s;             /**< homing.speed_rad_s (0 = the designer's) */
+    double homing_stall_current_A;         /**< homing.stall_current_A (0 = the designer's) */
+    double homing_back_off_rad;            /**< homing.back_off_rad (< 0 = the designer's) */
 } sil_scenario_t;
 
 /** The paper's Section III: t_s = 0.3 s, t_c = 0.6 s, 2 Nm at 0.63 s, theta0 = 30 deg, 2.4 s, 20 kHz. */
