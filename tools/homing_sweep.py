@@ -37,6 +37,7 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import report  # noqa: E402
 from mc_preset import chain_sets  # noqa: E402
+from stepdir_compare import microsteps_for, move_time  # noqa: E402  (the STEP/DIR case's count and timing)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 MOTORS = ["paper", "17hs4401", "bj42d29", "as1050"]
@@ -47,6 +48,8 @@ STOP_FULL_STEPS = 4.37        # cruise before the stop, full steps (off a detent
 STOP_COMPLIANCE_FULL_STEPS = 0.05
 STOP_DAMPING_RATIO = 0.5
 BOUND_FULL_STEPS = 0.25
+STEPDIR_BACK_FULL_STEPS = 2.0  # the STEP/DIR case's back-off after the dwell
+STEPDIR_DWELL_S = 0.1
 THETA0_ELECTRICAL_DEG = 30.0  # the rotor's start: the c-alignment's equilibrium at theta = 0 is the nearest
 LEAD_S = 0.1                  # from RUN's start to the homing
 TAIL_S = 0.3                  # after the back-off's expected end
@@ -64,6 +67,8 @@ def read_motor(path):
 
 
 def design(tune, motor_ini, ini_out, robust, sets):
+    """pmstep-tune's design into @p ini_out: its top speed, RUN's start, and the step tracker's bandwidth and
+    the stall detection's bound (the STEP/DIR case's microsteps)."""
     cmd = [tune, "--motor", motor_ini, "--write-ini", ini_out] + (["--robust"] if robust else [])
     for s in sets:
         cmd += ["--set", s]
@@ -73,7 +78,8 @@ def design(tune, motor_ini, ini_out, robust, sets):
     ini.read(ini_out)
     run_start = float(ini["controller.commissioning"]["offset_calibration_time_s"]) + float(
         ini["controller.alignment"]["c_align_time_s"])
-    return top, run_start
+    return (top, run_start, float(ini["controller.gains"]["reference_bandwidth_rad_s"]),
+            float(ini["controller.detection"]["stall_speed_error_rad_s"]))
 
 
 def designed_homing(sil, scenario, out_dir):
@@ -95,14 +101,21 @@ def run_sil(sil, scenario, sets, out_dir):
         return proc.returncode, json.load(f)
 
 
+def stop_sets(motor, direction, reach):
+    """The plant's hard stop @p reach from the c-alignment's equilibrium toward @p direction."""
+    full_step = math.pi / (2.0 * motor["p"])
+    stiffness = motor["holding_Nm"] / (STOP_COMPLIANCE_FULL_STEPS * full_step)
+    damping = 2.0 * STOP_DAMPING_RATIO * math.sqrt(stiffness * motor["J"])
+    return [f"motor.stop_side={direction}", f"motor.stop_position_rad={direction * reach:.9g}",
+            f"motor.stop_stiffness_Nm_rad={stiffness:.9g}", f"motor.stop_damping_Nms_rad={damping:.9g}"]
+
+
 def plan(motor, top, run_start, homing, fraction, direction, with_stop):
     """The --set items of one homing run; @p fraction of the top speed (None: the designer's speed)."""
     full_step = math.pi / (2.0 * motor["p"])
     v = homing["speed_rad_s"] if fraction is None else fraction * top
     a = homing["accel_rad_s2"]
     reach = STOP_FULL_STEPS * full_step + v * v / a
-    stiffness = motor["holding_Nm"] / (STOP_COMPLIANCE_FULL_STEPS * full_step)
-    damping = 2.0 * STOP_DAMPING_RATIO * math.sqrt(stiffness * motor["J"])
     back_off = homing["back_off_rad"]
     travel = 3.0 * reach if with_stop else 0.5 * reach
     start = run_start + LEAD_S
@@ -112,8 +125,7 @@ def plan(motor, top, run_start, homing, fraction, direction, with_stop):
             f"position.points={start:.6f}:{direction * travel:.9g}", f"homing.speed_rad_s={v:.9g}",
             f"run.duration_s={duration:.6f}"]
     if with_stop:
-        sets += [f"motor.stop_side={direction}", f"motor.stop_position_rad={direction * reach:.9g}",
-                 f"motor.stop_stiffness_Nm_rad={stiffness:.9g}", f"motor.stop_damping_Nms_rad={damping:.9g}"]
+        sets += stop_sets(motor, direction, reach)
     return v, sets
 
 
@@ -151,8 +163,69 @@ def one_run(args, name, chain, motor, scenario, top, run_start, homing, fraction
     return row
 
 
+def stepdir_case(args, name, chain, motor, scenario, figures, homing, extra):
+    """Homing on DIAG as a motion controller does it over STEP/DIR (stepdir.stall_current_A the designer's
+    homing stall current): the count moves at the designer's homing speed to twice the stop's distance, then,
+    after a dwell, back by STEPDIR_BACK_FULL_STEPS; the steps toward the stop past the stall are dropped, so
+    the rotor ends that far from the stop."""
+    top, run_start, tracking, stall = figures
+    full_step = math.pi / (2.0 * motor["p"])
+    microsteps = microsteps_for(motor, tracking, stall)
+    v, a = homing["speed_rad_s"], homing["accel_rad_s2"]
+    reach = STOP_FULL_STEPS * full_step + v * v / a
+    back = STEPDIR_BACK_FULL_STEPS * full_step
+    t0 = run_start + LEAD_S
+    t1 = t0 + move_time(2.0 * reach, v, a, 0.0) + STEPDIR_DWELL_S
+    end = t1 + move_time(back, v, a, 0.0) + TAIL_S
+    sets = ["speed.points=0:0", "load.type=none", "position.source=stepdir", f"stepdir.microsteps={microsteps}",
+            f"stepdir.stall_current_A={homing['stall_current_a']:.9g}",
+            f"position.points={t0:.6f}:{2.0 * reach:.9g}, {t1:.6f}:{2.0 * reach - back:.9g}",
+            f"position.v_max_rad_s={v:.9g}", f"position.a_max_rad_s2={a:.9g}", "position.j_max_rad_s3=0",
+            f"run.duration_s={end:.6f}", f"run.theta0_deg={THETA0_ELECTRICAL_DEG / motor['p']:.9g}"]
+    sets += stop_sets(motor, 1, reach)
+    rc, s = run_sil(args.sil, scenario, sets + extra, os.path.join(args.out, f"{name}_{chain}_stepdir"))
+    d = s["stepdir"]
+    q = 2.0 * math.pi / (4.0 * motor["p"] * microsteps)
+    from_stop = d["generator_steps"] * q - d["final_error_full_steps"] * full_step - reach
+    row = {"motor": name, "chain": chain, "microsteps": microsteps, "speed_rad_s": v, "top_rad_s": top,
+           "fault": s["fault"]["name"], "exit_status": rc, "stepdir": d, "stop_contact_s": s["stop_contact_s"],
+           "final_error_full_steps": (from_stop + back) / full_step,
+           "diag_after_contact_s": (d["diag_first_s"] - s["stop_contact_s"]
+                                    if d["diag_first_s"] >= 0 and s["stop_contact_s"] >= 0 else None)}
+    failures = []
+    if row["fault"] != "NONE":
+        failures.append("fault " + row["fault"])
+    if d["following_start_s"] < 0.0 or d["following_end_s"] >= 0.0:
+        failures.append("not following the count to the end")
+    if d["drive_steps"] != d["generator_steps"]:
+        failures.append(f"counted {d['drive_steps']} of {d['generator_steps']} microsteps")
+    if row["diag_after_contact_s"] is None or row["diag_after_contact_s"] < 0.0:
+        failures.append("no DIAG at the stop")
+    if abs(row["final_error_full_steps"]) > BOUND_FULL_STEPS:
+        failures.append(f"final error {row['final_error_full_steps']:+.3f}")
+    row["failures"] = failures
+    return row
+
+
+def stepdir_line(row, markdown):
+    d = row["stepdir"]
+    cells = [row["motor"], row["chain"], str(row["microsteps"]),
+             f"{row['speed_rad_s']:.3g} rad/s ({row['speed_rad_s'] / row['top_rad_s']:.3g} top)",
+             f"{1e3 * row['diag_after_contact_s']:.1f} ms" if row["diag_after_contact_s"] is not None else "-",
+             str(d["diag_periods"]), f"{row['final_error_full_steps']:+.3f}",
+             "met" if not row["failures"] else "; ".join(row["failures"])]
+    if markdown:
+        return "| " + " | ".join(cells) + " |"
+    return "  ".join(cells)
+
+
+STEPDIR_COLUMNS = ["motor", "chain", "µsteps", "speed", "DIAG after contact", "DIAG periods",
+                   "final error", "verdict"]
+
+
 def sweep(args):
     jobs = []
+    stepdir_jobs = []
     for name in args.motors.split(","):
         motor_ini = os.path.join(ROOT, "sil", "scenarios", "motors", f"{name}.ini")
         motor = read_motor(motor_ini)
@@ -160,7 +233,8 @@ def sweep(args):
             robust = chain == "realistic"
             sets = chain_sets({"rated_current_A": motor["rated_A"]}) if robust else []
             scenario = os.path.join(args.out, f"{name}_{chain}.ini")
-            top, run_start = design(args.tune, motor_ini, scenario, robust, sets)
+            figures = design(args.tune, motor_ini, scenario, robust, sets)
+            top, run_start = figures[0], figures[1]
             homing = designed_homing(args.sil, scenario, os.path.join(args.out, f"{name}_{chain}_design"))
             extra = sets + ([f"motor.resistance_Ohm={1.2 * motor['R']:.9g}"] if robust else [])
             fractions = (QUICK_FRACTIONS if args.quick else SPEED_FRACTIONS) + [None]
@@ -168,15 +242,24 @@ def sweep(args):
                 jobs.append((name, chain, motor, scenario, top, run_start, homing, fraction, 1 if n % 2 == 0 else -1,
                              True, extra))
             jobs.append((name, chain, motor, scenario, top, run_start, homing, None, 1, False, extra))
+            stepdir_jobs.append((name, chain, motor, scenario, figures, homing, extra))
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
         futures = [pool.submit(one_run, args, *job) for job in jobs]
+        stepdir_futures = [pool.submit(stepdir_case, args, *job) for job in stepdir_jobs]
         rows = []
         for future in futures:
             row = future.result()
             rows.append(row)
             print(line(row, False))
             sys.stdout.flush()
-    return rows
+        print("STEP/DIR homing on DIAG: " + "  ".join(STEPDIR_COLUMNS))
+        stepdir_rows = []
+        for future in stepdir_futures:
+            row = future.result()
+            stepdir_rows.append(row)
+            print(stepdir_line(row, False))
+            sys.stdout.flush()
+    return rows, stepdir_rows
 
 
 COLUMNS = ["motor", "chain", "speed", "stop", "state", "found by", "after contact", "stop error", "final error",
@@ -240,14 +323,41 @@ def summary_text(rows):
     return "; ".join(parts) + "."
 
 
-def report_text(rows, args, argv):
+def stepdir_summary(stepdir_rows):
+    met = [r for r in stepdir_rows if not r["failures"]]
+    latency = [r["diag_after_contact_s"] for r in met]
+    worst = max((abs(r["final_error_full_steps"]) for r in met), default=0.0)
+    text = f"STEP/DIR homing on DIAG: {len(met)} of {len(stepdir_rows)} met"
+    if met:
+        text += (f", DIAG {1e3 * min(latency):.1f} to {1e3 * max(latency):.1f} ms after the contact, the rotor "
+                 f"{STEPDIR_BACK_FULL_STEPS:g} full steps from the stop after the back-off within {worst:.3f} full steps")
+    return text + "."
+
+
+def report_text(rows, stepdir_rows, args, argv):
     lines = [report.header("Homing without a switch", "tools/homing_sweep.py", argv, __doc__.split("\n\n")[1]
                            .replace("\n", " ").strip()), ""]
+    lines += ["## Console homing (pmstep_homing.h)", ""]
     lines.append("| " + " | ".join(COLUMNS) + " |")
     lines.append("|" + "---|" * len(COLUMNS))
     lines += [line(r, True) for r in rows]
     lines += ["", summary_text(rows), ""]
+    lines += ["## Homing on DIAG over STEP/DIR (stepdir.stall_current_A)", "", STEPDIR_TEXT, ""]
+    lines.append("| " + " | ".join(STEPDIR_COLUMNS) + " |")
+    lines.append("|" + "---|" * len(STEPDIR_COLUMNS))
+    lines += [stepdir_line(r, True) for r in stepdir_rows]
+    lines += ["", stepdir_summary(stepdir_rows), ""]
     return "\n".join(lines)
+
+
+STEPDIR_TEXT = ("The count (the SIL's step generator, trapezoids at the designer's homing speed and acceleration) "
+                "runs to twice the stop's distance, then, after a dwell, back by "
+                f"{STEPDIR_BACK_FULL_STEPS:g} full steps, as a motion controller homing on DIAG and backing off "
+                "does; the drive's stall current is the designer's homing stall current. **DIAG after contact**: "
+                "the first DIAG period less the rotor's first contact; **final error**: the rotor's true distance "
+                f"from the stop less the {STEPDIR_BACK_FULL_STEPS:g} full steps of the back-off (the steps toward "
+                "the stop past the stall are dropped). Verdict: every pulse counted, following to the end, DIAG at "
+                f"the stop, no fault, |final error| within {BOUND_FULL_STEPS:g} full steps.")
 
 
 def main(argv=None):
@@ -272,14 +382,15 @@ def main(argv=None):
             ap.error(f"unknown chain '{c}' (chains: {', '.join(CHAINS)})")
     os.makedirs(args.out, exist_ok=True)
     print("  ".join(COLUMNS))
-    rows = sweep(args)
+    rows, stepdir_rows = sweep(args)
     print("homing_sweep: " + summary_text(rows))
+    print("homing_sweep: " + stepdir_summary(stepdir_rows))
     if args.json:
         with open(args.json, "w") as f:
-            json.dump(rows, f, indent=1)
+            json.dump({"console": rows, "stepdir": stepdir_rows}, f, indent=1)
     if args.report:
-        print(f"homing_sweep: wrote {report.write(args.report, report_text(rows, args, argv))}")
-    failed = [r for r in rows if r["failures"]]
+        print(f"homing_sweep: wrote {report.write(args.report, report_text(rows, stepdir_rows, args, argv))}")
+    failed = [r for r in rows + stepdir_rows if r["failures"]]
     return 1 if (failed and args.check) else 0
 
 

@@ -265,7 +265,7 @@ static void start_tracking(pmstep_position_t *pos)
 }
 
 /* Every N-th period: the estimate (the fine angle) and, in position mode, the loop. */
-POSITION_OUT_OF_LINE static void update(pmstep_position_t *pos)
+POSITION_OUT_OF_LINE static void update(pmstep_position_t *pos, float i_q_ref_A)
 {
     const float position_rad = estimate(pos);
     pos->loop_countdown = PMSTEP_POSITION_DECIMATION;
@@ -282,6 +282,16 @@ POSITION_OUT_OF_LINE static void update(pmstep_position_t *pos)
         pmstep_stepdir_track(pos->steps); /* every update, the hold's included: it sees the next step */
         if (pos->steps->moving && pmstep_position_vector_held(pos)) {
             pmstep_position_release_hold(pos);
+        }
+        if (!pos->steps->moving && !pos->steps->stalled) {
+            pos->steps->rest_load_Nm = pos->inst->observer.load_hat_Nm;
+        }
+        /* the push: i_q* beyond what the tracker's own acceleration asks */
+        if (pmstep_stepdir_stall(pos->steps, position_rad,
+                                 i_q_ref_A - pos->inst->law_coeffs.j_over_km * pos->steps->accel_rad_s2)) {
+            /* the loop stops pressing the block: no integral, and the block's reaction out of T_L-hat */
+            pos->error_integral_rad_s = 0.0f;
+            pos->inst->observer.load_hat_Nm = pos->steps->rest_load_Nm;
         }
     }
     if (pos->out.position_mode) {
@@ -324,7 +334,7 @@ void pmstep_position_update(pmstep_position_t *pos, const pmstep_output_t *out, 
         pos->speed_hat_rad_s = out->speed_hat_rad_s;
         pos->loop_countdown--;
         if (pos->loop_countdown <= 0) {
-            update(pos);
+            update(pos, out->i_q_ref_A);
         }
     }
     *pos_out = pos->out;
@@ -510,11 +520,15 @@ pmstep_status_t pmstep_position_follow_steps(pmstep_position_t *pos, struct pmst
     if (!pos->out.tracked) {
         return PMSTEP_ERR_BAD_MODE;
     }
+    if (!(sd->cfg.stall_current_A < pos->inst->cfg->limits.max_phase_current_A)) {
+        return PMSTEP_ERR_STEPDIR_STALL_CURRENT;
+    }
     pmstep_position_release_hold(pos);
     start = profile_start(pos);
     stop_following(pos);
     pmstep_motion_reset(&pos->motion, start.position, pos->motion.period_s); /* no move left to resume */
     pmstep_stepdir_start(sd, &start);
+    sd->rest_load_Nm = pos->inst->observer.load_hat_Nm;
     pos->steps = sd;
     enter_position_mode(pos);
     pos->ahead = start;

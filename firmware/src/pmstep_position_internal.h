@@ -43,6 +43,11 @@ void pmstep_stepdir_start(struct pmstep_stepdir *sd, const pmstep_motion_sample_
 /* An update: the tracker predicted over T and corrected by the count; at rest after stop_time_s. */
 void pmstep_stepdir_track(struct pmstep_stepdir *sd);
 
+/* An update after the tracker's, with stall_current_A > 0 or while stalled (pmstep_stepdir.h, Stall): the
+ * stall test on theta-hat @p position_rad and the q current @p push_A beyond the tracker's acceleration's,
+ * the steps toward a block dropped. @return true when a stall was found at this update. */
+bool pmstep_stepdir_stall(struct pmstep_stepdir *sd, float position_rad, float push_A);
+
 /* The tracker's state moved on by @p ahead_s at constant acceleration. */
 pmstep_motion_sample_t pmstep_stepdir_predict(const struct pmstep_stepdir *sd, float ahead_s);
 

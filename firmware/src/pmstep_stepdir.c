@@ -8,6 +8,7 @@
 #include <math.h> /* fabsf: one instruction, no libm call */
 #include <stddef.h>
 
+#include "pmstep/pmstep_homing.h"
 #include "pmstep/pmstep_position.h"
 #include "pmstep_position_internal.h"
 
@@ -16,6 +17,8 @@
 #define MAX_POLE_PHASE 4.0f          /* w_t T at most: the tracker's poles at e^-4 or nearer 1 */
 #define STOP_TIME_PER_TRACKER 8.0f   /* the designer's stop time: 8 / w_t, the tracker settled to e^-8 */
 #define DIAG_PULSE_S 1e-3f           /* the designer's DIAG pulse */
+#define STALL_UP ((int32_t)1)        /* stall_direction */
+#define STALL_DOWN ((int32_t)-1)
 
 /* e^-x for 0 <= x <= MAX_POLE_PHASE without libm: the series of e^-(x/16) to x^5, squared four times
  * (relative error below 1e-5 over the range). */
@@ -50,6 +53,7 @@ pmstep_status_t pmstep_stepdir_design(const pmstep_config_t *cfg, uint32_t micro
     if (sd->diag_pulse_periods == 0u) {
         sd->diag_pulse_periods = 1u;
     }
+    sd->stall_current_A = 0.0f;
     return PMSTEP_OK;
 }
 
@@ -80,6 +84,9 @@ pmstep_status_t pmstep_stepdir_init(pmstep_stepdir_t *sd, const pmstep_stepdir_c
     if ((cfg->diag_mode != PMSTEP_DIAG_LEVEL) && (cfg->diag_mode != PMSTEP_DIAG_PULSE)) {
         return PMSTEP_ERR_STEPDIR_DIAG_MODE;
     }
+    if (!(cfg->stall_current_A >= 0.0f) || (cfg->stall_current_A - cfg->stall_current_A) != 0.0f) {
+        return PMSTEP_ERR_STEPDIR_STALL_CURRENT;
+    }
     sd->cfg = *cfg;
     sd->rad_per_microstep = TWO_PI / (4.0f * (float)pole_pairs * (float)cfg->microsteps);
     sd->update_s = update_s;
@@ -102,6 +109,11 @@ pmstep_status_t pmstep_stepdir_init(pmstep_stepdir_t *sd, const pmstep_stepdir_c
     sd->diag = false;
     sd->diag_cause = false;
     sd->diag_pulse_left = 0u;
+    sd->stalled = false;
+    sd->stall_direction = 0;
+    sd->stall_steps = 0;
+    sd->stall_position_rad = 0.0f;
+    sd->rest_load_Nm = 0.0f;
     return PMSTEP_OK;
 }
 
@@ -119,7 +131,7 @@ bool pmstep_stepdir_diag(pmstep_stepdir_t *sd, pmstep_mode_t mode, float positio
 {
     const bool lost = sd->following && tracked
                       && fabsf(pmstep_stepdir_following_error(sd, position_rad)) > sd->cfg.following_error_limit_rad;
-    const bool cause = mode == PMSTEP_MODE_FAULT || lost;
+    const bool cause = mode == PMSTEP_MODE_FAULT || lost || (sd->following && sd->stalled);
     if (sd->cfg.diag_mode == PMSTEP_DIAG_LEVEL) {
         sd->diag = cause;
     } else {
@@ -137,6 +149,7 @@ bool pmstep_stepdir_diag(pmstep_stepdir_t *sd, pmstep_mode_t mode, float positio
 
 void pmstep_stepdir_start(pmstep_stepdir_t *sd, const pmstep_motion_sample_t *start)
 {
+    sd->stalled = false;
     sd->steps_at_update = sd->steps;
     sd->origin_rad = start->position - (float)sd->steps * sd->rad_per_microstep;
     sd->position_rad = start->position;
@@ -182,4 +195,43 @@ pmstep_motion_sample_t pmstep_stepdir_predict(const pmstep_stepdir_t *sd, float 
     s.accel = sd->accel_rad_s2;
     s.jerk = 0.0f;
     return s;
+}
+
+/* The tracker at rest on the stall's position, the count up to now mapped there: the steps since are dropped. */
+static void drop_steps(pmstep_stepdir_t *sd)
+{
+    sd->stall_steps = sd->steps_at_update;
+    sd->origin_rad = sd->stall_position_rad - (float)sd->steps_at_update * sd->rad_per_microstep;
+    sd->position_rad = sd->stall_position_rad;
+    sd->speed_rad_s = 0.0f;
+    sd->accel_rad_s2 = 0.0f;
+}
+
+bool pmstep_stepdir_stall(pmstep_stepdir_t *sd, float position_rad, float push_A)
+{
+    bool found = false;
+    if (sd->stalled) {
+        const int32_t moved = sd->steps_at_update - sd->stall_steps;
+        if (moved * sd->stall_direction > 0) {
+            drop_steps(sd); /* still toward the block */
+        } else if (moved != 0) {
+            sd->stalled = false; /* a step away: followed from where the rotor rests */
+        } else {
+            /* no step since */
+        }
+    } else if (sd->cfg.stall_current_A > 0.0f) {
+        const float error_rad = pmstep_stepdir_following_error(sd, position_rad);
+        const float direction = error_rad >= 0.0f ? 1.0f : -1.0f;
+        if (pmstep_homing_stalled(direction, error_rad, sd->cfg.following_error_limit_rad, push_A,
+                                  sd->cfg.stall_current_A, true)) {
+            sd->stalled = true;
+            sd->stall_direction = (error_rad >= 0.0f) ? STALL_UP : STALL_DOWN;
+            sd->stall_position_rad = position_rad;
+            drop_steps(sd);
+            found = true;
+        }
+    } else {
+        /* no stall test */
+    }
+    return found;
 }

@@ -83,6 +83,7 @@ const char *pmstep_status_str(pmstep_status_t status)
     case PMSTEP_ERR_STEPDIR_TRACKING: return "step tracker bandwidth not usable";
     case PMSTEP_ERR_STEPDIR_LIMIT: return "following-error limit, stop time or DIAG pulse not > 0";
     case PMSTEP_ERR_STEPDIR_DIAG_MODE: return "DIAG mode neither level nor pulse";
+    case PMSTEP_ERR_STEPDIR_STALL_CURRENT: return "STEP/DIR stall current not within 0 to the trip";
     case PMSTEP_ERR_HOMING: return "homing: speed, acceleration, travel, stall error > 0, back-off >= 0, stall current below the trip";
     case PMSTEP_ERR_POSITION_GAIN: return "need 0 < k_theta <= k_w/2";
     case PMSTEP_ERR_POSITION_INTEGRAL_GAIN: return "need 0 <= k_I <= k_theta^2/4";

@@ -296,6 +296,9 @@ static cJSON *summary_json(const sil_scenario_t *sc, const sil_summary_t *s)
     if (sc->position_moves > 0 && sc->position_source == SIL_SOURCE_STEPDIR) {
         add_stepdir_json(root, sc, s);
     }
+    if (sc->motor.stop_side != 0) {
+        cJSON_AddNumberToObject(root, "stop_contact_s", s->stop_contact_s);
+    }
     if (sc->position_moves > 0 && sc->position_source == SIL_SOURCE_HOMING) {
         add_homing_json(root, s);
     }

@@ -183,6 +183,7 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
     if (s->init_status != PMSTEP_OK) {
         return -1;
     }
+    s->stop_contact_s = -1.0;
     if (sil_bind_plant(sc, &plant) != 0) {
         return -3;
     }
@@ -302,6 +303,9 @@ int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user
             sil_stepdir_run_sample(&stepdir_run, &sample, s);
         }
         sil_metrics_add(&metrics, &sample, s);
+        if (s->stop_contact_s < 0.0 && plant_stop_torque(&plant.params, sample.theta_rad, 0.0) != 0.0) {
+            s->stop_contact_s = t_s;
+        }
 
         if (progress && k + 1 >= steps * next_progress_decile / 10) {
             /* A line that rewrites itself on a terminal, one line per 10 % in a log. */

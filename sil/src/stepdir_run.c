@@ -36,6 +36,7 @@ pmstep_status_t sil_stepdir_run_init(sil_stepdir_run_t *run, const sil_scenario_
             return status;
         }
         cfg.diag_mode = sc->stepdir_diag_mode;
+        cfg.stall_current_A = sc->stepdir_stall_current_A;
         if (sc->stepdir_tracking_bandwidth_rad_s > 0.0f) {
             /* the designer's stop time is a fixed number of tracker time constants: it scales with 1 / w_t */
             cfg.stop_time_s *= cfg.tracking_bandwidth_rad_s / sc->stepdir_tracking_bandwidth_rad_s;

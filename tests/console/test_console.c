@@ -15,6 +15,7 @@
 
 #include "pmstep_console.h"
 #include "console_test_frame.h"
+#include "stepdir_settings_equal.h"
 
 static pmstep_console_t con;
 static pmstep_config_t cfg;
@@ -197,7 +198,7 @@ static void test_config_by_name_and_id(void **state)
         if ((t[id].flags & PMSTEP_CONSOLE_CFG_READ_ONLY) == 0u) {
             assert_int_equal(pmstep_console_config_set(&copy, &sd, id, v), 0);
             assert_memory_equal(&copy, &cfg, sizeof cfg);
-            assert_memory_equal(&sd, &con.stepdir, sizeof sd);
+            assert_stepdir_settings_equal(&sd, &con.stepdir);
         } else {
             assert_int_equal(pmstep_console_config_set(&copy, &sd, id, v), PMSTEP_CONSOLE_ERR_READ_ONLY);
         }

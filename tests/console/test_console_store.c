@@ -15,6 +15,7 @@
 #include "console_test_frame.h"
 #include "fake_flash.h"
 #include "pmstep_console.h"
+#include "stepdir_settings_equal.h"
 
 #define BOARD_ID 0x51454D55u
 
@@ -362,7 +363,7 @@ static void test_stepdir_settings_set_saved_and_booted(void **state)
     const pmstep_config_t before = cfg;
     uint8_t flags = 0u;
     (void)state;
-    assert_memory_equal(&con.stepdir, &defaults_sd, sizeof defaults_sd);
+    assert_stepdir_settings_equal(&con.stepdir, &defaults_sd);
     assert_true(get_by_name("stepdir.microsteps", &flags) == 16.0f);
     assert_int_equal(flags, PMSTEP_CONSOLE_CFG_STEPDIR);
     assert_true(get_by_name("stepdir.following_error_limit_full_steps", &flags) == 1.0f);
@@ -376,7 +377,10 @@ static void test_stepdir_settings_set_saved_and_booted(void **state)
     assert_int_equal(set_by_name("stepdir.following_error_limit_full_steps", -0.5f), PMSTEP_ERR_STEPDIR_LIMIT);
     assert_int_equal(set_by_name("stepdir.microsteps", 12.5f), 1000 + PMSTEP_CONSOLE_ERR_BAD_VALUE);
     assert_int_equal(set_by_name("stepdir.invert_direction", 2.0f), 1000 + PMSTEP_CONSOLE_ERR_BAD_VALUE);
-    assert_memory_equal(&con.stepdir, &defaults_sd, sizeof defaults_sd);
+    assert_int_equal(set_by_name("stepdir.stall_current_A", -0.1f), PMSTEP_ERR_STEPDIR_STALL_CURRENT);
+    assert_int_equal(set_by_name("stepdir.stall_current_A", cfg.limits.max_phase_current_A),
+                     PMSTEP_ERR_STEPDIR_STALL_CURRENT); /* at the trip a stall would never be found */
+    assert_stepdir_settings_equal(&con.stepdir, &defaults_sd);
     /* Accepted: in force at once; the core's configuration untouched. */
     assert_int_equal(set_by_name("stepdir.microsteps", 256.0f), PMSTEP_OK);
     assert_int_equal(set_by_name("stepdir.microsteps", 1.0f), PMSTEP_OK);
@@ -386,6 +390,12 @@ static void test_stepdir_settings_set_saved_and_booted(void **state)
     assert_int_equal(set_by_name("stepdir.diag_active_high", 0.0f), PMSTEP_OK);
     assert_int_equal(set_by_name("stepdir.diag_mode", 1.0f), PMSTEP_OK);
     assert_int_equal(set_by_name("stepdir.following_error_limit_full_steps", 1.5f), PMSTEP_OK);
+    assert_int_equal(set_by_name("stepdir.stall_current_A", 0.9f * cfg.limits.max_phase_current_A), PMSTEP_OK);
+    assert_memory_equal(&cfg, &before, sizeof cfg);
+    assert_true(con.stepdir.stall_current_A == 0.9f * cfg.limits.max_phase_current_A);
+    /* the trip may not be lowered to the stall current: refused by the STEP/DIR setting's name */
+    assert_int_equal(set_by_name("limits.max_phase_current_A", 0.9f * cfg.limits.max_phase_current_A),
+                     PMSTEP_ERR_STEPDIR_STALL_CURRENT);
     assert_memory_equal(&cfg, &before, sizeof cfg);
     assert_int_equal(con.stepdir.microsteps, 32u);
     assert_true(con.stepdir.invert_direction && con.stepdir.enable_active_high && !con.stepdir.diag_active_high);
@@ -395,7 +405,7 @@ static void test_stepdir_settings_set_saved_and_booted(void **state)
      * force, then ours again, saved. */
     write_record(b, n, 58u);
     assert_int_equal(ack(PMSTEP_CONSOLE_CONFIG_APPLY), 0);
-    assert_memory_equal(&con.stepdir, &defaults_sd, sizeof defaults_sd);
+    assert_stepdir_settings_equal(&con.stepdir, &defaults_sd);
     assert_int_equal(set_by_name("stepdir.microsteps", 32.0f), PMSTEP_OK);
     assert_int_equal(set_by_name("stepdir.enable_active_high", 1.0f), PMSTEP_OK);
     assert_int_equal(set_by_name("stepdir.diag_mode", 1.0f), PMSTEP_OK);
@@ -414,7 +424,7 @@ static void test_stepdir_settings_set_saved_and_booted(void **state)
     assert_int_equal(ack(PMSTEP_CONSOLE_STOP), PMSTEP_OK);
     step();
     assert_int_equal(ack(PMSTEP_CONSOLE_CONFIG_DEFAULTS), PMSTEP_OK);
-    assert_memory_equal(&con.stepdir, &defaults_sd, sizeof defaults_sd);
+    assert_stepdir_settings_equal(&con.stepdir, &defaults_sd);
 }
 
 /* The step tracker's settings from the STEP/DIR settings: the designer's with ours over them, the limit
@@ -487,7 +497,7 @@ static void test_boot_record_before_stepdir_settings(void **state)
     assert_int_equal(boot(), PMSTEP_STORE_ERR_LAYOUT);
     assert_false(cs.configured);
     assert_memory_equal(&cfg, &defaults, sizeof cfg);
-    assert_memory_equal(&con.stepdir, &defaults_sd, sizeof defaults_sd);
+    assert_stepdir_settings_equal(&con.stepdir, &defaults_sd);
     send_request(PMSTEP_CONSOLE_CONFIG_STATUS, NULL, 0u);
     assert_int_equal(replies(&r, 1), 1u);
     assert_int_equal(console_test_i16(&r.data[1]), PMSTEP_STORE_ERR_LAYOUT);

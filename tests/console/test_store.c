@@ -14,6 +14,7 @@
 #include "fake_flash.h"
 #include "pmstep_console.h"
 #include "pmstep_store.h"
+#include "stepdir_settings_equal.h"
 
 #define BOARD_ID 0x47343331u
 
@@ -124,7 +125,7 @@ static void test_round_trip(void **state)
     assert_int_equal(pmstep_store_decode(b, n, BOARD_ID, &board, &back, NULL, &seq), PMSTEP_STORE_OK);
     assert_int_equal(seq, 7u);
     assert_memory_equal(&back.measured, &rec.measured, sizeof rec.measured);
-    assert_memory_equal(&back.stepdir, &rec.stepdir, sizeof rec.stepdir);
+    assert_stepdir_settings_equal(&back.stepdir, &rec.stepdir);
     assert_true(back.config.motor.inertia_kgm2 == 0.01f * 1.7f);
     {
         uint32_t id;
@@ -347,10 +348,18 @@ static void test_record_before_stepdir_settings_refused(void **state)
     uint8_t b[PMSTEP_STORE_RECORD_MAX_BYTES];
     uint32_t n;
     uint32_t off;
+    uint32_t count;
+    uint32_t stepdir_values = 0u;
+    uint32_t id;
     (void)state;
     memset(b, 0xFF, sizeof b);
+    (void)pmstep_console_config_table(&count);
+    for (id = 0; id < count; ++id) {
+        stepdir_values += pmstep_console_config_is_stepdir(id) ? 1u : 0u;
+    }
     n = record_before_stepdir(&rec, 1u, b);
-    assert_int_equal(n, pmstep_store_record_bytes() - 4u * 6u); /* six STEP/DIR values fewer */
+    assert_int_equal(stepdir_values, 7u);
+    assert_int_equal(n, pmstep_store_record_bytes() - 4u * stepdir_values); /* the STEP/DIR values fewer */
     assert_int_equal(pmstep_store_decode(b, n, BOARD_ID, &board, &out, NULL, NULL), PMSTEP_STORE_ERR_LAYOUT);
     assert_int_equal(flash.ops.erase(flash.ops.ctx, 0u), 0);
     for (off = 0; off < ((n + 7u) & ~7u); off += 8u) {
@@ -363,7 +372,7 @@ static void test_record_before_stepdir_settings_refused(void **state)
     assert_int_equal(store.slot, 1);
     assert_int_equal(pmstep_store_init(&store, &flash.ops, BOARD_ID), PMSTEP_STORE_OK);
     assert_int_equal(pmstep_store_load(&store, &board, &out, NULL), PMSTEP_STORE_OK);
-    assert_memory_equal(&out.stepdir, &rec.stepdir, sizeof rec.stepdir);
+    assert_stepdir_settings_equal(&out.stepdir, &rec.stepdir);
 }
 
 static void test_empty_store(void **state)

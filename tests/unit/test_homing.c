@@ -16,6 +16,7 @@
 #include "pmstep/pmstep_homing.h"
 #include "pmstep/pmstep_position.h"
 #include "pmstep/pmstep_ref.h"
+#include "pmstep/pmstep_stepdir.h"
 
 #define PAPER_P 6.0
 
@@ -157,6 +158,24 @@ static void settings_refused_by_cause(void **state)
     assert_int_equal(pmstep_homing_start(&f.homing, &f.pos, &f.homing_cfg, 1), PMSTEP_ERR_BAD_MODE);
 }
 
+/* The STEP/DIR input's stall current must stay below the trip, where a stall can be found. */
+static void stepdir_stall_current_below_the_trip(void **state)
+{
+    fixture_t f;
+    pmstep_stepdir_t sd;
+    pmstep_stepdir_config_t c;
+    (void)state;
+    fixture_init(&f);
+    assert_int_equal(pmstep_stepdir_design(&f.cfg, 16u, &c), PMSTEP_OK);
+    c.stall_current_A = f.cfg.limits.max_phase_current_A;
+    assert_int_equal(pmstep_stepdir_init(&sd, &c, f.cfg.motor.pole_pairs, f.cfg.timing.period_s, 0u), PMSTEP_OK);
+    assert_int_equal(pmstep_position_follow_steps(&f.pos, &sd), PMSTEP_ERR_STEPDIR_STALL_CURRENT);
+    assert_false(f.pos.out.position_mode);
+    c.stall_current_A = f.homing_cfg.stall_current_A;
+    assert_int_equal(pmstep_stepdir_init(&sd, &c, f.cfg.motor.pole_pairs, f.cfg.timing.period_s, 0u), PMSTEP_OK);
+    assert_int_equal(pmstep_position_follow_steps(&f.pos, &sd), PMSTEP_OK);
+}
+
 /* The rotor meets a stop at 0.3 rad: found by the following error, the zero put there, one full step back. */
 static void finds_the_stop_by_the_following_error_and_backs_off(void **state)
 {
@@ -248,6 +267,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(designer_rule_from_the_motor_data),
         cmocka_unit_test(settings_refused_by_cause),
+        cmocka_unit_test(stepdir_stall_current_below_the_trip),
         cmocka_unit_test(finds_the_stop_by_the_following_error_and_backs_off),
         cmocka_unit_test(finds_the_stop_by_the_current_once_cruising),
         cmocka_unit_test(not_found_within_the_travel),

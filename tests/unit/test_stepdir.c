@@ -54,6 +54,12 @@ static void settings_refused_by_cause(void **state)
     c = designed(16u);
     c.diag_mode = (pmstep_diag_mode_t)2;
     assert_int_equal(pmstep_stepdir_init(&sd, &c, POLE_PAIRS, PERIOD_S, 0u), PMSTEP_ERR_STEPDIR_DIAG_MODE);
+    c = designed(16u);
+    assert_true(c.stall_current_A == 0.0f); /* the designer's: off */
+    c.stall_current_A = -0.1f;
+    assert_int_equal(pmstep_stepdir_init(&sd, &c, POLE_PAIRS, PERIOD_S, 0u), PMSTEP_ERR_STEPDIR_STALL_CURRENT);
+    c.stall_current_A = NAN;
+    assert_int_equal(pmstep_stepdir_init(&sd, &c, POLE_PAIRS, PERIOD_S, 0u), PMSTEP_ERR_STEPDIR_STALL_CURRENT);
 }
 
 /* The 16-bit counter wraps; a difference is signed; DIR's sense can be reversed. */
@@ -162,6 +168,72 @@ static void diag_level_and_pulse(void **state)
     assert_int_equal(asserted, 20u);
 }
 
+/* @p steps counted (microsteps, signed), then one tracker update. */
+static void count_and_track(pmstep_stepdir_t *sd, int32_t steps)
+{
+    pmstep_stepdir_count(sd, (uint32_t)(uint16_t)((int32_t)sd->last_counter + steps));
+    pmstep_stepdir_track(sd);
+}
+
+/* With a stall current: the following error beyond the limit, or the push beyond the stall current toward
+ * the count, is a stall (DIAG); the tracker rests on theta-hat, steps toward the block are dropped, the
+ * first step away releases it and is followed from there. Off (0): never a stall. */
+static void stall_drops_the_steps_toward_the_block(void **state)
+{
+    pmstep_stepdir_t sd;
+    pmstep_stepdir_config_t c = designed(16u);
+    const pmstep_motion_sample_t rest = {0.0f, 0.0f, 0.0f, 0.0f};
+    const float limit = c.following_error_limit_rad;
+    float microstep;
+    (void)state;
+    c.stall_current_A = 1.0f;
+    assert_int_equal(pmstep_stepdir_init(&sd, &c, POLE_PAIRS, PERIOD_S, 0u), PMSTEP_OK);
+    microstep = sd.rad_per_microstep;
+    pmstep_stepdir_start(&sd, &rest);
+    /* 60 microsteps toward +, the rotor blocked at 0.01 rad: the error within the limit, the push below */
+    count_and_track(&sd, 60);
+    assert_true(pmstep_stepdir_following_error(&sd, 0.01f) < limit);
+    assert_false(pmstep_stepdir_stall(&sd, 0.01f, 0.5f));
+    count_and_track(&sd, 140);
+    assert_true(pmstep_stepdir_following_error(&sd, 0.01f) > limit);
+    assert_true(pmstep_stepdir_stall(&sd, 0.01f, 0.5f));  /* the following error: a stall */
+    assert_true(sd.stalled);
+    assert_int_equal(sd.stall_direction, 1);
+    assert_float_equal(sd.position_rad, 0.01f, 1e-7f);
+    assert_float_equal(sd.speed_rad_s, 0.0f, 0.0f);
+    assert_float_equal(pmstep_stepdir_following_error(&sd, 0.01f), 0.0f, 1e-6f);
+    assert_true(pmstep_stepdir_diag(&sd, PMSTEP_MODE_RUN, 0.01f, true)); /* level: while stalled */
+    /* more steps toward the block: dropped, the tracker stays on the rotor */
+    count_and_track(&sd, 16);
+    assert_false(pmstep_stepdir_stall(&sd, 0.01f, 0.0f));
+    assert_float_equal(sd.position_rad, 0.01f, 1e-7f);
+    assert_float_equal(pmstep_stepdir_commanded(&sd), 0.01f, 1e-6f);
+    assert_true(sd.stalled);
+    /* steps away: released, followed from where the rotor rests */
+    count_and_track(&sd, -8);
+    assert_false(pmstep_stepdir_stall(&sd, 0.01f, 0.0f));
+    assert_false(sd.stalled);
+    assert_float_equal(pmstep_stepdir_commanded(&sd), 0.01f - 8.0f * microstep, 1e-6f);
+    assert_false(pmstep_stepdir_diag(&sd, PMSTEP_MODE_RUN, 0.01f, true));
+    /* the push beyond the stall current toward the count is a stall too, with no following error yet */
+    count_and_track(&sd, -4);
+    assert_true(pmstep_stepdir_following_error(&sd, 0.01f) < 0.0f); /* the count below the rotor */
+    assert_false(pmstep_stepdir_stall(&sd, 0.01f, 1.1f)); /* a push up, away from the count: not a stall */
+    count_and_track(&sd, 4);
+    assert_true(pmstep_stepdir_following_error(&sd, -0.02f) > 0.0f);
+    assert_true(pmstep_stepdir_following_error(&sd, -0.02f) < limit);
+    assert_true(pmstep_stepdir_stall(&sd, -0.02f, 1.1f));
+    assert_int_equal(sd.stall_direction, 1);
+    /* off: the same error and push are not a stall */
+    c.stall_current_A = 0.0f;
+    assert_int_equal(pmstep_stepdir_init(&sd, &c, POLE_PAIRS, PERIOD_S, 0u), PMSTEP_OK);
+    pmstep_stepdir_start(&sd, &rest);
+    count_and_track(&sd, 200);
+    assert_true(pmstep_stepdir_following_error(&sd, 0.01f) > limit);
+    assert_false(pmstep_stepdir_stall(&sd, 0.01f, 5.0f));
+    assert_false(sd.stalled);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -170,6 +242,7 @@ int main(void)
         cmocka_unit_test(tracker_has_no_steady_lag),
         cmocka_unit_test(at_rest_on_the_last_count),
         cmocka_unit_test(diag_level_and_pulse),
+        cmocka_unit_test(stall_drops_the_steps_toward_the_block),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

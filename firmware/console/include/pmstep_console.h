@@ -262,15 +262,17 @@ pmstep_stepdir_settings_t pmstep_console_stepdir_defaults(void);
  * @retval PMSTEP_ERR_STEPDIR_MICROSTEPS  microsteps not within 1..PMSTEP_STEPDIR_MAX_MICROSTEPS
  * @retval PMSTEP_ERR_STEPDIR_DIAG_MODE   diag_mode neither PMSTEP_DIAG_LEVEL nor PMSTEP_DIAG_PULSE
  * @retval PMSTEP_ERR_STEPDIR_LIMIT       following_error_limit_full_steps not > 0 (or not finite)
+ * @retval PMSTEP_ERR_STEPDIR_STALL_CURRENT  stall_current_A < 0 (or not finite)
  */
 pmstep_status_t pmstep_console_stepdir_validate(const pmstep_stepdir_settings_t *sd);
 
 /**
  * The step tracker's settings for the motor of @p cfg from the STEP/DIR settings @p sd: the
- * designer's (pmstep_stepdir_design()) with sd's microsteps, direction, DIAG mode and following-error
- * limit (full steps times pi / (2 p)).
- * @return pmstep_console_stepdir_validate()'s or pmstep_stepdir_design()'s status; @p out written on
- *         PMSTEP_OK only.
+ * designer's (pmstep_stepdir_design()) with sd's microsteps, direction, DIAG mode, following-error
+ * limit (full steps times pi / (2 p)) and stall current.
+ * @return pmstep_console_stepdir_validate()'s or pmstep_stepdir_design()'s status, or
+ *         PMSTEP_ERR_STEPDIR_STALL_CURRENT for a stall current not below @p cfg's max_phase_current_A;
+ *         @p out written on PMSTEP_OK only.
  */
 pmstep_status_t pmstep_console_stepdir_config(const pmstep_config_t *cfg, const pmstep_stepdir_settings_t *sd,
                                               pmstep_stepdir_config_t *out);

@@ -99,6 +99,10 @@ typedef struct {
     uint32_t diag_mode;                     /**< DIAG's mode: PMSTEP_DIAG_LEVEL (0) or PMSTEP_DIAG_PULSE (1) */
     float following_error_limit_full_steps; /**< DIAG beyond this following error, in full steps of the motor
                                                  (pi / (2 p) mechanical rad each; > 0, the designer's 1) */
+    float stall_current_A;                  /**< homing on DIAG: a stall at this q current (or at the following-error
+                                                 limit) drops the steps toward the block (pmstep_stepdir.h); 0 = off,
+                                                 else below max_phase_current_A (the designer's homing: half the rated
+                                                 current) */
 } pmstep_stepdir_settings_t;
 
 /** A record's contents. */

@@ -191,13 +191,17 @@ void pmstep_console_boundary(pmstep_console_t *c, pmstep_t *inst, pmstep_config_
         if (pmstep_console_config_is_stepdir(req->cfg_id)) {
             /* The STEP/DIR input's: checked whole, in force when accepted; the core is not touched (the
              * image applies them when it next starts following). */
-            st = (int32_t)pmstep_console_stepdir_validate(&stepdir);
+            pmstep_stepdir_config_t in_force;
+            st = (int32_t)pmstep_console_stepdir_config(cfg, &stepdir, &in_force); /* the stall current by the trip */
             if (st == (int32_t)PMSTEP_OK) {
                 c->stepdir = stepdir;
             }
             break;
         }
         st = (int32_t)pmstep_validate_config(&trial);
+        if (st == (int32_t)PMSTEP_OK && !(c->stepdir.stall_current_A < trial.limits.max_phase_current_A)) {
+            st = (int32_t)PMSTEP_ERR_STEPDIR_STALL_CURRENT; /* the trip lowered to or below the STEP/DIR stall current */
+        }
         if (st == (int32_t)PMSTEP_OK) {
             *cfg = trial;
             st = (int32_t)pmstep_init(inst, cfg);

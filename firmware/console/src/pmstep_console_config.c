@@ -92,6 +92,7 @@ static const pmstep_console_config_entry_t table[] = {
     SD_BOOL(diag_active_high),
     SD_U32(diag_mode),
     SD_F32(following_error_limit_full_steps),
+    SD_F32(stall_current_A),
 };
 
 #define HALF_PI 1.5707963f
@@ -203,6 +204,7 @@ pmstep_stepdir_settings_t pmstep_console_stepdir_defaults(void)
     sd.diag_active_high = true;
     sd.diag_mode = (uint32_t)PMSTEP_DIAG_LEVEL;
     sd.following_error_limit_full_steps = 1.0f;
+    sd.stall_current_A = 0.0f;
     return sd;
 }
 
@@ -220,6 +222,9 @@ pmstep_status_t pmstep_console_stepdir_validate(const pmstep_stepdir_settings_t 
     if (!(sd->following_error_limit_full_steps > 0.0f)
         || (sd->following_error_limit_full_steps - sd->following_error_limit_full_steps) != 0.0f) {
         return PMSTEP_ERR_STEPDIR_LIMIT;
+    }
+    if (!(sd->stall_current_A >= 0.0f) || (sd->stall_current_A - sd->stall_current_A) != 0.0f) {
+        return PMSTEP_ERR_STEPDIR_STALL_CURRENT;
     }
     return PMSTEP_OK;
 }
@@ -242,6 +247,10 @@ pmstep_status_t pmstep_console_stepdir_config(const pmstep_config_t *cfg, const 
     c.invert_direction = sd->invert_direction;
     c.diag_mode = sd->diag_mode == (uint32_t)PMSTEP_DIAG_PULSE ? PMSTEP_DIAG_PULSE : PMSTEP_DIAG_LEVEL;
     c.following_error_limit_rad = sd->following_error_limit_full_steps * HALF_PI / (float)cfg->motor.pole_pairs;
+    if (!(sd->stall_current_A < cfg->limits.max_phase_current_A)) {
+        return PMSTEP_ERR_STEPDIR_STALL_CURRENT; /* a stall at or beyond the trip would never be found */
+    }
+    c.stall_current_A = sd->stall_current_A;
     *out = c;
     return PMSTEP_OK;
 }

@@ -224,7 +224,8 @@ pmstep_store_status_t pmstep_store_decode(const uint8_t *in, uint32_t n, uint32_
     trial.measured.friction_Nms_rad = measured[6];
     valid = pmstep_validate_config(&trial.config);
     if (valid == PMSTEP_OK) {
-        valid = pmstep_console_stepdir_validate(&trial.stepdir);
+        pmstep_stepdir_config_t in_force;
+        valid = pmstep_console_stepdir_config(&trial.config, &trial.stepdir, &in_force); /* with the trip */
     }
     if (valid != PMSTEP_OK) {
         if (validation != NULL) {

@@ -240,6 +240,7 @@ pmstep_status_t pmstep_position_rest_here(pmstep_position_t *pos);
  * pmstep_position_hold() or a speed command end it, as does leaving RUN.
  * @retval PMSTEP_OK, PMSTEP_ERR_NULL_ARGUMENT
  * @retval PMSTEP_ERR_BAD_MODE  not tracked (not in RUN)
+ * @retval PMSTEP_ERR_STEPDIR_STALL_CURRENT  @p sd's stall current not below max_phase_current_A
  */
 pmstep_status_t pmstep_position_follow_steps(pmstep_position_t *pos, struct pmstep_stepdir *sd);
 

@@ -25,8 +25,19 @@
  * At rest: no step for stop_time_s, the reference is at rest on the last count's position, and the
  * position loop's vector hold may take over (pmstep_position.h); the next step releases it.
  *
- * DIAG: asserted while the core is in FAULT, and when |theta* - theta-hat| exceeds
- * following_error_limit_rad (lost steps, a stall); in level mode for as long as either holds, in
+ * Stall (stall_current_A > 0: sensorless homing against a stop, and a cap on the push into whatever
+ * blocks the axis): at an update, when the following error toward the count exceeds
+ * following_error_limit_rad, or the law's i_q* less the tracker's own acceleration's current
+ * (J a_f / k_M) exceeds stall_current_A toward the count (pmstep_homing_stalled()), the rotor is
+ * taken as blocked: the count's origin is moved so that the tracker rests on theta-hat, the position
+ * loop's integral is cleared and T_L-hat put back to its value at the last rest (the block's reaction
+ * out of it): the loop stops pressing. Further steps toward the block are dropped.
+ * The first step away ends the stall: the drive follows it from where the rotor is, so a motion
+ * controller that homes on DIAG, stops and backs off finds the stop where the rotor met it. 0: off,
+ * the loop keeps following (DIAG reports the error) and pushes harder as the error grows.
+ *
+ * DIAG: asserted while the core is in FAULT, while stalled, and when |theta* - theta-hat| exceeds
+ * following_error_limit_rad (lost steps, a stall); in level mode for as long as one holds, in
  * pulse mode for diag_pulse_periods at each new assertion (as a TMC driver's StallGuard output).
  */
 #ifndef PMSTEP_STEPDIR_H
@@ -59,6 +70,8 @@ typedef struct {
     float stop_time_s;                 /**< no step for this long: the reference is at rest */
     pmstep_diag_mode_t diag_mode;
     uint32_t diag_pulse_periods;       /**< DIAG's pulse in pulse mode (periods, > 0) */
+    float stall_current_A;             /**< > 0: a stall at this q current drops the steps toward the block (header
+                                            text), below max_phase_current_A; 0: off (designer: off) */
 } pmstep_stepdir_config_t;
 
 /** The STEP/DIR input's state (allocate it statically beside the position control). */
@@ -83,11 +96,18 @@ typedef struct pmstep_stepdir {
     bool diag;                /**< DIAG's state (asserted: true) */
     bool diag_cause;          /**< a fault or a following error held at the last evaluation */
     uint32_t diag_pulse_left; /**< pulse mode: periods of the pulse left */
+    bool stalled;             /**< the rotor is blocked toward stall_direction: steps that way are dropped */
+    int32_t stall_direction;  /**< +1 or -1 while stalled */
+    int32_t stall_steps;      /**< the count when the steps were last dropped */
+    float stall_position_rad; /**< theta-hat where the stall was found: the tracker rests there */
+    float rest_load_Nm;       /**< T_L-hat at the last update at rest before a stall: the load the axis had
+                                   before the block took its share (pmstep_position.c puts it back at a stall) */
 } pmstep_stepdir_t;
 
 /**
  * The designer's settings for @p cfg's motor with @p microsteps per full step: w_t = varpi_0, the
- * following-error limit one full step, stop_time_s 8 / w_t, DIAG in level mode (pulse 1 ms).
+ * following-error limit one full step, stop_time_s 8 / w_t, DIAG in level mode (pulse 1 ms), no stall
+ * current (the homing's, pmstep_homing_design(), when the axis homes on DIAG).
  * @retval PMSTEP_OK, PMSTEP_ERR_NULL_ARGUMENT
  * @retval PMSTEP_ERR_STEPDIR_MICROSTEPS  @p microsteps not within 1..256
  */
@@ -101,6 +121,8 @@ pmstep_status_t pmstep_stepdir_design(const pmstep_config_t *cfg, uint32_t micro
  * @retval PMSTEP_ERR_STEPDIR_TRACKING    w_t not > 0, or w_t T above 4 (the tracker's poles at e^-4)
  * @retval PMSTEP_ERR_STEPDIR_LIMIT       the following-error limit or the stop time not > 0, or a pulse of 0
  * @retval PMSTEP_ERR_STEPDIR_DIAG_MODE   diag_mode neither PMSTEP_DIAG_LEVEL nor PMSTEP_DIAG_PULSE
+ * @retval PMSTEP_ERR_STEPDIR_STALL_CURRENT  the stall current < 0 or not finite (its bound by the trip is
+ *                                           checked by pmstep_position_follow_steps())
  */
 pmstep_status_t pmstep_stepdir_init(pmstep_stepdir_t *sd, const pmstep_stepdir_config_t *cfg, int32_t pole_pairs,
                                     float period_s, uint16_t counter);

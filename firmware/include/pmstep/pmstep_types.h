@@ -132,6 +132,8 @@ typedef enum {
     PMSTEP_ERR_STEPDIR_LIMIT = -137,        /**< the following-error limit or the stop time not > 0, or a DIAG pulse
                                                  of 0 periods */
     PMSTEP_ERR_STEPDIR_DIAG_MODE = -138,    /**< DIAG's mode neither PMSTEP_DIAG_LEVEL (0) nor PMSTEP_DIAG_PULSE (1) */
+    PMSTEP_ERR_STEPDIR_STALL_CURRENT = -140, /**< the STEP/DIR stall current < 0, not finite, or not below
+                                                  max_phase_current_A */
     /* homing (pmstep_homing.h) */
     PMSTEP_ERR_HOMING = -139                /**< a homing speed, acceleration, travel or stall error not > 0, a back-off
                                                  < 0, a stall current not in (0, max_phase_current_A), or a direction

@@ -157,6 +157,7 @@ typedef struct {
     sil_position_summary_t position;       /**< position scenario only (zero otherwise) */
     sil_stepdir_summary_t stepdir;         /**< STEP/DIR scenario only (zero otherwise) */
     sil_homing_summary_t homing;           /**< homing scenario only (zero otherwise) */
+    double stop_contact_s;                 /**< the rotor first met the plant's hard stop (motor.stop_*), -1 if never */
 } sil_summary_t;
 
 /** Running sums behind the summary. */

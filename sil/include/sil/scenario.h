@@ -109,6 +109,8 @@ typedef struct {
     pmstep_diag_mode_t stepdir_diag_mode;  /**< stepdir.diag_mode: level | pulse */
     float stepdir_tracking_bandwidth_rad_s; /**< stepdir.tracking_bandwidth_rad_s: the step tracker's w_t (0 = the
                                                  designer's, pmstep_stepdir_design()) */
+    float stepdir_stall_current_A;         /**< stepdir.stall_current_A: homing on DIAG, the steps toward a block
+                                                dropped at this q current (0 = off, the designer's) */
     /* position.source = homing: the designer's settings (pmstep_homing_design()) unless given here. */
     double homing_speed_rad_s;             /**< homing.speed_rad_s (0 = the designer's) */
     double homing_stall_current_A;         /**< homing.stall_current_A (0 = the designer's) */
