@@ -5,7 +5,7 @@
 function(pmstep_label_tests_here)
   get_directory_property(tests TESTS)
   foreach(test IN LISTS tests)
-    if(test MATCHES "^pil\\." OR test MATCHES "^console\\.qemu_e2e$")
+    if(test MATCHES "^pil\\." OR test MATCHES "^console\\.qemu_(stepdir_)?e2e$")
       set(speed pil slow)
     elseif(test MATCHES "^(closed_loop|robustness|oracle)\\."
            OR test MATCHES "^gain_check\\.(theory_and_sil|cli_doa_smoke)$"

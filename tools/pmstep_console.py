@@ -98,7 +98,7 @@ MOVE_TO, HOLD, GET_POSITION, SET_POSITION_ZERO = 0x0D, 0x0E, 0x0F, 0x10
 CONFIG_READ, CONFIG_WRITE, CONFIG_APPLY, CONFIG_SAVE = 0x11, 0x12, 0x13, 0x14
 CONFIG_ERASE, CONFIG_DEFAULTS, CONFIG_STATUS = 0x15, 0x16, 0x17
 CALIBRATE, CALIBRATE_STATUS = 0x18, 0x19
-SIM_ADVANCE, SIM_FINISH = 0x40, 0x41
+SIM_ADVANCE, SIM_FINISH, SIM_STEPS, SIM_FOLLOW_STEPS, SIM_STEPDIR = 0x40, 0x41, 0x42, 0x43, 0x44
 TELEMETRY_FRAME, ERROR_FRAME = 0x90, 0xFF
 REQUEST_NAMES = {HELLO: "HELLO", START: "START", STOP: "STOP", CLEAR_FAULT: "CLEAR_FAULT",
                  SPEED_TARGET: "SPEED_TARGET", ID_TARGET: "ID_TARGET", GET_STATUS: "STATUS",
@@ -108,7 +108,8 @@ REQUEST_NAMES = {HELLO: "HELLO", START: "START", STOP: "STOP", CLEAR_FAULT: "CLE
                  CONFIG_WRITE: "CONFIG_WRITE", CONFIG_APPLY: "CONFIG_APPLY", CONFIG_SAVE: "CONFIG_SAVE",
                  CONFIG_ERASE: "CONFIG_ERASE", CONFIG_DEFAULTS: "CONFIG_DEFAULTS", CONFIG_STATUS: "CONFIG_STATUS",
                  CALIBRATE: "CALIBRATE", CALIBRATE_STATUS: "CALIBRATE_STATUS",
-                 SIM_ADVANCE: "SIM_ADVANCE", SIM_FINISH: "SIM_FINISH"}
+                 SIM_ADVANCE: "SIM_ADVANCE", SIM_FINISH: "SIM_FINISH", SIM_STEPS: "SIM_STEPS",
+                 SIM_FOLLOW_STEPS: "SIM_FOLLOW_STEPS", SIM_STEPDIR: "SIM_STEPDIR"}
 
 MODES = {0: "IDLE", 1: "S_ALIGN", 2: "C_ALIGN", 3: "RUN", 4: "FAULT", 5: "OFFSET_CAL"}
 ERRORS = {1: "unknown command", 2: "bad length", 3: "bad value (NaN, Inf or out of range)",
@@ -119,6 +120,8 @@ ERRORS = {1: "unknown command", 2: "bad length", 3: "bad value (NaN, Inf or out 
 ERR_NOT_CONFIGURED = 10
 HELLO_STORE, HELLO_CONFIGURED = 1, 2  # HELLO flags
 POSITION_FLAGS = {1: "tracked", 2: "position_mode", 4: "moving"}
+SIM_STEPDIR_FLAGS = {1: "following", 2: "moving", 4: "diag"}
+SIM_STEPS_MAX = 60  # periods of STEP edges one SIM_STEPS carries (PMSTEP_CONSOLE_SIM_STEPS_MAX)
 STATUS_FIELDS = ["speed_ref_rad_s", "speed_hat_rad_s", "load_hat_Nm", "cos_hat", "sin_hat", "i_a_A", "i_b_A",
                  "bus_voltage_V", "u_a_V", "u_b_V", "i_d_A", "i_q_A"]
 TELEMETRY_FIELDS = ["period", "mode", "fault", "speed_ref_rad_s", "speed_hat_rad_s", "load_hat_Nm", "cos_hat",
@@ -282,6 +285,7 @@ CONFIG_MIN_BYTES = 7     # id, type, flags u8, value f32, name
 COMMISSIONING_BYTES = 41  # measured u8, offset samples u32, realignments u32, 8 f32
 COUNTERS_BYTES = 44      # 11 u32
 POSITION_BYTES = 19      # status i16, period u32, 3 f32, flags u8
+SIM_STEPDIR_BYTES = 23   # period u32, steps i32, edges i32, counter u16, flags u8, 2 f32
 
 
 def check_reply(ftype, data, n_bytes, text=False):
@@ -644,6 +648,29 @@ class Console:
 
     def sim_finish(self):
         return self._ack(SIM_FINISH)
+
+    def sim_steps(self, edges):
+        """A simulation image's emulated STEP/DIR input: the STEP edges of each of the next len(@p edges)
+        periods it runs (1 to SIM_STEPS_MAX of them, each -128..127, DIR by the sign), onto its 16-bit
+        step counter. Answered at once; BUSY while edges of the last call remain."""
+        if not 1 <= len(edges) <= SIM_STEPS_MAX or any(not -128 <= e <= 127 for e in edges):
+            raise UsageError(f"SIM_STEPS takes 1 to {SIM_STEPS_MAX} periods of -128..127 edges")
+        return self._ack(SIM_STEPS, struct.pack(f"<{len(edges)}b", *edges))
+
+    def sim_follow_steps(self):
+        """The STEP/DIR input started afresh at the counter's present value and the position loop on its
+        count from the next period; DeviceError (status -2) while the position is not tracked."""
+        return self._ack(SIM_FOLLOW_STEPS)
+
+    def sim_stepdir(self):
+        """The emulated STEP/DIR input: its count, the edges and the counter, its flags, the count's
+        position and the following error (mechanical rad)."""
+        d = check_reply(SIM_STEPDIR, self.request(SIM_STEPDIR), SIM_STEPDIR_BYTES)
+        period, steps, edges, counter, flags, commanded, error = struct.unpack_from("<IiiHBff", d)
+        s = {"period": period, "steps": steps, "edges": edges, "counter": counter, "commanded_rad": commanded,
+             "following_error_rad": error}
+        s.update({name: bool(flags & bit) for bit, name in SIM_STEPDIR_FLAGS.items()})
+        return s
 
 
 # ---- names of status codes ----

@@ -5,7 +5,8 @@
  *
  * usage: console-host-drive [--position] [--flash FILE [--board-id N] [--power-cut-after N]]
  *   --position   position control attached, updated after every step (without it the drive is an
- *                image in speed mode)
+ *                image in speed mode), and the STEP/DIR input on the console's emulated counter, read
+ *                after every step (SIM_STEPS, SIM_FOLLOW_STEPS, SIM_STEPDIR), as the QEMU image's
  *   --flash      the stored configuration attached, on a flash kept in FILE: two slots of 2048 bytes,
  *                slot 0 then slot 1 (a file that is absent or shorter reads as erased, 0xFF). Every
  *                erase and program is written to the file before it returns, so killing the process
@@ -236,6 +237,7 @@ int main(int argc, char **argv)
 {
     static pmstep_position_t position;
     static pmstep_position_output_t pos_out;
+    static pmstep_stepdir_t stepdir;
     static pmstep_t motor;
     static pmstep_config_t cfg;
     static pmstep_config_t defaults;
@@ -308,6 +310,9 @@ int main(int argc, char **argv)
     if (flash_path != NULL) {
         pmstep_console_attach_store(&con, &stored);
     }
+    if (with_position && pmstep_console_attach_sim_stepdir(&con, &stepdir, &cfg) != PMSTEP_OK) {
+        return 2;
+    }
     (void)fcntl(0, F_SETFL, fcntl(0, F_GETFL) | O_NONBLOCK);
     while (!pmstep_console_finish_requested(&con)) {
         struct pollfd p = {0, POLLIN, 0};
@@ -325,7 +330,9 @@ int main(int argc, char **argv)
             pmstep_console_boundary(&con, &motor, &cfg, &snap);
             pmstep_step(&motor, &meas, &snap.out);
             if (with_position) {
+                pmstep_stepdir_count(&stepdir, pmstep_console_sim_steps_period(&con));
                 pmstep_position_update(&position, &snap.out, &pos_out);
+                (void)pmstep_stepdir_diag(&stepdir, snap.out.mode, pos_out.position_rad, pos_out.tracked);
             }
             snap.meas = meas;
             snap.period++;

@@ -64,11 +64,16 @@ def _stop_boards():
 
 
 class Board:
-    """One boot of the image: QEMU with the flash file, the console connected."""
+    """One boot of the image: QEMU with the flash file (none: an image without a store), the console
+    connected. @p extra: more of the image's options; @p nodelay: QEMU sends each byte of the image's
+    replies at once (TCP_NODELAY; without it the host's delayed ACK holds a reply back some 40 ms)."""
 
-    def __init__(self, a, flash, duration_s, summary=None, cut_after=None, no_load=False):
+    def __init__(self, a, flash, duration_s, summary=None, cut_after=None, no_load=False, substeps=SUBSTEPS,
+                 extra=(), nodelay=False):
         self.port = free_port()
-        args = ["pil-console", "--duration", str(duration_s), "--substeps", str(SUBSTEPS), "--flash", str(flash)]
+        args = ["pil-console", "--duration", str(duration_s), "--substeps", str(substeps)]
+        args += ["--flash", str(flash)] if flash is not None else []
+        args += list(extra)
         if summary:
             args += ["--summary", str(summary)]
         if cut_after:
@@ -77,7 +82,8 @@ class Board:
             args.append("--no-load")
         semi = ",".join(["enable=on", "target=native"] + [f"arg={x}" for x in args])
         self.cmd = [a.qemu, "-M", "mps2-an386", "-cpu", "cortex-m4", "-nographic", "-monitor", "none", "-serial",
-                    f"tcp:127.0.0.1:{self.port},server=on,wait=on", "-semihosting-config", semi, "-kernel", a.image]
+                    f"tcp:127.0.0.1:{self.port},server=on,wait=on" + (",nodelay=on" if nodelay else ""),
+                    "-semihosting-config", semi, "-kernel", a.image]
         self.qemu = subprocess.Popen(self.cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
         BOARDS.append(self)
         self.link = None

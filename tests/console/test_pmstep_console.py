@@ -186,6 +186,13 @@ class AgainstTheFirmwareConsole(unittest.TestCase):
                 call()
         self.assertEqual(c.counters()["rx_error_replies"], 4)
 
+    def test_sim_stepdir_without_the_input(self):
+        c = self.con
+        for call in (lambda: c.sim_steps([1, -1]), c.sim_follow_steps, c.sim_stepdir):
+            with self.assertRaisesRegex(pc.DeviceError, "not supported by this image"):
+                call()
+        self.assertEqual(c.counters()["rx_error_replies"], 3)
+
     def test_interactive(self):
         out = io.StringIO()
         shell = pc.Shell(self.con)
@@ -225,6 +232,32 @@ class AgainstAPositionDrive(AgainstTheFirmwareConsole):
 
     def test_position_requests_without_position_control(self):
         pass  # attached here
+
+    def test_sim_stepdir_without_the_input(self):
+        pass  # attached here
+
+    def test_sim_stepdir(self):
+        c = self.con
+        s = c.sim_stepdir()
+        self.assertEqual((s["steps"], s["edges"], s["counter"], s["following"], s["moving"], s["diag"]),
+                         (0, 0, 0, False, False, False))
+        self.assertEqual(c.sim_steps([-128] * pc.SIM_STEPS_MAX), 0)
+        with self.assertRaisesRegex(pc.DeviceError, "busy"):  # the first's edges not out yet
+            c.sim_steps([1])
+        for bad in ([], [128], [0] * (pc.SIM_STEPS_MAX + 1)):
+            with self.assertRaises(pc.UsageError):
+                c.sim_steps(bad)
+        self.assertEqual(c.sim_advance(100), 100)  # 60 periods of edges, then none
+        self.assertEqual(c.sim_steps([127] * 20 + [1]), 0)
+        self.assertEqual(c.sim_advance(21), 121)
+        total = -128 * pc.SIM_STEPS_MAX + 127 * 20 + 1
+        s = c.sim_stepdir()
+        self.assertEqual((s["period"], s["steps"], s["edges"], s["counter"]), (120, total, total, total % 65536))
+        self.assertAlmostEqual(s["commanded_rad"], total * 2 * math.pi / (4 * 6 * 16), places=2)  # p 6, 16 microsteps
+        with self.assertRaisesRegex(pc.DeviceError, "status -2"):  # not tracked: the drive never reaches RUN
+            c.sim_follow_steps()
+        self.assertEqual(c.sim_stepdir()["steps"], total)  # refused: the input as it was
+        self.assertEqual(c.counters()["rx_error_replies"], 1)
 
     def test_position_before_run(self):
         c = self.con
@@ -280,6 +313,11 @@ class CodeNames(unittest.TestCase):
     def test_store_codes_match_the_header(self):
         header = self.parse_header_enum("firmware/console/include/pmstep_store.h", "pmstep_store_status_t")
         self.assertEqual({code: row[0] for code, row in pc.STORE_CODES.items()}, header)
+
+    def test_request_names_match_the_header(self):
+        header = self.parse_header_enum("firmware/console/include/pmstep_console.h", "pmstep_console_type_t")
+        frames = {pc.TELEMETRY_FRAME, pc.ERROR_FRAME}  # not requests
+        self.assertEqual(set(pc.REQUEST_NAMES), set(header) - frames)
 
     def test_console_errors_match_the_header(self):
         header = self.parse_header_enum("firmware/console/include/pmstep_console.h", "pmstep_console_error_t")

@@ -9,11 +9,14 @@
  *     pmstep_validate_config();
  *   - a command waiting in the mailbox is unchanged by any later frame (busy refusals change
  *     nothing);
+ *   - the STEP/DIR input on the emulated counter (simulation): every period its count moves by
+ *     exactly the edges the counter took (by DIR's sense), and it last read the counter's value;
  *   - every frame the console transmits has its sync byte, a length in 2..64 and a good CRC.
  * A broken invariant aborts with a message (a crash for libFuzzer and for the replay driver).
  *
  * Input layout (every read past the end gives zeros, so any input is valid):
- *   byte 0: bit 0 attach position control, bit 1 the simulation requests;
+ *   byte 0: bit 0 attach position control, bit 1 the simulation requests, bit 2 (with both) the
+ *           STEP/DIR input on the emulated counter (SIM_STEPS, SIM_FOLLOW_STEPS, SIM_STEPDIR);
  *   then operations, one opcode byte each (op % 6) with its payload, until the input or the step
  *   budget (FUZZ_MAX_STEPS) runs out:
  *     0 raw bytes: n (1 byte), then n bytes, in one receive call
@@ -50,6 +53,8 @@ typedef struct {
     pmstep_t motor;
     pmstep_position_t position;
     pmstep_position_output_t position_out;
+    pmstep_stepdir_t stepdir;
+    bool stepdir_attached;
     pmstep_console_snapshot_t snap;
     pmstep_config_t cfg_before;
     double i_a_A, i_b_A; /* the winding model's currents */
@@ -190,7 +195,22 @@ static void period(state_t *st)
     meas.load_torque_Nm = 0.0f;
     meas.phase_voltage_a_V = 0.0f;
     meas.phase_voltage_b_V = 0.0f;
+    if (st->stepdir_attached) {
+        /* the counter read once a period, as a port reads its timer: the count moves by its edges */
+        const int32_t steps = st->stepdir.steps;
+        const uint32_t edges = st->con.sim_step_edges;
+        int32_t moved;
+        pmstep_stepdir_count(&st->stepdir, pmstep_console_sim_steps_period(&st->con));
+        moved = (int32_t)(st->con.sim_step_edges - edges);
+        CHECK(moved >= -128 && moved <= 127, "more edges in a period than a SIM_STEPS carries");
+        CHECK(st->stepdir.steps - steps == (st->stepdir.cfg.invert_direction ? -moved : moved),
+              "the STEP/DIR input lost or invented an edge");
+        CHECK(st->stepdir.last_counter == st->con.sim_step_counter, "the STEP/DIR input did not read the counter");
+    }
     pmstep_position_step(&st->position, &meas, out, &st->position_out);
+    if (st->stepdir_attached) {
+        (void)pmstep_stepdir_diag(&st->stepdir, out->mode, st->position_out.position_rad, st->position_out.tracked);
+    }
     st->snap.meas = meas;
     st->snap.period++;
     st->steps++;
@@ -265,6 +285,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     if ((setup & 2u) != 0u) {
         pmstep_console_attach_simulation(&st->con);
+    }
+    if ((setup & 7u) == 7u) {
+        if (pmstep_console_attach_sim_stepdir(&st->con, &st->stepdir, &st->cfg) != PMSTEP_OK) {
+            fail(st, "the STEP/DIR input is refused");
+        }
+        st->stepdir_attached = true;
     }
     st->snap.period = UINT32_MAX;
     while (r.pos < r.size && st->steps < FUZZ_MAX_STEPS) {

@@ -110,6 +110,7 @@ scenario = {
 C_RAW, C_FRAME, C_TWO, C_PERIODS, C_SILENCE, C_SPECIAL = range(6)
 HELLO, START, STOP, CLEAR_FAULT, SPEED_TARGET, ID_TARGET, GET_STATUS, GET_CONFIG, SET_CONFIG = range(1, 10)
 TELEMETRY, MOVE_TO, SIM_ADVANCE = 0x0B, 0x0D, 0x40
+SIM_STEPS, SIM_FOLLOW_STEPS, SIM_STEPDIR = 0x42, 0x43, 0x44
 TRIP, MAX_BUS = 21, 23  # ids of limits.max_phase_current_A and limits.max_bus_voltage_V (pmstep_console_config.c)
 
 
@@ -155,6 +156,13 @@ console = {
     # the simulation requests on a simulation console
     "simulation": bytes([2, C_FRAME]) + c_frame(SIM_ADVANCE, 1, struct.pack("<I", 5)) + bytes([C_FRAME])
     + c_frame(SIM_ADVANCE, 2, struct.pack("<I", 5)) + c_periods(2),
+    # the emulated STEP/DIR input: bursts through the counter's wrap, into RUN, following, edges both ways,
+    # a read-back, a second SIM_STEPS refused while the first's edges remain
+    "stepdir": bytes([7, C_FRAME]) + c_frame(START) + b"".join(
+        bytes([C_FRAME]) + c_frame(SIM_STEPS, 2, bytes([127]) * 60) + c_periods(60) for _ in range(9))
+    + c_periods(1000) + bytes([C_FRAME]) + c_frame(SIM_FOLLOW_STEPS, 3) + c_periods(1) + bytes([C_TWO])
+    + c_frame(SIM_STEPS, 4, bytes([1, 0, 0xFF, 2]) * 15) + c_frame(SIM_STEPS, 5, bytes([1])) + c_periods(60)
+    + bytes([C_FRAME]) + c_frame(SIM_STEPDIR, 6) + c_periods(2),
 }
 
 for folder, seeds in (("core", core), ("scenario", scenario), ("console", console)):

@@ -78,6 +78,26 @@
  *                                                       status i16 (0), period u32
  *   0x41 SIM_FINISH         -                        -> (simulation images only) ACK, then the
  *                                                       image writes its results and exits
+ *   0x42 SIM_STEPS          edges i8 per period (1..PMSTEP_CONSOLE_SIM_STEPS_MAX)  -> (simulation images
+ *                              with the STEP/DIR input attached, pmstep_console_attach_sim_stepdir())
+ *                              ACK: status 0 at once. The emulated STEP/DIR input: the STEP edges of each of
+ *                              the next periods the image runs, DIR by the sign, onto the emulated 16-bit
+ *                              step counter before the image reads it that period (it wraps as a timer's
+ *                              CNT); periods beyond them get none. BUSY while edges of the last SIM_STEPS
+ *                              remain, or a SIM_ADVANCE runs
+ *   0x43 SIM_FOLLOW_STEPS   -                        -> (the same images) ACK: the STEP/DIR input started
+ *                              afresh on the STEP/DIR settings in force at the counter's present value
+ *                              (what it counted before is dropped, as EN does on a STEP/DIR image), and
+ *                              the position loop follows its count from the next period
+ *                              (pmstep_position_follow_steps(); status -2 BAD_MODE, nothing changed, while
+ *                              not tracked). MOVE_TO, HOLD, a speed command or leaving RUN end it
+ *   0x44 SIM_STEPDIR        -                        -> (the same images) period u32, steps i32 (the
+ *                              input's count since it was started), edges i32 (every edge the emulated
+ *                              counter took since it was attached), counter u16, flags u8 (1 following,
+ *                              2 moving, 4 DIAG asserted), commanded f32 (the count's position, mechanical
+ *                              rad: pmstep_stepdir_commanded()), following error f32 (the count's position
+ *                              at the last update less its theta-hat: pmstep_stepdir_following_error(); 0
+ *                              while not following)
  *
  * ACK status: 0 done, a negative pmstep_status_t when the core refused (e.g. -2
  * PMSTEP_ERR_BAD_MODE), and the period from which the command takes effect (the first
@@ -152,6 +172,9 @@ typedef enum {
     PMSTEP_CONSOLE_CALIBRATE_STATUS = 0x19,
     PMSTEP_CONSOLE_SIM_ADVANCE = 0x40,
     PMSTEP_CONSOLE_SIM_FINISH = 0x41,
+    PMSTEP_CONSOLE_SIM_STEPS = 0x42,
+    PMSTEP_CONSOLE_SIM_FOLLOW_STEPS = 0x43,
+    PMSTEP_CONSOLE_SIM_STEPDIR = 0x44,
     PMSTEP_CONSOLE_TELEMETRY_FRAME = 0x90,
     PMSTEP_CONSOLE_ERROR_FRAME = 0xFF
 } pmstep_console_type_t;
@@ -172,6 +195,13 @@ typedef enum {
     PMSTEP_CONSOLE_ERR_NO_STORE = 11,      /**< a CONFIG_* or CALIBRATE request, no stored configuration attached */
     PMSTEP_CONSOLE_ERR_NO_CALIBRATION = 12 /**< CALIBRATE, no self-commissioning attached */
 } pmstep_console_error_t;
+
+#define PMSTEP_CONSOLE_SIM_STEPS_MAX 60u /**< periods of STEP edges one SIM_STEPS carries at most (a byte each) */
+
+/** SIM_STEPDIR flags. */
+#define PMSTEP_CONSOLE_SIM_STEPDIR_FOLLOWING 1u /**< the position loop follows the count */
+#define PMSTEP_CONSOLE_SIM_STEPDIR_MOVING 2u    /**< steps within the stop time, or the tracker not yet at rest */
+#define PMSTEP_CONSOLE_SIM_STEPDIR_DIAG 4u      /**< DIAG asserted after the last period */
 
 /** GET_POSITION flags. */
 #define PMSTEP_CONSOLE_POSITION_TRACKED 1u
@@ -344,8 +374,9 @@ typedef bool (*pmstep_console_store_apply_t)(struct pmstep_console *c, const pms
                                              pmstep_t *inst, pmstep_config_t *cfg,
                                              const pmstep_console_snapshot_t *snap);
 
-/** The simulation images' requests (SIM_ADVANCE, SIM_FINISH; pmstep_console_sim.c): answers
- *  @p type with DATA @p d of @p n bytes. @return 0, or the pmstep_console_error_t to reply. */
+/** The simulation images' requests answered at once (SIM_ADVANCE, SIM_FINISH, SIM_STEPS;
+ *  pmstep_console_sim.c): answers @p type with DATA @p d of @p n bytes. @return 0, or the
+ *  pmstep_console_error_t to reply. */
 typedef int (*pmstep_console_sim_request_t)(struct pmstep_console *c, uint8_t type, uint8_t seq,
                                             const uint8_t *d, uint32_t n);
 
@@ -379,6 +410,15 @@ typedef struct pmstep_console {
     uint8_t advance_seq;
     bool advancing;
     bool finish_requested;
+    /* a simulation image's STEP/DIR input on an emulated counter (NULL: none; SIM_STEPS, SIM_FOLLOW_STEPS
+     * and SIM_STEPDIR refused) */
+    pmstep_stepdir_t *sim_stepdir;
+    pmstep_console_store_apply_t sim_stepdir_apply; /**< SIM_FOLLOW_STEPS and SIM_STEPDIR at the boundary */
+    uint8_t sim_edges[PMSTEP_CONSOLE_SIM_STEPS_MAX]; /**< SIM_STEPS: the STEP edges of the coming periods (i8 each) */
+    uint32_t sim_edges_queued;                      /**< periods of them queued */
+    uint32_t sim_edges_next;                        /**< the next period's among them */
+    uint16_t sim_step_counter;                      /**< the emulated counter (a timer's CNT: 16 bits, wraps) */
+    uint32_t sim_step_edges;                        /**< edges it took since attached (signed, modulo 2^32) */
     /* telemetry */
     uint32_t decimation;
     uint32_t next_telemetry;
@@ -400,6 +440,24 @@ void pmstep_console_init(pmstep_console_t *c, const char *identity);
  * reply PMSTEP_CONSOLE_ERR_NOT_SUPPORTED.
  */
 void pmstep_console_attach_simulation(pmstep_console_t *c);
+
+/**
+ * Attaches a simulation image's STEP/DIR input @p sd (after pmstep_console_attach_simulation() and
+ * pmstep_console_attach_position(), and after pmstep_console_attach_store() if the image has one, whose
+ * STEP/DIR settings it takes): @p sd is started on the console's STEP/DIR settings for the motor of
+ * @p cfg, its counter the emulated one at 0 (a timer after reset), and SIM_STEPS, SIM_FOLLOW_STEPS and
+ * SIM_STEPDIR are served (pmstep_console_sim.c). Every period, after the step, the image reads the
+ * counter as a port reads its timer: pmstep_stepdir_count(sd, pmstep_console_sim_steps_period(c)), then
+ * runs pmstep_position_update() and pmstep_stepdir_diag().
+ * @return pmstep_console_stepdir_config()'s or pmstep_stepdir_init()'s status (nothing attached unless
+ *         PMSTEP_OK); PMSTEP_ERR_NULL_ARGUMENT without a simulation or position control attached.
+ */
+pmstep_status_t pmstep_console_attach_sim_stepdir(pmstep_console_t *c, pmstep_stepdir_t *sd,
+                                                  const pmstep_config_t *cfg);
+
+/** One period of the emulated STEP/DIR input (simulation images, once a period before the counter is
+ *  read): the period's edges queued by SIM_STEPS onto the counter. @return the counter. */
+uint16_t pmstep_console_sim_steps_period(pmstep_console_t *c);
 
 /**
  * Attaches position control (@p pos, initialised with pmstep_position_init() on the instance the

@@ -66,7 +66,8 @@ static void send_position(pmstep_console_t *c, uint8_t seq, int32_t status, cons
 static bool allowed_while_calibrating(uint8_t cmd)
 {
     return cmd == PMSTEP_CONSOLE_GET_STATUS || cmd == PMSTEP_CONSOLE_GET_CONFIG || cmd == PMSTEP_CONSOLE_GET_COMMISSIONING
-           || cmd == PMSTEP_CONSOLE_TELEMETRY || cmd == PMSTEP_CONSOLE_GET_POSITION || cmd == PMSTEP_CONSOLE_CONFIG_READ;
+           || cmd == PMSTEP_CONSOLE_TELEMETRY || cmd == PMSTEP_CONSOLE_GET_POSITION || cmd == PMSTEP_CONSOLE_CONFIG_READ
+           || cmd == PMSTEP_CONSOLE_SIM_STEPDIR;
 }
 
 void pmstep_console_boundary(pmstep_console_t *c, pmstep_t *inst, pmstep_config_t *cfg,
@@ -115,6 +116,10 @@ void pmstep_console_boundary(pmstep_console_t *c, pmstep_t *inst, pmstep_config_
         if (!c->store_apply(c, req, inst, cfg, snap)) { /* attached: checked at parsing; it replies */
             c->count.commands_applied--;
         }
+        return;
+    case PMSTEP_CONSOLE_SIM_FOLLOW_STEPS:
+    case PMSTEP_CONSOLE_SIM_STEPDIR:
+        (void)c->sim_stepdir_apply(c, req, inst, cfg, snap); /* attached: checked at parsing; it replies */
         return;
     case PMSTEP_CONSOLE_STOP:
         st = (int32_t)pmstep_stop(inst);

@@ -24,6 +24,7 @@ typedef int (*request_parse_t)(pmstep_console_t *c, const uint8_t *d, uint32_t n
 #define NEEDS_SIMULATION 2u /* a simulation image, else PMSTEP_CONSOLE_ERR_NOT_SUPPORTED */
 #define NEEDS_STORE 3u      /* the stored configuration attached, else PMSTEP_CONSOLE_ERR_NO_STORE */
 #define NEEDS_CALIBRATION 4u /* the store and self-commissioning attached, else _NO_STORE / _NO_CALIBRATION */
+#define NEEDS_SIM_STEPDIR 5u /* a simulation image's STEP/DIR input attached, else PMSTEP_CONSOLE_ERR_NOT_SUPPORTED */
 
 typedef struct {
     uint8_t type;
@@ -289,6 +290,9 @@ static const request_row_t requests[] = {
     {PMSTEP_CONSOLE_CALIBRATE_STATUS, NEEDS_CALIBRATION, 0u, 0u, parse_calibrate_status},
     {PMSTEP_CONSOLE_SIM_ADVANCE, NEEDS_SIMULATION, 4u, 4u, parse_simulation},
     {PMSTEP_CONSOLE_SIM_FINISH, NEEDS_SIMULATION, 0u, 0u, parse_simulation},
+    {PMSTEP_CONSOLE_SIM_STEPS, NEEDS_SIM_STEPDIR, 1u, PMSTEP_CONSOLE_SIM_STEPS_MAX, parse_simulation},
+    {PMSTEP_CONSOLE_SIM_FOLLOW_STEPS, NEEDS_SIM_STEPDIR, 0u, 0u, parse_plain},
+    {PMSTEP_CONSOLE_SIM_STEPDIR, NEEDS_SIM_STEPDIR, 0u, 0u, parse_plain},
 };
 
 static const request_row_t *request_row(uint8_t type)
@@ -308,7 +312,10 @@ static int row_available(const pmstep_console_t *c, const request_row_t *row)
     if (row->needs == NEEDS_POSITION && (c->position == NULL || c->position_apply == NULL)) {
         return PMSTEP_CONSOLE_ERR_NO_POSITION;
     }
-    if (row->needs == NEEDS_SIMULATION && c->sim_request == NULL) {
+    if ((row->needs == NEEDS_SIMULATION || row->needs == NEEDS_SIM_STEPDIR) && c->sim_request == NULL) {
+        return PMSTEP_CONSOLE_ERR_NOT_SUPPORTED;
+    }
+    if (row->needs == NEEDS_SIM_STEPDIR && (c->sim_stepdir == NULL || c->sim_stepdir_apply == NULL)) {
         return PMSTEP_CONSOLE_ERR_NOT_SUPPORTED;
     }
     if ((row->needs == NEEDS_STORE || row->needs == NEEDS_CALIBRATION) && (c->store == NULL || c->store_apply == NULL)) {

@@ -10,7 +10,7 @@
  * at the period boundary and sends replies and telemetry; bad input is dropped or answered.
  *
  * usage (semihosting command line):
- *   pil-console [--duration S] [--substeps N] [--summary FILE] [--cost FILE]
+ *   pil-console [--duration S] [--substeps N] [--summary FILE] [--cost FILE] [--stepdir FILE]
  *               [--flash FILE [--board-id N] [--power-cut-after N]] [--no-load]
  * --flash: the board's stored configuration (pmstep_store.h) and self-commissioning attached, on a
  * flash of two 2 KiB slots kept in FILE on the host (read at boot, every erase and program written
@@ -25,6 +25,16 @@
  * Position control (pmstep_position) is attached to the console: pmstep_position_update() runs
  * after every step (in the main loop, after the control interrupt), and MOVE_TO, HOLD,
  * GET_POSITION, SET_POSITION_ZERO reach it; in speed mode it changes nothing of the run.
+ * A STEP/DIR input (pmstep_stepdir) on the console's emulated step counter is attached too
+ * (pmstep_console_attach_sim_stepdir()): the host puts STEP edges on the counter period by period
+ * (SIM_STEPS), the image reads it after every step as the STM32G4 port reads its timer (the count,
+ * the position update, DIAG), and SIM_FOLLOW_STEPS puts the position loop on the count; with no
+ * edges and no SIM_FOLLOW_STEPS it changes nothing of the run.
+ * --stepdir: the STEP/DIR run's figures on the plant's true position, from the period the loop
+ * starts following the count (the first SIM_FOLLOW_STEPS accepted): the edges the host sent since,
+ * the input's count, the following error (the count's position less the plant's angle from the
+ * equilibrium p theta = 0 mod 2 pi nearest the rotor then, in full steps pi / (2 p), as the host
+ * SIL's stepdir summary) at its largest and at the end, and the periods DIAG was asserted.
  * --summary: the closed-loop metrics (the keys of pil-closed-loop's summary);
  * --cost: the control step's cost per mode from SysTick (with -icount shift=0), and the
  * console's counters.
@@ -47,6 +57,7 @@
 #define PMSTEP_VERSION_TEXT "0.0.0"
 #endif
 
+#define PI 3.14159265358979323846
 #define SYST_CVR (*(volatile uint32_t *)0xE000E018u)
 #define SYSTICK_HZ 25000000u /* QEMU's mps2 SysTick reference clock */
 
@@ -57,6 +68,7 @@ static pmstep_store_t store;
 static pmstep_console_store_t stored;
 static pmstep_calibrate_t calibration;
 static pmstep_position_t position;
+static pmstep_stepdir_t stepdir; /* the STEP/DIR input, on the console's emulated counter */
 static const char *const mode_names[MPS2_PIL_MODES] = {"IDLE", "S_ALIGN", "C_ALIGN", "RUN", "FAULT"};
 
 /* ---- the console's side of the main loop ---- */
@@ -210,15 +222,47 @@ static int flash_open(const char *path)
 
 /* ---- the closed loop (as pil_closed_loop.c) ---- */
 
+/* The STEP/DIR run on the plant's true position (--stepdir). */
+typedef struct {
+    bool on;                 /* the loop follows the count (from the first SIM_FOLLOW_STEPS accepted) */
+    uint32_t edges_at_start; /* the emulated counter's edges then */
+    double origin_rad;       /* the equilibrium the count's position is measured from */
+    long periods;            /* periods since */
+    double max_error;        /* the following error at its largest (|.|, full steps) */
+    double final_error;      /* at the last period (full steps) */
+    long diag_periods;       /* periods DIAG was asserted (the whole run) */
+} stepdir_figures_t;
+
 typedef struct {
     sil_scenario_t sc;
     plant_t plant;
     sil_inverter_t inv;
     sil_metrics_t metrics;
     sil_summary_t s;
+    stepdir_figures_t sd;
     double period_s;
     double p;
 } loop_t;
+
+/* The count's position (the edges the host sent since following began) less the plant's angle @p theta_rad
+ * at the start of the period, from the equilibrium nearest the rotor when following began. */
+static void stepdir_figures(loop_t *L, double theta_rad, uint32_t edges_before)
+{
+    stepdir_figures_t *f = &L->sd;
+    if (!f->on && stepdir.following) {
+        f->on = true;
+        f->edges_at_start = edges_before;
+        f->origin_rad = floor(theta_rad * L->p / (2.0 * PI) + 0.5) * 2.0 * PI / L->p;
+    }
+    if (f->on) {
+        const double count = (double)(int32_t)(console.sim_step_edges - f->edges_at_start);
+        const double microstep_rad = 2.0 * PI / (4.0 * L->p * (double)stepdir.cfg.microsteps);
+        const double error = (count * microstep_rad - (theta_rad - f->origin_rad)) / (0.5 * PI / L->p);
+        f->max_error = fmax(f->max_error, fabs(error));
+        f->final_error = error;
+        f->periods++;
+    }
+}
 
 static void run_period(loop_t *L, long k, pmstep_console_snapshot_t *snap)
 {
@@ -242,8 +286,15 @@ static void run_period(loop_t *L, long k, pmstep_console_snapshot_t *snap)
     meas.phase_voltage_b_V = (float)L->inv.applied_b_V;
     mps2_pil_control_period(&meas, &out);
     {
+        /* the port's order: the step, the step counter read, the position update, DIAG */
+        const uint32_t edges_before = console.sim_step_edges;
         pmstep_position_output_t pos_out;
+        pmstep_stepdir_count(&stepdir, pmstep_console_sim_steps_period(&console));
         pmstep_position_update(&position, &out, &pos_out);
+        if (pmstep_stepdir_diag(&stepdir, out.mode, pos_out.position_rad, pos_out.tracked)) {
+            L->sd.diag_periods++;
+        }
+        stepdir_figures(L, sample.theta_rad, edges_before);
     }
     sil_inverter_apply(&L->inv, &out, (double)meas.bus_voltage_V);
     sil_drive_advance(&L->plant, &L->inv, L->period_s, L->sc.substeps);
@@ -286,6 +337,15 @@ static void write_cost(FILE *f, double insns_per_tick, long periods)
             (unsigned long)n->tx_dropped, (unsigned long)n->telemetry_frames);
 }
 
+static void write_stepdir(FILE *f, const stepdir_figures_t *sd)
+{
+    fprintf(f, "pil_stepdir 1\nfollowing_periods %ld\nedges_sent %ld\nsteps_counted %ld\nmicrosteps %lu\n", sd->periods,
+            sd->on ? (long)(int32_t)(console.sim_step_edges - sd->edges_at_start) : 0L, (long)stepdir.steps,
+            (unsigned long)stepdir.cfg.microsteps);
+    fprintf(f, "max_error_full_steps %.9g\nfinal_error_full_steps %.9g\ndiag_periods %ld\n", sd->max_error,
+            sd->final_error, sd->diag_periods);
+}
+
 static int write_file(const char *path, int which, loop_t *L, double insns_per_tick, long steps)
 {
     FILE *f = fopen(path, "w");
@@ -295,8 +355,10 @@ static int write_file(const char *path, int which, loop_t *L, double insns_per_t
     }
     if (which == 0) {
         pil_write_summary(f, "qemu mps2-an386 (Cortex-M4F), console-driven", &L->s, L->sc.duration_s, L->sc.substeps);
-    } else {
+    } else if (which == 1) {
         write_cost(f, insns_per_tick, steps);
+    } else {
+        write_stepdir(f, &L->sd);
     }
     return fclose(f) == 0 ? 0 : 2;
 }
@@ -307,6 +369,7 @@ int main(int argc, char **argv)
     static pmstep_console_snapshot_t snap;
     const char *summary_path = NULL;
     const char *cost_path = NULL;
+    const char *stepdir_path = NULL;
     const char *flash_path = NULL;
     bool no_load = false;
     uint32_t board_id = 0x4D505332u; /* "MPS2" */
@@ -328,6 +391,8 @@ int main(int argc, char **argv)
             summary_path = argv[++i];
         } else if (strcmp(argv[i], "--cost") == 0 && i + 1 < argc) {
             cost_path = argv[++i];
+        } else if (strcmp(argv[i], "--stepdir") == 0 && i + 1 < argc) {
+            stepdir_path = argv[++i];
         } else if (strcmp(argv[i], "--flash") == 0 && i + 1 < argc) {
             flash_path = argv[++i];
         } else if (strcmp(argv[i], "--board-id") == 0 && i + 1 < argc) {
@@ -338,7 +403,8 @@ int main(int argc, char **argv)
             no_load = true;
         } else {
             fprintf(stderr, "usage: pil-console [--duration S] [--substeps N] [--summary FILE] [--cost FILE]\n"
-                            "                   [--flash FILE [--board-id N] [--power-cut-after N]] [--no-load]\n");
+                            "                   [--stepdir FILE] [--flash FILE [--board-id N] [--power-cut-after N]]\n"
+                            "                   [--no-load]\n");
             return 2;
         }
     }
@@ -402,6 +468,11 @@ int main(int argc, char **argv)
         pmstep_console_attach_store(&console, &stored);
         pmstep_console_attach_calibration(&console, &calibration);
     }
+    st = pmstep_console_attach_sim_stepdir(&console, &stepdir, &config); /* the settings in force, stored or not */
+    if (st != PMSTEP_OK) {
+        fprintf(stderr, "pil-console: pmstep_console_attach_sim_stepdir: %s\n", pmstep_status_str(st));
+        return 2;
+    }
     snap.period = UINT32_MAX; /* no step yet */
     systick_last = SYST_CVR;
 
@@ -443,6 +514,9 @@ int main(int argc, char **argv)
         return 2;
     }
     if (cost_path != NULL && write_file(cost_path, 1, &L, insns_per_tick, k) != 0) {
+        return 2;
+    }
+    if (stepdir_path != NULL && write_file(stepdir_path, 2, &L, insns_per_tick, k) != 0) {
         return 2;
     }
     return k != steps ? 4 : (L.s.fault != PMSTEP_FAULT_NONE ? 3 : 0);
