@@ -20,6 +20,11 @@ Commands (one per run, or several in the interactive mode):
   hold [--amax RAD_S2]                   stop and hold (a_max used only from speed mode)
   position                               theta-hat, theta*, their difference, the flags
   zero                                   the present position becomes 0
+  home +|- --travel RAD [--speed RAD_S] [--stall-current A] [--timeout S] [--advance N]
+                                         homing without a switch: toward a hard stop (at most TRAVEL
+                                         rad), found by the following error or the stall current, the
+                                         zero put there, a full step back; speed and stall current
+                                         the designer's unless given; progress printed
   plot FILE.csv                          plot a telemetry CSV afterwards
   interactive                            a prompt for all of the above
 
@@ -98,6 +103,7 @@ MOVE_TO, HOLD, GET_POSITION, SET_POSITION_ZERO = 0x0D, 0x0E, 0x0F, 0x10
 CONFIG_READ, CONFIG_WRITE, CONFIG_APPLY, CONFIG_SAVE = 0x11, 0x12, 0x13, 0x14
 CONFIG_ERASE, CONFIG_DEFAULTS, CONFIG_STATUS = 0x15, 0x16, 0x17
 CALIBRATE, CALIBRATE_STATUS = 0x18, 0x19
+HOME, HOME_STATUS = 0x1A, 0x1B
 SIM_ADVANCE, SIM_FINISH, SIM_STEPS, SIM_FOLLOW_STEPS, SIM_STEPDIR = 0x40, 0x41, 0x42, 0x43, 0x44
 TELEMETRY_FRAME, ERROR_FRAME = 0x90, 0xFF
 REQUEST_NAMES = {HELLO: "HELLO", START: "START", STOP: "STOP", CLEAR_FAULT: "CLEAR_FAULT",
@@ -107,7 +113,8 @@ REQUEST_NAMES = {HELLO: "HELLO", START: "START", STOP: "STOP", CLEAR_FAULT: "CLE
                  GET_POSITION: "POSITION", SET_POSITION_ZERO: "SET_POSITION_ZERO", CONFIG_READ: "CONFIG_READ",
                  CONFIG_WRITE: "CONFIG_WRITE", CONFIG_APPLY: "CONFIG_APPLY", CONFIG_SAVE: "CONFIG_SAVE",
                  CONFIG_ERASE: "CONFIG_ERASE", CONFIG_DEFAULTS: "CONFIG_DEFAULTS", CONFIG_STATUS: "CONFIG_STATUS",
-                 CALIBRATE: "CALIBRATE", CALIBRATE_STATUS: "CALIBRATE_STATUS",
+                 CALIBRATE: "CALIBRATE", CALIBRATE_STATUS: "CALIBRATE_STATUS", HOME: "HOME",
+                 HOME_STATUS: "HOME_STATUS",
                  SIM_ADVANCE: "SIM_ADVANCE", SIM_FINISH: "SIM_FINISH", SIM_STEPS: "SIM_STEPS",
                  SIM_FOLLOW_STEPS: "SIM_FOLLOW_STEPS", SIM_STEPDIR: "SIM_STEPDIR"}
 
@@ -285,6 +292,8 @@ CONFIG_MIN_BYTES = 7     # id, type, flags u8, value f32, name
 COMMISSIONING_BYTES = 41  # measured u8, offset samples u32, realignments u32, 8 f32
 COUNTERS_BYTES = 44      # 11 u32
 POSITION_BYTES = 19      # status i16, period u32, 3 f32, flags u8
+HOME_STATUS_BYTES = 16   # status i16, period u32, state u8, found by u8, stop f32, position f32
+HOMING_STATES = {0: "idle", 1: "seeking", 2: "backing off", 3: "done", 4: "not found", 5: "aborted"}
 SIM_STEPDIR_BYTES = 23   # period u32, steps i32, edges i32, counter u16, flags u8, 2 f32
 
 
@@ -555,6 +564,21 @@ class Console:
              "position_error_rad": err}
         p.update({name: bool(flags & bit) for bit, name in POSITION_FLAGS.items()})
         return p
+
+    def home(self, direction, travel_rad, speed_rad_s=0.0, stall_current_a=0.0):
+        """Starts homing toward @p direction (+1, -1); raises DeviceError naming the code that refused it."""
+        status, period = self._ack_status(HOME, struct.pack("<ffff", direction, speed_rad_s, travel_rad,
+                                                            stall_current_a))
+        if status != 0:
+            raise DeviceError(f"the drive refused to home: {describe_code(status)}", status=status, request=HOME)
+        return period
+
+    def home_status(self):
+        d = check_reply(HOME_STATUS, self.request(HOME_STATUS), HOME_STATUS_BYTES)
+        status, period, state, by_current, stop, position = struct.unpack_from("<hIBBff", d)
+        return {"status": status, "period": period, "state": HOMING_STATES.get(state, str(state)),
+                "found_by": "stall current" if by_current else "following error", "stop_rad": stop,
+                "position_rad": position}
 
     # ---- the stored configuration ----
     def config_read(self, offset):
@@ -1158,6 +1182,38 @@ FAULTS = {0: "none", 1: "MEASUREMENT_NONFINITE", 2: "OVERCURRENT", 3: "BUS_UNDER
           14: "OPEN_PHASE_B", 15: "CURRENT_STUCK_A", 16: "CURRENT_STUCK_B", 17: "ESTIMATE_RANGE"}
 
 
+def home(con, a):
+    """HOME, then HOME_STATUS every tenth of a second (a simulation image: --advance periods of its time
+    each) until the homing is over; where the stop was found and the outcome printed."""
+    if len(a.args) != 1 or a.args[0] not in ("+", "-") or a.travel is None:
+        raise UsageError("home +|- --travel RAD [--speed RAD_S] [--stall-current A] [--timeout S] [--advance N]")
+    direction = 1.0 if a.args[0] == "+" else -1.0
+    con.home(direction, a.travel, a.speed or 0.0, a.stall_current or 0.0)
+    print(f"homing toward {a.args[0]}, at most {a.travel} rad" + (f" at {a.speed} rad/s" if a.speed else ""))
+    deadline = time.monotonic() + a.timeout
+    last = None
+    while True:
+        if a.advance:
+            con.sim_advance(a.advance, timeout=600.0)
+        else:
+            con.pump(0.1)
+        st = con.home_status()
+        if st["state"] != last:
+            print(f"  {st['state']:12s} position {st['position_rad']:+.5f} rad")
+            last = st["state"]
+        if st["state"] not in ("seeking", "backing off"):
+            break
+        if time.monotonic() > deadline:
+            con.hold(None)
+            raise DeviceError(f"homing not over after {a.timeout:.0f} s: holding where it is")
+    if st["state"] != "done":
+        raise DeviceError(f"homing {st['state']}: " + {
+            "not found": f"no stop within {a.travel} rad; the drive holds at the end of the travel",
+            "aborted": "the drive left RUN or another command took over"}.get(st["state"], "not started"))
+    print(f"home: the stop found by the {st['found_by']} at {st['stop_rad']:+.5f} rad; it is the zero now, the "
+          f"rotor at {st['position_rad']:+.5f} rad")
+
+
 def calibrate(con, a):
     """CALIBRATE, then CALIBRATE_STATUS every half second (a simulation image: --advance periods of its
     time each) until it is done or failed; the measured motor and the outcome printed."""
@@ -1330,6 +1386,9 @@ def run_command(con, argv):
     p.add_argument("--pole-pairs", type=int, default=50)
     p.add_argument("--paper", action="store_true")
     p.add_argument("--detent-fraction", type=float, default=0.05)
+    p.add_argument("--travel", type=float)
+    p.add_argument("--speed", type=float)
+    p.add_argument("--stall-current", type=float)
     p.add_argument("--timeout", type=float, default=120.0)
     p.add_argument("--advance", type=int, default=0)
     a = p.parse_args(argv)
@@ -1418,6 +1477,8 @@ def run_command(con, argv):
         print_store(con)
     elif w == "calibrate":
         calibrate(con, a)
+    elif w == "home":
+        home(con, a)
     else:
         return False
     return True
@@ -1426,7 +1487,8 @@ def run_command(con, argv):
 class Shell(cmd.Cmd):
     intro = "pmstep console: hello, status, start, stop, clear, speed T [--ramp R], id A, config, get K, " \
             "set K V, commissioning, counters, telemetry [--decimation N --seconds S --csv F --plot], " \
-            "move X [--vmax V --amax A --jmax J], hold [--amax A], position, zero, setup (--motor F | " \
+            "move X [--vmax V --amax A --jmax J], hold [--amax A], position, zero, " \
+            "home +|- --travel X [--speed V --stall-current A], setup (--motor F | " \
             "--motor-db F --name N) [--robust --set K=V --bus-voltage V --tune P], backup F, restore F [--save], " \
             "save, erase, defaults, store, calibrate --current A [--pole-pairs P --paper --detent-fraction D], quit"
     prompt = "pmstep> "

@@ -332,6 +332,7 @@ int main(int argc, char **argv)
             if (with_position) {
                 pmstep_stepdir_count(&stepdir, pmstep_console_sim_steps_period(&con));
                 pmstep_position_update(&position, &snap.out, &pos_out);
+                pmstep_console_home_period(&con, &snap.out, &pos_out);
                 (void)pmstep_stepdir_diag(&stepdir, snap.out.mode, pos_out.position_rad, pos_out.tracked);
             }
             snap.meas = meas;

@@ -209,12 +209,90 @@ static void test_requests_at_the_boundary(void **state)
     assert_int_equal(con.count.rx_error_replies, 0u);
 }
 
+/* The HOME_STATUS reply: status, period, state, found by, stop, position. */
+static reply_t home_status(uint8_t seq)
+{
+    reply_t r;
+    request(PMSTEP_CONSOLE_HOME_STATUS, seq, NULL, 0u);
+    pmstep_console_boundary(&con, &motor, &cfg, &snap);
+    r = one_reply();
+    assert_int_equal(r.type, PMSTEP_CONSOLE_HOME_STATUS | 0x80u);
+    assert_int_equal(r.n, 16u);
+    return r;
+}
+
+/* HOME and HOME_STATUS: lengths and values checked at parsing, the core's refusals by code, a homing
+ * started on the designer's settings with the request's, run by pmstep_console_home_period() and ended
+ * (aborted) when RUN ends. */
+static void test_home(void **state)
+{
+    const float toward_plus[3] = {1.0f, 0.5f, 2.0f};
+    const float with_current[4] = {-1.0f, 0.0f, 2.0f, 0.25f};
+    const float no_direction[3] = {0.0f, 0.5f, 2.0f};
+    const float no_travel[3] = {1.0f, 0.5f, 0.0f};
+    const float nan_speed[3] = {1.0f, NAN, 2.0f};
+    pmstep_homing_config_t designed;
+    pmstep_output_t out;
+    pmstep_position_output_t pos_out;
+    reply_t r;
+    (void)state;
+    assert_int_equal(pmstep_homing_design(&cfg, &designed), PMSTEP_OK);
+    request(PMSTEP_CONSOLE_HOME, 1u, toward_plus, 12u);
+    expect_error(PMSTEP_CONSOLE_HOME, PMSTEP_CONSOLE_ERR_NO_POSITION);
+    pmstep_console_attach_position(&con, &position);
+    request(PMSTEP_CONSOLE_HOME, 2u, toward_plus, 8u);
+    expect_error(PMSTEP_CONSOLE_HOME, PMSTEP_CONSOLE_ERR_BAD_LENGTH);
+    request(PMSTEP_CONSOLE_HOME, 3u, nan_speed, 12u);
+    expect_error(PMSTEP_CONSOLE_HOME, PMSTEP_CONSOLE_ERR_BAD_VALUE);
+    request(PMSTEP_CONSOLE_HOME_STATUS, 4u, toward_plus, 4u);
+    expect_error(PMSTEP_CONSOLE_HOME_STATUS, PMSTEP_CONSOLE_ERR_BAD_LENGTH);
+    r = home_status(5u);
+    assert_int_equal(status_of(&r), PMSTEP_OK);
+    assert_int_equal(r.data[6], PMSTEP_HOMING_IDLE);
+    request(PMSTEP_CONSOLE_HOME, 6u, toward_plus, 12u);
+    pmstep_console_boundary(&con, &motor, &cfg, &snap);
+    r = one_reply();
+    assert_int_equal(status_of(&r), PMSTEP_ERR_BAD_MODE); /* not tracked */
+    run_period(0.0);
+    request(PMSTEP_CONSOLE_HOME, 7u, no_direction, 12u);
+    pmstep_console_boundary(&con, &motor, &cfg, &snap);
+    assert_int_equal(status_of((r = one_reply(), &r)), PMSTEP_ERR_HOMING);
+    request(PMSTEP_CONSOLE_HOME, 8u, no_travel, 12u);
+    pmstep_console_boundary(&con, &motor, &cfg, &snap);
+    assert_int_equal(status_of((r = one_reply(), &r)), PMSTEP_ERR_HOMING);
+    assert_int_equal(con.homing.state, PMSTEP_HOMING_IDLE);
+    /* toward -, the designer's speed, a stall current of 0.25 A */
+    request(PMSTEP_CONSOLE_HOME, 9u, with_current, 16u);
+    pmstep_console_boundary(&con, &motor, &cfg, &snap);
+    r = one_reply();
+    assert_int_equal(r.type, PMSTEP_CONSOLE_HOME | 0x80u);
+    assert_int_equal(status_of(&r), PMSTEP_OK);
+    assert_int_equal(con.homing.state, PMSTEP_HOMING_SEEKING);
+    assert_true(con.homing.direction == -1.0f);
+    assert_true(con.homing.cfg.speed_rad_s == designed.speed_rad_s);
+    assert_true(con.homing.cfg.max_travel_rad == 2.0f);
+    assert_true(con.homing.cfg.stall_current_A == 0.25f);
+    assert_true(position.out.position_mode);
+    assert_float_equal(position.motion.target, -2.0f, 1e-6f);
+    r = home_status(10u);
+    assert_int_equal(r.data[6], PMSTEP_HOMING_SEEKING);
+    assert_float_equal(console_test_f32(&r.data[12]), 0.0f, 1e-6f); /* theta-hat */
+    /* the image's period: the homing sees RUN end and is aborted */
+    memset(&out, 0, sizeof out);
+    out.mode = PMSTEP_MODE_FAULT;
+    pmstep_position_update(&position, &out, &pos_out);
+    pmstep_console_home_period(&con, &out, &pos_out);
+    r = home_status(11u);
+    assert_int_equal(r.data[6], PMSTEP_HOMING_ABORTED);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup(test_no_position_instance, setup),
         cmocka_unit_test_setup(test_wrong_length_and_non_finite, setup),
         cmocka_unit_test_setup(test_requests_at_the_boundary, setup),
+        cmocka_unit_test_setup(test_home, setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -278,6 +278,27 @@ class AgainstAPositionDrive(AgainstTheFirmwareConsole):
         n = c.counters()
         self.assertEqual((n["rx_error_replies"], n["commands_applied"]), (1, 6))
 
+    def test_home_before_run(self):
+        c = self.con
+        h = c.home_status()
+        self.assertEqual((h["status"], h["state"], h["position_rad"]), (0, "idle", 0.0))
+        with self.assertRaisesRegex(pc.DeviceError, "refused to home.*-2"):  # not tracked: not in RUN
+            c.home(1.0, 2.0)
+        with self.assertRaisesRegex(pc.DeviceError, "bad value"):
+            c.home(1.0, math.nan)
+        out = io.StringIO()
+        err = io.StringIO()
+        self.link.close()
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            self.assertEqual(pc.main(["--port", self.slave_name, "home", "+"]), 2)  # no --travel: usage
+            self.assertEqual(pc.main(["--port", self.slave_name, "home", "up", "--travel", "1"]), 2)
+            self.assertEqual(pc.main(["--port", self.slave_name, "home", "-", "--travel", "1"]), 1)
+        self.assertIn("home +|- --travel RAD", err.getvalue())
+        self.assertIn("refused to home", err.getvalue())
+        self.link = pc.open_endpoint(self.slave_name, 115200)
+        self.con = pc.Console(self.link)
+        self.assertEqual(self.con.home_status()["state"], "idle")
+
     def test_command_line_position(self):
         out = io.StringIO()
         err = io.StringIO()

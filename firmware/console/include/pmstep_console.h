@@ -71,6 +71,17 @@
  *                              period boundaries; when done, the design is in force, the drive configured
  *                              and the record saved. STOP cancels it; while it runs, any other request
  *                              that touches the core gets BUSY
+ *   0x1A HOME               direction f32, speed f32, travel f32 [, stall current f32]
+ *                                                    -> ACK (pmstep_homing_start() toward direction's sign
+ *                              (+1 or -1) on the designer's homing settings (pmstep_homing_design()), with
+ *                              speed (rad/s; 0 = the designer's), the largest travel (rad, > 0) and the
+ *                              stall current (A; absent or 0 = the designer's); runs at the period
+ *                              boundaries (pmstep_console_home_period()); found, the zero is at the stop.
+ *                              A position or speed command, or leaving RUN, ends it (aborted)
+ *   0x1B HOME_STATUS        -                        -> status i16, period u32, state u8
+ *                              (pmstep_homing_state_t), found by u8 (1 the current, 0 the following
+ *                              error), stop f32 (where it was found, rad before the zero was set), position
+ *                              f32 (theta-hat now, 0 while not tracked)
  *   0x19 CALIBRATE_STATUS   -                        -> stage u8, status i16, fault u8, runs u8,
  *                              identification u8, save status i16, R f32, L f32, k_M f32, J f32, F f32;
  *                              answered at once
@@ -101,7 +112,7 @@
  *
  * ACK status: 0 done, a negative pmstep_status_t when the core refused (e.g. -2
  * PMSTEP_ERR_BAD_MODE), and the period from which the command takes effect (the first
- * step that sees it). The position requests 0x0D..0x10 need position control attached
+ * step that sees it). The position requests 0x0D..0x10, 0x1A and 0x1B need position control attached
  * (pmstep_console_attach_position); without it (an image in speed mode) they get the error
  * reply PMSTEP_CONSOLE_ERR_NO_POSITION (9). The CONFIG_* requests 0x11..0x17 need the stored
  * configuration attached (pmstep_console_attach_store), else PMSTEP_CONSOLE_ERR_NO_STORE (11); with it,
@@ -128,6 +139,7 @@
 #include <stdint.h>
 
 #include "pmstep/pmstep.h"
+#include "pmstep/pmstep_homing.h"
 #include "pmstep/pmstep_position.h"
 #include "pmstep/pmstep_stepdir.h"
 #include "pmstep_store.h"
@@ -170,6 +182,8 @@ typedef enum {
     PMSTEP_CONSOLE_CONFIG_STATUS = 0x17,
     PMSTEP_CONSOLE_CALIBRATE = 0x18,
     PMSTEP_CONSOLE_CALIBRATE_STATUS = 0x19,
+    PMSTEP_CONSOLE_HOME = 0x1A,
+    PMSTEP_CONSOLE_HOME_STATUS = 0x1B,
     PMSTEP_CONSOLE_SIM_ADVANCE = 0x40,
     PMSTEP_CONSOLE_SIM_FINISH = 0x41,
     PMSTEP_CONSOLE_SIM_STEPS = 0x42,
@@ -208,19 +222,24 @@ typedef enum {
 #define PMSTEP_CONSOLE_POSITION_MODE 2u
 #define PMSTEP_CONSOLE_POSITION_MOVING 4u
 
-/** What GET_POSITION reads (mechanical rad). */
+/** What GET_POSITION and HOME_STATUS read (mechanical rad). */
 typedef struct {
     float position_rad;
     float position_ref_rad;
     float position_error_rad;
     uint8_t flags;
+    uint8_t homing_state;   /**< HOME_STATUS: pmstep_homing_state_t */
+    uint8_t homing_by_current;
+    float homing_stop_rad;
 } pmstep_console_position_reading_t;
 
-/** Applies a position request to @p pos (pmstep_console_position.c, linked only by an image that
- *  attaches position control): @p args as parsed; @p reading filled for GET_POSITION. @p cmd
+struct pmstep_console;
+
+/** Applies a position request to @p c's position control (pmstep_console_position.c, linked only by an
+ *  image that attaches it): @p args as parsed; @p reading filled for GET_POSITION and HOME_STATUS. @p cmd
  *  SET_CONFIG: the core's configuration changed, the loop's gains are designed from it again.
  *  @return the pmstep_status_t of the core's call. */
-typedef int32_t (*pmstep_console_position_apply_t)(pmstep_position_t *pos, uint8_t cmd, const float *args,
+typedef int32_t (*pmstep_console_position_apply_t)(struct pmstep_console *c, uint8_t cmd, const float *args,
                                                     pmstep_console_position_reading_t *reading);
 
 /** What the console counted, since init. */
@@ -396,6 +415,7 @@ typedef struct pmstep_console {
     /* position control (NULL: none, the position requests are refused) */
     pmstep_position_t *position;
     pmstep_console_position_apply_t position_apply;
+    pmstep_homing_t homing;       /**< HOME's run (pmstep_console_home_period()) */
     /* simulation images (NULL: none, the simulation requests are refused): periods to run */
     pmstep_console_sim_request_t sim_request;
     /* stored configuration (NULL: none; the image's configuration is then the one in force) */
@@ -465,6 +485,11 @@ uint16_t pmstep_console_sim_steps_period(pmstep_console_t *c);
  * period boundary. The application runs pmstep_position_update() after every step.
  */
 void pmstep_console_attach_position(pmstep_console_t *c, pmstep_position_t *pos);
+
+/** HOME's run, once a period after pmstep_position_update() with that period's outputs (an image with
+ *  position control attached): pmstep_homing_update() while a homing started by HOME is under way. */
+void pmstep_console_home_period(pmstep_console_t *c, const pmstep_output_t *out,
+                                const pmstep_position_output_t *pos_out);
 
 /**
  * Attaches the stored configuration (@p cs, filled by pmstep_console_store_boot()): the STEP/DIR

@@ -63,6 +63,20 @@ static void send_position(pmstep_console_t *c, uint8_t seq, int32_t status, cons
 
 /* What a request may do while a calibration runs: read, or STOP it (the calibration's); the rest would
  * reach a core the calibration drives. */
+static void send_home_status(pmstep_console_t *c, uint8_t seq, int32_t status, const pmstep_console_snapshot_t *s,
+                             const pmstep_console_position_reading_t *r)
+{
+    writer_t w;
+    w.n = 0;
+    put_u16(&w, (uint32_t)(uint16_t)(int16_t)status);
+    put_u32(&w, s->period);
+    put_u8(&w, r->homing_state);
+    put_u8(&w, r->homing_by_current);
+    put_f32(&w, r->homing_stop_rad);
+    put_f32(&w, r->position_rad);
+    pmstep_console_send(c, PMSTEP_CONSOLE_HOME_STATUS | 0x80u, seq, w.b, w.n);
+}
+
 static bool allowed_while_calibrating(uint8_t cmd)
 {
     return cmd == PMSTEP_CONSOLE_GET_STATUS || cmd == PMSTEP_CONSOLE_GET_CONFIG || cmd == PMSTEP_CONSOLE_GET_COMMISSIONING
@@ -141,12 +155,19 @@ void pmstep_console_boundary(pmstep_console_t *c, pmstep_t *inst, pmstep_config_
     case PMSTEP_CONSOLE_MOVE_TO:
     case PMSTEP_CONSOLE_HOLD:
     case PMSTEP_CONSOLE_SET_POSITION_ZERO:
-        st = c->position_apply(c->position, req->cmd, req->arg, NULL); /* attached: checked at parsing */
+    case PMSTEP_CONSOLE_HOME:
+        st = c->position_apply(c, req->cmd, req->arg, NULL); /* attached: checked at parsing */
         break;
     case PMSTEP_CONSOLE_GET_POSITION: {
         pmstep_console_position_reading_t r;
-        st = c->position_apply(c->position, req->cmd, req->arg, &r);
+        st = c->position_apply(c, req->cmd, req->arg, &r);
         send_position(c, seq, st, snap, &r);
+        return;
+    }
+    case PMSTEP_CONSOLE_HOME_STATUS: {
+        pmstep_console_position_reading_t r;
+        st = c->position_apply(c, req->cmd, req->arg, &r);
+        send_home_status(c, seq, st, snap, &r);
         return;
     }
     case PMSTEP_CONSOLE_GET_STATUS:
@@ -212,7 +233,7 @@ void pmstep_console_boundary(pmstep_console_t *c, pmstep_t *inst, pmstep_config_
             st = (int32_t)pmstep_init(inst, cfg);
         }
         if (st == (int32_t)PMSTEP_OK && c->position_apply != NULL) {
-            st = c->position_apply(c->position, PMSTEP_CONSOLE_SET_CONFIG, req->arg, NULL); /* gains anew */
+            st = c->position_apply(c, PMSTEP_CONSOLE_SET_CONFIG, req->arg, NULL); /* gains anew */
         }
         break;
     }

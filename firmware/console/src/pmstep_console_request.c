@@ -155,7 +155,7 @@ static int parse_config(pmstep_console_t *c, const uint8_t *d, uint32_t n, pmste
     return is_finite(req->a) ? REQUEST_QUEUE : PMSTEP_CONSOLE_ERR_BAD_VALUE;
 }
 
-/* A position request's values, whole floats only (MOVE_TO 3 or 4, HOLD 0 or 1), absent ones 0. */
+/* A position request's values, whole floats only (MOVE_TO and HOME 3 or 4, HOLD 0 or 1), absent ones 0. */
 static int parse_position(pmstep_console_t *c, const uint8_t *d, uint32_t n, pmstep_console_request_t *req)
 {
     uint32_t i;
@@ -279,6 +279,8 @@ static const request_row_t requests[] = {
     {PMSTEP_CONSOLE_HOLD, NEEDS_POSITION, 0u, 4u, parse_position},
     {PMSTEP_CONSOLE_GET_POSITION, NEEDS_POSITION, 0u, 0u, parse_position},
     {PMSTEP_CONSOLE_SET_POSITION_ZERO, NEEDS_POSITION, 0u, 0u, parse_position},
+    {PMSTEP_CONSOLE_HOME, NEEDS_POSITION, 12u, 16u, parse_position},
+    {PMSTEP_CONSOLE_HOME_STATUS, NEEDS_POSITION, 0u, 0u, parse_position},
     {PMSTEP_CONSOLE_CONFIG_READ, NEEDS_STORE, 2u, 2u, parse_config_read},
     {PMSTEP_CONSOLE_CONFIG_WRITE, NEEDS_STORE, 3u, NAME_ROOM, parse_config_write},
     {PMSTEP_CONSOLE_CONFIG_APPLY, NEEDS_STORE, 0u, 0u, parse_plain},

@@ -73,7 +73,7 @@ int32_t pmstep_console_put_in_force(pmstep_console_t *c, pmstep_t *inst, pmstep_
     st = (int32_t)pmstep_init(inst, cfg);
     if (st == (int32_t)PMSTEP_OK && c->position_apply != NULL) {
         const float none[4] = {0.0f, 0.0f, 0.0f, 0.0f};
-        st = c->position_apply(c->position, PMSTEP_CONSOLE_SET_CONFIG, none, NULL);
+        st = c->position_apply(c, PMSTEP_CONSOLE_SET_CONFIG, none, NULL);
     }
     return st;
 }

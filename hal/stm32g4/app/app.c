@@ -114,6 +114,7 @@ static void after_step(const pmstep_output_t *out)
 {
     pmstep_stepdir_count(&stepdir, pmstep_stm32g4_step_counter());
     pmstep_position_update(&position, out, &position_out);
+    pmstep_console_home_period(&console, out, &position_out);
     follow_enable();
     if (position_out.tracked && !stepdir_was_tracked && stepdir_start() == PMSTEP_OK) {
         (void)pmstep_position_follow_steps(&position, &stepdir);
@@ -140,6 +141,7 @@ static void stepdir_settings_to_port(void)
 static void after_step(const pmstep_output_t *out)
 {
     pmstep_position_update(&position, out, &position_out);
+    pmstep_console_home_period(&console, out, &position_out); /* a HOME under way */
 }
 #endif
 

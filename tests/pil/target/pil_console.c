@@ -291,6 +291,7 @@ static void run_period(loop_t *L, long k, pmstep_console_snapshot_t *snap)
         pmstep_position_output_t pos_out;
         pmstep_stepdir_count(&stepdir, pmstep_console_sim_steps_period(&console));
         pmstep_position_update(&position, &out, &pos_out);
+        pmstep_console_home_period(&console, &out, &pos_out);
         if (pmstep_stepdir_diag(&stepdir, out.mode, pos_out.position_rad, pos_out.tracked)) {
             L->sd.diag_periods++;
         }
