@@ -317,7 +317,7 @@ def summary_text(rows):
         if lo is None:
             parts.append(f"{motor} {chain}: the designer's speed missed ({n_met} of {n} met)")
         else:
-            parts.append(f"{motor} {chain}: {n_met} of {n} met; every speed from {lo:.3g} to {hi:.3g} rad/s "
+            parts.append(f"{motor} {chain}: {n_met} of {n} met, every speed from {lo:.3g} to {hi:.3g} rad/s "
                          f"({lo / top:.3g} to {hi / top:.3g} of the top speed) met, the stop found there within "
                          f"{worst:.3f} full steps")
     return "; ".join(parts) + "."
@@ -334,14 +334,31 @@ def stepdir_summary(stepdir_rows):
     return text + "."
 
 
+WHAT = ("Per public motor preset, on the **ideal** chain (pmstep-tune's design, the plant's detent torque on) and "
+        "on the **realistic** one (pmstep-tune --robust under the presets' realistic measurement chain of "
+        "tools/mc_preset.py, the plant's R 20 % above the firmware's), the drive homes (`position.source = "
+        "homing`, pmstep_homing.h) toward the SIL's hard stop (`motor.stop_*`: a one-sided spring that the "
+        f"holding torque presses in by {STOP_COMPLIANCE_FULL_STEPS:g} of a full step, damped at ζ = "
+        f"{STOP_DAMPING_RATIO:g} on the rotor's inertia), placed {STOP_FULL_STEPS:g} full steps plus the distance "
+        "to reach the speed from the c-alignment's equilibrium, at speeds from "
+        f"{SPEED_FRACTIONS[0]:g} to {SPEED_FRACTIONS[-1]:g} of the design's top speed and at the designer's own, "
+        "alternately in the two directions, and once with no stop in reach. Full steps are π / 2p. **Stop "
+        "error**: the zero the drive set less where the rotor meets the stop; **final error**: the drive's "
+        "position after the back-off less the rotor's true distance from the stop; **current on the stop**: "
+        "the largest phase current from the contact to the find; **stop's push**: the largest torque of the "
+        "stop on the rotor while seeking (the impact at the higher speeds). Verdict: homing done, no fault, "
+        f"|stop error| and |final error| within {BOUND_FULL_STEPS:g} full steps, the current on the stop within "
+        "the stall current plus the current of the homing's acceleration; with no stop in reach, not found and "
+        "holding without a fault.")
+
+
 def report_text(rows, stepdir_rows, args, argv):
-    lines = [report.header("Homing without a switch", "tools/homing_sweep.py", argv, __doc__.split("\n\n")[1]
-                           .replace("\n", " ").strip()), ""]
+    lines = [report.header("Homing without a switch", "tools/homing_sweep.py", argv, WHAT), ""]
     lines += ["## Console homing (pmstep_homing.h)", ""]
     lines.append("| " + " | ".join(COLUMNS) + " |")
     lines.append("|" + "---|" * len(COLUMNS))
     lines += [line(r, True) for r in rows]
-    lines += ["", summary_text(rows), ""]
+    lines += [""] + ["- " + part for part in summary_text(rows).rstrip(".").split("; ")] + [""]
     lines += ["## Homing on DIAG over STEP/DIR (stepdir.stall_current_A)", "", STEPDIR_TEXT, ""]
     lines.append("| " + " | ".join(STEPDIR_COLUMNS) + " |")
     lines.append("|" + "---|" * len(STEPDIR_COLUMNS))

@@ -28,7 +28,11 @@ pmstep_status_t pmstep_homing_design(const pmstep_config_t *cfg, pmstep_homing_c
     }
     k_m = cfg->motor.torque_constant_Nm_A;
     j = cfg->motor.inertia_kgm2;
+    /* half the rated current, and half the trip where that is lower: always below the trip */
     homing->stall_current_A = 0.5f * cfg->motor.rated_current_A;
+    if (cfg->limits.max_phase_current_A < cfg->motor.rated_current_A) {
+        homing->stall_current_A = 0.5f * cfg->limits.max_phase_current_A;
+    }
     /* the loop's push on contact J k_w v within a quarter of the stall torque */
     homing->speed_rad_s = CONTACT_PUSH_SHARE * k_m * homing->stall_current_A / (j * cfg->gains.speed_gain_per_s);
     bus_speed = BUS_SPEED_SHARE * cfg->limits.min_bus_voltage_V / k_m;

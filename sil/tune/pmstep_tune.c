@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pmstep/pmstep_homing.h"
 #include "pmstep/pmstep_text.h"
 #include "pmstep_tune.h"
 
@@ -283,6 +284,13 @@ int main(int argc, char **argv)
     }
     printf("  position loop: k_theta %g 1/s, k_I %g 1/s^2; vector hold at %g A\n", (double)sc.position.gain_per_s,
            (double)sc.position.integral_gain_per_s2, (double)sc.position.hold_current_A);
+    {
+        pmstep_homing_config_t homing;
+        (void)pmstep_homing_design(&sc.controller, &homing);
+        printf("  homing: %g rad/s (%.0f rpm) at %g rad/s^2, stall current %g A, stall error %g rad\n",
+               (double)homing.speed_rad_s, (double)homing.speed_rad_s * 60.0 / (2.0 * 3.14159265358979),
+               (double)homing.accel_rad_s2, (double)homing.stall_current_A, (double)homing.stall_error_rad);
+    }
     if (ini_path != NULL) {
         FILE *f = fopen(ini_path, "w");
         if (f == NULL) {

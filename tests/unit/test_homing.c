@@ -109,6 +109,13 @@ static void designer_rule_from_the_motor_data(void **state)
     assert_float_equal(h.back_off_rad, full_step, 1e-7);
     assert_float_equal(h.max_travel_rad, 2.0 * M_PI, 1e-6);
     assert_true(h.stall_current_A < cfg.limits.max_phase_current_A);
+    {
+        /* a trip below the rated current: half the trip, still below it */
+        pmstep_config_t low_trip = cfg;
+        low_trip.limits.max_phase_current_A = 0.6f * cfg.motor.rated_current_A;
+        assert_int_equal(pmstep_homing_design(&low_trip, &h), PMSTEP_OK);
+        assert_float_equal(h.stall_current_A, 0.5 * (double)low_trip.limits.max_phase_current_A, 1e-6);
+    }
 }
 
 static void settings_refused_by_cause(void **state)

@@ -43,7 +43,7 @@ typedef struct {
     float accel_rad_s2;    /**< to and from that speed, > 0 (designer: k_M I_s / (4 J)) */
     float max_travel_rad;  /**< no stop within this travel: not found (> 0; designer: one revolution) */
     float stall_current_A; /**< the stop when d i_q* exceeds it while cruising; in (0, max_phase_current_A)
-                                (designer: half the rated current) */
+                                (designer: half the rated current, or half the trip if lower) */
     float stall_error_rad; /**< the stop when the following error exceeds it, > 0 (designer: half a full step) */
     float back_off_rad;    /**< moved away from the stop once found, >= 0 (designer: one full step) */
 } pmstep_homing_config_t;
