@@ -1,7 +1,8 @@
 """Tests of the report writers (python3 -m unittest test_reports): tools/report.py's header and
 sections, and each measuring tool's --report text on fixed figures (bench_target.py,
 bench_position_target.py, bench_sil.py, envelope.py, position_acceptance.py, monte_carlo.py with
-mc_report.py). Standard library only; nothing is measured or run."""
+mc_report.py, stepdir_compare.py with its load-step search). Standard library only; nothing is measured
+or run."""
 import argparse
 import contextlib
 import datetime
@@ -10,6 +11,7 @@ import os
 import re
 import tempfile
 import unittest
+from unittest import mock
 
 import bench_position_target
 import bench_sil
@@ -19,6 +21,7 @@ import mc_report
 import monte_carlo
 import position_acceptance
 import report
+import stepdir_compare
 
 TODAY = datetime.date.today().isoformat()
 
@@ -318,6 +321,100 @@ class MonteCarlo(ReportCase):
         argv = ["m.py", "--report=r.md", "--cases", "4", "--report-section", "s", "--seed", "1"]
         self.assertEqual(mc_report.campaign_command(argv), ["m.py", "--cases", "4", "--seed", "1"])
         self.assertEqual(mc_report.campaign_command(argv, 100003), ["m.py", "--seed", "1", "--case", "100003"])
+
+
+class StepDirCompare(ReportCase):
+    PRESET = {"rated_A": 1.7, "k_M": 0.16638, "J": 5.4e-6, "R": 1.5, "p": 50}
+    DESIGN = (1100.0, 0.25, 2000.0, 13.8)   # top speed, RUN's start, varpi_0, stall bound
+
+    @staticmethod
+    def summary(fault="NONE", final=0.0, following_end=-1.0, diag=0):
+        return {"fault": {"name": fault}, "rms_phase_current_A": 1.2, "max_abs_phase_current_a": 3.3,
+                "stepdir": {"following_start_s": 0.35, "following_end_s": following_end, "max_error_full_steps": 2.5,
+                            "final_error_full_steps": final, "diag_periods": diag,
+                            "diag_first_s": 0.46 if diag else -1.0}}
+
+    def load_row(self, motor, drive, survived, failed, holding=0.4):
+        row = {"motor": motor, "drive": drive, "holding_torque_Nm": holding, "k_M_rated_Nm": holding / 2 ** 0.5,
+               "step_time_s": 0.459, "cruise_s": (0.304, 0.614), "iterations": 9, "survived_Nm": survived,
+               "failed_Nm": failed, "failed_why": ["fault OVERCURRENT"] if failed is not None else [],
+               "overcurrent_trip_A": 3.4 if drive == "pmstep" else None,
+               "survived_fraction": None if survived is None else survived / holding}
+        if survived is not None:
+            row.update({"max_error_full_steps": 6.052, "final_error_full_steps": 0.0, "rms_phase_current_A": 1.647,
+                        "peak_phase_current_a_A": 3.397, "diag_periods": 136 if drive == "pmstep" else 0,
+                        "diag_first_s": 0.46 if drive == "pmstep" else -1.0})
+        return row
+
+    def test_survived(self):
+        """The same verdict for both drives: DIAG is no failure, half a full step at the end is."""
+        self.assertEqual(stepdir_compare.load_failures(self.summary(final=0.49, diag=300)), [])
+        self.assertEqual(len(stepdir_compare.load_failures(self.summary(final=-0.5))), 1)
+        self.assertEqual(stepdir_compare.load_failures(self.summary(final=412.2)), ["+412 full steps lost"])
+        self.assertEqual(stepdir_compare.load_failures(self.summary(fault="STALL", following_end=0.5)),
+                         ["fault STALL", "not following the count to the end"])
+
+    def test_bisection(self):
+        """The bracket [0, 1.5 T_H] run at both ends, then halved: the threshold lies in (survived, failed]."""
+        with tempfile.TemporaryDirectory() as work:
+            base = os.path.join(work, "m.ini")
+            with open(base, "w") as f:
+                f.write("[controller.limits]\nmax_phase_current_A = 3.4\n")
+            args = argparse.Namespace(designs={"m": self.DESIGN})
+            for threshold, survived, failed in ((0.153, 0.15, 0.1875), (0.7, 0.6, None), (-1.0, None, 0.0)):
+                torques = []
+
+                def run(args, motor, drive, torque, work, threshold=threshold):
+                    torques.append(torque)
+                    return self.summary(), ([] if torque <= threshold else ["lost"])
+
+                with mock.patch.object(stepdir_compare, "designed", return_value=(self.PRESET, 0.4, base)), \
+                        mock.patch.object(stepdir_compare, "load_run", side_effect=run):
+                    row = stepdir_compare.load_search(args, "m", "pmstep", 4, work)
+                self.assertEqual(torques[0], 0.0)
+                if len(torques) > 1:
+                    self.assertAlmostEqual(torques[1], 0.6)
+                self.assertAlmostEqual(row["survived_Nm"] or 0.0, survived or 0.0)
+                self.assertEqual(row["survived_Nm"] is None, survived is None)
+                if failed is None:
+                    self.assertIsNone(row["failed_Nm"])
+                else:
+                    self.assertAlmostEqual(row["failed_Nm"], failed)
+                self.assertEqual(len(torques), 6 if 0.0 <= threshold < 0.6 else (2 if threshold >= 0.6 else 1))
+                self.assertEqual(row["overcurrent_trip_A"], 3.4)
+                self.assertAlmostEqual(row["resolution_Nm"], 0.6 / 16)
+                self.assertGreater(row["step_time_s"], row["move_start_s"])
+                self.assertLess(row["step_time_s"], row["move_end_s"])
+
+    def test_report(self):
+        run = {"motor": "17hs4401", "case": "moves", "drive": "pmstep", "microsteps": 16, "step_rate_hz": 17600.0,
+               "rms_phase_current_A": 0.84, "checked": True, "failures": [], "notes": [],
+               "stepdir": {"max_error_moving_full_steps": 0.113, "rms_error_moving_full_steps": 0.033,
+                           "max_error_full_steps": 0.113, "rms_error_full_steps": 0.023, "final_error_full_steps": 0.0,
+                           "lost_full_steps": 0, "diag_periods": 0, "diag_first_s": -1.0}}
+        loads = [self.load_row("17hs4401", "pmstep", 0.4535, 0.4547),
+                 self.load_row("17hs4401", "microstep", 0.1793, 0.1805),
+                 self.load_row("bj42d29", "pmstep", 0.1, 0.11, 0.41),
+                 self.load_row("bj42d29", "microstep", 0.2, 0.21, 0.41)]
+        args = argparse.Namespace(quick=False, plot_motor="17hs4401", plot_case="moves")
+        argv = ["tools/stepdir_compare.py", "--check"]
+        text = stepdir_compare.report_text([run], args, argv, None, loads)
+        self.assert_header(text, "tools/stepdir_compare.py --check")
+        self.assert_tables(text)
+        self.assertIn("## Largest load step survived during a move", text)
+        self.assertIn("| 17hs4401 | pmstep | 0.4 N·m | 0.459 s (cruise 0.304–0.614 s) | 0.4535 N·m | 1.134 | "
+                      "0.4547 N·m: fault OVERCURRENT | 6.052 | +0.000 | yes (0.460 s) | 1.647 A | "
+                      "3.40 A (trip 3.4 A) | 2.53 |", text)
+        self.assertIn("| 17hs4401 | microstep | 0.4 N·m | 0.459 s (cruise 0.304–0.614 s) | 0.1793 N·m | 0.448 |",
+                      text)
+        self.assertIn("9 halvings: resolution 1.5 / 512 = 0.29 % of the holding torque", text)
+        self.assertIn("√2 k_M I on these presets", text)
+        self.assertIn("pmstep survives at least microstepping's load step on 1 of 2 presets; "
+                      "pmstep / microstepping 0.50–2.53.", text)
+        self.assertEqual(len(stepdir_compare.load_check(loads)), 1)
+        self.assertTrue(stepdir_compare.load_check(loads)[0].startswith("bj42d29:"))
+        self.assertEqual(stepdir_compare.load_check(loads[:2]), [])
+        self.assertNotIn("## Largest load step", stepdir_compare.report_text([run], args, argv, None, []))
 
 
 if __name__ == "__main__":
