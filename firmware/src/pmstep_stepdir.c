@@ -45,6 +45,15 @@ pmstep_status_t pmstep_stepdir_design(const pmstep_config_t *cfg, uint32_t micro
     sd->microsteps = microsteps;
     sd->invert_direction = false;
     sd->tracking_bandwidth_rad_s = cfg->gains.reference_bandwidth_rad_s;
+    if (cfg->detection.stall_speed_error_rad_s > 0.0f) {
+        /* a microstep q moves the tracker's speed by about q w_t: at most the stall detection's bound
+         * (docs/design/20-step-dir.md, The staircase) */
+        const float microstep_rad = TWO_PI / (4.0f * (float)cfg->motor.pole_pairs * (float)microsteps);
+        const float staircase_rad_s = cfg->detection.stall_speed_error_rad_s / microstep_rad;
+        if (staircase_rad_s < sd->tracking_bandwidth_rad_s) {
+            sd->tracking_bandwidth_rad_s = staircase_rad_s;
+        }
+    }
     sd->following_error_limit_rad = HALF_PI / (float)cfg->motor.pole_pairs; /* one full step */
     sd->stop_time_s = STOP_TIME_PER_TRACKER / sd->tracking_bandwidth_rad_s;
     sd->diag_mode = PMSTEP_DIAG_LEVEL;

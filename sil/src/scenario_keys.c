@@ -121,7 +121,7 @@ const key_t_ scenario_keys[] = {
     {"position.hold_start_s", KEY_DOUBLE, OFF(hold_start_s), 0, 0, 3600, 0, "start of the hold window of the position metrics (s); 0 = none"},
     {"position.source", KEY_POSITION_SOURCE, OFF(position_source), 0, 0, 0, 0, "move (a pmstep_position_move_to() per point) | stepdir (the step generator plans the moves, the drive follows the count) | homing (one point t:theta: homes toward theta's sign, |theta| at most)"},
     {"stepdir.microsteps", KEY_UINT, OFF(stepdir_microsteps), 1, 0, 256, 0, "microsteps per full step of the STEP/DIR input (one is 2 pi / (4 p m) mechanical rad)"},
-    {"stepdir.tracking_bandwidth_rad_s", KEY_FLOAT, OFF(stepdir_tracking_bandwidth_rad_s), 0, 0, BIG, 0, "w_t of the drive's step tracker (rad/s); 0 = the designer's (varpi_0)"},
+    {"stepdir.tracking_bandwidth_rad_s", KEY_FLOAT, OFF(stepdir_tracking_bandwidth_rad_s), 0, 0, BIG, 0, "w_t of the drive's step tracker (rad/s); 0 = the designer's (varpi_0, at most the stall bound over the microstep)"},
     {"stepdir.stall_current_A", KEY_FLOAT, OFF(stepdir_stall_current_A), 0, 0, BIG, 0, "a stall at this q current (or the following-error limit) drops the steps toward the block, DIAG asserted (A); 0 = off"},
     {"stepdir.diag_mode", KEY_DIAG_MODE, OFF(stepdir_diag_mode), 0, 0, 0, 0, "level (DIAG asserted while a fault or a following error beyond a full step holds) | pulse (a 1 ms pulse at each new one)"},
     {"homing.speed_rad_s", KEY_DOUBLE, OFF(homing_speed_rad_s), 0, 0, 1e6, 0, "homing speed (rad/s); 0 = the designer's (pmstep_homing_design)"},

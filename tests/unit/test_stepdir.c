@@ -63,6 +63,32 @@ static void settings_refused_by_cause(void **state)
 }
 
 /* The 16-bit counter wraps; a difference is signed; DIR's sense can be reversed. */
+/* The designer's w_t: varpi_0, or the stall detection's speed bound over the microstep where that is lower
+ * (a microstep moves the tracker's speed by about q w_t); no bound with the stall detection off. */
+static void designer_bounds_the_tracker_by_the_microstep(void **state)
+{
+    pmstep_config_t cfg = pmstep_paper_config();
+    const float w0 = cfg.gains.reference_bandwidth_rad_s;
+    uint32_t m;
+    pmstep_stepdir_config_t c;
+    (void)state;
+    assert_true(cfg.detection.stall_speed_error_rad_s > 0.0f);
+    for (m = 1u; m <= PMSTEP_STEPDIR_MAX_MICROSTEPS; m *= 2u) {
+        const float q = 6.2831853f / (4.0f * (float)cfg.motor.pole_pairs * (float)m);
+        const float bound = cfg.detection.stall_speed_error_rad_s / q;
+        assert_int_equal(pmstep_stepdir_design(&cfg, m, &c), PMSTEP_OK);
+        assert_true(c.tracking_bandwidth_rad_s <= w0);
+        assert_true(c.tracking_bandwidth_rad_s * q <= cfg.detection.stall_speed_error_rad_s * 1.0001f);
+        assert_true(c.tracking_bandwidth_rad_s >= 0.9999f * (bound < w0 ? bound : w0));
+        assert_true(fabsf(c.stop_time_s * c.tracking_bandwidth_rad_s - 8.0f) < 1e-4f); /* 8 / w_t */
+    }
+    assert_int_equal(pmstep_stepdir_design(&cfg, 1u, &c), PMSTEP_OK);
+    assert_true(c.tracking_bandwidth_rad_s < w0); /* one full step per count: the bound acts */
+    cfg.detection.stall_speed_error_rad_s = 0.0f;   /* the stall detection off: no bound */
+    assert_int_equal(pmstep_stepdir_design(&cfg, 1u, &c), PMSTEP_OK);
+    assert_true(c.tracking_bandwidth_rad_s == w0);
+}
+
 static void counter_wraps_and_direction(void **state)
 {
     pmstep_stepdir_t sd;
@@ -238,6 +264,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(settings_refused_by_cause),
+        cmocka_unit_test(designer_bounds_the_tracker_by_the_microstep),
         cmocka_unit_test(counter_wraps_and_direction),
         cmocka_unit_test(tracker_has_no_steady_lag),
         cmocka_unit_test(at_rest_on_the_last_count),

@@ -64,7 +64,9 @@ typedef enum {
 typedef struct {
     uint32_t microsteps;               /**< m, microsteps per full step: 1 to PMSTEP_STEPDIR_MAX_MICROSTEPS */
     bool invert_direction;             /**< DIR's sense reversed */
-    float tracking_bandwidth_rad_s;    /**< w_t of the tracker (designer: the speed reference's varpi_0) */
+    float tracking_bandwidth_rad_s;    /**< w_t of the tracker (designer: the speed reference's varpi_0, at most
+                                            stall_speed_error_rad_s / q: a microstep q moves the tracker's speed
+                                            by about q w_t) */
     float following_error_limit_rad;   /**< DIAG beyond this |theta* - theta-hat|, mechanical rad (designer: one
                                             full step, pi / (2 p)) */
     float stop_time_s;                 /**< no step for this long: the reference is at rest */
@@ -105,7 +107,8 @@ typedef struct pmstep_stepdir {
 } pmstep_stepdir_t;
 
 /**
- * The designer's settings for @p cfg's motor with @p microsteps per full step: w_t = varpi_0, the
+ * The designer's settings for @p cfg's motor with @p microsteps per full step: w_t = varpi_0, or the
+ * stall detection's speed bound over the microstep q where that is lower (docs/design/20-step-dir.md), the
  * following-error limit one full step, stop_time_s 8 / w_t, DIAG in level mode (pulse 1 ms), no stall
  * current (the homing's, pmstep_homing_design(), when the axis homes on DIAG).
  * @retval PMSTEP_OK, PMSTEP_ERR_NULL_ARGUMENT
