@@ -76,8 +76,8 @@ COST_TITLE = "Cost on the target (Cortex-M4F)"
 COST_SECTIONS = ("step", "position")
 COST_WHAT = ("What the control step costs on a Cortex-M4F (QEMU's mps2-an386, the images' flags: `-Os` with "
              "link-time optimisation) and what the core and the STM32G431 image take, each figure beside the "
-             "budget ctest enforces (`pil.cost`, `pil.position_cost` in tests/pil/CMakeLists.txt; the image's "
-             "fit in hal/stm32g4/check_image.cmake).")
+             "budget ctest enforces (`pil.cost`, `pil.position_cost`, `pil.stepdir_cost` in "
+             "tests/pil/CMakeLists.txt; the image's fit in hal/stm32g4/check_image.cmake).")
 
 
 def run(cmd, **kw):
