@@ -76,8 +76,8 @@ COST_TITLE = "Cost on the target (Cortex-M4F)"
 COST_SECTIONS = ("step", "position")
 COST_WHAT = ("What the control step costs on a Cortex-M4F (QEMU's mps2-an386, the images' flags: `-Os` with "
              "link-time optimisation) and what the core and the STM32G431 image take, each figure beside the "
-             "budget ctest enforces (`pil.cost`, `pil.position_cost` in tests/pil/CMakeLists.txt; the image's "
-             "fit in hal/stm32g4/check_image.cmake).")
+             "budget ctest enforces (`pil.cost`, `pil.position_cost`, `pil.stepdir_cost` in "
+             "tests/pil/CMakeLists.txt; the image's fit in hal/stm32g4/check_image.cmake).")
 
 
 def run(cmd, **kw):
@@ -287,17 +287,19 @@ def static_stack(root_function="pmstep_step"):
 # ---- the budgets ctest enforces, read where they are set, and the report ----
 def budgets():
     """{name: value} of the budgets ctest enforces: pil.cost's MAX_RUN, MAX_STACK, MAX_INSTANCE,
-    MAX_FLASH and pil.position_cost's --max-mean (tests/pil/CMakeLists.txt) as run, stack, instance,
-    flash and position; the STM32G431 image's flash and RAM limits (hal/stm32g4/check_image.cmake)
-    as image_flash and image_ram. A budget not found is None."""
-    out = dict.fromkeys(("run", "stack", "instance", "flash", "position", "image_flash", "image_ram"))
+    MAX_FLASH, pil.position_cost's --max-mean and pil.stepdir_cost's --stepdir-max-mean
+    (tests/pil/CMakeLists.txt) as run, stack, instance, flash, position and stepdir; the STM32G431
+    image's flash and RAM limits (hal/stm32g4/check_image.cmake) as image_flash and image_ram. A
+    budget not found is None."""
+    out = dict.fromkeys(("run", "stack", "instance", "flash", "position", "stepdir", "image_flash", "image_ram"))
     try:
         text = PIL_CMAKE.read_text()
         for key, value in re.findall(r"-DMAX_(RUN|STACK|INSTANCE|FLASH)=(\d+)", text):
             out[key.lower()] = int(value)
-        m = re.search(r"bench_position_target\.py[^)]*--max-mean\s+([0-9.]+)", text)
-        if m:
-            out["position"] = float(m.group(1))
+        for key, flag in (("position", "--max-mean"), ("stepdir", "--stepdir-max-mean")):
+            m = re.search(r"bench_position_target\.py[^)]*\s%s\s+([0-9.]+)" % flag, text)
+            if m:
+                out[key] = float(m.group(1))
     except OSError:
         pass
     try:

@@ -122,8 +122,8 @@ COST = {"qemu": "QEMU emulator version 7.2", "gcc": "12.2.1", "bit_identical": T
         "branch_penalty": 2, "load_store_pipelining": True, "stack_measured_bytes": 252,
         "static_path": ["pmstep_step", "pmstep_commission_finish"], "static_unknown": ["memset"],
         "image": (33884, 0, 2976), "run_mix": [("vldr", 128.5)]}
-BUDGETS = {"run": 600, "stack": 256, "instance": 816, "flash": 19456, "position": 615.0, "image_flash": 131072,
-           "image_ram": 30720}
+BUDGETS = {"run": 600, "stack": 256, "instance": 816, "flash": 19456, "position": 615.0, "stepdir": 615.0,
+           "image_flash": 131072, "image_ram": 30720}
 
 
 class Cost(ReportCase):
@@ -175,6 +175,27 @@ class Cost(ReportCase):
                 page_text = f.read()
         self.assertEqual([n for n, _ in report.sections(page_text)], ["step", "position"])
         self.assertEqual(page_text.count("## Control period with the position loop"), 1)
+        self.assertNotIn("STEP/DIR", text)
+
+    def test_position_section_with_stepdir(self):
+        figures = {"p": {"label": "RUN, position mode", "periods": 45999, "step": [449, 544.8, 764],
+                         "update": [32, 62.0, 556], "total": [481, 606.8, 1079]}}
+        sd = {"p_update": {"label": "RUN following steps, at an update", "periods": 6000, "step": [449, 506.2, 525],
+                           "after": [248, 336.5, 641], "total": [697, 842.7, 1164]},
+              "p": {"label": "RUN following steps, every period", "periods": 47999, "step": [449, 545.2, 764],
+                    "after": [86, 118.7, 641], "total": [535, 663.9, 1164]}}
+        stepdir = {"figures": sd, "image_report": "pil-position: STEP/DIR at 16 microsteps, fault NONE",
+                   "microsteps": 16, "max_mean": 615.0, "enforced": 615.0}
+        argv = ["tools/bench_position_target.py", "--report", "docs/reports/cost.md"]
+        text = bench_position_target.report_section(figures, "", 615.0, 615.0, "3", argv, stepdir)
+        self.assert_tables(text)
+        self.assertIn("quantised to 16 microsteps per full step", text)
+        self.assertIn("| RUN following steps, at an update | 6000 | 449 / 506.2 / 525 | 248 / 336.5 / 641 | "
+                      "697 / 842.7 / 1164 |", text)
+        self.assertIn("mean **606.8** instructions, budget 615 (ctest pil.position_cost): within.", text)
+        self.assertIn("STEP/DIR period: mean **663.9** instructions, budget 615 (ctest pil.stepdir_cost): **OVER**.",
+                      text)
+        self.assertLess(text.index("RUN, position mode"), text.index("RUN following steps"))
 
 
 class Benchmarks(ReportCase):
