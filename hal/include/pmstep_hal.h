@@ -2,7 +2,7 @@
  * @file pmstep_hal.h
  * @brief The contract between the control core and a port (host SIL, STM32G4,
  *        QEMU Cortex-M4). A port implements these functions; the build links
- *        exactly one port. No function pointers in the interrupt path.
+ *        exactly one port, so the core's calls into it are direct.
  *
  * The control interrupt of every port does the same three things, once per
  * period, in this order (see pmstep_hal_control_period()):
@@ -12,6 +12,13 @@
  *   3. pmstep_hal_apply_output(): voltages to duties against the measured bus,
  *      bridge enable/disable. Duties written here take effect at the next
  *      carrier period; configure computational_delay_periods accordingly.
+ *
+ * Optional: work that needs each step's output (position control's
+ * pmstep_position_update(), a STEP/DIR input's count and DIAG, a console's
+ * homing) may run in the same interrupt once the output is applied. A port
+ * may offer it as one hook the application sets before the interrupt starts
+ * (the STM32G4 port's pmstep_stm32g4_set_after_step()): the one indirect call
+ * of the interrupt, after the bridge has its duties, so it never delays them.
  */
 #ifndef PMSTEP_HAL_H
 #define PMSTEP_HAL_H

@@ -19,6 +19,7 @@
 #include "pmstep_hal_stm32g4.h"
 #include "stm32g4_model.h"
 #include "stm32g4_regs.h"
+#include "model_console_host.h"
 
 #define M stm32g4_model
 
@@ -96,42 +97,6 @@ static void test_app_en_open_reads_disabled(void **state)
 
 static uint32_t uart_cursor; /* frames in M.uart_tx before this are read */
 
-static void host_send(uint8_t type, uint8_t seq, const void *data, uint32_t n)
-{
-    uint8_t f[80];
-    uint16_t crc;
-    f[0] = PMSTEP_CONSOLE_SYNC;
-    f[1] = (uint8_t)(n + 2u);
-    f[2] = type;
-    f[3] = seq;
-    if (n > 0u) {
-        memcpy(&f[4], data, n);
-    }
-    crc = pmstep_console_crc16(0xFFFFu, &f[1], n + 3u);
-    f[4 + n] = (uint8_t)(crc & 0xFFu);
-    f[5 + n] = (uint8_t)(crc >> 8);
-    stm32g4_model_uart_send(f, n + 6u);
-}
-
-/* The next frame the drive sent of @p type (others skipped); @return its data length, or -1. */
-static int host_receive(uint8_t type, uint8_t *data)
-{
-    while (uart_cursor + 4u <= M.uart_tx_len) {
-        const uint8_t *f = &M.uart_tx[uart_cursor];
-        const uint32_t len = f[1];
-        assert_int_equal(f[0], PMSTEP_CONSOLE_SYNC);
-        if (uart_cursor + len + 4u > M.uart_tx_len) {
-            return -1;
-        }
-        uart_cursor += len + 4u;
-        if (f[2] == type) {
-            memcpy(data, &f[4], len - 2u);
-            return (int)len - 2;
-        }
-    }
-    return -1;
-}
-
 /* @p periods carrier periods, the main loop turning four times per period. */
 static void app_run(unsigned periods)
 {
@@ -152,9 +117,9 @@ static int16_t console_set(uint8_t seq, const char *name, float value)
     d[0] = 0xFFu;
     memcpy(&d[1], &value, 4u);
     memcpy(&d[5], name, k);
-    host_send(PMSTEP_CONSOLE_SET_CONFIG, seq, d, 5u + k);
+    model_host_send(PMSTEP_CONSOLE_SET_CONFIG, seq, d, 5u + k);
     app_run(2u);
-    n = host_receive(PMSTEP_CONSOLE_SET_CONFIG | 0x80u, d);
+    n = model_host_receive(&uart_cursor, PMSTEP_CONSOLE_SET_CONFIG | 0x80u, d);
     assert_int_equal(n, 6);
     return (int16_t)(d[0] | (d[1] << 8));
 }
@@ -331,9 +296,9 @@ static void test_app_en_edges_only(void **state)
     en(true);
     app_run(3u);
     assert_int_equal(last_out().mode, PMSTEP_MODE_S_ALIGN);
-    host_send(PMSTEP_CONSOLE_STOP, 1u, NULL, 0u);
+    model_host_send(PMSTEP_CONSOLE_STOP, 1u, NULL, 0u);
     app_run(2u);
-    assert_int_equal(host_receive(PMSTEP_CONSOLE_STOP | 0x80u, d), 6);
+    assert_int_equal(model_host_receive(&uart_cursor, PMSTEP_CONSOLE_STOP | 0x80u, d), 6);
     app_run(20u);
     assert_int_equal(last_out().mode, PMSTEP_MODE_IDLE);
     assert_false(pmstep_stm32g4_bridge_on());

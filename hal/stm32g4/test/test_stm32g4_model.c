@@ -17,6 +17,7 @@
 #include "pmstep_hal_stm32g4.h"
 #include "stm32g4_model.h"
 #include "stm32g4_regs.h"
+#include "model_console_host.h"
 
 #define M stm32g4_model
 
@@ -742,43 +743,6 @@ static void test_port_firmware_fault_turns_bridge_off(void **state)
 
 static uint32_t uart_cursor; /* frames in M.uart_tx before this are read */
 
-static void host_send(uint8_t type, uint8_t seq, const void *data, uint32_t n)
-{
-    uint8_t f[80];
-    uint16_t crc;
-    f[0] = PMSTEP_CONSOLE_SYNC;
-    f[1] = (uint8_t)(n + 2u);
-    f[2] = type;
-    f[3] = seq;
-    if (n > 0u) {
-        memcpy(&f[4], data, n);
-    }
-    crc = pmstep_console_crc16(0xFFFFu, &f[1], n + 3u);
-    f[4 + n] = (uint8_t)(crc & 0xFFu);
-    f[5 + n] = (uint8_t)(crc >> 8);
-    stm32g4_model_uart_send(f, n + 6u);
-}
-
-/* The next frame the drive sent of @p type (others skipped); @return its data length, or -1. */
-static int host_receive(uint8_t type, uint8_t *data)
-{
-    while (uart_cursor + 4u <= M.uart_tx_len) {
-        const uint8_t *f = &M.uart_tx[uart_cursor];
-        const uint32_t len = f[1];
-        assert_int_equal(f[0], PMSTEP_CONSOLE_SYNC);
-        if (uart_cursor + len + 4u > M.uart_tx_len) {
-            return -1; /* not all sent yet */
-        }
-        assert_int_equal(pmstep_console_crc16(0xFFFFu, &f[1], len + 1u), f[2 + len] | (f[3 + len] << 8));
-        uart_cursor += len + 4u;
-        if (f[2] == type) {
-            memcpy(data, &f[4], len - 2u);
-            return (int)len - 2;
-        }
-    }
-    return -1;
-}
-
 /* @p periods carrier periods, the main loop turning four times per period. */
 static void app_run(uint32_t arr, unsigned periods)
 {
@@ -820,9 +784,9 @@ static void check_hello(uint8_t seq, uint8_t flags)
 {
     uint8_t d[64];
     int n;
-    host_send(PMSTEP_CONSOLE_HELLO, seq, NULL, 0u);
+    model_host_send(PMSTEP_CONSOLE_HELLO, seq, NULL, 0u);
     turns();
-    n = host_receive(0x81u, d);
+    n = model_host_receive(&uart_cursor, 0x81u, d);
     assert_true(n > 4);
     assert_int_equal(d[2], PMSTEP_STORE_FORMAT_VERSION);
     assert_int_equal(d[3], flags);
@@ -856,18 +820,18 @@ static void test_app_boots_unconfigured_with_empty_flash(void **state)
     assert_int_equal(pmstep_app_step_count(), 0);
     uart_cursor = 0u;
     check_hello(1u, HELLO_STORE);
-    host_send(PMSTEP_CONSOLE_START, 2u, NULL, 0u);
+    model_host_send(PMSTEP_CONSOLE_START, 2u, NULL, 0u);
     turns();
     app_run(arr, 2u);
-    n = host_receive(PMSTEP_CONSOLE_ERROR_FRAME, d);
+    n = model_host_receive(&uart_cursor, PMSTEP_CONSOLE_ERROR_FRAME, d);
     assert_int_equal(n, 2);
     assert_int_equal(d[0], PMSTEP_CONSOLE_START);
     assert_int_equal(d[1], PMSTEP_CONSOLE_ERR_NOT_CONFIGURED);
     app_run(arr, 20u);
     assert_false(pmstep_stm32g4_bridge_on());
-    host_send(PMSTEP_CONSOLE_GET_STATUS, 3u, NULL, 0u);
+    model_host_send(PMSTEP_CONSOLE_GET_STATUS, 3u, NULL, 0u);
     turns();
-    n = host_receive(0x87u, d);
+    n = model_host_receive(&uart_cursor, 0x87u, d);
     assert_int_equal(n, 60);
     assert_int_equal(d[4], PMSTEP_MODE_IDLE);
 }
@@ -891,15 +855,15 @@ static void test_app_console_on_the_model(void **state)
     assert_false(pmstep_stm32g4_bridge_on());
     assert_int_equal(M.adc_irqs, 10u);
     /* Start, telemetry every 10 periods: applied at a boundary, the bridge on. */
-    host_send(PMSTEP_CONSOLE_START, 2u, NULL, 0u);
+    model_host_send(PMSTEP_CONSOLE_START, 2u, NULL, 0u);
     turns();
-    n = host_receive(0x82u, d);
+    n = model_host_receive(&uart_cursor, 0x82u, d);
     assert_int_equal(n, 6);
     assert_int_equal(d[0] | (d[1] << 8), 0);
     assert_true(stm32g4_fake.nvic.ISER[0] & STM32G4_BIT(STM32G4_IRQ_ADC1_2)); /* released again */
     {
         const uint32_t dec = 10u;
-        host_send(PMSTEP_CONSOLE_TELEMETRY, 3u, &dec, 4u);
+        model_host_send(PMSTEP_CONSOLE_TELEMETRY, 3u, &dec, 4u);
     }
     app_run(arr, 50u);
     assert_true(pmstep_stm32g4_bridge_on());
@@ -908,7 +872,7 @@ static void test_app_console_on_the_model(void **state)
         unsigned frames = 0;
         uint32_t last = 0;
         const uint32_t save = uart_cursor;
-        while ((n = host_receive(PMSTEP_CONSOLE_TELEMETRY_FRAME, d)) > 0) {
+        while ((n = model_host_receive(&uart_cursor, PMSTEP_CONSOLE_TELEMETRY_FRAME, d)) > 0) {
             uint32_t period;
             float bus;
             memcpy(&period, d, 4u);
@@ -923,25 +887,25 @@ static void test_app_console_on_the_model(void **state)
         uart_cursor = save;
     }
     /* Status: mode, currents as sampled. */
-    host_send(PMSTEP_CONSOLE_GET_STATUS, 4u, NULL, 0u);
+    model_host_send(PMSTEP_CONSOLE_GET_STATUS, 4u, NULL, 0u);
     turns();
-    n = host_receive(0x87u, d);
+    n = model_host_receive(&uart_cursor, 0x87u, d);
     assert_int_equal(n, 60);
     assert_int_equal(d[4], PMSTEP_MODE_S_ALIGN);
     /* A break: every switch off in the port; the status shows the port's fault. */
     M.bkin_pin_high = false;
     app_run(arr, 2u);
     assert_false(pmstep_stm32g4_bridge_on());
-    host_send(PMSTEP_CONSOLE_GET_STATUS, 5u, NULL, 0u);
+    model_host_send(PMSTEP_CONSOLE_GET_STATUS, 5u, NULL, 0u);
     turns();
-    n = host_receive(0x87u, d);
+    n = model_host_receive(&uart_cursor, 0x87u, d);
     assert_int_equal(d[6], PMSTEP_STM32G4_FAULT_BREAK);
     /* Released, cleared through the console: the port's latch clears too. */
     M.bkin_pin_high = true;
     app_run(arr, 1u);
-    host_send(PMSTEP_CONSOLE_CLEAR_FAULT, 6u, NULL, 0u);
+    model_host_send(PMSTEP_CONSOLE_CLEAR_FAULT, 6u, NULL, 0u);
     turns();
-    n = host_receive(0x84u, d);
+    n = model_host_receive(&uart_cursor, 0x84u, d);
     assert_int_equal(n, 6);
     assert_int_equal(pmstep_stm32g4_fault(), PMSTEP_STM32G4_FAULT_NONE);
     /* Garbage on the line: counted, nothing else. */
@@ -950,9 +914,9 @@ static void test_app_console_on_the_model(void **state)
         uint32_t garbage;
         stm32g4_model_uart_send(junk, sizeof junk);
         turns();
-        host_send(PMSTEP_CONSOLE_GET_COUNTERS, 7u, NULL, 0u);
+        model_host_send(PMSTEP_CONSOLE_GET_COUNTERS, 7u, NULL, 0u);
         pmstep_app_poll();
-        n = host_receive(0x8Cu, d);
+        n = model_host_receive(&uart_cursor, 0x8Cu, d);
         assert_int_equal(n, 44);
         memcpy(&garbage, &d[8], 4u);
         assert_int_equal(garbage, 5u);
