@@ -81,8 +81,7 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
         float u_a_V = inst->actuator.u_applied_a_V;
         float u_b_V = inst->actuator.u_applied_b_V;
         if (!inst->voltage_corrected) {
-            /* the command is the period's voltage: one test a period here (it was two), which pays
-             * for the angle smoothing's test in the position mode's budget */
+            /* the command is the period's voltage: tested first, as the most common case */
         } else if (inst->actuate_coeffs.sensed) {
             sensed_period_voltage(inst, sample, &u_a_V, &u_b_V);
         } else { /* compensated: the dead time's loss, where the samples fix it */

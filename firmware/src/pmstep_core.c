@@ -274,7 +274,7 @@ static void reference_current_over_period(const pmstep_t *inst, const pmstep_mea
     const float half_turn = 0.5f * inst->law_coeffs.pole_pairs * inst->cfg->timing.period_s
                             * pmstep_abs(out->speed_hat_rad_s);
     /* the command's voltage sets the ripple; a bridge without ripple is handed 0 V (h = 0), as a
-     * factor rather than a branch (one instruction a period less) */
+     * factor rather than a branch (no branch in the period) */
     const float ripple_voltage_factor = inst->cfg->inverter.ripple_dead_zone ? 1.0f : 0.0f;
     float cos_act;
     float sin_act;

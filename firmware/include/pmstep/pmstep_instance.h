@@ -52,7 +52,7 @@ typedef struct {
     uint32_t mode_step;   /**< periods since the alignment started */
     bool run_started;     /**< RUN initialised at t_c */
     bool estimate_kept;   /**< the standstill's kept rotor is the period's estimate, not the integrals'
-                               (pmstep_hold.h; here, in padding, not in the hold's flags: +4 B there) */
+                               (pmstep_hold.h; kept here, in the padding of the flags before it) */
 
     /* Controller (6) state and commands. */
     pmstep_ref_t speed_ref;
