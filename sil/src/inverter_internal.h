@@ -1,5 +1,6 @@
-/* The inverter's period bookkeeping and plant stepping, shared by the averaged model and bridge-off
- * freewheeling (inverter.c) and the switching model (inverter_switching.c). Not part of the SIL's API. */
+/* The inverter's period bookkeeping and plant stepping (inverter_period.c), shared by the averaged
+ * model and bridge-off freewheeling (inverter.c) and the switching model (inverter_switching.c).
+ * Calls go one way: inverter.c -> inverter_switching.c -> inverter_period.c. Not part of the SIL's API. */
 #ifndef SIL_INVERTER_INTERNAL_H
 #define SIL_INVERTER_INTERNAL_H
 
