@@ -80,6 +80,7 @@ pmstep_status_t pmstep_homing_start(pmstep_homing_t *homing, pmstep_position_t *
         return status; /* the travel beyond the estimate's range */
     }
     homing->cfg = *cfg;
+    homing->target_rad = pos->motion.target;
     homing->state = PMSTEP_HOMING_SEEKING;
     homing->direction = (float)direction;
     homing->start_rad = position_rad;
@@ -98,6 +99,7 @@ static void stop_found(pmstep_homing_t *homing, pmstep_position_t *pos, bool by_
     if (homing->cfg.back_off_rad > 0.0f) {
         (void)pmstep_position_move_to(pos, -homing->direction * homing->cfg.back_off_rad, homing->cfg.speed_rad_s,
                                       homing->cfg.accel_rad_s2, 0.0f);
+        homing->target_rad = pos->motion.target;
         homing->state = PMSTEP_HOMING_BACKING_OFF;
     } else {
         homing->state = PMSTEP_HOMING_DONE;
@@ -111,7 +113,8 @@ pmstep_homing_state_t pmstep_homing_update(pmstep_homing_t *homing, pmstep_posit
     if (!active) {
         return homing->state;
     }
-    if (!pos_out->tracked || !pos_out->position_mode || pos->steps != NULL) {
+    if (!pos_out->tracked || !pos_out->position_mode || pos->steps != NULL || pos->motion.target != homing->target_rad) {
+        /* left RUN, or another command took the loop: a speed command, STEP/DIR, a move, a stop or a zero */
         homing->state = PMSTEP_HOMING_ABORTED;
         return homing->state;
     }

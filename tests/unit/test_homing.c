@@ -267,6 +267,21 @@ static void aborted_when_run_ends_or_a_command_takes_over(void **state)
     assert_int_equal(run(&f, 100), PMSTEP_HOMING_SEEKING);
     assert_int_equal(pmstep_set_speed_target(&f.inst, 0.0f, 1.0f), PMSTEP_OK);
     assert_int_equal(run(&f, 2 * PMSTEP_POSITION_DECIMATION), PMSTEP_HOMING_ABORTED);
+    /* a move, a stop or a new zero given while it seeks: aborted, never taken for the stop */
+    fixture_init(&f);
+    assert_int_equal(pmstep_homing_start(&f.homing, &f.pos, &f.homing_cfg, 1), PMSTEP_OK);
+    assert_int_equal(run(&f, 100), PMSTEP_HOMING_SEEKING);
+    assert_int_equal(pmstep_position_move_to(&f.pos, -0.5f, 1.0f, 10.0f, 0.0f), PMSTEP_OK);
+    assert_int_equal(run(&f, 1), PMSTEP_HOMING_ABORTED);
+    fixture_init(&f);
+    assert_int_equal(pmstep_homing_start(&f.homing, &f.pos, &f.homing_cfg, 1), PMSTEP_OK);
+    assert_int_equal(pmstep_position_hold(&f.pos, 10.0f), PMSTEP_OK);
+    assert_int_equal(run(&f, 1), PMSTEP_HOMING_ABORTED);
+    fixture_init(&f);
+    assert_int_equal(pmstep_homing_start(&f.homing, &f.pos, &f.homing_cfg, 1), PMSTEP_OK);
+    assert_int_equal(run(&f, 100), PMSTEP_HOMING_SEEKING);
+    assert_int_equal(pmstep_position_set_zero(&f.pos), PMSTEP_OK);
+    assert_int_equal(run(&f, 1), PMSTEP_HOMING_ABORTED);
 }
 
 int main(void)

@@ -21,7 +21,8 @@
  * pushing), the zero is set there (pmstep_position_set_zero()), and the rotor moves back_off_rad
  * away from the stop (0: it stays against it, held). Done when that move has ended.
  * Not found: theta-hat went max_travel_rad without meeting a stop; the drive stops and holds.
- * Aborted: the drive left RUN (a fault), or another command took position mode away.
+ * Aborted: the drive left RUN (a fault), or another command took the loop: a speed command, STEP/DIR
+ * following, a move, a stop (pmstep_position_hold()) or a new zero changes the homing's own target.
  *
  * The same stall test serves the STEP/DIR input's homing (pmstep_stepdir.h, stall_current_A).
  */
@@ -66,6 +67,7 @@ typedef struct {
     float start_rad;        /**< theta-hat when it started */
     float stop_rad;         /**< theta-hat at the stop, in the frame before the zero was set */
     bool stalled_by_current; /**< the stop was found by the current test (else by the following error) */
+    float target_rad;       /**< the target of the homing's own move (another command's moves it: aborted) */
 } pmstep_homing_t;
 
 /**
