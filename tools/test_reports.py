@@ -514,6 +514,8 @@ class TorqueSpeed(ReportCase):
         self.assertIn("resolution 1.5 T_H / 128", text)
         self.assertIn("2.33–2.33 over 1 cases; pmstep holds less than microstepping in 0 of them", text)
         self.assertIn("![17hs4401: largest held load against speed](x-17hs4401.png)", text)
+        self.assertIn("- 17hs4401 24 V, 0.75 × top, microstep: holds no load (fault OVERCURRENT)", text)
+        self.assertIn("- pmstep, first failure above the largest held load: fault OVERCURRENT in 1", text)
 
 
 if __name__ == "__main__":

@@ -235,6 +235,24 @@ def unevaluated(rows):
             for r in rows if r["error"]]
 
 
+def limits(rows):
+    """What stopped each drive above its largest held load: Markdown list lines, one per case where the drive
+    held no load (its reason at no load), then per drive a count of the first failures' kinds."""
+    lines = [f"- {r['motor']} {r['bus_V']:g} V, {r['fraction']:g} × top, {r['drive']}: holds no load ("
+             + "; ".join(r["failed_why"]) + ")" for r in rows if not r["error"] and r["held_Nm"] is None]
+    for drive in DRIVES:
+        kinds = {}
+        for r in rows:
+            if r["drive"] == drive and r["held_Nm"] is not None and r["failed_why"]:
+                kind = r["failed_why"][0].split(" at ")[0].split(" rad/s")[0]
+                kind = "speed error" if kind.startswith("speed error") else kind
+                kinds[kind] = kinds.get(kind, 0) + 1
+        if kinds:
+            lines.append(f"- {drive}, first failure above the largest held load: "
+                         + ", ".join(f"{k} in {n}" for k, n in sorted(kinds.items())))
+    return lines
+
+
 def summary(rows):
     """One sentence: the ratios' range and how many cases pmstep holds less."""
     pairs = [(pm, ms) for _, pm, ms in pair_rows(rows) if pm and ms]
@@ -287,7 +305,10 @@ WHAT = ("Per public preset and bus voltage, pmstep-tune's design for that bus, a
         "π; pmstep: angle estimate off by more than `run.loss_angle_error_rad`), and |ω − ω*| within "
         "`run.loss_speed_error_rad_s` from the load ramp's start to the end. Bisection on [0, "
         f"{LOAD_BOUND:g} × the datasheet holding torque T_H]; \"≥\": held at the bracket's top. Copper loss: "
-        "2 R I_rms² at the largest held load, I_rms per phase over the hold (the load at its full value).")
+        "2 R I_rms² at the largest held load, I_rms per phase over the hold (the load at its full value). "
+        "Currents differ: microstepping drives rated current whatever the load (pull-out torque k_M I); pmstep's "
+        "current follows the load up to its overcurrent trip (`controller.limits.max_phase_current_A`, above rated "
+        "current), so its largest held load may need more than rated current: compare the copper losses.")
 
 
 def report_text(rows, refused, args, argv, pictures):
@@ -295,6 +316,8 @@ def report_text(rows, refused, args, argv, pictures):
                    f"{LOAD_BOUND / 2 ** args.iterations * 100:.2g} % of T_H.")
     lines = [report.header("Torque against speed: pmstep and open-loop microstepping", "tools/torque_speed.py",
                            argv, what), table(rows, refused, True), "", summary(rows), ""]
+    if limits(rows):
+        lines += limits(rows) + [""]
     for motor, picture in pictures:
         lines += [f"![{motor}: largest held load against speed]({picture})", ""]
     return "\n".join(lines)
@@ -333,6 +356,8 @@ def main(argv=None):
     print(f"torque_speed: load N m (x datasheet holding torque), resolution {LOAD_BOUND:g} T_H / "
           f"{2 ** args.iterations}; Cu W: 2 R I_rms^2 at the largest held load")
     print("torque_speed: " + summary(rows))
+    for line in limits(rows):
+        print("torque_speed: " + line[2:])
     bad = unevaluated(rows)
     for b in bad:
         print("torque_speed: not evaluated: " + b)
