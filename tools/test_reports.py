@@ -22,6 +22,7 @@ import monte_carlo
 import position_acceptance
 import report
 import stepdir_compare
+import torque_speed
 
 TODAY = datetime.date.today().isoformat()
 
@@ -436,6 +437,85 @@ class StepDirCompare(ReportCase):
         self.assertTrue(stepdir_compare.load_check(loads)[0].startswith("bj42d29:"))
         self.assertEqual(stepdir_compare.load_check(loads[:2]), [])
         self.assertNotIn("## Largest load step", stepdir_compare.report_text([run], args, argv, None, []))
+
+
+class TorqueSpeed(ReportCase):
+    @staticmethod
+    def row(motor, bus, fraction, drive, held, failed, holding=0.4, error=None):
+        r = {"motor": motor, "bus_V": bus, "fraction": fraction, "drive": drive, "speed_rad_s": 69.0 * fraction,
+             "holding_Nm": holding, "error": error, "held_Nm": held, "failed_Nm": failed,
+             "failed_why": ["fault OVERCURRENT"] if failed is not None else []}
+        if held is not None:
+            r.update({"held_fraction": held / holding, "rms_phase_current_A": 1.5,
+                      "copper_loss_W": torque_speed.copper_loss_W(1.5, 1.5)})
+        return r
+
+    def test_bisection(self):
+        """A run at each end of the bracket, then halvings: the threshold lies in [held, failed)."""
+        for threshold, held, failed, runs in ((0.153, 0.15, 0.1875, 6), (0.7, 0.6, None, 2), (-1.0, None, 0.0, 1)):
+            xs = []
+
+            def ok(x, threshold=threshold):
+                xs.append(x)
+                return x <= threshold
+
+            lo, hi = torque_speed.bisect(ok, 0.0, 0.6, 4)
+            self.assertEqual(xs[0], 0.0)
+            self.assertEqual(len(xs), runs)
+            self.assertEqual(lo is None, held is None)
+            self.assertAlmostEqual(lo or 0.0, held or 0.0)
+            self.assertEqual(hi is None, failed is None)
+            self.assertAlmostEqual(hi or 0.0, failed or 0.0)
+
+    def test_copper_loss(self):
+        """2 R I_rms^2: 1.5 A per phase in 1.5 ohm is 6.75 W for the two phases."""
+        self.assertAlmostEqual(torque_speed.copper_loss_W(1.5, 1.5), 6.75)
+        self.assertEqual(torque_speed.copper_loss_W(0.0, 2.0), 0.0)
+
+    def test_held(self):
+        """The same rule for both drives: a fault, a loss of synchronism or the speed error above the bound."""
+        def summary(fault="NONE", lost=False, error=1.0):
+            return {"fault": {"name": fault}, "loss_of_synchronism": lost, "loss_of_synchronism_time_s": 0.5,
+                    "robustness": {"max_speed_error_rad_s": error, "max_speed_error_time_s": 0.6}}
+
+        self.assertEqual(torque_speed.held_failures(summary(error=2.0), 2.0), [])
+        self.assertEqual(torque_speed.held_failures(summary(error=2.01), 2.0), ["speed error 2.01 rad/s at 0.600 s"])
+        self.assertEqual(len(torque_speed.held_failures(summary("OVERCURRENT", True, 3.0), 2.0)), 3)
+
+    def test_timeline(self):
+        """The ramp from RUN's start + LEAD_S at min(a_ref / 4, A_AXIS); the load after SETTLE_S at the speed."""
+        motor = {"rated_A": 1.7, "k_M": 0.16638, "J": 5.4e-6, "R": 1.5, "p": 50, "holding_Nm": 0.4}
+        tl = torque_speed.timeline(motor, 69.0, 0.25, 0.5)
+        self.assertAlmostEqual(tl["a"], 1000.0)
+        self.assertAlmostEqual(tl["reached_s"] - tl["ramp_s"], 0.0345)
+        self.assertAlmostEqual(tl["load_s"], 0.25 + torque_speed.LEAD_S + 0.0345 + torque_speed.SETTLE_S)
+        self.assertAlmostEqual(tl["end_s"] - tl["load_s"], torque_speed.LOAD_RAMP_S + torque_speed.HOLD_S)
+
+    def test_report(self):
+        rows = [self.row("17hs4401", 24.0, 0.25, "pmstep", 0.525, 0.5625),
+                self.row("17hs4401", 24.0, 0.25, "microstep", 0.225, 0.2625),
+                self.row("17hs4401", 24.0, 0.75, "pmstep", 0.6, None),
+                self.row("17hs4401", 24.0, 0.75, "microstep", None, 0.0),
+                self.row("17hs4401", 12.0, 0.25, "pmstep", None, None, error="pmstep-sil failed (1): x"),
+                self.row("17hs4401", 12.0, 0.25, "microstep", 0.1, 0.11)]
+        refused = [{"motor": "paper", "bus_V": 12.0, "why": "cannot design"}]
+        self.assertAlmostEqual(torque_speed.ratio(0.525, 0.225), 2.3333333)
+        self.assertIsNone(torque_speed.ratio(0.5, 0.0))
+        self.assertEqual(len(torque_speed.unevaluated(rows)), 1)
+        args = argparse.Namespace(iterations=7)
+        argv = ["tools/torque_speed.py", "--report", "x.md"]
+        text = torque_speed.report_text(rows, refused, args, argv, [("17hs4401", "x-17hs4401.png")])
+        self.assert_header(text, "tools/torque_speed.py --report x.md")
+        self.assert_tables(text)
+        self.assertIn("| 17hs4401 | 24 | 0.25 | 17.2 | 0.525 (1.31) | 0.225 (0.56) | 2.33 | 6.75 | 6.75 |", text)
+        self.assertIn("| ≥ 0.600 (1.50) | none | - |", text)
+        self.assertIn("| n/a | 0.100 (0.25) |", text)
+        self.assertIn("| paper | 12 | - | - | no design | no design |", text)
+        self.assertIn("resolution 1.5 T_H / 128", text)
+        self.assertIn("2.33–2.33 over 1 cases; pmstep holds less than microstepping in 0 of them", text)
+        self.assertIn("![17hs4401: largest held load against speed](x-17hs4401.png)", text)
+        self.assertIn("- 17hs4401 24 V, 0.75 × top, microstep: holds no load (fault OVERCURRENT)", text)
+        self.assertIn("- pmstep, first failure above the largest held load: fault OVERCURRENT in 1", text)
 
 
 if __name__ == "__main__":

@@ -1,0 +1,381 @@
+#!/usr/bin/env python3
+"""The torque-speed curve, measured: the largest constant load torque pmstep (speed mode) and open-loop
+microstepping at rated current hold at a set of speeds, per public preset and bus voltage.
+
+For each public preset (sil/scenarios/motors/*.ini) and bus voltage (run.bus_voltage_V: 12, 24, 48 V)
+pmstep-tune designs the drive for that bus (--set run.bus_voltage_V=V); a preset the designer refuses at a
+bus is recorded as "no design". At SPEED_FRACTIONS of that design's top speed, each drive runs a speed
+scenario of pmstep-sil on the design, the same for both drives (run.controller = pmstep | microstep):
+
+  speed.points  0 until RUN's start + LEAD_S, a ramp at min(a_ref / 4, A_AXIS) (a_ref = k_M I / J, the rated
+                torque's acceleration of the bare rotor) to the speed, held to the end;
+  load          a table (load.type = table): 0 until SETTLE_S after the speed is reached, then up to the load
+                torque T over LOAD_RAMP_S and held HOLD_S to the end. T > 0 opposes the forward motion
+                (J dw/dt = T_e - F w - T_L). A slow ramp, not a step: the figure is the torque held at the
+                speed, not the speed loop's response to a step (over 0.1 s, pmstep's speed error on the ramp
+                met the bound at about half the load it holds over 1 s).
+
+Held, the same rule for both drives: no fault; the summary's loss_of_synchronism false over the whole run
+(microstepping: the load angle theta_e* - p theta beyond pi; pmstep: its angle estimate off by more than
+run.loss_angle_error_rad); and |omega - omega*| at most run.loss_speed_error_rad_s (the run's
+loss-of-control bound) from the start of the load ramp to the end of the hold (the summary's
+robustness.max_speed_error_rad_s after settling, the settle set to the load ramp's start by run.transient_window_s).
+
+The largest held load by bisection on [0, LOAD_BOUND x the datasheet holding torque] after a run at each
+end: ITERATIONS halvings (resolution LOAD_BOUND T_H / 2^n). Copper loss at it: 2 R I_rms^2 (two phases, the
+preset's R, the summary's per-phase RMS current over the hold, the load at its full value).
+
+--check exits 1 only when a case could not be evaluated (the SIL failed or gave no summary); a drive that
+holds not even no load ("none") and pmstep holding less than microstepping are reported, not failed. --quick: one
+preset (17hs4401), 24 V, speeds 0.25 and 0.75 of the top, 4 halvings (CI). --report FILE writes Markdown
+(tools/report.py), with a plot per motor beside it when matplotlib is installed.
+
+usage: tools/torque_speed.py [--sil PATH] [--tune PATH] [--motors paper,17hs4401,bj42d29,as1050]
+                             [--buses 12,24,48] [--speeds 0.01,0.25,0.5,0.75,1.0] [--iterations 7]
+                             [--quick] [--check] [--jobs 2] [--out DIR] [--json FILE] [--report FILE]
+"""
+import argparse
+import concurrent.futures
+import configparser
+import json
+import math
+import os
+import subprocess
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import report  # noqa: E402
+from homing_sweep import design, read_motor  # noqa: E402  (pmstep-tune's design with --set; the preset)
+from stepdir_compare import A_AXIS, run_sil  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+MOTORS = ["paper", "17hs4401", "bj42d29", "as1050"]
+BUSES = [12.0, 24.0, 48.0]
+SPEED_FRACTIONS = [0.01, 0.25, 0.5, 0.75, 1.0]
+QUICK_FRACTIONS = [0.25, 0.75]
+DRIVES = ["pmstep", "microstep"]
+LEAD_S = 0.1         # from RUN's start to the speed ramp
+SETTLE_S = 0.1       # at the speed before the load ramp
+LOAD_RAMP_S = 1.0    # the load from 0 to T: quasi-static (a ramp of 0.1 s measured the speed loop's tracking of it)
+HOLD_S = 0.5         # T held to the end
+LOAD_BOUND = 1.5     # the bracket: [0, 1.5 x the datasheet holding torque]
+ITERATIONS = 7       # 1.5 T_H / 128: 1.2 % of the holding torque
+ITERATIONS_QUICK = 4  # 1.5 T_H / 16: 9.4 % of it
+
+
+def bisect(held, lo, hi, iterations):
+    """The largest x in [lo, hi] with held(x), assuming held falls off once: a run at each end, then
+    @p iterations halvings. Returns (largest held, smallest failed); None for either when there is none
+    (held(lo) false: (None, lo); held(hi) true: (hi, None))."""
+    if not held(lo):
+        return None, lo
+    if held(hi):
+        return hi, None
+    for _ in range(iterations):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if held(mid) else (lo, mid)
+    return lo, hi
+
+
+def copper_loss_W(rms_phase_current_A, resistance_Ohm):
+    """Both phases' copper loss, 2 R I_rms^2, from the per-phase RMS current."""
+    return 2.0 * resistance_Ohm * rms_phase_current_A ** 2
+
+
+def timeline(motor, top, run_start, fraction):
+    """The speed and the times of one case: ramp start, speed reached, load ramp start, end."""
+    v = fraction * top
+    a = min(0.25 * motor["k_M"] * motor["rated_A"] / motor["J"], A_AXIS)
+    ramp = run_start + LEAD_S
+    reached = ramp + v / a
+    load = reached + SETTLE_S
+    return {"v": v, "a": a, "ramp_s": ramp, "reached_s": reached, "load_s": load,
+            "end_s": load + LOAD_RAMP_S + HOLD_S}
+
+
+def held_failures(s, bound_rad_s):
+    """Why a run did not hold its load; [] when it did (the rule of the module's docstring), @p bound_rad_s the
+    run's loss-of-control bound on the speed error."""
+    why = []
+    if s["fault"]["name"] != "NONE":
+        why.append("fault " + s["fault"]["name"])
+    if s["loss_of_synchronism"]:
+        why.append(f"loss of synchronism at {s['loss_of_synchronism_time_s']:.3f} s")
+    r = s["robustness"]
+    if r["max_speed_error_rad_s"] > bound_rad_s:
+        why.append(f"speed error {r['max_speed_error_rad_s']:.3g} rad/s at {r['max_speed_error_time_s']:.3f} s")
+    return why
+
+
+def one_run(args, case, drive, torque, out_dir):
+    tl = case["timeline"]
+    # The metrics' t_c: RUN's start for pmstep, the end of the hold (the ramp's start) for microstepping.
+    t_c = case["run_start"] if drive == "pmstep" else tl["ramp_s"]
+    sets = [f"run.controller={drive}", "load.type=table",
+            f"speed.points=0:0, {tl['ramp_s']:.6f}:0, {tl['reached_s']:.6f}:{tl['v']:.9g}",
+            f"load.points=0:0, {tl['load_s']:.6f}:0, {tl['load_s'] + LOAD_RAMP_S:.6f}:{torque:.9g}",
+            f"run.duration_s={tl['end_s']:.6f}", f"run.transient_window_s={tl['load_s'] - t_c:.6f}",
+            f"run.metrics_start_s={tl['load_s'] + LOAD_RAMP_S:.6f}"]
+    _, s = run_sil(args.sil, case["scenario"], sets, out_dir, False)
+    return s
+
+
+def search(args, case, drive):
+    """The largest load @p drive holds in @p case, with the figures of the run at it."""
+    out_dir = os.path.join(args.out, f"{case['motor']}_{case['bus']:g}V_{case['fraction']:g}_{drive}")
+    runs = {}
+
+    def held(torque):
+        s = one_run(args, case, drive, torque, out_dir)
+        runs[torque] = (s, held_failures(s, case["loss_speed_rad_s"]))
+        return not runs[torque][1]
+
+    row = {"motor": case["motor"], "bus_V": case["bus"], "fraction": case["fraction"], "drive": drive,
+           "speed_rad_s": case["timeline"]["v"], "holding_Nm": case["preset"]["holding_Nm"],
+           "bound_Nm": LOAD_BOUND * case["preset"]["holding_Nm"], "iterations": args.iterations,
+           "error": None, "held_Nm": None, "failed_Nm": None, "failed_why": []}
+    try:
+        lo, hi = bisect(held, 0.0, row["bound_Nm"], args.iterations)
+    except (RuntimeError, KeyError, ValueError) as e:
+        row["error"] = str(e)
+        return row
+    row.update({"held_Nm": lo, "failed_Nm": hi, "failed_why": runs[hi][1] if hi is not None else [],
+                "runs": len(runs)})
+    if lo is not None:
+        s = runs[lo][0]
+        row.update({"held_fraction": lo / row["holding_Nm"], "rms_phase_current_A": s["rms_phase_current_A"],
+                    "copper_loss_W": copper_loss_W(s["rms_phase_current_A"], case["preset"]["R"]),
+                    "max_speed_error_rad_s": s["robustness"]["max_speed_error_rad_s"]})
+    else:
+        row["none_why"] = row["failed_why"]
+    return row
+
+
+def cases(args):
+    """The designs (one per preset and bus) and the cases at their speeds; the designs the tune refuses."""
+    out, refused = [], []
+    os.makedirs(args.out, exist_ok=True)
+    for motor in args.motors.split(","):
+        motor_ini = os.path.join(ROOT, "sil", "scenarios", "motors", f"{motor}.ini")
+        preset = read_motor(motor_ini)
+        for bus in args.bus_list:
+            scenario = os.path.join(args.out, f"{motor}_{bus:g}V.ini")
+            try:
+                top, run_start, _, _ = design(args.tune, motor_ini, scenario, False, [f"run.bus_voltage_V={bus:g}"])
+            except subprocess.CalledProcessError as e:
+                refused.append({"motor": motor, "bus_V": bus, "why": (e.stderr or "").strip().split("\n")[-1]})
+                continue
+            ini = configparser.ConfigParser(inline_comment_prefixes=(";",))
+            ini.read(scenario)
+            bound = float(ini["run"]["loss_speed_error_rad_s"])
+            for fraction in args.fraction_list:
+                out.append({"motor": motor, "bus": bus, "fraction": fraction, "preset": preset, "scenario": scenario,
+                            "top_rad_s": top, "run_start": run_start, "loss_speed_rad_s": bound,
+                            "timeline": timeline(preset, top, run_start, fraction)})
+    return out, refused
+
+
+def ratio(pm, ms):
+    """pmstep's largest held load over microstepping's (None without both, or microstepping's 0)."""
+    if pm is None or ms is None or ms <= 0.0:
+        return None
+    return pm / ms
+
+
+def pair_rows(rows):
+    """The rows joined per case: [(case key, pmstep row, microstep row)] in the rows' order."""
+    by = {}
+    for r in rows:
+        by.setdefault((r["motor"], r["bus_V"], r["fraction"]), {})[r["drive"]] = r
+    return [(k, d.get("pmstep"), d.get("microstep")) for k, d in by.items()]
+
+
+def _load(r):
+    if r is None or r["error"]:
+        return "n/a"
+    if r["held_Nm"] is None:
+        return "none"
+    t = f"{r['held_Nm']:.3f}"
+    return ("≥ " if r["failed_Nm"] is None else "") + t + f" ({r['held_fraction']:.2f})"
+
+
+def _loss(r):
+    return "-" if r is None or r.get("copper_loss_W") is None else f"{r['copper_loss_W']:.2f}"
+
+
+def table(rows, refused, markdown):
+    head = ["motor", "bus V", "speed", "rad/s", "pmstep N·m (× T_H)", "microstep N·m (× T_H)", "ratio",
+            "pmstep Cu W", "microstep Cu W"]
+    out = []
+    if markdown:
+        out += ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    else:
+        out.append(f"{'motor':9s} {'bus':>4s} {'speed':>5s} {'rad/s':>7s} {'pmstep Nm (xT_H)':>18s} "
+                   f"{'microstep Nm (xT_H)':>20s} {'ratio':>6s} {'pm Cu W':>8s} {'ms Cu W':>8s}")
+    for (motor, bus, fraction), pm, ms in pair_rows(rows):
+        r = ratio(pm["held_Nm"] if pm else None, ms["held_Nm"] if ms else None)
+        speed = (pm or ms)["speed_rad_s"]
+        cells = [motor, f"{bus:g}", f"{fraction:g}", f"{speed:.1f}", _load(pm), _load(ms),
+                 "-" if r is None else f"{r:.2f}", _loss(pm), _loss(ms)]
+        if markdown:
+            out.append("| " + " | ".join(cells) + " |")
+        else:
+            out.append(f"{cells[0]:9s} {cells[1]:>4s} {cells[2]:>5s} {cells[3]:>7s} {cells[4]:>18s} {cells[5]:>20s} "
+                       f"{cells[6]:>6s} {cells[7]:>8s} {cells[8]:>8s}")
+    for d in refused:
+        cells = [d["motor"], f"{d['bus_V']:g}", "-", "-", "no design", "no design", "-", "-", "-"]
+        out.append("| " + " | ".join(cells) + " |" if markdown else
+                   f"{d['motor']:9s} {d['bus_V']:4g}  no design: {d['why']}")
+    return "\n".join(out)
+
+
+def unevaluated(rows):
+    """--check: the cases that could not be evaluated (the SIL failed or gave no summary)."""
+    return [f"{r['motor']} {r['bus_V']:g} V {r['fraction']:g} x top {r['drive']}: {r['error']}"
+            for r in rows if r["error"]]
+
+
+def limits(rows):
+    """What stopped each drive above its largest held load: Markdown list lines, one per case where the drive
+    held no load (its reason at no load), then per drive a count of the first failures' kinds."""
+    lines = [f"- {r['motor']} {r['bus_V']:g} V, {r['fraction']:g} × top, {r['drive']}: holds no load ("
+             + "; ".join(r["failed_why"]) + ")" for r in rows if not r["error"] and r["held_Nm"] is None]
+    for drive in DRIVES:
+        kinds = {}
+        for r in rows:
+            if r["drive"] == drive and r["held_Nm"] is not None and r["failed_why"]:
+                kind = r["failed_why"][0].split(" at ")[0].split(" rad/s")[0]
+                kind = "speed error" if kind.startswith("speed error") else kind
+                kinds[kind] = kinds.get(kind, 0) + 1
+        if kinds:
+            lines.append(f"- {drive}, first failure above the largest held load: "
+                         + ", ".join(f"{k} in {n}" for k, n in sorted(kinds.items())))
+    return lines
+
+
+def summary(rows):
+    """One sentence: the ratios' range and how many cases pmstep holds less."""
+    pairs = [(pm, ms) for _, pm, ms in pair_rows(rows) if pm and ms]
+    rs = [x for x in (ratio(pm["held_Nm"], ms["held_Nm"]) for pm, ms in pairs) if x is not None]
+    if not rs:
+        return "no case with both drives' figures."
+    less = sum(1 for x in rs if x < 1.0)
+    return (f"pmstep / microstepping largest held load {min(rs):.2f}–{max(rs):.2f} over {len(rs)} cases; "
+            f"pmstep holds less than microstepping in {less} of them.")
+
+
+def plot(rows, motor, path):
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        return None
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    drawn = False
+    for i, bus in enumerate(sorted({r["bus_V"] for r in rows if r["motor"] == motor})):
+        for drive, style in (("pmstep", "-"), ("microstep", "--")):
+            pts = sorted((r["speed_rad_s"], r["held_Nm"]) for r in rows
+                         if r["motor"] == motor and r["bus_V"] == bus and r["drive"] == drive
+                         and r["held_Nm"] is not None)
+            if pts:
+                ax.plot([p[0] for p in pts], [p[1] for p in pts], style, marker="o", color=f"C{i}",
+                        label=f"{drive}, {bus:g} V")
+                drawn = True
+    if not drawn:
+        plt.close(fig)
+        return None
+    ax.set_xlabel("speed (rad/s)")
+    ax.set_ylabel("largest constant load held (N·m)")
+    ax.set_title(f"{motor}: torque against speed")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+WHAT = ("Per public preset and bus voltage, pmstep-tune's design for that bus, and at fractions of its top speed the "
+        "largest constant load torque each drive holds: pmstep in speed mode and open-loop microstepping at rated "
+        f"current (`run.controller = microstep`) on the same plant and scenario. The speed ramps at min(¼ k_M I / J, "
+        f"{A_AXIS:g} rad/s²) from RUN's start + {LEAD_S:g} s; {SETTLE_S:g} s after it is reached the load (opposing "
+        f"the motion) ramps from 0 over {LOAD_RAMP_S:g} s and is held {HOLD_S:g} s to the end. **Held**, the same "
+        "rule for both drives: no fault, the summary's `loss_of_synchronism` false (microstepping: load angle beyond "
+        "π; pmstep: angle estimate off by more than `run.loss_angle_error_rad`), and |ω − ω*| within "
+        "`run.loss_speed_error_rad_s` from the load ramp's start to the end. Bisection on [0, "
+        f"{LOAD_BOUND:g} × the datasheet holding torque T_H]; \"≥\": held at the bracket's top. Copper loss: "
+        "2 R I_rms² at the largest held load, I_rms per phase over the hold (the load at its full value). "
+        "Currents differ: microstepping drives rated current whatever the load (pull-out torque k_M I); pmstep's "
+        "current follows the load up to its overcurrent trip (`controller.limits.max_phase_current_A`, above rated "
+        "current), so its largest held load may need more than rated current: compare the copper losses.")
+
+
+def report_text(rows, refused, args, argv, pictures):
+    what = WHAT + (f" {args.iterations} halvings: resolution {LOAD_BOUND:g} T_H / {2 ** args.iterations} = "
+                   f"{LOAD_BOUND / 2 ** args.iterations * 100:.2g} % of T_H.")
+    lines = [report.header("Torque against speed: pmstep and open-loop microstepping", "tools/torque_speed.py",
+                           argv, what), table(rows, refused, True), "", summary(rows), ""]
+    if limits(rows):
+        lines += limits(rows) + [""]
+    for motor, picture in pictures:
+        lines += [f"![{motor}: largest held load against speed]({picture})", ""]
+    return "\n".join(lines)
+
+
+def main(argv=None):
+    argv = sys.argv if argv is None else argv
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--sil", default=os.path.join(ROOT, "build", "host-release", "sil", "pmstep-sil"))
+    ap.add_argument("--tune", default=os.path.join(ROOT, "build", "host-release", "sil", "pmstep-tune"))
+    ap.add_argument("--motors")
+    ap.add_argument("--buses", help="bus voltages, V (default 12,24,48; 24 with --quick)")
+    ap.add_argument("--speeds", help="fractions of the design's top speed")
+    ap.add_argument("--iterations", type=int, help=f"halvings (default {ITERATIONS}, {ITERATIONS_QUICK} with --quick)")
+    ap.add_argument("--quick", action="store_true", help="17hs4401, 24 V, speeds 0.25 and 0.75, 4 halvings (CI)")
+    ap.add_argument("--check", action="store_true", help="exit 1 if a case could not be evaluated")
+    ap.add_argument("--jobs", type=int, default=2, help="searches at once (threads, each running pmstep-sil)")
+    ap.add_argument("--out", default=os.path.join(ROOT, "out", "torque_speed"))
+    ap.add_argument("--json", help="also write every search's figures to this file")
+    ap.add_argument("--report", metavar="FILE", help="write the table as Markdown, the plots beside it")
+    args = ap.parse_args(argv[1:])
+    args.motors = args.motors or ("17hs4401" if args.quick else ",".join(MOTORS))
+    args.bus_list = [float(x) for x in (args.buses or ("24" if args.quick else "12,24,48")).split(",")]
+    args.fraction_list = [float(x) for x in (args.speeds or ",".join(
+        str(f) for f in (QUICK_FRACTIONS if args.quick else SPEED_FRACTIONS))).split(",")]
+    if args.iterations is None:
+        args.iterations = ITERATIONS_QUICK if args.quick else ITERATIONS
+    for m in args.motors.split(","):
+        if not os.path.isfile(os.path.join(ROOT, "sil", "scenarios", "motors", f"{m}.ini")):
+            ap.error(f"unknown motor '{m}' (presets: {', '.join(MOTORS)})")
+    all_cases, refused = cases(args)
+    with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
+        futures = [pool.submit(search, args, c, d) for c in all_cases for d in DRIVES]
+        rows = [f.result() for f in futures]
+    print(table(rows, refused, False))
+    print(f"torque_speed: load N m (x datasheet holding torque), resolution {LOAD_BOUND:g} T_H / "
+          f"{2 ** args.iterations}; Cu W: 2 R I_rms^2 at the largest held load")
+    print("torque_speed: " + summary(rows))
+    for line in limits(rows):
+        print("torque_speed: " + line[2:])
+    bad = unevaluated(rows)
+    for b in bad:
+        print("torque_speed: not evaluated: " + b)
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump({"cases": rows, "no_design": refused}, f, indent=1)
+    if args.report:
+        pictures = []
+        stem = os.path.splitext(args.report)[0]
+        for motor in dict.fromkeys(r["motor"] for r in rows):
+            path = plot(rows, motor, f"{stem}-{motor}.png")
+            if path:
+                pictures.append((motor, os.path.basename(path)))
+        if not pictures:
+            print("torque_speed: matplotlib not installed, no plots", file=sys.stderr)
+        print(f"torque_speed: wrote {report.write(args.report, report_text(rows, refused, args, argv, pictures))}")
+    return 1 if bad and args.check else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
