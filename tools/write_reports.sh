@@ -28,6 +28,8 @@
 #                        same step streams                     -> docs/reports/step-dir.md (+ step-dir.png)
 #   homing               tools/homing_sweep.py, every preset, ideal and realistic chains, homing speeds from
 #                        0.1 % to 50 % of the top speed         -> docs/reports/homing.md
+#   torque-speed         tools/torque_speed.py, every preset on 12, 24 and 48 V, pmstep and open-loop
+#                        microstepping                          -> docs/reports/torque-speed.md (+ plots)
 #
 # The campaigns run on a thread pool of 2 (--engine threads --jobs 2; a case's result depends on its
 # seed alone, not on the engine). Outputs of the runs (tables, cases, plots) go to OUT (out/reports);
@@ -45,7 +47,7 @@ set -uo pipefail
 cd "$(dirname "$0")/.."
 
 STEPS_ALL=(cost position-cost benchmarks envelope position-acceptance mc-presets mc-robust mc-position fault-injection
-           motor-sweep self-commissioning step-dir homing)
+           motor-sweep self-commissioning step-dir homing torque-speed)
 MC_PRESETS=(paper 17hs4401 bj42d29 as1050)
 MC_POSITION=(17hs4401 bj42d29 as1050)
 OUT=${OUT:-out/reports}
@@ -172,6 +174,11 @@ for step in "${STEPS[@]}"; do
       rm -rf "$OUT/homing_sweep"
       run homing "$REPORTS/homing.md" "$PYTHON" tools/homing_sweep.py --sil "$SIL" --tune "$TUNE" \
         --out "$OUT/homing_sweep" --report "$REPORTS/homing.md" ;;
+    torque-speed)
+      need_sil
+      rm -rf "$OUT/torque_speed"
+      run torque-speed "$REPORTS/torque-speed.md" "$PYTHON" tools/torque_speed.py --sil "$SIL" --tune "$TUNE" \
+        --out "$OUT/torque_speed" --report "$REPORTS/torque-speed.md" ;;
   esac
 done
 
