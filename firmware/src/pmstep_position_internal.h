@@ -1,5 +1,6 @@
 /* Private to the position library's sources: the vector hold at the end of a move
- * (pmstep_position_hold.c), called from the loop's updates (pmstep_position.c). */
+ * (pmstep_position_hold.c), called from the loop's updates (pmstep_position.c); the loop's reference
+ * for the commands (pmstep_position_commands.c); the STEP/DIR tracker's updates. */
 #ifndef PMSTEP_POSITION_INTERNAL_H
 #define PMSTEP_POSITION_INTERNAL_H
 
@@ -32,6 +33,16 @@ void pmstep_position_vector_hold(pmstep_position_t *pos, float position_rad);
 
 /* Ends a vector hold (a move, a stop); the stage returns to none. */
 void pmstep_position_release_hold(pmstep_position_t *pos);
+
+/* ---- the loop's reference (pmstep_position.c), for the commands (pmstep_position_commands.c) ---- */
+
+/* Puts the speed reference channel at (w*, w*', w*'') for the coming N periods, its set-point held so
+ * that w* ends them at @p end_speed (pmstep_position.c). */
+void pmstep_position_put_speed_reference(pmstep_position_t *pos, float speed, float rate, float accel,
+                                         float end_speed);
+
+/* The loop no longer follows a STEP/DIR input (a move, a stop, a speed command, leaving RUN). */
+void pmstep_position_stop_following(pmstep_position_t *pos);
 
 /* ---- STEP/DIR (pmstep_stepdir.c), run from the position loop ---- */
 struct pmstep_stepdir;
