@@ -30,14 +30,13 @@ import configparser
 import json
 import math
 import os
-import re
-import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import report  # noqa: E402
 from mc_preset import chain_sets  # noqa: E402
-from stepdir_compare import microsteps_for, move_time  # noqa: E402  (the STEP/DIR case's count and timing)
+from stepdir_compare import design, microsteps_for, move_time, run_sil  # noqa: E402  (the tune's design, the
+# SIL's run, the STEP/DIR case's count and timing)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 MOTORS = ["paper", "17hs4401", "bj42d29", "as1050"]
@@ -66,39 +65,11 @@ def read_motor(path):
             "p": int(ini["motor"]["pole_pairs"])}
 
 
-def design(tune, motor_ini, ini_out, robust, sets):
-    """pmstep-tune's design into @p ini_out: its top speed, RUN's start, and the step tracker's bandwidth and
-    the stall detection's bound (the STEP/DIR case's microsteps)."""
-    cmd = [tune, "--motor", motor_ini, "--write-ini", ini_out] + (["--robust"] if robust else [])
-    for s in sets:
-        cmd += ["--set", s]
-    out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
-    top = float(re.search(r"top speed: ([0-9.eE+-]+) rad/s", out).group(1))
-    ini = configparser.ConfigParser(inline_comment_prefixes=(";",))
-    ini.read(ini_out)
-    run_start = float(ini["controller.commissioning"]["offset_calibration_time_s"]) + float(
-        ini["controller.alignment"]["c_align_time_s"])
-    return (top, run_start, float(ini["controller.gains"]["reference_bandwidth_rad_s"]),
-            float(ini["controller.detection"]["stall_speed_error_rad_s"]))
-
-
 def designed_homing(sil, scenario, out_dir):
     """The designer's homing settings for the design (a run of no length prints them in its summary)."""
     s = run_sil(sil, scenario, ["speed.points=0:0", "position.source=homing", "position.points=1e3:1",
                                 "run.duration_s=1e-3"], out_dir)[1]
     return s["homing"]
-
-
-def run_sil(sil, scenario, sets, out_dir):
-    cmd = [sil, "--quiet", "--no-csv", "--out", out_dir, "--scenario", scenario]
-    for s in sets:
-        cmd += ["--set", s]
-    proc = subprocess.run(cmd, capture_output=True, text=True)
-    path = os.path.join(out_dir, "summary.json")
-    if proc.returncode not in (0, 3, 4) or not os.path.isfile(path):
-        raise RuntimeError(f"pmstep-sil failed ({proc.returncode}): {proc.stderr.strip()}")
-    with open(path) as f:
-        return proc.returncode, json.load(f)
 
 
 def stop_sets(motor, direction, reach):

@@ -96,11 +96,13 @@ LOAD_ITERATIONS = 9     # its halvings: 1.5 T_H / 512, 0.3 % of the holding torq
 LOAD_ITERATIONS_QUICK = 4   # --quick: 1.5 T_H / 16, 9.4 % of it
 
 
-def design(tune, motor_ini, ini_out):
-    """pmstep-tune's design of the preset into @p ini_out; returns its top speed, RUN's start, varpi_0 (the
-    tracker's w_t) and the stall detection's bound."""
-    out = subprocess.run([tune, "--motor", motor_ini, "--write-ini", ini_out], check=True, capture_output=True,
-                         text=True).stdout
+def design(tune, motor_ini, ini_out, robust=False, sets=()):
+    """pmstep-tune's design of the preset into @p ini_out (--robust and the --set items when given); returns
+    its top speed, RUN's start, varpi_0 (the tracker's w_t) and the stall detection's bound."""
+    cmd = [tune, "--motor", motor_ini, "--write-ini", ini_out] + (["--robust"] if robust else [])
+    for item in sets:
+        cmd += ["--set", item]
+    out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
     top = float(re.search(r"top speed: ([0-9.eE+-]+) rad/s", out).group(1))
     ini = configparser.ConfigParser(inline_comment_prefixes=(";",))
     ini.read(ini_out)
@@ -181,7 +183,7 @@ def schedule(m, start_s):
     return points, end
 
 
-def run_sil(sil, scenario, sets, out_dir, with_csv):
+def run_sil(sil, scenario, sets, out_dir, with_csv=False):
     cmd = [sil, "--quiet", "--out", out_dir, "--scenario", scenario] + ([] if with_csv else ["--no-csv"])
     for s in sets:
         cmd += ["--set", s]

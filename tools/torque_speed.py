@@ -45,8 +45,8 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import report  # noqa: E402
-from homing_sweep import design, read_motor  # noqa: E402  (pmstep-tune's design with --set; the preset)
-from stepdir_compare import A_AXIS, run_sil  # noqa: E402
+from homing_sweep import read_motor  # noqa: E402  (the preset)
+from stepdir_compare import A_AXIS, design, run_sil  # noqa: E402  (the tune's design with --set, the SIL's run)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 MOTORS = ["paper", "17hs4401", "bj42d29", "as1050"]

@@ -83,7 +83,6 @@ pmstep_status_t pmstep_homing_start(pmstep_homing_t *homing, pmstep_position_t *
     homing->target_rad = pos->motion.target;
     homing->state = PMSTEP_HOMING_SEEKING;
     homing->direction = (float)direction;
-    homing->start_rad = position_rad;
     homing->stop_rad = 0.0f;
     homing->stalled_by_current = false;
     return PMSTEP_OK;

@@ -64,7 +64,6 @@ typedef struct {
     pmstep_homing_config_t cfg;
     pmstep_homing_state_t state;
     float direction;        /**< +1 or -1: toward the stop */
-    float start_rad;        /**< theta-hat when it started */
     float stop_rad;         /**< theta-hat at the stop, in the frame before the zero was set */
     bool stalled_by_current; /**< the stop was found by the current test (else by the following error) */
     float target_rad;       /**< the target of the homing's own move (another command's moves it: aborted) */

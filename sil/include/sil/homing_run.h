@@ -25,7 +25,6 @@ typedef struct {
     double full_step_rad;
     bool started;
     pmstep_homing_state_t last_state;
-    double contact_rad;       /**< the stop's contact in the drive's frame at RUN (from the c-alignment's equilibrium) */
 } sil_homing_run_t;
 
 /** The homing settings the scenario runs with: the designer's (pmstep_homing_design()) with the
