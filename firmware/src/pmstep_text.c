@@ -72,6 +72,8 @@ const char *pmstep_status_str(pmstep_status_t status)
     case PMSTEP_ERR_DATASHEET_TORQUE_CONSTANT:
         return "k_M far from holding torque / (sqrt(2) rated current): check the units of both";
     case PMSTEP_ERR_DATASHEET_TIME_CONSTANT: return "L/R outside 0.1-20 ms: check the units of R and L";
+    case PMSTEP_ERR_DETENT_ABOVE_ALIGNMENT:
+        return "detent torque above what the alignment current (condition (4), rating) can pull across";
     case PMSTEP_ERR_DATASHEET_INERTIA: return "rotor inertia far from what the holding torque gives: check its units";
     case PMSTEP_ERR_DATASHEET_FLUX_RATIO:
         return "p L I / k_M outside 0.1-10: the holding torque, the inductance or the current is off";

@@ -65,11 +65,12 @@ void print_design(const sil_scenario_t *sc, const pmstep_design_report_t *r, boo
     printf("  detent torque compensated: %g Nm, fading above %.1f rad/s (0 = no fade)\n",
            (double)c->motor.detent_torque_Nm, (double)c->gains.detent_fade_speed_rad_s);
     printf("  alignment: %.3f A (u = %.3f V), lead-in %.2f s, t_s %.2f s, t_c %.2f s; swing %.0f rad/s, "
-           "damping %.2f; condition (4) holds %.2fx over\n",
+           "damping %.2f; condition (4) holds %.2fx over, the detent's barrier %.2fx (0 = no detent)\n",
            (double)r->alignment_current_A, (double)c->alignment.s_align_voltage_V,
            (double)c->alignment.s_lead_in_time_s, (double)c->alignment.s_align_time_s,
            (double)c->alignment.c_align_time_s,
-           (double)r->alignment_frequency_rad_s, (double)r->alignment_damping, (double)r->condition_4_margin);
+           (double)r->alignment_frequency_rad_s, (double)r->alignment_damping, (double)r->condition_4_margin,
+           (double)r->detent_margin);
     printf("  trips: %.2f A, bus %.1f..%.1f V; detection: stall/consistency %.2f rad/s, residual %.3f A, %.3f s\n",
            (double)c->limits.max_phase_current_A, (double)c->limits.min_bus_voltage_V,
            (double)c->limits.max_bus_voltage_V, (double)c->detection.stall_speed_error_rad_s,

@@ -54,6 +54,7 @@ int write_summary(const char *path, const char *motor_path, bool robust, pmstep_
         cJSON_AddNumberToObject(design, "alignment_frequency_rad_s", (double)r->alignment_frequency_rad_s);
         cJSON_AddNumberToObject(design, "alignment_damping", (double)r->alignment_damping);
         cJSON_AddNumberToObject(design, "condition_4_margin", (double)r->condition_4_margin);
+        cJSON_AddNumberToObject(design, "detent_margin", (double)r->detent_margin);
         cJSON_AddNumberToObject(design, "magnetising_current_A", (double)r->magnetising_current_A);
         cJSON_AddNumberToObject(design, "rated_torque_Nm", (double)r->rated_torque_Nm);
     }

@@ -211,6 +211,45 @@ static void s_alignment_leads_in_where_there_is_a_detent(void **state)
     }
 }
 
+/* docs/design/04-alignment.md#alignment-current: c-alignment pulls the rotor a full step across the
+ * detent, which needs k_M I_al >= T_d / 0.9186. The current is raised to twice that, within 0.8 of
+ * (4)'s limit k_M/(p L) (0.951 A on the 17HS4401) and the rating; a detent beyond what that current
+ * pulls across is refused. */
+static void alignment_current_pulls_the_rotor_across_the_detent(void **state)
+{
+    static const struct {
+        float detent_Nm;
+        float current_A;  /* expected alignment current */
+        pmstep_status_t expected;
+    } cases[] = {
+        {0.02f, 0.594214f, PMSTEP_OK},   /* the preset's: (4)'s half limit covers it */
+        {0.07f, 0.916057f, PMSTEP_OK},   /* twice the barrier's least current */
+        {0.10f, 0.950742f, PMSTEP_OK},   /* 0.8 of (4)'s limit: margin 1.45 */
+        {0.15f, 0.0f, PMSTEP_ERR_DETENT_ABOVE_ALIGNMENT},
+    };
+    size_t n;
+    int robust;
+    (void)state;
+    for (robust = 0; robust <= 1; ++robust) {
+        for (n = 0; n < sizeof cases / sizeof cases[0]; ++n) {
+            pmstep_design_input_t in = input_of(&presets[1], robust != 0);
+            pmstep_config_t cfg;
+            pmstep_design_report_t report;
+            in.motor.detent_torque_Nm = cases[n].detent_Nm;
+            assert_int_equal(pmstep_design(&in, &cfg, &report), cases[n].expected);
+            if (cases[n].expected != PMSTEP_OK) {
+                continue;
+            }
+            assert_float_equal(report.alignment_current_A, cases[n].current_A, 1e-4f);
+            assert_float_equal(cfg.alignment.c_align_voltage_V, in.motor.resistance_Ohm * cases[n].current_A, 1e-4f);
+            assert_true(report.condition_4_margin >= 1.2499f);
+            assert_float_equal(report.detent_margin,
+                               0.918559f * in.motor.torque_constant_Nm_A * cases[n].current_A / cases[n].detent_Nm, 1e-3f);
+            assert_true(report.detent_margin > 1.0f);
+        }
+    }
+}
+
 static void observer_poles_are_placed(void **state)
 {
     /* s^3 + (a_e + F/J) s^2 + (a_e F/J + g_w b^2) s + g_T b^2/J = (s + w_o)^3, b = k_M/L,
@@ -538,6 +577,7 @@ int main(void)
         cmocka_unit_test(every_preset_gets_a_valid_design),
         cmocka_unit_test(detent_compensation_fades_where_the_current_loop_ends),
         cmocka_unit_test(s_alignment_leads_in_where_there_is_a_detent),
+        cmocka_unit_test(alignment_current_pulls_the_rotor_across_the_detent),
         cmocka_unit_test(residual_bound_has_the_dead_time_floor),
         cmocka_unit_test(observer_poles_are_placed),
         cmocka_unit_test(bad_motor_data_gets_a_named_error),

@@ -39,8 +39,18 @@
 #define STILL_ROTOR_SWING_PHASE 0.1f /* RUN takes the measured L, k_M only if w_n x L window is below this */
 /* Speed correction k_w kappa at most this fraction of the rated current's acceleration k_M I / J. */
 #define KAPPA_CURRENT_FRACTION 0.5f
-/* Alignment current at most this fraction of k_M/(p L), where condition (4) runs out. */
+/* Alignment current: this fraction of k_M/(p L), where condition (4) runs out, within the rated
+ * current ... */
 #define CONDITION_4_FRACTION 0.5f
+/* ... raised where the detent torque asks for more. c-alignment turns the rotor a full step against
+ * the detent's -T_d sin(4 p theta); the alignment's k_M I sin(p theta') beats it over the whole step
+ * only if k_M I >= T_d / DETENT_BARRIER_RATIO, the least sin(x) / -sin(4 x) over the quarter of the
+ * step where the detent opposes (x in (pi/4, pi/2), least at x = 1.150). The current is raised to
+ * DETENT_BARRIER_MARGIN times that, within MAX_CONDITION_4_FRACTION of (4)'s limit and the rated
+ * current (docs/design/04-alignment.md). */
+#define DETENT_BARRIER_RATIO 0.918559f
+#define DETENT_BARRIER_MARGIN 2.0f
+#define MAX_CONDITION_4_FRACTION 0.8f
 /* The alignments last until the swing has decayed by e^-13.8 (1e-6), plus 5 L/R of current rise. */
 #define SETTLING_DECAY 13.8155f
 #define CURRENT_RISE_TIME_CONSTANTS 5.0f
@@ -181,6 +191,16 @@ pmstep_status_t pmstep_design_check_datasheet(const pmstep_design_input_t *in)
     return PMSTEP_OK;
 }
 
+/* The alignment current (docs/design/04-alignment.md#alignment-current). */
+static float alignment_current(const pmstep_design_input_t *in)
+{
+    const pmstep_motor_config_t *m = &in->motor;
+    const float condition_limit_A = m->torque_constant_Nm_A / ((float)m->pole_pairs * m->inductance_H);
+    const float detent_A = DETENT_BARRIER_MARGIN * m->detent_torque_Nm / (DETENT_BARRIER_RATIO * m->torque_constant_Nm_A);
+    return min2(in->motor.rated_current_A,
+                max2(CONDITION_4_FRACTION * condition_limit_A, min2(detent_A, MAX_CONDITION_4_FRACTION * condition_limit_A)));
+}
+
 static pmstep_status_t check_input(const pmstep_design_input_t *in)
 {
     const pmstep_motor_config_t *m = &in->motor;
@@ -239,6 +259,11 @@ static pmstep_status_t check_input(const pmstep_design_input_t *in)
     if (!((m->resistance_Ohm / m->inductance_H + m->friction_Nms_rad / m->inertia_kgm2) * in->period_s
           <= MAX_WINDING_RATE_X_PERIOD)) {
         return PMSTEP_ERR_RATE_TOO_SLOW;
+    }
+    /* c-alignment turns the rotor a full step; a detent the current it may use cannot pull the rotor
+     * across would leave it a full step off the equilibrium the angle starts from. */
+    if (!(DETENT_BARRIER_RATIO * m->torque_constant_Nm_A * alignment_current(in) > m->detent_torque_Nm)) {
+        return PMSTEP_ERR_DETENT_ABOVE_ALIGNMENT;
     }
     return PMSTEP_OK;
 }
@@ -341,7 +366,7 @@ static float design_alignment(const pmstep_design_input_t *in, pmstep_config_t *
     const float r = m->resistance_Ohm;
     const float l_over_r = m->inductance_H / r;
     const float condition_limit_A = m->torque_constant_Nm_A / (p * m->inductance_H);
-    const float current_A = min2(in->motor.rated_current_A, CONDITION_4_FRACTION * condition_limit_A);
+    const float current_A = alignment_current(in);
     const float stiffness = p * m->torque_constant_Nm_A * current_A;
     const float natural = sqrtf(stiffness / m->inertia_kgm2);
     const float lag = natural * l_over_r;
@@ -382,6 +407,10 @@ static float design_alignment(const pmstep_design_input_t *in, pmstep_config_t *
     report->alignment_damping = zeta;
     /* (4) with u_cs = u_cc = R I: k_M I/(p L) > I^2, i.e. condition_limit_A / I > 1. */
     report->condition_4_margin = condition_limit_A / current_A;
+    /* k_M I over the least it needs to pass the detent's barrier (0: no detent). */
+    report->detent_margin = m->detent_torque_Nm > 0.0f
+                                ? DETENT_BARRIER_RATIO * m->torque_constant_Nm_A * current_A / m->detent_torque_Nm
+                                : 0.0f;
     return window_s;
 }
 

@@ -110,6 +110,8 @@ typedef enum {
     PMSTEP_ERR_DATASHEET_INERTIA = -116,    /**< J outside [1/10, 10] x its estimate from the holding torque */
     PMSTEP_ERR_DATASHEET_FLUX_RATIO = -117, /**< p L I / k_M outside [0.1, 10]: the winding's flux at rated current
                                                  against the magnet's, which no stepper has */
+    PMSTEP_ERR_DETENT_ABOVE_ALIGNMENT = -118, /**< the detent torque holds the rotor against the largest
+                                                 alignment current condition (4) and the rating allow */
     /* commissioning: identification of J and F at the start of RUN (pmstep_identify.h) */
     PMSTEP_ERR_IDENTIFICATION_WINDOW = -120, /**< identification window < 0 or longer than PMSTEP_MAX_DURATION_PERIODS */
     PMSTEP_ERR_IDENTIFICATION_SPEED = -121,  /**< identification's lowest speed < 0 */

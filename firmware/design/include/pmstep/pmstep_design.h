@@ -56,6 +56,8 @@ typedef struct {
     float alignment_frequency_rad_s; /**< sqrt(p k_M I_al / J): natural frequency of the alignment swing */
     float alignment_damping;         /**< its damping ratio (electrical damping through the winding, and F) */
     float condition_4_margin;        /**< left side of (4) over its right side (> 1 when (4) holds) */
+    float detent_margin;             /**< 0.9186 k_M I_al / T_d: c-alignment's torque over the least that pulls
+                                          the rotor across the detent (0: no detent) */
     float magnetising_current_A;     /**< i_d* the robust mode should run with (0 in paper mode) */
     float rated_torque_Nm;           /**< k_M x rated current (torque of one phase at rated current) */
     float inertia_kgm2;              /**< the rotor inertia designed for: the input's, or its estimate */
@@ -105,6 +107,8 @@ pmstep_status_t pmstep_design_check_datasheet(const pmstep_design_input_t *in);
  * @retval PMSTEP_ERR_BUS_ABOVE_SENSE_RANGE    the bus sensing cannot read 1.1 x the bus likewise
  * @retval PMSTEP_ERR_RATE_TOO_SLOW        R/L or F/J too large for the control period
  * @retval PMSTEP_ERR_DEAD_TIME            dead time < 0 or 4 t_d >= T_s
+ * @retval PMSTEP_ERR_DETENT_ABOVE_ALIGNMENT  the detent torque T_d at or above k_M I_al x 0.9186, I_al the
+ *                                         largest alignment current (4) (0.8 of its limit) and the rating allow
  * @retval PMSTEP_ERR_DATASHEET_TORQUE_CONSTANT ... PMSTEP_ERR_DATASHEET_FLUX_RATIO
  *                                         pmstep_design_check_datasheet(), unless accept_implausible
  * @retval other                           the designed configuration fails pmstep_validate_config()
