@@ -249,15 +249,15 @@ static void alignment_stage(const pmstep_t *inst, pmstep_output_t *out)
 }
 
 /* Supervise stage, in RUN, every PMSTEP_DETECTION_DECIMATION periods: the observer's estimates
- * within what the motor and the bus allow (an estimate beyond is a lost observer, caught before it
- * runs away to overflow: its injections grow with its own terms), then detection. */
+ * within what the motor and the bus allow (the observer holds them at that range's edge, so an
+ * estimate at it is a lost observer), then detection. */
 static pmstep_fault_t supervise_stage(pmstep_t *inst, const pmstep_output_t *out, const pmstep_meas_t *sample)
 {
     if ((inst->step_count % PMSTEP_DETECTION_DECIMATION) != 0u) {
         return PMSTEP_FAULT_NONE;
     }
-    if ((pmstep_abs(inst->observer.speed_hat_rad_s) > inst->observer_coeffs.speed_bound_rad_s)
-        || (pmstep_abs(inst->observer.load_hat_Nm) > inst->observer_coeffs.load_bound_Nm)) {
+    if ((pmstep_abs(inst->observer.speed_hat_rad_s) >= inst->observer_coeffs.speed_bound_rad_s)
+        || (pmstep_abs(inst->observer.load_hat_Nm) >= inst->observer_coeffs.load_bound_Nm)) {
         return PMSTEP_FAULT_ESTIMATE_RANGE;
     }
     return pmstep_detect_check(&inst->scratch.run.detector, &inst->detect_coeffs, &inst->cfg->detection, out, sample);

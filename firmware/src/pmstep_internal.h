@@ -12,6 +12,12 @@ static inline float pmstep_abs(float x)
     return fabsf(x);
 }
 
+/* x limited to [-bound, bound] (bound >= 0); NaN passes through. */
+static inline float pmstep_limit(float x, float bound)
+{
+    return (x > bound) ? bound : ((x < -bound) ? -bound : x);
+}
+
 /* x - x is 0 for every finite x and NaN for NaN and +/-Inf, so one compare checks a sum of
  * such differences (cheaper than one isfinite per value on the FPU). */
 static inline bool pmstep_all_finite4(float a, float b, float c, float d)

@@ -2,6 +2,7 @@
 #include "pmstep/pmstep_observer.h"
 
 #include "pmstep/pmstep_rotation.h"
+#include "pmstep_internal.h"
 
 void pmstep_observer_coeffs_init(pmstep_observer_coeffs_t *coeffs, const pmstep_config_t *cfg,
                                  const pmstep_electrical_t *model)
@@ -118,6 +119,10 @@ void pmstep_observer_advance(pmstep_observer_t *obs, const pmstep_observer_coeff
         obs->i_a_hat_A = coeffs->current_decay * obs->i_a_hat_A + coeffs->current_step_s * drive_a;
         obs->i_b_hat_A = coeffs->current_decay * obs->i_b_hat_A + coeffs->current_step_s * drive_b;
     }
-    obs->speed_hat_rad_s += period_s * mech->speed_hat_rate_rad_s2;
-    obs->load_hat_Nm += period_s * mech->load_hat_rate_Nm_s;
+    /* Held within the range beyond which the supervision takes the observer for lost
+     * (PMSTEP_FAULT_ESTIMATE_RANGE at its next check): a lost observer's injections grow with its
+     * own terms, and between two checks they would take it to overflow. */
+    obs->speed_hat_rad_s = pmstep_limit(obs->speed_hat_rad_s + period_s * mech->speed_hat_rate_rad_s2,
+                                        coeffs->speed_bound_rad_s);
+    obs->load_hat_Nm = pmstep_limit(obs->load_hat_Nm + period_s * mech->load_hat_rate_Nm_s, coeffs->load_bound_Nm);
 }

@@ -168,12 +168,52 @@ static void boost_scales_the_injections_beyond_the_residual_bound(void **state)
     }
 }
 
+/* A lost observer: the full bus on phase a while the samples read no current (an open winding the
+ * open-phase detection has not yet caught), at a fixed angle estimate. The injections integrate an
+ * error that never closes. The speed and load estimates stay within the range the supervision
+ * checks (PMSTEP_ESTIMATE_RANGE_FACTOR x max_bus_voltage_V / k_M and x k_M x max_phase_current_A),
+ * every state finite, and one of them reaches that range's edge, where the supervision's next check
+ * faults ESTIMATE_RANGE. */
+static void lost_observer_stays_within_the_estimate_range(void **state)
+{
+    const pmstep_config_t cfg = pmstep_paper_config();
+    const pmstep_electrical_t model = pmstep_configured_electrical(&cfg);
+    const float bus_V = cfg.limits.max_bus_voltage_V;
+    pmstep_observer_coeffs_t coeffs;
+    pmstep_observer_t obs;
+    pmstep_observer_input_t in;
+    float max_speed = 0.0f;
+    float max_load = 0.0f;
+    long k;
+    (void)state;
+    pmstep_observer_coeffs_init(&coeffs, &cfg, &model);
+    assert_float_equal(coeffs.speed_bound_rad_s, PMSTEP_ESTIMATE_RANGE_FACTOR * bus_V / model.torque_constant_Nm_A,
+                       1e-3f);
+    observer_and_input(&obs, &in, 0.0f, 0.0f);
+    in.cos_hat = 0.03f; /* the flux integrals' magnitude collapsed */
+    in.sin_hat = 0.01f;
+    for (k = 0; k < 200000; ++k) { /* 10 s */
+        pmstep_observer_mech_rates_t mech = pmstep_observer_mech_rates(&obs, &coeffs, &in, false);
+        pmstep_observer_advance(&obs, &coeffs, &in, &mech, bus_V, 0.0f, cfg.timing.period_s);
+        assert_true(isfinite(obs.i_a_hat_A) && isfinite(obs.i_b_hat_A));
+        assert_true(isfinite(obs.speed_hat_rad_s) && isfinite(obs.load_hat_Nm));
+        assert_true(fabsf(obs.speed_hat_rad_s) <= coeffs.speed_bound_rad_s);
+        assert_true(fabsf(obs.load_hat_Nm) <= coeffs.load_bound_Nm);
+        max_speed = fmaxf(max_speed, fabsf(obs.speed_hat_rad_s));
+        max_load = fmaxf(max_load, fabsf(obs.load_hat_Nm));
+    }
+    print_message("largest |w-hat| %.1f of %.1f rad/s, |T_L-hat| %.2f of %.2f N m\n", (double)max_speed,
+                  (double)coeffs.speed_bound_rad_s, (double)max_load, (double)coeffs.load_bound_Nm);
+    assert_true(max_speed == coeffs.speed_bound_rad_s || max_load == coeffs.load_bound_Nm);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(injection_gains_reduce_to_paper_values_without_friction),
         cmocka_unit_test(observer_converges_on_exact_samples),
         cmocka_unit_test(voltage_correction_redoes_the_advance),
+        cmocka_unit_test(lost_observer_stays_within_the_estimate_range),
         cmocka_unit_test(boost_scales_the_injections_beyond_the_residual_bound),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
