@@ -12,10 +12,13 @@ static inline float pmstep_abs(float x)
     return fabsf(x);
 }
 
-/* x limited to [-bound, bound] (bound >= 0); NaN passes through. */
+/* x limited to [-bound, bound] (bound >= 0); NaN passes through. One compare on the common path. */
 static inline float pmstep_limit(float x, float bound)
 {
-    return (x > bound) ? bound : ((x < -bound) ? -bound : x);
+    if (pmstep_abs(x) > bound) {
+        return (x > 0.0f) ? bound : -bound;
+    }
+    return x;
 }
 
 /* x - x is 0 for every finite x and NaN for NaN and +/-Inf, so one compare checks a sum of

@@ -119,10 +119,12 @@ void pmstep_observer_advance(pmstep_observer_t *obs, const pmstep_observer_coeff
         obs->i_a_hat_A = coeffs->current_decay * obs->i_a_hat_A + coeffs->current_step_s * drive_a;
         obs->i_b_hat_A = coeffs->current_decay * obs->i_b_hat_A + coeffs->current_step_s * drive_b;
     }
-    /* Held within the range beyond which the supervision takes the observer for lost
+    /* w-hat held within the range beyond which the supervision takes the observer for lost
      * (PMSTEP_FAULT_ESTIMATE_RANGE at its next check): a lost observer's injections grow with its
-     * own terms, and between two checks they would take it to overflow. */
+     * own speed's powers (the back EMF's mean over the period), and between two checks they would
+     * take it to overflow. With w-hat bounded the current estimates are a stable filter of bounded
+     * inputs, and T_L-hat grows at most linearly until the check. */
     obs->speed_hat_rad_s = pmstep_limit(obs->speed_hat_rad_s + period_s * mech->speed_hat_rate_rad_s2,
                                         coeffs->speed_bound_rad_s);
-    obs->load_hat_Nm = pmstep_limit(obs->load_hat_Nm + period_s * mech->load_hat_rate_Nm_s, coeffs->load_bound_Nm);
+    obs->load_hat_Nm += period_s * mech->load_hat_rate_Nm_s;
 }

@@ -61,7 +61,7 @@ typedef struct {
 /** How far beyond what the motor and the bus allow the speed and load estimates may go before the
  *  core takes them for lost (PMSTEP_FAULT_ESTIMATE_RANGE): a loaded rotor can be driven past the
  *  bus's speed, and an observer's transient overshoots, by less than this. pmstep_observer_advance()
- *  holds both estimates within that range, so that every state stays finite until the check. */
+ *  holds the speed estimate within that range, so that every state stays finite until the check. */
 #define PMSTEP_ESTIMATE_RANGE_FACTOR 4.0f
 
 /** Signals the mechanical part of the observer needs at one sample. */
