@@ -8,10 +8,11 @@
 
 /* Bandwidths as fractions of the control rate 1/T_s (docs/design/02-current-and-speed-loops.md). */
 #define CURRENT_BANDWIDTH_X_PERIOD 0.2f   /* (R/L + K_i) T_s */
-/* The observer's triple pole w_o: at least OBSERVER_BANDWIDTH_X_PERIOD / T_s; in paper mode raised to
+/* The observer's triple pole w_o: at least OBSERVER_BANDWIDTH_X_PERIOD / T_s, raised to
  * OBSERVER_HALF_RESPONSE / t_step, t_step the time the rated torque takes to turn the told rotor by
  * one full step (a triple pole's step response is half way at w_o t = 2.674: half a load step is
- * estimated before it has slipped the rotor a full step), up to MAX_OBSERVER_BANDWIDTH_X_PERIOD / T_s
+ * estimated before it has slipped the rotor a full step; robust mode's transient boost meets that at
+ * a third of it), up to MAX_OBSERVER_BANDWIDTH_X_PERIOD / T_s
  * (3 w_o T_s = 0.3 within the forward-Euler observer's 0.5; docs/design/03-observer.md). */
 #define OBSERVER_BANDWIDTH_X_PERIOD 0.05f
 #define MAX_OBSERVER_BANDWIDTH_X_PERIOD 0.1f
@@ -291,10 +292,13 @@ static float observer_bandwidth(const pmstep_design_input_t *in)
     const float step_time_s = sqrtf(DESIGN_PI * m->inertia_kgm2 / ((float)m->pole_pairs * rated_torque_Nm));
     const float w_step = OBSERVER_HALF_RESPONSE / step_time_s;
     if (in->self_commissioning) {
-        /* Robust mode answers a load step with its transient observer boost (3 w_o beyond the
-         * residual bound) and aims its standstill hold by T_L-hat, into which a raised observer passes
-         * more of the samples' noise: it keeps the rate's bandwidth. */
-        return OBSERVER_BANDWIDTH_X_PERIOD / in->period_s;
+        /* Robust mode answers a load step with its transient observer boost, k = 3 times the
+         * observer's mechanical bandwidth beyond the residual bound, and aims its standstill hold by
+         * T_L-hat, into which a raised observer passes more of the samples' noise: the boosted
+         * observer meets the load rule, k w_o >= w_step. */
+        return min2(max2(OBSERVER_BANDWIDTH_X_PERIOD, w_step * in->period_s / TRANSIENT_OBSERVER_BOOST),
+                    MAX_OBSERVER_BANDWIDTH_X_PERIOD)
+               / in->period_s;
     }
     return min2(max2(OBSERVER_BANDWIDTH_X_PERIOD, w_step * in->period_s), MAX_OBSERVER_BANDWIDTH_X_PERIOD)
            / in->period_s;
