@@ -2,6 +2,7 @@
 #include "pmstep/pmstep_design.h"
 
 #include "pmstep/pmstep.h"
+#include "pmstep_design_internal.h"
 
 #include <math.h> /* sqrtf, isfinite: one FPU instruction / a classification macro, no libm call */
 #include <stddef.h>
@@ -18,11 +19,6 @@
 #define MAX_OBSERVER_BANDWIDTH_X_PERIOD 0.1f
 #define OBSERVER_HALF_RESPONSE 2.674f
 #define DESIGN_PI 3.14159265f
-/* A winding faster than those: the current loop at this many times R/L, the observer's current pole
- * 3 w_o at this many times R/L + F/J; and the fastest winding designed for, (R/L + F/J) T_s, which
- * keeps (R/L + K_i) T_s and (R/L + K_e) T_s under the 0.5 init accepts. */
-#define WINDING_RATE_MARGIN 1.25f
-#define MAX_WINDING_RATE_X_PERIOD 0.35f
 /* Robust mode's angle smoothing: the reading and the turned previous estimate weighted equally
  * (the samples' noise in the estimate x 0.58; docs/design/16-angle-smoothing.md) */
 #define ANGLE_SMOOTHING 0.5f
@@ -40,32 +36,12 @@
 #define STILL_ROTOR_SWING_PHASE 0.1f /* RUN takes the measured L, k_M only if w_n x L window is below this */
 /* Speed correction k_w kappa at most this fraction of the rated current's acceleration k_M I / J. */
 #define KAPPA_CURRENT_FRACTION 0.5f
-/* Alignment current: this fraction of k_M/(p L), where condition (4) runs out, within the rated
- * current ... */
-#define CONDITION_4_FRACTION 0.5f
-/* ... raised where the detent torque asks for more. c-alignment turns the rotor a full step against
- * the detent's -T_d sin(4 p theta); the alignment's k_M I sin(p theta') beats it over the whole step
- * only if k_M I >= T_d / DETENT_BARRIER_RATIO, the least sin(x) / -sin(4 x) over the quarter of the
- * step where the detent opposes (x in (pi/4, pi/2), least at x = 1.150). The current is raised to
- * DETENT_BARRIER_MARGIN times that, within MAX_CONDITION_4_FRACTION of (4)'s limit and the rated
- * current (docs/design/04-alignment.md). */
-#define DETENT_BARRIER_RATIO 0.918559f
-#define DETENT_BARRIER_MARGIN 2.0f
-#define MAX_CONDITION_4_FRACTION 0.8f
 /* The alignments last until the swing has decayed by e^-13.8 (1e-6), plus 5 L/R of current rise. */
 #define SETTLING_DECAY 13.8155f
 #define CURRENT_RISE_TIME_CONSTANTS 5.0f
 #define TIME_GRANULARITY_S 0.01f
 /* Protections. */
-#define USABLE_BUS_FRACTION 0.9f
 #define TRIP_CURRENT_PER_RATED 2.0f
-/* Where the drive's current sensing cannot read twice the rated current, the trip goes down to
- * what it reads (PMSTEP_SENSE_RANGE_USABLE_FRACTION of its range), but not below this many times the
- * rated current: a drive that trips at its motor's rating cannot drive it. */
-#define MIN_TRIP_CURRENT_PER_RATED 1.25f
-/* Likewise the overvoltage trip, down to the bus measurement's usable range, but not below this
- * many times the nominal bus (supply tolerance and regeneration). */
-#define MIN_MAX_BUS_FRACTION 1.1f
 #define MIN_BUS_FRACTION 0.625f
 #define MAX_BUS_FRACTION 1.25f
 /* Detection (docs/design/05-protections-and-detection.md). */
@@ -110,16 +86,6 @@
  * bandwidths (docs/design/02-current-and-speed-loops.md): calibrated on the Monte Carlo. */
 #define DETENT_FADE_PER_CURRENT_BANDWIDTH 2.0f
 
-static float max2(float a, float b)
-{
-    return a > b ? a : b;
-}
-
-static float min2(float a, float b)
-{
-    return a < b ? a : b;
-}
-
 /* @p t_s rounded up to a whole number of TIME_GRANULARITY_S. */
 static float round_up_time(float t_s)
 {
@@ -129,144 +95,6 @@ static float round_up_time(float t_s)
         ++whole;
     }
     return (float)whole * TIME_GRANULARITY_S;
-}
-
-static bool finite_input(const pmstep_design_input_t *in)
-{
-    const pmstep_motor_config_t *m = &in->motor;
-    return isfinite(m->resistance_Ohm) && isfinite(m->inductance_H) && isfinite(m->inertia_kgm2)
-           && isfinite(m->friction_Nms_rad) && isfinite(m->torque_constant_Nm_A) && isfinite(in->motor.rated_current_A)
-           && isfinite(in->bus_voltage_V) && isfinite(in->period_s) && isfinite(in->dead_time_s)
-           && isfinite(in->current_resolution_A) && isfinite(in->current_sense_range_A)
-           && isfinite(in->bus_sense_range_V) && isfinite(m->detent_torque_Nm) && isfinite(in->holding_torque_Nm);
-}
-
-/* The datasheet check's bounds (pmstep_design_check_datasheet()). */
-#define DATASHEET_KM_RATIO 2.0f
-#define DATASHEET_MIN_TIME_CONSTANT_S 1e-4f
-#define DATASHEET_MAX_TIME_CONSTANT_S 2e-2f
-#define DATASHEET_INERTIA_RATIO 10.0f
-/* p L I / k_M, the winding's flux at rated current over the magnet's, is a property of a frame's
- * magnetic design (a rewound winding scales L I^2 and k_M I alike): 0.5-3 in stepper datasheets. */
-#define DATASHEET_MIN_FLUX_RATIO 0.1f
-#define DATASHEET_MAX_FLUX_RATIO 10.0f
-
-static float inertia_estimate(float holding_torque_Nm)
-{
-    return PMSTEP_DESIGN_INERTIA_PER_TORQUE * holding_torque_Nm * sqrtf(holding_torque_Nm);
-}
-
-pmstep_status_t pmstep_design_check_datasheet(const pmstep_design_input_t *in)
-{
-    const pmstep_motor_config_t *m;
-    float km_ratio;
-    float time_constant_s;
-    if (in == NULL) {
-        return PMSTEP_ERR_NULL_ARGUMENT;
-    }
-    m = &in->motor;
-    if (!(in->holding_torque_Nm > 0.0f) || !(m->rated_current_A > 0.0f) || !(m->resistance_Ohm > 0.0f)) {
-        return PMSTEP_OK; /* nothing to compare with (the designer's own checks name what is missing) */
-    }
-    km_ratio = m->torque_constant_Nm_A * 1.41421356f * m->rated_current_A / in->holding_torque_Nm;
-    if (!(km_ratio >= 1.0f / DATASHEET_KM_RATIO && km_ratio <= DATASHEET_KM_RATIO)) {
-        return PMSTEP_ERR_DATASHEET_TORQUE_CONSTANT;
-    }
-    time_constant_s = m->inductance_H / m->resistance_Ohm;
-    if (!(time_constant_s >= DATASHEET_MIN_TIME_CONSTANT_S && time_constant_s <= DATASHEET_MAX_TIME_CONSTANT_S)) {
-        return PMSTEP_ERR_DATASHEET_TIME_CONSTANT;
-    }
-    {
-        const float flux_ratio = (float)m->pole_pairs * m->inductance_H * m->rated_current_A
-                                 / (in->holding_torque_Nm / (1.41421356f * m->rated_current_A));
-        if (!(flux_ratio >= DATASHEET_MIN_FLUX_RATIO && flux_ratio <= DATASHEET_MAX_FLUX_RATIO)) {
-            return PMSTEP_ERR_DATASHEET_FLUX_RATIO;
-        }
-    }
-    if (m->inertia_kgm2 > 0.0f) {
-        const float j_ratio = m->inertia_kgm2 / inertia_estimate(in->holding_torque_Nm);
-        if (!(j_ratio >= 1.0f / DATASHEET_INERTIA_RATIO && j_ratio <= DATASHEET_INERTIA_RATIO)) {
-            return PMSTEP_ERR_DATASHEET_INERTIA;
-        }
-    }
-    return PMSTEP_OK;
-}
-
-/* The alignment current (docs/design/04-alignment.md#alignment-current). */
-static float alignment_current(const pmstep_design_input_t *in)
-{
-    const pmstep_motor_config_t *m = &in->motor;
-    const float condition_limit_A = m->torque_constant_Nm_A / ((float)m->pole_pairs * m->inductance_H);
-    const float detent_A = DETENT_BARRIER_MARGIN * m->detent_torque_Nm / (DETENT_BARRIER_RATIO * m->torque_constant_Nm_A);
-    return min2(in->motor.rated_current_A,
-                max2(CONDITION_4_FRACTION * condition_limit_A, min2(detent_A, MAX_CONDITION_4_FRACTION * condition_limit_A)));
-}
-
-static pmstep_status_t check_input(const pmstep_design_input_t *in)
-{
-    const pmstep_motor_config_t *m = &in->motor;
-    if (!finite_input(in)) {
-        return PMSTEP_ERR_NONFINITE_PARAMETER;
-    }
-    if (!(m->resistance_Ohm > 0.0f)) {
-        return PMSTEP_ERR_RESISTANCE;
-    }
-    if (!(m->inductance_H > 0.0f)) {
-        return PMSTEP_ERR_INDUCTANCE;
-    }
-    if (!(m->inertia_kgm2 > 0.0f)) {
-        return PMSTEP_ERR_INERTIA;
-    }
-    if (!(m->torque_constant_Nm_A > 0.0f)) {
-        return PMSTEP_ERR_TORQUE_CONSTANT;
-    }
-    if (!(m->friction_Nms_rad >= 0.0f)) {
-        return PMSTEP_ERR_FRICTION;
-    }
-    if (m->pole_pairs < 1) {
-        return PMSTEP_ERR_POLE_PAIRS;
-    }
-    if (!(in->period_s >= PMSTEP_MIN_PERIOD_S && in->period_s <= PMSTEP_MAX_PERIOD_S)) {
-        return PMSTEP_ERR_PERIOD;
-    }
-    if (in->computational_delay_periods > 1u) {
-        return PMSTEP_ERR_DELAY;
-    }
-    if (!(in->motor.rated_current_A > 0.0f)) {
-        return PMSTEP_ERR_RATED_CURRENT;
-    }
-    if (!(in->bus_voltage_V > 0.0f)
-        || !(m->resistance_Ohm * in->motor.rated_current_A < USABLE_BUS_FRACTION * in->bus_voltage_V)) {
-        return PMSTEP_ERR_BUS_BELOW_RATED;
-    }
-    if (!(in->current_sense_range_A > 0.0f) || !(in->bus_sense_range_V > 0.0f)) {
-        return PMSTEP_ERR_SENSE_RANGE;
-    }
-    if (PMSTEP_SENSE_RANGE_USABLE_FRACTION * in->current_sense_range_A
-        < MIN_TRIP_CURRENT_PER_RATED * in->motor.rated_current_A) {
-        return PMSTEP_ERR_SENSE_RANGE_BELOW_RATED;
-    }
-    if (PMSTEP_SENSE_RANGE_USABLE_FRACTION * in->bus_sense_range_V < MIN_MAX_BUS_FRACTION * in->bus_voltage_V) {
-        return PMSTEP_ERR_BUS_ABOVE_SENSE_RANGE;
-    }
-    if (!(in->dead_time_s >= 0.0f && 4.0f * in->dead_time_s < in->period_s)) {
-        return PMSTEP_ERR_DEAD_TIME;
-    }
-    /* The current loop's and the observer's poles lie beyond the winding's own R/L and the
-     * mechanics' F/J (K_i, K_e > 0); where R/L or F/J passes the bandwidths the control rate gives
-     * them, those are raised to WINDING_RATE_MARGIN times it (current_bandwidth(),
-     * observer_bandwidth()), up to what the discretisation takes: (R/L + F/J) T_s at most
-     * MAX_WINDING_RATE_X_PERIOD (docs/design/03-observer.md). */
-    if (!((m->resistance_Ohm / m->inductance_H + m->friction_Nms_rad / m->inertia_kgm2) * in->period_s
-          <= MAX_WINDING_RATE_X_PERIOD)) {
-        return PMSTEP_ERR_RATE_TOO_SLOW;
-    }
-    /* c-alignment turns the rotor a full step; a detent the current it may use cannot pull the rotor
-     * across would leave it a full step off the equilibrium the angle starts from. */
-    if (!(DETENT_BARRIER_RATIO * m->torque_constant_Nm_A * alignment_current(in) > m->detent_torque_Nm)) {
-        return PMSTEP_ERR_DETENT_ABOVE_ALIGNMENT;
-    }
-    return PMSTEP_OK;
 }
 
 /* The bus's speed: (R I + k_M w)^2 + (p w L I)^2 = (0.9 V)^2 at rated current, i_d = 0
@@ -370,7 +198,7 @@ static float design_alignment(const pmstep_design_input_t *in, pmstep_config_t *
     const float r = m->resistance_Ohm;
     const float l_over_r = m->inductance_H / r;
     const float condition_limit_A = m->torque_constant_Nm_A / (p * m->inductance_H);
-    const float current_A = alignment_current(in);
+    const float current_A = pmstep_design_alignment_current(in);
     const float stiffness = p * m->torque_constant_Nm_A * current_A;
     const float natural = sqrtf(stiffness / m->inertia_kgm2);
     const float lag = natural * l_over_r;
@@ -543,15 +371,15 @@ pmstep_status_t pmstep_design(const pmstep_design_input_t *given, pmstep_config_
          * Paper mode takes the top of the estimate's range (docs/design/10-inertia-and-friction.md). */
         estimated = *given;
         estimated.motor.inertia_kgm2 = (given->self_commissioning ? 1.0f : PMSTEP_DESIGN_INERTIA_ESTIMATE_SPREAD)
-                                       * inertia_estimate(given->holding_torque_Nm);
+                                       * pmstep_design_inertia_estimate(given->holding_torque_Nm);
         report->inertia_estimated = true;
         in = &estimated;
     }
     report->inertia_kgm2 = in->motor.inertia_kgm2;
     /* Data no stepper has first: a unit typed wrong shows there before it fails a rule below. */
-    status = (!finite_input(in) || in->accept_implausible) ? PMSTEP_OK : pmstep_design_check_datasheet(in);
+    status = (!pmstep_design_finite_input(in) || in->accept_implausible) ? PMSTEP_OK : pmstep_design_check_datasheet(in);
     if (status == PMSTEP_OK) {
-        status = check_input(in);
+        status = pmstep_design_check_input(in);
     }
     if (status != PMSTEP_OK) {
         return status;
