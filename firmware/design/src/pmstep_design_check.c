@@ -78,12 +78,9 @@ float pmstep_design_alignment_current(const pmstep_design_input_t *in)
                 max2(CONDITION_4_FRACTION * condition_limit_A, min2(detent_A, MAX_CONDITION_4_FRACTION * condition_limit_A)));
 }
 
-pmstep_status_t pmstep_design_check_input(const pmstep_design_input_t *in)
+/* The motor's own data: each constant of its model in range. */
+static pmstep_status_t check_motor(const pmstep_motor_config_t *m)
 {
-    const pmstep_motor_config_t *m = &in->motor;
-    if (!pmstep_design_finite_input(in)) {
-        return PMSTEP_ERR_NONFINITE_PARAMETER;
-    }
     if (!(m->resistance_Ohm > 0.0f)) {
         return PMSTEP_ERR_RESISTANCE;
     }
@@ -102,14 +99,22 @@ pmstep_status_t pmstep_design_check_input(const pmstep_design_input_t *in)
     if (m->pole_pairs < 1) {
         return PMSTEP_ERR_POLE_PAIRS;
     }
+    if (!(m->rated_current_A > 0.0f)) {
+        return PMSTEP_ERR_RATED_CURRENT;
+    }
+    return PMSTEP_OK;
+}
+
+/* The drive's: its period and delay, its bus and sensing against the motor's rated current, its
+ * dead time. */
+static pmstep_status_t check_drive(const pmstep_design_input_t *in)
+{
+    const pmstep_motor_config_t *m = &in->motor;
     if (!(in->period_s >= PMSTEP_MIN_PERIOD_S && in->period_s <= PMSTEP_MAX_PERIOD_S)) {
         return PMSTEP_ERR_PERIOD;
     }
     if (in->computational_delay_periods > 1u) {
         return PMSTEP_ERR_DELAY;
-    }
-    if (!(in->motor.rated_current_A > 0.0f)) {
-        return PMSTEP_ERR_RATED_CURRENT;
     }
     if (!(in->bus_voltage_V > 0.0f)
         || !(m->resistance_Ohm * in->motor.rated_current_A < USABLE_BUS_FRACTION * in->bus_voltage_V)) {
@@ -127,6 +132,23 @@ pmstep_status_t pmstep_design_check_input(const pmstep_design_input_t *in)
     }
     if (!(in->dead_time_s >= 0.0f && 4.0f * in->dead_time_s < in->period_s)) {
         return PMSTEP_ERR_DEAD_TIME;
+    }
+    return PMSTEP_OK;
+}
+
+pmstep_status_t pmstep_design_check_input(const pmstep_design_input_t *in)
+{
+    const pmstep_motor_config_t *m = &in->motor;
+    pmstep_status_t status;
+    if (!pmstep_design_finite_input(in)) {
+        return PMSTEP_ERR_NONFINITE_PARAMETER;
+    }
+    status = check_motor(m);
+    if (status == PMSTEP_OK) {
+        status = check_drive(in);
+    }
+    if (status != PMSTEP_OK) {
+        return status;
     }
     /* The current loop's and the observer's poles lie beyond the winding's own R/L and the
      * mechanics' F/J (K_i, K_e > 0); where R/L or F/J passes the bandwidths the control rate gives
