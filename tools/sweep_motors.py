@@ -21,7 +21,10 @@ failures sit over the groups that decide the design:
 
 Usage: tools/sweep_motors.py --tune build/host-release/sil/pmstep-tune [--count 500] [--seed 2026]
        [--sample N] [--modes paper-ideal,robust-realistic] [--jobs J] [--engine threads|dask]
-       [--out DIR] [--report FILE] [--plot FILE] [--check PCT]
+       [--out DIR] [--report FILE] [--plot FILE] [--check PCT] [--mc-sample N [--mc-cases C] [--sil PATH]]
+
+--mc-sample N adds a short speed Monte Carlo (C cases, default 20) on N population motors
+(tools/sweep_mc.py): the cases by class, and the motors with a silent failure.
 """
 import argparse
 import collections
@@ -38,6 +41,7 @@ import time
 import mc_preset
 import motor_population
 import report
+import sweep_mc
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -235,7 +239,7 @@ def summary_lines(results, modes):
     return lines
 
 
-def report_text(results, modes, argv, seconds, jobs, population_note):
+def report_text(results, modes, argv, seconds, jobs, population_note, mc=None):
     out = [report.header("Motor sweep", "tools/sweep_motors.py", argv,
                          "The gain designer and the control over a population of motors drawn by "
                          "tools/motor_population.py (" + population_note + ") and the public presets. A motor passes "
@@ -272,6 +276,8 @@ def report_text(results, modes, argv, seconds, jobs, population_note):
             out.append(f"| {m['name']} | {r['mode']} | {outcome(r)} | {m['resistance_Ohm']:.3g} | "
                        f"{1e3 * m['inductance_H']:.3g} | {m['rated_current_A']:.3g} | {m['holding_torque_Nm']:.3g} | "
                        f"{m['pole_pairs']} | {m['bus_voltage_V']:g} |")
+    if mc is not None:
+        out += sweep_mc.report_lines(mc["results"], mc["cases"])
     return "\n".join(out) + "\n"
 
 
@@ -292,6 +298,10 @@ def main(argv=None):
     parser.add_argument("--check", type=float, help="exit 1 unless every mode passes at least this many percent")
     parser.add_argument("--require-clean", action="store_true",
                         help="exit 1 if a run overflowed (STATE_NONFINITE) or pmstep-tune gave no summary")
+    parser.add_argument("--mc-sample", type=int, default=0, metavar="N",
+                        help="a short speed Monte Carlo on N population motors (tools/sweep_mc.py)")
+    parser.add_argument("--mc-cases", type=int, default=20, help="cases per motor of --mc-sample (default 20)")
+    parser.add_argument("--sil", help="pmstep-sil for --mc-sample (default: beside --tune)")
     parser.add_argument("--told-exact", action="store_true",
                         help="tell the designer the plant's J and F (no estimate from the holding torque)")
     args = parser.parse_args(argv[1:])
@@ -318,11 +328,20 @@ def main(argv=None):
         results, seconds = run_all(tasks, os.path.abspath(args.tune), work, args.jobs, args.engine)
         results.sort(key=lambda r: (r["mode"], r["motor"]["name"]))
         write_csv(os.path.join(work, "results.csv"), results)
+        mc = None
+        if args.mc_sample > 0:
+            tune = os.path.abspath(args.tune)
+            sil = os.path.abspath(args.sil or os.path.join(os.path.dirname(tune), "pmstep-sil"))
+            mc = {"cases": args.mc_cases,
+                  "results": sweep_mc.run_sample(sweep_mc.sample(population, args.mc_sample), sil, tune, work,
+                                                 args.mc_cases, args.jobs)}
     for line in summary_lines(results, modes):
         print(line)
     print(f"sweep_motors: {len(results)} runs in {seconds:.0f} s on {args.jobs} workers")
+    if mc is not None:
+        print(sweep_mc.summary_line(mc["results"], mc["cases"]))
     if args.report:
-        report.write(args.report, report_text(results, modes, argv, seconds, args.jobs, note))
+        report.write(args.report, report_text(results, modes, argv, seconds, args.jobs, note, mc))
         print(f"sweep_motors: wrote {args.report}")
     if args.plot:
         plot(args.plot, results)
@@ -332,7 +351,12 @@ def main(argv=None):
                    or any(c["fault"] == "STATE_NONFINITE" for c in r["summary"]["checks"])]
         for r in unclean:
             print(f"sweep_motors: UNCLEAN: {r['motor']['name']} {r['mode']}: {outcome(r)}")
-        if unclean:
+        mc_unclean = [] if mc is None else [r for r in mc["results"] if r.get("nonfinite", 0) > 0
+                                                or r.get("counts", {}).get("crashed", 0) > 0]
+        for r in mc_unclean:
+            print(f"sweep_motors: UNCLEAN: Monte Carlo on {r['motor']['name']}: {r.get('counts')}, "
+                  f"non-finite in {r.get('nonfinite')}")
+        if unclean or mc_unclean:
             return 1
     if args.check is not None:
         for mode in modes:

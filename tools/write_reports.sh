@@ -21,7 +21,8 @@
 #   fault-injection      tools/fault_injection.py, every fault on paper, 17hs4401, bj42d29, as1050
 #                                                              -> docs/reports/fault-injection.md
 #   motor-sweep          tools/sweep_motors.py, the 500 motors of tools/motor_population.py (seed 2026),
-#                        paper, robust and self-commissioning modes -> docs/reports/motor-sweep.md (+ .png)
+#                        paper, robust and self-commissioning modes, a speed Monte Carlo on 50 of its motors
+#                                                              -> docs/reports/motor-sweep.md (+ .png)
 #   self-commissioning   tools/self_commission.py, every preset on its chain and the realistic one
 #                                                              -> docs/reports/self-commissioning.md
 #   step-dir             tools/stepdir_compare.py, every preset, pmstep and open-loop microstepping on the
@@ -158,7 +159,7 @@ for step in "${STEPS[@]}"; do
     motor-sweep)
       need_sil
       run motor-sweep "$REPORTS/motor-sweep.md" "$PYTHON" tools/sweep_motors.py --tune "$TUNE" --jobs 2 \
-        --modes paper-ideal,robust-realistic,self-commission-realistic \
+        --modes paper-ideal,robust-realistic,self-commission-realistic --mc-sample 50 \
         --report "$REPORTS/motor-sweep.md" --plot "$REPORTS/motor-sweep.png" ;;
     self-commissioning)
       need_sil
