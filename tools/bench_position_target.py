@@ -32,6 +32,7 @@ usage: tools/bench_position_target.py [--no-build] [--image ELF --work DIR] [--d
 (ctest's pil.position_cost and pil.stepdir_cost run it with --no-build on the image of their own
 cross build)
 """
+
 import argparse
 import json
 import re
@@ -46,13 +47,18 @@ import report  # noqa: E402
 
 IMAGE = bt.PIL / "tests" / "pil" / "target" / "pmstep-pil-position.elf"
 # Kinds of period: key -> (label, the image's mode character, at an update (True), between (False) or either)
-KINDS = {"p": ("RUN, position mode", "p", None), "r": ("RUN, speed mode (estimate only)", "r", None),
-         "a": ("alignment and idle", "a", None)}
-STEPDIR_KINDS = {"p_update": ("RUN following steps, at an update", "p", True),
-                 "p_between": ("RUN following steps, between updates", "p", False),
-                 "p": ("RUN following steps, every period", "p", None),
-                 "r": ("RUN, speed mode (before following)", "r", None),
-                 "a": ("alignment and idle", "a", None)}
+KINDS = {
+    "p": ("RUN, position mode", "p", None),
+    "r": ("RUN, speed mode (estimate only)", "r", None),
+    "a": ("alignment and idle", "a", None),
+}
+STEPDIR_KINDS = {
+    "p_update": ("RUN following steps, at an update", "p", True),
+    "p_between": ("RUN following steps, between updates", "p", False),
+    "p": ("RUN following steps, every period", "p", None),
+    "r": ("RUN, speed mode (before following)", "r", None),
+    "a": ("alignment and idle", "a", None),
+}
 
 
 def call_addresses(elf, callee, caller):
@@ -78,14 +84,19 @@ def counts(image, work, plugin, calls, prefix, image_args):
     values, seen, out = {}, [], ""
     for name, (entry, ret) in calls.items():
         path = work / ("%s-%s.txt" % (prefix, name))
-        out = bt.qemu(image, [modes, *image_args, "--updates", updates],
-                      ["-plugin", "%s,entry=0x%x,ret=0x%x,out=%s" % (plugin, entry, ret, path)]).stdout
+        out = bt.qemu(
+            image,
+            [modes, *image_args, "--updates", updates],
+            ["-plugin", "%s,entry=0x%x,ret=0x%x,out=%s" % (plugin, entry, ret, path)],
+        ).stdout
         values[name] = [int(l) for l in path.read_text().splitlines() if not l.startswith("#")]
         seen.append((modes.read_text(), updates.read_text()))
     mode_text, update_text = seen[0]
     if any(s != seen[0] for s in seen) or any(len(v) != len(mode_text) for v in values.values()):
-        sys.exit("bench_position_target: %s: %s counts for %d periods, or the runs differ" %
-                 (prefix, ", ".join("%d %s" % (len(v), n) for n, v in values.items()), len(mode_text)))
+        sys.exit(
+            "bench_position_target: %s: %s counts for %d periods, or the runs differ"
+            % (prefix, ", ".join("%d %s" % (len(v), n) for n, v in values.items()), len(mode_text))
+        )
     return values, mode_text, update_text, out.strip()
 
 
@@ -119,18 +130,21 @@ def print_table(figures, columns):
 
 def markdown_rows(figures, columns):
     """@p figures as Markdown table rows, @p columns the keys after the period and its count."""
-    return [f"| {f['label']} | {f['periods']} | " + " | ".join(fmt(f[k]) for k in columns) + " |"
-            for f in figures.values()]
+    return [
+        f"| {f['label']} | {f['periods']} | " + " | ".join(fmt(f[k]) for k in columns) + " |" for f in figures.values()
+    ]
 
 
 def budget_line(what, mean, budget, enforced, max_mean, flag, test):
     """The verdict on @p mean against @p budget (ctest @p test's, @p enforced, if known; else this
     run's @p max_mean, given as @p flag)."""
-    return (f"{what}: mean **{mean:.1f}** instructions, budget {budget:g} "
-            f"({'ctest ' + test if enforced is not None else 'this run'}): "
-            f"{'within' if mean <= budget else '**OVER**'}"
-            + (f"; {'within' if mean <= max_mean else 'over'} this run's {flag} {max_mean:g}"
-               if max_mean != budget else "") + ".")
+    return (
+        f"{what}: mean **{mean:.1f}** instructions, budget {budget:g} "
+        f"({'ctest ' + test if enforced is not None else 'this run'}): "
+        f"{'within' if mean <= budget else '**OVER**'}"
+        + (f"; {'within' if mean <= max_mean else 'over'} this run's {flag} {max_mean:g}" if max_mean != budget else "")
+        + "."
+    )
 
 
 def report_section(figures, image_report, max_mean, enforced, duration, argv, stepdir=None):
@@ -139,43 +153,74 @@ def report_section(figures, image_report, max_mean, enforced, duration, argv, st
     @p enforced (None if unknown); with @p stepdir (main()'s --json "stepdir": its figures, image
     report, microsteps, max_mean and enforced budget) the STEP/DIR table after it."""
     budget = enforced if enforced is not None else max_mean
-    lines = [report.section_header("Control period with the position loop: `pmstep_position_step()`",
-                                   "tools/bench_position_target.py", argv),
-             f"The image tests/pil/target/pil_position.c runs the paper's motor on the target through two moves and "
-             f"a hold ({duration} s simulated); every period `pmstep_step()` in the control interrupt, then "
-             "`pmstep_position_update()`. Exact instruction counts of each call (QEMU plugin, callees included); "
-             "their sum per period is the cost of `pmstep_position_step()`. Min / mean / max per kind of period.", ""]
+    lines = [
+        report.section_header(
+            "Control period with the position loop: `pmstep_position_step()`", "tools/bench_position_target.py", argv
+        ),
+        f"The image tests/pil/target/pil_position.c runs the paper's motor on the target through two moves and "
+        f"a hold ({duration} s simulated); every period `pmstep_step()` in the control interrupt, then "
+        "`pmstep_position_update()`. Exact instruction counts of each call (QEMU plugin, callees included); "
+        "their sum per period is the cost of `pmstep_position_step()`. Min / mean / max per kind of period.",
+        "",
+    ]
     if image_report:
         lines += ["The image's own report:", "", "```", image_report, "```", ""]
-    lines += ["| period | periods | `pmstep_step` | `pmstep_position_update` | sum (`pmstep_position_step`) |",
-              "|---|---|---|---|---|"]
+    lines += [
+        "| period | periods | `pmstep_step` | `pmstep_position_update` | sum (`pmstep_position_step`) |",
+        "|---|---|---|---|---|",
+    ]
     lines += markdown_rows(figures, ("step", "update", "total"))
     lines.append("")
     if "p" in figures:
-        lines.append(budget_line("Position-mode period", figures["p"]["total"][1], budget, enforced, max_mean,
-                                 "--max-mean", "pil.position_cost"))
+        lines.append(
+            budget_line(
+                "Position-mode period",
+                figures["p"]["total"][1],
+                budget,
+                enforced,
+                max_mean,
+                "--max-mean",
+                "pil.position_cost",
+            )
+        )
     else:
         lines.append("No period in position mode: **no figure**.")
     if stepdir is not None:
         sd_budget = stepdir["enforced"] if stepdir["enforced"] is not None else stepdir["max_mean"]
-        lines += ["", "### Following a STEP/DIR step count", "",
-                  f"The same image in its STEP/DIR mode: the two moves, planned by the SIL's step generator with the "
-                  f"drive's jerk, sampled each period and quantised to {stepdir['microsteps']} microsteps per full "
-                  "step, advance an emulated 16-bit step counter; following starts once the position is tracked. "
-                  "Every period `pmstep_step()` in the control interrupt, then the image's `after_step()`, one call: "
-                  "`pmstep_stepdir_count()` (inline), `pmstep_position_update()` (at an update, every "
-                  "`PMSTEP_POSITION_DECIMATION`-th period, the step tracker, the stall test and the position loop) "
-                  "and `pmstep_stepdir_diag()`. Min / mean / max per kind of period.", ""]
+        lines += [
+            "",
+            "### Following a STEP/DIR step count",
+            "",
+            f"The same image in its STEP/DIR mode: the two moves, planned by the SIL's step generator with the "
+            f"drive's jerk, sampled each period and quantised to {stepdir['microsteps']} microsteps per full "
+            "step, advance an emulated 16-bit step counter; following starts once the position is tracked. "
+            "Every period `pmstep_step()` in the control interrupt, then the image's `after_step()`, one call: "
+            "`pmstep_stepdir_count()` (inline), `pmstep_position_update()` (at an update, every "
+            "`PMSTEP_POSITION_DECIMATION`-th period, the step tracker, the stall test and the position loop) "
+            "and `pmstep_stepdir_diag()`. Min / mean / max per kind of period.",
+            "",
+        ]
         if stepdir["image_report"]:
             lines += ["The image's own report:", "", "```", stepdir["image_report"], "```", ""]
-        lines += ["| period | periods | `pmstep_step` | after the step (count, `pmstep_position_update`, "
-                  "`pmstep_stepdir_diag`) | sum (the period) |", "|---|---|---|---|---|"]
+        lines += [
+            "| period | periods | `pmstep_step` | after the step (count, `pmstep_position_update`, "
+            "`pmstep_stepdir_diag`) | sum (the period) |",
+            "|---|---|---|---|---|",
+        ]
         lines += markdown_rows(stepdir["figures"], ("step", "after", "total"))
         lines.append("")
         if "p" in stepdir["figures"]:
-            lines.append(budget_line("STEP/DIR period", stepdir["figures"]["p"]["total"][1], sd_budget,
-                                     stepdir["enforced"], stepdir["max_mean"], "--stepdir-max-mean",
-                                     "pil.stepdir_cost"))
+            lines.append(
+                budget_line(
+                    "STEP/DIR period",
+                    stepdir["figures"]["p"]["total"][1],
+                    sd_budget,
+                    stepdir["enforced"],
+                    stepdir["max_mean"],
+                    "--stepdir-max-mean",
+                    "pil.stepdir_cost",
+                )
+            )
         else:
             lines.append("No period following the steps: **no figure**.")
     return "\n".join(lines) + "\n"
@@ -188,21 +233,38 @@ def main():
     ap.add_argument("--work", type=Path, default=bt.BENCH, help="directory for the plugin and the counts")
     ap.add_argument("--duration", default="3", help="simulated seconds (default 3: two moves and a hold)")
     ap.add_argument("--json", help="also write the figures to this JSON file")
-    ap.add_argument("--max-mean", type=float, default=600.0,
-                    help="budget of a position-mode period, mean instructions (default 600)")
-    ap.add_argument("--stepdir", action="store_true",
-                    help="measure the STEP/DIR path (the image's --stepdir) instead of the drive's own moves")
+    ap.add_argument(
+        "--max-mean",
+        type=float,
+        default=600.0,
+        help="budget of a position-mode period, mean instructions (default 600)",
+    )
+    ap.add_argument(
+        "--stepdir",
+        action="store_true",
+        help="measure the STEP/DIR path (the image's --stepdir) instead of the drive's own moves",
+    )
     ap.add_argument("--microsteps", type=int, default=16, help="STEP/DIR microsteps per full step (default 16)")
-    ap.add_argument("--stepdir-max-mean", type=float, default=700.0,
-                    help="budget of a period following the steps, mean instructions (default 700)")
-    ap.add_argument("--report", metavar="FILE",
-                    help="measure both and write the tables as Markdown into the section \"position\" of this "
-                         "page (docs/reports/cost.md)")
+    ap.add_argument(
+        "--stepdir-max-mean",
+        type=float,
+        default=700.0,
+        help="budget of a period following the steps, mean instructions (default 700)",
+    )
+    ap.add_argument(
+        "--report",
+        metavar="FILE",
+        help='measure both and write the tables as Markdown into the section "position" of this '
+        "page (docs/reports/cost.md)",
+    )
     args = ap.parse_args()
     if not args.no_build:
         bt.run(["cmake", "--preset", "qemu-pil"], cwd=bt.ROOT, stdout=subprocess.DEVNULL)
-        bt.run(["cmake", "--build", "--preset", "qemu-pil", "--target", "pmstep-pil-position"], cwd=bt.ROOT,
-               stdout=subprocess.DEVNULL)
+        bt.run(
+            ["cmake", "--build", "--preset", "qemu-pil", "--target", "pmstep-pil-position"],
+            cwd=bt.ROOT,
+            stdout=subprocess.DEVNULL,
+        )
     args.work.mkdir(parents=True, exist_ok=True)
     plugin = args.work / "pil_insn_plugin.so"
     bt.run(["cc", "-shared", "-fPIC", "-O2", "-Wall", "-Wextra", "-o", plugin, bt.PLUGIN_SRC])
@@ -211,39 +273,62 @@ def main():
     figures, stepdir, verdicts, report_lines = None, None, [], ""
     if args.report or not args.stepdir:
         values, modes, updates, report_lines = counts(
-            args.image, args.work, plugin,
+            args.image,
+            args.work,
+            plugin,
             {"step": step, "update": call_addresses(args.image, "pmstep_position_update", "main")},
-            "position", ["--duration", args.duration])
+            "position",
+            ["--duration", args.duration],
+        )
         figures = kind_figures(KINDS, modes, updates, values)
         print("Control period with the position loop on a Cortex-M4F: QEMU mps2-an386, -Os + LTO")
         print(report_lines)
         print()
-        print_table(figures, (("step", "pmstep_step min/mean/max"), ("update", "position_update"),
-                              ("total", "sum (position_step)")))
+        print_table(
+            figures,
+            (("step", "pmstep_step min/mean/max"), ("update", "position_update"), ("total", "sum (position_step)")),
+        )
         verdicts.append(("position-mode period", figures, args.max_mean))
     if args.report or args.stepdir:
         values, modes, updates, sd_lines = counts(
-            args.image, args.work, plugin, {"step": step, "after": call_addresses(args.image, "after_step", "main")},
-            "stepdir", ["--duration", args.duration, "--stepdir", args.microsteps])
-        stepdir = {"figures": kind_figures(STEPDIR_KINDS, modes, updates, values), "image_report": sd_lines,
-                   "microsteps": args.microsteps, "max_mean": args.stepdir_max_mean, "enforced": budgets["stepdir"]}
+            args.image,
+            args.work,
+            plugin,
+            {"step": step, "after": call_addresses(args.image, "after_step", "main")},
+            "stepdir",
+            ["--duration", args.duration, "--stepdir", args.microsteps],
+        )
+        stepdir = {
+            "figures": kind_figures(STEPDIR_KINDS, modes, updates, values),
+            "image_report": sd_lines,
+            "microsteps": args.microsteps,
+            "max_mean": args.stepdir_max_mean,
+            "enforced": budgets["stepdir"],
+        }
         if figures is not None:
             print()
-        print("Control period following a STEP/DIR step count (%d microsteps per full step) on a Cortex-M4F: "
-              "pmstep_step, then after_step (the count, pmstep_position_update, pmstep_stepdir_diag)" % args.microsteps)
+        print(
+            "Control period following a STEP/DIR step count (%d microsteps per full step) on a Cortex-M4F: "
+            "pmstep_step, then after_step (the count, pmstep_position_update, pmstep_stepdir_diag)" % args.microsteps
+        )
         print(sd_lines)
         print()
-        print_table(stepdir["figures"], (("step", "pmstep_step min/mean/max"), ("after", "after_step"),
-                                         ("total", "sum (period)")))
+        print_table(
+            stepdir["figures"],
+            (("step", "pmstep_step min/mean/max"), ("after", "after_step"), ("total", "sum (period)")),
+        )
         verdicts.append(("STEP/DIR period", stepdir["figures"], args.stepdir_max_mean))
     if args.json:
-        Path(args.json).write_text(json.dumps(dict(figures or {}, **({"stepdir": stepdir} if stepdir else {})),
-                                              indent=1))
+        Path(args.json).write_text(
+            json.dumps(dict(figures or {}, **({"stepdir": stepdir} if stepdir else {})), indent=1)
+        )
     if args.report:  # written now, printed last
-        text = report_section(figures, report_lines, args.max_mean, budgets["position"], args.duration, sys.argv,
-                              stepdir)
+        text = report_section(
+            figures, report_lines, args.max_mean, budgets["position"], args.duration, sys.argv, stepdir
+        )
         wrote = "bench_position_target: wrote %s" % report.write_section(
-            args.report, bt.COST_TITLE, "position", text, bt.COST_WHAT, bt.COST_SECTIONS)
+            args.report, bt.COST_TITLE, "position", text, bt.COST_WHAT, bt.COST_SECTIONS
+        )
     ok = True
     for what, figs, max_mean in verdicts:
         if "p" not in figs:
@@ -251,8 +336,10 @@ def main():
             ok = False
             continue
         mean = figs["p"]["total"][1]
-        print("%s: mean %.1f instructions, budget %.0f: %s" % (what, mean, max_mean,
-                                                                "within" if mean <= max_mean else "OVER"))
+        print(
+            "%s: mean %.1f instructions, budget %.0f: %s"
+            % (what, mean, max_mean, "within" if mean <= max_mean else "OVER")
+        )
         ok = ok and mean <= max_mean
     if args.report:
         print(wrote)

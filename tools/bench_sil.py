@@ -13,6 +13,7 @@ Targets: >= 150x at the default, >= 60x with the switching inverter. Standard li
 --report FILE also writes the table as Markdown (command, commit, date, the machine and its load;
 tools/report.py).
 """
+
 import argparse
 import json
 import os
@@ -67,24 +68,34 @@ def report_text(rows, runs, machine, argv):
     """benchmarks.md: @p rows as main() measures them (label, target, rtf, rtf_cpu, per_period_ns,
     plant_ns, plant_share, firmware_ns, firmware_share, wall_s), @p runs per setting, @p machine
     (cpu, cores, load_before, load_after)."""
+
     def load(v):
         return "-" if v is None else f"{v:.2f}"
-    lines = [report.header("SIL benchmark", "tools/bench_sil.py", argv),
-             f"The paper scenario (2.4 s simulated at 20 kHz) without CSV output, median of {runs} runs per "
-             f"setting, on {machine['cpu'] or 'an unnamed processor'} ({machine['cores']} cores, shared: load average "
-             f"{load(machine['load_before'])} before the runs, {load(machine['load_after'])} after).", "",
-             "| setting | real-time factor | target | per CPU s | ns per period | plant | firmware | wall |",
-             "|---|---|---|---|---|---|---|---|"]
+
+    lines = [
+        report.header("SIL benchmark", "tools/bench_sil.py", argv),
+        f"The paper scenario (2.4 s simulated at 20 kHz) without CSV output, median of {runs} runs per "
+        f"setting, on {machine['cpu'] or 'an unnamed processor'} ({machine['cores']} cores, shared: load average "
+        f"{load(machine['load_before'])} before the runs, {load(machine['load_after'])} after).",
+        "",
+        "| setting | real-time factor | target | per CPU s | ns per period | plant | firmware | wall |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
     for r in rows:
         target = f"≥ {r['target']:.0f}x" + ("" if r["rtf"] >= r["target"] else " (**below**)") if r["target"] else "-"
-        lines.append(f"| {r['label']} | {r['rtf']:.1f}x | {target} | {r['rtf_cpu']:.1f}x | {r['per_period_ns']:.0f} | "
-                     f"{r['plant_ns']:.0f} ns ({100 * r['plant_share']:.0f} %) | "
-                     f"{r['firmware_ns']:.0f} ns ({100 * r['firmware_share']:.0f} %) | {r['wall_s']:.3f} s |")
-    lines += ["", "Real-time factor: simulated s per wall s of the run's loop (the target's measure); per CPU s: per "
-              "CPU second of the process over the same loop, which leaves out waiting for a core on a shared machine. "
-              "Plant: the inverter model and the integration of (1); firmware: the HAL read, `pmstep_step` and the "
-              "HAL apply (shares of the wall, every 16th period timed and scaled); the rest is the runner: "
-              "set-points, sample, metrics."]
+        lines.append(
+            f"| {r['label']} | {r['rtf']:.1f}x | {target} | {r['rtf_cpu']:.1f}x | {r['per_period_ns']:.0f} | "
+            f"{r['plant_ns']:.0f} ns ({100 * r['plant_share']:.0f} %) | "
+            f"{r['firmware_ns']:.0f} ns ({100 * r['firmware_share']:.0f} %) | {r['wall_s']:.3f} s |"
+        )
+    lines += [
+        "",
+        "Real-time factor: simulated s per wall s of the run's loop (the target's measure); per CPU s: per "
+        "CPU second of the process over the same loop, which leaves out waiting for a core on a shared machine. "
+        "Plant: the inverter model and the integration of (1); firmware: the HAL read, `pmstep_step` and the "
+        "HAL apply (shares of the wall, every 16th period timed and scaled); the rest is the runner: "
+        "set-points, sample, metrics.",
+    ]
     return "\n".join(lines) + "\n"
 
 
@@ -92,19 +103,24 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=7, help="runs per setting (median is reported)")
     parser.add_argument("--sil", default=str(ROOT / "build/host-release/sil/pmstep-sil"))
-    parser.add_argument("--report", metavar="FILE",
-                        help="also write the table as Markdown (docs/reports/benchmarks.md)")
+    parser.add_argument(
+        "--report", metavar="FILE", help="also write the table as Markdown (docs/reports/benchmarks.md)"
+    )
     args = parser.parse_args()
     sil = pathlib.Path(args.sil)
     if not sil.exists():
-        sys.exit(f"bench_sil: {sil} not found; build it with: cmake --preset host-release && "
-                 "cmake --build --preset host-release")
+        sys.exit(
+            f"bench_sil: {sil} not found; build it with: cmake --preset host-release && "
+            "cmake --build --preset host-release"
+        )
     if args.runs < 1:
         sys.exit("bench_sil: --runs must be >= 1")
 
     print(f"paper scenario, 2.4 s simulated at 20 kHz; median of {args.runs} runs")
-    print(f"{'setting':<38} {'real-time':>10} {'target':>7} {'(CPU)':>8} {'ns/period':>10} {'plant':>14}"
-          f" {'firmware':>14} {'wall':>8}")
+    print(
+        f"{'setting':<38} {'real-time':>10} {'target':>7} {'(CPU)':>8} {'ns/period':>10} {'plant':>14}"
+        f" {'firmware':>14} {'wall':>8}"
+    )
     failed = []
     rows = []
     machine = {"cpu": cpu_model(), "cores": os.cpu_count(), "load_before": load_average()}
@@ -120,19 +136,34 @@ def main():
             firmware = statistics.median(t["firmware_wall_s"] for t in timing)
             per_period = wall / steps * 1e9
             target_text = f"{target:6.0f}x" if target else "      -"
-            print(f"{label:<38} {rtf:9.1f}x {target_text} {rtf_cpu:7.1f}x {per_period:10.0f}"
-                  f" {plant / steps * 1e9:5.0f} ns {100 * plant / wall:3.0f}%"
-                  f" {firmware / steps * 1e9:5.0f} ns {100 * firmware / wall:3.0f}% {wall:7.3f}s")
+            print(
+                f"{label:<38} {rtf:9.1f}x {target_text} {rtf_cpu:7.1f}x {per_period:10.0f}"
+                f" {plant / steps * 1e9:5.0f} ns {100 * plant / wall:3.0f}%"
+                f" {firmware / steps * 1e9:5.0f} ns {100 * firmware / wall:3.0f}% {wall:7.3f}s"
+            )
             if target and rtf < target:
                 failed.append(f"{label}: {rtf:.1f}x < {target:.0f}x")
-            rows.append({"label": label, "target": target, "rtf": rtf, "rtf_cpu": rtf_cpu, "per_period_ns": per_period,
-                         "plant_ns": plant / steps * 1e9, "plant_share": plant / wall,
-                         "firmware_ns": firmware / steps * 1e9, "firmware_share": firmware / wall, "wall_s": wall})
+            rows.append(
+                {
+                    "label": label,
+                    "target": target,
+                    "rtf": rtf,
+                    "rtf_cpu": rtf_cpu,
+                    "per_period_ns": per_period,
+                    "plant_ns": plant / steps * 1e9,
+                    "plant_share": plant / wall,
+                    "firmware_ns": firmware / steps * 1e9,
+                    "firmware_share": firmware / wall,
+                    "wall_s": wall,
+                }
+            )
     machine["load_after"] = load_average()
-    print("(real-time: simulated s per wall s of the run's loop, the target's measure; CPU: per CPU s of the process"
-          " over the same loop, which leaves out waiting for a core on a shared machine. plant: the inverter model and"
-          " the integration of (1); firmware: the HAL read, pmstep_step and the HAL apply; the rest is the runner:"
-          " set-points, sample, metrics)")
+    print(
+        "(real-time: simulated s per wall s of the run's loop, the target's measure; CPU: per CPU s of the process"
+        " over the same loop, which leaves out waiting for a core on a shared machine. plant: the inverter model and"
+        " the integration of (1); firmware: the HAL read, pmstep_step and the HAL apply; the rest is the runner:"
+        " set-points, sample, metrics)"
+    )
     if failed:
         print("below target: " + "; ".join(failed))
     if args.report:

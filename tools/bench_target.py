@@ -41,6 +41,7 @@ tools/bench_position_target.py --report writes the section "position" of the sam
 usage: tools/bench_target.py [--no-build] [--branch-penalty P] [--no-pipelining] [--json FILE]
                              [--report docs/reports/cost.md]
 """
+
 import argparse
 import collections
 import json
@@ -65,19 +66,21 @@ PLUGIN_SRC = ROOT / "hal" / "qemu_mps2" / "tools" / "pil_insn_plugin.c"
 MODES = ["IDLE", "S_ALIGN", "C_ALIGN", "RUN", "FAULT", "OFFSET_CAL"]  # pmstep_mode_t
 CPU_HZ = 170e6
 CONTROL_HZ = 20e3
-IN_WORDS = 6    # SIL_RECORD_IN_WORDS
+IN_WORDS = 6  # SIL_RECORD_IN_WORDS
 OUT_WORDS = 19  # SIL_RECORD_OUT_WORDS
-OUT_MODE = 4    # SIL_RECORD_OUT_MODE
+OUT_MODE = 4  # SIL_RECORD_OUT_MODE
 IMAGE = ROOT / "build" / "stm32g431" / "hal" / "stm32g4" / "pmstep-stm32g431.elf"
 PIL_CMAKE = ROOT / "tests" / "pil" / "CMakeLists.txt"
 IMAGE_CHECK = ROOT / "hal" / "stm32g4" / "check_image.cmake"
 # The cost page (docs/reports/cost.md): this tool's section, then bench_position_target.py's.
 COST_TITLE = "Cost on the target (Cortex-M4F)"
 COST_SECTIONS = ("step", "position")
-COST_WHAT = ("What the control step costs on a Cortex-M4F (QEMU's mps2-an386, the images' flags: `-Os` with "
-             "link-time optimisation) and what the core and the STM32G431 image take, each figure beside the "
-             "budget ctest enforces (`pil.cost`, `pil.position_cost`, `pil.stepdir_cost` in "
-             "tests/pil/CMakeLists.txt; the image's fit in hal/stm32g4/check_image.cmake).")
+COST_WHAT = (
+    "What the control step costs on a Cortex-M4F (QEMU's mps2-an386, the images' flags: `-Os` with "
+    "link-time optimisation) and what the core and the STM32G431 image take, each figure beside the "
+    "budget ctest enforces (`pil.cost`, `pil.position_cost`, `pil.stepdir_cost` in "
+    "tests/pil/CMakeLists.txt; the image's fit in hal/stm32g4/check_image.cmake)."
+)
 
 
 def run(cmd, **kw):
@@ -93,9 +96,27 @@ def build():
 
 def qemu(image, args, extra=()):
     semi = "enable=on,target=native," + ",".join("arg=" + str(a) for a in [image.name, *args])
-    return run(["qemu-system-arm", "-M", "mps2-an386", "-cpu", "cortex-m4", "-nographic", "-monitor", "none",
-                "-serial", "none", *extra, "-semihosting-config", semi, "-kernel", image],
-               stdout=subprocess.PIPE, text=True)
+    return run(
+        [
+            "qemu-system-arm",
+            "-M",
+            "mps2-an386",
+            "-cpu",
+            "cortex-m4",
+            "-nographic",
+            "-monitor",
+            "none",
+            "-serial",
+            "none",
+            *extra,
+            "-semihosting-config",
+            semi,
+            "-kernel",
+            image,
+        ],
+        stdout=subprocess.PIPE,
+        text=True,
+    )
 
 
 def step_addresses(elf):
@@ -117,15 +138,14 @@ def record_outputs(path):
     # header: magic, version, config words, input words, output words, config, i_d* (sil/include/sil/record.h)
     config_words, in_words, out_words = w[2], w[3], w[4]
     if (in_words, out_words) != (IN_WORDS, OUT_WORDS):
-        sys.exit("bench_target: record layout %d/%d words, expected %d/%d" % (in_words, out_words, IN_WORDS,
-                                                                               OUT_WORDS))
+        sys.exit("bench_target: record layout %d/%d words, expected %d/%d" % (in_words, out_words, IN_WORDS, OUT_WORDS))
     i, outs = 5 + config_words + 1, []
     while True:
         tag = w[i]
         if tag == 1:
             i += 3
         elif tag == 2:
-            outs.append(w[i + 1 + IN_WORDS:i + 1 + IN_WORDS + OUT_WORDS])
+            outs.append(w[i + 1 + IN_WORDS : i + 1 + IN_WORDS + OUT_WORDS])
             i += 1 + IN_WORDS + OUT_WORDS
         elif tag == 3:
             return outs
@@ -136,7 +156,7 @@ def record_outputs(path):
 def target_outputs(path):
     w = struct.unpack("<%dI" % (os.path.getsize(path) // 4), Path(path).read_bytes())
     n = (len(w) - 5) // OUT_WORDS
-    return [w[3 + OUT_WORDS * k:3 + OUT_WORDS * (k + 1)] for k in range(n)]
+    return [w[3 + OUT_WORDS * k : 3 + OUT_WORDS * (k + 1)] for k in range(n)]
 
 
 def mode_ranges(modes):
@@ -150,10 +170,49 @@ def mode_ranges(modes):
 
 # ---- cycle model (Cortex-M4 TRM, ARM DDI 0439B) ----
 CONDS = {"eq", "ne", "cs", "cc", "hs", "lo", "mi", "pl", "vs", "vc", "hi", "ls", "ge", "lt", "gt", "le", "al"}
-BASES = ["ldrsb", "ldrsh", "ldrb", "ldrh", "ldrd", "ldr", "strb", "strh", "strd", "str", "ldmia", "ldmdb", "ldm",
-         "stmia", "stmdb", "stm", "push", "pop", "vldr", "vstr", "vldmia", "vldmdb", "vstmia", "vstmdb", "vpush",
-         "vpop", "vdiv", "vsqrt", "vmla", "vmls", "vnmla", "vnmls", "vfma", "vfms", "vfnma", "vfnms", "vmov",
-         "sdiv", "udiv", "mla", "mls"]
+BASES = [
+    "ldrsb",
+    "ldrsh",
+    "ldrb",
+    "ldrh",
+    "ldrd",
+    "ldr",
+    "strb",
+    "strh",
+    "strd",
+    "str",
+    "ldmia",
+    "ldmdb",
+    "ldm",
+    "stmia",
+    "stmdb",
+    "stm",
+    "push",
+    "pop",
+    "vldr",
+    "vstr",
+    "vldmia",
+    "vldmdb",
+    "vstmia",
+    "vstmdb",
+    "vpush",
+    "vpop",
+    "vdiv",
+    "vsqrt",
+    "vmla",
+    "vmls",
+    "vnmla",
+    "vnmls",
+    "vfma",
+    "vfms",
+    "vfnma",
+    "vfnms",
+    "vmov",
+    "sdiv",
+    "udiv",
+    "mla",
+    "mls",
+]
 
 
 def register_count(ops):
@@ -231,8 +290,7 @@ def model_cycles(profile_path, insns, penalty, pipelining):
         pc, count, jumps = int(pc, 16), int(count), int(jumps)
         mnemonic, ops = insns.get(pc, ("?", ""))
         c = base_cycles(mnemonic, ops)
-        if pipelining and single_load_store(mnemonic) and pc in previous \
-                and single_load_store(insns[previous[pc]][0]):
+        if pipelining and single_load_store(mnemonic) and pc in previous and single_load_store(insns[previous[pc]][0]):
             c = 1
         cycles += count * c
         taken += jumps
@@ -332,85 +390,126 @@ def report_section(r, budget, argv):
     """The section "step" of the cost page from the figures @p r main() measured (the keys of its
     --json, plus stack_measured_bytes, static_path, static_unknown, run_mix, image) and @p budget
     (budgets())."""
-    lines = [report.section_header("Control step: `pmstep_step()` on the paper scenario", "tools/bench_target.py",
-                                   argv),
-             f"{r['qemu']}, arm-none-eabi-gcc {r['gcc']}, `-Os` with link-time optimisation; all {r['periods']} "
-             f"periods of the paper scenario recorded by the host SIL and replayed through the real `pmstep_step()` "
-             f"from the port's control interrupt; outputs "
-             f"{'**bit-identical** to' if r['bit_identical'] else '**DIFFERENT** from'} the host's.", "",
-             "Instructions per step: exact counts of a QEMU plugin (every instruction from the step's entry to its "
-             "return, callees included) and the SysTick estimate under `-icount shift=0` (what `pil.cost` checks). "
-             "Time and CPU load at 170 MHz and 20 kHz, at 1 cycle per instruction and in the Cortex-M4 timing model "
-             f"(ARM DDI 0439B cycle counts, {r['branch_penalty']} cycles per taken branch"
-             f"{', neighbouring loads and stores pipelined' if r['load_store_pipelining'] else ''}, no wait states).",
-             ""]
+    lines = [
+        report.section_header("Control step: `pmstep_step()` on the paper scenario", "tools/bench_target.py", argv),
+        f"{r['qemu']}, arm-none-eabi-gcc {r['gcc']}, `-Os` with link-time optimisation; all {r['periods']} "
+        f"periods of the paper scenario recorded by the host SIL and replayed through the real `pmstep_step()` "
+        f"from the port's control interrupt; outputs "
+        f"{'**bit-identical** to' if r['bit_identical'] else '**DIFFERENT** from'} the host's.",
+        "",
+        "Instructions per step: exact counts of a QEMU plugin (every instruction from the step's entry to its "
+        "return, callees included) and the SysTick estimate under `-icount shift=0` (what `pil.cost` checks). "
+        "Time and CPU load at 170 MHz and 20 kHz, at 1 cycle per instruction and in the Cortex-M4 timing model "
+        f"(ARM DDI 0439B cycle counts, {r['branch_penalty']} cycles per taken branch"
+        f"{', neighbouring loads and stores pipelined' if r['load_store_pipelining'] else ''}, no wait states).",
+        "",
+    ]
     modes = [m for m in ("S_ALIGN", "C_ALIGN", "RUN") if m in r["modes"]]
     lines += ["| | " + " | ".join(modes) + " |", "|---|" + "---|" * len(modes)]
 
     def row(label, cell):
         lines.append(f"| {label} | " + " | ".join(cell(r["modes"][m], m) for m in modes) + " |")
+
     row("steps", lambda f, m: str(f["steps"]))
-    row("instructions, exact: min / mean / max",
-        lambda f, m: f"{f['instructions_min']} / {f['instructions_mean']:.1f} / {f['instructions_max']}")
-    row("instructions, SysTick mean" + (f" (budget of RUN: {budget['run']})" if budget["run"] is not None else ""),
-        lambda f, m: f"{f['systick_instructions_mean']:.1f}"
-        + (f" ({verdict(f['systick_instructions_mean'], budget['run'])})" if m == "RUN" else ""))
-    row("1 cycle/instruction: mean time, CPU at 20 kHz (worst step)",
-        lambda f, m: f"{f['instructions_mean'] / CPU_HZ * 1e6:.2f} µs, "
-                     f"{f['instructions_mean'] / CPU_HZ * CONTROL_HZ * 100:.1f} % "
-                     f"({f['instructions_max'] / CPU_HZ * 1e6:.2f} µs, "
-                     f"{f['instructions_max'] / CPU_HZ * CONTROL_HZ * 100:.1f} %)")
-    row("Cortex-M4 timing model: mean cycles, time, CPU at 20 kHz",
-        lambda f, m: f"{f['cycles_model_mean']:.0f}, {f['cycles_model_mean'] / CPU_HZ * 1e6:.2f} µs, "
-                     f"{f['cycles_model_mean'] / CPU_HZ * CONTROL_HZ * 100:.1f} %")
-    row("stack measured in the LTO image" + (f" (budget {budget['stack']} B)" if budget["stack"] is not None else ""),
-        lambda f, m: f"{f['stack_bytes_measured']} B ({verdict(f['stack_bytes_measured'], budget['stack'])})")
+    row(
+        "instructions, exact: min / mean / max",
+        lambda f, m: f"{f['instructions_min']} / {f['instructions_mean']:.1f} / {f['instructions_max']}",
+    )
+    row(
+        "instructions, SysTick mean" + (f" (budget of RUN: {budget['run']})" if budget["run"] is not None else ""),
+        lambda f, m: (
+            f"{f['systick_instructions_mean']:.1f}"
+            + (f" ({verdict(f['systick_instructions_mean'], budget['run'])})" if m == "RUN" else "")
+        ),
+    )
+    row(
+        "1 cycle/instruction: mean time, CPU at 20 kHz (worst step)",
+        lambda f, m: (
+            f"{f['instructions_mean'] / CPU_HZ * 1e6:.2f} µs, "
+            f"{f['instructions_mean'] / CPU_HZ * CONTROL_HZ * 100:.1f} % "
+            f"({f['instructions_max'] / CPU_HZ * 1e6:.2f} µs, "
+            f"{f['instructions_max'] / CPU_HZ * CONTROL_HZ * 100:.1f} %)"
+        ),
+    )
+    row(
+        "Cortex-M4 timing model: mean cycles, time, CPU at 20 kHz",
+        lambda f, m: (
+            f"{f['cycles_model_mean']:.0f}, {f['cycles_model_mean'] / CPU_HZ * 1e6:.2f} µs, "
+            f"{f['cycles_model_mean'] / CPU_HZ * CONTROL_HZ * 100:.1f} %"
+        ),
+    )
+    row(
+        "stack measured in the LTO image" + (f" (budget {budget['stack']} B)" if budget["stack"] is not None else ""),
+        lambda f, m: f"{f['stack_bytes_measured']} B ({verdict(f['stack_bytes_measured'], budget['stack'])})",
+    )
     if r.get("run_mix"):
         lines += ["", "RUN's instruction mix, per step: " + ", ".join(f"{k} {n:.1f}" for k, n in r["run_mix"]) + "."]
-    lines += ["", "| footprint | measured | budget | |", "|---|---|---|---|",
-              f"| core flash, text + rodata (`libpmstep_core.a`, `-Os`, arm-none-eabi-size --totals) | "
-              f"{r['core_flash_bytes']} B | {budget_cell(budget['flash'])} | "
-              f"{verdict(r['core_flash_bytes'], budget['flash'])} |",
-              f"| instance `sizeof(pmstep_t)` | {r['instance_bytes']} B | "
-              f"{budget_cell(budget['instance'])} | "
-              f"{verdict(r['instance_bytes'], budget['instance'])} |",
-              f"| configuration `sizeof(pmstep_config_t)` (const, may live in flash) | {r['config_bytes']} B | - | - |",
-              f"| stack of `pmstep_step()`, measured in the LTO image (deepest mode) | {r['stack_measured_bytes']} B | "
-              f"{budget_cell(budget['stack'])} | "
-              f"{verdict(r['stack_measured_bytes'], budget['stack'])} |",
-              f"| stack of `pmstep_step()`, static bound (`-fstack-usage` + call graph, non-LTO library) | "
-              f"{r['stack_static_bytes']} B | not checked | - |"]
+    lines += [
+        "",
+        "| footprint | measured | budget | |",
+        "|---|---|---|---|",
+        f"| core flash, text + rodata (`libpmstep_core.a`, `-Os`, arm-none-eabi-size --totals) | "
+        f"{r['core_flash_bytes']} B | {budget_cell(budget['flash'])} | "
+        f"{verdict(r['core_flash_bytes'], budget['flash'])} |",
+        f"| instance `sizeof(pmstep_t)` | {r['instance_bytes']} B | "
+        f"{budget_cell(budget['instance'])} | "
+        f"{verdict(r['instance_bytes'], budget['instance'])} |",
+        f"| configuration `sizeof(pmstep_config_t)` (const, may live in flash) | {r['config_bytes']} B | - | - |",
+        f"| stack of `pmstep_step()`, measured in the LTO image (deepest mode) | {r['stack_measured_bytes']} B | "
+        f"{budget_cell(budget['stack'])} | "
+        f"{verdict(r['stack_measured_bytes'], budget['stack'])} |",
+        f"| stack of `pmstep_step()`, static bound (`-fstack-usage` + call graph, non-LTO library) | "
+        f"{r['stack_static_bytes']} B | not checked | - |",
+    ]
     image = r.get("image")
     if image:
         text, data, bss = image
-        lines += [f"| STM32G431 image flash, text + data (build/stm32g431, arm-none-eabi-size) | {text + data} B | "
-                  f"{budget_cell(budget['image_flash'])} | "
-                  f"{verdict(text + data, budget['image_flash'])} |",
-                  f"| STM32G431 image RAM, data + bss (the 2 KiB stack reserve apart) | {data + bss} B | "
-                  f"{budget_cell(budget['image_ram'])} | "
-                  f"{verdict(data + bss, budget['image_ram'])} |"]
+        lines += [
+            f"| STM32G431 image flash, text + data (build/stm32g431, arm-none-eabi-size) | {text + data} B | "
+            f"{budget_cell(budget['image_flash'])} | "
+            f"{verdict(text + data, budget['image_flash'])} |",
+            f"| STM32G431 image RAM, data + bss (the 2 KiB stack reserve apart) | {data + bss} B | "
+            f"{budget_cell(budget['image_ram'])} | "
+            f"{verdict(data + bss, budget['image_ram'])} |",
+        ]
     else:
-        lines.append("| STM32G431 image | not built (`cmake --preset stm32g431 && cmake --build --preset "
-                     "stm32g431`) | | |")
-    lines += ["", f"Static bound's deepest path: {' → '.join(r['static_path'])}"
-              + (f"; not counted: {', '.join(r['static_unknown'])} (newlib leaf routines)" if r["static_unknown"]
-                 else "") + "."]
+        lines.append(
+            "| STM32G431 image | not built (`cmake --preset stm32g431 && cmake --build --preset stm32g431`) | | |"
+        )
+    lines += [
+        "",
+        f"Static bound's deepest path: {' → '.join(r['static_path'])}"
+        + (f"; not counted: {', '.join(r['static_unknown'])} (newlib leaf routines)" if r["static_unknown"] else "")
+        + ".",
+    ]
     return "\n".join(lines) + "\n"
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--no-build", action="store_true", help="use the existing build/qemu-pil, host-release, arm-m4f, stm32g431")
+    ap.add_argument(
+        "--no-build", action="store_true", help="use the existing build/qemu-pil, host-release, arm-m4f, stm32g431"
+    )
     ap.add_argument("--branch-penalty", type=int, default=2, help="pipeline refill cycles per taken branch (1..3)")
-    ap.add_argument("--no-pipelining", action="store_true",
-                    help="charge every single load/store 2 cycles (no credit for neighbouring ones)")
+    ap.add_argument(
+        "--no-pipelining",
+        action="store_true",
+        help="charge every single load/store 2 cycles (no credit for neighbouring ones)",
+    )
     ap.add_argument("--json", help="also write the figures to this JSON file")
-    ap.add_argument("--report", metavar="FILE",
-                    help="also write the figures as Markdown into the section \"step\" of this page "
-                         "(docs/reports/cost.md)")
-    ap.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
-                    help="override a key of the paper scenario for the recorded run (pmstep-sil --set), e.g. "
-                         "controller.commissioning.identification_time_s=1.8 to count RUN with identification")
+    ap.add_argument(
+        "--report",
+        metavar="FILE",
+        help='also write the figures as Markdown into the section "step" of this page (docs/reports/cost.md)',
+    )
+    ap.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="SECTION.KEY=VALUE",
+        help="override a key of the paper scenario for the recorded run (pmstep-sil --set), e.g. "
+        "controller.commissioning.identification_time_s=1.8 to count RUN with identification",
+    )
     args = ap.parse_args()
     for tool in ("qemu-system-arm", "arm-none-eabi-gcc", "cc"):
         if shutil.which(tool) is None:
@@ -431,9 +530,10 @@ def main():
     cost_path = BENCH / "cost.txt"
     qemu(REPLAY, [rec, out_icount, cost_path], ["-icount", "shift=0"])
     cost = cost_path.read_text()
-    systick = {m.group(1): (float(m.group(2)), int(m.group(3)))
-               for m in re.finditer(r"^mode (\S+) steps \d+ .* instructions_mean ([0-9.]+) stack_max_bytes (\d+)",
-                                    cost, re.M)}
+    systick = {
+        m.group(1): (float(m.group(2)), int(m.group(3)))
+        for m in re.finditer(r"^mode (\S+) steps \d+ .* instructions_mean ([0-9.]+) stack_max_bytes (\d+)", cost, re.M)
+    }
     instance = int(re.search(r"^sizeof_pmstep_t (\d+)", cost, re.M).group(1))
     config_size = int(re.search(r"^sizeof_pmstep_config_t (\d+)", cost, re.M).group(1))
 
@@ -457,74 +557,144 @@ def main():
     cycles = {}
     for m, (first, last) in sorted(mode_ranges(modes).items(), key=lambda kv: kv[1]):
         prof = BENCH / ("profile-%s.txt" % m)
-        qemu(REPLAY, [rec, BENCH / "target-profile.out"],
-             ["-plugin", "%s,entry=0x%x,ret=0x%x,out=%s,profile=%s,profile_from=%d,profile_to=%d"
-              % (plugin, entry, ret, BENCH / "steps-profile.txt", prof, first, last)])
+        qemu(
+            REPLAY,
+            [rec, BENCH / "target-profile.out"],
+            [
+                "-plugin",
+                "%s,entry=0x%x,ret=0x%x,out=%s,profile=%s,profile_from=%d,profile_to=%d"
+                % (plugin, entry, ret, BENCH / "steps-profile.txt", prof, first, last),
+            ],
+        )
         total, taken, mix = model_cycles(prof, insns, args.branch_penalty, not args.no_pipelining)
         cycles[m] = (total / (last - first), taken / (last - first), mix)
 
-    size = run(["arm-none-eabi-size", "--totals", PIL / "firmware" / "libpmstep_core.a"],
-               stdout=subprocess.PIPE, text=True).stdout
+    size = run(
+        ["arm-none-eabi-size", "--totals", PIL / "firmware" / "libpmstep_core.a"], stdout=subprocess.PIPE, text=True
+    ).stdout
     flash = int(re.search(r"^\s*(\d+)\s+(\d+)\s+(\d+)\s+\d+\s+[0-9a-f]+\s+\(TOTALS\)", size, re.M).group(1))
-    image_size = run(["arm-none-eabi-size", IMAGE], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True,
-                     check=False).stdout
+    image_size = run(
+        ["arm-none-eabi-size", IMAGE], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, check=False
+    ).stdout
     static_total, static_path, static_unknown = static_stack()
     gcc = run(["arm-none-eabi-gcc", "-dumpversion"], stdout=subprocess.PIPE, text=True).stdout.strip()
     qemu_version = run(["qemu-system-arm", "--version"], stdout=subprocess.PIPE, text=True).stdout.splitlines()[0]
 
     print("Control step on a Cortex-M4F: QEMU mps2-an386 (%s), arm-none-eabi-gcc %s, -Os + LTO" % (qemu_version, gcc))
-    print("paper scenario, %d periods replayed; outputs %s the host's" %
-          (len(counts), "bit-identical to" if identical else "DIFFERENT from"))
+    print(
+        "paper scenario, %d periods replayed; outputs %s the host's"
+        % (len(counts), "bit-identical to" if identical else "DIFFERENT from")
+    )
     print()
-    print("%-8s %6s  %5s %7s %5s  %8s  %8s %7s %6s  %8s %7s %6s" % (
-        "mode", "steps", "min", "mean", "max", "SysTick", "cyc 1/i", "us", "CPU%", "cyc M4", "us", "CPU%"))
-    print("%-8s %6s  %19s  %8s  %22s  %22s" % ("", "", "instructions (exact)", "estimate", "@170 MHz, 20 kHz",
-                                              "TRM timings, P=%d%s" % (args.branch_penalty,
-                                                                      "" if args.no_pipelining else ", pipel.")))
+    print(
+        "%-8s %6s  %5s %7s %5s  %8s  %8s %7s %6s  %8s %7s %6s"
+        % ("mode", "steps", "min", "mean", "max", "SysTick", "cyc 1/i", "us", "CPU%", "cyc M4", "us", "CPU%")
+    )
+    print(
+        "%-8s %6s  %19s  %8s  %22s  %22s"
+        % (
+            "",
+            "",
+            "instructions (exact)",
+            "estimate",
+            "@170 MHz, 20 kHz",
+            "TRM timings, P=%d%s" % (args.branch_penalty, "" if args.no_pipelining else ", pipel."),
+        )
+    )
     figures = {}
     for m in ("S_ALIGN", "C_ALIGN", "RUN"):
         v = per_mode[m]
         mean = sum(v) / len(v)
         c = cycles[m][0]
         us1, usm = mean / CPU_HZ * 1e6, c / CPU_HZ * 1e6
-        print("%-8s %6d  %5d %7.1f %5d  %8.1f  %8.0f %7.2f %6.1f  %8.0f %7.2f %6.1f" % (
-            m, len(v), min(v), mean, max(v), systick[m][0], mean, us1, us1 * CONTROL_HZ / 1e4,
-            c, usm, usm * CONTROL_HZ / 1e4))
-        figures[m] = {"steps": len(v), "instructions_min": min(v), "instructions_mean": mean,
-                      "instructions_max": max(v), "systick_instructions_mean": systick[m][0],
-                      "cycles_model_mean": c, "taken_branches_mean": cycles[m][1],
-                      "stack_bytes_measured": systick[m][1]}
+        print(
+            "%-8s %6d  %5d %7.1f %5d  %8.1f  %8.0f %7.2f %6.1f  %8.0f %7.2f %6.1f"
+            % (
+                m,
+                len(v),
+                min(v),
+                mean,
+                max(v),
+                systick[m][0],
+                mean,
+                us1,
+                us1 * CONTROL_HZ / 1e4,
+                c,
+                usm,
+                usm * CONTROL_HZ / 1e4,
+            )
+        )
+        figures[m] = {
+            "steps": len(v),
+            "instructions_min": min(v),
+            "instructions_mean": mean,
+            "instructions_max": max(v),
+            "systick_instructions_mean": systick[m][0],
+            "cycles_model_mean": c,
+            "taken_branches_mean": cycles[m][1],
+            "stack_bytes_measured": systick[m][1],
+        }
     run_max = max(per_mode["RUN"])
     print()
-    print("worst RUN step: %d instructions = %.2f us at 1 cycle/instruction, %.1f %% of a 50 us period" % (
-        run_max, run_max / CPU_HZ * 1e6, run_max / CPU_HZ * CONTROL_HZ * 100))
+    print(
+        "worst RUN step: %d instructions = %.2f us at 1 cycle/instruction, %.1f %% of a 50 us period"
+        % (run_max, run_max / CPU_HZ * 1e6, run_max / CPU_HZ * CONTROL_HZ * 100)
+    )
     top = cycles["RUN"][2].most_common(8)
     print("RUN instruction mix (per step): " + ", ".join("%s %.1f" % (k, n / len(per_mode["RUN"])) for k, n in top))
     print()
     print("footprint")
     print("  core flash (text + rodata, libpmstep_core.a, -Os): %d B" % flash)
-    print("  instance sizeof(pmstep_t): %d B; configuration sizeof(pmstep_config_t): %d B (const, may live in flash)"
-          % (instance, config_size))
-    print("  stack of pmstep_step(), measured in the LTO image: %d B (deepest of all modes)" %
-          max(s for _, s in systick.values()))
-    print("  stack of pmstep_step(), static bound (-fstack-usage, non-LTO library): %d B via %s%s" % (
-        static_total, " -> ".join(static_path),
-        ("; not counted: " + ", ".join(static_unknown) + " (newlib leaf routines)") if static_unknown else ""))
+    print(
+        "  instance sizeof(pmstep_t): %d B; configuration sizeof(pmstep_config_t): %d B (const, may live in flash)"
+        % (instance, config_size)
+    )
+    print(
+        "  stack of pmstep_step(), measured in the LTO image: %d B (deepest of all modes)"
+        % max(s for _, s in systick.values())
+    )
+    print(
+        "  stack of pmstep_step(), static bound (-fstack-usage, non-LTO library): %d B via %s%s"
+        % (
+            static_total,
+            " -> ".join(static_path),
+            ("; not counted: " + ", ".join(static_unknown) + " (newlib leaf routines)") if static_unknown else "",
+        )
+    )
     if image_size:
         print("  STM32G431 image (build/stm32g431):")
         print("    " + "\n    ".join(image_size.strip().splitlines()))
-    result = {"qemu": qemu_version, "gcc": gcc, "bit_identical": identical, "periods": len(counts),
-              "modes": figures, "core_flash_bytes": flash, "instance_bytes": instance,
-              "config_bytes": config_size, "stack_static_bytes": static_total,
-              "branch_penalty": args.branch_penalty, "load_store_pipelining": not args.no_pipelining}
+    result = {
+        "qemu": qemu_version,
+        "gcc": gcc,
+        "bit_identical": identical,
+        "periods": len(counts),
+        "modes": figures,
+        "core_flash_bytes": flash,
+        "instance_bytes": instance,
+        "config_bytes": config_size,
+        "stack_static_bytes": static_total,
+        "branch_penalty": args.branch_penalty,
+        "load_store_pipelining": not args.no_pipelining,
+    }
     if args.json:
         Path(args.json).write_text(json.dumps(result, indent=2) + "\n")
     if args.report:
-        result.update({"stack_measured_bytes": max(s for _, s in systick.values()), "static_path": static_path,
-                       "static_unknown": static_unknown, "image": image_sizes(image_size),
-                       "run_mix": [(k, n / len(per_mode["RUN"])) for k, n in top]})
-        print("bench_target: wrote %s" % report.write_section(
-            args.report, COST_TITLE, "step", report_section(result, budgets(), sys.argv), COST_WHAT, COST_SECTIONS))
+        result.update(
+            {
+                "stack_measured_bytes": max(s for _, s in systick.values()),
+                "static_path": static_path,
+                "static_unknown": static_unknown,
+                "image": image_sizes(image_size),
+                "run_mix": [(k, n / len(per_mode["RUN"])) for k, n in top],
+            }
+        )
+        print(
+            "bench_target: wrote %s"
+            % report.write_section(
+                args.report, COST_TITLE, "step", report_section(result, budgets(), sys.argv), COST_WHAT, COST_SECTIONS
+            )
+        )
     return 0 if identical else 1
 
 

@@ -18,6 +18,7 @@ docs.render): a broken theme or an empty page fails.
 Runs under .venv's Python (matplotlib reads the PNGs; re-executes itself there). Exit status 77
 (ctest: skipped) without Chromium, without .venv, or without doxygen / mkdocs for a build.
 """
+
 import argparse
 import html
 import os
@@ -36,14 +37,25 @@ SITE = os.path.join(ROOT, "build", "site")
 VENV_PYTHON = os.path.join(ROOT, ".venv", "bin", "python")
 WIDTH, HEIGHT = 1280, 1600
 # (URL path in the site, source page under docs/, screenshot name)
-PAGES = [("", "index.md", "front"),
-         ("reference/configuration/", "reference/configuration.md", "reference-configuration")]
+PAGES = [
+    ("", "index.md", "front"),
+    ("reference/configuration/", "reference/configuration.md", "reference-configuration"),
+]
 # On a closed network every request to the outside must fail at once rather than wait: the
 # background services are off, and host names other than the loopback resolve to nothing (the
 # theme's web fonts then fall back to the system's at once).
-CHROMIUM_FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-                  "--disable-background-networking", "--disable-component-update", "--disable-sync",
-                  "--hide-scrollbars", "--host-resolver-rules=MAP * ~NOTFOUND, EXCLUDE 127.0.0.1"]
+CHROMIUM_FLAGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--hide-scrollbars",
+    "--host-resolver-rules=MAP * ~NOTFOUND, EXCLUDE 127.0.0.1",
+]
 CHROMIUM_TIMEOUT_S = 120.0
 # A page shows when its pixels spread (grey-level standard deviation) and a share of them differ
 # from the background; the theme shows when the top band is mostly one colour unlike it.
@@ -70,7 +82,9 @@ def ensure_venv():
         import matplotlib  # noqa: F401
         import yaml  # noqa: F401
     except ImportError:
-        if os.path.exists(VENV_PYTHON) and os.path.realpath(sys.prefix) != os.path.realpath(os.path.join(ROOT, ".venv")):
+        if os.path.exists(VENV_PYTHON) and os.path.realpath(sys.prefix) != os.path.realpath(
+            os.path.join(ROOT, ".venv")
+        ):
             os.execv(VENV_PYTHON, [VENV_PYTHON] + sys.argv)
         skip("no .venv with matplotlib and mkdocs: run tools/setup_venv.sh")
 
@@ -82,6 +96,7 @@ def expected_titles():
 
     class Loader(yaml.SafeLoader):
         pass
+
     Loader.add_multi_constructor("", lambda loader, suffix, node: None)  # !!python/name: and the like
     with open(os.path.join(ROOT, "mkdocs.yml"), encoding="utf-8") as f:
         config = yaml.load(f, Loader=Loader)
@@ -95,6 +110,7 @@ def expected_titles():
                         titles.setdefault(value, title)
                     else:
                         walk(value)
+
     walk(config.get("nav"))
     return titles
 
@@ -123,8 +139,12 @@ class Server:
 
     def __init__(self, log_path):
         self.log = open(log_path, "w")
-        self.proc = subprocess.Popen([sys.executable, "-u", "-m", "http.server", "0", "--bind", "127.0.0.1",
-                                      "--directory", SITE], stdout=subprocess.PIPE, stderr=self.log, text=True)
+        self.proc = subprocess.Popen(
+            [sys.executable, "-u", "-m", "http.server", "0", "--bind", "127.0.0.1", "--directory", SITE],
+            stdout=subprocess.PIPE,
+            stderr=self.log,
+            text=True,
+        )
         line = []
         reader = threading.Thread(target=lambda: line.append(self.proc.stdout.readline()), daemon=True)
         reader.start()
@@ -171,7 +191,7 @@ def check_html(server, path, source, title):
     h1 = re.search(r"<h1\b[^>]*>(.*?)</h1>", article, re.S)
     if heading is not None and (not h1 or plain(h1.group(1)) != heading):
         fail(f"/{path}: the article's h1 is {plain(h1.group(1)) if h1 else None!r}, not {heading!r} ({source})")
-    text = plain(article[h1.end():] if h1 else article)
+    text = plain(article[h1.end() :] if h1 else article)
     if len(text) < MIN_ARTICLE_CHARS:
         fail(f"/{path}: the article is empty ({text!r})")
     css = re.findall(r"<link rel=\"stylesheet\" href=\"([^\"]*assets/stylesheets/main\.[^\"]*\.css)\"", page)
@@ -186,8 +206,11 @@ def check_html(server, path, source, title):
 
 def screenshot(chromium, url, png, log_path):
     with tempfile.TemporaryDirectory(prefix="pmstep-chromium-") as profile, open(log_path, "w") as log:
-        command = [chromium] + CHROMIUM_FLAGS + [f"--user-data-dir={profile}", f"--screenshot={png}",
-                                                  f"--window-size={WIDTH},{HEIGHT}", url]
+        command = (
+            [chromium]
+            + CHROMIUM_FLAGS
+            + [f"--user-data-dir={profile}", f"--screenshot={png}", f"--window-size={WIDTH},{HEIGHT}", url]
+        )
         log.write(" ".join(command) + "\n")
         log.flush()
         proc = subprocess.Popen(command, stdin=subprocess.DEVNULL, stdout=log, stderr=log, start_new_session=True)
@@ -207,6 +230,7 @@ def check_png(png):
     """Checks one screenshot is not blank and shows the theme's bar; returns a line for the report."""
     import matplotlib.image
     import numpy as np
+
     image = matplotlib.image.imread(png)
     if image.dtype != np.float32 and image.dtype != np.float64:
         image = image / 255.0
@@ -231,25 +255,35 @@ def check_png(png):
     background, _ = mode_colour(rgb)
     share = float(unlike(rgb, background).mean())
     if grey_std < MIN_GREY_STD or share < MIN_SHARE_UNLIKE_BACKGROUND:
-        fail(f"{png} is blank: grey-level std {grey_std:.4f} (min {MIN_GREY_STD}), {100 * share:.2f} % of pixels "
-             f"unlike the background {hex_colour(background)} (min {100 * MIN_SHARE_UNLIKE_BACKGROUND:.0f} %)")
+        fail(
+            f"{png} is blank: grey-level std {grey_std:.4f} (min {MIN_GREY_STD}), {100 * share:.2f} % of pixels "
+            f"unlike the background {hex_colour(background)} (min {100 * MIN_SHARE_UNLIKE_BACKGROUND:.0f} %)"
+        )
     header, header_share = mode_colour(rgb[:HEADER_ROWS])
     if header_share < MIN_HEADER_SHARE or not unlike(header, background):
-        fail(f"{png}: no theme header bar: the top {HEADER_ROWS} rows are {100 * header_share:.0f} % "
-             f"{hex_colour(header)}, background {hex_colour(background)} (the theme's stylesheet did not apply?)")
-    return (f"std {grey_std:.3f}, {100 * share:.1f} % of pixels unlike the background {hex_colour(background)}, "
-            f"header bar {hex_colour(header)}")
+        fail(
+            f"{png}: no theme header bar: the top {HEADER_ROWS} rows are {100 * header_share:.0f} % "
+            f"{hex_colour(header)}, background {hex_colour(background)} (the theme's stylesheet did not apply?)"
+        )
+    return (
+        f"std {grey_std:.3f}, {100 * share:.1f} % of pixels unlike the background {hex_colour(background)}, "
+        f"header bar {hex_colour(header)}"
+    )
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--out", default=os.path.join(ROOT, "build", "docs-render"),
-                        help="folder for the screenshots and logs (build/docs-render)")
+    parser.add_argument(
+        "--out",
+        default=os.path.join(ROOT, "build", "docs-render"),
+        help="folder for the screenshots and logs (build/docs-render)",
+    )
     parser.add_argument("--build", action="store_true", help="build the site first even if it exists")
     args = parser.parse_args()
     ensure_venv()
-    chromium = next((shutil.which(name) for name in ("chromium", "chromium-browser", "google-chrome")
-                     if shutil.which(name)), None)
+    chromium = next(
+        (shutil.which(name) for name in ("chromium", "chromium-browser", "google-chrome") if shutil.which(name)), None
+    )
     if chromium is None:
         skip("no chromium: run tools/install_deps.sh")
 

@@ -11,6 +11,7 @@ is not allowed, 0 otherwise. Standard library only.
 the same files with another file joined fail, and an allowance whose cycle is gone fails too
 (remove it). What ctest static.file_cycles runs on the host build's libraries.
 """
+
 import argparse
 import os
 import re
@@ -126,8 +127,7 @@ def cycles(table):
     result = []
     for component in components(table.keys(), graph):
         members = set(component)
-        inner = {edge: symbols for edge, symbols in sorted(graph.items())
-                 if edge[0] in members and edge[1] in members}
+        inner = {edge: symbols for edge, symbols in sorted(graph.items()) if edge[0] in members and edge[1] in members}
         result.append((component, inner))
     return result
 
@@ -156,16 +156,20 @@ def check(libraries, allowed, out=sys.stdout):
         status = 1
         print(f"--allow {':'.join(sorted(key))}: no such cycle any more; remove the allowance", file=out)
     if status == 0:
-        print(f"no cycle between the source files of {len(libraries)} libraries"
-              + (f" ({len(seen)} allowed)" if seen else ""), file=out)
+        print(
+            f"no cycle between the source files of {len(libraries)} libraries"
+            + (f" ({len(seen)} allowed)" if seen else ""),
+            file=out,
+        )
     return status
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--nm", default="nm", help="the nm to run (CMake's CMAKE_NM)")
-    parser.add_argument("--allow", action="append", default=[], metavar="A.c:B.c",
-                        help="tolerate a cycle of exactly these files")
+    parser.add_argument(
+        "--allow", action="append", default=[], metavar="A.c:B.c", help="tolerate a cycle of exactly these files"
+    )
     parser.add_argument("libraries", nargs="+", help="static libraries (.a) or objects")
     args = parser.parse_args(argv)
     allowed = {frozenset(entry.split(":")) for entry in args.allow}

@@ -35,6 +35,7 @@ block, an unterminated fence, a marked block in another language or running tool
 or the pages have no marked block at all; 77 (ctest: skipped) when there is no getting-started
 page yet.
 """
+
 import argparse
 import glob
 import os
@@ -84,24 +85,32 @@ def marked_blocks(path):
         code, i = [], i + 1
         while i < len(lines):
             closing = FENCE.match(lines[i])
-            if closing and closing.group("fence").startswith(fence) and not closing.group("info").strip() \
-                    and closing.group("fence")[0] == fence[0]:
+            if (
+                closing
+                and closing.group("fence").startswith(fence)
+                and not closing.group("info").strip()
+                and closing.group("fence")[0] == fence[0]
+            ):
                 break
             line = lines[i]
-            code.append(line[len(indent):] if line.startswith(indent) else line.lstrip())
+            code.append(line[len(indent) :] if line.startswith(indent) else line.lstrip())
             i += 1
         else:
             raise PageError(f"{rel}:{start}: the marked block's fence is never closed")
         i += 1
         if language not in LANGUAGES:
-            raise PageError(f"{rel}:{start}: a marked block must be {', '.join(LANGUAGES)} "
-                            f"(commands without prompts), not {language or 'a block without a language'}")
+            raise PageError(
+                f"{rel}:{start}: a marked block must be {', '.join(LANGUAGES)} "
+                f"(commands without prompts), not {language or 'a block without a language'}"
+            )
         text = "\n".join(code).strip("\n") + "\n"
         for n, line in enumerate(code):
             if FULL_TEST.search(line.split("#", 1)[0]):
-                raise PageError(f"{rel}:{start + 1 + n}: a checked block may not run tools/test_all.sh, the full "
-                                "test command (CI runs it; it runs ctest, which runs this check): leave that "
-                                "block unmarked")
+                raise PageError(
+                    f"{rel}:{start + 1 + n}: a checked block may not run tools/test_all.sh, the full "
+                    "test command (CI runs it; it runs ctest, which runs this check): leave that "
+                    "block unmarked"
+                )
         if not text.strip():
             raise PageError(f"{rel}:{start}: the marked block is empty")
         blocks.append((start, language, text))
@@ -130,8 +139,7 @@ def run_block(rel, line, number, count, text, timeout_s):
         script = f.name
     started = time.monotonic()
     env = dict(os.environ, PMSTEP_QUICKSTART_BLOCK=f"{rel}:{line}")
-    proc = subprocess.Popen(["bash", "-e", script], cwd=ROOT, stdin=subprocess.DEVNULL, env=env,
-                            start_new_session=True)
+    proc = subprocess.Popen(["bash", "-e", script], cwd=ROOT, stdin=subprocess.DEVNULL, env=env, start_new_session=True)
     try:
         rc = proc.wait(timeout=timeout_s)
         reason = f"exit code {rc}"
@@ -163,7 +171,9 @@ def main():
     if os.environ.get("PMSTEP_QUICKSTART_BLOCK"):
         print(f"check_quickstart: inside the block {os.environ['PMSTEP_QUICKSTART_BLOCK']}: not again (skipped)")
         return 77
-    pages = [os.path.abspath(p) for p in args.pages] or nav_order(glob.glob(os.path.join(ROOT, "docs", "getting-started", "*.md")))
+    pages = [os.path.abspath(p) for p in args.pages] or nav_order(
+        glob.glob(os.path.join(ROOT, "docs", "getting-started", "*.md"))
+    )
     if not pages:
         print("check_quickstart: no page in docs/getting-started/ yet: nothing to check (skipped)")
         return 77
@@ -176,8 +186,11 @@ def main():
     for rel, blocks in found:
         print(f"{rel}: {len(blocks)} marked block(s)")
     if total == 0:
-        print(f"check_quickstart: no block of {', '.join(rel for rel, _ in found)} is marked {MARKER}: mark the "
-              "commands a reader runs (see this script's docstring)", file=sys.stderr)
+        print(
+            f"check_quickstart: no block of {', '.join(rel for rel, _ in found)} is marked {MARKER}: mark the "
+            "commands a reader runs (see this script's docstring)",
+            file=sys.stderr,
+        )
         return 1
     if args.list:
         for rel, blocks in found:
@@ -186,8 +199,10 @@ def main():
         return 0
 
     if not os.path.exists(os.path.join(ROOT, "build", "host-release", "sil", "pmstep-sil")):
-        print("check_quickstart: note: build/host-release is not built yet; blocks that run tools/run_paper.sh "
-              "or tools/setup_host.sh build it first (minutes)")
+        print(
+            "check_quickstart: note: build/host-release is not built yet; blocks that run tools/run_paper.sh "
+            "or tools/setup_host.sh build it first (minutes)"
+        )
     failed, not_run = [], []
     for rel, blocks in found:
         for number, (line, _, text) in enumerate(blocks, start=1):
@@ -197,8 +212,11 @@ def main():
                 break
     print()
     if failed:
-        print(f"check_quickstart: FAILED: {', '.join(failed)}" +
-              (f"; not run after it: {', '.join(not_run)}" if not_run else ""), file=sys.stderr)
+        print(
+            f"check_quickstart: FAILED: {', '.join(failed)}"
+            + (f"; not run after it: {', '.join(not_run)}" if not_run else ""),
+            file=sys.stderr,
+        )
         return 1
     print(f"check_quickstart: all {total} marked block(s) of {len(found)} page(s) ran")
     return 0

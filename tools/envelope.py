@@ -4,7 +4,8 @@ microstepping at rated current (issue 11). A benchmark that prints and writes fi
 
 For each preset (sil/scenarios/motors/) and chain (ideal; realistic = sil/scenarios/robust.ini's
 measurement chain with the robust mode; sensed = realistic on a drive that also senses each
-phase's mean voltage per period, tools/mc_preset.py's PHASE_VOLTAGE_SENSING), it designs the gains with pmstep-tune (no hand tuning),
+phase's mean voltage per period, tools/mc_preset.py's PHASE_VOLTAGE_SENSING), it designs the gains with pmstep-tune
+(no hand tuning),
 then runs pmstep-sil:
   ramps     RUN of --duration s: ramps to +-80 % and +-5 % of the top speed and holds, repeated;
             fault, max |w - w*| after the transients (% of top), max angle-estimate error
@@ -22,6 +23,7 @@ then runs pmstep-sil:
 --report FILE also writes the table as Markdown (command, commit, date; tools/report.py) and the
 plot beside it (FILE with .png for .md), shown in the report.
 """
+
 import argparse
 import csv
 import json
@@ -66,8 +68,11 @@ def design(args, name, chain, out_dir):
     robust = chain in ROBUST_CHAINS
     chain_items = chain_sets(preset, chain == "sensed") if robust else []
     ini = os.path.join(out_dir, "design.ini")
-    cmd = [args.tune, "--motor", os.path.join(ROOT, "sil", "scenarios", "motors", name + ".ini"),
-           "--write-ini", ini] + (["--robust"] if robust else []) + sets(chain_items)
+    cmd = (
+        [args.tune, "--motor", os.path.join(ROOT, "sil", "scenarios", "motors", name + ".ini"), "--write-ini", ini]
+        + (["--robust"] if robust else [])
+        + sets(chain_items)
+    )
     r = run(cmd)
     if r.returncode != 0:
         raise SystemExit("pmstep-tune failed: %s\n%s" % (" ".join(cmd), r.stderr))
@@ -90,8 +95,12 @@ def profile(start, legs):
 
 
 def sil(args, ini, out_dir, extra, csv_out=False):
-    cmd = [args.sil, "--scenario", ini, "--out", out_dir, "--quiet"] + ([] if csv_out else ["--no-csv"]) \
-        + sets(extra) + sets(args.set)
+    cmd = (
+        [args.sil, "--scenario", ini, "--out", out_dir, "--quiet"]
+        + ([] if csv_out else ["--no-csv"])
+        + sets(extra)
+        + sets(args.set)
+    )
     r = run(cmd)
     summary_path = os.path.join(out_dir, "summary.json")
     if not os.path.exists(summary_path):
@@ -104,8 +113,11 @@ def fault_name(summary):
 
 
 def ok(summary):
-    return fault_name(summary) == "NONE" and summary.get("final_mode") == "RUN" \
+    return (
+        fault_name(summary) == "NONE"
+        and summary.get("final_mode") == "RUN"
         and not summary.get("loss_of_synchronism", False)
+    )
 
 
 def ok_microstep(summary):
@@ -157,24 +169,39 @@ def envelope(args, name, chain):
         t += ramp
         holds.append((t, t + hold))
         t += hold
-    s, _ = sil(args, ini, os.path.join(out, "ramps"), ["speed.points=" + points, "run.duration_s=%g" % end,
-                                                         "load.type=none"], csv_out=True)
+    s, _ = sil(
+        args,
+        ini,
+        os.path.join(out, "ramps"),
+        ["speed.points=" + points, "run.duration_s=%g" % end, "load.type=none"],
+        csv_out=True,
+    )
     row["ramps_fault"] = fault_name(s)
     row["ramps_speed_error_pct_top"] = 100.0 * hold_error(os.path.join(out, "ramps"), holds, SETTLE_S) / top
     row["ramps_angle_error_rad"] = s["robustness"]["max_angle_error_rad"]
-    print("%-9s %-9s top %6.1f rad/s  ramps: fault %s, |w-w*| %.2f %% of top, angle %.4f rad" % (
-        name, chain, top, row["ramps_fault"], row["ramps_speed_error_pct_top"], row["ramps_angle_error_rad"]),
-        flush=True)
+    print(
+        "%-9s %-9s top %6.1f rad/s  ramps: fault %s, |w-w*| %.2f %% of top, angle %.4f rad"
+        % (name, chain, top, row["ramps_fault"], row["ramps_speed_error_pct_top"], row["ramps_angle_error_rad"]),
+        flush=True,
+    )
 
     def step_run(fraction_of_top, load_fraction, microstep, csv_out=False, delay_s=0.0):
         pts, end = profile(start, [(ramp_s, fraction_of_top * top, 1.0)])
         step_time = end - 0.5 + delay_s  # the run lasts 0.5 s past every step (the speed holds)
-        extra = ["speed.points=" + pts, "run.duration_s=%g" % (end + delay_s), "load.type=step",
-                 "load.torque_Nm=%g" % (load_fraction * preset["holding_torque_Nm"]), "load.step_time_s=%g" % step_time]
+        extra = [
+            "speed.points=" + pts,
+            "run.duration_s=%g" % (end + delay_s),
+            "load.type=step",
+            "load.torque_Nm=%g" % (load_fraction * preset["holding_torque_Nm"]),
+            "load.step_time_s=%g" % step_time,
+        ]
         if microstep:
             extra.append("run.controller=microstep")
-        d = os.path.join(out, "step_%s_%g_%g%s" % ("ms" if microstep else "ours", fraction_of_top, load_fraction,
-                                                   "_at_%.6f" % delay_s if delay_s else ""))
+        d = os.path.join(
+            out,
+            "step_%s_%g_%g%s"
+            % ("ms" if microstep else "ours", fraction_of_top, load_fraction, "_at_%.6f" % delay_s if delay_s else ""),
+        )
         summary, _ = sil(args, ini, d, extra, csv_out)
         return summary, d, step_time
 
@@ -182,24 +209,42 @@ def envelope(args, name, chain):
         s, d, t_step = step_run(fraction, 0.5, False, csv_out=True)
         dip, recovery = dip_and_recovery(d, t_step, 0.02 * top)
         key = "step_at_%g" % fraction
-        row[key] = {"fault": fault_name(s), "lost_sync": s.get("loss_of_synchronism"), "dip_rad_s": dip,
-                    "recovery_ms": 1e3 * recovery, "max_angle_error_rad": s["robustness"]["max_angle_error_rad"]}
+        row[key] = {
+            "fault": fault_name(s),
+            "lost_sync": s.get("loss_of_synchronism"),
+            "dip_rad_s": dip,
+            "recovery_ms": 1e3 * recovery,
+            "max_angle_error_rad": s["robustness"]["max_angle_error_rad"],
+        }
         detent_period_s = 2.0 * math.pi / (4.0 * pole_pairs * fraction * top)
         survived = int(ok(s)) + sum(
             int(ok(step_run(fraction, 0.5, False, delay_s=k * detent_period_s / STEP_POSITIONS)[0]))
-            for k in range(1, STEP_POSITIONS))
+            for k in range(1, STEP_POSITIONS)
+        )
         row[key]["survived_positions"] = survived
-        print("%-9s %-9s 0.5 T_H at %g top: fault %s, sync lost %s, dip %.2f rad/s, recovery %.1f ms; "
-              "survived at %d of %d positions over a detent period" % (
-                  name, chain, fraction, fault_name(s), s.get("loss_of_synchronism"), dip, 1e3 * recovery,
-                  survived, STEP_POSITIONS), flush=True)
+        print(
+            "%-9s %-9s 0.5 T_H at %g top: fault %s, sync lost %s, dip %.2f rad/s, recovery %.1f ms; "
+            "survived at %d of %d positions over a detent period"
+            % (
+                name,
+                chain,
+                fraction,
+                fault_name(s),
+                s.get("loss_of_synchronism"),
+                dip,
+                1e3 * recovery,
+                survived,
+                STEP_POSITIONS,
+            ),
+            flush=True,
+        )
 
     for microstep in (False, True):
         lo, hi = 0.0, 1.0
         for _ in range(BISECTION_STEPS):
             mid = 0.5 * (lo + hi)
             s, _, _ = step_run(0.5, mid, microstep)
-            if (ok_microstep(s) if microstep else ok(s)):
+            if ok_microstep(s) if microstep else ok(s):
                 lo = mid
             else:
                 hi = mid
@@ -207,15 +252,29 @@ def envelope(args, name, chain):
     # Copper loss at light load.
     pts, end = profile(start, [(ramp_s, 0.5 * top, 1.0)])
     for microstep in (False, True):
-        extra = ["speed.points=" + pts, "run.duration_s=%g" % end, "load.type=none", "run.metrics_start_s=%g" % (end - 0.5)]
+        extra = [
+            "speed.points=" + pts,
+            "run.duration_s=%g" % end,
+            "load.type=none",
+            "run.metrics_start_s=%g" % (end - 0.5),
+        ]
         if microstep:
             extra.append("run.controller=microstep")
         s, _ = sil(args, ini, os.path.join(out, "rms_%s" % ("ms" if microstep else "ours")), extra)
         row["rms_current_%s_A" % ("microstep" if microstep else "ours")] = s.get("rms_phase_current_A")
-    print("%-9s %-9s largest step at 0.5 top: ours %.3f, microstepping %.3f of T_H; rms current ours %.3f A, "
-          "microstepping %.3f A" % (name, chain, row["pullout_ours_of_holding"], row["pullout_microstep_of_holding"],
-                                    _or(row["rms_current_ours_A"], -1), _or(row["rms_current_microstep_A"], -1)),
-          flush=True)
+    print(
+        "%-9s %-9s largest step at 0.5 top: ours %.3f, microstepping %.3f of T_H; rms current ours %.3f A, "
+        "microstepping %.3f A"
+        % (
+            name,
+            chain,
+            row["pullout_ours_of_holding"],
+            row["pullout_microstep_of_holding"],
+            _or(row["rms_current_ours_A"], -1),
+            _or(row["rms_current_microstep_A"], -1),
+        ),
+        flush=True,
+    )
     return row
 
 
@@ -225,46 +284,67 @@ def _or(value, missing):
 
 
 def markdown(rows):
-    lines = ["| preset | chain | top speed (rad/s) | ramps: fault, max |w-w*| (% top), angle error (rad) | "
-             "0.5 T_H step at 50 % / 5 % top: dip (rad/s), recovery (ms); survived at k of "
-             + str(STEP_POSITIONS) + " positions | largest step at 50 % top, ours / "
-             "microstepping (x T_H) | RMS phase current at 50 % top, no load: ours / microstepping (A) |",
-             "|---|---|---|---|---|---|---|"]
+    lines = [
+        "| preset | chain | top speed (rad/s) | ramps: fault, max |w-w*| (% top), angle error (rad) | "
+        "0.5 T_H step at 50 % / 5 % top: dip (rad/s), recovery (ms); survived at k of "
+        + str(STEP_POSITIONS)
+        + " positions | largest step at 50 % top, ours / "
+        "microstepping (x T_H) | RMS phase current at 50 % top, no load: ours / microstepping (A) |",
+        "|---|---|---|---|---|---|---|",
+    ]
     for r in rows:
-        def step(k):
+
+        def step(k, r=r):
             x = r[k]
             positions = "; %d/%d" % (x["survived_positions"], STEP_POSITIONS)
             if x["fault"] not in ("NONE", None) or x["lost_sync"]:
                 return "%s%s%s" % (x["fault"], ", sync lost" if x["lost_sync"] else "", positions)
             return "%.1f, %.0f%s" % (x["dip_rad_s"], x["recovery_ms"], positions)
-        lines.append("| %s | %s | %.1f | %s, %.2f, %.4f | %s / %s | %.3f / %.3f | %.3f / %.3f |" % (
-            r["preset"], r["chain"], r["top_speed_rad_s"], r["ramps_fault"], r["ramps_speed_error_pct_top"],
-            _or(r["ramps_angle_error_rad"], math.nan), step("step_at_0.5"), step("step_at_0.05"),
-            r["pullout_ours_of_holding"], r["pullout_microstep_of_holding"], _or(r["rms_current_ours_A"], math.nan),
-            _or(r["rms_current_microstep_A"], math.nan)))
+
+        lines.append(
+            "| %s | %s | %.1f | %s, %.2f, %.4f | %s / %s | %.3f / %.3f | %.3f / %.3f |"
+            % (
+                r["preset"],
+                r["chain"],
+                r["top_speed_rad_s"],
+                r["ramps_fault"],
+                r["ramps_speed_error_pct_top"],
+                _or(r["ramps_angle_error_rad"], math.nan),
+                step("step_at_0.5"),
+                step("step_at_0.05"),
+                r["pullout_ours_of_holding"],
+                r["pullout_microstep_of_holding"],
+                _or(r["rms_current_ours_A"], math.nan),
+                _or(r["rms_current_microstep_A"], math.nan),
+            )
+        )
     return "\n".join(lines) + "\n"
 
 
 def report_text(rows, args, argv, plot_name=None):
     """The report: what was measured (@p args' presets, chains, duration and --set), markdown(@p rows)
     and, if @p plot_name, the plot beside it."""
-    what = ("Designer's gains (`pmstep-tune`, no per-motor tuning), 20 kHz, the plant's detent torque on; "
-            "\"realistic\" is sil/scenarios/robust.ini's chain (12-bit ADC over ±3 I, ±20 mA offsets, 5 mA noise, "
-            "one period of delay, 1 µs dead time, switching inverter) with the robust mode, \"sensed\" the same on a "
-            "drive that senses the phase voltages (tools/mc_preset.py). Ramps: %g s of RUN to ±80 %% and ±5 %% of "
-            "the top speed (at least that long: whole rounds of four), each level held %g s; tracking is the "
-            "largest |w-w*| in the holds from %g s after each "
-            "ramp. Steps: half the holding torque T_H stepped on at 50 %% and 5 %% of the top speed (dip and "
-            "recovery, back within 2 %% of the top speed, of the nominal step), and again at %d rotor positions "
-            "over one detent period. Pull-out: the largest step survived at 50 %% of the top speed without a fault "
-            "or a loss of synchronism (bisection, %d steps). Microstepping: the SIL's open-loop baseline at rated "
-            "current." % (args.duration, HOLD_S, SETTLE_S, STEP_POSITIONS, BISECTION_STEPS))
+    what = (
+        "Designer's gains (`pmstep-tune`, no per-motor tuning), 20 kHz, the plant's detent torque on; "
+        '"realistic" is sil/scenarios/robust.ini\'s chain (12-bit ADC over ±3 I, ±20 mA offsets, 5 mA noise, '
+        'one period of delay, 1 µs dead time, switching inverter) with the robust mode, "sensed" the same on a '
+        "drive that senses the phase voltages (tools/mc_preset.py). Ramps: %g s of RUN to ±80 %% and ±5 %% of "
+        "the top speed (at least that long: whole rounds of four), each level held %g s; tracking is the "
+        "largest |w-w*| in the holds from %g s after each "
+        "ramp. Steps: half the holding torque T_H stepped on at 50 %% and 5 %% of the top speed (dip and "
+        "recovery, back within 2 %% of the top speed, of the nominal step), and again at %d rotor positions "
+        "over one detent period. Pull-out: the largest step survived at 50 %% of the top speed without a fault "
+        "or a loss of synchronism (bisection, %d steps). Microstepping: the SIL's open-loop baseline at rated "
+        "current." % (args.duration, HOLD_S, SETTLE_S, STEP_POSITIONS, BISECTION_STEPS)
+    )
     if args.set:
         what += " Every run after the design with " + ", ".join("`--set %s`" % item for item in args.set) + "."
     # markdown()'s header has |w-w*| unescaped, which splits its cell in a Markdown table: escaped here,
     # out/.../envelope.md and the printed table left as they are.
-    lines = [report.header("Operating envelope against open-loop microstepping", "tools/envelope.py", argv, what),
-             markdown(rows).replace("max |w-w*|", "max \\|w-w*\\|", 1)]
+    lines = [
+        report.header("Operating envelope against open-loop microstepping", "tools/envelope.py", argv, what),
+        markdown(rows).replace("max |w-w*|", "max \\|w-w*\\|", 1),
+    ]
     if plot_name:
         lines += ["![Largest load step survived and RMS phase current, ours and microstepping](%s)" % plot_name, ""]
     return "\n".join(lines)
@@ -273,6 +353,7 @@ def report_text(rows, args, argv, plot_name=None):
 def plot(rows, path):
     try:
         import matplotlib
+
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError:
@@ -282,8 +363,9 @@ def plot(rows, path):
     x = range(len(rows))
     fig, axes = plt.subplots(1, 2, figsize=(12, 4))
     axes[0].bar([i - 0.2 for i in x], [r["pullout_ours_of_holding"] for r in rows], 0.4, label="pmstep (sensorless)")
-    axes[0].bar([i + 0.2 for i in x], [r["pullout_microstep_of_holding"] for r in rows], 0.4,
-                label="open-loop microstepping")
+    axes[0].bar(
+        [i + 0.2 for i in x], [r["pullout_microstep_of_holding"] for r in rows], 0.4, label="open-loop microstepping"
+    )
     axes[0].set_ylabel("largest load step survived at 50 % top speed (x holding torque)")
     axes[1].bar([i - 0.2 for i in x], [r["rms_current_ours_A"] or 0 for r in rows], 0.4, label="pmstep")
     axes[1].bar([i + 0.2 for i in x], [r["rms_current_microstep_A"] or 0 for r in rows], 0.4, label="microstepping")
@@ -304,14 +386,25 @@ def main():
     ap.add_argument("--tune", required=True)
     ap.add_argument("--out", required=True)
     ap.add_argument("--presets", default=",".join(PRESETS))
-    ap.add_argument("--chains", default="ideal,realistic",
-                    help="comma-separated: ideal, realistic, sensed (realistic with phase-voltage sensing)")
+    ap.add_argument(
+        "--chains",
+        default="ideal,realistic",
+        help="comma-separated: ideal, realistic, sensed (realistic with phase-voltage sensing)",
+    )
     ap.add_argument("--duration", type=float, default=20.0, help="RUN time of the ramps run (s)")
-    ap.add_argument("--report", metavar="FILE",
-                    help="also write the table as Markdown here (docs/reports/envelope.md), the plot beside it")
-    ap.add_argument("--set", action="append", default=[], metavar="SECTION.KEY=VALUE",
-                    help="a pmstep-sil --set applied to every run after the design (e.g. one impairment "
-                         "of the chain removed: --set inverter.dead_time_s=0 --set controller.inverter.dead_time_s=0)")
+    ap.add_argument(
+        "--report",
+        metavar="FILE",
+        help="also write the table as Markdown here (docs/reports/envelope.md), the plot beside it",
+    )
+    ap.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="SECTION.KEY=VALUE",
+        help="a pmstep-sil --set applied to every run after the design (e.g. one impairment "
+        "of the chain removed: --set inverter.dead_time_s=0 --set controller.inverter.dead_time_s=0)",
+    )
     args = ap.parse_args()
     unknown = [c for c in args.chains.split(",") if c not in ("ideal",) + ROBUST_CHAINS]
     if unknown:

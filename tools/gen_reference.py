@@ -42,6 +42,7 @@ field or of another type, a sign rule on a field that is not a float, a field wh
 known unit suffix. Exit status: 0 written, 1 GenError (message on stderr). Notes (a code or field
 without a doc comment, a float setting outside sign_rules[]) go to stderr and do not fail.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -206,8 +207,9 @@ class Source:
     def find_one(self, pattern: str, start: int = 0, end: int | None = None) -> tuple[int, re.Match]:
         """The one line in [start, end) matching @p pattern (re.match), else GenError."""
         regex = re.compile(pattern)
-        hits = [(i, m) for i in range(start, len(self.lines) if end is None else end)
-                if (m := regex.match(self.lines[i]))]
+        hits = [
+            (i, m) for i in range(start, len(self.lines) if end is None else end) if (m := regex.match(self.lines[i]))
+        ]
         if len(hits) != 1:
             where = f"{self.name}:{hits[1][0] + 1}: " if len(hits) > 1 else f"{self.name}: "
             raise GenError(f"{where}expected one line matching {pattern!r}, found {len(hits)}")
@@ -230,6 +232,7 @@ class Source:
 # ---------------------------------------------------------------------------------------------------
 # C pieces
 # ---------------------------------------------------------------------------------------------------
+
 
 def clean(text: str) -> str:
     """Comment text on one line: whitespace collapsed."""
@@ -270,8 +273,8 @@ def doc_comment_above(src: Source, index: int) -> str:
         j -= 1
     if j < 0:
         return ""
-    text = " ".join(src.lines[j:end + 1])
-    text = text[text.index("/**") + 3:text.rindex("*/")]
+    text = " ".join(src.lines[j : end + 1])
+    text = text[text.index("/**") + 3 : text.rindex("*/")]
     return clean(re.sub(r"(^|\s)\*(?=\s)", " ", text))
 
 
@@ -447,8 +450,9 @@ def parse_text_function(src: Source, function: str) -> tuple[str, dict[str, str]
     return enum_type, texts, c_string(src, i, m.group(1))
 
 
-def join_texts(values: list[EnumValue], texts: dict[str, str], src: Source, function: str,
-               enum_name: str) -> dict[str, str]:
+def join_texts(
+    values: list[EnumValue], texts: dict[str, str], src: Source, function: str, enum_name: str
+) -> dict[str, str]:
     """Every value has a text and every text a value, else GenError (a real inconsistency)."""
     names = {v.name for v in values}
     missing = [v.name for v in values if v.name not in texts]
@@ -494,8 +498,19 @@ def c_int(expr: str, macros: dict[str, tuple[str, str]], src: Source, index: int
         tree = ast.parse(text, mode="eval")
     except SyntaxError as e:
         raise src.error(index, f"not an integer expression: {expr!r}") from e
-    allowed = (ast.Expression, ast.BinOp, ast.UnaryOp, ast.Constant, ast.Add, ast.Sub, ast.Mult,
-               ast.FloorDiv, ast.Div, ast.USub, ast.UAdd)
+    allowed = (
+        ast.Expression,
+        ast.BinOp,
+        ast.UnaryOp,
+        ast.Constant,
+        ast.Add,
+        ast.Sub,
+        ast.Mult,
+        ast.FloorDiv,
+        ast.Div,
+        ast.USub,
+        ast.UAdd,
+    )
     if not all(isinstance(node, allowed) for node in ast.walk(tree)):
         raise src.error(index, f"not an integer expression: {expr!r}")
     text = text.replace("/", "//")
@@ -519,8 +534,17 @@ def numeric_constants(src: Source) -> dict[str, str]:
 # ---------------------------------------------------------------------------------------------------
 
 _ESCAPES = {
-    "\\": "&#92;", "[": "&#91;", "]": "&#93;", "<": "&lt;", "$": "&#36;",
-    "`": "\\`", "*": "\\*", "_": "\\_", "{": "\\{", "}": "\\}", "|": "\\|",
+    "\\": "&#92;",
+    "[": "&#91;",
+    "]": "&#93;",
+    "<": "&lt;",
+    "$": "&#36;",
+    "`": "\\`",
+    "*": "\\*",
+    "_": "\\_",
+    "{": "\\{",
+    "}": "\\}",
+    "|": "\\|",
 }
 
 
@@ -566,8 +590,9 @@ def rich(text: str, constants: dict[str, str], names: set[str] | frozenset[str] 
     followed by its value."""
     alternatives = [r"\bPMSTEP_[A-Z0-9_]+\b", r"\bpmstep_[\w.]*\w(?:\(\))?"]
     if names:
-        alternatives.insert(0, r"(?<![\w.])(?:" + "|".join(re.escape(n) for n in sorted(names, key=len, reverse=True))
-                            + r")(?!\w)")
+        alternatives.insert(
+            0, r"(?<![\w.])(?:" + "|".join(re.escape(n) for n in sorted(names, key=len, reverse=True)) + r")(?!\w)"
+        )
     parts = re.split("(" + "|".join(alternatives) + ")", text)
     out = []
     for k, part in enumerate(parts):
@@ -597,10 +622,11 @@ def fmt_number(v: float) -> str:
 # The configuration
 # ---------------------------------------------------------------------------------------------------
 
+
 @dataclass
 class ConfigField:
-    path: str           # motor.resistance_Ohm
-    group: str          # motor, or "" for the top level
+    path: str  # motor.resistance_Ohm
+    group: str  # motor, or "" for the top level
     ctype: str
     doc: str
     line: int
@@ -609,12 +635,12 @@ class ConfigField:
     read_only: bool = False
     sign: str | None = None
     sign_code: str | None = None
-    codes: list[str] = field(default_factory=list)   # every code of init that names it, enum order
+    codes: list[str] = field(default_factory=list)  # every code of init that names it, enum order
 
 
 @dataclass
 class ConfigGroup:
-    name: str           # the member of pmstep_config_t, "" for the top level
+    name: str  # the member of pmstep_config_t, "" for the top level
     struct: str
     doc: str
     fields: list[ConfigField]
@@ -629,8 +655,10 @@ def unit_of(path: str, ctype: str) -> str:
             return UNIT_SUFFIXES[suffix]
     if path in UNSUFFIXED_FIELDS:
         return ""
-    raise GenError(f"{path}: no known unit suffix (UNIT_SUFFIXES in tools/gen_reference.py); add the "
-                   f"suffix there, or the field to UNSUFFIXED_FIELDS if it is a plain number")
+    raise GenError(
+        f"{path}: no known unit suffix (UNIT_SUFFIXES in tools/gen_reference.py); add the "
+        f"suffix there, or the field to UNSUFFIXED_FIELDS if it is a plain number"
+    )
 
 
 def parse_config_fields(types_h: Source) -> list[ConfigGroup]:
@@ -663,10 +691,16 @@ def parse_console_table(src: Source) -> list[tuple[str, str, bool, int]]:
     settings' entries (pmstep_stepdir_settings_t, PMSTEP_CONSOLE_CFG_STEPDIR) have the path stepdir.<field>."""
     macros = {}
     for i, line in enumerate(src.lines):
-        m = re.match(r"^#define (\w+)\(field\) \{#field, PMSTEP_CONSOLE_CFG_(\w+), (0u|PMSTEP_CONSOLE_CFG_READ_ONLY), "
-                     r"\(uint16_t\)offsetof\(pmstep_config_t, field\)\}\s*$", line)
-        sd = re.match(r'^#define (\w+)\(field\) \{"stepdir\." #field, PMSTEP_CONSOLE_CFG_(\w+), '
-                      r"PMSTEP_CONSOLE_CFG_STEPDIR, \(uint16_t\)offsetof\(pmstep_stepdir_settings_t, field\)\}\s*$", line)
+        m = re.match(
+            r"^#define (\w+)\(field\) \{#field, PMSTEP_CONSOLE_CFG_(\w+), (0u|PMSTEP_CONSOLE_CFG_READ_ONLY), "
+            r"\(uint16_t\)offsetof\(pmstep_config_t, field\)\}\s*$",
+            line,
+        )
+        sd = re.match(
+            r'^#define (\w+)\(field\) \{"stepdir\." #field, PMSTEP_CONSOLE_CFG_(\w+), '
+            r"PMSTEP_CONSOLE_CFG_STEPDIR, \(uint16_t\)offsetof\(pmstep_stepdir_settings_t, field\)\}\s*$",
+            line,
+        )
         if m or sd:
             kind = (m or sd).group(2)
             if kind not in CONSOLE_TYPES:
@@ -759,6 +793,7 @@ def phrase_matches(text: str, phrases: dict[str, str]) -> list[tuple[str, str]]:
 @dataclass
 class Reference:
     """Everything the pages are written from."""
+
     root: Path
     groups: list[ConfigGroup]
     console_rows: list[tuple[str, str, bool, int]]
@@ -766,11 +801,11 @@ class Reference:
     faults: list[EnumValue]
     modes: list[EnumValue]
     identification: list[EnumValue]
-    texts: dict[str, dict[str, str]]          # enum type -> name -> text
-    init_codes: list[str]                      # status codes pmstep_config.c returns, enum order
-    code_fields: dict[str, list[str]]          # status code -> settings its cause names
+    texts: dict[str, dict[str, str]]  # enum type -> name -> text
+    init_codes: list[str]  # status codes pmstep_config.c returns, enum order
+    code_fields: dict[str, list[str]]  # status code -> settings its cause names
     constants: dict[str, str]
-    names: set[str]                            # the settings' names as comments write them
+    names: set[str]  # the settings' names as comments write them
     console_errors: list[EnumValue]
     console_error_texts: dict[int, str]
     console_types: list[EnumValue]
@@ -784,9 +819,17 @@ class Reference:
         return [f for g in self.groups for f in g.fields]
 
 
-def link_config(ref_groups: list[ConfigGroup], console_rows, sign_rules, status: list[EnumValue],
-                init_codes: list[str], notes: list[str],
-                types_h: Source, console_c: Source, config_c: Source) -> dict[str, list[str]]:
+def link_config(
+    ref_groups: list[ConfigGroup],
+    console_rows,
+    sign_rules,
+    status: list[EnumValue],
+    init_codes: list[str],
+    notes: list[str],
+    types_h: Source,
+    console_c: Source,
+    config_c: Source,
+) -> dict[str, list[str]]:
     fields = {f.path: f for g in ref_groups for f in g.fields}
     # console ids
     seen = set()
@@ -799,8 +842,7 @@ def link_config(ref_groups: list[ConfigGroup], console_rows, sign_rules, status:
         seen.add(path)
         f = fields[path]
         if CONSOLE_TYPES[ctype] != f.ctype:
-            raise GenError(f"{console_c.name}:{line}: {path} is {ctype} on the console but {f.ctype} in "
-                           f"{types_h.name}")
+            raise GenError(f"{console_c.name}:{line}: {path} is {ctype} on the console but {f.ctype} in {types_h.name}")
         f.console_id, f.console_type, f.read_only = cid, ctype, read_only
     # signs
     status_names = {v.name for v in status}
@@ -823,11 +865,13 @@ def link_config(ref_groups: list[ConfigGroup], console_rows, sign_rules, status:
                 raise GenError(f"{config_c.name}:{line}: a sign rule that refuses with PMSTEP_OK")
             f.sign, f.sign_code = SIGNS[sign], code_name
     for f in fields.values():
-        if f.group == "stepdir":   # checked by pmstep_console_stepdir_validate(), not by init
+        if f.group == "stepdir":  # checked by pmstep_console_stepdir_validate(), not by init
             continue
         if f.ctype == "float" and f.sign is None:
-            notes.append(f"{f.path} is a float setting outside sign_rules[] ({config_c.name}): init does not "
-                         "check that it is finite")
+            notes.append(
+                f"{f.path} is a float setting outside sign_rules[] ({config_c.name}): init does not "
+                "check that it is finite"
+            )
         if f.sign == "any":
             f.sign = None
         if not f.doc:
@@ -863,10 +907,13 @@ def link_config(ref_groups: list[ConfigGroup], console_rows, sign_rules, status:
         code_fields[c] = named
     stale = [p for extra in FIELD_PHRASES.values() for p in extra if p not in used_phrases]
     if stale:
-        raise GenError("FIELD_PHRASES in tools/gen_reference.py: no cause of a status code init returns uses "
-                       + ", ".join(repr(p) for p in stale) + " any more: remove or update it")
+        raise GenError(
+            "FIELD_PHRASES in tools/gen_reference.py: no cause of a status code init returns uses "
+            + ", ".join(repr(p) for p in stale)
+            + " any more: remove or update it"
+        )
     for f in fields.values():
-        if f.group == "stepdir":   # its codes are pmstep_console_stepdir_validate()'s (parse_stepdir_rules)
+        if f.group == "stepdir":  # its codes are pmstep_console_stepdir_validate()'s (parse_stepdir_rules)
             for c in f.codes:
                 code_fields.setdefault(c, []).append(f.path)
             continue
@@ -875,8 +922,9 @@ def link_config(ref_groups: list[ConfigGroup], console_rows, sign_rules, status:
             codes.add(f.sign_code)
             if f.path not in code_fields.setdefault(f.sign_code, []):
                 code_fields[f.sign_code].append(f.path)
-        f.codes = ([f.sign_code] if f.sign_code else []) + [v.name for v in status
-                                                            if v.name in codes and v.name != f.sign_code]
+        f.codes = ([f.sign_code] if f.sign_code else []) + [
+            v.name for v in status if v.name in codes and v.name != f.sign_code
+        ]
     # settings in field order for each code
     order = {p: k for k, p in enumerate(fields)}
     return {c: sorted(ps, key=order.__getitem__) for c, ps in code_fields.items()}
@@ -886,24 +934,25 @@ def link_config(ref_groups: list[ConfigGroup], console_rows, sign_rules, status:
 # The console protocol
 # ---------------------------------------------------------------------------------------------------
 
+
 @dataclass
 class Request:
     code: int
-    name: str            # HELLO (pmstep_console_type_t without PMSTEP_CONSOLE_)
-    needs: str           # NEEDS_*
-    needs_text: str      # the macro's comment
+    name: str  # HELLO (pmstep_console_type_t without PMSTEP_CONSOLE_)
+    needs: str  # NEEDS_*
+    needs_text: str  # the macro's comment
     min_length: int
     max_length: int
-    data: str            # from the header's list
+    data: str  # from the header's list
     reply: str
 
 
 @dataclass
 class ConsoleProtocol:
-    prose_before: list[tuple[str, str]]   # ("text" | "pre", content) paragraphs before the request list
+    prose_before: list[tuple[str, str]]  # ("text" | "pre", content) paragraphs before the request list
     prose_after: list[tuple[str, str]]
     requests: list[Request]
-    other_types: list[EnumValue]          # pmstep_console_type_t values that are not requests
+    other_types: list[EnumValue]  # pmstep_console_type_t values that are not requests
     constants: list[tuple[str, str, str]]  # PMSTEP_CONSOLE_* macros: name, value, comment
     shared_replies: list[tuple[Request, str]]  # a request whose reply TYPE is another frame's TYPE too
 
@@ -982,7 +1031,7 @@ def parse_header_requests(src: Source, types: list[EnumValue]) -> tuple[dict[str
         rest = left
         while m := re.match(r"^(0x[0-9A-F]{2}) ([A-Z_]+)(,\s*)?", rest):
             names.append((int(m.group(1), 16), m.group(2)))
-            rest = rest[m.end():]
+            rest = rest[m.end() :]
             if not m.group(3):
                 break
         data = rest.strip()
@@ -990,8 +1039,9 @@ def parse_header_requests(src: Source, types: list[EnumValue]) -> tuple[dict[str
             raise src.error(start, f"request list entry not understood: {text!r}")
         for code_value, name in names:
             if codes.get(name) != code_value:
-                raise src.error(start, f"request list: 0x{code_value:02X} {name} is not a value of "
-                                       "pmstep_console_type_t")
+                raise src.error(
+                    start, f"request list: 0x{code_value:02X} {name} is not a value of pmstep_console_type_t"
+                )
             if name in out:
                 raise src.error(start, f"request list: {name} twice")
             out[name] = (data, reply)
@@ -1017,26 +1067,33 @@ def parse_console(console_h: Source, request_c: Source, types: list[EnumValue]) 
             raise request_c.error(i, f"{m.group(2)} is not defined")
         name = m.group(1).removeprefix("PMSTEP_CONSOLE_")
         if name not in listed:
-            raise request_c.error(i, f"{name} is in requests[] but not in the \"Requests (DATA):\" list of "
-                                     f"{console_h.name}")
+            raise request_c.error(
+                i, f'{name} is in requests[] but not in the "Requests (DATA):" list of {console_h.name}'
+            )
         lo, hi = c_int(m.group(3), macros, request_c, i), c_int(m.group(4), macros, request_c, i)
         if lo > hi:
             raise request_c.error(i, f"{name}: DATA length {lo} > {hi}")
         data, reply = listed[name]
-        requests.append(Request(by_name[m.group(1)].value, name, m.group(2), macros[m.group(2)][1],
-                                lo, hi, data, reply))
+        requests.append(
+            Request(by_name[m.group(1)].value, name, m.group(2), macros[m.group(2)][1], lo, hi, data, reply)
+        )
     in_table = {r.name for r in requests}
     if len(in_table) != len(requests):
         raise request_c.error(start, "requests[] has a type twice")
     unlisted = [n for n in listed if n not in in_table]
     if unlisted:
-        raise GenError(f"{console_h.name}: the \"Requests (DATA):\" list has {', '.join(unlisted)}, which "
-                       f"requests[] of {request_c.name} does not serve")
+        raise GenError(
+            f'{console_h.name}: the "Requests (DATA):" list has {", ".join(unlisted)}, which '
+            f"requests[] of {request_c.name} does not serve"
+        )
     others = [v for v in types if v.name.removeprefix("PMSTEP_CONSOLE_") not in in_table]
-    constants = [(n, v, c) for n, (v, c) in defines(console_h).items()
-                 if n.startswith("PMSTEP_CONSOLE_") and not n.startswith(("PMSTEP_CONSOLE_CFG_",
-                                                                         "PMSTEP_CONSOLE_POSITION_"))
-                 and not n.endswith("_H")]
+    constants = [
+        (n, v, c)
+        for n, (v, c) in defines(console_h).items()
+        if n.startswith("PMSTEP_CONSOLE_")
+        and not n.startswith(("PMSTEP_CONSOLE_CFG_", "PMSTEP_CONSOLE_POSITION_"))
+        and not n.endswith("_H")
+    ]
     shared = []
     for r in requests:
         for v in types:
@@ -1063,14 +1120,16 @@ def host_error_texts(root: Path, errors: list[EnumValue]) -> dict[int, str]:
     texts, line = found
     codes = {v.value for v in errors}
     if set(texts) != codes:
-        raise GenError(f"{CONSOLE_PY}:{line}: ERRORS has the codes {sorted(texts)}, pmstep_console_error_t "
-                       f"{sorted(codes)}")
+        raise GenError(
+            f"{CONSOLE_PY}:{line}: ERRORS has the codes {sorted(texts)}, pmstep_console_error_t {sorted(codes)}"
+        )
     return texts
 
 
 # ---------------------------------------------------------------------------------------------------
 # The scenario keys
 # ---------------------------------------------------------------------------------------------------
+
 
 @dataclass
 class ScenarioKey:
@@ -1088,9 +1147,9 @@ class ScenarioKey:
 @dataclass
 class Scenario:
     keys: list[ScenarioKey]
-    enums: dict[str, list[str]]      # key type -> value names (in the C enum's order)
-    enum_arrays: dict[str, str]      # key type -> the name array
-    big: str                         # the table's "no bound" magnitude, as written
+    enums: dict[str, list[str]]  # key type -> value names (in the C enum's order)
+    enum_arrays: dict[str, str]  # key type -> the name array
+    big: str  # the table's "no bound" magnitude, as written
     defaults_from: str | None = None
 
 
@@ -1123,8 +1182,9 @@ def parse_scenario(keys_c: Source, keys_h: Source) -> Scenario:
             enums[t] = arrays[array]
             enum_arrays[t] = f"{array}_names"
         elif t not in KEY_TYPES:
-            raise GenError(f"{keys_h.name}: key type {t} has no name array and no text in KEY_TYPES of "
-                           "tools/gen_reference.py")
+            raise GenError(
+                f"{keys_h.name}: key type {t} has no name array and no text in KEY_TYPES of tools/gen_reference.py"
+            )
     for array in arrays:
         if "KEY_" + array.upper() not in key_types:
             raise GenError(f"{keys_h.name}: {array}_names names the values of no key type (KEY_{array.upper()})")
@@ -1135,8 +1195,10 @@ def parse_scenario(keys_c: Source, keys_h: Source) -> Scenario:
     if "BIG" not in macros:
         raise GenError(f"{keys_c.name}: no '#define BIG <number>'")
     number = r"(-?(?:BIG|[\d.]+(?:[eE][-+]?\d+)?))"
-    row = re.compile(rf'^\s*\{{{STRING}, (KEY_[A-Z_]+), (?:OFF\([\w.]+\)|0), {number}, ([01]), {number}, ([01]), '
-                     rf'{STRING}\}},\s*$')
+    row = re.compile(
+        rf"^\s*\{{{STRING}, (KEY_[A-Z_]+), (?:OFF\([\w.]+\)|0), {number}, ([01]), {number}, ([01]), "
+        rf"{STRING}\}},\s*$"
+    )
     start, lines = keys_c.table_rows(r"^const key_t_ scenario_keys\[\] = \{\s*$", "scenario_keys[]")
     keys = []
     for i, line in lines:
@@ -1154,8 +1216,18 @@ def parse_scenario(keys_c: Source, keys_h: Source) -> Scenario:
         name = c_string(keys_c, i, r.group(1))
         if not re.fullmatch(r"[a-z_0-9]+(\.[a-z_0-9]+)*\.[A-Za-z_0-9]+", name):
             raise keys_c.error(i, f"key {name!r} is not section.key")
-        keys.append(ScenarioKey(name, r.group(2), value(r.group(3)), r.group(4) == "1", value(r.group(5)),
-                                r.group(6) == "1", c_string(keys_c, i, r.group(7)), i + 1))
+        keys.append(
+            ScenarioKey(
+                name,
+                r.group(2),
+                value(r.group(3)),
+                r.group(4) == "1",
+                value(r.group(5)),
+                r.group(6) == "1",
+                c_string(keys_c, i, r.group(7)),
+                i + 1,
+            )
+        )
     names = [k.name for k in keys]
     if len(set(names)) != len(names):
         raise keys_c.error(start, "scenario_keys[] has a key twice")
@@ -1174,7 +1246,7 @@ def sil_defaults(sil: Path, scenario: Scenario) -> None:
         raise GenError(f"--sil {sil}: --print-scenario did not finish in 60 s") from e
     if run.returncode != 0:
         raise GenError(f"--sil {sil}: --print-scenario exited {run.returncode}: {run.stderr.strip()}")
-    printed: list[tuple[str, str, str]] = []   # key, help, value
+    printed: list[tuple[str, str, str]] = []  # key, help, value
     section = None
     help_text = None
     for n, line in enumerate(run.stdout.split("\n"), 1):
@@ -1201,9 +1273,11 @@ def sil_defaults(sil: Path, scenario: Scenario) -> None:
     if printed_keys != table_keys:
         only_table = [k for k in table_keys if k not in printed_keys]
         only_sil = [k for k in printed_keys if k not in table_keys]
-        raise GenError(f"--sil {sil}: its keys differ from {SCENARIO_KEYS_C} (a stale binary?): only in the table: "
-                       f"{only_table or 'none'}; only in the binary: {only_sil or 'none'}"
-                       + ("; same keys, another order" if not only_table and not only_sil else ""))
+        raise GenError(
+            f"--sil {sil}: its keys differ from {SCENARIO_KEYS_C} (a stale binary?): only in the table: "
+            f"{only_table or 'none'}; only in the binary: {only_sil or 'none'}"
+            + ("; same keys, another order" if not only_table and not only_sil else "")
+        )
     for k, (_, h, v) in zip(scenario.keys, printed):
         if h != k.help:
             raise GenError(f"--sil {sil}: help of {k.name} differs from {SCENARIO_KEYS_C}:{k.line} (a stale binary?)")
@@ -1214,6 +1288,7 @@ def sil_defaults(sil: Path, scenario: Scenario) -> None:
 # ---------------------------------------------------------------------------------------------------
 # Reading everything
 # ---------------------------------------------------------------------------------------------------
+
 
 def load(root: Path = ROOT, sil: Path | None = None) -> Reference:
     notes: list[str] = []
@@ -1228,12 +1303,19 @@ def load(root: Path = ROOT, sil: Path | None = None) -> Reference:
     faults = parse_enum(types_h, "pmstep_fault_t")
     modes = parse_enum(types_h, "pmstep_mode_t")
     identification = parse_enum(types_h, "pmstep_identification_t")
-    enums = {"pmstep_status_t": status, "pmstep_fault_t": faults, "pmstep_mode_t": modes,
-             "pmstep_identification_t": identification}
+    enums = {
+        "pmstep_status_t": status,
+        "pmstep_fault_t": faults,
+        "pmstep_mode_t": modes,
+        "pmstep_identification_t": identification,
+    }
     texts: dict[str, dict[str, str]] = {}
-    for function, enum_name in (("pmstep_status_str", "pmstep_status_t"), ("pmstep_fault_str", "pmstep_fault_t"),
-                                ("pmstep_mode_str", "pmstep_mode_t"),
-                                ("pmstep_identification_str", "pmstep_identification_t")):
+    for function, enum_name in (
+        ("pmstep_status_str", "pmstep_status_t"),
+        ("pmstep_fault_str", "pmstep_fault_t"),
+        ("pmstep_mode_str", "pmstep_mode_t"),
+        ("pmstep_identification_str", "pmstep_identification_t"),
+    ):
         enum_type, found, _ = parse_text_function(text_c, function)
         if enum_type != enum_name:
             raise GenError(f"{text_c.name}: {function}() takes {enum_type}, expected {enum_name}")
@@ -1245,7 +1327,7 @@ def load(root: Path = ROOT, sil: Path | None = None) -> Reference:
     groups = parse_config_fields(types_h) + [parse_stepdir_group(Source(root, STORE_H))]
     for g in groups:
         for f in g.fields:
-            unit_of(f.path, f.ctype)   # raises on an unknown suffix
+            unit_of(f.path, f.ctype)  # raises on an unknown suffix
     console_rows = parse_console_table(console_c)
     sign_rules = parse_sign_rules(config_c)
     names = {v.name for v in status}
@@ -1256,11 +1338,14 @@ def load(root: Path = ROOT, sil: Path | None = None) -> Reference:
         raise GenError(f"{config_c.name}: {', '.join(unknown)} not values of pmstep_status_t")
     init_codes = [v.name for v in status if v.name in returned]
     parse_stepdir_rules(console_c, groups[-1], names)
-    code_fields = link_config(groups, console_rows, sign_rules, status, init_codes, notes, types_h, console_c,
-                              config_c)
+    code_fields = link_config(groups, console_rows, sign_rules, status, init_codes, notes, types_h, console_c, config_c)
     constants = numeric_constants(types_h)
-    for values, what in ((status, "status code"), (faults, "fault code"), (modes, "mode"),
-                         (identification, "identification outcome")):
+    for values, what in (
+        (status, "status code"),
+        (faults, "fault code"),
+        (modes, "mode"),
+        (identification, "identification outcome"),
+    ):
         for v in values:
             if not v.doc and v.value != 0:
                 notes.append(f"{types_h.name}:{v.line}: {what} {v.name} has no doc comment (no cause on the page)")
@@ -1284,8 +1369,9 @@ def load(root: Path = ROOT, sil: Path | None = None) -> Reference:
         enum_type, found, _ = parse_text_function(stm32_c, "pmstep_stm32g4_status_str")
         if enum_type != "pmstep_stm32g4_status_t":
             raise GenError(f"{stm32_c.name}: pmstep_stm32g4_status_str() takes {enum_type}")
-        texts["pmstep_stm32g4_status_t"] = join_texts(stm32_status, found, stm32_c, "pmstep_stm32g4_status_str",
-                                                      "pmstep_stm32g4_status_t")
+        texts["pmstep_stm32g4_status_t"] = join_texts(
+            stm32_status, found, stm32_c, "pmstep_stm32g4_status_str", "pmstep_stm32g4_status_t"
+        )
         for v in stm32_status:
             if not v.doc and v.value != 0:
                 notes.append(f"{stm32_h.name}:{v.line}: {v.name} has no doc comment")
@@ -1296,14 +1382,34 @@ def load(root: Path = ROOT, sil: Path | None = None) -> Reference:
     all_paths = [f.path for g in groups for f in g.fields]
     bare = [p.rsplit(".", 1)[-1] for p in all_paths]
     names = set(all_paths) | {b for b in bare if bare.count(b) == 1}
-    return Reference(root, groups, console_rows, status, faults, modes, identification, texts, init_codes,
-                     code_fields, constants, names, console_errors, console_error_texts, console_types, console,
-                     stm32_status, stm32_faults, scenario, notes)
+    return Reference(
+        root,
+        groups,
+        console_rows,
+        status,
+        faults,
+        modes,
+        identification,
+        texts,
+        init_codes,
+        code_fields,
+        constants,
+        names,
+        console_errors,
+        console_error_texts,
+        console_types,
+        console,
+        stm32_status,
+        stm32_faults,
+        scenario,
+        notes,
+    )
 
 
 # ---------------------------------------------------------------------------------------------------
 # Pages
 # ---------------------------------------------------------------------------------------------------
+
 
 def code_link(name: str) -> str:
     return f"[{code(name)}](codes.md#{anchor(name)})"
@@ -1331,9 +1437,15 @@ def config_row(ref: Reference, f: ConfigField) -> list[str]:
     else:
         cid, access = str(f.console_id), "read-only" if f.read_only else "read/write"
     unit = unit_of(f.path, f.ctype)
-    return [cid, code(f.path) + f'<span id="{field_anchor(f.path)}"></span>', code(f.ctype),
-            esc(unit) if unit else "-", access, rich(f.doc, ref.constants, ref.names) if f.doc else "-",
-            range_cell(ref, f)]
+    return [
+        cid,
+        code(f.path) + f'<span id="{field_anchor(f.path)}"></span>',
+        code(f.ctype),
+        esc(unit) if unit else "-",
+        access,
+        rich(f.doc, ref.constants, ref.names) if f.doc else "-",
+        range_cell(ref, f),
+    ]
 
 
 def page_configuration(ref: Reference) -> str:
@@ -1363,11 +1475,15 @@ def page_configuration(ref: Reference) -> str:
         out += [f"## {title}", ""]
         struct = f"{code(g.struct)}" + (f": {esc(g.doc)}" if g.doc else "")
         if g.name == "stepdir":
-            out += [f"Not part of {code('pmstep_config_t')}: the STEP/DIR settings, a {struct}", "",
-                    "The console reads and writes them by name (`stepdir.` and the field) as the settings "
-                    "above, with the motor stopped; a record holds them with the rest. **Range** is what "
-                    f"{code(STEPDIR_VALIDATE + '()')} accepts (SET\_CONFIG's ACK and a record's check give "
-                    "its code); the core does not read them.", ""]
+            out += [
+                f"Not part of {code('pmstep_config_t')}: the STEP/DIR settings, a {struct}",
+                "",
+                "The console reads and writes them by name (`stepdir.` and the field) as the settings "
+                "above, with the motor stopped; a record holds them with the rest. **Range** is what "
+                rf"{code(STEPDIR_VALIDATE + '()')} accepts (SET\_CONFIG's ACK and a record's check give "
+                "its code); the core does not read them.",
+                "",
+            ]
         elif g.name:
             out += [f"{code(g.name)} is a {struct}", ""]
         else:
@@ -1379,9 +1495,15 @@ def page_configuration(ref: Reference) -> str:
     return "\n".join(out)
 
 
-def enum_table(values: list[EnumValue], texts: dict[str, str] | None, ref: Reference,
-               text_header: str, extra: dict[str, str] | None = None, extra_header: str | None = None,
-               group: bool = False) -> list[str]:
+def enum_table(
+    values: list[EnumValue],
+    texts: dict[str, str] | None,
+    ref: Reference,
+    text_header: str,
+    extra: dict[str, str] | None = None,
+    extra_header: str | None = None,
+    group: bool = False,
+) -> list[str]:
     headers = ["Code", "Name"] + ([text_header] if texts is not None else []) + ["Cause"]
     if group:
         headers.append("Group")
@@ -1420,50 +1542,86 @@ def page_codes(ref: Reference) -> str:
         "(see [Configuration](configuration.md)).",
         "",
     ]
-    settings = {c: "<br>".join(f"[{code(p)}](configuration.md#{field_anchor(p)})" for p in ps)
-                for c, ps in ref.code_fields.items() if ps}
-    out += enum_table(ref.status, ref.texts["pmstep_status_t"], ref, "Text", settings, "Settings",
-                      group=True)
-    out += ["", f"## Fault codes ({code('pmstep_fault_t')})", "",
-            f"Latched by {code('pmstep_step()')} (the drive goes to FAULT, bridge off). "
-            f"Text: {code('pmstep_fault_str()')}.", ""]
+    settings = {
+        c: "<br>".join(f"[{code(p)}](configuration.md#{field_anchor(p)})" for p in ps)
+        for c, ps in ref.code_fields.items()
+        if ps
+    }
+    out += enum_table(ref.status, ref.texts["pmstep_status_t"], ref, "Text", settings, "Settings", group=True)
+    out += [
+        "",
+        f"## Fault codes ({code('pmstep_fault_t')})",
+        "",
+        f"Latched by {code('pmstep_step()')} (the drive goes to FAULT, bridge off). "
+        f"Text: {code('pmstep_fault_str()')}.",
+        "",
+    ]
     out += enum_table(ref.faults, ref.texts["pmstep_fault_t"], ref, "Text")
     out += ["", f"## Modes ({code('pmstep_mode_t')})", "", f"Text: {code('pmstep_mode_str()')}.", ""]
     out += enum_table(ref.modes, ref.texts["pmstep_mode_t"], ref, "Text")
-    out += ["", f"## Identification outcomes ({code('pmstep_identification_t')})", "",
-            f"The identification of J and F at the start of RUN. Text: {code('pmstep_identification_str()')}.", ""]
+    out += [
+        "",
+        f"## Identification outcomes ({code('pmstep_identification_t')})",
+        "",
+        f"The identification of J and F at the start of RUN. Text: {code('pmstep_identification_str()')}.",
+        "",
+    ]
     out += enum_table(ref.identification, ref.texts["pmstep_identification_t"], ref, "Text")
     out += ["", f"## Console error replies ({code('pmstep_console_error_t')})", ""]
     out += console_errors_section(ref)
-    out += ["", f"## Stored configuration status codes ({code('pmstep_store_status_t')})", "",
-            f"What a load, save, erase or a record written on the console came to ({code(STORE_H)}); an ACK of "
-            f"{code('CONFIG_APPLY')}, {code('CONFIG_SAVE')} or {code('CONFIG_ERASE')} carries one, and "
-            f"{code('CONFIG_STATUS')} the boot's.", ""]
+    out += [
+        "",
+        f"## Stored configuration status codes ({code('pmstep_store_status_t')})",
+        "",
+        f"What a load, save, erase or a record written on the console came to ({code(STORE_H)}); an ACK of "
+        f"{code('CONFIG_APPLY')}, {code('CONFIG_SAVE')} or {code('CONFIG_ERASE')} carries one, and "
+        f"{code('CONFIG_STATUS')} the boot's.",
+        "",
+    ]
     out += enum_table(parse_enum(Source(ref.root, STORE_H), "pmstep_store_status_t"), None, ref, "")
-    out += ["", f"## Self-commissioning status codes ({code('pmstep_calibrate_status_t')})", "",
-            f"Why a calibration ({code(CALIBRATE_H)}) failed: {code('CALIBRATE_STATUS')}'s status; a design the designer "
-            "or the core refused gives its status code above instead.", ""]
+    out += [
+        "",
+        f"## Self-commissioning status codes ({code('pmstep_calibrate_status_t')})",
+        "",
+        f"Why a calibration ({code(CALIBRATE_H)}) failed: {code('CALIBRATE_STATUS')}'s status; a design the designer "
+        "or the core refused gives its status code above instead.",
+        "",
+    ]
     out += enum_table(parse_enum(Source(ref.root, CALIBRATE_H), "pmstep_calibrate_status_t"), None, ref, "")
     if ref.stm32_status is not None:
-        out += ["", f"## STM32G4 port status codes ({code('pmstep_stm32g4_status_t')})", "",
-                f"Returned by the port's set-up calls. Text: {code('pmstep_stm32g4_status_str()')}.", ""]
+        out += [
+            "",
+            f"## STM32G4 port status codes ({code('pmstep_stm32g4_status_t')})",
+            "",
+            f"Returned by the port's set-up calls. Text: {code('pmstep_stm32g4_status_str()')}.",
+            "",
+        ]
         out += enum_table(ref.stm32_status, ref.texts["pmstep_stm32g4_status_t"], ref, "Text")
-        out += ["", f"## STM32G4 port faults ({code('pmstep_stm32g4_fault_t')})", "",
-                "Why the port holds the bridge off, independently of the core (the console's "
-                f"{code('port_fault')}). The port has no text function for these.", ""]
+        out += [
+            "",
+            f"## STM32G4 port faults ({code('pmstep_stm32g4_fault_t')})",
+            "",
+            "Why the port holds the bridge off, independently of the core (the console's "
+            f"{code('port_fault')}). The port has no text function for these.",
+            "",
+        ]
         out += enum_table(ref.stm32_faults, None, ref, "")
     out.append("")
     return "\n".join(out)
 
 
 def console_errors_section(ref: Reference, anchors: bool = True) -> list[str]:
-    out = [f"An error reply has TYPE 0xFF and DATA = the request's TYPE, then one of these codes. "
-           f"Text: the host tool's ({code(CONSOLE_PY)}, {code('ERRORS')}).", ""]
+    out = [
+        f"An error reply has TYPE 0xFF and DATA = the request's TYPE, then one of these codes. "
+        f"Text: the host tool's ({code(CONSOLE_PY)}, {code('ERRORS')}).",
+        "",
+    ]
     rows = []
     for v in ref.console_errors:
         name = code(v.name) + (f'<span id="{anchor(v.name)}"></span>' if anchors else "")
-        rows.append([str(v.value), name, esc(ref.console_error_texts[v.value]),
-                     rich(v.doc, {}, ref.names) if v.doc else "-"])
+        rows.append(
+            [str(v.value), name, esc(ref.console_error_texts[v.value]), rich(v.doc, {}, ref.names) if v.doc else "-"]
+        )
     out += table(["Code", "Name", "Text", "Cause"], rows)
     return out
 
@@ -1491,29 +1649,49 @@ def page_console(ref: Reference) -> str:
     out += ["## Framing", ""]
     out += prose(c.prose_before)
     if c.constants:
-        out += table(["Constant", "Value", "Meaning"],
-                     [[code(n), code(re.sub(r"(?<=[0-9A-Fa-f])[uU]$", "", v)), esc(d) if d else "-"]
-                      for n, v, d in c.constants])
+        out += table(
+            ["Constant", "Value", "Meaning"],
+            [[code(n), code(re.sub(r"(?<=[0-9A-Fa-f])[uU]$", "", v)), esc(d) if d else "-"] for n, v, d in c.constants],
+        )
         out.append("")
-    out += ["## Requests", "",
-            f"One row per entry of the request table ({code('requests[]')} in {code(CONSOLE_REQUEST_C)}), with "
-            f"the DATA layout and the reply as the header describes them. **Reply TYPE** is the request's "
-            f"{code('TYPE | 0x80')}. **Needs**: what the image must have, else the error reply named. "
-            f"**DATA bytes**: the lengths accepted (else {code('BAD_LENGTH')}).", ""]
+    out += [
+        "## Requests",
+        "",
+        f"One row per entry of the request table ({code('requests[]')} in {code(CONSOLE_REQUEST_C)}), with "
+        f"the DATA layout and the reply as the header describes them. **Reply TYPE** is the request's "
+        f"{code('TYPE | 0x80')}. **Needs**: what the image must have, else the error reply named. "
+        f"**DATA bytes**: the lengths accepted (else {code('BAD_LENGTH')}).",
+        "",
+    ]
     rows = []
     for r in c.requests:
-        needs = "-" if r.needs == "NEEDS_NOTHING" else code(r.needs) + (f": {rich(r.needs_text, {})}"
-                                                                        if r.needs_text else "")
+        needs = (
+            "-"
+            if r.needs == "NEEDS_NOTHING"
+            else code(r.needs) + (f": {rich(r.needs_text, {})}" if r.needs_text else "")
+        )
         length = str(r.min_length) if r.min_length == r.max_length else f"{r.min_length} to {r.max_length}"
         data = "-" if r.data == "-" else rich(r.data, {})
-        rows.append([code(f"0x{r.code:02X}"), code(r.name), code(f"0x{r.code | 0x80:02X}"), needs, length, data,
-                     rich(r.reply, {})])
+        rows.append(
+            [
+                code(f"0x{r.code:02X}"),
+                code(r.name),
+                code(f"0x{r.code | 0x80:02X}"),
+                needs,
+                length,
+                data,
+                rich(r.reply, {}),
+            ]
+        )
     out += table(["TYPE", "Request", "Reply TYPE", "Needs", "DATA bytes", "DATA", "Reply"], rows)
     out.append("")
     for r, other in c.shared_replies:
-        out += ['!!! warning "A reply TYPE that another frame has too"',
-                f"    The reply to {code(r.name)} has TYPE {code(f'0x{r.code | 0x80:02X}')}, which is also the TYPE of "
-                f"{code(other)}: a client cannot tell the two apart by TYPE alone.", ""]
+        out += [
+            '!!! warning "A reply TYPE that another frame has too"',
+            f"    The reply to {code(r.name)} has TYPE {code(f'0x{r.code | 0x80:02X}')}, which is also the TYPE of "
+            f"{code(other)}: a client cannot tell the two apart by TYPE alone.",
+            "",
+        ]
     if c.other_types:
         out += ["Frame types that are not requests (sent by the drive):", ""]
         out += table(["TYPE", "Name"], [[code(f"0x{v.value:02X}"), code(v.name)] for v in c.other_types])
@@ -1534,8 +1712,9 @@ def range_text(k: ScenarioKey) -> str:
 def page_scenario(ref: Reference) -> str:
     s = ref.scenario
     out = ["# Scenario keys", ""]
-    out += generated_banner([SCENARIO_KEYS_C, SCENARIO_KEYS_H]
-                            + (["pmstep-sil --print-scenario"] if s.defaults_from else []))
+    out += generated_banner(
+        [SCENARIO_KEYS_C, SCENARIO_KEYS_H] + (["pmstep-sil --print-scenario"] if s.defaults_from else [])
+    )
     big = fmt_number(float(s.big))
     out += [
         f"Every key of a {code('pmstep-sil')} scenario: an INI file ({code('--scenario FILE')}) on top of the "
@@ -1551,8 +1730,10 @@ def page_scenario(ref: Reference) -> str:
         "",
     ]
     if s.defaults_from:
-        out += [f"**Paper**: the value in the built-in paper scenario "
-                f"(from {code('pmstep-sil --print-scenario')}).", ""]
+        out += [
+            f"**Paper**: the value in the built-in paper scenario (from {code('pmstep-sil --print-scenario')}).",
+            "",
+        ]
     sections: dict[str, list[ScenarioKey]] = {}
     for k in s.keys:
         sections.setdefault(k.name.rpartition(".")[0], []).append(k)
@@ -1574,14 +1755,24 @@ def page_scenario(ref: Reference) -> str:
             rows.append(row)
         out += table(headers, rows)
         out.append("")
-    out += ["## Enumerated values", "",
-            f"The values of the enumerated key types ({code(SCENARIO_KEYS_H)}), in the order of the C enums "
-            "they stand for.", ""]
+    out += [
+        "## Enumerated values",
+        "",
+        f"The values of the enumerated key types ({code(SCENARIO_KEYS_H)}), in the order of the C enums "
+        "they stand for.",
+        "",
+    ]
     rows = []
     for t, values in s.enums.items():
         users = [k.name for k in s.keys if k.type == t]
-        rows.append([code(t), code(s.enum_arrays[t]), ", ".join(code(v) for v in values),
-                     "<br>".join(code(u) for u in users) if users else "-"])
+        rows.append(
+            [
+                code(t),
+                code(s.enum_arrays[t]),
+                ", ".join(code(v) for v in values),
+                "<br>".join(code(u) for u in users) if users else "-",
+            ]
+        )
     out += table(["Key type", "Names", "Values", "Keys"], rows)
     out.append("")
     return "\n".join(out)
@@ -1599,12 +1790,13 @@ PAGES = {
 # Tables in hand-written pages
 # ---------------------------------------------------------------------------------------------------
 
+
 @dataclass
 class PinUse:
-    function: str     # "STEP input"
-    signal: str       # "TIM4_CH2", "GPIO input"
-    field: str        # the member of step_input: step_pin
-    pin: str          # PB7
+    function: str  # "STEP input"
+    signal: str  # "TIM4_CH2", "GPIO input"
+    field: str  # the member of step_input: step_pin
+    pin: str  # PB7
     af: int
     line: int
 
@@ -1614,7 +1806,7 @@ def parse_stepdir_pins(board_c: Source) -> list[PinUse]:
     "SIGNAL", 0u, cfg->step_input.FIELD};`, in order) with the pins pmstep_stm32g4_default_config() gives
     those fields (`c.step_input.FIELD = (pmstep_stm32g4_pin_t){PORT, PIN, AF};`)."""
     ports = {}
-    for i, line in enumerate(board_c.lines):
+    for line in board_c.lines:
         m = re.match(r"^#define (P[A-G]) (\d+)u\s*$", line)
         if m:
             ports[m.group(1)] = int(m.group(2))
@@ -1631,8 +1823,11 @@ def parse_stepdir_pins(board_c: Source) -> list[PinUse]:
     for i, line in enumerate(board_c.lines):
         if "cfg->step_input." not in line or "pmstep_stm32g4_pin_use_t" not in line:
             continue
-        m = re.match(r'^\s*all\[n\+\+\] = \(pmstep_stm32g4_pin_use_t\)\{"([^"]+)", "([^"]+)", 0u, '
-                     r"cfg->step_input\.(\w+)\};\s*$", line)
+        m = re.match(
+            r'^\s*all\[n\+\+\] = \(pmstep_stm32g4_pin_use_t\)\{"([^"]+)", "([^"]+)", 0u, '
+            r"cfg->step_input\.(\w+)\};\s*$",
+            line,
+        )
         if not m:
             raise board_c.error(i, f"STEP/DIR pin map row not understood: {line.strip()!r}")
         if m.group(3) not in defaults:
@@ -1656,8 +1851,10 @@ def pin_mode(use: PinUse) -> str:
 
 
 def table_stm32g4_stepdir_pins(root: Path) -> list[str]:
-    rows = [[esc(u.function), u.pin, esc(u.signal), pin_mode(u), code(f"step_input.{u.field}")]
-            for u in parse_stepdir_pins(Source(root, STM32G4_BOARD_C))]
+    rows = [
+        [esc(u.function), u.pin, esc(u.signal), pin_mode(u), code(f"step_input.{u.field}")]
+        for u in parse_stepdir_pins(Source(root, STM32G4_BOARD_C))
+    ]
     return table(["Signal", "Pin", "MCU signal", "Mode", "Pin setting"], rows)
 
 
@@ -1670,8 +1867,10 @@ PAGE_TABLES = {
 
 
 def table_markers(name: str, sources: list[str]) -> tuple[str, str]:
-    begin = (f"<!-- Generated by tools/gen_reference.py ({name}) from {', '.join(sources)}: do not edit down to "
-             "the end marker; edit the sources and run it again. -->")
+    begin = (
+        f"<!-- Generated by tools/gen_reference.py ({name}) from {', '.join(sources)}: do not edit down to "
+        "the end marker; edit the sources and run it again. -->"
+    )
     return begin, f"<!-- End of the table generated by tools/gen_reference.py ({name}). -->"
 
 
@@ -1680,8 +1879,9 @@ def fill_tables(text: str, page: str, root: Path) -> str:
     for name, (sources, render) in PAGE_TABLES[page].items():
         begin, end = table_markers(name, sources)
         if text.count(begin) != 1 or text.count(end) != 1:
-            raise GenError(f"{page}: the markers of the generated table {name} must be there once each:\n  {begin}\n"
-                           f"  {end}")
+            raise GenError(
+                f"{page}: the markers of the generated table {name} must be there once each:\n  {begin}\n  {end}"
+            )
         head, rest = text.split(begin, 1)
         if end not in rest:
             raise GenError(f"{page}: the end marker of the generated table {name} comes before its start")
@@ -1714,7 +1914,7 @@ def write_page_tables(texts: dict[Path, tuple[str, str]]) -> list[Path]:
 
 
 def write_pages(ref: Reference, out_dir: Path) -> list[Path]:
-    texts = {name: render(ref) for name, render in PAGES.items()}   # all rendered before any is written
+    texts = {name: render(ref) for name, render in PAGES.items()}  # all rendered before any is written
     out_dir.mkdir(parents=True, exist_ok=True)
     written = []
     for name, text in texts.items():
@@ -1725,19 +1925,32 @@ def write_pages(ref: Reference, out_dir: Path) -> list[Path]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--out", type=Path, default=ROOT / "docs" / "reference",
-                        help="folder of the pages (default: docs/reference of this tree)")
-    parser.add_argument("--docs", type=Path, default=ROOT / "docs",
-                        help="folder of the hand-written pages with generated tables (default: docs/ of this tree)")
-    parser.add_argument("--sil", type=Path, default=None,
-                        help="a pmstep-sil binary: cross-check the scenario keys against its --print-scenario "
-                             "and add the paper scenario's values")
+    parser = argparse.ArgumentParser(
+        description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument(
+        "--out",
+        type=Path,
+        default=ROOT / "docs" / "reference",
+        help="folder of the pages (default: docs/reference of this tree)",
+    )
+    parser.add_argument(
+        "--docs",
+        type=Path,
+        default=ROOT / "docs",
+        help="folder of the hand-written pages with generated tables (default: docs/ of this tree)",
+    )
+    parser.add_argument(
+        "--sil",
+        type=Path,
+        default=None,
+        help="a pmstep-sil binary: cross-check the scenario keys against its --print-scenario "
+        "and add the paper scenario's values",
+    )
     args = parser.parse_args(argv)
     try:
         ref = load(ROOT, args.sil)
-        page_tables = render_page_tables(ROOT, args.docs)   # before any page is written
+        page_tables = render_page_tables(ROOT, args.docs)  # before any page is written
         written = write_pages(ref, args.out)
         tables = write_page_tables(page_tables)
     except GenError as e:

@@ -3,6 +3,7 @@ and the draws (see monte_carlo.py for the whole tool).
 
 Every scenario key comes from scenario_keys.KEYS.
 """
+
 import configparser
 import math
 
@@ -39,8 +40,8 @@ DISTRIBUTIONS = [
     (KEYS["firmware_dead_time"], "times " + KEYS["inverter_dead_time"], 0.9, 1.1),
 ]
 
-SEED_STRIDE = 100000          # case seed = base seed * SEED_STRIDE + case index
-SEED_KEY = KEYS["seed"]       # the SIL's noise seed
+SEED_STRIDE = 100000  # case seed = base seed * SEED_STRIDE + case index
+SEED_KEY = KEYS["seed"]  # the SIL's noise seed
 DURATION_KEY = KEYS["duration"]
 
 # Drawn parameters shown in the worst-case table (key, column title, show as factor).
@@ -75,12 +76,12 @@ def split_case_seed(seed):
 
 def parse_scenario(text):
     """Scenario INI text (pmstep-sil --print-scenario) to {"section.key": "value"}."""
-    parser = configparser.ConfigParser(comment_prefixes=(";", "#"), inline_comment_prefixes=None,
-                                       interpolation=None, strict=False)
+    parser = configparser.ConfigParser(
+        comment_prefixes=(";", "#"), inline_comment_prefixes=None, interpolation=None, strict=False
+    )
     parser.optionxform = str  # keep the keys' case
     parser.read_string(text)
-    return {f"{section}.{key}": value.strip()
-            for section in parser.sections() for key, value in parser.items(section)}
+    return {f"{section}.{key}": value.strip() for section in parser.sections() for key, value in parser.items(section)}
 
 
 def missing_keys(scenario, table=DISTRIBUTIONS, extra=(SEED_KEY,)):
@@ -121,8 +122,8 @@ def draw_parameters(seed, base, table=DISTRIBUTIONS):
             params[key] = base[key] * u
         elif kind == "uniform":
             params[key] = u
-        elif kind.startswith("times ") and kind[len("times "):] in params:
-            params[key] = params[kind[len("times "):]] * u
+        elif kind.startswith("times ") and kind[len("times ") :] in params:
+            params[key] = params[kind[len("times ") :]] * u
         else:
             raise ValueError(f"{key}: unknown distribution kind '{kind}'")
     return params
@@ -141,8 +142,9 @@ def distribution_rows(scenario):
             value = float(scenario[key])
             rows.append((key, f"scenario value x U[{a:g}, {b:g}]", f"{value:g}", f"[{value * a:.4g}, {value * b:.4g})"))
         elif kind.startswith("times "):
-            rows.append((key, f"{kind[len('times '):]} x U[{a:g}, {b:g}]", f"{scenario.get(key, '-')} (replaced)",
-                         "-"))
+            rows.append(
+                (key, f"{kind[len('times ') :]} x U[{a:g}, {b:g}]", f"{scenario.get(key, '-')} (replaced)", "-")
+            )
         else:
             rows.append((key, f"U[{a:g}, {b:g}]", f"{scenario.get(key, '-')} (replaced)", f"[{a:g}, {b:g})"))
     return rows

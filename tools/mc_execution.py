@@ -12,6 +12,7 @@ which unpickles the graph, and the workers, which run it, need Python with the s
 dask.distributed and, on the workers, the pmstep-sil binary (shipped with --ship-sil) and its
 shared libraries; nothing of the project on their path, and no folder shared with the client.
 """
+
 import configparser
 import hashlib
 import json
@@ -26,13 +27,22 @@ import tempfile
 import threading
 import time
 
-from mc_distributions import DISTRIBUTIONS, DURATION_KEY, SEED_KEY, ToolError, draw_parameters, format_value, \
-    missing_keys, parse_scenario, split_case_seed
+from mc_distributions import (
+    DISTRIBUTIONS,
+    DURATION_KEY,
+    SEED_KEY,
+    ToolError,
+    draw_parameters,
+    format_value,
+    missing_keys,
+    parse_scenario,
+    split_case_seed,
+)
 from mc_outcome import FAULT_EXIT_STATUS, classify, extract_metrics, fault_name
 
 STDERR_TAIL_CHARS = 2000
 ENGINES = ("dask", "threads")
-RESULT_FILE = "result.json"   # cases/<seed>/result.json: a finished case (what run_sil returned)
+RESULT_FILE = "result.json"  # cases/<seed>/result.json: a finished case (what run_sil returned)
 CAMPAIGN_FILE = "campaign.json"
 # Dask's own periodic work, slowed for a local cluster whose workers spend their time waiting for
 # pmstep-sil: no statistical profiler (it samples the running thread every 10 ms for a dashboard
@@ -40,8 +50,13 @@ CAMPAIGN_FILE = "campaign.json"
 # memory and system monitors every 1 and 2 s instead of 100 and 500 ms. Measured on 2 workers
 # each waiting 10 s for a subprocess: 1.3 s of CPU (workers and client together) with Dask's
 # defaults, 0.2 s with these: 5 % of a 2-core machine back for pmstep-sil.
-QUIET_DASK = {"distributed.worker.profile.enabled": False, "distributed.admin.tick.interval": "1s",
-              "distributed.worker.memory.monitor-interval": "1s", "distributed.admin.system-monitor.interval": "2s"}
+QUIET_DASK = {
+    "distributed.worker.profile.enabled": False,
+    "distributed.admin.tick.interval": "1s",
+    "distributed.worker.memory.monitor-interval": "1s",
+    "distributed.admin.system-monitor.interval": "2s",
+}
+
 
 def read_scenario(sil, scenario_file):
     """{"section.key": value} of the scenario as pmstep-sil applies it (--print-scenario)."""
@@ -84,7 +99,7 @@ def check_keys(sil, scenario_file, scenario, need_duration):
             if kind == "scale":
                 how = f"scenario value x U[{a:g}, {b:g}]"
             elif kind.startswith("times "):
-                how = f"{kind[len('times '):]} x U[{a:g}, {b:g}]"
+                how = f"{kind[len('times ') :]} x U[{a:g}, {b:g}]"
             else:
                 how = f"U[{a:g}, {b:g}]"
             lines.append(f"  {key:34s} drawn {how}")
@@ -97,7 +112,8 @@ def check_keys(sil, scenario_file, scenario, need_duration):
         + "\n".join(lines)
         + f"\n(its keys: {shlex.join([sil, '--scenario', scenario_file, '--print-scenario'])})\n"
         "Rebuild pmstep-sil from a tree that has them (cmake --build --preset host-release) or point --sil "
-        "at one that does; no key is skipped.")
+        "at one that does; no key is skipped."
+    )
 
 
 def sil_arguments(seed, params, duration):
@@ -121,7 +137,18 @@ def sil_command(args, seed, params, case_dir, csv_output):
 def rerun_command(args, seed):
     """The command that re-runs one case with this tool (same bounds, same output folder)."""
     if getattr(args, "preset", None):
-        cmd = ["python3", args.script, "--sil", args.sil, "--preset", args.preset, "--tune", args.tune, "--out", args.out]
+        cmd = [
+            "python3",
+            args.script,
+            "--sil",
+            args.sil,
+            "--preset",
+            args.preset,
+            "--tune",
+            args.tune,
+            "--out",
+            args.out,
+        ]
         if getattr(args, "phase_voltage_sensing", False):
             cmd += ["--phase-voltage-sensing"]
     else:
@@ -153,8 +180,10 @@ class Progress:
         with self.lock:
             elapsed_s = time.monotonic() - self.start_s
             eta_s = elapsed_s / done * (self.total - done) if done else math.nan
-            line = (f"monte_carlo: {done}/{self.total} cases ({100.0 * done / self.total:.0f} %), "
-                    f"{failures} failure{'s' if failures != 1 else ''}, elapsed {elapsed_s:.1f} s, ETA {eta_s:.1f} s")
+            line = (
+                f"monte_carlo: {done}/{self.total} cases ({100.0 * done / self.total:.0f} %), "
+                f"{failures} failure{'s' if failures != 1 else ''}, elapsed {elapsed_s:.1f} s, ETA {eta_s:.1f} s"
+            )
             if self.tty:
                 self.stream.write("\r" + line + "\033[K" + ("\n" if done == self.total else ""))  # [K: clear the rest
                 self.stream.flush()
@@ -173,6 +202,7 @@ def worker_address():
     """The Dask worker this runs on ("" outside a worker)."""
     try:
         from distributed import get_worker
+
         return get_worker().address
     except (ImportError, ValueError):
         return ""
@@ -182,6 +212,7 @@ def shipped_sil_path(name):
     """Path of a pmstep-sil shipped to this Dask worker (--ship-sil), made executable; None if none."""
     try:
         from distributed import get_worker
+
         worker = get_worker()
     except (ImportError, ValueError):
         return None
@@ -202,8 +233,15 @@ def run_sil(task):
     "summary" (parsed summary.json or None), "host", "worker"}. Runs in a temporary folder it removes.
     """
     sil = task["sil"] or shipped_sil_path(task["sil_name"])
-    result = {"seed": task["seed"], "exit_status": None, "problem": None, "stderr_tail": "", "summary": None,
-              "host": os.uname().nodename, "worker": worker_address()}
+    result = {
+        "seed": task["seed"],
+        "exit_status": None,
+        "problem": None,
+        "stderr_tail": "",
+        "summary": None,
+        "host": os.uname().nodename,
+        "worker": worker_address(),
+    }
     if sil is None:
         result["problem"] = f"no pmstep-sil on this worker ({task['sil_name']} was not shipped)"
         return result
@@ -215,8 +253,14 @@ def run_sil(task):
         out = os.path.join(work, "out")
         cmd = [sil, "--scenario", scenario_path, "--out", out, "--quiet", "--no-csv"] + task["set"]
         try:
-            proc = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
-                                  errors="replace", timeout=task["timeout_s"])
+            proc = subprocess.run(
+                cmd,
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.PIPE,
+                text=True,
+                errors="replace",
+                timeout=task["timeout_s"],
+            )
             result["exit_status"], stderr_text = proc.returncode, proc.stderr
         except subprocess.TimeoutExpired as e:
             result["problem"] = f"timed out after {task['timeout_s']:g} s"
@@ -243,8 +287,15 @@ def make_record(args, result, params, base, command):
     """The record of one case (what the report and cases.csv use) from what run_sil returned."""
     summary = result["summary"]
     exit_status = result["exit_status"]
-    outcome = classify(summary, exit_status, args.speed_bound, args.angle_bound, args.latency_bound,
-                       result["problem"], getattr(args, "position_bound", None))
+    outcome = classify(
+        summary,
+        exit_status,
+        args.speed_bound,
+        args.angle_bound,
+        args.latency_bound,
+        result["problem"],
+        getattr(args, "position_bound", None),
+    )
     seed = result["seed"]
     return {
         "seed": seed,
@@ -257,8 +308,11 @@ def make_record(args, result, params, base, command):
         "latency_s": outcome["latency_s"],
         "reason": outcome["reason"],
         "fault_name": fault_name(summary) if isinstance(summary, dict) and outcome["class"] != "crashed" else "",
-        "metrics": (dict(extract_metrics(summary, params, base), failure_time_s=outcome["failure_time_s"])
-                    if outcome["class"] != "crashed" else {}),
+        "metrics": (
+            dict(extract_metrics(summary, params, base), failure_time_s=outcome["failure_time_s"])
+            if outcome["class"] != "crashed"
+            else {}
+        ),
         "stderr_tail": result["stderr_tail"] if outcome["class"] == "crashed" else "",
         "summary": summary,
         "host": result.get("host", ""),
@@ -274,12 +328,24 @@ def run_case(args, seed, base, csv_output=False):
         if os.path.exists(os.path.join(case_dir, stale)):
             os.remove(os.path.join(case_dir, stale))
     cmd = sil_command(args, seed, params, case_dir, csv_output)
-    result = {"seed": seed, "exit_status": None, "problem": None, "stderr_tail": "", "summary": None,
-              "host": os.uname().nodename}
+    result = {
+        "seed": seed,
+        "exit_status": None,
+        "problem": None,
+        "stderr_tail": "",
+        "summary": None,
+        "host": os.uname().nodename,
+    }
     stderr_text = ""
     try:
-        proc = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
-                              errors="replace", timeout=args.case_timeout)
+        proc = subprocess.run(
+            cmd,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+            text=True,
+            errors="replace",
+            timeout=args.case_timeout,
+        )
         result["exit_status"], stderr_text = proc.returncode, proc.stderr
     except subprocess.TimeoutExpired as e:
         result["problem"] = f"timed out after {args.case_timeout:g} s"
@@ -342,8 +408,10 @@ def open_campaign(args, scenario_text):
             raise ToolError(f"{path} unreadable ({e}): remove it, or use another --out") from None
         differ = [key for key in identity if stored.get(key) != identity[key]]
         if differ:
-            raise ToolError(f"{args.out} holds another campaign ({', '.join(differ)} differ): its finished cases "
-                            "would not be this campaign's; use another --out (or remove the folder)")
+            raise ToolError(
+                f"{args.out} holds another campaign ({', '.join(differ)} differ): its finished cases "
+                "would not be this campaign's; use another --out (or remove the folder)"
+            )
     else:
         os.makedirs(args.out, exist_ok=True)
         write_json_atomic(path, identity)
@@ -377,10 +445,15 @@ def store_result(args, result):
 def make_task(args, seed, base, scenario_text, shipped):
     """What run_sil needs for one case, and the case's drawn parameters."""
     params = draw_parameters(seed, base)
-    task = {"seed": seed, "sil": None if shipped else os.path.abspath(args.sil),
-            "sil_name": os.path.basename(args.sil), "scenario_text": scenario_text,
-            "scenario_name": os.path.basename(args.scenario), "set": sil_arguments(seed, params, args.duration),
-            "timeout_s": args.case_timeout}
+    task = {
+        "seed": seed,
+        "sil": None if shipped else os.path.abspath(args.sil),
+        "sil_name": os.path.basename(args.sil),
+        "scenario_text": scenario_text,
+        "scenario_name": os.path.basename(args.scenario),
+        "set": sil_arguments(seed, params, args.duration),
+        "timeout_s": args.case_timeout,
+    }
     return task, params
 
 
@@ -437,13 +510,17 @@ def run_dask(args, tasks, on_result):
         from distributed import Client, LocalCluster, as_completed
         from distributed.diagnostics.plugin import UploadFile
     except ImportError as e:
-        raise ToolError(f"the Dask engine needs dask.distributed ({e}): install tools/requirements.txt "
-                        "(e.g. tools/setup_venv.sh, then run with .venv/bin/python) or pass --engine threads") from None
+        raise ToolError(
+            f"the Dask engine needs dask.distributed ({e}): install tools/requirements.txt "
+            "(e.g. tools/setup_venv.sh, then run with .venv/bin/python) or pass --engine threads"
+        ) from None
     # The scheduler and the workers need nothing of these tools: run_sil travels by value (and
     # ShipSil below, a class of this module registered by value, too).
     case = ByValue(run_sil)
     cluster = None
-    with dask.config.set(QUIET_DASK):  # the local cluster's processes and this client (an external cluster's are its own)
+    with dask.config.set(
+        QUIET_DASK
+    ):  # the local cluster's processes and this client (an external cluster's are its own)
         if args.scheduler:
             client = Client(args.scheduler, timeout="60s")
         else:
@@ -451,13 +528,15 @@ def run_dask(args, tasks, on_result):
             client = Client(cluster)
     try:
         if args.ship_sil:
+
             class ShipSil(UploadFile):
                 name = "pmstep-sil"  # its own plugin name, beside any other uploaded file
 
             client.register_plugin(ShipSil(args.sil, load=False))
         workers = len(client.scheduler_info(n_workers=-1)["workers"]) if args.scheduler else args.jobs
-        futures = client.map(case, tasks, key=[f"pmstep-case-{task['seed']}" for task in tasks], pure=False,
-                             batch_size=DASK_BATCH)
+        futures = client.map(
+            case, tasks, key=[f"pmstep-case-{task['seed']}" for task in tasks], pure=False, batch_size=DASK_BATCH
+        )
         try:
             for future in as_completed(futures):
                 on_result(future.result())
@@ -499,8 +578,11 @@ def run_all(args, base, scenario_text):
         progress.update(counter["done"], counter["failures"])
 
     if done:
-        print(f"monte_carlo: resuming {args.out}: {len(done)} of {len(args.seeds)} cases already finished, "
-              f"{len(tasks)} to run", file=sys.stderr)
+        print(
+            f"monte_carlo: resuming {args.out}: {len(done)} of {len(args.seeds)} cases already finished, "
+            f"{len(tasks)} to run",
+            file=sys.stderr,
+        )
     for seed in args.seeds:
         if seed in done:
             on_result(done[seed], stored=True)

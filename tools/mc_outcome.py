@@ -1,10 +1,11 @@
 """Monte Carlo campaigns, part 2a: the outcome of one case. Its class against the bounds and
 the numbers the report uses, from pmstep-sil's exit status and summary.json (see monte_carlo.py
 for the whole tool)."""
+
 import math
 import signal
 
-FAULT_EXIT_STATUS = 3         # pmstep-sil: the run finished and a fault is latched
+FAULT_EXIT_STATUS = 3  # pmstep-sil: the run finished and a fault is latched
 
 CLASSES = ("success", "detected", "silent", "out_of_spec", "crashed")
 CLASS_TEXT = {
@@ -72,8 +73,15 @@ def fault_name(summary):
     return str(fault.get("name") or fault.get("text") or f"code {fault.get('code')}")
 
 
-def classify(summary, exit_status, speed_bound_rad_s=0.5, angle_bound_rad=0.05, latency_bound_s=0.05,
-             problem=None, position_bound_rad=None):
+def classify(
+    summary,
+    exit_status,
+    speed_bound_rad_s=0.5,
+    angle_bound_rad=0.05,
+    latency_bound_s=0.05,
+    problem=None,
+    position_bound_rad=None,
+):
     """Class of one run: dict with "class", "false_trip", "latency_s", "reason".
 
     summary: the parsed summary.json (None if missing or unparsable); exit_status: the
@@ -82,9 +90,15 @@ def classify(summary, exit_status, speed_bound_rad_s=0.5, angle_bound_rad=0.05, 
     position_bound_rad: a position scenario's success also needs every move issued, finished and
     ending within this many electrical rad of its target (summary.json "position").
     """
+
     def result(cls, reason, false_trip=False, latency_s=None, failure_time_s=None):
-        return {"class": cls, "false_trip": false_trip, "latency_s": latency_s, "reason": reason,
-                "failure_time_s": failure_time_s}
+        return {
+            "class": cls,
+            "false_trip": false_trip,
+            "latency_s": latency_s,
+            "reason": reason,
+            "failure_time_s": failure_time_s,
+        }
 
     if problem:
         return result("crashed", problem)
@@ -113,22 +127,35 @@ def classify(summary, exit_status, speed_bound_rad_s=0.5, angle_bound_rad=0.05, 
 
     if fault_code != 0:
         if not lost:
-            return result("detected", f"false trip: {fault_name(summary)} without loss of control", false_trip=True,
-                          failure_time_s=summary["fault"]["time_s"])
+            return result(
+                "detected",
+                f"false trip: {fault_name(summary)} without loss of control",
+                false_trip=True,
+                failure_time_s=summary["fault"]["time_s"],
+            )
         latency_s = number_or_none(rob.get("detection_latency_s"))
         if latency_s is None:
             latency_s = summary["fault"]["time_s"] - loss_time_s
         if latency_s > latency_bound_s:
-            return result("silent", f"loss of control at {loss_time_s:.6g} s, {fault_name(summary)} "
-                                    f"only {latency_s:.3g} s later (> {latency_bound_s:g} s)", latency_s=latency_s,
-                          failure_time_s=loss_time_s)
-        return result("detected", f"loss of control at {loss_time_s:.6g} s caught by {fault_name(summary)} "
-                                  f"after {latency_s:.3g} s", latency_s=latency_s, failure_time_s=loss_time_s)
+            return result(
+                "silent",
+                f"loss of control at {loss_time_s:.6g} s, {fault_name(summary)} "
+                f"only {latency_s:.3g} s later (> {latency_bound_s:g} s)",
+                latency_s=latency_s,
+                failure_time_s=loss_time_s,
+            )
+        return result(
+            "detected",
+            f"loss of control at {loss_time_s:.6g} s caught by {fault_name(summary)} after {latency_s:.3g} s",
+            latency_s=latency_s,
+            failure_time_s=loss_time_s,
+        )
     if lost:
         realignments = number_or_none((summary.get("commissioning") or {}).get("realignments"))
         note = f" ({realignments:g} re-alignment(s))" if realignments else ""
-        return result("silent", f"loss of control at {loss_time_s:.6g} s, no fault latched{note}",
-                      failure_time_s=loss_time_s)
+        return result(
+            "silent", f"loss of control at {loss_time_s:.6g} s, no fault latched{note}", failure_time_s=loss_time_s
+        )
 
     speed_error = number_or_none(rob["max_speed_error_rad_s"])
     angle_error = number_or_none(rob["max_angle_error_rad"])
@@ -145,8 +172,11 @@ def classify(summary, exit_status, speed_bound_rad_s=0.5, angle_bound_rad=0.05, 
     if position_bound_rad is not None:
         exceeded += position_exceeded(summary.get("position"), position_bound_rad)
     if exceeded:
-        return result("out_of_spec", "; ".join(exceeded),
-                      failure_time_s=failure_time_s if failure_time_s is None or failure_time_s >= 0.0 else None)
+        return result(
+            "out_of_spec",
+            "; ".join(exceeded),
+            failure_time_s=failure_time_s if failure_time_s is None or failure_time_s >= 0.0 else None,
+        )
     return result("success", "")
 
 
@@ -160,8 +190,10 @@ def position_exceeded(position, bound_rad):
             problems.append(f"{position.get(key)} {key.replace('_', ' ')}")
     final = number_or_none(position.get("max_final_error_electrical_rad"))
     if final is None or final >= bound_rad:
-        problems.append(f"move {position.get('worst_move')} ends {position.get('max_final_error_electrical_rad')} "
-                        f"electrical rad off >= {bound_rad:g}")
+        problems.append(
+            f"move {position.get('worst_move')} ends {position.get('max_final_error_electrical_rad')} "
+            f"electrical rad off >= {bound_rad:g}"
+        )
     return problems
 
 
@@ -179,7 +211,9 @@ def extract_metrics(summary, params, base):
         "loss_of_control_time_s": number_or_none(rob.get("loss_of_control_time_s")),
         "detection_latency_s": number_or_none(rob.get("detection_latency_s")),
         "nonfinite_seen": bool(rob.get("nonfinite_seen", False)),
-        "tracking_max_abs_error_rad_s": number_or_none((summary.get("speed") or {}).get("tracking_max_abs_error_rad_s")),
+        "tracking_max_abs_error_rad_s": number_or_none(
+            (summary.get("speed") or {}).get("tracking_max_abs_error_rad_s")
+        ),
         "fault_time_s": number_or_none(fault.get("time_s")),
         "wall_s": number_or_none((summary.get("timing") or {}).get("wall_s")),
         "cpu_s": number_or_none((summary.get("timing") or {}).get("cpu_s")),
@@ -194,33 +228,49 @@ def extract_metrics(summary, params, base):
     moved = (number_or_none(pos.get("moves")) or 0) > 0
     held = moved and (number_or_none(pos.get("hold_duration_s")) or 0.0) > 0.0
     drift = number_or_none(pos.get("hold_drift_electrical_rad_s")) if held else None
-    metrics["position_max_final_error_rad"] = number_or_none(pos.get("max_final_error_electrical_rad")) if moved else None
-    metrics["position_max_tracking_error_rad"] = (number_or_none(pos.get("max_tracking_error_electrical_rad"))
-                                                  if moved else None)
+    metrics["position_max_final_error_rad"] = (
+        number_or_none(pos.get("max_final_error_electrical_rad")) if moved else None
+    )
+    metrics["position_max_tracking_error_rad"] = (
+        number_or_none(pos.get("max_tracking_error_electrical_rad")) if moved else None
+    )
     metrics["position_hold_max_error_rad"] = number_or_none(pos.get("hold_max_error_electrical_rad")) if held else None
     metrics["position_abs_hold_drift_rad_s"] = abs(drift) if drift is not None else None
     # The "after settling" maxima mean nothing when a fault stopped the run before settling.
     settle_s, fault_s = metrics["settle_time_s"], metrics["fault_time_s"]
-    metrics["past_settle"] = not (fault.get("code") and settle_s is not None and fault_s is not None
-                                  and 0.0 <= fault_s < settle_s)
+    metrics["past_settle"] = not (
+        fault.get("code") and settle_s is not None and fault_s is not None and 0.0 <= fault_s < settle_s
+    )
     # Commissioned value against the plant's (drawn, else the scenario's) value.
-    for name, key, field in (("r_rel_error", "motor.resistance_Ohm", "resistance_Ohm"),
-                             ("l_rel_error", "motor.inductance_H", "inductance_H"),
-                             ("k_rel_error", "motor.torque_constant_Nm_A", "torque_constant_Nm_A")):
+    for name, key, field in (
+        ("r_rel_error", "motor.resistance_Ohm", "resistance_Ohm"),
+        ("l_rel_error", "motor.inductance_H", "inductance_H"),
+        ("k_rel_error", "motor.torque_constant_Nm_A", "torque_constant_Nm_A"),
+    ):
         plant = params.get(key, base.get(key))
         measured = number_or_none(com.get(field))
         ok = metrics["commissioning_measured"] and measured is not None and plant
         metrics[name] = measured / plant - 1.0 if ok else None
-    for name, key, field in (("offset_a_error_A", "sensors.offset_a_A", "offset_a_A"),
-                             ("offset_b_error_A", "sensors.offset_b_A", "offset_b_A")):
+    for name, key, field in (
+        ("offset_a_error_A", "sensors.offset_a_A", "offset_a_A"),
+        ("offset_b_error_A", "sensors.offset_b_A", "offset_b_A"),
+    ):
         measured = number_or_none(com.get(field))
         ok = metrics["commissioning_measured"] and measured is not None and key in params
         metrics[name] = measured - params[key] if ok else None
     # Where commissioning put the rotor at t_c (its start angle) against where the plant's rotor was.
     align = summary.get("alignment") if isinstance(summary.get("alignment"), dict) else {}
-    rest = [number_or_none(v) for v in (com.get("equilibrium_cos"), com.get("equilibrium_sin"),
-                                         align.get("cos_ptheta_at_tc"), align.get("sin_ptheta_at_tc"))]
+    rest = [
+        number_or_none(v)
+        for v in (
+            com.get("equilibrium_cos"),
+            com.get("equilibrium_sin"),
+            align.get("cos_ptheta_at_tc"),
+            align.get("sin_ptheta_at_tc"),
+        )
+    ]
     ok = metrics["commissioning_measured"] and all(v is not None for v in rest)
-    metrics["rest_angle_error_rad"] = (math.atan2(rest[1] * rest[2] - rest[0] * rest[3],
-                                                  rest[0] * rest[2] + rest[1] * rest[3]) if ok else None)
+    metrics["rest_angle_error_rad"] = (
+        math.atan2(rest[1] * rest[2] - rest[0] * rest[3], rest[0] * rest[2] + rest[1] * rest[3]) if ok else None
+    )
     return metrics

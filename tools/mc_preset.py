@@ -30,6 +30,7 @@ paper motor, whose top speed is 9.6 rad/s, so a preset's are the same fractions 
 speed (5.2 % and 21 %); --speed-bound overrides the first. The angle bounds (0.05 rad for
 success, 0.5 rad for a loss of control) are electrical angles and stay as they are.
 """
+
 import configparser
 import os
 import re
@@ -44,7 +45,7 @@ PAPER_PRESET = os.path.join(os.path.dirname(HERE), "sil", "scenarios", "motors",
 # The paper table's absolute values and the paper motor's figures they are relative to.
 PAPER_LOAD_NM = 2.0
 PAPER_FRICTION_MAX_NMS = 0.005
-PAPER_PEAK_SPEED_RAD_S = 10.0    # robust.ini's profile: +-10 rad/s
+PAPER_PEAK_SPEED_RAD_S = 10.0  # robust.ini's profile: +-10 rad/s
 PAPER_RIPPLE_MAX_V = 2.0
 PAPER_BUS_V = 48.0
 PAPER_SOURCE_RESISTANCE_MAX_OHM = 0.2
@@ -52,9 +53,15 @@ PAPER_RESISTANCE_OHM = 3.0
 
 # sil/scenarios/robust.ini's measurement chain, as tools/envelope.py gives it to pmstep-tune
 # (the ADC span follows the motor: 3 x the rated current).
-REALISTIC_CHAIN = ("sensors.adc_bits=12", "sensors.offset_a_A=0.02", "sensors.offset_b_A=-0.02",
-                   "sensors.noise_rms_A=0.005", "inverter.model=switching", "inverter.dead_time_s=1e-6",
-                   "run.delay_periods=1")
+REALISTIC_CHAIN = (
+    "sensors.adc_bits=12",
+    "sensors.offset_a_A=0.02",
+    "sensors.offset_b_A=-0.02",
+    "sensors.noise_rms_A=0.005",
+    "inverter.model=switching",
+    "inverter.dead_time_s=1e-6",
+    "run.delay_periods=1",
+)
 ADC_SPAN_RATED = 3.0
 # A drive that senses each phase's mean voltage over every period (the paper's premise: stator
 # voltages measured; controller.inverter.phase_voltage_sensing): the realistic chain plus that
@@ -63,10 +70,15 @@ ADC_SPAN_RATED = 3.0
 # firmware's offset calibration takes them off), gain errors of +-0.5 % (divider and bus
 # measurement) and 5 mV rms of noise.
 PHASE_VOLTAGE_SPAN_BUS = 1.5
-PHASE_VOLTAGE_SENSING = (f"{KEYS['phase_voltage_sensing']}=true", f"{KEYS['phase_voltage_bits']}=14",
-                         f"{KEYS['phase_voltage_offset_a']}=0.05",
-                         f"{KEYS['phase_voltage_offset_b']}=-0.05", f"{KEYS['phase_voltage_gain_error_a']}=0.005",
-                         f"{KEYS['phase_voltage_gain_error_b']}=-0.005", f"{KEYS['phase_voltage_noise']}=0.005")
+PHASE_VOLTAGE_SENSING = (
+    f"{KEYS['phase_voltage_sensing']}=true",
+    f"{KEYS['phase_voltage_bits']}=14",
+    f"{KEYS['phase_voltage_offset_a']}=0.05",
+    f"{KEYS['phase_voltage_offset_b']}=-0.05",
+    f"{KEYS['phase_voltage_gain_error_a']}=0.005",
+    f"{KEYS['phase_voltage_gain_error_b']}=-0.005",
+    f"{KEYS['phase_voltage_noise']}=0.005",
+)
 # The Monte Carlo draws that sensor's errors too; the rows follow DISTRIBUTIONS' rows, so a case
 # draws the same plant, current sensors, inverter and load as with the realistic chain (paired).
 PHASE_VOLTAGE_DISTRIBUTIONS = [
@@ -76,9 +88,9 @@ PHASE_VOLTAGE_DISTRIBUTIONS = [
     (KEYS["phase_voltage_gain_error_b"], "uniform", -0.005, 0.005),
     (KEYS["phase_voltage_noise"], "uniform", 0.0025, 0.0075),
 ]
-LOAD_STEP_AFTER_RUN_S = 0.03     # robust.ini's: 30 ms after RUN starts (0.68 s)
-PAPER_SPEED_BOUND_RAD_S = 0.5    # the paper campaign's success bound (monte_carlo.py --speed-bound)
-PAPER_LOSS_SPEED_RAD_S = 2.0     # robust.ini's run.loss_speed_error_rad_s
+LOAD_STEP_AFTER_RUN_S = 0.03  # robust.ini's: 30 ms after RUN starts (0.68 s)
+PAPER_SPEED_BOUND_RAD_S = 0.5  # the paper campaign's success bound (monte_carlo.py --speed-bound)
+PAPER_LOSS_SPEED_RAD_S = 2.0  # robust.ini's run.loss_speed_error_rad_s
 
 
 def _ini(path):
@@ -94,8 +106,13 @@ def read_preset(path):
     "holding_torque_Nm", "resistance_Ohm", "friction_Nms_rad", "bus_voltage_V"}; ToolError if
     one is missing or not a positive number (the friction may be 0)."""
     ini = _ini(path)
-    wanted = (("datasheet", "rated_current_A"), ("datasheet", "holding_torque_Nm"), ("motor", "resistance_Ohm"),
-              ("motor", "friction_Nms_rad"), ("run", "bus_voltage_V"))
+    wanted = (
+        ("datasheet", "rated_current_A"),
+        ("datasheet", "holding_torque_Nm"),
+        ("motor", "resistance_Ohm"),
+        ("motor", "friction_Nms_rad"),
+        ("run", "bus_voltage_V"),
+    )
     figures = {"name": ini.get("scenario", "name", fallback=os.path.splitext(os.path.basename(path))[0])}
     for section, key in wanted:
         try:
@@ -118,7 +135,8 @@ def chain_sets(preset, phase_voltage_sensing=False):
     sets = list(REALISTIC_CHAIN) + [f"sensors.current_full_scale_A={ADC_SPAN_RATED * preset['rated_current_A']:g}"]
     if phase_voltage_sensing:
         sets += list(PHASE_VOLTAGE_SENSING) + [
-            f"{KEYS['phase_voltage_span']}={PHASE_VOLTAGE_SPAN_BUS * preset['bus_voltage_V']:g}"]
+            f"{KEYS['phase_voltage_span']}={PHASE_VOLTAGE_SPAN_BUS * preset['bus_voltage_V']:g}"
+        ]
     return sets
 
 
@@ -129,8 +147,10 @@ def preset_distributions(preset, peak_speed_rad_s, paper_holding_Nm, phase_volta
     if not peak_speed_rad_s > 0.0:
         raise ToolError(f"the preset's profile peak speed {peak_speed_rad_s:g} rad/s is not positive")
     torque_ratio = preset["holding_torque_Nm"] / paper_holding_Nm
-    friction_max = max(2.0 * preset["friction_Nms_rad"],
-                       PAPER_FRICTION_MAX_NMS * PAPER_PEAK_SPEED_RAD_S * torque_ratio / peak_speed_rad_s)
+    friction_max = max(
+        2.0 * preset["friction_Nms_rad"],
+        PAPER_FRICTION_MAX_NMS * PAPER_PEAK_SPEED_RAD_S * torque_ratio / peak_speed_rad_s,
+    )
     replace = {
         KEYS["plant_resistance"]: ("scale", 0.9, 1.1),
         KEYS["plant_inductance"]: ("scale", 0.9, 1.1),
@@ -138,8 +158,11 @@ def preset_distributions(preset, peak_speed_rad_s, paper_holding_Nm, phase_volta
         KEYS["plant_inertia"]: ("scale", 0.8, 1.2),
         KEYS["plant_friction"]: ("uniform", 0.0, friction_max),
         KEYS["bus_ripple"]: ("uniform", 0.0, PAPER_RIPPLE_MAX_V * preset["bus_voltage_V"] / PAPER_BUS_V),
-        KEYS["bus_source_resistance"]: ("uniform", 0.0, PAPER_SOURCE_RESISTANCE_MAX_OHM * preset["resistance_Ohm"]
-                                        / PAPER_RESISTANCE_OHM),
+        KEYS["bus_source_resistance"]: (
+            "uniform",
+            0.0,
+            PAPER_SOURCE_RESISTANCE_MAX_OHM * preset["resistance_Ohm"] / PAPER_RESISTANCE_OHM,
+        ),
         KEYS["load_torque"]: ("scale", 0.0, 1.0),  # of the scenario's load: PAPER_LOAD_NM x torque_ratio
     }
     table = [(key,) + replace[key] if key in replace else (key, kind, a, b) for key, kind, a, b in DISTRIBUTIONS]
@@ -170,7 +193,7 @@ def _run_designer(cmd):
 def _points_lines(points):
     """speed.points as an INI value on continuation lines of three points: a point printed at full
     precision takes up to 49 characters, and the scenario reader takes lines of 197 at most."""
-    rows = [", ".join(points[i:i + 3]) for i in range(0, len(points), 3)]
+    rows = [", ".join(points[i : i + 3]) for i in range(0, len(points), 3)]
     return ",\n    ".join(rows)
 
 
@@ -216,10 +239,20 @@ def scenario_info(tune, preset_path, scenario_path, phase_voltage_sensing=False,
     preset = read_preset(preset_path)
     top, paper_top, cmd = _top_speeds(tune, preset_path, chain_sets(preset, phase_voltage_sensing), low_speed_drive)
     peak, load = _scenario_peak_and_load(_ini(scenario_path), scenario_path)
-    return {"preset": preset["name"], "preset_file": preset_path, "top_speed_rad_s": top,
-            "paper_top_speed_rad_s": paper_top, "run_start_s": None, "peak_speed_rad_s": peak, "load_Nm": load,
-            "tune_command": cmd, "figures": preset, "paper_holding_torque_Nm": paper_holding_torque(),
-            "speed_bound_rad_s": PAPER_SPEED_BOUND_RAD_S * top / paper_top, "designed": False}
+    return {
+        "preset": preset["name"],
+        "preset_file": preset_path,
+        "top_speed_rad_s": top,
+        "paper_top_speed_rad_s": paper_top,
+        "run_start_s": None,
+        "peak_speed_rad_s": peak,
+        "load_Nm": load,
+        "tune_command": cmd,
+        "figures": preset,
+        "paper_holding_torque_Nm": paper_holding_torque(),
+        "speed_bound_rad_s": PAPER_SPEED_BOUND_RAD_S * top / paper_top,
+        "designed": False,
+    }
 
 
 def design_scenario(tune, preset_path, out_dir, phase_voltage_sensing=False, low_speed_drive=False):
@@ -237,14 +270,24 @@ def design_scenario(tune, preset_path, out_dir, phase_voltage_sensing=False, low
         points = [p.strip() for p in ini.get("speed", "points").replace("\n", " ").split(",") if p.strip()]
         peak = max(abs(float(p.split(":")[1])) for p in points)
         # RUN starts after the offset calibration and the two alignments (t_c counts from their start).
-        run_start = (float(ini.get("controller.commissioning", "offset_calibration_time_s", fallback="0"))
-                     + float(ini.get("controller.alignment", "c_align_time_s")))
+        run_start = float(ini.get("controller.commissioning", "offset_calibration_time_s", fallback="0")) + float(
+            ini.get("controller.alignment", "c_align_time_s")
+        )
     except (configparser.Error, ValueError, IndexError) as e:
         raise ToolError(f"{design_path}: cannot read speed.points and the alignment times ({e})") from None
-    info = {"preset": preset["name"], "preset_file": preset_path, "top_speed_rad_s": top,
-            "paper_top_speed_rad_s": paper_top, "run_start_s": run_start, "peak_speed_rad_s": peak,
-            "load_Nm": PAPER_LOAD_NM * preset["holding_torque_Nm"] / paper_holding,
-            "tune_command": cmd, "figures": preset, "paper_holding_torque_Nm": paper_holding, "designed": True}
+    info = {
+        "preset": preset["name"],
+        "preset_file": preset_path,
+        "top_speed_rad_s": top,
+        "paper_top_speed_rad_s": paper_top,
+        "run_start_s": run_start,
+        "peak_speed_rad_s": peak,
+        "load_Nm": PAPER_LOAD_NM * preset["holding_torque_Nm"] / paper_holding,
+        "tune_command": cmd,
+        "figures": preset,
+        "paper_holding_torque_Nm": paper_holding,
+        "designed": True,
+    }
     speed_bound = PAPER_SPEED_BOUND_RAD_S * top / paper_top
     loss_speed = loss_speed_error(top, paper_top)
     ini.set("scenario", "name", f"{preset['name']}_mc")
@@ -252,10 +295,12 @@ def design_scenario(tune, preset_path, out_dir, phase_voltage_sensing=False, low
     ini.set("load", "torque_Nm", repr(info["load_Nm"]))
     ini.set("load", "step_time_s", repr(run_start + LOAD_STEP_AFTER_RUN_S))
     ini.set("run", "loss_speed_error_rad_s", repr(loss_speed))
-    lines = ["; Monte Carlo scenario of the motor preset " + os.path.basename(preset_path) + " (monte_carlo.py --preset):",
-             "; pmstep-tune --robust behind the realistic chain (tools/mc_preset.py), with a load step",
-             f"; of {info['load_Nm']:.6g} N m {LOAD_STEP_AFTER_RUN_S:g} s into RUN and loss of control at",
-             f"; |w - w*| > {loss_speed:.6g} rad/s (2 rad/s x top speed / the paper motor's)"]
+    lines = [
+        "; Monte Carlo scenario of the motor preset " + os.path.basename(preset_path) + " (monte_carlo.py --preset):",
+        "; pmstep-tune --robust behind the realistic chain (tools/mc_preset.py), with a load step",
+        f"; of {info['load_Nm']:.6g} N m {LOAD_STEP_AFTER_RUN_S:g} s into RUN and loss of control at",
+        f"; |w - w*| > {loss_speed:.6g} rad/s (2 rad/s x top speed / the paper motor's)",
+    ]
     for section in ini.sections():
         lines.append(f"[{section}]")
         for key, value in ini.items(section):

@@ -2,14 +2,22 @@
 report.md with its histograms, cases.csv, and the campaign's section of a page of campaigns
 (--report FILE --report-section NAME: docs/reports/monte-carlo.md) (see monte_carlo.py for the
 whole tool)."""
+
 import csv
 import math
 import os
 import shlex
 import statistics
 
-from mc_distributions import DURATION_KEY, KEY_PARAMETERS, SEED_KEY, SEED_STRIDE, DISTRIBUTIONS, \
-    distribution_rows, format_value
+from mc_distributions import (
+    DURATION_KEY,
+    KEY_PARAMETERS,
+    SEED_KEY,
+    SEED_STRIDE,
+    DISTRIBUTIONS,
+    distribution_rows,
+    format_value,
+)
 from mc_execution import rerun_command
 from mc_outcome import CLASSES, CLASS_TEXT
 import report
@@ -54,9 +62,11 @@ def spans_decades(values, decades=2.0):
 def worst_order(cases):
     """Cases sorted for the worst-case table: failures (any class but success) first, then
     by max speed error after settling, largest first (a missing value counts as infinite)."""
+
     def key(case):
         speed = case["metrics"].get("max_speed_error_rad_s")
         return (case["class"] == "success", -(speed if speed is not None else math.inf), case["seed"])
+
     return sorted(cases, key=key)
 
 
@@ -71,12 +81,18 @@ def aggregate(records, args):
         if r["fault_name"]:
             faults[r["fault_name"]] = faults.get(r["fault_name"], 0) + 1
     nonfinite = sum(1 for r in records if r["metrics"].get("nonfinite_seen"))
-    latencies = [r["latency_s"] for r in records
-                 if r["class"] == "detected" and not r["false_trip"] and r["latency_s"] is not None]
+    latencies = [
+        r["latency_s"]
+        for r in records
+        if r["class"] == "detected" and not r["false_trip"] and r["latency_s"] is not None
+    ]
 
     def stats(name, transform=lambda v: v, past_settle_only=False):
-        values = [transform(r["metrics"][name]) for r in records if r["metrics"].get(name) is not None
-                  and (r["metrics"]["past_settle"] or not past_settle_only)]
+        values = [
+            transform(r["metrics"][name])
+            for r in records
+            if r["metrics"].get(name) is not None and (r["metrics"]["past_settle"] or not past_settle_only)
+        ]
         out = {"n": len(values)}
         for q in (50, 90, 99):
             out[f"p{q}"] = percentile(values, q)
@@ -108,12 +124,18 @@ def aggregate(records, args):
         "false_trips": false_trips,
         "faults_by_name": dict(sorted(faults.items(), key=lambda kv: (-kv[1], kv[0]))),
         "nonfinite_cases": nonfinite,
-        "detection_latency_s": {"n": len(latencies), "max": max(latencies) if latencies else None,
-                                "median": statistics.median(latencies) if latencies else None},
+        "detection_latency_s": {
+            "n": len(latencies),
+            "max": max(latencies) if latencies else None,
+            "median": statistics.median(latencies) if latencies else None,
+        },
         "distributions": distributions,
-        "bounds": {"speed_bound_rad_s": args.speed_bound, "angle_bound_rad": args.angle_bound,
-                   "latency_bound_s": args.latency_bound,
-                   "position_bound_electrical_rad": getattr(args, "position_bound", None)},
+        "bounds": {
+            "speed_bound_rad_s": args.speed_bound,
+            "angle_bound_rad": args.angle_bound,
+            "latency_bound_s": args.latency_bound,
+            "position_bound_electrical_rad": getattr(args, "position_bound", None),
+        },
     }
 
 
@@ -148,8 +170,11 @@ def make_plots(out_dir, records, args):
     import numpy as np
 
     def values(name, past_settle_only):
-        return [r["metrics"][name] for r in records if r["metrics"].get(name) is not None
-                and (r["metrics"]["past_settle"] or not past_settle_only)]
+        return [
+            r["metrics"][name]
+            for r in records
+            if r["metrics"].get(name) is not None and (r["metrics"]["past_settle"] or not past_settle_only)
+        ]
 
     plots = []
 
@@ -171,8 +196,11 @@ def make_plots(out_dir, records, args):
             ax.legend()
         ax.set_xlabel(xlabel)
         ax.set_ylabel("cases")
-        ax.set_title(f"{title}, {len(data)} cases{note}" + ("\n(cases not stopped by a fault before settling)"
-                                                           if bound is not None else ""), fontsize=10)
+        ax.set_title(
+            f"{title}, {len(data)} cases{note}"
+            + ("\n(cases not stopped by a fault before settling)" if bound is not None else ""),
+            fontsize=10,
+        )
         ax.grid(True, alpha=0.3)
         fig.tight_layout()
         fig.savefig(os.path.join(out_dir, file_name), dpi=110)
@@ -180,14 +208,35 @@ def make_plots(out_dir, records, args):
         plots.append((title, file_name))
 
     for name, title, xlabel, file_name, bound in (
-            ("max_speed_error_rad_s", "Max speed error after settling", "max |w - w*| (rad/s)",
-             "hist_speed_error.png", args.speed_bound),
-            ("max_angle_error_rad", "Max angle-estimate error after settling", "max |angle error| (rad)",
-             "hist_angle_error.png", args.angle_bound),
-            ("r_rel_error", "Commissioned R relative error", "R_commissioned / R_plant - 1",
-             "hist_commissioning_r.png", None),
-            ("l_rel_error", "Commissioned L relative error", "L_commissioned / L_plant - 1",
-             "hist_commissioning_l.png", None)):
+        (
+            "max_speed_error_rad_s",
+            "Max speed error after settling",
+            "max |w - w*| (rad/s)",
+            "hist_speed_error.png",
+            args.speed_bound,
+        ),
+        (
+            "max_angle_error_rad",
+            "Max angle-estimate error after settling",
+            "max |angle error| (rad)",
+            "hist_angle_error.png",
+            args.angle_bound,
+        ),
+        (
+            "r_rel_error",
+            "Commissioned R relative error",
+            "R_commissioned / R_plant - 1",
+            "hist_commissioning_r.png",
+            None,
+        ),
+        (
+            "l_rel_error",
+            "Commissioned L relative error",
+            "L_commissioned / L_plant - 1",
+            "hist_commissioning_l.png",
+            None,
+        ),
+    ):
         data = values(name, past_settle_only=bound is not None)
         if data:
             histogram(data, title, xlabel, file_name, bound)
@@ -200,42 +249,62 @@ def write_report(path, records, agg, args, scenario, version, plots, started_utc
     counts = agg["counts"]
     low, high = agg["success_rate_wilson95"]
     lines = ["# Monte Carlo robustness report", ""]
-    lines += [f"- command: `{shlex.join(args.argv)}`",
-              f"- scenario: `{args.scenario}` (name `{scenario.get('scenario.name', '?')}`)",
-              f"- cases: {n}, base seed {args.seed} (case k has seed {args.seed} * {SEED_STRIDE} + k)",
-              f"- date: {started_utc}"]
+    lines += [
+        f"- command: `{shlex.join(args.argv)}`",
+        f"- scenario: `{args.scenario}` (name `{scenario.get('scenario.name', '?')}`)",
+        f"- cases: {n}, base seed {args.seed} (case k has seed {args.seed} * {SEED_STRIDE} + k)",
+        f"- date: {started_utc}",
+    ]
     preset = agg.get("preset")
     if preset:
         designed = "designed by" if preset["designed"] else "the scenario as given; top speed from"
         load_step = " 30 ms into RUN" if preset["designed"] else " (the scenario's)"
-        lines.append(f"- motor preset: `{preset['preset_file']}`, {designed} `{shlex.join(preset['tune_command'])}`: "
-                     f"top speed {preset['top_speed_rad_s']:g} rad/s, profile peak {preset['peak_speed_rad_s']:g} rad/s, "
-                     f"load step {preset['load_Nm']:.4g} N m{load_step} (distributions scaled to the motor: "
-                     "tools/mc_preset.py)")
+        lines.append(
+            f"- motor preset: `{preset['preset_file']}`, {designed} `{shlex.join(preset['tune_command'])}`: "
+            f"top speed {preset['top_speed_rad_s']:g} rad/s, profile peak {preset['peak_speed_rad_s']:g} rad/s, "
+            f"load step {preset['load_Nm']:.4g} N m{load_step} (distributions scaled to the motor: "
+            "tools/mc_preset.py)"
+        )
     if version:
         lines.append(f"- pmstep-sil: {version}")
     if args.duration is not None:
         lines.append(f"- duration: {args.duration:g} s per case (`--set {DURATION_KEY}`)")
-    lines.append(f"- bounds: max speed error < {args.speed_bound:g} rad/s, max angle error < {args.angle_bound:g} rad "
-                 f"(after settling), fault within {args.latency_bound:g} s of a loss of control")
+    lines.append(
+        f"- bounds: max speed error < {args.speed_bound:g} rad/s, max angle error < {args.angle_bound:g} rad "
+        f"(after settling), fault within {args.latency_bound:g} s of a loss of control"
+    )
     if getattr(args, "position_bound", None) is not None:
-        lines.append(f"- position: every move issued, finished and ending within {args.position_bound:g} electrical "
-                     f"rad of its target")
+        lines.append(
+            f"- position: every move issued, finished and ending within {args.position_bound:g} electrical "
+            f"rad of its target"
+        )
     lines.append("")
     rate = agg["success_rate"]
-    lines += ["## Result", "",
-              f"**Success rate: {counts['success']}/{n} = {fmt(100 * rate if rate is not None else None, '.1f')} %** "
-              f"(Wilson 95 % interval {100 * low:.1f} % to {100 * high:.1f} %)", "",
-              "| class | cases |", "|---|---|"]
+    lines += [
+        "## Result",
+        "",
+        f"**Success rate: {counts['success']}/{n} = {fmt(100 * rate if rate is not None else None, '.1f')} %** "
+        f"(Wilson 95 % interval {100 * low:.1f} % to {100 * high:.1f} %)",
+        "",
+        "| class | cases |",
+        "|---|---|",
+    ]
     for cls in CLASSES:
         lines.append(f"| {CLASS_TEXT[cls]} | {counts[cls]} |")
-    lines += [f"| of which detected losses of control | {agg['detected_losses']} |",
-              f"| of which false trips (fault, no loss of control) | {agg['false_trips']} |", "",
-              f"Cases that saw a non-finite value (NaN/Inf): {agg['nonfinite_cases']}", ""]
+    lines += [
+        f"| of which detected losses of control | {agg['detected_losses']} |",
+        f"| of which false trips (fault, no loss of control) | {agg['false_trips']} |",
+        "",
+        f"Cases that saw a non-finite value (NaN/Inf): {agg['nonfinite_cases']}",
+        "",
+    ]
     lat = agg["detection_latency_s"]
     if lat["n"]:
-        lines += [f"Detection latency over the {lat['n']} detected losses of control: "
-                  f"max {lat['max'] * 1e3:.3g} ms, median {lat['median'] * 1e3:.3g} ms", ""]
+        lines += [
+            f"Detection latency over the {lat['n']} detected losses of control: "
+            f"max {lat['max'] * 1e3:.3g} ms, median {lat['median'] * 1e3:.3g} ms",
+            "",
+        ]
     else:
         lines += ["Detection latency: no detected loss of control.", ""]
     if agg["faults_by_name"]:
@@ -248,33 +317,48 @@ def write_report(path, records, agg, args, scenario, version, plots, started_utc
     by_segment = agg.get("failures_by_segment") or []
     if by_segment:
         classes = list(by_segment[0][1])
-        lines += ["Failures by the speed profile's segment at their failure time (the loss of control; a false "
-                  "trip's fault; out of spec: the largest angle error's sample, or the speed error's where only "
-                  "that bound was exceeded):", "",
-                  "| segment | " + " | ".join(classes) + " |", "|---|" + "---|" * len(classes)]
-        lines += ["| " + segment + " | " + " | ".join(str(row[cls]) for cls in classes) + " |"
-                  for segment, row in by_segment]
+        lines += [
+            "Failures by the speed profile's segment at their failure time (the loss of control; a false "
+            "trip's fault; out of spec: the largest angle error's sample, or the speed error's where only "
+            "that bound was exceeded):",
+            "",
+            "| segment | " + " | ".join(classes) + " |",
+            "|---|" + "---|" * len(classes),
+        ]
+        lines += [
+            "| " + segment + " | " + " | ".join(str(row[cls]) for cls in classes) + " |" for segment, row in by_segment
+        ]
         lines.append("")
-    lines += ["## Distributions", "",
-              "Over the cases that produced the value: the errors after settling over the cases not stopped by "
-              "a fault before settling, the commissioning errors where the core measured, a position "
-              "scenario's moves and hold on the true position.", "",
-              "| quantity | n | p50 | p90 | p99 | max |", "|---|---|---|---|---|---|"]
-    titles = (("max_speed_error_rad_s", "max speed error after settling (rad/s)"),
-              ("max_angle_error_rad", "max angle error after settling (rad)"),
-              ("commissioning_abs_r_rel_error", "\\|R commissioned / R plant - 1\\|"),
-              ("commissioning_abs_l_rel_error", "\\|L commissioned / L plant - 1\\|"),
-              ("commissioning_abs_k_rel_error", "\\|k_M commissioned / k_M plant - 1\\|"),
-              ("commissioning_abs_offset_a_error_A", "\\|offset a commissioned - true\\| (A)"),
-              ("commissioning_abs_offset_b_error_A", "\\|offset b commissioned - true\\| (A)"),
-              ("commissioning_abs_rest_angle_error_rad", "\\|rotor's rest at t_c commissioned - true\\| (electrical rad)"))
-    titles += tuple((name, title) for name, title in zip(POSITION_METRICS, POSITION_TITLES)
-                    if agg["distributions"][name]["n"])  # a position scenario's
+    lines += [
+        "## Distributions",
+        "",
+        "Over the cases that produced the value: the errors after settling over the cases not stopped by "
+        "a fault before settling, the commissioning errors where the core measured, a position "
+        "scenario's moves and hold on the true position.",
+        "",
+        "| quantity | n | p50 | p90 | p99 | max |",
+        "|---|---|---|---|---|---|",
+    ]
+    titles = (
+        ("max_speed_error_rad_s", "max speed error after settling (rad/s)"),
+        ("max_angle_error_rad", "max angle error after settling (rad)"),
+        ("commissioning_abs_r_rel_error", "\\|R commissioned / R plant - 1\\|"),
+        ("commissioning_abs_l_rel_error", "\\|L commissioned / L plant - 1\\|"),
+        ("commissioning_abs_k_rel_error", "\\|k_M commissioned / k_M plant - 1\\|"),
+        ("commissioning_abs_offset_a_error_A", "\\|offset a commissioned - true\\| (A)"),
+        ("commissioning_abs_offset_b_error_A", "\\|offset b commissioned - true\\| (A)"),
+        ("commissioning_abs_rest_angle_error_rad", "\\|rotor's rest at t_c commissioned - true\\| (electrical rad)"),
+    )
+    titles += tuple(
+        (name, title) for name, title in zip(POSITION_METRICS, POSITION_TITLES) if agg["distributions"][name]["n"]
+    )  # a position scenario's
     for name, title in titles:
         d = agg["distributions"][name]
         lines.append(f"| {title} | {d['n']} | {fmt(d['p50'])} | {fmt(d['p90'])} | {fmt(d['p99'])} | {fmt(d['max'])} |")
-    bias = [(label, agg["distributions"][f"commissioning_abs_{name}"]["mean_signed"])
-            for label, name in (("R", "r_rel_error"), ("L", "l_rel_error"), ("k_M", "k_rel_error"))]
+    bias = [
+        (label, agg["distributions"][f"commissioning_abs_{name}"]["mean_signed"])
+        for label, name in (("R", "r_rel_error"), ("L", "l_rel_error"), ("k_M", "k_rel_error"))
+    ]
     if any(v is not None for _l, v in bias):
         lines += ["", "Mean signed commissioning error: " + ", ".join(f"{label} {fmt(v, '+.3g')}" for label, v in bias)]
     lines.append("")
@@ -282,16 +366,25 @@ def write_report(path, records, agg, args, scenario, version, plots, started_utc
         lines += [f"![{title}]({file_name})", ""]
 
     worst = worst_order(records)[:WORST_CASES]
-    lines += [f"## The {len(worst)} worst cases", "",
-              "Failures first, then by max speed error after settling. Re-run one with the command in the "
-              "last column (from the same working folder); it writes the CSV too, for `tools/plot_run.py`.", ""]
+    lines += [
+        f"## The {len(worst)} worst cases",
+        "",
+        "Failures first, then by max speed error after settling. Re-run one with the command in the "
+        "last column (from the same working folder); it writes the CSV too, for `tools/plot_run.py`.",
+        "",
+    ]
     header = ["seed", "class", "fault", "max speed err (rad/s)", "max angle err (rad)"]
     header += [title for _k, title, _f in KEY_PARAMETERS] + ["re-run"]
     lines += ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     for r in worst:
         m = r["metrics"]
-        cells = [str(r["seed"]), r["class"] + (" (false trip)" if r["false_trip"] else ""), r["fault_name"] or "-",
-                 fmt(m.get("max_speed_error_rad_s")), fmt(m.get("max_angle_error_rad"))]
+        cells = [
+            str(r["seed"]),
+            r["class"] + (" (false trip)" if r["false_trip"] else ""),
+            r["fault_name"] or "-",
+            fmt(m.get("max_speed_error_rad_s")),
+            fmt(m.get("max_angle_error_rad")),
+        ]
         for key, _title, as_factor in KEY_PARAMETERS:
             value = r["params"].get(key)
             if value is None:
@@ -308,16 +401,26 @@ def write_report(path, records, agg, args, scenario, version, plots, started_utc
     if worst:
         lines += ["The same cases as raw pmstep-sil commands (what the tool ran):", ""]
     for r in worst:
-        lines += [f"Case {r['seed']} ({r['class']}){': ' + r['reason'] if r['reason'] else ''}", "",
-                  "```sh", shlex.join(r["command"]), "```"]
+        lines += [
+            f"Case {r['seed']} ({r['class']}){': ' + r['reason'] if r['reason'] else ''}",
+            "",
+            "```sh",
+            shlex.join(r["command"]),
+            "```",
+        ]
         if r["stderr_tail"].strip():
             lines += ["", "stderr (tail):", "", "```", r["stderr_tail"].rstrip(), "```"]
         lines.append("")
 
-    lines += ["## Distribution table", "",
-              "Drawn per case by `random.Random(case seed)`, one draw per row in this order "
-              "(`DISTRIBUTIONS` in tools/mc_distributions.py); U[a, b] excludes b.", "",
-              "| key | drawn as | scenario file's value | range |", "|---|---|---|---|"]
+    lines += [
+        "## Distribution table",
+        "",
+        "Drawn per case by `random.Random(case seed)`, one draw per row in this order "
+        "(`DISTRIBUTIONS` in tools/mc_distributions.py); U[a, b] excludes b.",
+        "",
+        "| key | drawn as | scenario file's value | range |",
+        "|---|---|---|---|",
+    ]
     lines += [f"| `{key}` | {law} | {value} | {span} |" for key, law, value, span in distribution_rows(scenario)]
     lines += ["", f"Every case also sets `{SEED_KEY}` to its case seed (the SIL's noise).", ""]
     with open(path, "w") as f:
@@ -326,13 +429,15 @@ def write_report(path, records, agg, args, scenario, version, plots, started_utc
 
 # ---- the campaign's section of a page of campaigns (--report FILE --report-section NAME) ----
 PAGE_TITLE = "Monte Carlo campaigns"
-PAGE_WHAT = ("One section per campaign of tools/monte_carlo.py (each with the command that reruns it): random "
-             "plants, sensors, inverters, buses, initial angles and loads drawn per case from its seed. A case is a "
-             "success with no fault, no non-finite value and, after settling, the speed and angle errors within the "
-             "bounds; *detected*: a fault latched (within the latency bound of a loss of control, or a false trip "
-             "without one); *silent*: a loss of control with no fault in time; *out of spec*: a bound exceeded "
-             "without a loss of control or a fault; *crashed*: pmstep-sil failed. The campaign's own report.md "
-             "(histograms, worst cases, distribution table) is in its --out folder.")
+PAGE_WHAT = (
+    "One section per campaign of tools/monte_carlo.py (each with the command that reruns it): random "
+    "plants, sensors, inverters, buses, initial angles and loads drawn per case from its seed. A case is a "
+    "success with no fault, no non-finite value and, after settling, the speed and angle errors within the "
+    "bounds; *detected*: a fault latched (within the latency bound of a loss of control, or a false trip "
+    "without one); *silent*: a loss of control with no fault in time; *out of spec*: a bound exceeded "
+    "without a loss of control or a fault; *crashed*: pmstep-sil failed. The campaign's own report.md "
+    "(histograms, worst cases, distribution table) is in its --out folder."
+)
 REPORT_OPTIONS = ("--report", "--report-section")
 
 
@@ -340,7 +445,7 @@ def campaign_command(argv, case=None):
     """@p argv without the --report options (and, with @p case, that case's --case instead of
     --cases): the command that reruns the campaign, or one case of it."""
     out, skip = [], False
-    for i, a in enumerate(argv):
+    for a in argv:
         if skip:
             skip = False
             continue
@@ -360,16 +465,24 @@ def campaign_section(name, records, agg, args, argv):
     low, high = agg["success_rate_wilson95"]
     preset = agg.get("preset")
     subject = f"preset `{preset['preset']}`" if preset else f"`{report.command([args.scenario])}`"
-    lines = [report.section_header(f"{name}: {subject}, {n} cases, seed {args.seed}", "tools/monte_carlo.py",
-                                   campaign_command(argv))]
+    lines = [
+        report.section_header(
+            f"{name}: {subject}, {n} cases, seed {args.seed}", "tools/monte_carlo.py", campaign_command(argv)
+        )
+    ]
     what = [f"Scenario `{report.command([args.scenario])}`"]
     if preset:
-        what.append(f"designed for `{report.command([preset['preset_file']])}` "
-                    f"(top speed {preset['top_speed_rad_s']:g} rad/s, profile peak {preset['peak_speed_rad_s']:g} "
-                    f"rad/s, load step {preset['load_Nm']:.4g} N m)" if preset["designed"] else
-                    f"with the distributions of `{report.command([preset['preset_file']])}`")
-    bounds = (f"bounds: |w - w*| < {args.speed_bound:.4g} rad/s and angle error < {args.angle_bound:g} rad after "
-              f"settling, a fault within {args.latency_bound:g} s of a loss of control")
+        what.append(
+            f"designed for `{report.command([preset['preset_file']])}` "
+            f"(top speed {preset['top_speed_rad_s']:g} rad/s, profile peak {preset['peak_speed_rad_s']:g} "
+            f"rad/s, load step {preset['load_Nm']:.4g} N m)"
+            if preset["designed"]
+            else f"with the distributions of `{report.command([preset['preset_file']])}`"
+        )
+    bounds = (
+        f"bounds: |w - w*| < {args.speed_bound:.4g} rad/s and angle error < {args.angle_bound:g} rad after "
+        f"settling, a fault within {args.latency_bound:g} s of a loss of control"
+    )
     if getattr(args, "position_bound", None) is not None:
         bounds += f", every move ending within {args.position_bound:g} electrical rad of its target"
     what.append(bounds)
@@ -379,61 +492,100 @@ def campaign_section(name, records, agg, args, argv):
         what.append(f"pmstep-sil {agg['pmstep_sil_version']}")
     ex = agg.get("execution") or {}
     if ex.get("wall_s") is not None:
-        what.append(f"{ex.get('cases_run')} cases run ({ex.get('cases_resumed')} resumed) in {ex['wall_s']:.0f} s "
-                    f"({ex.get('engine')}, {ex.get('workers')} workers)")
+        what.append(
+            f"{ex.get('cases_run')} cases run ({ex.get('cases_resumed')} resumed) in {ex['wall_s']:.0f} s "
+            f"({ex.get('engine')}, {ex.get('workers')} workers)"
+        )
     lines += ["; ".join(what) + ".", ""]
     rate = agg["success_rate"]
     faults = ", ".join(f"{fault} {count}" for fault, count in agg["faults_by_name"].items()) or "none"
     lat = agg["detection_latency_s"]
     speed = agg["distributions"]["max_speed_error_rad_s"]
     angle = agg["distributions"]["max_angle_error_rad"]
-    lines += ["| | |", "|---|---|",
-              f"| success | **{counts['success']} / {n}** = {fmt(100 * rate if rate is not None else None, '.1f')} % "
-              f"(Wilson 95 %: {100 * low:.1f}–{100 * high:.1f} %) |",
-              f"| silent failures | **{counts['silent']}** |",
-              f"| detected (of which false trips) | {counts['detected']} ({agg['false_trips']}) |",
-              f"| out of spec | {counts['out_of_spec']} |",
-              f"| crashed | {counts['crashed']} |",
-              f"| cases with a non-finite value | {agg['nonfinite_cases']} |",
-              f"| faults latched | {faults} |",
-              f"| detection latency, max / median | "
-              + (f"{lat['max'] * 1e3:.3g} / {lat['median'] * 1e3:.3g} ms |" if lat["n"]
-                 else "no detected loss of control |"),
-              f"| max \\|w - w*\\| after settling, p50 / p90 / p99 / max (rad/s) | {fmt(speed['p50'])} / "
-              f"{fmt(speed['p90'])} / {fmt(speed['p99'])} / {fmt(speed['max'])} |",
-              f"| max angle error after settling, p50 / p90 / p99 / max (rad) | {fmt(angle['p50'])} / "
-              f"{fmt(angle['p90'])} / {fmt(angle['p99'])} / {fmt(angle['max'])} |"]
+    lines += [
+        "| | |",
+        "|---|---|",
+        f"| success | **{counts['success']} / {n}** = {fmt(100 * rate if rate is not None else None, '.1f')} % "
+        f"(Wilson 95 %: {100 * low:.1f}–{100 * high:.1f} %) |",
+        f"| silent failures | **{counts['silent']}** |",
+        f"| detected (of which false trips) | {counts['detected']} ({agg['false_trips']}) |",
+        f"| out of spec | {counts['out_of_spec']} |",
+        f"| crashed | {counts['crashed']} |",
+        f"| cases with a non-finite value | {agg['nonfinite_cases']} |",
+        f"| faults latched | {faults} |",
+        "| detection latency, max / median | "
+        + (f"{lat['max'] * 1e3:.3g} / {lat['median'] * 1e3:.3g} ms |" if lat["n"] else "no detected loss of control |"),
+        f"| max \\|w - w*\\| after settling, p50 / p90 / p99 / max (rad/s) | {fmt(speed['p50'])} / "
+        f"{fmt(speed['p90'])} / {fmt(speed['p99'])} / {fmt(speed['max'])} |",
+        f"| max angle error after settling, p50 / p90 / p99 / max (rad) | {fmt(angle['p50'])} / "
+        f"{fmt(angle['p90'])} / {fmt(angle['p99'])} / {fmt(angle['max'])} |",
+    ]
     by_segment = agg.get("failures_by_segment") or []
     if by_segment:
         classes = list(by_segment[0][1])
-        lines += ["", "Failures by the speed profile's segment at their failure time:", "",
-                  "| segment | " + " | ".join(classes) + " |", "|---|" + "---|" * len(classes)]
-        lines += ["| " + segment + " | " + " | ".join(str(row[cls]) for cls in classes) + " |"
-                  for segment, row in by_segment]
+        lines += [
+            "",
+            "Failures by the speed profile's segment at their failure time:",
+            "",
+            "| segment | " + " | ".join(classes) + " |",
+            "|---|" + "---|" * len(classes),
+        ]
+        lines += [
+            "| " + segment + " | " + " | ".join(str(row[cls]) for cls in classes) + " |" for segment, row in by_segment
+        ]
     failed = [r for r in worst_order(records) if r["class"] != "success"]
     if failed:
         shown = failed[:WORST_CASES]
-        lines += ["", f"Failed cases ({len(failed)}" + (f", the {len(shown)} worst" if len(failed) > len(shown) else "")
-                  + "): " + ", ".join(f"{r['seed']} ({r['class']}" + (", false trip" if r["false_trip"] else "")
-                                      + ")" for r in shown) + ". Rerun one (with its CSV, for tools/plot_run.py): "
-                  f"`{report.command(campaign_command(argv, shown[0]['seed']))}`, another seed in place of "
-                  f"{shown[0]['seed']}."]
+        lines += [
+            "",
+            f"Failed cases ({len(failed)}"
+            + (f", the {len(shown)} worst" if len(failed) > len(shown) else "")
+            + "): "
+            + ", ".join(f"{r['seed']} ({r['class']}" + (", false trip" if r["false_trip"] else "") + ")" for r in shown)
+            + ". Rerun one (with its CSV, for tools/plot_run.py): "
+            f"`{report.command(campaign_command(argv, shown[0]['seed']))}`, another seed in place of "
+            f"{shown[0]['seed']}.",
+        ]
     return "\n".join(lines) + "\n"
 
 
 # A position scenario's figures (electrical rad; none for a speed scenario).
-POSITION_METRICS = ("position_max_final_error_rad", "position_max_tracking_error_rad",
-                    "position_hold_max_error_rad", "position_abs_hold_drift_rad_s")
-POSITION_TITLES = ("largest final error of a move (electrical rad)",
-                   "largest \\|theta* - theta\\| in position mode (electrical rad)",
-                   "largest hold error (electrical rad)",
-                   "\\|hold drift\\| (electrical rad/s)")
+POSITION_METRICS = (
+    "position_max_final_error_rad",
+    "position_max_tracking_error_rad",
+    "position_hold_max_error_rad",
+    "position_abs_hold_drift_rad_s",
+)
+POSITION_TITLES = (
+    "largest final error of a move (electrical rad)",
+    "largest \\|theta* - theta\\| in position mode (electrical rad)",
+    "largest hold error (electrical rad)",
+    "\\|hold drift\\| (electrical rad/s)",
+)
 
-CSV_METRICS = ("max_speed_error_rad_s", "max_angle_error_rad", "failure_time_s", "failure_segment", "settle_time_s",
-               "loss_of_control_time_s", "detection_latency_s", "fault_time_s", "nonfinite_seen",
-               "tracking_max_abs_error_rad_s", "commissioning_measured", "r_rel_error", "l_rel_error", "k_rel_error",
-               "offset_a_error_A", "offset_b_error_A", "rest_angle_error_rad", "realignments", "final_mode",
-               "past_settle", "wall_s") + POSITION_METRICS
+CSV_METRICS = (
+    "max_speed_error_rad_s",
+    "max_angle_error_rad",
+    "failure_time_s",
+    "failure_segment",
+    "settle_time_s",
+    "loss_of_control_time_s",
+    "detection_latency_s",
+    "fault_time_s",
+    "nonfinite_seen",
+    "tracking_max_abs_error_rad_s",
+    "commissioning_measured",
+    "r_rel_error",
+    "l_rel_error",
+    "k_rel_error",
+    "offset_a_error_A",
+    "offset_b_error_A",
+    "rest_angle_error_rad",
+    "realignments",
+    "final_mode",
+    "past_settle",
+    "wall_s",
+) + POSITION_METRICS
 
 
 def write_cases_csv(path, records):
@@ -441,11 +593,17 @@ def write_cases_csv(path, records):
     keys = [row[0] for row in DISTRIBUTIONS]
     with open(path, "w", newline="") as f:
         writer = csv.writer(f)
-        writer.writerow(["seed", "class", "false_trip", "fault_name", "exit_status"] + keys + list(CSV_METRICS)
-                        + ["reason"])
+        writer.writerow(
+            ["seed", "class", "false_trip", "fault_name", "exit_status"] + keys + list(CSV_METRICS) + ["reason"]
+        )
         for r in records:
-            row = [r["seed"], r["class"], int(r["false_trip"]), r["fault_name"],
-                   "" if r["exit_status"] is None else r["exit_status"]]
+            row = [
+                r["seed"],
+                r["class"],
+                int(r["false_trip"]),
+                r["fault_name"],
+                "" if r["exit_status"] is None else r["exit_status"],
+            ]
             row += [format_value(r["params"][k]) for k in keys]
             for name in CSV_METRICS:
                 value = r["metrics"].get(name)

@@ -13,6 +13,7 @@ tightened) but do not fail.
                                        reasons of rules already recorded (new rules get
                                        "REASON NEEDED", which fails the check until written)
 """
+
 import collections
 import os
 import re
@@ -67,11 +68,19 @@ def findings():
     scratch = tempfile.mkdtemp(prefix="misra_")
     try:
         shutil.copytree(os.path.join(ROOT, "firmware"), os.path.join(scratch, "firmware"))
-        sources = sorted(os.path.join("firmware", "src", f)
-                         for f in os.listdir(os.path.join(scratch, "firmware", "src")) if f.endswith(".c"))
-        run = subprocess.run(["cppcheck", "--addon=misra", "--std=c99", "-Ifirmware/include", "--quiet",
-                              "--template={file}:{line}:{id}"] + sources,
-                             cwd=scratch, capture_output=True, text=True, check=False)
+        sources = sorted(
+            os.path.join("firmware", "src", f)
+            for f in os.listdir(os.path.join(scratch, "firmware", "src"))
+            if f.endswith(".c")
+        )
+        run = subprocess.run(
+            ["cppcheck", "--addon=misra", "--std=c99", "-Ifirmware/include", "--quiet", "--template={file}:{line}:{id}"]
+            + sources,
+            cwd=scratch,
+            capture_output=True,
+            text=True,
+            check=False,
+        )
         if run.returncode != 0:
             sys.exit(f"misra_check: cppcheck failed ({run.returncode}):\n{run.stderr}")
         found = collections.Counter()
@@ -136,14 +145,17 @@ def main():
             f.write("\n[findings]\n")
             for key in sorted(found, key=lambda k: (rule_key(k[0]), k[1], k[2], k[3])):
                 f.write(f"{key[0]} | {key[1]} | {key[2]} | {found[key]} | {key[3]}\n")
-        print(f"misra_check: wrote {os.path.relpath(RECORD, ROOT)}: {sum(found.values())} findings, "
-              f"{len(found)} keys, {len(rules)} rules")
+        print(
+            f"misra_check: wrote {os.path.relpath(RECORD, ROOT)}: {sum(found.values())} findings, "
+            f"{len(found)} keys, {len(rules)} rules"
+        )
         return 0
     failures = []
     for key, count in sorted(found.items()):
         if count > recorded.get(key, 0):
-            failures.append(f"  rule {key[0]} in {key[1]}, {key[2]}: {count} finding(s), "
-                            f"{recorded.get(key, 0)} recorded: {key[3]}")
+            failures.append(
+                f"  rule {key[0]} in {key[1]}, {key[2]}: {count} finding(s), {recorded.get(key, 0)} recorded: {key[3]}"
+            )
     for rule in sorted({k[0] for k in found}, key=rule_key):
         if reasons.get(rule, NEEDED) == NEEDED:
             failures.append(f"  rule {rule}: no reason in the record")
@@ -151,11 +163,15 @@ def main():
     per_rule = collections.Counter()
     for key, count in found.items():
         per_rule[key[0]] += count
-    print(f"misra_check: {sum(found.values())} findings in {len(per_rule)} rules: "
-          + ", ".join(f"{r}: {per_rule[r]}" for r in sorted(per_rule, key=rule_key)))
+    print(
+        f"misra_check: {sum(found.values())} findings in {len(per_rule)} rules: "
+        + ", ".join(f"{r}: {per_rule[r]}" for r in sorted(per_rule, key=rule_key))
+    )
     if stale:
-        print(f"misra_check: {len(stale)} recorded key(s) no longer (or less often) found; "
-              "tools/misra_check.py --write-record tightens the record")
+        print(
+            f"misra_check: {len(stale)} recorded key(s) no longer (or less often) found; "
+            "tools/misra_check.py --write-record tightens the record"
+        )
     if failures:
         print("misra_check: findings outside the deviation record " + os.path.relpath(RECORD, ROOT) + ":")
         print("\n".join(failures))

@@ -89,6 +89,7 @@ The threads engine and the report need only the standard library; dask.distribut
 imported for the Dask engine, numpy and matplotlib (tools/requirements.txt) only to draw
 the histograms.
 """
+
 import argparse
 import datetime
 import json
@@ -100,81 +101,203 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 # The three parts; their names are also this module's (the self-test uses them from here).
-from mc_distributions import (DISTRIBUTIONS, DURATION_KEY, KEY_PARAMETERS, SEED_KEY, SEED_STRIDE,  # noqa: E402,F401
-                              ToolError, base_values, case_seed, distribution_rows, draw_parameters,
-                              format_value, missing_keys, parse_scenario, split_case_seed)
-from mc_execution import (ENGINES, check_keys, read_scenario, rerun_command, run_all,  # noqa: E402,F401
-                          run_case, sil_command, sil_version)
-from mc_outcome import (CLASSES, CLASS_TEXT, FAULT_EXIT_STATUS, REQUIRED_FIELDS, classify,  # noqa: E402,F401
-                        extract_metrics, fault_name, get_path, number_or_none, summary_problem)
-from mc_preset import design_scenario, preset_distributions, read_preset, scenario_info  # noqa: E402
-from mc_segments import (failures_by_segment, label_failures, profile_segments, segment_of,  # noqa: E402,F401
-                         speed_points)
+from mc_distributions import (
+    DISTRIBUTIONS,
+    DURATION_KEY,
+    KEY_PARAMETERS,
+    SEED_KEY,
+    SEED_STRIDE,
+    ToolError,
+    base_values,
+    case_seed,
+    distribution_rows,
+    draw_parameters,
+    format_value,
+    missing_keys,
+    parse_scenario,
+    split_case_seed,
+)
+from mc_execution import (
+    ENGINES,
+    check_keys,
+    read_scenario,
+    rerun_command,
+    run_all,
+    run_case,
+    sil_command,
+    sil_version,
+)
+from mc_outcome import (
+    CLASSES,
+    CLASS_TEXT,
+    FAULT_EXIT_STATUS,
+    REQUIRED_FIELDS,
+    classify,
+    extract_metrics,
+    fault_name,
+    get_path,
+    number_or_none,
+    summary_problem,
+)
+from mc_preset import design_scenario, preset_distributions, read_preset, scenario_info
+from mc_segments import (
+    failures_by_segment,
+    label_failures,
+    profile_segments,
+    segment_of,
+    speed_points,
+)
 
 FAILURE_CLASSES = ("detected", "silent", "out_of_spec")  # the classes the segment table counts
-from mc_report import (CSV_METRICS, PAGE_TITLE, PAGE_WHAT, WORST_CASES, aggregate,  # noqa: E402,F401
-                       campaign_section, check_verdict, make_plots, percentile, spans_decades, wilson_interval,
-                       worst_order, write_cases_csv, write_report)
+from mc_report import (
+    CSV_METRICS,
+    PAGE_TITLE,
+    PAGE_WHAT,
+    WORST_CASES,
+    aggregate,
+    campaign_section,
+    check_verdict,
+    make_plots,
+    percentile,
+    spans_decades,
+    wilson_interval,
+    worst_order,
+    write_cases_csv,
+    write_report,
+)
 import report  # noqa: E402
 
 
 def parse_args(argv):
     parser = argparse.ArgumentParser(
         description="Monte Carlo robustness runner for pmstep-sil (see the module docstring).",
-        formatter_class=argparse.RawDescriptionHelpFormatter, epilog=__doc__.split("\n\n", 1)[1])
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog=__doc__.split("\n\n", 1)[1],
+    )
     parser.add_argument("--sil", required=True, help="the pmstep-sil executable")
     parser.add_argument("--scenario", default=None, help="scenario INI file the cases start from")
-    parser.add_argument("--preset", default=None, metavar="FILE",
-                        help="a motor preset (sil/scenarios/motors/*.ini): the designer's gains, the realistic chain, "
-                             "distributions scaled to the motor (mc_preset.py); with --scenario, that scenario "
-                             "(written for the preset) with the preset's distributions")
-    parser.add_argument("--tune", default=None, metavar="PATH",
-                        help="pmstep-tune for --preset (default: the one next to --sil)")
-    parser.add_argument("--phase-voltage-sensing", action="store_true",
-                        help="with --preset: the drive also senses each phase's mean voltage per period, and the "
-                             "cases draw that sensor's errors (mc_preset.py)")
-    parser.add_argument("--low-speed-drive", action="store_true",
-                        help="with --preset: the design turns the standstill hold's vector below 2 V_bus t_d / (T_s k_M) "
-                             "(pmstep-tune --low-speed-drive)")
+    parser.add_argument(
+        "--preset",
+        default=None,
+        metavar="FILE",
+        help="a motor preset (sil/scenarios/motors/*.ini): the designer's gains, the realistic chain, "
+        "distributions scaled to the motor (mc_preset.py); with --scenario, that scenario "
+        "(written for the preset) with the preset's distributions",
+    )
+    parser.add_argument(
+        "--tune", default=None, metavar="PATH", help="pmstep-tune for --preset (default: the one next to --sil)"
+    )
+    parser.add_argument(
+        "--phase-voltage-sensing",
+        action="store_true",
+        help="with --preset: the drive also senses each phase's mean voltage per period, and the "
+        "cases draw that sensor's errors (mc_preset.py)",
+    )
+    parser.add_argument(
+        "--low-speed-drive",
+        action="store_true",
+        help="with --preset: the design turns the standstill hold's vector below 2 V_bus t_d / (T_s k_M) "
+        "(pmstep-tune --low-speed-drive)",
+    )
     parser.add_argument("--out", required=True, help="output folder")
     parser.add_argument("--cases", type=int, default=100, help="number of cases N (default 100)")
     parser.add_argument("--seed", type=int, default=1, help="base seed S: case k has seed S*100000+k (default 1)")
-    parser.add_argument("--engine", choices=ENGINES, default="dask",
-                        help="dask (default): dask.distributed; threads: a thread pool on this machine")
-    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
-                        help="local Dask workers or threads (default: one per core)")
-    parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
-                        help="run on the existing Dask cluster of this scheduler (e.g. tcp://host:8786)")
-    parser.add_argument("--ship-sil", action="store_true",
-                        help="upload --sil to every Dask worker (else each worker runs the --sil path)")
-    parser.add_argument("--duration", type=float, default=None, metavar="SECONDS",
-                        help="simulated time per case (run.duration_s; default: the scenario's)")
+    parser.add_argument(
+        "--engine",
+        choices=ENGINES,
+        default="dask",
+        help="dask (default): dask.distributed; threads: a thread pool on this machine",
+    )
+    parser.add_argument(
+        "--jobs", type=int, default=os.cpu_count() or 1, help="local Dask workers or threads (default: one per core)"
+    )
+    parser.add_argument(
+        "--scheduler",
+        default=None,
+        metavar="ADDRESS",
+        help="run on the existing Dask cluster of this scheduler (e.g. tcp://host:8786)",
+    )
+    parser.add_argument(
+        "--ship-sil",
+        action="store_true",
+        help="upload --sil to every Dask worker (else each worker runs the --sil path)",
+    )
+    parser.add_argument(
+        "--duration",
+        type=float,
+        default=None,
+        metavar="SECONDS",
+        help="simulated time per case (run.duration_s; default: the scenario's)",
+    )
     parser.add_argument("--no-plots", action="store_true", help="no PNG histograms (no numpy/matplotlib needed)")
     parser.add_argument("--check", action="store_true", help="exit 1 unless the run meets the criteria")
-    parser.add_argument("--case", type=int, default=None, metavar="CASE_SEED",
-                        help="re-run the one case with this case seed and print its summary")
-    parser.add_argument("--speed-bound", type=float, default=None, metavar="RAD_S",
-                        help="max |w - w*| after settling for success (default 0.5 rad/s; with --preset the same "
-                             "fraction of the designer's top speed as 0.5 rad/s of the paper motor's)")
-    parser.add_argument("--angle-bound", type=float, default=0.05, metavar="RAD",
-                        help="max angle-estimate error after settling for success (default 0.05 rad)")
-    parser.add_argument("--position-bound", type=float, default=None, metavar="RAD",
-                        help="a position scenario (position.points): success also needs every move to end within "
-                             "this many electrical rad of its target (default: not checked)")
-    parser.add_argument("--latency-bound", type=float, default=0.05, metavar="SECONDS",
-                        help="a fault later than this after a loss of control is a silent failure (default 0.05 s)")
+    parser.add_argument(
+        "--case",
+        type=int,
+        default=None,
+        metavar="CASE_SEED",
+        help="re-run the one case with this case seed and print its summary",
+    )
+    parser.add_argument(
+        "--speed-bound",
+        type=float,
+        default=None,
+        metavar="RAD_S",
+        help="max |w - w*| after settling for success (default 0.5 rad/s; with --preset the same "
+        "fraction of the designer's top speed as 0.5 rad/s of the paper motor's)",
+    )
+    parser.add_argument(
+        "--angle-bound",
+        type=float,
+        default=0.05,
+        metavar="RAD",
+        help="max angle-estimate error after settling for success (default 0.05 rad)",
+    )
+    parser.add_argument(
+        "--position-bound",
+        type=float,
+        default=None,
+        metavar="RAD",
+        help="a position scenario (position.points): success also needs every move to end within "
+        "this many electrical rad of its target (default: not checked)",
+    )
+    parser.add_argument(
+        "--latency-bound",
+        type=float,
+        default=0.05,
+        metavar="SECONDS",
+        help="a fault later than this after a loss of control is a silent failure (default 0.05 s)",
+    )
     parser.add_argument("--min-success", type=float, default=0.99, help="--check: minimum success rate (default 0.99)")
-    parser.add_argument("--exclude", action="append", default=[], metavar="KEY",
-                        help="leave this row of the distribution table out (the scenario's value stays); "
-                             "repeatable, e.g. --exclude controller.inverter.dead_time_s for a firmware without compensation")
-    parser.add_argument("--report", default=None, metavar="FILE",
-                        help="also write the campaign's summary as a section of this Markdown page "
-                             "(docs/reports/monte-carlo.md), replacing the section of the same name")
-    parser.add_argument("--report-section", default=None, metavar="NAME",
-                        help="the section's name for --report (letters, digits, '.', '_', '-'; default: the "
-                             "preset's name, or the scenario file's without .ini)")
-    parser.add_argument("--case-timeout", type=float, default=600.0, metavar="SECONDS",
-                        help="wall time after which one run counts as crashed (default 600 s)")
+    parser.add_argument(
+        "--exclude",
+        action="append",
+        default=[],
+        metavar="KEY",
+        help="leave this row of the distribution table out (the scenario's value stays); "
+        "repeatable, e.g. --exclude controller.inverter.dead_time_s for a firmware without compensation",
+    )
+    parser.add_argument(
+        "--report",
+        default=None,
+        metavar="FILE",
+        help="also write the campaign's summary as a section of this Markdown page "
+        "(docs/reports/monte-carlo.md), replacing the section of the same name",
+    )
+    parser.add_argument(
+        "--report-section",
+        default=None,
+        metavar="NAME",
+        help="the section's name for --report (letters, digits, '.', '_', '-'; default: the "
+        "preset's name, or the scenario file's without .ini)",
+    )
+    parser.add_argument(
+        "--case-timeout",
+        type=float,
+        default=600.0,
+        metavar="SECONDS",
+        help="wall time after which one run counts as crashed (default 600 s)",
+    )
     args = parser.parse_args(argv[1:])
     if args.scenario is None and args.preset is None:
         parser.error("give --scenario, --preset or both")
@@ -206,9 +329,14 @@ def parse_args(argv):
         source = args.preset if args.preset is not None and args.scenario is None else args.scenario
         args.report_section = re.sub(r"[^A-Za-z0-9._-]+", "-", os.path.splitext(os.path.basename(source))[0])
         if args.preset is not None and args.scenario is None:
-            args.report_section += "".join(suffix for flag, suffix in ((args.phase_voltage_sensing, "-sensed"),
-                                                                       (args.low_speed_drive, "-low-speed-drive"))
-                                           if flag)
+            args.report_section += "".join(
+                suffix
+                for flag, suffix in (
+                    (args.phase_voltage_sensing, "-sensed"),
+                    (args.low_speed_drive, "-low-speed-drive"),
+                )
+                if flag
+            )
     if args.report_section is not None and not re.fullmatch(r"[A-Za-z0-9._-]+", args.report_section):
         parser.error("--report-section: letters, digits, '.', '_' and '-' only")
     args.argv = argv
@@ -254,18 +382,35 @@ def use_preset(args):
             raise ToolError(f"scenario file {args.scenario} not found")
         info = scenario_info(args.tune, args.preset, args.scenario, args.phase_voltage_sensing, args.low_speed_drive)
     else:
-        args.scenario, info = design_scenario(args.tune, args.preset, args.out, args.phase_voltage_sensing,
-                                              args.low_speed_drive)
+        args.scenario, info = design_scenario(
+            args.tune, args.preset, args.out, args.phase_voltage_sensing, args.low_speed_drive
+        )
     # In place, so every function's default table (the same list object) sees it.
-    DISTRIBUTIONS[:] = preset_distributions(info["figures"], info["peak_speed_rad_s"], info["paper_holding_torque_Nm"],
-                                            args.phase_voltage_sensing)
+    DISTRIBUTIONS[:] = preset_distributions(
+        info["figures"], info["peak_speed_rad_s"], info["paper_holding_torque_Nm"], args.phase_voltage_sensing
+    )
     if args.speed_bound is None:
         args.speed_bound = info["speed_bound_rad_s"]
-    print(f"monte_carlo: preset {info['preset']}: top speed {info['top_speed_rad_s']:g} rad/s, profile peak "
-          f"{info['peak_speed_rad_s']:g} rad/s, load step {info['load_Nm']:.4g} N m, speed bound "
-          f"{args.speed_bound:.4g} rad/s; scenario {args.scenario}", file=sys.stderr)
-    return {key: info[key] for key in ("preset", "preset_file", "top_speed_rad_s", "run_start_s", "peak_speed_rad_s",
-                                       "load_Nm", "speed_bound_rad_s", "tune_command", "designed")}
+    print(
+        f"monte_carlo: preset {info['preset']}: top speed {info['top_speed_rad_s']:g} rad/s, profile peak "
+        f"{info['peak_speed_rad_s']:g} rad/s, load step {info['load_Nm']:.4g} N m, speed bound "
+        f"{args.speed_bound:.4g} rad/s; scenario {args.scenario}",
+        file=sys.stderr,
+    )
+    return {
+        key: info[key]
+        for key in (
+            "preset",
+            "preset_file",
+            "top_speed_rad_s",
+            "run_start_s",
+            "peak_speed_rad_s",
+            "load_Nm",
+            "speed_bound_rad_s",
+            "tune_command",
+            "designed",
+        )
+    }
 
 
 def main(argv):
@@ -290,8 +435,10 @@ def main(argv):
     started_utc = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC")
     try:
         if not (os.path.isfile(args.sil) and os.access(args.sil, os.X_OK)):
-            raise ToolError(f"{args.sil} is not an executable file (build it: cmake --preset host-release && "
-                            "cmake --build --preset host-release)")
+            raise ToolError(
+                f"{args.sil} is not an executable file (build it: cmake --preset host-release && "
+                "cmake --build --preset host-release)"
+            )
         if not os.path.isfile(args.scenario):
             raise ToolError(f"scenario file {args.scenario} not found")
         if not args.no_plots and args.case is None:
@@ -299,8 +446,10 @@ def main(argv):
                 import matplotlib  # noqa: F401
                 import numpy  # noqa: F401
             except ImportError as e:
-                raise ToolError(f"the histograms need numpy and matplotlib ({e}); install tools/requirements.txt "
-                                "(e.g. into .venv) or pass --no-plots") from None
+                raise ToolError(
+                    f"the histograms need numpy and matplotlib ({e}); install tools/requirements.txt "
+                    "(e.g. into .venv) or pass --no-plots"
+                ) from None
         scenario = read_scenario(args.sil, args.scenario)
         check_keys(args.sil, args.scenario, scenario, args.duration is not None)
         base = base_values(scenario)
@@ -314,10 +463,16 @@ def main(argv):
         return run_one(args, scenario, base)
 
     version = sil_version(args.sil)
-    where = args.scheduler if args.scheduler else (f"{args.jobs} local " + ("workers" if args.engine == "dask"
-                                                                           else "threads"))
-    print(f"monte_carlo: {args.cases} cases of {args.scenario}, base seed {args.seed}, {args.engine} on {where} "
-          f"-> {args.out}", file=sys.stderr)
+    where = (
+        args.scheduler
+        if args.scheduler
+        else (f"{args.jobs} local " + ("workers" if args.engine == "dask" else "threads"))
+    )
+    print(
+        f"monte_carlo: {args.cases} cases of {args.scenario}, base seed {args.seed}, {args.engine} on {where} "
+        f"-> {args.out}",
+        file=sys.stderr,
+    )
     args.seeds = [case_seed(args.seed, k) for k in range(args.cases)]
     wall_start = time.monotonic()
     try:
@@ -333,6 +488,7 @@ def main(argv):
         print("0 passed, 0 failed")
         return 2
     wall_s = time.monotonic() - wall_start
+
     def mean_of(name):
         values = [r["metrics"].get(name) for r in records if r["metrics"].get(name) is not None]
         return sum(values) / len(values) if values else None
@@ -340,23 +496,41 @@ def main(argv):
     segments = label_failures(records, scenario)
     agg = aggregate(records, args)
     agg["failures_by_segment"] = failures_by_segment(records, FAILURE_CLASSES, segments)
-    agg.update({"scenario": args.scenario, "command": shlex.join(args.argv), "date": started_utc,
-                "pmstep_sil_version": version, "duration_s": args.duration,
-                "execution": {"engine": engine, "workers": workers, "cases_run": len(records) - resumed,
-                              "cases_resumed": resumed, "wall_s": wall_s,
-                              "campaign_wall_s_per_case": wall_s / (len(records) - resumed)
-                              if len(records) > resumed else None,
-                              # Inside pmstep-sil, per case: the run's loop, its CPU time, the firmware and
-                              # plant shares (sampled), as each summary.json's timing reports them.
-                              "sil_loop_wall_s_mean": mean_of("wall_s"), "sil_loop_cpu_s_mean": mean_of("cpu_s"),
-                              "sil_firmware_wall_s_mean": mean_of("firmware_wall_s"),
-                              "sil_plant_wall_s_mean": mean_of("plant_wall_s")},
-                "distribution_table": [list(row) for row in DISTRIBUTIONS],
-                "preset": preset_info,
-                "worst_cases": [{"seed": r["seed"], "class": r["class"], "reason": r["reason"],
-                                 "max_speed_error_rad_s": r["metrics"].get("max_speed_error_rad_s"),
-                                 "command": shlex.join(r["command"])}
-                                for r in worst_order(records)[:WORST_CASES]]})
+    agg.update(
+        {
+            "scenario": args.scenario,
+            "command": shlex.join(args.argv),
+            "date": started_utc,
+            "pmstep_sil_version": version,
+            "duration_s": args.duration,
+            "execution": {
+                "engine": engine,
+                "workers": workers,
+                "cases_run": len(records) - resumed,
+                "cases_resumed": resumed,
+                "wall_s": wall_s,
+                "campaign_wall_s_per_case": wall_s / (len(records) - resumed) if len(records) > resumed else None,
+                # Inside pmstep-sil, per case: the run's loop, its CPU time, the firmware and
+                # plant shares (sampled), as each summary.json's timing reports them.
+                "sil_loop_wall_s_mean": mean_of("wall_s"),
+                "sil_loop_cpu_s_mean": mean_of("cpu_s"),
+                "sil_firmware_wall_s_mean": mean_of("firmware_wall_s"),
+                "sil_plant_wall_s_mean": mean_of("plant_wall_s"),
+            },
+            "distribution_table": [list(row) for row in DISTRIBUTIONS],
+            "preset": preset_info,
+            "worst_cases": [
+                {
+                    "seed": r["seed"],
+                    "class": r["class"],
+                    "reason": r["reason"],
+                    "max_speed_error_rad_s": r["metrics"].get("max_speed_error_rad_s"),
+                    "command": shlex.join(r["command"]),
+                }
+                for r in worst_order(records)[:WORST_CASES]
+            ],
+        }
+    )
     plots = []
     if not args.no_plots:
         plots = make_plots(args.out, records, args)
@@ -370,10 +544,12 @@ def main(argv):
 
     counts = agg["counts"]
     low, high = agg["success_rate_wilson95"]
-    print(f"success {counts['success']}/{agg['cases']} ({100 * agg['success_rate']:.1f} %, "
-          f"Wilson 95 % {100 * low:.1f}-{100 * high:.1f} %); "
-          + ", ".join(f"{cls} {counts[cls]}" for cls in CLASSES[1:])
-          + f" (false trips {agg['false_trips']}); non-finite {agg['nonfinite_cases']}")
+    print(
+        f"success {counts['success']}/{agg['cases']} ({100 * agg['success_rate']:.1f} %, "
+        f"Wilson 95 % {100 * low:.1f}-{100 * high:.1f} %); "
+        + ", ".join(f"{cls} {counts[cls]}" for cls in CLASSES[1:])
+        + f" (false trips {agg['false_trips']}); non-finite {agg['nonfinite_cases']}"
+    )
     if agg["faults_by_name"]:
         print("faults: " + ", ".join(f"{name} x{count}" for name, count in agg["faults_by_name"].items()))
     crashed = [r for r in records if r["class"] == "crashed"]
@@ -382,19 +558,30 @@ def main(argv):
         print(f"crashed case {r['seed']}: {r['reason']}" + (f" ({tail[-1]})" if tail else ""))
     if len(crashed) > WORST_CASES:
         print(f"... and {len(crashed) - WORST_CASES} more crashed cases (cases.csv)")
-    print(f"{engine}, {workers} workers: {len(records) - resumed} cases run ({resumed} resumed) in {wall_s:.1f} s"
-          + (f", {(wall_s / (len(records) - resumed)):.3f} s per case" if len(records) > resumed else ""))
+    print(
+        f"{engine}, {workers} workers: {len(records) - resumed} cases run ({resumed} resumed) in {wall_s:.1f} s"
+        + (f", {(wall_s / (len(records) - resumed)):.3f} s per case" if len(records) > resumed else "")
+    )
     ex = agg["execution"]
     if ex["sil_loop_wall_s_mean"] is not None:
+
         def secs(name):
             return "-" if ex[name] is None else f"{ex[name]:.3f} s"
-        print(f"per case inside pmstep-sil (mean): loop {secs('sil_loop_wall_s_mean')} wall, "
-              f"{secs('sil_loop_cpu_s_mean')} CPU; firmware {secs('sil_firmware_wall_s_mean')}, "
-              f"plant {secs('sil_plant_wall_s_mean')}")
+
+        print(
+            f"per case inside pmstep-sil (mean): loop {secs('sil_loop_wall_s_mean')} wall, "
+            f"{secs('sil_loop_cpu_s_mean')} CPU; firmware {secs('sil_firmware_wall_s_mean')}, "
+            f"plant {secs('sil_plant_wall_s_mean')}"
+        )
     print(f"report: {os.path.join(args.out, 'report.md')}")
     if args.report:
-        page = report.write_section(args.report, PAGE_TITLE, args.report_section,
-                                    campaign_section(args.report_section, records, agg, args, args.argv), PAGE_WHAT)
+        page = report.write_section(
+            args.report,
+            PAGE_TITLE,
+            args.report_section,
+            campaign_section(args.report_section, records, agg, args, args.argv),
+            PAGE_WHAT,
+        )
         print(f"report section {args.report_section}: {page}")
     status = 0
     if args.check:
@@ -402,7 +589,9 @@ def main(argv):
             print("check FAILED: " + "; ".join(reasons))
             status = 1
         else:
-            print(f"check passed: success rate >= {args.min_success:g}, no silent failure, no crash, no non-finite value")
+            print(
+                f"check passed: success rate >= {args.min_success:g}, no silent failure, no crash, no non-finite value"
+            )
     print(f"{counts['success']} passed, {agg['cases'] - counts['success']} failed")
     return status
 

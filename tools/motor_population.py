@@ -29,6 +29,7 @@ plant's true values.
 Usage: tools/motor_population.py --out DIR [--count 500] [--seed 2026]   (writes DIR/*.ini and
 DIR/population.csv); also importable: draw(count, seed) -> list of dicts.
 """
+
 import argparse
 import csv
 import math
@@ -56,7 +57,7 @@ def log_uniform(rng, low, high):
 
 def inertia_fit_kgm2(holding_Nm):
     """The rotor inertia a frame's datasheets give for its holding torque (the fit in the docstring)."""
-    return 2.1e-5 * holding_Nm ** 1.5
+    return 2.1e-5 * holding_Nm**1.5
 
 
 def friction_estimate_Nms_rad(holding_Nm):
@@ -75,9 +76,11 @@ def draw_one(rng, index):
         resistance = log_uniform(rng, 1.0, 12.0) / current
         torque_constant = holding / (math.sqrt(2.0) * current)
         inductance = log_uniform(rng, 0.4, 4.0) * torque_constant / (pole_pairs * current)
-        if not (LIMITS["resistance_Ohm"][0] <= resistance <= LIMITS["resistance_Ohm"][1]
-                and LIMITS["inductance_H"][0] <= inductance <= LIMITS["inductance_H"][1]
-                and 0.2e-3 <= inductance / resistance <= 20e-3):
+        if not (
+            LIMITS["resistance_Ohm"][0] <= resistance <= LIMITS["resistance_Ohm"][1]
+            and LIMITS["inductance_H"][0] <= inductance <= LIMITS["inductance_H"][1]
+            and 0.2e-3 <= inductance / resistance <= 20e-3
+        ):
             continue
         buses = [b for b in BUSES_V if resistance * current <= 0.5 * b]
         if not buses:
@@ -87,13 +90,21 @@ def draw_one(rng, index):
         load_ratio = rng.choice((0.0, 1.0))
         detent = rng.uniform(0.0, 0.10) * holding
         return {
-            "name": f"m{index:04d}", "frame": frame, "pole_pairs": pole_pairs,
-            "rated_current_A": current, "holding_torque_Nm": holding, "detent_torque_Nm": detent,
-            "resistance_Ohm": resistance, "inductance_H": inductance,
+            "name": f"m{index:04d}",
+            "frame": frame,
+            "pole_pairs": pole_pairs,
+            "rated_current_A": current,
+            "holding_torque_Nm": holding,
+            "detent_torque_Nm": detent,
+            "resistance_Ohm": resistance,
+            "inductance_H": inductance,
             "torque_constant_Nm_A": torque_constant,
-            "inertia_kgm2": rotor * (1.0 + load_ratio), "rotor_inertia_kgm2": rotor, "load_ratio": load_ratio,
+            "inertia_kgm2": rotor * (1.0 + load_ratio),
+            "rotor_inertia_kgm2": rotor,
+            "load_ratio": load_ratio,
             "friction_Nms_rad": friction_estimate_Nms_rad(holding),
-            "told_inertia_kgm2": inertia_fit_kgm2(holding), "told_friction_Nms_rad": friction_estimate_Nms_rad(holding),
+            "told_inertia_kgm2": inertia_fit_kgm2(holding),
+            "told_friction_Nms_rad": friction_estimate_Nms_rad(holding),
             "bus_voltage_V": bus,
         }
 
@@ -106,22 +117,52 @@ def draw(count=COUNT, seed=SEED):
 
 def preset_text(m):
     """A motor preset (sil/scenarios/motors/*.ini layout) for @p m."""
-    return "\n".join([
-        f"; Drawn by tools/motor_population.py: {m['frame']}, {200 * m['pole_pairs'] // 50} steps/rev,"
-        f" load inertia {m['load_ratio']:g} x the rotor's.",
-        "[scenario]", f"name = {m['name']}", "",
-        "[datasheet]", f"rated_current_A = {m['rated_current_A']:.6g}", f"holding_torque_Nm = {m['holding_torque_Nm']:.6g}",
-        f"detent_torque_Nm = {m['detent_torque_Nm']:.6g}", "",
-        "[motor]", f"resistance_Ohm = {m['resistance_Ohm']:.6g}", f"inductance_H = {m['inductance_H']:.6g}",
-        f"inertia_kgm2 = {m['inertia_kgm2']:.6g}", f"friction_Nms_rad = {m['friction_Nms_rad']:.6g}",
-        f"torque_constant_Nm_A = {m['torque_constant_Nm_A']:.6g}", f"pole_pairs = {m['pole_pairs']}",
-        f"detent_torque_Nm = {m['detent_torque_Nm']:.6g}", "",
-        "[run]", f"bus_voltage_V = {m['bus_voltage_V']:g}", ""])
+    return "\n".join(
+        [
+            f"; Drawn by tools/motor_population.py: {m['frame']}, {200 * m['pole_pairs'] // 50} steps/rev,"
+            f" load inertia {m['load_ratio']:g} x the rotor's.",
+            "[scenario]",
+            f"name = {m['name']}",
+            "",
+            "[datasheet]",
+            f"rated_current_A = {m['rated_current_A']:.6g}",
+            f"holding_torque_Nm = {m['holding_torque_Nm']:.6g}",
+            f"detent_torque_Nm = {m['detent_torque_Nm']:.6g}",
+            "",
+            "[motor]",
+            f"resistance_Ohm = {m['resistance_Ohm']:.6g}",
+            f"inductance_H = {m['inductance_H']:.6g}",
+            f"inertia_kgm2 = {m['inertia_kgm2']:.6g}",
+            f"friction_Nms_rad = {m['friction_Nms_rad']:.6g}",
+            f"torque_constant_Nm_A = {m['torque_constant_Nm_A']:.6g}",
+            f"pole_pairs = {m['pole_pairs']}",
+            f"detent_torque_Nm = {m['detent_torque_Nm']:.6g}",
+            "",
+            "[run]",
+            f"bus_voltage_V = {m['bus_voltage_V']:g}",
+            "",
+        ]
+    )
 
 
-FIELDS = ["name", "frame", "pole_pairs", "rated_current_A", "holding_torque_Nm", "detent_torque_Nm", "resistance_Ohm",
-          "inductance_H", "torque_constant_Nm_A", "inertia_kgm2", "rotor_inertia_kgm2", "load_ratio",
-          "friction_Nms_rad", "told_inertia_kgm2", "told_friction_Nms_rad", "bus_voltage_V"]
+FIELDS = [
+    "name",
+    "frame",
+    "pole_pairs",
+    "rated_current_A",
+    "holding_torque_Nm",
+    "detent_torque_Nm",
+    "resistance_Ohm",
+    "inductance_H",
+    "torque_constant_Nm_A",
+    "inertia_kgm2",
+    "rotor_inertia_kgm2",
+    "load_ratio",
+    "friction_Nms_rad",
+    "told_inertia_kgm2",
+    "told_friction_Nms_rad",
+    "bus_voltage_V",
+]
 
 
 def write(motors, out):

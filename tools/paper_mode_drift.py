@@ -18,6 +18,7 @@ exceeds 0.05 and 0.5 rad, the loss of control and the fault), DIR/summary.json a
 case ran and the ideal chain stays below 1e-3 rad (the paper's method is exact there). The last
 line printed is "N passed, N failed" (passed = cases that ran).
 """
+
 import argparse
 import concurrent.futures
 import configparser
@@ -29,28 +30,41 @@ import shlex
 import subprocess
 import sys
 
-RUN_MODE = 3            # pmstep_mode_t PMSTEP_MODE_RUN
-HORIZON_S = 10.0        # observed time after t_c
-WINDOW_S = 0.1          # "|e| at t" is the max over (t - WINDOW_S, t]
+RUN_MODE = 3  # pmstep_mode_t PMSTEP_MODE_RUN
+HORIZON_S = 10.0  # observed time after t_c
+WINDOW_S = 0.1  # "|e| at t" is the max over (t - WINDOW_S, t]
 MARKS_S = (1.0, 5.0, 10.0)
 THRESHOLDS_RAD = (0.05, 0.5)
 
 # The firmware in the paper's mode, detection off (see the module docstring).
 PAPER_FIRMWARE = {
-    "controller.commissioning.offset_calibration_time_s": "0", "controller.commissioning.alignment_offset_calibration": "false",
-    "controller.commissioning.steady_state_window_s": "0", "controller.commissioning.inductance_window_s": "0",
-    "controller.commissioning.use_measured_resistance": "false", "controller.commissioning.use_measured_inductance": "false",
-    "controller.commissioning.use_measured_torque_constant": "false", "controller.commissioning.voltage_bias_level_fraction": "0",
-    "controller.inverter.dead_time_s": "0", "controller.gains.angle_correction_gain_per_s": "0", "speed.id_target_A": "0",
-    "controller.detection.angle_magnitude_bound": "0", "controller.detection.speed_consistency_bound_rad_s": "0",
-    "controller.detection.stall_speed_error_rad_s": "0", "controller.detection.observer_residual_bound_A": "0",
+    "controller.commissioning.offset_calibration_time_s": "0",
+    "controller.commissioning.alignment_offset_calibration": "false",
+    "controller.commissioning.steady_state_window_s": "0",
+    "controller.commissioning.inductance_window_s": "0",
+    "controller.commissioning.use_measured_resistance": "false",
+    "controller.commissioning.use_measured_inductance": "false",
+    "controller.commissioning.use_measured_torque_constant": "false",
+    "controller.commissioning.voltage_bias_level_fraction": "0",
+    "controller.inverter.dead_time_s": "0",
+    "controller.gains.angle_correction_gain_per_s": "0",
+    "speed.id_target_A": "0",
+    "controller.detection.angle_magnitude_bound": "0",
+    "controller.detection.speed_consistency_bound_rad_s": "0",
+    "controller.detection.stall_speed_error_rad_s": "0",
+    "controller.detection.observer_residual_bound_A": "0",
     "load.step_time_s": "0.63",  # 30 ms after t_c = 0.6 s, as in the paper
 }
 
 # Every non-ideality off; the paper's plant R.
 IDEAL_CHAIN = {
-    "sensors.adc_bits": "0", "sensors.offset_a_A": "0", "sensors.offset_b_A": "0", "sensors.noise_rms_A": "0",
-    "inverter.dead_time_s": "0", "run.delay_periods": "0", "motor.resistance_Ohm": "3",
+    "sensors.adc_bits": "0",
+    "sensors.offset_a_A": "0",
+    "sensors.offset_b_A": "0",
+    "sensors.noise_rms_A": "0",
+    "inverter.dead_time_s": "0",
+    "run.delay_periods": "0",
+    "motor.resistance_Ohm": "3",
 }
 
 # (name, keys taken back from the scenario file on top of the ideal chain)
@@ -66,13 +80,17 @@ ALONE = [
 
 def scenario_values(sil, scenario):
     """{section.key: text} of every key of the scenario (pmstep-sil --print-scenario)."""
-    text = subprocess.run([sil, "--scenario", scenario, "--print-scenario"], check=True, capture_output=True,
-                          text=True).stdout
+    text = subprocess.run(
+        [sil, "--scenario", scenario, "--print-scenario"], check=True, capture_output=True, text=True
+    ).stdout
     parser = configparser.ConfigParser(comment_prefixes=(";",), interpolation=None)
     parser.optionxform = str  # keep the keys' case: units are in them (motor.resistance_Ohm)
     parser.read_string(text)
-    return {f"{section}.{key}": " ".join(value.split()) for section in parser.sections()
-            for key, value in parser[section].items()}
+    return {
+        f"{section}.{key}": " ".join(value.split())
+        for section in parser.sections()
+        for key, value in parser[section].items()
+    }
 
 
 def cases(values, t_c_s):
@@ -83,8 +101,17 @@ def cases(values, t_c_s):
     for name, keys in ALONE:
         out.append((name, {**paper, **IDEAL_CHAIN, **{k: values[k] for k in keys}}))
     out.append(("all of the scenario's chain", paper))
-    out.append(("robust mode, all", {"run.duration_s": repr(float(values["controller.commissioning.offset_calibration_time_s"])
-                                                            + t_c_s + HORIZON_S), "run.decimation": "20"}))
+    out.append(
+        (
+            "robust mode, all",
+            {
+                "run.duration_s": repr(
+                    float(values["controller.commissioning.offset_calibration_time_s"]) + t_c_s + HORIZON_S
+                ),
+                "run.decimation": "20",
+            },
+        )
+    )
     return out
 
 
@@ -126,18 +153,25 @@ def run_case(sil, scenario, out_dir, name, sets):
         for row in csv.DictReader(f):
             if int(row["mode"]) == RUN_MODE:
                 times.append(float(row["t_s"]) - t_c)
-                errors.append(angle_error_rad(float(row["cos_hat"]), float(row["sin_hat"]),
-                                              float(row["cos_ptheta"]), float(row["sin_ptheta"])))
+                errors.append(
+                    angle_error_rad(
+                        float(row["cos_hat"]), float(row["sin_hat"]), float(row["cos_ptheta"]), float(row["sin_ptheta"])
+                    )
+                )
     loss = summary["robustness"]["loss_of_control_time_s"]
-    result.update({
-        "ran": True, "times_s": times, "errors_rad": errors,
-        "at_s": {str(m): window_max(times, errors, m) for m in MARKS_S},
-        "max_rad": max((abs(e) for e in errors), default=None),
-        "first_above_s": {str(th): first_crossing(times, errors, th) for th in THRESHOLDS_RAD},
-        "loss_after_tc_s": loss - t_c if loss >= 0 else None,
-        "fault": summary["fault"]["name"], "fault_after_tc_s": (summary["fault"]["time_s"] - t_c
-                                                                if summary["fault"]["time_s"] >= 0 else None),
-    })
+    result.update(
+        {
+            "ran": True,
+            "times_s": times,
+            "errors_rad": errors,
+            "at_s": {str(m): window_max(times, errors, m) for m in MARKS_S},
+            "max_rad": max((abs(e) for e in errors), default=None),
+            "first_above_s": {str(th): first_crossing(times, errors, th) for th in THRESHOLDS_RAD},
+            "loss_after_tc_s": loss - t_c if loss >= 0 else None,
+            "fault": summary["fault"]["name"],
+            "fault_after_tc_s": (summary["fault"]["time_s"] - t_c if summary["fault"]["time_s"] >= 0 else None),
+        }
+    )
     return result
 
 
@@ -146,25 +180,39 @@ def fmt(value, spec=".3g", unit=""):
 
 
 def table(results):
-    head = ("| case | \\|e\\| at 1 s | at 5 s | at 10 s | max | > 0.05 rad at | > 0.5 rad at "
-            "| loss of control at | fault |\n|---|---|---|---|---|---|---|---|---|\n")
+    head = (
+        "| case | \\|e\\| at 1 s | at 5 s | at 10 s | max | > 0.05 rad at | > 0.5 rad at "
+        "| loss of control at | fault |\n|---|---|---|---|---|---|---|---|---|\n"
+    )
     rows = []
     for r in results:
         if not r["ran"]:
             rows.append(f"| {r['name']} | did not run: {r.get('error', '')} |||||||| |")
             continue
         fault = "-" if r["fault"] == "NONE" else f"{r['fault']} at {fmt(r['fault_after_tc_s'], '.3f', ' s')}"
-        rows.append("| " + " | ".join([
-            r["name"], *(fmt(r["at_s"][str(m)]) for m in MARKS_S), fmt(r["max_rad"]),
-            *(fmt(r["first_above_s"][str(th)], ".3f", " s") for th in THRESHOLDS_RAD),
-            fmt(r["loss_after_tc_s"], ".3f", " s"), fault]) + " |")
+        rows.append(
+            "| "
+            + " | ".join(
+                [
+                    r["name"],
+                    *(fmt(r["at_s"][str(m)]) for m in MARKS_S),
+                    fmt(r["max_rad"]),
+                    *(fmt(r["first_above_s"][str(th)], ".3f", " s") for th in THRESHOLDS_RAD),
+                    fmt(r["loss_after_tc_s"], ".3f", " s"),
+                    fault,
+                ]
+            )
+            + " |"
+        )
     return head + "\n".join(rows) + "\n"
 
 
 def plot(results, path):
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
     fig, ax = plt.subplots(figsize=(9, 5))
     for r in results:
         if r["ran"] and r["times_s"]:
@@ -199,13 +247,19 @@ def main(argv):
         for done, future in enumerate(concurrent.futures.as_completed(futures), 1):
             results[futures[future]] = future.result()
             print(f"paper_mode_drift: {done}/{len(todo)} runs", file=sys.stderr)
-    report = ["# The paper's method under a real measurement chain", "",
-              f"Plant and chain of `{args.scenario}`; the firmware in the paper's mode (no calibration, "
-              "commissioning, dead-time compensation or drift-free correction; i_d* = 0) with detection off, "
-              f"observed for {HORIZON_S:g} s after t_c. Each non-ideality alone on an ideal chain, then all of them; "
-              "the last row is the scenario unchanged (robust mode, detection on). |e| is the electrical "
-              f"angle error of (c-hat, s-hat), max over the {WINDOW_S:g} s before each mark.", "", table(results),
-              "Commands:", ""]
+    report = [
+        "# The paper's method under a real measurement chain",
+        "",
+        f"Plant and chain of `{args.scenario}`; the firmware in the paper's mode (no calibration, "
+        "commissioning, dead-time compensation or drift-free correction; i_d* = 0) with detection off, "
+        f"observed for {HORIZON_S:g} s after t_c. Each non-ideality alone on an ideal chain, then all of them; "
+        "the last row is the scenario unchanged (robust mode, detection on). |e| is the electrical "
+        f"angle error of (c-hat, s-hat), max over the {WINDOW_S:g} s before each mark.",
+        "",
+        table(results),
+        "Commands:",
+        "",
+    ]
     report += [f"- {r['name']}: `{r['command']}`" for r in results]
     if not args.no_plots:
         plot(results, os.path.join(args.out, "drift.png"))
@@ -221,8 +275,11 @@ def main(argv):
     if args.check:
         ideal = results[0]
         if failed or not ideal["ran"] or not (ideal["max_rad"] is not None and ideal["max_rad"] < 1e-3):
-            print(f"check FAILED: {failed} case(s) did not run; ideal chain max {fmt(ideal.get('max_rad'))} rad "
-                  "(bound 1e-3)", file=sys.stderr)
+            print(
+                f"check FAILED: {failed} case(s) did not run; ideal chain max {fmt(ideal.get('max_rad'))} rad "
+                "(bound 1e-3)",
+                file=sys.stderr,
+            )
             status = 1
     print(f"{ran} passed, {failed} failed")
     return 1 if failed else status

@@ -8,6 +8,7 @@ for every direction of the estimation errors (i~_a A, i~_b A, e_w rad/s, T~_L Nm
 the start of controller (6), the radii that converged and the first that failed, and the
 fraction of directions that converge at each radius, beside the radius of Theorem 3.
 """
+
 import csv
 import json
 import math
@@ -72,8 +73,9 @@ def main(argv):
     ax_frac.set_title("Convergence against radius")
 
     for ax in (ax_rays, ax_frac):
-        ax.axvline(rho_ceiling, color="tab:purple", linestyle="--",
-                   label=f"Theorem 3 rho at best (any p_e): {rho_ceiling:.3g}")
+        ax.axvline(
+            rho_ceiling, color="tab:purple", linestyle="--", label=f"Theorem 3 rho at best (any p_e): {rho_ceiling:.3g}"
+        )
         if met and rho is not None:
             ax.axvline(rho, color="tab:purple", linestyle="-", label=f"Theorem 3 radius rho: {rho:.3g}")
         ax.axvline(r_all, color="black", linestyle="-", label=f"100% convergence up to {r_all:.4g}")
@@ -87,11 +89,14 @@ def main(argv):
         f"{len(directions)} directions, {int(doa['runs'])} SIL runs; converged = no fault, "
         f"|w - w*|, |w-hat - w| < {opts['speed_tol_rad_s']:g} rad/s on the last {opts['final_window_s']:g} s, "
         f"|T_L-hat - T_L| < {opts['load_tol_Nm']:g} Nm",
-        fontsize=9)
+        fontsize=9,
+    )
     fig.tight_layout()
     fig.savefig(out_path, dpi=130)
-    print(f"plot_doa: wrote {out_path} (100% convergence up to {r_all:.4g}; theory best case {rho_ceiling:.3g}, "
-          f"ratio {r_all / rho_ceiling if rho_ceiling else math.nan:.3g})")
+    print(
+        f"plot_doa: wrote {out_path} (100% convergence up to {r_all:.4g}; theory best case {rho_ceiling:.3g}, "
+        f"ratio {r_all / rho_ceiling if rho_ceiling else math.nan:.3g})"
+    )
     return 0
 
 

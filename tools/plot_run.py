@@ -6,9 +6,11 @@ Usage: tools/plot_run.py RUN_DIR [--out DIR]
 Reads RUN_DIR/run.csv and RUN_DIR/summary.json (written by pmstep-sil) and writes
 fig1_reference_and_load.png, fig2_alignment.png and fig3_tracking.png into DIR
 (default RUN_DIR), printing each path; a position scenario's run (columns position_ref_rad,
-position_hat_rad, position_rad) also gives fig4_position.png: the position and its errors. Exit status 2 if a file, a key or a column is
+position_hat_rad, position_rad) also gives fig4_position.png: the position and its errors. Exit status 2 if a file, a
+key or a column is
 missing or unreadable.
 """
+
 import argparse
 import csv
 import json
@@ -23,8 +25,23 @@ import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
 import numpy as np  # noqa: E402
 from matplotlib.ticker import FuncFormatter, MultipleLocator  # noqa: E402
 
-COLUMNS = ("t_s", "theta_rad", "omega_rad_s", "omega_ref_rad_s", "i_a_A", "i_b_A", "u_a_V", "u_b_V",
-           "cos_hat", "sin_hat", "cos_ptheta", "sin_ptheta", "load_hat_Nm", "load_Nm", "mode")
+COLUMNS = (
+    "t_s",
+    "theta_rad",
+    "omega_rad_s",
+    "omega_ref_rad_s",
+    "i_a_A",
+    "i_b_A",
+    "u_a_V",
+    "u_b_V",
+    "cos_hat",
+    "sin_hat",
+    "cos_ptheta",
+    "sin_ptheta",
+    "load_hat_Nm",
+    "load_Nm",
+    "mode",
+)
 POSITION_COLUMNS = ("position_ref_rad", "position_hat_rad", "position_rad")
 KEYS = ("pole_pairs", "s_align_time_s", "c_align_time_s")
 MODE_RUN, MODE_FAULT = 3, 4
@@ -71,8 +88,7 @@ def load(run_dir):
 
 def mark(ax, t, label, color="0.35"):
     ax.axvline(t, color=color, ls=":", lw=1)
-    ax.text(t, 1.01, label, transform=ax.get_xaxis_transform(), ha="center", va="bottom",
-            color=color, fontsize=9)
+    ax.text(t, 1.01, label, transform=ax.get_xaxis_transform(), ha="center", va="bottom", color=color, fontsize=9)
 
 
 def pi_ticks(ax, lo, hi):
@@ -84,6 +100,7 @@ def pi_ticks(ax, lo, hi):
         num, den = (n // 2, "") if n % 2 == 0 else (n, "/2")
         coef = {0: "0", 1: "π", -1: "−π"}.get(num, f"{num}π".replace("-", "−"))
         return coef if num == 0 else coef + den
+
     ax.yaxis.set_major_formatter(FuncFormatter(fmt))
 
 
@@ -106,7 +123,7 @@ def main():
     p, ts, tc = summary["pole_pairs"], summary["s_align_time_s"], summary["c_align_time_s"]
     name = summary.get("scenario", os.path.basename(os.path.normpath(args.run_dir)))
     t = d["t_s"]
-    run = (t >= tc) & (d["mode"] == MODE_RUN)   # estimates are meaningful only in RUN
+    run = (t >= tc) & (d["mode"] == MODE_RUN)  # estimates are meaningful only in RUN
     after = t >= tc
     before = t <= tc
     faulted = np.flatnonzero(d["mode"] == MODE_FAULT)
@@ -155,13 +172,19 @@ def main():
     fig, axes = plt.subplots(4, 1, sharex=True, figsize=(WIDTH_IN, 9.5))
     if not after.any():
         sys.stderr.write("plot_run.py: warning: the run ends before t_c; Fig. 3 is empty\n")
-        axes[0].text(0.5, 0.5, f"no samples at t ≥ t_c (run ends at {t[-1]:.3f} s)",
-                     transform=axes[0].transAxes, ha="center", va="center", color="tab:red")
+        axes[0].text(
+            0.5,
+            0.5,
+            f"no samples at t ≥ t_c (run ends at {t[-1]:.3f} s)",
+            transform=axes[0].transAxes,
+            ha="center",
+            va="center",
+            color="tab:red",
+        )
     ta = t[after]
     axes[0].plot(ta, (d["omega_rad_s"] - d["omega_ref_rad_s"])[after], color="tab:blue")
     axes[0].set_ylabel("ω − ω* (rad/s)")
-    axes[0].set_title("Fig. 3 — Speed tracking error, (a, b) currents and voltages, angle estimate"
-                      " (t ≥ $t_c$)", pad=16)
+    axes[0].set_title("Fig. 3 — Speed tracking error, (a, b) currents and voltages, angle estimate (t ≥ $t_c$)", pad=16)
     axes[1].plot(ta, d["i_a_A"][after], label="$i_a$")
     axes[1].plot(ta, d["i_b_A"][after], label="$i_b$")
     axes[1].set_ylabel("current (A)")
@@ -190,10 +213,14 @@ def main():
         a1.set_ylabel("position (rad, mechanical)")
         a1.set_title(f"Fig. 4 — Position control ({name}): position and position error", pad=16)
         a1.legend(loc="best", fontsize=9)
-        a2.plot(t[run], p * (d["position_ref_rad"] - d["position_rad"])[run], color="tab:blue",
-                label="p (θ* − θ)")
-        a2.plot(t[run], p * (d["position_hat_rad"] - d["position_rad"])[run], color="tab:red", lw=1,
-                label="p ($\\hat{θ}$ − θ)")
+        a2.plot(t[run], p * (d["position_ref_rad"] - d["position_rad"])[run], color="tab:blue", label="p (θ* − θ)")
+        a2.plot(
+            t[run],
+            p * (d["position_hat_rad"] - d["position_rad"])[run],
+            color="tab:red",
+            lw=1,
+            label="p ($\\hat{θ}$ − θ)",
+        )
         a2.set_ylabel("error (electrical rad)")
         a2.ticklabel_format(axis="y", style="sci", scilimits=(-2, 3), useOffset=False)
         a2.legend(loc="best", fontsize=9)

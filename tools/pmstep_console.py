@@ -68,6 +68,7 @@ and goes on, except after a line failure, which ends it):
      (LinkError)
   6  the port could not be opened: missing device, refused connection, bad URL (PortOpenError)
 """
+
 import argparse
 import cmd
 import configparser
@@ -87,6 +88,7 @@ from pathlib import Path
 
 try:
     import termios  # a serial port's flush/in_waiting raise termios.error on a line gone away
+
     LINK_ERRORS = (OSError, termios.error)  # OSError: pyserial's SerialException among them
 except ImportError:  # Windows
     LINK_ERRORS = (OSError,)
@@ -106,48 +108,133 @@ CALIBRATE, CALIBRATE_STATUS = 0x18, 0x19
 HOME, HOME_STATUS = 0x1A, 0x1B
 SIM_ADVANCE, SIM_FINISH, SIM_STEPS, SIM_FOLLOW_STEPS, SIM_STEPDIR = 0x40, 0x41, 0x42, 0x43, 0x44
 TELEMETRY_FRAME, ERROR_FRAME = 0x90, 0xFF
-REQUEST_NAMES = {HELLO: "HELLO", START: "START", STOP: "STOP", CLEAR_FAULT: "CLEAR_FAULT",
-                 SPEED_TARGET: "SPEED_TARGET", ID_TARGET: "ID_TARGET", GET_STATUS: "STATUS",
-                 GET_CONFIG: "CONFIG", SET_CONFIG: "SET_CONFIG", GET_COMMISSIONING: "COMMISSIONING",
-                 TELEMETRY: "TELEMETRY", GET_COUNTERS: "COUNTERS", MOVE_TO: "MOVE_TO", HOLD: "HOLD",
-                 GET_POSITION: "POSITION", SET_POSITION_ZERO: "SET_POSITION_ZERO", CONFIG_READ: "CONFIG_READ",
-                 CONFIG_WRITE: "CONFIG_WRITE", CONFIG_APPLY: "CONFIG_APPLY", CONFIG_SAVE: "CONFIG_SAVE",
-                 CONFIG_ERASE: "CONFIG_ERASE", CONFIG_DEFAULTS: "CONFIG_DEFAULTS", CONFIG_STATUS: "CONFIG_STATUS",
-                 CALIBRATE: "CALIBRATE", CALIBRATE_STATUS: "CALIBRATE_STATUS", HOME: "HOME",
-                 HOME_STATUS: "HOME_STATUS",
-                 SIM_ADVANCE: "SIM_ADVANCE", SIM_FINISH: "SIM_FINISH", SIM_STEPS: "SIM_STEPS",
-                 SIM_FOLLOW_STEPS: "SIM_FOLLOW_STEPS", SIM_STEPDIR: "SIM_STEPDIR"}
+REQUEST_NAMES = {
+    HELLO: "HELLO",
+    START: "START",
+    STOP: "STOP",
+    CLEAR_FAULT: "CLEAR_FAULT",
+    SPEED_TARGET: "SPEED_TARGET",
+    ID_TARGET: "ID_TARGET",
+    GET_STATUS: "STATUS",
+    GET_CONFIG: "CONFIG",
+    SET_CONFIG: "SET_CONFIG",
+    GET_COMMISSIONING: "COMMISSIONING",
+    TELEMETRY: "TELEMETRY",
+    GET_COUNTERS: "COUNTERS",
+    MOVE_TO: "MOVE_TO",
+    HOLD: "HOLD",
+    GET_POSITION: "POSITION",
+    SET_POSITION_ZERO: "SET_POSITION_ZERO",
+    CONFIG_READ: "CONFIG_READ",
+    CONFIG_WRITE: "CONFIG_WRITE",
+    CONFIG_APPLY: "CONFIG_APPLY",
+    CONFIG_SAVE: "CONFIG_SAVE",
+    CONFIG_ERASE: "CONFIG_ERASE",
+    CONFIG_DEFAULTS: "CONFIG_DEFAULTS",
+    CONFIG_STATUS: "CONFIG_STATUS",
+    CALIBRATE: "CALIBRATE",
+    CALIBRATE_STATUS: "CALIBRATE_STATUS",
+    HOME: "HOME",
+    HOME_STATUS: "HOME_STATUS",
+    SIM_ADVANCE: "SIM_ADVANCE",
+    SIM_FINISH: "SIM_FINISH",
+    SIM_STEPS: "SIM_STEPS",
+    SIM_FOLLOW_STEPS: "SIM_FOLLOW_STEPS",
+    SIM_STEPDIR: "SIM_STEPDIR",
+}
 
 MODES = {0: "IDLE", 1: "S_ALIGN", 2: "C_ALIGN", 3: "RUN", 4: "FAULT", 5: "OFFSET_CAL"}
-ERRORS = {1: "unknown command", 2: "bad length", 3: "bad value (NaN, Inf or out of range)",
-          4: "unknown configuration value", 5: "read-only value", 6: "refused while the motor runs",
-          7: "busy: the previous command has not reached the core yet", 8: "not supported by this image",
-          9: "no position control in this image (speed mode only)", 10: "no motor configured",
-          11: "no stored configuration in this image", 12: "no self-commissioning (CALIBRATE) in this image"}
+ERRORS = {
+    1: "unknown command",
+    2: "bad length",
+    3: "bad value (NaN, Inf or out of range)",
+    4: "unknown configuration value",
+    5: "read-only value",
+    6: "refused while the motor runs",
+    7: "busy: the previous command has not reached the core yet",
+    8: "not supported by this image",
+    9: "no position control in this image (speed mode only)",
+    10: "no motor configured",
+    11: "no stored configuration in this image",
+    12: "no self-commissioning (CALIBRATE) in this image",
+}
 ERR_NOT_CONFIGURED = 10
 HELLO_STORE, HELLO_CONFIGURED = 1, 2  # HELLO flags
 POSITION_FLAGS = {1: "tracked", 2: "position_mode", 4: "moving"}
 SIM_STEPDIR_FLAGS = {1: "following", 2: "moving", 4: "diag"}
 SIM_STEPS_MAX = 60  # periods of STEP edges one SIM_STEPS carries (PMSTEP_CONSOLE_SIM_STEPS_MAX)
-STATUS_FIELDS = ["speed_ref_rad_s", "speed_hat_rad_s", "load_hat_Nm", "cos_hat", "sin_hat", "i_a_A", "i_b_A",
-                 "bus_voltage_V", "u_a_V", "u_b_V", "i_d_A", "i_q_A"]
-TELEMETRY_FIELDS = ["period", "mode", "fault", "speed_ref_rad_s", "speed_hat_rad_s", "load_hat_Nm", "cos_hat",
-                    "sin_hat", "i_a_A", "i_b_A", "bus_voltage_V", "u_a_V", "u_b_V", "i_q_A"]
-COUNTER_FIELDS = ["rx_bytes", "rx_frames", "rx_garbage_bytes", "rx_bad_length", "rx_crc_errors", "rx_truncated",
-                  "rx_error_replies", "commands_applied", "tx_frames", "tx_dropped", "telemetry_frames"]
-COMMISSIONING_FIELDS = ["offset_a_A", "offset_b_A", "resistance_Ohm", "phase_a_current_scale", "inductance_H",
-                        "torque_constant_Nm_A", "voltage_bias_a_V", "voltage_bias_b_V"]
+STATUS_FIELDS = [
+    "speed_ref_rad_s",
+    "speed_hat_rad_s",
+    "load_hat_Nm",
+    "cos_hat",
+    "sin_hat",
+    "i_a_A",
+    "i_b_A",
+    "bus_voltage_V",
+    "u_a_V",
+    "u_b_V",
+    "i_d_A",
+    "i_q_A",
+]
+TELEMETRY_FIELDS = [
+    "period",
+    "mode",
+    "fault",
+    "speed_ref_rad_s",
+    "speed_hat_rad_s",
+    "load_hat_Nm",
+    "cos_hat",
+    "sin_hat",
+    "i_a_A",
+    "i_b_A",
+    "bus_voltage_V",
+    "u_a_V",
+    "u_b_V",
+    "i_q_A",
+]
+COUNTER_FIELDS = [
+    "rx_bytes",
+    "rx_frames",
+    "rx_garbage_bytes",
+    "rx_bad_length",
+    "rx_crc_errors",
+    "rx_truncated",
+    "rx_error_replies",
+    "commands_applied",
+    "tx_frames",
+    "tx_dropped",
+    "telemetry_frames",
+]
+COMMISSIONING_FIELDS = [
+    "offset_a_A",
+    "offset_b_A",
+    "resistance_Ohm",
+    "phase_a_current_scale",
+    "inductance_H",
+    "torque_constant_Nm_A",
+    "voltage_bias_a_V",
+    "voltage_bias_b_V",
+]
 CONFIG_TYPES = {0: "f32", 1: "u32", 2: "i32", 3: "bool"}
 
 # The record of the stored configuration (firmware/console/include/pmstep_store.h): a header, the
 # configuration table's values (f32 each, in id order), what they were measured with, a CRC-32.
 RECORD_MAGIC = 0x52534D50  # "PMSR" in memory order (little-endian)
-RECORD_FORMAT = 1          # the record format this tool reads and writes
+RECORD_FORMAT = 1  # the record format this tool reads and writes
 RECORD_HEADER = struct.Struct("<IHHIIIHHII")  # magic, format, header bytes, board id, layout id,
 #                                                sequence, value count, measured count, record bytes, reserved
-MEASURED_FIELDS = ["flags", "offset_a_A", "offset_b_A", "resistance_Ohm", "inductance_H", "torque_constant_Nm_A",
-                   "inertia_kgm2", "friction_Nms_rad"]  # flags u32, then f32 each
-CONFIG_STATUS_BYTES = 23   # configured u8, boot, validation, last i16, slot i8, sequence u32, record bytes u16,
+MEASURED_FIELDS = [
+    "flags",
+    "offset_a_A",
+    "offset_b_A",
+    "resistance_Ohm",
+    "inductance_H",
+    "torque_constant_Nm_A",
+    "inertia_kgm2",
+    "friction_Nms_rad",
+]  # flags u32, then f32 each
+CONFIG_STATUS_BYTES = 23  # configured u8, boot, validation, last i16, slot i8, sequence u32, record bytes u16,
 #                            format u8, layout id u32, board id u32
 CONFIG_READ_MIN_BYTES = 4  # offset u16, total u16, then the bytes
 CALIBRATE_STATUS_BYTES = 28  # stage u8, status i16, fault u8, runs u8, identification u8, save status i16, 5 f32
@@ -163,8 +250,11 @@ STORE_CODES = {
     -141: ("PMSTEP_STORE_ERR_CRC", "bad CRC", "the record's CRC does not match its bytes"),
     -142: ("PMSTEP_STORE_ERR_FORMAT", "another format", "a record of another firmware"),
     -143: ("PMSTEP_STORE_ERR_LAYOUT", "another layout", "a record of another firmware's configuration table"),
-    -144: ("PMSTEP_STORE_ERR_BOARD", "another board",
-           "made for another board: its id or its read-only values (period, delay, sensing) differ"),
+    -144: (
+        "PMSTEP_STORE_ERR_BOARD",
+        "another board",
+        "made for another board: its id or its read-only values (period, delay, sensing) differ",
+    ),
     -145: ("PMSTEP_STORE_ERR_LENGTH", "bad length", "the record's length does not match its counts or the bytes"),
     -146: ("PMSTEP_STORE_ERR_INVALID", "invalid", "a value the configuration cannot take, or one the core refuses"),
     -147: ("PMSTEP_STORE_ERR_FLASH", "flash error", "the flash reported an error; the previous record stays in force"),
@@ -222,25 +312,27 @@ class Decoder:
                 continue
             if len(self.buf) < n + 4:
                 return frames
-            body = bytes(self.buf[1:2 + n])
+            body = bytes(self.buf[1 : 2 + n])
             (crc,) = struct.unpack_from("<H", self.buf, 2 + n)
             if crc16(body) != crc:
                 self.bad += 1
                 del self.buf[:1]
                 continue
             frames.append((body[1], body[2], body[3:]))
-            del self.buf[:n + 4]
+            del self.buf[: n + 4]
 
 
 class ConsoleError(Exception):
     """A request or the line failed; exit_code: the command line's exit status for it (module
     docstring)."""
+
     exit_code = 1
 
 
 class DeviceError(ConsoleError):
     """The drive answered with an error frame (code: its error code, request: the request's type), or
     the core or the store refused a command (status: the ACK's status)."""
+
     exit_code = 1
 
     def __init__(self, message, code=None, request=None, status=None):
@@ -253,48 +345,54 @@ class DeviceError(ConsoleError):
 class ConfigurationRefused(DeviceError):
     """The tool refuses a design or a backup that does not fit the board, or a record read back that
     differs from the one written."""
+
     exit_code = 1
 
 
 class UsageError(ConsoleError):
     """A bad argument: a missing pmstep-tune or file, a file that is no backup, conflicting options."""
+
     exit_code = 2
 
 
 class ReplyTimeout(ConsoleError, TimeoutError):
     """No reply within the deadline (whatever else the line carried meanwhile)."""
+
     exit_code = 3
 
 
 class MalformedReply(ConsoleError):
     """A reply of the right type and sequence number, too short for that type."""
+
     exit_code = 4
 
 
 class LinkError(ConsoleError):
     """The line failed or closed: a read or write raised (pty closed, port unplugged, socket
     dropped), or a write stalled past the link's write timeout."""
+
     exit_code = 5
 
 
 class PortOpenError(LinkError):
     """The port could not be opened (missing device, refused connection, bad URL, no pyserial)."""
+
     exit_code = 6
 
 
 # Reply DATA lengths (pmstep_console.h): fixed layouts, or the fixed part before a text. A longer
 # reply is accepted (fields a later firmware may append); a shorter one is a MalformedReply.
-ACK_BYTES = 6            # status i16, period u32
-HELLO_MIN_BYTES = 2      # protocol u8, max payload u8, text (protocol 1)
-HELLO_V2_MIN_BYTES = 4   # protocol u8, max payload u8, record format u8, flags u8, text (protocol 2)
-STATUS_BYTES = 60        # period u32, mode, fault, port fault, flags u8, fault step u32, 12 f32
-CONFIG_MIN_BYTES = 7     # id, type, flags u8, value f32, name
+ACK_BYTES = 6  # status i16, period u32
+HELLO_MIN_BYTES = 2  # protocol u8, max payload u8, text (protocol 1)
+HELLO_V2_MIN_BYTES = 4  # protocol u8, max payload u8, record format u8, flags u8, text (protocol 2)
+STATUS_BYTES = 60  # period u32, mode, fault, port fault, flags u8, fault step u32, 12 f32
+CONFIG_MIN_BYTES = 7  # id, type, flags u8, value f32, name
 COMMISSIONING_BYTES = 41  # measured u8, offset samples u32, realignments u32, 8 f32
-COUNTERS_BYTES = 44      # 11 u32
-POSITION_BYTES = 19      # status i16, period u32, 3 f32, flags u8
-HOME_STATUS_BYTES = 16   # status i16, period u32, state u8, found by u8, stop f32, position f32
+COUNTERS_BYTES = 44  # 11 u32
+POSITION_BYTES = 19  # status i16, period u32, 3 f32, flags u8
+HOME_STATUS_BYTES = 16  # status i16, period u32, state u8, found by u8, stop f32, position f32
 HOMING_STATES = {0: "idle", 1: "seeking", 2: "backing off", 3: "done", 4: "not found", 5: "aborted"}
-SIM_STEPDIR_BYTES = 23   # period u32, steps i32, edges i32, counter u16, flags u8, 2 f32
+SIM_STEPDIR_BYTES = 23  # period u32, steps i32, edges i32, counter u16, flags u8, 2 f32
 
 
 def check_reply(ftype, data, n_bytes, text=False):
@@ -302,8 +400,9 @@ def check_reply(ftype, data, n_bytes, text=False):
     (@p text: a text follows them); else raises MalformedReply."""
     if len(data) < n_bytes:
         name = REQUEST_NAMES.get(ftype, f"0x{ftype:02x}")
-        raise MalformedReply(f"malformed {name} reply: {len(data)} bytes, expected {n_bytes}"
-                             + (" or more" if text else ""))
+        raise MalformedReply(
+            f"malformed {name} reply: {len(data)} bytes, expected {n_bytes}" + (" or more" if text else "")
+        )
     return data
 
 
@@ -330,15 +429,15 @@ def open_endpoint(port, baud=115200, timeout=0.05, write_timeout=2.0):
     try:
         import serial  # pyserial, pinned in tools/requirements.txt
     except ImportError as e:
-        raise PortOpenError(f"pyserial is missing ({e}); tools/setup_venv.sh installs tools/requirements.txt") \
-            from e
+        raise PortOpenError(f"pyserial is missing ({e}); tools/setup_venv.sh installs tools/requirements.txt") from e
     try:
         if port.startswith("tcp:"):
             host, _, tcp_port = port[4:].rpartition(":")
             if not tcp_port.isdigit():
                 raise PortOpenError(f"cannot open port {port}: expected tcp:HOST:PORT or tcp:PORT")
-            return serial.serial_for_url(f"socket://{host or '127.0.0.1'}:{tcp_port}", timeout=timeout,
-                                         write_timeout=write_timeout)
+            return serial.serial_for_url(
+                f"socket://{host or '127.0.0.1'}:{tcp_port}", timeout=timeout, write_timeout=write_timeout
+            )
         return serial.serial_for_url(port, baudrate=baud, timeout=timeout, write_timeout=write_timeout)
     except (ValueError,) + LINK_ERRORS as e:
         raise PortOpenError(f"cannot open port {port}: {_reason(e)}") from e
@@ -427,8 +526,9 @@ class Console:
                 del self.pending[i]
                 if rtype == ERROR_FRAME:
                     code = rdata[1] if len(rdata) > 1 else 0
-                    raise DeviceError(f"request 0x{ftype:02x}: {ERRORS.get(code, f'error {code}')}", code=code,
-                                      request=ftype)
+                    raise DeviceError(
+                        f"request 0x{ftype:02x}: {ERRORS.get(code, f'error {code}')}", code=code, request=ftype
+                    )
                 return rdata
         return None
 
@@ -461,8 +561,9 @@ class Console:
     def _ack(self, ftype, data=b"", timeout=None):
         status, period = self._ack_status(ftype, data, timeout)
         if status != 0:
-            raise DeviceError(f"the core refused request 0x{ftype:02x}: {describe_code(status)}", status=status,
-                              request=ftype)
+            raise DeviceError(
+                f"the core refused request 0x{ftype:02x}: {describe_code(status)}", status=status, request=ftype
+            )
         return period
 
     # ---- commands ----
@@ -473,8 +574,14 @@ class Console:
         if d[0] < 2:
             return {"protocol": d[0], "max_payload": d[1], "identity": d[2:].decode("ascii", "replace")}
         d = check_reply(HELLO, d, HELLO_V2_MIN_BYTES, text=True)
-        return {"protocol": d[0], "max_payload": d[1], "record_format": d[2], "store": bool(d[3] & HELLO_STORE),
-                "configured": bool(d[3] & HELLO_CONFIGURED), "identity": d[4:].decode("ascii", "replace")}
+        return {
+            "protocol": d[0],
+            "max_payload": d[1],
+            "record_format": d[2],
+            "store": bool(d[3] & HELLO_STORE),
+            "configured": bool(d[3] & HELLO_CONFIGURED),
+            "identity": d[4:].decode("ascii", "replace"),
+        }
 
     def start(self):
         return self._ack(START)
@@ -495,8 +602,15 @@ class Console:
         d = check_reply(GET_STATUS, self.request(GET_STATUS), STATUS_BYTES)
         period, mode, fault, port_fault, flags, fault_step = struct.unpack_from("<IBBBBI", d)
         values = struct.unpack_from("<12f", d, 12)
-        s = {"period": period, "mode": MODES.get(mode, str(mode)), "fault": fault, "port_fault": port_fault,
-             "bridge_enable": bool(flags & 1), "voltage_limited": bool(flags & 2), "fault_step": fault_step}
+        s = {
+            "period": period,
+            "mode": MODES.get(mode, str(mode)),
+            "fault": fault,
+            "port_fault": port_fault,
+            "bridge_enable": bool(flags & 1),
+            "voltage_limited": bool(flags & 2),
+            "fault_step": fault_step,
+        }
         s.update(zip(STATUS_FIELDS, values))
         return s
 
@@ -519,15 +633,24 @@ class Console:
 
     def get_config(self, key):
         k = self._key(key)
-        d = check_reply(GET_CONFIG, self.request(GET_CONFIG, k if isinstance(k, bytes) else k[0] + k[1]),
-                        CONFIG_MIN_BYTES, text=True)
+        d = check_reply(
+            GET_CONFIG,
+            self.request(GET_CONFIG, k if isinstance(k, bytes) else k[0] + k[1]),
+            CONFIG_MIN_BYTES,
+            text=True,
+        )
         cid, ctype, flags, value = struct.unpack_from("<BBBf", d)
         try:
             name = d[7:].decode("ascii")
         except UnicodeDecodeError:
             raise MalformedReply(f"malformed CONFIG reply: the name of value {cid} is not ASCII") from None
-        return {"id": cid, "name": name, "type": CONFIG_TYPES.get(ctype, "?"),
-                "read_only": bool(flags & 1), "value": value}
+        return {
+            "id": cid,
+            "name": name,
+            "type": CONFIG_TYPES.get(ctype, "?"),
+            "read_only": bool(flags & 1),
+            "value": value,
+        }
 
     def set_config(self, key, value):
         k = self._key(key)
@@ -560,15 +683,21 @@ class Console:
         tracked, not in RUN) comes back in the dict with zero positions."""
         d = check_reply(GET_POSITION, self.request(GET_POSITION), POSITION_BYTES)
         status, period, pos, ref, err, flags = struct.unpack_from("<hIfffB", d)
-        p = {"status": status, "period": period, "position_rad": pos, "position_ref_rad": ref,
-             "position_error_rad": err}
+        p = {
+            "status": status,
+            "period": period,
+            "position_rad": pos,
+            "position_ref_rad": ref,
+            "position_error_rad": err,
+        }
         p.update({name: bool(flags & bit) for bit, name in POSITION_FLAGS.items()})
         return p
 
     def home(self, direction, travel_rad, speed_rad_s=0.0, stall_current_a=0.0):
         """Starts homing toward @p direction (+1, -1); raises DeviceError naming the code that refused it."""
-        status, period = self._ack_status(HOME, struct.pack("<ffff", direction, speed_rad_s, travel_rad,
-                                                            stall_current_a))
+        status, period = self._ack_status(
+            HOME, struct.pack("<ffff", direction, speed_rad_s, travel_rad, stall_current_a)
+        )
         if status != 0:
             raise DeviceError(f"the drive refused to home: {describe_code(status)}", status=status, request=HOME)
         return period
@@ -576,9 +705,14 @@ class Console:
     def home_status(self):
         d = check_reply(HOME_STATUS, self.request(HOME_STATUS), HOME_STATUS_BYTES)
         status, period, state, by_current, stop, position = struct.unpack_from("<hIBBff", d)
-        return {"status": status, "period": period, "state": HOMING_STATES.get(state, str(state)),
-                "found_by": "stall current" if by_current else "following error", "stop_rad": stop,
-                "position_rad": position}
+        return {
+            "status": status,
+            "period": period,
+            "state": HOMING_STATES.get(state, str(state)),
+            "found_by": "stall current" if by_current else "following error",
+            "stop_rad": stop,
+            "position_rad": position,
+        }
 
     # ---- the stored configuration ----
     def config_read(self, offset):
@@ -595,8 +729,10 @@ class Console:
         while total is None or len(data) < total:
             off, tot, chunk = self.config_read(len(data))
             if off != len(data) or (total is not None and tot != total) or not chunk or len(data) + len(chunk) > tot:
-                raise MalformedReply(f"malformed CONFIG_READ reply: offset {off}, total {tot}, {len(chunk)} bytes "
-                                     f"after {len(data)} bytes read")
+                raise MalformedReply(
+                    f"malformed CONFIG_READ reply: offset {off}, total {tot}, {len(chunk)} bytes "
+                    f"after {len(data)} bytes read"
+                )
             total = tot
             data += chunk
         return bytes(data)
@@ -611,7 +747,7 @@ class Console:
         piece = MAX_PAYLOAD - 4  # TYPE, SEQ, offset u16
         pieces = 0
         for off in range(0, len(record), piece):
-            chunk = record[off:off + piece]
+            chunk = record[off : off + piece]
             staged = self.config_write(off, chunk)
             if staged != off + len(chunk):
                 raise DeviceError(f"CONFIG_WRITE: the drive staged {staged} bytes, expected {off + len(chunk)}")
@@ -622,8 +758,11 @@ class Console:
         """Puts the staged record in force; raises DeviceError naming the code that refused it."""
         status, period = self._ack_status(CONFIG_APPLY)
         if status != 0:
-            raise DeviceError(f"the drive refused the record: {describe_code(status)}; the configuration in force "
-                              "is unchanged", status=status, request=CONFIG_APPLY)
+            raise DeviceError(
+                f"the drive refused the record: {describe_code(status)}; the configuration in force is unchanged",
+                status=status,
+                request=CONFIG_APPLY,
+            )
         return period
 
     def _store_ack(self, ftype, doing):
@@ -643,29 +782,50 @@ class Console:
 
     def config_status(self):
         d = check_reply(CONFIG_STATUS, self.request(CONFIG_STATUS), CONFIG_STATUS_BYTES)
-        (configured, boot, validation, last, slot, sequence, record_bytes, fmt, layout,
-         board) = struct.unpack_from("<BhhhbIHBII", d)
-        return {"configured": bool(configured), "boot_status": boot, "boot_validation": validation,
-                "last_status": last, "slot": slot, "sequence": sequence, "record_bytes": record_bytes,
-                "record_format": fmt, "layout_id": layout, "board_id": board}
+        (configured, boot, validation, last, slot, sequence, record_bytes, fmt, layout, board) = struct.unpack_from(
+            "<BhhhbIHBII", d
+        )
+        return {
+            "configured": bool(configured),
+            "boot_status": boot,
+            "boot_validation": validation,
+            "last_status": last,
+            "slot": slot,
+            "sequence": sequence,
+            "record_bytes": record_bytes,
+            "record_format": fmt,
+            "layout_id": layout,
+            "board_id": board,
+        }
 
     def calibrate(self, rated_current_a, pole_pairs=50, paper_mode=False, detent_fraction=0.05):
         """Starts self-commissioning; raises DeviceError naming the code that refused it."""
-        data = struct.pack("<fHBf", rated_current_a, pole_pairs, CALIBRATE_PAPER_MODE if paper_mode else 0,
-                           detent_fraction)
+        data = struct.pack(
+            "<fHBf", rated_current_a, pole_pairs, CALIBRATE_PAPER_MODE if paper_mode else 0, detent_fraction
+        )
         status, period = self._ack_status(CALIBRATE, data)
         if status != 0:
-            raise DeviceError(f"the drive refused to calibrate: {describe_code(status)}", status=status,
-                              request=CALIBRATE)
+            raise DeviceError(
+                f"the drive refused to calibrate: {describe_code(status)}", status=status, request=CALIBRATE
+            )
         return period
 
     def calibrate_status(self):
         d = check_reply(CALIBRATE_STATUS, self.request(CALIBRATE_STATUS), CALIBRATE_STATUS_BYTES)
         stage, status, fault, runs, ident, save, r, l, k, j, f = struct.unpack_from("<BhBBBh5f", d)
-        return {"stage": CALIBRATE_STAGES.get(stage, str(stage)), "status": status, "fault": fault, "runs": runs,
-                "identification": IDENTIFICATION.get(ident, str(ident)), "save_status": save,
-                "resistance_Ohm": r, "inductance_H": l, "torque_constant_Nm_A": k, "inertia_kgm2": j,
-                "friction_Nms_rad": f}
+        return {
+            "stage": CALIBRATE_STAGES.get(stage, str(stage)),
+            "status": status,
+            "fault": fault,
+            "runs": runs,
+            "identification": IDENTIFICATION.get(ident, str(ident)),
+            "save_status": save,
+            "resistance_Ohm": r,
+            "inductance_H": l,
+            "torque_constant_Nm_A": k,
+            "inertia_kgm2": j,
+            "friction_Nms_rad": f,
+        }
 
     def sim_advance(self, periods, timeout=120.0):
         return self._ack(SIM_ADVANCE, struct.pack("<I", periods), timeout=timeout)
@@ -691,8 +851,14 @@ class Console:
         position and the following error (mechanical rad)."""
         d = check_reply(SIM_STEPDIR, self.request(SIM_STEPDIR), SIM_STEPDIR_BYTES)
         period, steps, edges, counter, flags, commanded, error = struct.unpack_from("<IiiHBff", d)
-        s = {"period": period, "steps": steps, "edges": edges, "counter": counter, "commanded_rad": commanded,
-             "following_error_rad": error}
+        s = {
+            "period": period,
+            "steps": steps,
+            "edges": edges,
+            "counter": counter,
+            "commanded_rad": commanded,
+            "following_error_rad": error,
+        }
         s.update({name: bool(flags & bit) for bit, name in SIM_STEPDIR_FLAGS.items()})
         return s
 
@@ -718,8 +884,10 @@ def core_status_codes():
                 sys.modules[spec.name] = module  # its dataclasses look their module up
                 spec.loader.exec_module(module)
                 values = module.parse_enum(module.Source(ROOT, header), "pmstep_status_t")
-                values += module.parse_enum(module.Source(ROOT, "firmware/design/include/pmstep/pmstep_calibrate.h"),
-                                            "pmstep_calibrate_status_t")
+                values += module.parse_enum(
+                    module.Source(ROOT, "firmware/design/include/pmstep/pmstep_calibrate.h"),
+                    "pmstep_calibrate_status_t",
+                )
                 _CORE_CODES = {v.value: (v.name, v.doc) for v in values}
             except Exception:  # noqa: BLE001 - a parser or header of another shape: numbers only
                 _CORE_CODES = {}
@@ -771,14 +939,24 @@ class Record:
         self.board_id = board_id
         self.layout_id = layout_id
         self.sequence = sequence
-        self.values = list(values)     # floats (float32 values)
+        self.values = list(values)  # floats (float32 values)
         self.measured = dict(measured)  # MEASURED_FIELDS: flags int, the others float32 values
 
     def encode(self):
         """The record's bytes, CRC included. Every value must be a float32 (f32())."""
         n = RECORD_HEADER.size + 4 * len(self.values) + 4 * len(MEASURED_FIELDS) + 4
-        body = RECORD_HEADER.pack(RECORD_MAGIC, self.format, RECORD_HEADER.size, self.board_id, self.layout_id,
-                                  self.sequence, len(self.values), len(MEASURED_FIELDS), n, 0)
+        body = RECORD_HEADER.pack(
+            RECORD_MAGIC,
+            self.format,
+            RECORD_HEADER.size,
+            self.board_id,
+            self.layout_id,
+            self.sequence,
+            len(self.values),
+            len(MEASURED_FIELDS),
+            n,
+            0,
+        )
         body += struct.pack(f"<{len(self.values)}f", *self.values)
         body += struct.pack("<I7f", self.measured["flags"], *(self.measured[k] for k in MEASURED_FIELDS[1:]))
         return body + struct.pack("<I", zlib.crc32(body))
@@ -792,10 +970,16 @@ class Record:
         (crc,) = struct.unpack_from("<I", data, len(data) - 4)
         if magic != RECORD_MAGIC or nbytes != len(data) or zlib.crc32(data[:-4]) != crc:
             raise MalformedReply("malformed record: bad magic, length or CRC")
-        if fmt != RECORD_FORMAT or header != RECORD_HEADER.size or m != len(MEASURED_FIELDS) \
-                or nbytes != header + 4 * n + 4 * m + 4:
-            raise MalformedReply(f"record format {fmt} ({header}-byte header, {m} measured values): this tool "
-                                 f"reads format {RECORD_FORMAT}; a newer pmstep_console.py is needed")
+        if (
+            fmt != RECORD_FORMAT
+            or header != RECORD_HEADER.size
+            or m != len(MEASURED_FIELDS)
+            or nbytes != header + 4 * n + 4 * m + 4
+        ):
+            raise MalformedReply(
+                f"record format {fmt} ({header}-byte header, {m} measured values): this tool "
+                f"reads format {RECORD_FORMAT}; a newer pmstep_console.py is needed"
+            )
         values = struct.unpack_from(f"<{n}f", data, header)
         flags, *rest = struct.unpack_from("<I7f", data, header + 4 * n)
         return cls(fmt, board, layout, seq, values, dict(zip(MEASURED_FIELDS, [flags] + rest)))
@@ -867,15 +1051,19 @@ def read_board(con):
     give the record's layout id (else the names would not be the values' own)."""
     hello = con.hello()
     if hello["protocol"] < 2 or not hello["store"]:
-        raise DeviceError(f"this drive keeps no stored configuration (protocol {hello['protocol']}"
-                          f"{', no store attached' if hello['protocol'] >= 2 else ''}): {hello['identity']}",
-                          code=11)
+        raise DeviceError(
+            f"this drive keeps no stored configuration (protocol {hello['protocol']}"
+            f"{', no store attached' if hello['protocol'] >= 2 else ''}): {hello['identity']}",
+            code=11,
+        )
     raw = con.read_record()
     record = Record.decode(raw)
     table = [con.get_config(i) for i in range(len(record.values))]
     if layout_id(table) != record.layout_id:
-        raise MalformedReply(f"the configuration table read by id (layout 0x{layout_id(table):08x}) is not the "
-                             f"record's (layout 0x{record.layout_id:08x})")
+        raise MalformedReply(
+            f"the configuration table read by id (layout 0x{layout_id(table):08x}) is not the "
+            f"record's (layout 0x{record.layout_id:08x})"
+        )
     for e, v in zip(table, record.values):
         if f32(e["value"]) != v:
             raise MalformedReply(f"the record and GET_CONFIG disagree on {e['name']}: {v!r} and {e['value']!r}")
@@ -886,8 +1074,11 @@ def require_idle(con, doing):
     """DeviceError unless the motor is IDLE (a record is applied only there): before any work."""
     mode = con.status()["mode"]
     if mode != "IDLE":
-        raise DeviceError(f"{doing} needs the motor stopped (IDLE), it is in {mode}: "
-                          f"`{'clear' if mode == 'FAULT' else 'stop'}` first", code=6)
+        raise DeviceError(
+            f"{doing} needs the motor stopped (IDLE), it is in {mode}: "
+            f"`{'clear' if mode == 'FAULT' else 'stop'}` first",
+            code=6,
+        )
 
 
 def put_record(con, board, record):
@@ -908,8 +1099,9 @@ def put_record(con, board, record):
         if struct.pack("<f", w) != struct.pack("<f", r):
             diffs.append(f"{e['name']}: written {f32_text(w)}, read {f32_text(r)}")
     for k in MEASURED_FIELDS:
-        if struct.pack("<f" if k != "flags" else "<I", record.measured[k]) != \
-                struct.pack("<f" if k != "flags" else "<I", back.measured[k]):
+        if struct.pack("<f" if k != "flags" else "<I", record.measured[k]) != struct.pack(
+            "<f" if k != "flags" else "<I", back.measured[k]
+        ):
             diffs.append(f"measured {k}: written {record.measured[k]}, read {back.measured[k]}")
     if diffs:
         raise ConfigurationRefused("the record read back differs from the one written:\n  " + "\n  ".join(diffs))
@@ -937,10 +1129,12 @@ def typed_text(entry, value):
 # The board's read-only values and the scenario keys that give them to pmstep-tune (sil/src/scenario_keys.c:
 # run.period_s and run.delay_periods are the controller's timing; the sense ranges are the sensors' full
 # scales, sil_scenario_sense_ranges()).
-READ_ONLY_SCENARIO_KEYS = {"timing.period_s": "run.period_s",
-                           "timing.computational_delay_periods": "run.delay_periods",
-                           "limits.current_sense_range_A": "sensors.current_full_scale_A",
-                           "limits.bus_sense_range_V": "sensors.bus_full_scale_V"}
+READ_ONLY_SCENARIO_KEYS = {
+    "timing.period_s": "run.period_s",
+    "timing.computational_delay_periods": "run.delay_periods",
+    "limits.current_sense_range_A": "sensors.current_full_scale_A",
+    "limits.bus_sense_range_V": "sensors.bus_full_scale_V",
+}
 BUS_VOLTAGE_KEY = "run.bus_voltage_V"
 DEFAULT_TUNE = "build/host-release/sil/pmstep-tune"
 
@@ -954,9 +1148,11 @@ def find_tune(option):
     else:
         path, origin = ROOT / DEFAULT_TUNE, "the default"
     if not path.is_file() or not os.access(path, os.X_OK):
-        raise UsageError(f"pmstep-tune not found at {path} ({origin}): build it (cmake --preset host-release && "
-                         f"cmake --build --preset host-release --target pmstep-tune) or give its path with --tune "
-                         f"or $PMSTEP_TUNE")
+        raise UsageError(
+            f"pmstep-tune not found at {path} ({origin}): build it (cmake --preset host-release && "
+            f"cmake --build --preset host-release --target pmstep-tune) or give its path with --tune "
+            f"or $PMSTEP_TUNE"
+        )
     return path
 
 
@@ -974,7 +1170,7 @@ def read_design(path):
         for key, text in cp.items(section):
             keys[f"{section}.{key}"] = text
             if section == "controller" or section.startswith("controller."):
-                prefix = section[len("controller."):] + "." if section != "controller" else ""
+                prefix = section[len("controller.") :] + "." if section != "controller" else ""
                 design[prefix + key] = text
     return design, keys
 
@@ -1025,15 +1221,19 @@ def setup(con, a):
     board = read_board(con)
     require_idle(con, "setup")
     h, r = board.hello, board.record
-    print(f"board: {h['identity']}, record format {r.format}, board id 0x{r.board_id:08x}, layout 0x{r.layout_id:08x}, "
-          f"{len(r.values)} values; {'a motor configured' if h['configured'] else 'no motor configured'}")
+    print(
+        f"board: {h['identity']}, record format {r.format}, board id 0x{r.board_id:08x}, layout 0x{r.layout_id:08x}, "
+        f"{len(r.values)} values; {'a motor configured' if h['configured'] else 'no motor configured'}"
+    )
     # The board's read-only values go to pmstep-tune as the scenario's: the design is made for them.
     board_sets = []
     for e in board.table:
         if e["read_only"]:
             if e["name"] not in READ_ONLY_SCENARIO_KEYS:
-                raise ConfigurationRefused(f"the board's read-only value {e['name']} has no scenario key this tool "
-                                           "knows: a design for it cannot be made (a newer pmstep_console.py?)")
+                raise ConfigurationRefused(
+                    f"the board's read-only value {e['name']} has no scenario key this tool "
+                    "knows: a design for it cannot be made (a newer pmstep_console.py?)"
+                )
             v = typed(e, board.value(e["name"]))
             board_sets.append(f"{READ_ONLY_SCENARIO_KEYS[e['name']]}={v!r}")
     if a.bus_voltage is not None:
@@ -1062,8 +1262,10 @@ def setup(con, a):
             key = READ_ONLY_SCENARIO_KEYS[e["name"]]
             text = keys.get(key)
             if text is None or f32(design_number(key, text)) != board.value(e["name"]):
-                raise ConfigurationRefused(f"pmstep-tune designed for {key} = {text}, the board's {e['name']} is "
-                                           f"{f32_text(board.value(e['name']))}")
+                raise ConfigurationRefused(
+                    f"pmstep-tune designed for {key} = {text}, the board's {e['name']} is "
+                    f"{f32_text(board.value(e['name']))}"
+                )
     bus_text = keys.get(BUS_VOLTAGE_KEY, "?")
     if a.bus_voltage is not None:
         origin = "--bus-voltage"
@@ -1073,9 +1275,11 @@ def setup(con, a):
         origin = f"the motor preset's {BUS_VOLTAGE_KEY}"
     else:
         origin = "pmstep-tune's default: " + ("the preset gives none" if a.motor else "a motor database gives none")
-    print("designed for the board's " + ", ".join(f"{e['name']} = {typed_text(e, board.value(e['name']))}"
-                                                  for e in board.table if e["read_only"])
-          + f"; bus {bus_text} V ({origin})")
+    print(
+        "designed for the board's "
+        + ", ".join(f"{e['name']} = {typed_text(e, board.value(e['name']))}" for e in board.table if e["read_only"])
+        + f"; bus {bus_text} V ({origin})"
+    )
     # Onto the board's table by name: every value the board can take from the design.
     values = list(r.values)
     kept = []
@@ -1091,11 +1295,14 @@ def setup(con, a):
         print("designed, not on this board (not written): " + ", ".join(unused))
     if kept:
         which = "the board's default" if not h["configured"] else "the value in force"
-        print(f"not in the design, {which} kept: " + ", ".join(
-            f"{n} = {typed_text(board.table[board.index[n]], r.values[board.index[n]])}" for n in kept))
+        print(
+            f"not in the design, {which} kept: "
+            + ", ".join(f"{n} = {typed_text(board.table[board.index[n]], r.values[board.index[n]])}" for n in kept)
+        )
     # Nothing measured on this motor yet: a design from its data.
-    record = Record(r.format, r.board_id, r.layout_id, 0, values, {k: (0 if k == "flags" else 0.0)
-                                                                   for k in MEASURED_FIELDS})
+    record = Record(
+        r.format, r.board_id, r.layout_id, 0, values, {k: (0 if k == "flags" else 0.0) for k in MEASURED_FIELDS}
+    )
     pieces, back = put_record(con, board, record)
     print(f"record: {len(record.encode())} bytes written in {pieces} pieces, applied, read back equal")
     print_stored(con, board, back, save=True)
@@ -1107,11 +1314,18 @@ def backup(con):
     board = read_board(con)
     r = board.record
     measured = {k: (v if k == "flags" else float(f32_text(v))) for k, v in r.measured.items()}
-    return {"identity": board.hello["identity"], "protocol": board.hello["protocol"],
-            "configured": board.hello["configured"], "record_format": r.format, "board_id": r.board_id,
-            "layout_id": r.layout_id, "values": board.typed_values(),
-            "read_only": [e["name"] for e in board.table if e["read_only"]], "measured": measured,
-            "record": board.raw.hex()}
+    return {
+        "identity": board.hello["identity"],
+        "protocol": board.hello["protocol"],
+        "configured": board.hello["configured"],
+        "record_format": r.format,
+        "board_id": r.board_id,
+        "layout_id": r.layout_id,
+        "values": board.typed_values(),
+        "read_only": [e["name"] for e in board.table if e["read_only"]],
+        "measured": measured,
+        "record": board.raw.hex(),
+    }
 
 
 def load_backup(path):
@@ -1123,10 +1337,10 @@ def load_backup(path):
     except ValueError as e:
         raise UsageError(f"{path} is not JSON: {e}") from e
     if not isinstance(data, dict) or not isinstance(data.get("values"), dict):
-        raise UsageError(f"{path} is no backup of pmstep_console.py: no \"values\" by name")
+        raise UsageError(f'{path} is no backup of pmstep_console.py: no "values" by name')
     measured = data.get("measured")
     if measured is not None and (not isinstance(measured, dict) or set(measured) != set(MEASURED_FIELDS)):
-        raise UsageError(f"{path}: \"measured\" must have the fields {', '.join(MEASURED_FIELDS)}")
+        raise UsageError(f'{path}: "measured" must have the fields {", ".join(MEASURED_FIELDS)}')
     return data
 
 
@@ -1138,17 +1352,22 @@ def restore(con, path, save):
     r = board.record
     unknown = [n for n in data["values"] if n not in board.index]
     if unknown:
-        raise ConfigurationRefused("the backup has values this board does not: " + ", ".join(unknown)
-                                   + "; nothing written")
+        raise ConfigurationRefused(
+            "the backup has values this board does not: " + ", ".join(unknown) + "; nothing written"
+        )
     differ = []
     for name, v in data["values"].items():
         e = board.table[board.index[name]]
-        if e["read_only"] and (isinstance(v, bool) or not isinstance(v, (int, float))
-                               or to_entry_value(e, v, "backup") != board.value(name)):
+        if e["read_only"] and (
+            isinstance(v, bool)
+            or not isinstance(v, (int, float))
+            or to_entry_value(e, v, "backup") != board.value(name)
+        ):
             differ.append(f"{name} (backup {v}, board {typed_text(e, board.value(name))})")
     if differ:
-        raise ConfigurationRefused("the backup was made for other read-only values: " + ", ".join(differ)
-                                   + "; nothing written")
+        raise ConfigurationRefused(
+            "the backup was made for other read-only values: " + ", ".join(differ) + "; nothing written"
+        )
     if data.get("board_id") is not None and data["board_id"] != r.board_id:
         print(f"note: the backup was made on board id 0x{data['board_id']:08x}, this board is 0x{r.board_id:08x}")
     values = list(r.values)
@@ -1163,7 +1382,7 @@ def restore(con, path, save):
     if data.get("measured") is not None:
         for k, v in data["measured"].items():
             if k == "flags":
-                if isinstance(v, bool) or not isinstance(v, int) or not 0 <= v < 2 ** 32:
+                if isinstance(v, bool) or not isinstance(v, int) or not 0 <= v < 2**32:
                     raise ConfigurationRefused(f"backup measured flags = {v!r}: not a 32-bit whole number")
                 measured[k] = v
             else:
@@ -1176,10 +1395,26 @@ def restore(con, path, save):
     print_stored(con, board, back, save)
 
 
-FAULTS = {0: "none", 1: "MEASUREMENT_NONFINITE", 2: "OVERCURRENT", 3: "BUS_UNDERVOLTAGE", 4: "BUS_OVERVOLTAGE",
-          5: "STATE_NONFINITE", 6: "ANGLE_MAGNITUDE", 7: "SPEED_INCONSISTENT", 8: "STALL", 9: "COMMISSIONING",
-          10: "OBSERVER_RESIDUAL", 11: "PHASE_VOLTAGE_RANGE", 12: "ALIGNMENT_MOTION", 13: "OPEN_PHASE_A",
-          14: "OPEN_PHASE_B", 15: "CURRENT_STUCK_A", 16: "CURRENT_STUCK_B", 17: "ESTIMATE_RANGE"}
+FAULTS = {
+    0: "none",
+    1: "MEASUREMENT_NONFINITE",
+    2: "OVERCURRENT",
+    3: "BUS_UNDERVOLTAGE",
+    4: "BUS_OVERVOLTAGE",
+    5: "STATE_NONFINITE",
+    6: "ANGLE_MAGNITUDE",
+    7: "SPEED_INCONSISTENT",
+    8: "STALL",
+    9: "COMMISSIONING",
+    10: "OBSERVER_RESIDUAL",
+    11: "PHASE_VOLTAGE_RANGE",
+    12: "ALIGNMENT_MOTION",
+    13: "OPEN_PHASE_A",
+    14: "OPEN_PHASE_B",
+    15: "CURRENT_STUCK_A",
+    16: "CURRENT_STUCK_B",
+    17: "ESTIMATE_RANGE",
+}
 
 
 def home(con, a):
@@ -1207,11 +1442,17 @@ def home(con, a):
             con.hold(None)
             raise DeviceError(f"homing not over after {a.timeout:.0f} s: holding where it is")
     if st["state"] != "done":
-        raise DeviceError(f"homing {st['state']}: " + {
-            "not found": f"no stop within {a.travel} rad; the drive holds at the end of the travel",
-            "aborted": "the drive left RUN or another command took over"}.get(st["state"], "not started"))
-    print(f"home: the stop found by the {st['found_by']} at {st['stop_rad']:+.5f} rad; it is the zero now, the "
-          f"rotor at {st['position_rad']:+.5f} rad")
+        raise DeviceError(
+            f"homing {st['state']}: "
+            + {
+                "not found": f"no stop within {a.travel} rad; the drive holds at the end of the travel",
+                "aborted": "the drive left RUN or another command took over",
+            }.get(st["state"], "not started")
+        )
+    print(
+        f"home: the stop found by the {st['found_by']} at {st['stop_rad']:+.5f} rad; it is the zero now, the "
+        f"rotor at {st['position_rad']:+.5f} rad"
+    )
 
 
 def calibrate(con, a):
@@ -1221,8 +1462,10 @@ def calibrate(con, a):
         raise UsageError("calibrate --current RATED_A [--pole-pairs P] [--paper] [--detent-fraction D] [--timeout S]")
     require_idle(con, "calibrating")
     con.calibrate(a.current, a.pole_pairs, a.paper, a.detent_fraction)
-    print(f"calibrating from I = {a.current} A, p = {a.pole_pairs}, detent {a.detent_fraction} of the holding torque, "
-          f"{'paper' if a.paper else 'robust'} mode")
+    print(
+        f"calibrating from I = {a.current} A, p = {a.pole_pairs}, detent {a.detent_fraction} of the holding torque, "
+        f"{'paper' if a.paper else 'robust'} mode"
+    )
     deadline = time.monotonic() + a.timeout
     last = None
     while True:
@@ -1231,8 +1474,10 @@ def calibrate(con, a):
         else:
             con.pump(0.5)
         st = con.calibrate_status()
-        line = (f"  {st['stage']:11s} run {st['runs']}: R {st['resistance_Ohm']:.4g} Ohm, L {st['inductance_H']:.4g} H, "
-                f"k_M {st['torque_constant_Nm_A']:.4g} N m/A, J {st['inertia_kgm2']:.4g} kg m^2")
+        line = (
+            f"  {st['stage']:11s} run {st['runs']}: R {st['resistance_Ohm']:.4g} Ohm, L {st['inductance_H']:.4g} H, "
+            f"k_M {st['torque_constant_Nm_A']:.4g} N m/A, J {st['inertia_kgm2']:.4g} kg m^2"
+        )
         if line != last:
             print(line)
             last = line
@@ -1243,8 +1488,12 @@ def calibrate(con, a):
             raise DeviceError(f"calibration not over after {a.timeout:.0f} s: stopped")
     if st["stage"] == "failed":
         fault = f"; the run ended in {FAULTS.get(st['fault'], st['fault'])}" if st["fault"] else ""
-        raise DeviceError(f"calibration failed: {describe_code(st['status'])}{fault}; the board's defaults are in "
-                          "force, no motor configured", status=st["status"], request=CALIBRATE)
+        raise DeviceError(
+            f"calibration failed: {describe_code(st['status'])}{fault}; the board's defaults are in "
+            "force, no motor configured",
+            status=st["status"],
+            request=CALIBRATE,
+        )
     # The design is saved at the first boundary with the bridge off: wait for the drive to say so.
     for _ in range(20):
         if st["save_status"] != 0 or con.config_status()["configured"] and con.config_status()["slot"] >= 0:
@@ -1254,12 +1503,17 @@ def calibrate(con, a):
         else:
             con.pump(0.1)
         st = con.calibrate_status()
-    print(f"calibrated: R {st['resistance_Ohm']:.5g} Ohm, L {st['inductance_H']:.5g} H, "
-          f"k_M {st['torque_constant_Nm_A']:.5g} N m/A, J {st['inertia_kgm2']:.5g} kg m^2, "
-          f"F {st['friction_Nms_rad']:.4g} N m s/rad (identification {st['identification']}, {st['runs']} runs)")
+    print(
+        f"calibrated: R {st['resistance_Ohm']:.5g} Ohm, L {st['inductance_H']:.5g} H, "
+        f"k_M {st['torque_constant_Nm_A']:.5g} N m/A, J {st['inertia_kgm2']:.5g} kg m^2, "
+        f"F {st['friction_Nms_rad']:.4g} N m s/rad (identification {st['identification']}, {st['runs']} runs)"
+    )
     if st["save_status"] != 0:
-        raise DeviceError(f"the calibrated design is in force but was not saved: {describe_code(st['save_status'])}",
-                          status=st["save_status"], request=CALIBRATE)
+        raise DeviceError(
+            f"the calibrated design is in force but was not saved: {describe_code(st['save_status'])}",
+            status=st["save_status"],
+            request=CALIBRATE,
+        )
     store = con.config_status()
     print(f"saved: slot {store['slot']}, sequence {store['sequence']}")
 
@@ -1279,10 +1533,12 @@ def print_store(con):
     print(f"  {'board id':26s} 0x{st['board_id']:08x}")
 
 
-NOT_CONFIGURED_HELP = ("the drive has no motor configured (error 10): configure it first - `setup --motor MOTOR.ini` "
-                       "(or `setup --motor-db FILE --name NAME`) designs, writes and saves one from the motor's data, "
-                       "`restore BACKUP.json --save` brings back a backup, or the drive calibrates the motor itself "
-                       "(CALIBRATE, on images with self-commissioning)")
+NOT_CONFIGURED_HELP = (
+    "the drive has no motor configured (error 10): configure it first - `setup --motor MOTOR.ini` "
+    "(or `setup --motor-db FILE --name NAME`) designs, writes and saves one from the motor's data, "
+    "`restore BACKUP.json --save` brings back a backup, or the drive calibrates the motor itself "
+    "(CALIBRATE, on images with self-commissioning)"
+)
 
 
 # ---- telemetry to CSV, plots ----
@@ -1299,15 +1555,21 @@ def read_csv(path):
         return [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f)]
 
 
-PLOTS = [("speed_hat_rad_s", "speed_ref_rad_s", "rad/s"), ("load_hat_Nm", None, "Nm"),
-         ("i_a_A", "i_b_A", "A"), ("cos_hat", "sin_hat", "")]
+PLOTS = [
+    ("speed_hat_rad_s", "speed_ref_rad_s", "rad/s"),
+    ("load_hat_Nm", None, "Nm"),
+    ("i_a_A", "i_b_A", "A"),
+    ("cos_hat", "sin_hat", ""),
+]
 
 
 def plot_rows(rows, period_s=50e-6, path=None):
     import matplotlib
+
     if path:
         matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
     fig, axes = plt.subplots(len(PLOTS), 1, sharex=True, figsize=(8, 8))
     t = [r["period"] * period_s for r in rows]
     for ax, (a, b, unit) in zip(axes, PLOTS):
@@ -1330,6 +1592,7 @@ def stream(con, decimation, seconds, csv_path=None, live_plot=False):
     end = time.monotonic() + seconds
     if live_plot:
         import matplotlib.pyplot as plt
+
         plt.ion()
         fig, ax = plt.subplots()
         (line_hat,) = ax.plot([], [], label="speed_hat_rad_s")
@@ -1423,7 +1686,10 @@ def run_command(con, argv):
         c = con.get_config(a.args[0])
         print(f"  {c['id']} {c['name']} = {f32_text(c['value'])} ({c['type']})")
     elif w == "set":
-        print(f"set {a.args[0]} = {a.args[1]}: done (core re-initialised) at period {con.set_config(a.args[0], a.args[1])}")
+        print(
+            f"set {a.args[0]} = {a.args[1]}: done (core re-initialised) "
+            f"at period {con.set_config(a.args[0], a.args[1])}"
+        )
     elif w == "move":
         amax = 50.0 if a.amax is None else a.amax
         period = con.move_to(float(a.args[0]), a.vmax, amax, a.jmax)
@@ -1449,9 +1715,11 @@ def run_command(con, argv):
                 f.write("\n")
         except OSError as e:
             raise UsageError(f"cannot write {a.args[0]}: {e.strerror}") from e
-        print(f"backup of {data['identity']} (board id 0x{data['board_id']:08x}, record format "
-              f"{data['record_format']}, {len(data['values'])} values, "
-              f"{'a motor' if data['configured'] else 'no motor'} configured) written to {a.args[0]}")
+        print(
+            f"backup of {data['identity']} (board id 0x{data['board_id']:08x}, record format "
+            f"{data['record_format']}, {len(data['values'])} values, "
+            f"{'a motor' if data['configured'] else 'no motor'} configured) written to {a.args[0]}"
+        )
     elif w == "restore":
         if len(a.args) != 1:
             raise UsageError("restore FILE.json [--save]")
@@ -1471,8 +1739,10 @@ def run_command(con, argv):
         print("erased: both flash slots; the board's defaults in force, no motor configured")
     elif w == "defaults":
         con.config_defaults()
-        print("the board's defaults in force, no motor configured; the flash untouched (a reset brings back the "
-              "stored configuration)")
+        print(
+            "the board's defaults in force, no motor configured; the flash untouched (a reset brings back the "
+            "stored configuration)"
+        )
     elif w == "store":
         print_store(con)
     elif w == "calibrate":
@@ -1485,12 +1755,14 @@ def run_command(con, argv):
 
 
 class Shell(cmd.Cmd):
-    intro = "pmstep console: hello, status, start, stop, clear, speed T [--ramp R], id A, config, get K, " \
-            "set K V, commissioning, counters, telemetry [--decimation N --seconds S --csv F --plot], " \
-            "move X [--vmax V --amax A --jmax J], hold [--amax A], position, zero, " \
-            "home +|- --travel X [--speed V --stall-current A], setup (--motor F | " \
-            "--motor-db F --name N) [--robust --set K=V --bus-voltage V --tune P], backup F, restore F [--save], " \
-            "save, erase, defaults, store, calibrate --current A [--pole-pairs P --paper --detent-fraction D], quit"
+    intro = (
+        "pmstep console: hello, status, start, stop, clear, speed T [--ramp R], id A, config, get K, "
+        "set K V, commissioning, counters, telemetry [--decimation N --seconds S --csv F --plot], "
+        "move X [--vmax V --amax A --jmax J], hold [--amax A], position, zero, "
+        "home +|- --travel X [--speed V --stall-current A], setup (--motor F | "
+        "--motor-db F --name N) [--robust --set K=V --bus-voltage V --tune P], backup F, restore F [--save], "
+        "save, erase, defaults, store, calibrate --current A [--pole-pairs P --paper --detent-fraction D], quit"
+    )
     prompt = "pmstep> "
 
     def __init__(self, con):
@@ -1515,8 +1787,9 @@ class Shell(cmd.Cmd):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
-                                 formatter_class=argparse.RawDescriptionHelpFormatter, epilog=__doc__)
+    ap = argparse.ArgumentParser(
+        description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter, epilog=__doc__
+    )
     ap.add_argument("--port", help="serial device, pty, tcp:HOST:PORT or a pyserial URL")
     ap.add_argument("--baud", type=int, default=115200)
     ap.add_argument("command", nargs=argparse.REMAINDER, help="see below")

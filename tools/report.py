@@ -1,6 +1,7 @@
 """The header every measured report in docs/reports/ starts with: what wrote it, the command (paths
 relative to the repository), the commit and the date, so that a figure can be traced and
 regenerated. Reports are written by the tools that measure; never edited by hand."""
+
 import datetime
 import os
 import re
@@ -14,10 +15,15 @@ REPORTS = os.path.join(ROOT, "docs", "reports")
 def commit():
     """The commit of the working tree (with '+' when it has changes), or 'unknown'."""
     try:
-        head = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
-                              check=True).stdout.strip()
-        dirty = subprocess.run(["git", "-C", ROOT, "status", "--porcelain", "--untracked-files=no"],
-                               capture_output=True, text=True, check=True).stdout.strip()
+        head = subprocess.run(
+            ["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=True
+        ).stdout.strip()
+        dirty = subprocess.run(
+            ["git", "-C", ROOT, "status", "--porcelain", "--untracked-files=no"],
+            capture_output=True,
+            text=True,
+            check=True,
+        ).stdout.strip()
         return head + ("+" if dirty else "")
     except (OSError, subprocess.CalledProcessError):
         return "unknown"
@@ -42,17 +48,23 @@ def command(argv):
 def header(title, tool, argv, what=""):
     """The report's first lines: @p title, the @p tool that wrote it, @p argv, commit and date, and
     @p what (a paragraph on what the figures are)."""
-    return _provenance(f"# {title}",
-                       f"Written by `{tool}`; regenerate it with the command below, never edit it by hand.",
-                       argv, what)
+    return _provenance(
+        f"# {title}", f"Written by `{tool}`; regenerate it with the command below, never edit it by hand.", argv, what
+    )
 
 
 def _provenance(heading, written_by, argv, what):
     """@p heading, @p written_by, then the command, commit and date, and @p what."""
-    lines = [heading, "", written_by, "",
-             f"- command: `{command(argv)}`",
-             f"- commit: `{commit()}`",
-             f"- date: {datetime.date.today().isoformat()}", ""]
+    lines = [
+        heading,
+        "",
+        written_by,
+        "",
+        f"- command: `{command(argv)}`",
+        f"- commit: `{commit()}`",
+        f"- date: {datetime.date.today().isoformat()}",
+        "",
+    ]
     if what:
         lines += [what, ""]
     return "\n".join(lines)
@@ -79,9 +91,13 @@ def section_header(heading, tool, argv, what="", level=2):
 def page_header(title, what=""):
     """The first lines of a page written section by section: each section names its command,
     commit and date (section_header())."""
-    lines = [f"# {title}", "",
-             "Written section by section by the tools each section names; regenerate a section with its "
-             "command, never edit this page by hand.", ""]
+    lines = [
+        f"# {title}",
+        "",
+        "Written section by section by the tools each section names; regenerate a section with its "
+        "command, never edit this page by hand.",
+        "",
+    ]
     if what:
         lines += [what, ""]
     return "\n".join(lines)

@@ -14,6 +14,7 @@ calibration ended and every drive design passed.
 
 Usage: tools/self_commission.py --tune build/host-release/sil/pmstep-tune [--report FILE] [--check]
 """
+
 import argparse
 import json
 import os
@@ -28,11 +29,21 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 PRESETS = ("paper", "17hs4401", "bj42d29", "as1050")
 NO_DETENT = ("paper",)  # motors without a detent torque: the user says so
-MOTOR_ROWS = [("resistance_Ohm", "R", "Ohm"), ("inductance_H", "L", "H"), ("torque_constant_Nm_A", "k_M", "N m/A"),
-              ("inertia_kgm2", "J", "kg m^2"), ("friction_Nms_rad", "F", "N m s/rad")]
-DESIGN_ROWS = [("top_speed_rad_s", "top speed", "rad/s"), ("observer_bandwidth_rad_s", "observer bandwidth", "rad/s"),
-               ("speed_gain_per_s", "speed gain k_w", "1/s"), ("s_align_voltage_V", "alignment voltage", "V"),
-               ("c_align_time_s", "t_c", "s"), ("max_phase_current_A", "overcurrent trip", "A")]
+MOTOR_ROWS = [
+    ("resistance_Ohm", "R", "Ohm"),
+    ("inductance_H", "L", "H"),
+    ("torque_constant_Nm_A", "k_M", "N m/A"),
+    ("inertia_kgm2", "J", "kg m^2"),
+    ("friction_Nms_rad", "F", "N m s/rad"),
+]
+DESIGN_ROWS = [
+    ("top_speed_rad_s", "top speed", "rad/s"),
+    ("observer_bandwidth_rad_s", "observer bandwidth", "rad/s"),
+    ("speed_gain_per_s", "speed gain k_w", "1/s"),
+    ("s_align_voltage_V", "alignment voltage", "V"),
+    ("c_align_time_s", "t_c", "s"),
+    ("max_phase_current_A", "overcurrent trip", "A"),
+]
 
 
 def plant_motor(preset):
@@ -46,8 +57,18 @@ def run(tune, preset, chain, work):
     path = os.path.join(ROOT, "sil", "scenarios", "motors", f"{preset}.ini")
     summary = os.path.join(work, f"{preset}-{chain}.json")
     motor, rated = plant_motor(preset)
-    cmd = [tune, "--motor", path, "--robust", "--self-commission", "--detent-fraction",
-           "0" if preset in NO_DETENT else "0.05", "--validate", "--summary", summary]
+    cmd = [
+        tune,
+        "--motor",
+        path,
+        "--robust",
+        "--self-commission",
+        "--detent-fraction",
+        "0" if preset in NO_DETENT else "0.05",
+        "--validate",
+        "--summary",
+        summary,
+    ]
     if chain == "realistic":
         for item in mc_preset.chain_sets({"rated_current_A": rated}):
             cmd += ["--set", item]
@@ -57,8 +78,15 @@ def run(tune, preset, chain, work):
             s = json.load(f)
     except (OSError, ValueError):
         s = None
-    return {"preset": preset, "chain": chain, "command": cmd, "rc": proc.returncode, "summary": s, "plant": motor,
-            "stdout": proc.stdout}
+    return {
+        "preset": preset,
+        "chain": chain,
+        "command": cmd,
+        "rc": proc.returncode,
+        "summary": s,
+        "plant": motor,
+        "stdout": proc.stdout,
+    }
 
 
 def pct(a, b):
@@ -66,16 +94,23 @@ def pct(a, b):
 
 
 def render(results, argv):
-    lines = [report.header(
-        "Self-commissioning", "tools/self_commission.py", argv,
-        "The drive's own calibration (`pmstep_calibrate.h`, the `CALIBRATE` request) run in the SIL on each public "
-        "preset's plant, told only the rated current, the pole pairs and whether the motor has a detent torque; "
-        "its design beside the one `pmstep-tune` makes from the datasheet, and validated the same way. *Preset "
-        "chain*: the preset's own measurement chain and bridge; *realistic*: the Monte Carlo's (12-bit ADC, "
-        "offsets, noise, a switching bridge with 1 us dead time). How it works: "
-        "[design chapter 19](../design/19-self-commissioning.md).")]
-    lines += ["| Preset | Chain | Outcome | Runs | Simulated | R | L | k_M | J | F | Drive's design validated |",
-              "|---|---|---|---|---|---|---|---|---|---|---|"]
+    lines = [
+        report.header(
+            "Self-commissioning",
+            "tools/self_commission.py",
+            argv,
+            "The drive's own calibration (`pmstep_calibrate.h`, the `CALIBRATE` request) run in the SIL on each public "
+            "preset's plant, told only the rated current, the pole pairs and whether the motor has a detent torque; "
+            "its design beside the one `pmstep-tune` makes from the datasheet, and validated the same way. *Preset "
+            "chain*: the preset's own measurement chain and bridge; *realistic*: the Monte Carlo's (12-bit ADC, "
+            "offsets, noise, a switching bridge with 1 us dead time). How it works: "
+            "[design chapter 19](../design/19-self-commissioning.md).",
+        )
+    ]
+    lines += [
+        "| Preset | Chain | Outcome | Runs | Simulated | R | L | k_M | J | F | Drive's design validated |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
     for r in results:
         s = r["summary"]
         cal = (s or {}).get("self_commissioning")
@@ -83,27 +118,48 @@ def render(results, argv):
             lines.append(f"| {r['preset']} | {r['chain']} | no summary (exit {r['rc']}) | | | | | | | | |")
             continue
         drive = cal.get("drive")
-        errs = [pct(drive[k], r["plant"][k]) if drive and r["plant"][k] else
-                (f"{drive[k]:.3g}" if drive else "-") for k, _, _ in MOTOR_ROWS]
-        outcome = "done" if cal["status"] == 0 else f"failed: {cal['text']}" + (
-            f" ({cal['fault']})" if cal.get("fault", "NONE") != "NONE" else "")
-        validated = "pass" if s.get("synchronous") and s.get("passed") else (
-            "synchronous, envelope missed" if s.get("synchronous") else ("fail" if drive else "-"))
-        lines.append(f"| {r['preset']} | {r['chain']} | {outcome} | {cal['runs']} | {cal['simulated_s']:.2f} s | "
-                     + " | ".join(errs) + f" | {validated} |")
-    lines += ["", "R, L, k_M, J: the drive's measurement against the plant's value; F: the value identified (the "
-              "plants' F is small beside J/T_s, and the paper's is 0).", ""]
+        errs = [
+            pct(drive[k], r["plant"][k]) if drive and r["plant"][k] else (f"{drive[k]:.3g}" if drive else "-")
+            for k, _, _ in MOTOR_ROWS
+        ]
+        outcome = (
+            "done"
+            if cal["status"] == 0
+            else f"failed: {cal['text']}" + (f" ({cal['fault']})" if cal.get("fault", "NONE") != "NONE" else "")
+        )
+        validated = (
+            "pass"
+            if s.get("synchronous") and s.get("passed")
+            else ("synchronous, envelope missed" if s.get("synchronous") else ("fail" if drive else "-"))
+        )
+        lines.append(
+            f"| {r['preset']} | {r['chain']} | {outcome} | {cal['runs']} | {cal['simulated_s']:.2f} s | "
+            + " | ".join(errs)
+            + f" | {validated} |"
+        )
+    lines += [
+        "",
+        "R, L, k_M, J: the drive's measurement against the plant's value; F: the value identified (the "
+        "plants' F is small beside J/T_s, and the paper's is 0).",
+        "",
+    ]
     for r in results:
         s = r["summary"]
         cal = (s or {}).get("self_commissioning")
         if not cal or not cal.get("drive"):
             continue
         ds, drive = cal["datasheet"], cal["drive"]
-        lines += [f"## {r['preset']}, {r['chain']} chain", "", "| | Unit | Plant | Datasheet design | Drive's design | "
-                  "Drive against datasheet |", "|---|---|---|---|---|---|"]
+        lines += [
+            f"## {r['preset']}, {r['chain']} chain",
+            "",
+            "| | Unit | Plant | Datasheet design | Drive's design | Drive against datasheet |",
+            "|---|---|---|---|---|---|",
+        ]
         for key, name, unit in MOTOR_ROWS:
-            lines.append(f"| {name} | {unit} | {r['plant'][key]:.5g} | {ds[key]:.5g} | {drive[key]:.5g} | "
-                         f"{pct(drive[key], ds[key])} |")
+            lines.append(
+                f"| {name} | {unit} | {r['plant'][key]:.5g} | {ds[key]:.5g} | {drive[key]:.5g} | "
+                f"{pct(drive[key], ds[key])} |"
+            )
         for key, name, unit in DESIGN_ROWS:
             lines.append(f"| {name} | {unit} | | {ds[key]:.5g} | {drive[key]:.5g} | {pct(drive[key], ds[key])} |")
         lines.append("")
@@ -124,14 +180,19 @@ def main(argv=None):
                 r = run(a.tune, preset, chain, work)
                 results.append(r)
                 cal = (r["summary"] or {}).get("self_commissioning") or {}
-                print(f"{preset:9s} {chain:9s} {cal.get('text', 'no summary'):30s} runs {cal.get('runs', '-')}, "
-                      f"validation {'passed' if (r['summary'] or {}).get('passed') else 'FAILED'}", flush=True)
+                print(
+                    f"{preset:9s} {chain:9s} {cal.get('text', 'no summary'):30s} runs {cal.get('runs', '-')}, "
+                    f"validation {'passed' if (r['summary'] or {}).get('passed') else 'FAILED'}",
+                    flush=True,
+                )
     text = render(results, argv)
     if a.report:
         report.write(a.report, text)
         print(f"self_commission: wrote {a.report}")
-    ok = all(((r["summary"] or {}).get("self_commissioning") or {}).get("status") == 0
-             and (r["summary"] or {}).get("passed") for r in results)
+    ok = all(
+        ((r["summary"] or {}).get("self_commissioning") or {}).get("status") == 0 and (r["summary"] or {}).get("passed")
+        for r in results
+    )
     return 0 if ok or not a.check else 1
 
 

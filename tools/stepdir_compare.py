@@ -64,6 +64,7 @@ usage: tools/stepdir_compare.py --sil PATH --tune PATH [--motors paper,17hs4401,
                                 [--out DIR] [--json FILE] [--report docs/reports/step-dir.md]
                                 [--plot-motor 17hs4401] [--plot-case moves]
 """
+
 import argparse
 import concurrent.futures
 import configparser
@@ -86,14 +87,14 @@ CASES = ["moves", "low-speed", "high-rate", "aggressive"]
 CHECKED = ["moves", "low-speed", "high-rate"]
 DRIVES = ["pmstep", "microstep"]
 REVOLUTION = 2.0 * math.pi
-LEAD_S = 0.1            # from RUN's start to the first move
-TAIL_S = 0.4            # after the last move's end, at rest, to the end of the run
+LEAD_S = 0.1  # from RUN's start to the first move
+TAIL_S = 0.4  # after the last move's end, at rest, to the end of the run
 THETA0_ELECTRICAL_DEG = 30.0
-JERK_TIME_S = 0.02      # the moves case's S-curve: the acceleration reached in 20 ms
-A_AXIS = 1000.0         # rad/s^2: a printer axis (6400 mm/s^2 on a 40 mm pulley's turn)
-LOAD_BOUND = 1.5        # the load search's bracket: [0, 1.5 x the datasheet holding torque]
-LOAD_ITERATIONS = 9     # its halvings: 1.5 T_H / 512, 0.3 % of the holding torque
-LOAD_ITERATIONS_QUICK = 4   # --quick: 1.5 T_H / 16, 9.4 % of it
+JERK_TIME_S = 0.02  # the moves case's S-curve: the acceleration reached in 20 ms
+A_AXIS = 1000.0  # rad/s^2: a printer axis (6400 mm/s^2 on a 40 mm pulley's turn)
+LOAD_BOUND = 1.5  # the load search's bracket: [0, 1.5 x the datasheet holding torque]
+LOAD_ITERATIONS = 9  # its halvings: 1.5 T_H / 512, 0.3 % of the holding torque
+LOAD_ITERATIONS_QUICK = 4  # --quick: 1.5 T_H / 16, 9.4 % of it
 
 
 def design(tune, motor_ini, ini_out, robust=False, sets=()):
@@ -107,9 +108,14 @@ def design(tune, motor_ini, ini_out, robust=False, sets=()):
     ini = configparser.ConfigParser(inline_comment_prefixes=(";",))
     ini.read(ini_out)
     run_start = float(ini["controller.commissioning"]["offset_calibration_time_s"]) + float(
-        ini["controller.alignment"]["c_align_time_s"])
-    return (top, run_start, float(ini["controller.gains"]["reference_bandwidth_rad_s"]),
-            float(ini["controller.detection"]["stall_speed_error_rad_s"]))
+        ini["controller.alignment"]["c_align_time_s"]
+    )
+    return (
+        top,
+        run_start,
+        float(ini["controller.gains"]["reference_bandwidth_rad_s"]),
+        float(ini["controller.detection"]["stall_speed_error_rad_s"]),
+    )
 
 
 def microsteps_for(preset, tracking_rad_s, stall_rad_s):
@@ -155,16 +161,34 @@ def motion(case, preset, design_figures, quick):
         moves = [REVOLUTION, -0.5 * REVOLUTION, 0.0]
     if case == "moves":
         a = min(0.25 * a_ref, A_AXIS)
-        return {"microsteps": microsteps, "v": 0.5 * top, "a": a, "j": a / JERK_TIME_S, "targets": moves,
-                "dwell_s": 0.3}
+        return {
+            "microsteps": microsteps,
+            "v": 0.5 * top,
+            "a": a,
+            "j": a / JERK_TIME_S,
+            "targets": moves,
+            "dwell_s": 0.3,
+        }
     if case == "low-speed":
         steps = [2, 0, 8, -8, 20, 0] if not quick else [2, 0, 8, 0]
-        return {"microsteps": microsteps, "v": top / 50.0, "a": min(a_ref / 20.0, A_AXIS), "j": 0.0,
-                "targets": [s * full_step for s in steps], "dwell_s": 0.4 if not quick else 0.25}
+        return {
+            "microsteps": microsteps,
+            "v": top / 50.0,
+            "a": min(a_ref / 20.0, A_AXIS),
+            "j": 0.0,
+            "targets": [s * full_step for s in steps],
+            "dwell_s": 0.4 if not quick else 0.25,
+        }
     if case == "high-rate":
         turns = 5.0 if not quick else 2.0
-        return {"microsteps": 256, "v": 0.8 * top, "a": min(0.25 * a_ref, A_AXIS), "j": 0.0,
-                "targets": [turns * REVOLUTION, 0.0], "dwell_s": 0.2}
+        return {
+            "microsteps": 256,
+            "v": 0.8 * top,
+            "a": min(0.25 * a_ref, A_AXIS),
+            "j": 0.0,
+            "targets": [turns * REVOLUTION, 0.0],
+            "dwell_s": 0.2,
+        }
     if case == "aggressive":
         return {"microsteps": 16, "v": 0.5 * top, "a": 0.25 * a_ref, "j": 0.0, "targets": moves, "dwell_s": 0.3}
     raise ValueError(case)
@@ -222,23 +246,43 @@ def compare(args, motor, case, work):
     m = motion(case, preset, args.designs[motor], args.quick)
     points, end_s = schedule(m, run_start + LEAD_S)
     q = 2.0 * math.pi / (4.0 * preset["p"] * m["microsteps"])
-    sets = ["speed.points=0:0", "load.type=none", "position.source=stepdir",
-            f"stepdir.microsteps={m['microsteps']}",
-            "position.points=" + ", ".join(f"{t:.6f}:{x:.9g}" for t, x in points),
-            f"position.v_max_rad_s={m['v']:.9g}", f"position.a_max_rad_s2={m['a']:.9g}",
-            f"position.j_max_rad_s3={m['j']:.9g}", f"run.duration_s={end_s + TAIL_S:.6f}",
-            f"run.theta0_deg={THETA0_ELECTRICAL_DEG / preset['p']:.9g}",
-            f"run.metrics_start_s={points[0][0]:.6f}", f"run.decimation={args.decimation}"]
+    sets = [
+        "speed.points=0:0",
+        "load.type=none",
+        "position.source=stepdir",
+        f"stepdir.microsteps={m['microsteps']}",
+        "position.points=" + ", ".join(f"{t:.6f}:{x:.9g}" for t, x in points),
+        f"position.v_max_rad_s={m['v']:.9g}",
+        f"position.a_max_rad_s2={m['a']:.9g}",
+        f"position.j_max_rad_s3={m['j']:.9g}",
+        f"run.duration_s={end_s + TAIL_S:.6f}",
+        f"run.theta0_deg={THETA0_ELECTRICAL_DEG / preset['p']:.9g}",
+        f"run.metrics_start_s={points[0][0]:.6f}",
+        f"run.decimation={args.decimation}",
+    ]
     plotted = motor == args.plot_motor and case == args.plot_case
     rows = []
     for drive in DRIVES:
         out_dir = os.path.join(work, f"{motor}_{case}_{drive}")
         rc, s = run_sil(args.sil, base, sets + [f"run.controller={drive}"], out_dir, plotted)
-        row = {"motor": motor, "case": case, "drive": drive, "exit_status": rc, "fault": s["fault"]["name"],
-               "microsteps": m["microsteps"], "v_max_rad_s": m["v"], "a_max_rad_s2": m["a"], "j_max_rad_s3": m["j"],
-               "step_rate_hz": m["v"] / q, "moves": len(points), "duration_s": end_s + TAIL_S,
-               "rms_phase_current_A": s["rms_phase_current_A"], "loss_of_synchronism": s["loss_of_synchronism"],
-               "stepdir": s["stepdir"], "csv": os.path.join(out_dir, "run.csv") if plotted else None}
+        row = {
+            "motor": motor,
+            "case": case,
+            "drive": drive,
+            "exit_status": rc,
+            "fault": s["fault"]["name"],
+            "microsteps": m["microsteps"],
+            "v_max_rad_s": m["v"],
+            "a_max_rad_s2": m["a"],
+            "j_max_rad_s3": m["j"],
+            "step_rate_hz": m["v"] / q,
+            "moves": len(points),
+            "duration_s": end_s + TAIL_S,
+            "rms_phase_current_A": s["rms_phase_current_A"],
+            "loss_of_synchronism": s["loss_of_synchronism"],
+            "stepdir": s["stepdir"],
+            "csv": os.path.join(out_dir, "run.csv") if plotted else None,
+        }
         row["checked"] = drive == "pmstep" and case in CHECKED
         row["failures"] = verdict(row) if row["checked"] else []
         row["notes"] = verdict(row) if drive == "pmstep" and not row["checked"] else []
@@ -267,8 +311,9 @@ def load_move(preset, design_figures):
     duration = move_time(distance, m["v"], m["a"], m["j"])
     up = speed_up_s(m["v"], m["a"], m["j"])
     cruise = (start + up, start + duration - up) if m["v"] * up <= distance else None
-    return dict(m, distance=distance, start_s=start, end_s=start + duration, step_s=start + 0.5 * duration,
-                cruise=cruise)
+    return dict(
+        m, distance=distance, start_s=start, end_s=start + duration, step_s=start + 0.5 * duration, cruise=cruise
+    )
 
 
 def load_failures(s):
@@ -291,13 +336,22 @@ def load_run(args, motor, drive, torque_Nm, work):
     held to the end; returns the summary and its load_failures()."""
     preset, _, base = designed(args, motor, work)
     lm = load_move(preset, args.designs[motor])
-    sets = ["speed.points=0:0", "position.source=stepdir", f"stepdir.microsteps={lm['microsteps']}",
-            f"position.points={lm['start_s']:.6f}:{lm['distance']:.9g}",
-            f"position.v_max_rad_s={lm['v']:.9g}", f"position.a_max_rad_s2={lm['a']:.9g}",
-            f"position.j_max_rad_s3={lm['j']:.9g}", f"run.duration_s={lm['end_s'] + TAIL_S:.6f}",
-            f"run.theta0_deg={THETA0_ELECTRICAL_DEG / preset['p']:.9g}", f"run.metrics_start_s={lm['start_s']:.6f}",
-            "load.type=step", f"load.torque_Nm={torque_Nm:.9g}", f"load.step_time_s={lm['step_s']:.6f}",
-            f"run.controller={drive}"]
+    sets = [
+        "speed.points=0:0",
+        "position.source=stepdir",
+        f"stepdir.microsteps={lm['microsteps']}",
+        f"position.points={lm['start_s']:.6f}:{lm['distance']:.9g}",
+        f"position.v_max_rad_s={lm['v']:.9g}",
+        f"position.a_max_rad_s2={lm['a']:.9g}",
+        f"position.j_max_rad_s3={lm['j']:.9g}",
+        f"run.duration_s={lm['end_s'] + TAIL_S:.6f}",
+        f"run.theta0_deg={THETA0_ELECTRICAL_DEG / preset['p']:.9g}",
+        f"run.metrics_start_s={lm['start_s']:.6f}",
+        "load.type=step",
+        f"load.torque_Nm={torque_Nm:.9g}",
+        f"load.step_time_s={lm['step_s']:.6f}",
+        f"run.controller={drive}",
+    ]
     out_dir = os.path.join(work, f"{motor}_load-step_{drive}")
     if os.path.isfile(os.path.join(out_dir, "summary.json")):
         os.remove(os.path.join(out_dir, "summary.json"))
@@ -328,31 +382,51 @@ def load_search(args, motor, drive, iterations, work):
         for _ in range(iterations):
             mid = 0.5 * (lo + hi)
             lo, hi = (mid, hi) if survives(mid) else (lo, mid)
-    row = {"motor": motor, "drive": drive, "holding_torque_Nm": holding,
-           "k_M_rated_Nm": preset["k_M"] * preset["rated_A"], "microsteps": lm["microsteps"], "v_max_rad_s": lm["v"],
-           "a_max_rad_s2": lm["a"], "j_max_rad_s3": lm["j"], "move_rad": lm["distance"], "move_start_s": lm["start_s"],
-           "move_end_s": lm["end_s"], "step_time_s": lm["step_s"], "cruise_s": lm["cruise"],
-           "hold_s": TAIL_S, "bound_Nm": LOAD_BOUND * holding, "iterations": iterations, "runs": len(runs),
-           "resolution_Nm": LOAD_BOUND * holding / 2 ** iterations,
-           "overcurrent_trip_A":
-               float(limits["controller.limits"]["max_phase_current_A"]) if drive == "pmstep" else None,
-           "survived_Nm": lo, "failed_Nm": hi, "failed_why": runs[hi][1] if hi is not None else []}
+    row = {
+        "motor": motor,
+        "drive": drive,
+        "holding_torque_Nm": holding,
+        "k_M_rated_Nm": preset["k_M"] * preset["rated_A"],
+        "microsteps": lm["microsteps"],
+        "v_max_rad_s": lm["v"],
+        "a_max_rad_s2": lm["a"],
+        "j_max_rad_s3": lm["j"],
+        "move_rad": lm["distance"],
+        "move_start_s": lm["start_s"],
+        "move_end_s": lm["end_s"],
+        "step_time_s": lm["step_s"],
+        "cruise_s": lm["cruise"],
+        "hold_s": TAIL_S,
+        "bound_Nm": LOAD_BOUND * holding,
+        "iterations": iterations,
+        "runs": len(runs),
+        "resolution_Nm": LOAD_BOUND * holding / 2**iterations,
+        "overcurrent_trip_A": float(limits["controller.limits"]["max_phase_current_A"]) if drive == "pmstep" else None,
+        "survived_Nm": lo,
+        "failed_Nm": hi,
+        "failed_why": runs[hi][1] if hi is not None else [],
+    }
     row["survived_fraction"] = None if lo is None else lo / holding
     if lo is not None:
         s = runs[lo][0]
         d = s["stepdir"]
-        row.update({"max_error_full_steps": d["max_error_full_steps"],
-                    "final_error_full_steps": d["final_error_full_steps"],
-                    "diag_periods": d["diag_periods"], "diag_first_s": d["diag_first_s"],
-                    "rms_phase_current_A": s["rms_phase_current_A"],
-                    "peak_phase_current_a_A": s["max_abs_phase_current_a"]})
+        row.update(
+            {
+                "max_error_full_steps": d["max_error_full_steps"],
+                "final_error_full_steps": d["final_error_full_steps"],
+                "diag_periods": d["diag_periods"],
+                "diag_first_s": d["diag_first_s"],
+                "rms_phase_current_A": s["rms_phase_current_A"],
+                "peak_phase_current_a_A": s["max_abs_phase_current_a"],
+            }
+        )
     return row
 
 
 def load_searches(args, work):
     """load_search() of every motor and drive, two at a time (args.jobs); rows in motor, drive order."""
     for motor in args.motors.split(","):
-        designed(args, motor, work)     # the designs before the threads
+        designed(args, motor, work)  # the designs before the threads
     jobs = [(motor, drive) for motor in args.motors.split(",") for drive in DRIVES]
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
         futures = [pool.submit(load_search, args, motor, drive, args.load_iterations, work) for motor, drive in jobs]
@@ -376,8 +450,9 @@ def load_check(loads):
         by = {r["drive"]: r["survived_Nm"] for r in loads if r["motor"] == motor}
         pm, ms = by.get("pmstep"), by.get("microstep")
         if pm is None or (ms is not None and pm < ms):
-            failures.append(f"{motor}: pmstep survives a load step of {pm if pm is not None else 'no'} N m, "
-                            f"microstepping {ms} N m")
+            failures.append(
+                f"{motor}: pmstep survives a load step of {pm if pm is not None else 'no'} N m, microstepping {ms} N m"
+            )
     return failures
 
 
@@ -386,19 +461,38 @@ def _f(x, spec=".3f"):
 
 
 def table(rows, markdown):
-    head = ["motor", "case", "drive", "µsteps", "step rate", "max err moving", "RMS moving", "max err", "RMS err",
-            "final", "lost", "RMS current", "DIAG periods (first)", "verdict"]
+    head = [
+        "motor",
+        "case",
+        "drive",
+        "µsteps",
+        "step rate",
+        "max err moving",
+        "RMS moving",
+        "max err",
+        "RMS err",
+        "final",
+        "lost",
+        "RMS current",
+        "DIAG periods (first)",
+        "verdict",
+    ]
     out = []
     if markdown:
         out += ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     else:
-        out.append(f"{'motor':9s} {'case':10s} {'drive':9s} {'usteps':>6s} {'rate kHz':>8s} {'maxmov':>7s} "
-                   f"{'rmsmov':>7s} {'max':>7s} {'rms':>7s} {'final':>7s} {'lost':>4s} {'I_rms A':>7s} "
-                   f"{'DIAG':>12s}  verdict")
+        out.append(
+            f"{'motor':9s} {'case':10s} {'drive':9s} {'usteps':>6s} {'rate kHz':>8s} {'maxmov':>7s} "
+            f"{'rmsmov':>7s} {'max':>7s} {'rms':>7s} {'final':>7s} {'lost':>4s} {'I_rms A':>7s} "
+            f"{'DIAG':>12s}  verdict"
+        )
     for r in rows:
         d = r["stepdir"]
-        diag = "-" if r["drive"] == "microstep" else (
-            f"{d['diag_periods']} ({d['diag_first_s']:.3f} s)" if d["diag_periods"] > 0 else "0")
+        diag = (
+            "-"
+            if r["drive"] == "microstep"
+            else (f"{d['diag_periods']} ({d['diag_first_s']:.3f} s)" if d["diag_periods"] > 0 else "0")
+        )
         if r["drive"] == "microstep":
             ok = "-"
         elif not r["checked"]:
@@ -406,62 +500,120 @@ def table(rows, markdown):
         else:
             ok = "met" if not r["failures"] else "FAILED: " + "; ".join(r["failures"])
         if markdown:
-            out.append("| " + " | ".join([
-                r["motor"], r["case"], r["drive"], str(r["microsteps"]), f"{r['step_rate_hz'] / 1e3:.1f} kHz",
-                _f(d["max_error_moving_full_steps"]), _f(d["rms_error_moving_full_steps"]),
-                _f(d["max_error_full_steps"]), _f(d["rms_error_full_steps"]), _f(d["final_error_full_steps"], "+.3f"),
-                str(d["lost_full_steps"]), f"{r['rms_phase_current_A']:.3f} A", diag,
-                "**" + ok + "**" if ok.startswith("FAILED") else ok]) + " |")
+            out.append(
+                "| "
+                + " | ".join(
+                    [
+                        r["motor"],
+                        r["case"],
+                        r["drive"],
+                        str(r["microsteps"]),
+                        f"{r['step_rate_hz'] / 1e3:.1f} kHz",
+                        _f(d["max_error_moving_full_steps"]),
+                        _f(d["rms_error_moving_full_steps"]),
+                        _f(d["max_error_full_steps"]),
+                        _f(d["rms_error_full_steps"]),
+                        _f(d["final_error_full_steps"], "+.3f"),
+                        str(d["lost_full_steps"]),
+                        f"{r['rms_phase_current_A']:.3f} A",
+                        diag,
+                        "**" + ok + "**" if ok.startswith("FAILED") else ok,
+                    ]
+                )
+                + " |"
+            )
         else:
-            out.append(f"{r['motor']:9s} {r['case']:10s} {r['drive']:9s} {r['microsteps']:6d} "
-                       f"{r['step_rate_hz'] / 1e3:8.1f} {d['max_error_moving_full_steps']:7.3f} "
-                       f"{d['rms_error_moving_full_steps']:7.3f} {d['max_error_full_steps']:7.3f} "
-                       f"{d['rms_error_full_steps']:7.3f} {d['final_error_full_steps']:+7.3f} {d['lost_full_steps']:4d} "
-                       f"{r['rms_phase_current_A']:7.3f} {diag:>12s}  {ok}")
+            out.append(
+                f"{r['motor']:9s} {r['case']:10s} {r['drive']:9s} {r['microsteps']:6d} "
+                f"{r['step_rate_hz'] / 1e3:8.1f} {d['max_error_moving_full_steps']:7.3f} "
+                f"{d['rms_error_moving_full_steps']:7.3f} {d['max_error_full_steps']:7.3f} "
+                f"{d['rms_error_full_steps']:7.3f} {d['final_error_full_steps']:+7.3f} {d['lost_full_steps']:4d} "
+                f"{r['rms_phase_current_A']:7.3f} {diag:>12s}  {ok}"
+            )
     return "\n".join(out)
 
 
 def load_table(loads, markdown):
     """The load search's figures, a row per motor and drive."""
-    head = ["motor", "drive", "holding torque", "load step at", "largest load step survived", "× holding torque",
-            "first failure above", "max err", "final err", "DIAG", "RMS current", "peak i_a",
-            "pmstep / microstepping"]
+    head = [
+        "motor",
+        "drive",
+        "holding torque",
+        "load step at",
+        "largest load step survived",
+        "× holding torque",
+        "first failure above",
+        "max err",
+        "final err",
+        "DIAG",
+        "RMS current",
+        "peak i_a",
+        "pmstep / microstepping",
+    ]
     out = []
     if markdown:
         out += ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     else:
-        out.append(f"{'motor':9s} {'drive':9s} {'T_H Nm':>7s} {'step s':>7s} {'survived':>9s} {'x T_H':>6s} "
-                   f"{'fails at':>9s} {'maxerr':>7s} {'final':>7s} {'DIAG':>5s} {'I_rms A':>7s} {'peak ia':>7s} "
-                   f"{'ratio':>6s}  first failure")
+        out.append(
+            f"{'motor':9s} {'drive':9s} {'T_H Nm':>7s} {'step s':>7s} {'survived':>9s} {'x T_H':>6s} "
+            f"{'fails at':>9s} {'maxerr':>7s} {'final':>7s} {'DIAG':>5s} {'I_rms A':>7s} {'peak ia':>7s} "
+            f"{'ratio':>6s}  first failure"
+        )
     for r in loads:
         lo, hi = r["survived_Nm"], r["failed_Nm"]
         ratio = load_ratio(loads, r["motor"]) if r["drive"] == "pmstep" else None
-        diag = "-" if r["drive"] == "microstep" or lo is None else (
-            f"yes ({r['diag_first_s']:.3f} s)" if r["diag_periods"] > 0 else "no")
+        diag = (
+            "-"
+            if r["drive"] == "microstep" or lo is None
+            else (f"yes ({r['diag_first_s']:.3f} s)" if r["diag_periods"] > 0 else "no")
+        )
         why = "; ".join(r["failed_why"])
         if markdown:
-            at = f"{r['step_time_s']:.3f} s" + (f" (cruise {r['cruise_s'][0]:.3f}–{r['cruise_s'][1]:.3f} s)"
-                                                 if r["cruise_s"] else " (no cruise)")
-            peak = "-" if lo is None else f"{r['peak_phase_current_a_A']:.2f} A" + (
-                f" (trip {r['overcurrent_trip_A']:g} A)" if r["overcurrent_trip_A"] else "")
-            out.append("| " + " | ".join([
-                r["motor"], r["drive"], f"{r['holding_torque_Nm']:.4g} N·m", at,
-                "none" if lo is None else (f"≥ {lo:.4g} N·m" if hi is None else f"{lo:.4g} N·m"),
-                "-" if lo is None else f"{r['survived_fraction']:.3f}",
-                "-" if hi is None else f"{hi:.4g} N·m: {why}",
-                "-" if lo is None else _f(r["max_error_full_steps"]),
-                "-" if lo is None else _f(r["final_error_full_steps"], "+.3f"), diag,
-                "-" if lo is None else f"{r['rms_phase_current_A']:.3f} A", peak,
-                "-" if ratio is None else f"{ratio:.2f}"]) + " |")
+            at = f"{r['step_time_s']:.3f} s" + (
+                f" (cruise {r['cruise_s'][0]:.3f}–{r['cruise_s'][1]:.3f} s)" if r["cruise_s"] else " (no cruise)"
+            )
+            peak = (
+                "-"
+                if lo is None
+                else f"{r['peak_phase_current_a_A']:.2f} A"
+                + (f" (trip {r['overcurrent_trip_A']:g} A)" if r["overcurrent_trip_A"] else "")
+            )
+            out.append(
+                "| "
+                + " | ".join(
+                    [
+                        r["motor"],
+                        r["drive"],
+                        f"{r['holding_torque_Nm']:.4g} N·m",
+                        at,
+                        "none" if lo is None else (f"≥ {lo:.4g} N·m" if hi is None else f"{lo:.4g} N·m"),
+                        "-" if lo is None else f"{r['survived_fraction']:.3f}",
+                        "-" if hi is None else f"{hi:.4g} N·m: {why}",
+                        "-" if lo is None else _f(r["max_error_full_steps"]),
+                        "-" if lo is None else _f(r["final_error_full_steps"], "+.3f"),
+                        diag,
+                        "-" if lo is None else f"{r['rms_phase_current_A']:.3f} A",
+                        peak,
+                        "-" if ratio is None else f"{ratio:.2f}",
+                    ]
+                )
+                + " |"
+            )
         else:
-            out.append(f"{r['motor']:9s} {r['drive']:9s} {r['holding_torque_Nm']:7.4g} {r['step_time_s']:7.3f} "
-                       + (f"{'none':>9s} {'-':>6s} " if lo is None else f"{lo:9.4g} {r['survived_fraction']:6.3f} ")
-                       + (f"{'-':>9s} " if hi is None else f"{hi:9.4g} ")
-                       + (f"{'-':>7s} {'-':>7s} {'-':>5s} {'-':>7s} {'-':>7s} " if lo is None else
-                          f"{r['max_error_full_steps']:7.3f} {r['final_error_full_steps']:+7.3f} "
-                          f"{'-' if r['drive'] == 'microstep' else ('yes' if r['diag_periods'] > 0 else 'no'):>5s} "
-                          f"{r['rms_phase_current_A']:7.3f} {r['peak_phase_current_a_A']:7.3f} ")
-                       + (f"{'-':>6s}" if ratio is None else f"{ratio:6.2f}") + f"  {why}")
+            out.append(
+                f"{r['motor']:9s} {r['drive']:9s} {r['holding_torque_Nm']:7.4g} {r['step_time_s']:7.3f} "
+                + (f"{'none':>9s} {'-':>6s} " if lo is None else f"{lo:9.4g} {r['survived_fraction']:6.3f} ")
+                + (f"{'-':>9s} " if hi is None else f"{hi:9.4g} ")
+                + (
+                    f"{'-':>7s} {'-':>7s} {'-':>5s} {'-':>7s} {'-':>7s} "
+                    if lo is None
+                    else f"{r['max_error_full_steps']:7.3f} {r['final_error_full_steps']:+7.3f} "
+                    f"{'-' if r['drive'] == 'microstep' else ('yes' if r['diag_periods'] > 0 else 'no'):>5s} "
+                    f"{r['rms_phase_current_A']:7.3f} {r['peak_phase_current_a_A']:7.3f} "
+                )
+                + (f"{'-':>6s}" if ratio is None else f"{ratio:6.2f}")
+                + f"  {why}"
+            )
     return "\n".join(out)
 
 
@@ -476,17 +628,23 @@ def load_summary(loads):
             parts.append(f"{name} {min(fr):.2f}–{max(fr):.2f}")
     motors = list(dict.fromkeys(r["motor"] for r in loads))
     ratios = [x for x in (load_ratio(loads, m) for m in motors) if x is not None]
-    text = ("Largest load step survived during a move, as a fraction of the datasheet holding torque: "
-            + ", ".join(parts) + ".")
+    text = (
+        "Largest load step survived during a move, as a fraction of the datasheet holding torque: "
+        + ", ".join(parts)
+        + "."
+    )
     if ratios:
-        text += (f" pmstep survives at least microstepping's load step on {len(motors) - len(load_check(loads))} of "
-                 f"{len(motors)} presets; pmstep / microstepping {min(ratios):.2f}–{max(ratios):.2f}.")
+        text += (
+            f" pmstep survives at least microstepping's load step on {len(motors) - len(load_check(loads))} of "
+            f"{len(motors)} presets; pmstep / microstepping {min(ratios):.2f}–{max(ratios):.2f}."
+        )
     return text
 
 
 def plot(rows, path, motor, case):
     try:
         import matplotlib
+
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError:
@@ -504,7 +662,10 @@ def plot(rows, path, motor, case):
     if not series:
         return None
     fig, ax = plt.subplots(figsize=(10, 4))
-    labels = {"pmstep": "pmstep (sensorless, following the count)", "microstep": "open-loop microstepping, rated current"}
+    labels = {
+        "pmstep": "pmstep (sensorless, following the count)",
+        "microstep": "open-loop microstepping, rated current",
+    }
     for drive, (t, e) in series.items():
         ax.plot(t, e, label=labels[drive], linewidth=0.9)
     ax.axhline(1.0, color="grey", linestyle=":", linewidth=0.8)
@@ -531,24 +692,26 @@ def summary_text(rows):
             if rs:
                 lost = sum(1 for r in rs if r["stepdir"]["lost_full_steps"] != 0)
                 diag = sum(1 for r in rs if r["stepdir"]["diag_periods"] > 0)
-                parts.append(f"{name}, {'checked cases' if checked else 'aggressive case'}: largest following error "
-                             f"{max(r['stepdir']['max_error_full_steps'] for r in rs):.3f} full steps, "
-                             f"{lost} of {len(rs)} runs with steps lost"
-                             + (f", {diag} with DIAG" if drive == "pmstep" else ""))
+                parts.append(
+                    f"{name}, {'checked cases' if checked else 'aggressive case'}: largest following error "
+                    f"{max(r['stepdir']['max_error_full_steps'] for r in rs):.3f} full steps, "
+                    f"{lost} of {len(rs)} runs with steps lost" + (f", {diag} with DIAG" if drive == "pmstep" else "")
+                )
     return "; ".join(parts) + "."
 
 
 def load_text(loads):
     """The load search's section of the report: what was run, the table, the summary's sentence."""
     iterations = loads[0]["iterations"]
-    quadrature = all(abs(r["holding_torque_Nm"] - math.sqrt(2.0) * r["k_M_rated_Nm"]) <= 0.01 * r["holding_torque_Nm"]
-                     for r in loads)
+    quadrature = all(
+        abs(r["holding_torque_Nm"] - math.sqrt(2.0) * r["k_M_rated_Nm"]) <= 0.01 * r["holding_torque_Nm"] for r in loads
+    )
     what = (
         "Per preset and drive, the largest load torque step the drive survives during a move, found by bisection. "
         "The move is the first of **moves**: 2 revolutions forward from rest, S-curve at ½ the top speed and "
         f"min(¼ k_M I / J, {A_AXIS:g} rad/s²), the acceleration reached in {JERK_TIME_S * 1e3:g} ms, the same "
         "microsteps. The SIL's `load.type = step` steps the load torque up at the middle of the move (the middle of "
-        "its cruise; column \"load step at\") and holds it to the end of the run, "
+        'its cruise; column "load step at") and holds it to the end of the run, '
         f"{TAIL_S:g} s at rest after the move: the drive carries it while finishing the move and holding. "
         "`load.torque_Nm` is positive, which opposes the forward move (the plant's J dω/dt = T_e − F ω − T_L, "
         "T_L the load). "
@@ -558,46 +721,64 @@ def load_text(loads):
         "the step; it is reported for pmstep at its largest survived load but not counted as a failure, since "
         "open-loop microstepping has no DIAG. "
         f"Bisection on [0, {LOAD_BOUND:g} × the holding torque], after a run at each end, {iterations} halvings: "
-        f"resolution {LOAD_BOUND:g} / {2 ** iterations} = {LOAD_BOUND / 2 ** iterations * 100:.2g} % of the holding "
+        f"resolution {LOAD_BOUND:g} / {2**iterations} = {LOAD_BOUND / 2**iterations * 100:.2g} % of the holding "
         "torque (it assumes survival falls off once with the load). "
         "Holding torque: the preset's datasheet `holding_torque_Nm` (both phases at rated current"
-        + (", √2 k_M I on these presets" if quadrature else "") + "). "
+        + (", √2 k_M I on these presets" if quadrature else "")
+        + "). "
         "The figures of the run at the largest survived load: max and final following error (full steps, count − "
         "rotor), the RMS phase current from the move's start to the end, the peak of phase a's current. "
         "Currents differ: open-loop microstepping drives a sine of rated amplitude whatever the load, so its "
         "torque is at most k_M I (= holding / √2), and with the load held to the end its static lag counts in the "
         "final error: < ½ full step at rest allows k_M I sin 45° (½ × holding where holding = √2 k_M I) at most. "
         "pmstep's current follows the load up to the overcurrent trip of its design "
-        "(`controller.limits.max_phase_current_A`, given in the column \"peak i_a\"); a larger load faults it "
-        "(column \"first failure above\").")
-    return ["## Largest load step survived during a move", "", what, "", load_table(loads, True), "",
-            load_summary(loads), ""]
+        '(`controller.limits.max_phase_current_A`, given in the column "peak i_a"); a larger load faults it '
+        '(column "first failure above").'
+    )
+    return [
+        "## Largest load step survived during a move",
+        "",
+        what,
+        "",
+        load_table(loads, True),
+        "",
+        load_summary(loads),
+        "",
+    ]
 
 
 def report_text(rows, args, argv, picture, loads):
-    what = ("Per public preset, pmstep-tune's design (ideal measurement chain, the plant's detent torque on) and "
-            "the step streams below from the SIL's step generator (`position.source = stepdir`), each into the firmware "
-            "following the count (`pmstep_stepdir.h`, the designer's tracker and DIAG limit of one full step) and "
-            "into open-loop microstepping at rated current (`run.controller = microstep`) on the same plant: "
-            f"**moves** (S-curves at ½ the top speed and min(¼ k_M I / J, {A_AXIS:g} rad/s²), reversals, dwells), "
-            f"**low-speed** (trapezoids at 1/50 of the top speed over 2 to 20 full steps, reversals and standstill "
-            f"dwells), **high-rate** (256 µsteps, trapezoids at 0.8 × the top speed and min(¼ k_M I / J, {A_AXIS:g} "
-            "rad/s²), several revolutions and back) and, not checked, **aggressive** (16 µsteps, trapezoids at ½ the "
-            "top speed and ¼ k_M I / J, no jerk limit: beyond what a follower that sees the steps only as they come "
-            "is designed for). Microsteps of moves and low-speed: 16, or the smallest power of two whose microstep "
-            "moves the tracker's speed by at most the stall detection's bound (the paper motor, p = 6: 256). "
-            "Errors in full steps (π / 2p): the count's position less the rotor's true position, \"moving\" while a "
-            "move runs; lost = the final error rounded; the RMS phase current from the first move to the end; "
-            "DIAG periods of the firmware's output. Both drives start 30 electrical degrees off an equilibrium. "
-            "Verdict (pmstep, checked cases, `--check`): no step lost, every pulse counted, no DIAG, no fault, following to the "
-            "end." + (" Shorter motions (`--quick`)." if args.quick else ""))
-    lines = [report.header("STEP/DIR: pmstep against open-loop microstepping", "tools/stepdir_compare.py", argv, what),
-             table(rows, True), ""]
+    what = (
+        "Per public preset, pmstep-tune's design (ideal measurement chain, the plant's detent torque on) and "
+        "the step streams below from the SIL's step generator (`position.source = stepdir`), each into the firmware "
+        "following the count (`pmstep_stepdir.h`, the designer's tracker and DIAG limit of one full step) and "
+        "into open-loop microstepping at rated current (`run.controller = microstep`) on the same plant: "
+        f"**moves** (S-curves at ½ the top speed and min(¼ k_M I / J, {A_AXIS:g} rad/s²), reversals, dwells), "
+        f"**low-speed** (trapezoids at 1/50 of the top speed over 2 to 20 full steps, reversals and standstill "
+        f"dwells), **high-rate** (256 µsteps, trapezoids at 0.8 × the top speed and min(¼ k_M I / J, {A_AXIS:g} "
+        "rad/s²), several revolutions and back) and, not checked, **aggressive** (16 µsteps, trapezoids at ½ the "
+        "top speed and ¼ k_M I / J, no jerk limit: beyond what a follower that sees the steps only as they come "
+        "is designed for). Microsteps of moves and low-speed: 16, or the smallest power of two whose microstep "
+        "moves the tracker's speed by at most the stall detection's bound (the paper motor, p = 6: 256). "
+        "Errors in full steps (π / 2p): the count's position less the rotor's true position, \"moving\" while a "
+        "move runs; lost = the final error rounded; the RMS phase current from the first move to the end; "
+        "DIAG periods of the firmware's output. Both drives start 30 electrical degrees off an equilibrium. "
+        "Verdict (pmstep, checked cases, `--check`): no step lost, every pulse counted, no DIAG, no fault, "
+        "following to the "
+        "end." + (" Shorter motions (`--quick`)." if args.quick else "")
+    )
+    lines = [
+        report.header("STEP/DIR: pmstep against open-loop microstepping", "tools/stepdir_compare.py", argv, what),
+        table(rows, True),
+        "",
+    ]
     lines.append(summary_text(rows) + (" " + load_summary(loads) if loads else ""))
     lines.append("")
     if picture:
-        lines += [f"![Following error against time, {args.plot_motor}, motion {args.plot_case}, both drives]"
-                  f"({picture})", ""]
+        lines += [
+            f"![Following error against time, {args.plot_motor}, motion {args.plot_case}, both drives]({picture})",
+            "",
+        ]
     if loads:
         lines += load_text(loads)
     return "\n".join(lines)
@@ -615,13 +796,17 @@ def main(argv=None):
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "stepdir_compare"))
     ap.add_argument("--decimation", type=int, default=10, help="CSV row stride of the plotted runs (periods)")
     ap.add_argument("--json", help="also write every run's figures to this file")
-    ap.add_argument("--report", metavar="FILE", help="write the table as Markdown (docs/reports/step-dir.md), the "
-                                                     "plot beside it")
+    ap.add_argument(
+        "--report", metavar="FILE", help="write the table as Markdown (docs/reports/step-dir.md), the plot beside it"
+    )
     ap.add_argument("--plot-motor", default="17hs4401")
     ap.add_argument("--plot-case", default="moves")
-    ap.add_argument("--load-iterations", type=int,
-                    help=f"halvings of the load-step search (default {LOAD_ITERATIONS}, {LOAD_ITERATIONS_QUICK} with "
-                         "--quick); 0: no search")
+    ap.add_argument(
+        "--load-iterations",
+        type=int,
+        help=f"halvings of the load-step search (default {LOAD_ITERATIONS}, {LOAD_ITERATIONS_QUICK} with "
+        "--quick); 0: no search",
+    )
     ap.add_argument("--jobs", type=int, default=2, help="load searches run at once (threads, each a pmstep-sil)")
     args = ap.parse_args(argv[1:])
     if args.cases is None:

@@ -26,11 +26,11 @@ Usage: tools/sweep_motors.py --tune build/host-release/sil/pmstep-tune [--count 
 --mc-sample N adds a short speed Monte Carlo (C cases, default 20) on N population motors
 (tools/sweep_mc.py): the cases by class, and the motors with a silent failure.
 """
+
 import argparse
 import collections
 import csv
 import json
-import math
 import os
 import random
 import subprocess
@@ -62,14 +62,23 @@ def preset_motor(name):
     """A public preset as a population entry (the designer told its own J and F)."""
     path = os.path.join(ROOT, "sil", "scenarios", "motors", f"{name}.ini")
     ini = mc_preset._ini(path)
-    motor = {k: float(ini.get("motor", k)) for k in ("resistance_Ohm", "inductance_H", "inertia_kgm2",
-                                                      "friction_Nms_rad", "torque_constant_Nm_A")}
-    motor.update(name=name, frame="preset", pole_pairs=int(ini.get("motor", "pole_pairs")),
-                 rated_current_A=float(ini.get("datasheet", "rated_current_A")),
-                 holding_torque_Nm=float(ini.get("datasheet", "holding_torque_Nm")),
-                 detent_torque_Nm=float(ini.get("datasheet", "detent_torque_Nm", fallback="0")),
-                 bus_voltage_V=float(ini.get("run", "bus_voltage_V")), load_ratio=0.0, path=path,
-                 told_inertia_kgm2=None, told_friction_Nms_rad=None)
+    motor = {
+        k: float(ini.get("motor", k))
+        for k in ("resistance_Ohm", "inductance_H", "inertia_kgm2", "friction_Nms_rad", "torque_constant_Nm_A")
+    }
+    motor.update(
+        name=name,
+        frame="preset",
+        pole_pairs=int(ini.get("motor", "pole_pairs")),
+        rated_current_A=float(ini.get("datasheet", "rated_current_A")),
+        holding_torque_Nm=float(ini.get("datasheet", "holding_torque_Nm")),
+        detent_torque_Nm=float(ini.get("datasheet", "detent_torque_Nm", fallback="0")),
+        bus_voltage_V=float(ini.get("run", "bus_voltage_V")),
+        load_ratio=0.0,
+        path=path,
+        told_inertia_kgm2=None,
+        told_friction_Nms_rad=None,
+    )
     return motor
 
 
@@ -95,11 +104,17 @@ def run_motor(tune, motor, mode, work):
         with open(summary_path) as f:
             summary = json.load(f)
     except (OSError, ValueError):
-        summary = {"design": {"status": None, "text": f"pmstep-tune exit {proc.returncode}: "
-                                                     + (proc.stderr.strip().splitlines() or ['no output'])[-1]},
-                   "checks": [], "passed": False, "synchronous": False}
-    return {"motor": motor, "mode": mode, "summary": summary, "seconds": time.monotonic() - started,
-            "command": cmd}
+        summary = {
+            "design": {
+                "status": None,
+                "text": f"pmstep-tune exit {proc.returncode}: "
+                + (proc.stderr.strip().splitlines() or ["no output"])[-1],
+            },
+            "checks": [],
+            "passed": False,
+            "synchronous": False,
+        }
+    return {"motor": motor, "mode": mode, "summary": summary, "seconds": time.monotonic() - started, "command": cmd}
 
 
 def outcome(result):
@@ -125,15 +140,18 @@ def groups(result):
     m = result["motor"]
     d = result["summary"]["design"]
     period_s = 50e-6
-    out = {"R/L T_s": m["resistance_Ohm"] / m["inductance_H"] * period_s,
-           "F/J T_s": m["friction_Nms_rad"] / m["inertia_kgm2"] * period_s,
-           "p": m["pole_pairs"]}
+    out = {
+        "R/L T_s": m["resistance_Ohm"] / m["inductance_H"] * period_s,
+        "F/J T_s": m["friction_Nms_rad"] / m["inertia_kgm2"] * period_s,
+        "p": m["pole_pairs"],
+    }
     if d.get("top_speed_rad_s"):
         top = d["top_speed_rad_s"]
         out["p w_top T_s"] = m["pole_pairs"] * top * period_s
         out["k_M w_top / V_bus"] = m["torque_constant_Nm_A"] * top / m["bus_voltage_V"]
-        out["k_M I / (J w_top w_o)"] = (m["torque_constant_Nm_A"] * m["rated_current_A"] / m["inertia_kgm2"]
-                                        / top / d["observer_bandwidth_rad_s"])
+        out["k_M I / (J w_top w_o)"] = (
+            m["torque_constant_Nm_A"] * m["rated_current_A"] / m["inertia_kgm2"] / top / d["observer_bandwidth_rad_s"]
+        )
         out["I_align / noise"] = d["alignment_current_A"] / NOISE_A
     return out
 
@@ -144,6 +162,7 @@ def run_all(tasks, tune, work, jobs, engine):
     started = time.monotonic()
     if engine == "dask":
         from distributed import Client, LocalCluster, as_completed
+
         with LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True) as cluster, Client(cluster) as client:
             futures = [client.submit(run_motor, tune, m, mode, work, pure=False) for m, mode in tasks]
             for future in as_completed(futures):
@@ -151,6 +170,7 @@ def run_all(tasks, tune, work, jobs, engine):
                 progress(len(results), total, started)
     else:
         import concurrent.futures
+
         with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
             for result in pool.map(lambda t: run_motor(tune, t[0], t[1], work), tasks):
                 results.append(result)
@@ -175,37 +195,68 @@ def rate_table(results, key):
 
 
 def write_csv(path, results):
-    fields = ["name", "frame", "pole_pairs", "bus_voltage_V", "rated_current_A", "holding_torque_Nm",
-              "resistance_Ohm", "inductance_H", "inertia_kgm2", "load_ratio", "mode", "outcome", "envelope_pass",
-              "seconds"]
-    group_names = ["R/L T_s", "F/J T_s", "p w_top T_s", "k_M w_top / V_bus", "k_M I / (J w_top w_o)",
-                   "I_align / noise"]
+    fields = [
+        "name",
+        "frame",
+        "pole_pairs",
+        "bus_voltage_V",
+        "rated_current_A",
+        "holding_torque_Nm",
+        "resistance_Ohm",
+        "inductance_H",
+        "inertia_kgm2",
+        "load_ratio",
+        "mode",
+        "outcome",
+        "envelope_pass",
+        "seconds",
+    ]
+    group_names = ["R/L T_s", "F/J T_s", "p w_top T_s", "k_M w_top / V_bus", "k_M I / (J w_top w_o)", "I_align / noise"]
     with open(path, "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(fields + group_names)
         for r in results:
             m = r["motor"]
             g = groups(r)
-            w.writerow([m["name"], m["frame"], m["pole_pairs"], m["bus_voltage_V"], m["rated_current_A"],
-                        m["holding_torque_Nm"], m["resistance_Ohm"], m["inductance_H"], m["inertia_kgm2"],
-                        m["load_ratio"], r["mode"], outcome(r), r["summary"]["passed"], f"{r['seconds']:.2f}"]
-                       + [f"{g[n]:.6g}" if n in g else "" for n in group_names])
+            w.writerow(
+                [
+                    m["name"],
+                    m["frame"],
+                    m["pole_pairs"],
+                    m["bus_voltage_V"],
+                    m["rated_current_A"],
+                    m["holding_torque_Nm"],
+                    m["resistance_Ohm"],
+                    m["inductance_H"],
+                    m["inertia_kgm2"],
+                    m["load_ratio"],
+                    r["mode"],
+                    outcome(r),
+                    r["summary"]["passed"],
+                    f"{r['seconds']:.2f}",
+                ]
+                + [f"{g[n]:.6g}" if n in g else "" for n in group_names]
+            )
 
 
 def plot(path, results):
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    pairs = [("R/L T_s", "p w_top T_s"), ("k_M w_top / V_bus", "k_M I / (J w_top w_o)"),
-             ("I_align / noise", "F/J T_s")]
+
+    pairs = [("R/L T_s", "p w_top T_s"), ("k_M w_top / V_bus", "k_M I / (J w_top w_o)"), ("I_align / noise", "F/J T_s")]
     modes = sorted({r["mode"] for r in results})
     fig, axes = plt.subplots(len(modes), len(pairs), figsize=(5 * len(pairs), 4 * len(modes)), squeeze=False)
     for row, mode in enumerate(modes):
         for col, (x, y) in enumerate(pairs):
             ax = axes[row][col]
             for passed, colour, label in ((True, "tab:green", "pass"), (False, "tab:red", "fail or refused")):
-                pts = [(groups(r).get(x), groups(r).get(y)) for r in results
-                       if r["mode"] == mode and (outcome(r) == "pass") == passed]
+                pts = [
+                    (groups(r).get(x), groups(r).get(y))
+                    for r in results
+                    if r["mode"] == mode and (outcome(r) == "pass") == passed
+                ]
                 pts = [p for p in pts if p[0] and p[1]]
                 if pts:
                     ax.scatter([p[0] for p in pts], [p[1] for p in pts], s=8, c=colour, label=label, alpha=0.7)
@@ -232,31 +283,54 @@ def summary_lines(results, modes):
     lines = []
     for mode in modes:
         rs, passed, envelope, nonfinite = mode_counts(results, mode)
-        lines.append(f"{mode}: {passed} of {len(rs)} pass ({100.0 * passed / max(1, len(rs)):.1f} %); "
-                     f"envelope criteria {envelope}; STATE_NONFINITE in {nonfinite}")
+        lines.append(
+            f"{mode}: {passed} of {len(rs)} pass ({100.0 * passed / max(1, len(rs)):.1f} %); "
+            f"envelope criteria {envelope}; STATE_NONFINITE in {nonfinite}"
+        )
         modes_seen = collections.Counter(outcome(r) for r in rs if outcome(r) != "pass")
         lines += [f"  {n:4d}  {what}" for what, n in modes_seen.most_common()]
     return lines
 
 
 def report_text(results, modes, argv, seconds, jobs, population_note, mc=None):
-    out = [report.header("Motor sweep", "tools/sweep_motors.py", argv,
-                         "The gain designer and the control over a population of motors drawn by "
-                         "tools/motor_population.py (" + population_note + ") and the public presets. A motor passes "
-                         "when it is designed and its validation (ramps to +-80 % and +-5 % of the top speed, half "
-                         "the holding torque stepped on at 50 % and 5 % of it) runs with no fault and no loss of "
-                         "synchronism; *envelope* counts the motors that also meet the tracking (2 % of the top speed) "
-                         "and angle (0.05 rad) bounds."),
-           f"{len(results)} runs in {seconds:.0f} s on {jobs} workers.", ""]
-    out += ["## Pass rates", "", "| mode | motors | pass | % | envelope | STATE_NONFINITE |", "|---|---|---|---|---|---|"]
+    out = [
+        report.header(
+            "Motor sweep",
+            "tools/sweep_motors.py",
+            argv,
+            "The gain designer and the control over a population of motors drawn by "
+            "tools/motor_population.py (" + population_note + ") and the public presets. A motor passes "
+            "when it is designed and its validation (ramps to +-80 % and +-5 % of the top speed, half "
+            "the holding torque stepped on at 50 % and 5 % of it) runs with no fault and no loss of "
+            "synchronism; *envelope* counts the motors that also meet the tracking (2 % of the top speed) "
+            "and angle (0.05 rad) bounds.",
+        ),
+        f"{len(results)} runs in {seconds:.0f} s on {jobs} workers.",
+        "",
+    ]
+    out += [
+        "## Pass rates",
+        "",
+        "| mode | motors | pass | % | envelope | STATE_NONFINITE |",
+        "|---|---|---|---|---|---|",
+    ]
     for mode in modes:
         rs, passed, envelope, nonfinite = mode_counts(results, mode)
-        out.append(f"| {mode} | {len(rs)} | {passed} | {100.0 * passed / max(1, len(rs)):.1f} | {envelope} | "
-                   f"{nonfinite} |")
-    for title, key in (("frame", lambda r: r["motor"]["frame"]), ("steps/rev", lambda r: 4 * r["motor"]["pole_pairs"]),
-                       ("bus (V)", lambda r: f"{r['motor']['bus_voltage_V']:g}")):
-        out += ["", f"## By {title}", "", "| " + title + " | " + " | ".join(modes) + " |",
-                "|---|" + "---|" * len(modes)]
+        out.append(
+            f"| {mode} | {len(rs)} | {passed} | {100.0 * passed / max(1, len(rs)):.1f} | {envelope} | {nonfinite} |"
+        )
+    for title, key in (
+        ("frame", lambda r: r["motor"]["frame"]),
+        ("steps/rev", lambda r: 4 * r["motor"]["pole_pairs"]),
+        ("bus (V)", lambda r: f"{r['motor']['bus_voltage_V']:g}"),
+    ):
+        out += [
+            "",
+            f"## By {title}",
+            "",
+            "| " + title + " | " + " | ".join(modes) + " |",
+            "|---|" + "---|" * len(modes),
+        ]
         tables = {mode: rate_table([r for r in results if r["mode"] == mode], key) for mode in modes}
         for k in sorted({k for t in tables.values() for k in t}, key=str):
             cells = []
@@ -269,13 +343,17 @@ def report_text(results, modes, argv, seconds, jobs, population_note, mc=None):
     if not failures:
         out.append("None.")
     else:
-        out += ["| motor | mode | outcome | R (Ohm) | L (mH) | I (A) | T_H (N m) | p | bus (V) |",
-                "|---|---|---|---|---|---|---|---|---|"]
+        out += [
+            "| motor | mode | outcome | R (Ohm) | L (mH) | I (A) | T_H (N m) | p | bus (V) |",
+            "|---|---|---|---|---|---|---|---|---|",
+        ]
         for r in sorted(failures, key=lambda r: (r["mode"], r["motor"]["name"])):
             m = r["motor"]
-            out.append(f"| {m['name']} | {r['mode']} | {outcome(r)} | {m['resistance_Ohm']:.3g} | "
-                       f"{1e3 * m['inductance_H']:.3g} | {m['rated_current_A']:.3g} | {m['holding_torque_Nm']:.3g} | "
-                       f"{m['pole_pairs']} | {m['bus_voltage_V']:g} |")
+            out.append(
+                f"| {m['name']} | {r['mode']} | {outcome(r)} | {m['resistance_Ohm']:.3g} | "
+                f"{1e3 * m['inductance_H']:.3g} | {m['rated_current_A']:.3g} | {m['holding_torque_Nm']:.3g} | "
+                f"{m['pole_pairs']} | {m['bus_voltage_V']:g} |"
+            )
     if mc is not None:
         out += sweep_mc.report_lines(mc["results"], mc["cases"])
     return "\n".join(out) + "\n"
@@ -296,14 +374,25 @@ def main(argv=None):
     parser.add_argument("--report")
     parser.add_argument("--plot")
     parser.add_argument("--check", type=float, help="exit 1 unless every mode passes at least this many percent")
-    parser.add_argument("--require-clean", action="store_true",
-                        help="exit 1 if a run overflowed (STATE_NONFINITE) or pmstep-tune gave no summary")
-    parser.add_argument("--mc-sample", type=int, default=0, metavar="N",
-                        help="a short speed Monte Carlo on N population motors (tools/sweep_mc.py)")
+    parser.add_argument(
+        "--require-clean",
+        action="store_true",
+        help="exit 1 if a run overflowed (STATE_NONFINITE) or pmstep-tune gave no summary",
+    )
+    parser.add_argument(
+        "--mc-sample",
+        type=int,
+        default=0,
+        metavar="N",
+        help="a short speed Monte Carlo on N population motors (tools/sweep_mc.py)",
+    )
     parser.add_argument("--mc-cases", type=int, default=20, help="cases per motor of --mc-sample (default 20)")
     parser.add_argument("--sil", help="pmstep-sil for --mc-sample (default: beside --tune)")
-    parser.add_argument("--told-exact", action="store_true",
-                        help="tell the designer the plant's J and F (no estimate from the holding torque)")
+    parser.add_argument(
+        "--told-exact",
+        action="store_true",
+        help="tell the designer the plant's J and F (no estimate from the holding torque)",
+    )
     args = parser.parse_args(argv[1:])
     modes = args.modes.split(",")
     for mode in modes:
@@ -316,7 +405,9 @@ def main(argv=None):
         for m in population:
             m["told_inertia_kgm2"] = None
     note = f"{args.count} motors, seed {args.seed}" + (f", a sample of {len(population)}" if args.sample else "")
-    note += ", the designer told the plant's J and F" if args.told_exact else ", J and F estimated from the holding torque"
+    note += (
+        ", the designer told the plant's J and F" if args.told_exact else ", J and F estimated from the holding torque"
+    )
     with tempfile.TemporaryDirectory(prefix="pmstep-sweep-") as tmp:
         work = args.out or tmp
         os.makedirs(work, exist_ok=True)
@@ -332,9 +423,12 @@ def main(argv=None):
         if args.mc_sample > 0:
             tune = os.path.abspath(args.tune)
             sil = os.path.abspath(args.sil or os.path.join(os.path.dirname(tune), "pmstep-sil"))
-            mc = {"cases": args.mc_cases,
-                  "results": sweep_mc.run_sample(sweep_mc.sample(population, args.mc_sample), sil, tune, work,
-                                                 args.mc_cases, args.jobs)}
+            mc = {
+                "cases": args.mc_cases,
+                "results": sweep_mc.run_sample(
+                    sweep_mc.sample(population, args.mc_sample), sil, tune, work, args.mc_cases, args.jobs
+                ),
+            }
     for line in summary_lines(results, modes):
         print(line)
     print(f"sweep_motors: {len(results)} runs in {seconds:.0f} s on {args.jobs} workers")
@@ -347,15 +441,24 @@ def main(argv=None):
         plot(args.plot, results)
         print(f"sweep_motors: wrote {args.plot}")
     if args.require_clean:
-        unclean = [r for r in results if r["summary"]["design"]["status"] is None
-                   or any(c["fault"] == "STATE_NONFINITE" for c in r["summary"]["checks"])]
+        unclean = [
+            r
+            for r in results
+            if r["summary"]["design"]["status"] is None
+            or any(c["fault"] == "STATE_NONFINITE" for c in r["summary"]["checks"])
+        ]
         for r in unclean:
             print(f"sweep_motors: UNCLEAN: {r['motor']['name']} {r['mode']}: {outcome(r)}")
-        mc_unclean = [] if mc is None else [r for r in mc["results"] if r.get("nonfinite", 0) > 0
-                                                or r.get("counts", {}).get("crashed", 0) > 0]
+        mc_unclean = (
+            []
+            if mc is None
+            else [r for r in mc["results"] if r.get("nonfinite", 0) > 0 or r.get("counts", {}).get("crashed", 0) > 0]
+        )
         for r in mc_unclean:
-            print(f"sweep_motors: UNCLEAN: Monte Carlo on {r['motor']['name']}: {r.get('counts')}, "
-                  f"non-finite in {r.get('nonfinite')}")
+            print(
+                f"sweep_motors: UNCLEAN: Monte Carlo on {r['motor']['name']}: {r.get('counts')}, "
+                f"non-finite in {r.get('nonfinite')}"
+            )
         if unclean or mc_unclean:
             return 1
     if args.check is not None:

@@ -1,6 +1,7 @@
 """Tests of tools/check_file_cycles.py (python3 -m unittest test_check_file_cycles): the nm
 reading and the cycle finding on made-up symbol tables, with and without a cycle, and the
 allowance of a known one. Standard library only; nm is not run."""
+
 import io
 import unittest
 
@@ -23,8 +24,7 @@ libx.a[d.c.o]: weak_hook W 0000000000000000 0000000000000010
 
 def table(**files):
     """{file: (defined, undefined)} from keyword arguments file=("def1 def2", "undef1 ...")."""
-    return {name + ".c":
-            (set(defined.split()), set(undefined.split())) for name, (defined, undefined) in files.items()}
+    return {name + ".c": (set(defined.split()), set(undefined.split())) for name, (defined, undefined) in files.items()}
 
 
 class ParseNm(unittest.TestCase):
@@ -42,10 +42,18 @@ class ParseNm(unittest.TestCase):
 
     def test_edges_and_cycle_of_nm_text(self):
         parsed = cfc.parse_nm(NM_TEXT)
-        self.assertEqual(cfc.edges(parsed), {("a.c", "b.c"): ["helper_b"], ("b.c", "a.c"): ["api_a"],
-                                             ("c.c", "b.c"): ["state_b"], ("c.c", "d.c"): ["weak_hook"]})
-        self.assertEqual(cfc.cycles(parsed),
-                         [(["a.c", "b.c"], {("a.c", "b.c"): ["helper_b"], ("b.c", "a.c"): ["api_a"]})])
+        self.assertEqual(
+            cfc.edges(parsed),
+            {
+                ("a.c", "b.c"): ["helper_b"],
+                ("b.c", "a.c"): ["api_a"],
+                ("c.c", "b.c"): ["state_b"],
+                ("c.c", "d.c"): ["weak_hook"],
+            },
+        )
+        self.assertEqual(
+            cfc.cycles(parsed), [(["a.c", "b.c"], {("a.c", "b.c"): ["helper_b"], ("b.c", "a.c"): ["api_a"]})]
+        )
 
 
 class Cycles(unittest.TestCase):
@@ -59,8 +67,9 @@ class Cycles(unittest.TestCase):
 
     def test_three_files_and_a_separate_pair(self):
         # a -> b -> c -> a, and d <-> e; f uses a but is in no cycle
-        symbols = table(a=("fa", "fb"), b=("fb", "fc"), c=("fc", "fa"), d=("fd", "fe"), e=("fe", "fd"),
-                        f=("ff", "fa fd"))
+        symbols = table(
+            a=("fa", "fb"), b=("fb", "fc"), c=("fc", "fa"), d=("fd", "fe"), e=("fe", "fd"), f=("ff", "fa fd")
+        )
         found = cfc.cycles(symbols)
         self.assertEqual([files for files, _ in found], [["a.c", "b.c", "c.c"], ["d.c", "e.c"]])
         self.assertEqual(found[0][1], {("a.c", "b.c"): ["fb"], ("b.c", "c.c"): ["fc"], ("c.c", "a.c"): ["fa"]})
@@ -72,8 +81,7 @@ class Cycles(unittest.TestCase):
     def test_cycle_only_within_one_library(self):
         # the same names in two libraries: each library's graph is its own
         out = io.StringIO()
-        self.assertEqual(cfc.check({"liba.a": table(a=("fa", "fb")), "libb.a": table(b=("fb", "fa"))},
-                                   set(), out), 0)
+        self.assertEqual(cfc.check({"liba.a": table(a=("fa", "fb")), "libb.a": table(b=("fb", "fa"))}, set(), out), 0)
 
     def test_allowance_exact(self):
         pair = table(a=("fa", "fb"), b=("fb", "fa"), c=("fc", "fa"))
@@ -86,8 +94,9 @@ class Cycles(unittest.TestCase):
 
     def test_allowance_gone(self):
         out = io.StringIO()
-        self.assertEqual(cfc.check({"liba.a": table(a=("fa", "fb"), b=("fb", ""))},
-                                   {frozenset({"a.c", "b.c"})}, out), 1)
+        self.assertEqual(
+            cfc.check({"liba.a": table(a=("fa", "fb"), b=("fb", ""))}, {frozenset({"a.c", "b.c"})}, out), 1
+        )
         self.assertIn("--allow a.c:b.c: no such cycle any more", out.getvalue())
 
     def test_long_chain(self):

@@ -5,6 +5,7 @@ counts and names taken from the sources with simple, independent regular express
 the sources, broken on purpose, check that the parser and the consistency checks fail loudly.
 PMSTEP_SIL=<pmstep-sil> also runs the --sil cross-check against that binary.
 """
+
 import os
 import re
 import shutil
@@ -67,7 +68,7 @@ def block(text, opening):
     lines = text.split("\n")
     start = next(i for i, line in enumerate(lines) if re.match(opening, line))
     end = next(i for i in range(start, len(lines)) if lines[i].strip() == "};")
-    return lines[start + 1:end]
+    return lines[start + 1 : end]
 
 
 class RealSources(unittest.TestCase):
@@ -75,12 +76,16 @@ class RealSources(unittest.TestCase):
     def setUpClass(cls):
         cls.tmp = tempfile.TemporaryDirectory()
         cls.out = Path(cls.tmp.name) / "reference"
-        cls.docs = Path(cls.tmp.name) / "docs"   # copies of the pages with generated tables
+        cls.docs = Path(cls.tmp.name) / "docs"  # copies of the pages with generated tables
         for page in gen.PAGE_TABLES:
             (cls.docs / page).parent.mkdir(parents=True, exist_ok=True)
             shutil.copy(ROOT / "docs" / page, cls.docs / page)
-        run = subprocess.run([sys.executable, str(GEN), "--out", str(cls.out), "--docs", str(cls.docs)],
-                             capture_output=True, text=True, timeout=120)
+        run = subprocess.run(
+            [sys.executable, str(GEN), "--out", str(cls.out), "--docs", str(cls.docs)],
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
         if run.returncode != 0:
             raise AssertionError(f"gen_reference.py failed:\n{run.stdout}\n{run.stderr}")
         cls.pages = {p.name: p.read_text(encoding="utf-8") for p in cls.out.glob("*.md")}
@@ -103,15 +108,19 @@ class RealSources(unittest.TestCase):
         board = read(gen.STM32G4_BOARD_C)
         uses = re.findall(r'\{"([^"]+)", "([^"]+)", 0u, cfg->step_input\.(\w+)\}', board)
         self.assertEqual(len(uses), 4)
-        pins = {f: f"P{p[1]}{n}" for f, p, n in re.findall(r"c\.step_input\.(\w+) = \(pmstep_stm32g4_pin_t\)\{(P[A-G]), (\d+)u",
-                                                             board)}
+        pins = {
+            f: f"P{p[1]}{n}"
+            for f, p, n in re.findall(r"c\.step_input\.(\w+) = \(pmstep_stm32g4_pin_t\)\{(P[A-G]), (\d+)u", board)
+        }
         page = self.tabled["getting-started/nucleo-g431rb.md"]
         begin, end = gen.table_markers("stm32g4-stepdir-pins", [gen.STM32G4_BOARD_C])
         between = page.split(begin, 1)[1].split(end, 1)[0]
         [(header, rows)] = tables(between)
         self.assertEqual(header, ["Signal", "Pin", "MCU signal", "Mode", "Pin setting"])
-        self.assertEqual([(r[0], r[1], r[2].replace("\\_", "_"), r[4]) for r in rows],
-                         [(f, pins[field], sig, f"`step_input.{field}`") for f, sig, field in uses])
+        self.assertEqual(
+            [(r[0], r[1], r[2].replace("\\_", "_"), r[4]) for r in rows],
+            [(f, pins[field], sig, f"`step_input.{field}`") for f, sig, field in uses],
+        )
         self.assertEqual([r[3] for r in rows], ["AF2", "AF2", "input", "open drain"])
         self.assertIn("| STEP input | PB7 |", between)
 
@@ -147,14 +156,25 @@ class RealSources(unittest.TestCase):
 
     def test_configuration_has_every_field_once(self):
         text = read(gen.CONSOLE_CONFIG_C)
-        console = [line for line in block(text, r"^static const pmstep_console_config_entry_t table\[\]")
-                   if re.match(r"^\s+\w+\([\w.]+\),\s*$", line)]
-        def entry_name(line):   # the STEP/DIR settings' entries (SD_*) are named stepdir.<field>
+        console = [
+            line
+            for line in block(text, r"^static const pmstep_console_config_entry_t table\[\]")
+            if re.match(r"^\s+\w+\([\w.]+\),\s*$", line)
+        ]
+
+        def entry_name(line):  # the STEP/DIR settings' entries (SD_*) are named stepdir.<field>
             return ("stepdir." if re.match(r"^\s+SD_", line) else "") + re.search(r"\(([\w.]+)\)", line).group(1)
+
         console_names = {entry_name(line) for line in console}
         fields = [f.path for g in gen.parse_config_fields(gen.Source(ROOT, gen.TYPES_H)) for f in g.fields]
-        fields += ["stepdir." + m.group(1) for m in re.finditer(
-            r"^\s+(?:uint32_t|bool|float) (\w+);", block_struct(read(gen.STORE_H), "pmstep_stepdir_settings_t"), re.M)]
+        fields += [
+            "stepdir." + m.group(1)
+            for m in re.finditer(
+                r"^\s+(?:uint32_t|bool|float) (\w+);",
+                block_struct(read(gen.STORE_H), "pmstep_stepdir_settings_t"),
+                re.M,
+            )
+        ]
         unexposed = [f for f in fields if f not in console_names]
         rows = self.configuration_rows()
         self.assertEqual(len(rows), len(console) + len(unexposed))
@@ -180,8 +200,13 @@ class RealSources(unittest.TestCase):
         self.assertEqual(r["Unit"], "A")
         self.assertEqual(r["Console"], "read/write")
         self.assertTrue(r["Range (init)"].startswith("`> 0`<br>[`PMSTEP_ERR_MAX_CURRENT`]"), r["Range (init)"])
-        for c in ("PMSTEP_ERR_TRIP_ABOVE_RATED", "PMSTEP_ERR_TRIP_ABOVE_SENSE_RANGE", "PMSTEP_ERR_ALIGNMENT_CURRENT",
-                  "PMSTEP_ERR_DEAD_TIME_BAND", "PMSTEP_ERR_HOLD_CURRENT"):
+        for c in (
+            "PMSTEP_ERR_TRIP_ABOVE_RATED",
+            "PMSTEP_ERR_TRIP_ABOVE_SENSE_RANGE",
+            "PMSTEP_ERR_ALIGNMENT_CURRENT",
+            "PMSTEP_ERR_DEAD_TIME_BAND",
+            "PMSTEP_ERR_HOLD_CURRENT",
+        ):
             self.assertIn(f"[`{c}`](codes.md#{c.lower()})", r["Range (init)"])
         self.assertIn("`PMSTEP_MAX_TRIP_PER_RATED_CURRENT` (= 3)", r["Range (init)"])
         self.assertIn("FAULT\\_OVERCURRENT", r["Meaning"])
@@ -189,7 +214,7 @@ class RealSources(unittest.TestCase):
         r = self.row("timing.period_s")
         self.assertEqual((r["Id"], r["Unit"], r["Console"]), ("6", "s", "read-only"))
         self.assertIn("PMSTEP_ERR_PERIOD", r["Range (init)"])
-        self.assertNotIn("`> 0`", r["Range (init)"])           # SIGN_ANY: checked by range
+        self.assertNotIn("`> 0`", r["Range (init)"])  # SIGN_ANY: checked by range
         r = self.row("motor.friction_Nms_rad")
         self.assertEqual(r["Unit"], "Nm s/rad")
         self.assertTrue(r["Range (init)"].startswith("`>= 0`<br>[`PMSTEP_ERR_FRICTION`]"))
@@ -207,16 +232,32 @@ class RealSources(unittest.TestCase):
         self.assertIn("PMSTEP_ERR_STANDSTILL_KNOWN_LOAD", r["Range (init)"])
         # grouped by sub-structure, in pmstep_config_t's order, the top level last
         headings = re.findall(r"^## (.+)$", self.pages["configuration.md"], re.M)
-        self.assertEqual(headings, ["motor", "timing", "alignment", "gains", "limits", "commissioning", "inverter",
-                                    "detection", "standstill", "Top level", "stepdir"])
+        self.assertEqual(
+            headings,
+            [
+                "motor",
+                "timing",
+                "alignment",
+                "gains",
+                "limits",
+                "commissioning",
+                "inverter",
+                "detection",
+                "standstill",
+                "Top level",
+                "stepdir",
+            ],
+        )
 
     def test_stepdir_rows(self):
         """The STEP/DIR settings after the core's, each with the codes pmstep_console_stepdir_validate()
         refuses it with."""
         r = self.row("stepdir.microsteps")
         self.assertEqual((r["Type"], r["Unit"], r["Console"]), ("`uint32_t`", "-", "read/write"))
-        self.assertTrue(r["Range"].startswith("[`PMSTEP_ERR_STEPDIR_MICROSTEPS`](codes.md#pmstep_err_stepdir_microsteps)"),
-                        r["Range"])
+        self.assertTrue(
+            r["Range"].startswith("[`PMSTEP_ERR_STEPDIR_MICROSTEPS`](codes.md#pmstep_err_stepdir_microsteps)"),
+            r["Range"],
+        )
         r = self.row("stepdir.diag_mode")
         self.assertIn("PMSTEP_ERR_STEPDIR_DIAG_MODE", r["Range"])
         self.assertNotIn("PMSTEP_ERR_STEPDIR_MICROSTEPS", r["Range"])
@@ -235,11 +276,11 @@ class RealSources(unittest.TestCase):
 
     def test_every_status_code_once_with_its_text(self):
         types_h = read(gen.TYPES_H)
-        body = types_h[types_h.index("typedef enum {"):types_h.index("} pmstep_status_t;")]
+        body = types_h[types_h.index("typedef enum {") : types_h.index("} pmstep_status_t;")]
         codes = re.findall(r"^\s+(PMSTEP_\w+) = (-?\d+)", body, re.M)
         self.assertGreater(len(codes), 50)
         texts = dict(re.findall(r'case (PMSTEP_\w+):\s*return "([^"]*)";', read(gen.TEXT_C)))
-        (header, rows), = tables(section(self.pages["codes.md"], "## Status codes"))
+        ((header, rows),) = tables(section(self.pages["codes.md"], "## Status codes"))
         self.assertEqual(header[:4], ["Code", "Name", "Text", "Cause"])
         for name, value in codes:
             hits = [r for r in rows if r[1].startswith(f"`{name}`")]
@@ -252,19 +293,22 @@ class RealSources(unittest.TestCase):
     def test_other_code_tables(self):
         page = self.pages["codes.md"]
         types_h = read(gen.TYPES_H)
-        for heading, enum in (("## Fault codes", "pmstep_fault_t"), ("## Modes", "pmstep_mode_t"),
-                              ("## Identification outcomes", "pmstep_identification_t")):
-            body = types_h[:types_h.index(f"}} {enum};")]
-            body = body[body.rindex("typedef enum {"):]
+        for heading, enum in (
+            ("## Fault codes", "pmstep_fault_t"),
+            ("## Modes", "pmstep_mode_t"),
+            ("## Identification outcomes", "pmstep_identification_t"),
+        ):
+            body = types_h[: types_h.index(f"}} {enum};")]
+            body = body[body.rindex("typedef enum {") :]
             names = re.findall(r"^\s+(PMSTEP_\w+) = \d+", body, re.M)
-            (_, rows), = tables(section(page, heading))
+            ((_, rows),) = tables(section(page, heading))
             self.assertEqual([re.match(r"`(\w+)`", r[1]).group(1) for r in rows], names, heading)
         console_h = read(gen.CONSOLE_H)
         errors = re.findall(r"^\s+(PMSTEP_CONSOLE_ERR_\w+) = (\d+)", console_h, re.M)
-        (_, rows), = tables(section(page, "## Console error replies"))
+        ((_, rows),) = tables(section(page, "## Console error replies"))
         self.assertEqual([(re.match(r"`(\w+)`", r[1]).group(1), r[0]) for r in rows], errors)
         stm32 = re.findall(r"^\s+(PMSTEP_STM32G4_(?:OK|ERR_\w+)) = ", read(gen.STM32G4_H), re.M)
-        (_, rows), = tables(section(page, "## STM32G4 port status codes"))
+        ((_, rows),) = tables(section(page, "## STM32G4 port status codes"))
         self.assertEqual([re.match(r"`(\w+)`", r[1]).group(1) for r in rows], stm32)
         self.assertTrue(all(r[2] and r[2] != "-" for r in rows))
 
@@ -272,20 +316,23 @@ class RealSources(unittest.TestCase):
         page = self.pages["console-protocol.md"]
         self.assertIn("0xA5 | LEN | TYPE SEQ DATA", page)
         self.assertIn("CRC-16/CCITT-FALSE", page)
-        rows_c = [line for line in block(read(gen.CONSOLE_REQUEST_C), r"^static const request_row_t requests\[\]")
-                  if line.strip().startswith("{")]
+        rows_c = [
+            line
+            for line in block(read(gen.CONSOLE_REQUEST_C), r"^static const request_row_t requests\[\]")
+            if line.strip().startswith("{")
+        ]
         (header, rows), (_, others) = tables(section(page, "## Requests"))
         self.assertEqual(header, ["TYPE", "Request", "Reply TYPE", "Needs", "DATA bytes", "DATA", "Reply"])
         self.assertEqual(len(rows), len(rows_c))
         by_name = {r[1].strip("`"): r for r in rows}
         self.assertEqual(by_name["SPEED_TARGET"][:5], ["`0x05`", "`SPEED_TARGET`", "`0x85`", "-", "8"])
         self.assertEqual(by_name["SPEED_TARGET"][5], "target f32, ramp f32")
-        self.assertEqual(by_name["GET_CONFIG"][4], "1 to 62")     # NAME_ROOM = MAX_PAYLOAD - 2
+        self.assertEqual(by_name["GET_CONFIG"][4], "1 to 62")  # NAME_ROOM = MAX_PAYLOAD - 2
         self.assertIn("`PMSTEP_CONSOLE_ERR_NO_POSITION`", by_name["MOVE_TO"][3])
         self.assertEqual(by_name["MOVE_TO"][4], "12 to 16")
         self.assertIn("ACK: status i16, period u32", by_name["STOP"][6])
         self.assertEqual([r[1] for r in others], ["`PMSTEP_CONSOLE_TELEMETRY_FRAME`", "`PMSTEP_CONSOLE_ERROR_FRAME`"])
-        (_, errors), = tables(section(page, "## Error replies"))
+        ((_, errors),) = tables(section(page, "## Error replies"))
         self.assertEqual(len(errors), len(re.findall(r"^\s+PMSTEP_CONSOLE_ERR_\w+ = \d+", read(gen.CONSOLE_H), re.M)))
 
     def test_scenario_keys_page_has_every_key(self):
@@ -306,7 +353,7 @@ class RealSources(unittest.TestCase):
         self.assertEqual(r[2], "`(0, 3600]`")
         r = next(r for r in rows if r[0] == "`load.type`")
         self.assertEqual(r[1], "one of `none`, `constant`, `step`, `proportional`, `table`")
-        (_, enums), = tables(section(page, "## Enumerated values"))
+        ((_, enums),) = tables(section(page, "## Enumerated values"))
         self.assertEqual(len(enums), len(re.findall(r"_names\[\] = ", read(gen.SCENARIO_KEYS_H))))
 
 
@@ -331,8 +378,9 @@ class Units(unittest.TestCase):
 
 class Markdown(unittest.TestCase):
     def test_escape(self):
-        self.assertEqual(gen.esc("|i_a| <= 2*x [a, b] $5 {c} \\"),
-                         "\\|i\\_a\\| &lt;= 2\\*x &#91;a, b&#93; &#36;5 \\{c\\} &#92;")
+        self.assertEqual(
+            gen.esc("|i_a| <= 2*x [a, b] $5 {c} \\"), "\\|i\\_a\\| &lt;= 2\\*x &#91;a, b&#93; &#36;5 \\{c\\} &#92;"
+        )
 
     def test_code_span_refuses_backtick(self):
         with self.assertRaises(gen.GenError):
@@ -350,8 +398,22 @@ class Markdown(unittest.TestCase):
 class BrokenSources(unittest.TestCase):
     """The generator on a copy of the sources with one change: it must raise, naming the file."""
 
-    FILES = [gen.TYPES_H, gen.CONFIG_C, gen.TEXT_C, gen.CONSOLE_H, gen.CONSOLE_CONFIG_C, gen.CONSOLE_REQUEST_C,
-             gen.CONSOLE_PY, gen.STORE_H, gen.STM32G4_H, gen.STM32G4_BOARD_C, "docs/getting-started/nucleo-g431rb.md", gen.STM32G4_TEXT_C, gen.SCENARIO_KEYS_C, gen.SCENARIO_KEYS_H]
+    FILES = [
+        gen.TYPES_H,
+        gen.CONFIG_C,
+        gen.TEXT_C,
+        gen.CONSOLE_H,
+        gen.CONSOLE_CONFIG_C,
+        gen.CONSOLE_REQUEST_C,
+        gen.CONSOLE_PY,
+        gen.STORE_H,
+        gen.STM32G4_H,
+        gen.STM32G4_BOARD_C,
+        "docs/getting-started/nucleo-g431rb.md",
+        gen.STM32G4_TEXT_C,
+        gen.SCENARIO_KEYS_C,
+        gen.SCENARIO_KEYS_H,
+    ]
 
     def setUp(self):
         self.tmp = tempfile.TemporaryDirectory()
@@ -428,8 +490,9 @@ class BrokenSources(unittest.TestCase):
 
     def test_stepdir_entry_naming_no_field(self):
         self.edit(gen.CONSOLE_CONFIG_C, r"\bSD_U32\(microsteps\)", "SD_U32(microstep_count)")
-        self.assert_fails(f"{gen.CONSOLE_CONFIG_C}:", "stepdir.microstep_count",
-                          "not a field of pmstep_stepdir_settings_t")
+        self.assert_fails(
+            f"{gen.CONSOLE_CONFIG_C}:", "stepdir.microstep_count", "not a field of pmstep_stepdir_settings_t"
+        )
 
     def test_stepdir_check_of_no_field(self):
         self.edit(gen.CONSOLE_CONFIG_C, r"sd->diag_mode != \(uint32_t\)PMSTEP_DIAG_LEVEL", "sd->mode != 0u")
@@ -440,7 +503,9 @@ class BrokenSources(unittest.TestCase):
         self.assert_fails(f"{gen.CONSOLE_CONFIG_C}:", "PMSTEP_ERR_STEPDIR_MODE", "not a value of pmstep_status_t")
 
     def test_new_field_with_unknown_unit(self):
-        self.edit(gen.TYPES_H, r"^(\s*)float dead_time_s;", r"\1float gate_charge_nC; /**< new */\n\1float dead_time_s;")
+        self.edit(
+            gen.TYPES_H, r"^(\s*)float dead_time_s;", r"\1float gate_charge_nC; /**< new */\n\1float dead_time_s;"
+        )
         self.assert_fails("inverter.gate_charge_nC", "unit suffix")
 
     def test_scenario_row_shape_change(self):

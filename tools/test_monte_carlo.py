@@ -7,6 +7,7 @@ is test_monte_carlo_runs.py.
 Usage: python3 -m unittest -v test_monte_carlo     (from tools/)
        python3 tools/test_monte_carlo.py           (from anywhere)
 """
+
 import os
 import sys
 import textwrap
@@ -16,17 +17,35 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import monte_carlo as mc  # noqa: E402  (after the path is set)
 
 
-def summary(fault_code=0, fault_time_s=-1.0, loss_s=-1.0, latency_s=None, speed=0.01, angle=0.001,
-            nonfinite=False, name="overcurrent"):
+def summary(
+    fault_code=0,
+    fault_time_s=-1.0,
+    loss_s=-1.0,
+    latency_s=None,
+    speed=0.01,
+    angle=0.001,
+    nonfinite=False,
+    name="overcurrent",
+):
     """A summary.json as pmstep-sil writes it, with only what classification reads."""
     return {
         "seed": 1,
-        "fault": {"code": fault_code, "name": name if fault_code else "none", "text": "t",
-                  "step": -1, "time_s": fault_time_s},
+        "fault": {
+            "code": fault_code,
+            "name": name if fault_code else "none",
+            "text": "t",
+            "step": -1,
+            "time_s": fault_time_s,
+        },
         "final_mode": "FAULT" if fault_code else "RUN",
-        "robustness": {"settle_time_s": 0.8, "max_angle_error_rad": angle, "max_speed_error_rad_s": speed,
-                       "loss_of_control_time_s": loss_s, "detection_latency_s": latency_s,
-                       "nonfinite_seen": nonfinite},
+        "robustness": {
+            "settle_time_s": 0.8,
+            "max_angle_error_rad": angle,
+            "max_speed_error_rad_s": speed,
+            "loss_of_control_time_s": loss_s,
+            "detection_latency_s": latency_s,
+            "nonfinite_seen": nonfinite,
+        },
     }
 
 
@@ -50,8 +69,13 @@ class SeedMapping(unittest.TestCase):
 
 
 class Sampling(unittest.TestCase):
-    BASE = {"motor.resistance_Ohm": 3.0, "motor.inductance_H": 0.006, "motor.torque_constant_Nm_A": 2.0,
-            "motor.inertia_kgm2": 0.01, "load.torque_Nm": 2.0}
+    BASE = {
+        "motor.resistance_Ohm": 3.0,
+        "motor.inductance_H": 0.006,
+        "motor.torque_constant_Nm_A": 2.0,
+        "motor.inertia_kgm2": 0.01,
+        "load.torque_Nm": 2.0,
+    }
 
     def test_known_draws(self):
         # random.Random(700000).random() gives 0.5252184595196231, 0.7456568194701344, ...
@@ -70,7 +94,7 @@ class Sampling(unittest.TestCase):
             for key, kind, a, b in mc.DISTRIBUTIONS:
                 scale = self.BASE[key] if kind == "scale" else 1.0
                 if kind.startswith("times "):
-                    scale = p[kind[len("times "):]]  # relative to a key drawn before it
+                    scale = p[kind[len("times ") :]]  # relative to a key drawn before it
                 self.assertGreaterEqual(p[key], a * scale, key)
                 self.assertLess(p[key], b * scale, key)
         self.assertNotEqual(mc.draw_parameters(1, self.BASE), mc.draw_parameters(2, self.BASE))
@@ -104,8 +128,12 @@ class ScenarioParsing(unittest.TestCase):
 
     def test_missing_keys_in_table_order(self):
         s = mc.parse_scenario(self.TEXT)
-        table = [("motor.resistance_Ohm", "scale", 0.7, 1.3), ("sensors.noise_rms_A", "uniform", 0, 1),
-                 ("motor.inductance_H", "scale", 0.8, 1.2), ("bus.ripple_V", "uniform", 0, 2)]
+        table = [
+            ("motor.resistance_Ohm", "scale", 0.7, 1.3),
+            ("sensors.noise_rms_A", "uniform", 0, 1),
+            ("motor.inductance_H", "scale", 0.8, 1.2),
+            ("bus.ripple_V", "uniform", 0, 2),
+        ]
         self.assertEqual(mc.missing_keys(s, table), ["sensors.noise_rms_A", "bus.ripple_V", "run.seed"])
         self.assertEqual(mc.missing_keys(s, table[:1], extra=()), [])
 
@@ -127,7 +155,7 @@ class Classification(unittest.TestCase):
         self.assertEqual((r["class"], r["false_trip"], r["latency_s"]), ("success", False, None))
 
     def test_out_of_spec_on_each_bound(self):
-        self.assertEqual(self.cls(summary(speed=0.5))["class"], "out_of_spec")   # bound is strict
+        self.assertEqual(self.cls(summary(speed=0.5))["class"], "out_of_spec")  # bound is strict
         self.assertEqual(self.cls(summary(angle=0.05))["class"], "out_of_spec")
         self.assertEqual(self.cls(summary(speed=None))["class"], "out_of_spec")  # NaN written as null
         self.assertEqual(self.cls(summary(nonfinite=True))["class"], "out_of_spec")
@@ -137,11 +165,16 @@ class Classification(unittest.TestCase):
         """Issue 13: with --position-bound, every move issued, finished and within the bound."""
         base = summary()
         self.assertEqual(self.cls(base, position_bound_rad=0.5)["class"], "out_of_spec")  # no position figures
-        good = {"moves": 50, "rejected_moves": 0, "unfinished_moves": 0, "worst_move": 7,
-                "max_final_error_electrical_rad": 0.138}
+        good = {
+            "moves": 50,
+            "rejected_moves": 0,
+            "unfinished_moves": 0,
+            "worst_move": 7,
+            "max_final_error_electrical_rad": 0.138,
+        }
         self.assertEqual(self.cls(dict(base, position=good), position_bound_rad=0.5)["class"], "success")
-        self.assertEqual(self.cls(dict(base, position=good))["class"], "success")        # not checked by default
-        far = dict(good, max_final_error_electrical_rad=0.5)                               # bound is strict
+        self.assertEqual(self.cls(dict(base, position=good))["class"], "success")  # not checked by default
+        far = dict(good, max_final_error_electrical_rad=0.5)  # bound is strict
         r = self.cls(dict(base, position=far), position_bound_rad=0.5)
         self.assertEqual(r["class"], "out_of_spec")
         self.assertIn("move 7 ends 0.5 electrical rad off", r["reason"])
@@ -151,16 +184,18 @@ class Classification(unittest.TestCase):
     def test_failure_time(self):
         """Where the failure is: the loss of control, a false trip's fault, the exceeded maximum's sample
         (the angle's where both bounds are exceeded), none for a success or an older summary."""
+
         def timed(**kw):
             s = summary(**kw)
             s["robustness"].update(max_speed_error_time_s=1.5, max_angle_error_time_s=1.9)
             return s
+
         self.assertIsNone(self.cls(timed())["failure_time_s"])
         self.assertEqual(self.cls(timed(speed=0.6))["failure_time_s"], 1.5)
         self.assertEqual(self.cls(timed(angle=0.06))["failure_time_s"], 1.9)
         self.assertEqual(self.cls(timed(speed=0.6, angle=0.06))["failure_time_s"], 1.9)
-        self.assertIsNone(self.cls(summary(angle=0.06))["failure_time_s"])            # no time in the summary
-        self.assertEqual(self.cls(timed(loss_s=1.2))["failure_time_s"], 1.2)           # silent
+        self.assertIsNone(self.cls(summary(angle=0.06))["failure_time_s"])  # no time in the summary
+        self.assertEqual(self.cls(timed(loss_s=1.2))["failure_time_s"], 1.2)  # silent
         self.assertEqual(self.cls(timed(fault_code=6, fault_time_s=1.25, loss_s=1.2))["failure_time_s"], 1.2)
         self.assertEqual(self.cls(timed(fault_code=6, fault_time_s=0.9))["failure_time_s"], 0.9)  # false trip
 
@@ -179,8 +214,10 @@ class Classification(unittest.TestCase):
         r = self.cls(summary(fault_code=2, fault_time_s=1.3, loss_s=1.2, latency_s=0.1))
         self.assertEqual(r["class"], "silent")
         self.assertAlmostEqual(r["latency_s"], 0.1)
-        self.assertEqual(self.cls(summary(fault_code=2, fault_time_s=1.3, loss_s=1.2, latency_s=0.1),
-                                  latency_bound_s=0.2)["class"], "detected")
+        self.assertEqual(
+            self.cls(summary(fault_code=2, fault_time_s=1.3, loss_s=1.2, latency_s=0.1), latency_bound_s=0.2)["class"],
+            "detected",
+        )
 
     def test_fault_before_loss_is_detected(self):
         r = self.cls(summary(fault_code=2, fault_time_s=1.19, loss_s=1.2, latency_s=-0.01))
@@ -207,7 +244,7 @@ class Classification(unittest.TestCase):
         self.assertEqual(mc.classify(ok, None)["class"], "crashed")
         self.assertEqual(mc.classify(None, 0)["class"], "crashed")
         self.assertEqual(mc.classify(ok, 0, problem="timed out after 5 s")["reason"], "timed out after 5 s")
-        self.assertEqual(mc.classify(ok, 3)["class"], "crashed")            # exit 3 without a fault
+        self.assertEqual(mc.classify(ok, 3)["class"], "crashed")  # exit 3 without a fault
         self.assertEqual(mc.classify(summary(fault_code=2, fault_time_s=1.0), 0)["class"], "crashed")
         old = summary()
         del old["robustness"]["nonfinite_seen"]
@@ -222,15 +259,25 @@ class Classification(unittest.TestCase):
 class Metrics(unittest.TestCase):
     def test_commissioning_errors_against_the_plant(self):
         s = summary()
-        s["commissioning"] = {"measured": True, "resistance_Ohm": 3.03, "inductance_H": 0.0057,
-                              "torque_constant_Nm_A": 2.2, "offset_a_A": 0.015, "offset_b_A": -0.01,
-                              "realignments": 0}
-        params = {"motor.resistance_Ohm": 3.0, "motor.inductance_H": 0.006, "sensors.offset_a_A": 0.02,
-                  "sensors.offset_b_A": -0.02}
+        s["commissioning"] = {
+            "measured": True,
+            "resistance_Ohm": 3.03,
+            "inductance_H": 0.0057,
+            "torque_constant_Nm_A": 2.2,
+            "offset_a_A": 0.015,
+            "offset_b_A": -0.01,
+            "realignments": 0,
+        }
+        params = {
+            "motor.resistance_Ohm": 3.0,
+            "motor.inductance_H": 0.006,
+            "sensors.offset_a_A": 0.02,
+            "sensors.offset_b_A": -0.02,
+        }
         m = mc.extract_metrics(s, params, {"motor.torque_constant_Nm_A": 2.0})
         self.assertAlmostEqual(m["r_rel_error"], 0.01)
         self.assertAlmostEqual(m["l_rel_error"], -0.05)
-        self.assertAlmostEqual(m["k_rel_error"], 0.1)      # plant k_M from the scenario when not drawn
+        self.assertAlmostEqual(m["k_rel_error"], 0.1)  # plant k_M from the scenario when not drawn
         self.assertAlmostEqual(m["offset_a_error_A"], -0.005)
         self.assertAlmostEqual(m["offset_b_error_A"], 0.01)
         self.assertTrue(m["past_settle"])
@@ -243,22 +290,27 @@ class Metrics(unittest.TestCase):
         m = mc.extract_metrics(s, {}, {})
         self.assertIsNone(m["position_max_final_error_rad"])
         self.assertIsNone(m["position_abs_hold_drift_rad_s"])
-        s["position"] = {"moves": 50, "max_final_error_electrical_rad": 0.131, "max_tracking_error_electrical_rad": 0.366,
-                         "hold_duration_s": 60.0, "hold_max_error_electrical_rad": 0.35,
-                         "hold_drift_electrical_rad_s": -3.2e-4}
+        s["position"] = {
+            "moves": 50,
+            "max_final_error_electrical_rad": 0.131,
+            "max_tracking_error_electrical_rad": 0.366,
+            "hold_duration_s": 60.0,
+            "hold_max_error_electrical_rad": 0.35,
+            "hold_drift_electrical_rad_s": -3.2e-4,
+        }
         m = mc.extract_metrics(s, {}, {})
         self.assertEqual(m["position_max_final_error_rad"], 0.131)
         self.assertEqual(m["position_max_tracking_error_rad"], 0.366)
         self.assertEqual(m["position_hold_max_error_rad"], 0.35)
         self.assertEqual(m["position_abs_hold_drift_rad_s"], 3.2e-4)
-        s["position"]["hold_duration_s"] = 0.0           # no hold window: no hold figures
+        s["position"]["hold_duration_s"] = 0.0  # no hold window: no hold figures
         m = mc.extract_metrics(s, {}, {})
         self.assertIsNone(m["position_hold_max_error_rad"])
         self.assertIsNone(m["position_abs_hold_drift_rad_s"])
         self.assertEqual(m["position_max_final_error_rad"], 0.131)
 
     def test_fault_before_settling(self):
-        m = mc.extract_metrics(summary(fault_code=6, fault_time_s=0.7), {}, {})   # settle_time_s = 0.8
+        m = mc.extract_metrics(summary(fault_code=6, fault_time_s=0.7), {}, {})  # settle_time_s = 0.8
         self.assertFalse(m["past_settle"])
         self.assertTrue(mc.extract_metrics(summary(fault_code=6, fault_time_s=0.9), {}, {})["past_settle"])
 
@@ -269,7 +321,7 @@ class Statistics(unittest.TestCase):
         self.assertAlmostEqual(low, 0.236593090512564, places=12)
         self.assertAlmostEqual(high, 0.7634069094874361, places=12)
         low, high = mc.wilson_interval(12, 12)
-        self.assertAlmostEqual(low, 12 / (12 + 1.959963984540054 ** 2), places=12)  # = 0.75750599...
+        self.assertAlmostEqual(low, 12 / (12 + 1.959963984540054**2), places=12)  # = 0.75750599...
         self.assertEqual(high, 1.0)
         low, high = mc.wilson_interval(0, 10)
         self.assertEqual(low, 0.0)
@@ -300,22 +352,36 @@ class Statistics(unittest.TestCase):
     def test_worst_order(self):
         def case(seed, cls, speed):
             return {"seed": seed, "class": cls, "metrics": {"max_speed_error_rad_s": speed}}
-        cases = [case(1, "success", 0.4), case(2, "detected", 0.0), case(3, "success", 0.45),
-                 case(4, "crashed", None), case(5, "out_of_spec", 3.0)]
+
+        cases = [
+            case(1, "success", 0.4),
+            case(2, "detected", 0.0),
+            case(3, "success", 0.45),
+            case(4, "crashed", None),
+            case(5, "out_of_spec", 3.0),
+        ]
         self.assertEqual([c["seed"] for c in mc.worst_order(cases)], [4, 5, 2, 3, 1])
 
 
-
 class FailureSegments(unittest.TestCase):
-    SCENARIO = {"speed.points": "0:0, 0.33:0, 0.38:55.2,\n0.68:55.2, 0.73:-55.2, 1.0:0, 1.3:0",
-                "position.points": "0:0"}
+    SCENARIO = {
+        "speed.points": "0:0, 0.33:0, 0.38:55.2,\n0.68:55.2, 0.73:-55.2, 1.0:0, 1.3:0",
+        "position.points": "0:0",
+    }
 
     def test_segments_of_the_profile(self):
         segments = mc.profile_segments(mc.speed_points(self.SCENARIO))
-        self.assertEqual([label for _, _, label in segments],
-                         ["standstill, 0.000-0.330 s", "ramp 0 -> 55.2 rad/s, 0.330-0.380 s",
-                          "at 55.2 rad/s, 0.380-0.680 s", "ramp 55.2 -> -55.2 rad/s, 0.680-0.730 s",
-                          "ramp -55.2 -> 0 rad/s, 0.730-1.000 s", "standstill, 1.000-1.300 s"])
+        self.assertEqual(
+            [label for _, _, label in segments],
+            [
+                "standstill, 0.000-0.330 s",
+                "ramp 0 -> 55.2 rad/s, 0.330-0.380 s",
+                "at 55.2 rad/s, 0.380-0.680 s",
+                "ramp 55.2 -> -55.2 rad/s, 0.680-0.730 s",
+                "ramp -55.2 -> 0 rad/s, 0.730-1.000 s",
+                "standstill, 1.000-1.300 s",
+            ],
+        )
         self.assertEqual(mc.segment_of(0.2, 0.23, segments), "commissioning")
         self.assertEqual(mc.segment_of(0.3, 0.23, segments), "standstill, 0.000-0.330 s")
         self.assertEqual(mc.segment_of(0.38, 0.23, segments), "at 55.2 rad/s, 0.380-0.680 s")  # a start belongs to it
@@ -326,16 +392,32 @@ class FailureSegments(unittest.TestCase):
 
     def test_table_in_profile_order(self):
         def record(cls, time_s, run_start=0.23):
-            return {"class": cls, "metrics": {"failure_time_s": time_s},
-                    "summary": {"robustness": {"run_start_time_s": run_start}}}
-        records = [record("out_of_spec", 1.1), record("silent", 0.5), record("detected", 0.1),
-                   record("out_of_spec", 1.2), record("success", None), {"class": "crashed", "metrics": {}}]
+            return {
+                "class": cls,
+                "metrics": {"failure_time_s": time_s},
+                "summary": {"robustness": {"run_start_time_s": run_start}},
+            }
+
+        records = [
+            record("out_of_spec", 1.1),
+            record("silent", 0.5),
+            record("detected", 0.1),
+            record("out_of_spec", 1.2),
+            record("success", None),
+            {"class": "crashed", "metrics": {}},
+        ]
         segments = mc.label_failures(records, self.SCENARIO)
         self.assertIsNone(records[4]["metrics"]["failure_segment"])
         table = mc.failures_by_segment(records, ("detected", "silent", "out_of_spec"), segments)
-        self.assertEqual(table, [["commissioning", {"detected": 1, "silent": 0, "out_of_spec": 0}],
-                                 ["at 55.2 rad/s, 0.380-0.680 s", {"detected": 0, "silent": 1, "out_of_spec": 0}],
-                                 ["standstill, 1.000-1.300 s", {"detected": 0, "silent": 0, "out_of_spec": 2}]])
+        self.assertEqual(
+            table,
+            [
+                ["commissioning", {"detected": 1, "silent": 0, "out_of_spec": 0}],
+                ["at 55.2 rad/s, 0.380-0.680 s", {"detected": 0, "silent": 1, "out_of_spec": 0}],
+                ["standstill, 1.000-1.300 s", {"detected": 0, "silent": 0, "out_of_spec": 2}],
+            ],
+        )
+
 
 if __name__ == "__main__":
     unittest.main()

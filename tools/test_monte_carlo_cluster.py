@@ -12,6 +12,7 @@ Python running this) and the real pmstep-sil: $PMSTEP_SIL, else build/host-relea
 or build/host/sil/pmstep-sil. Usage:
   PMSTEP_SIL=build/host/sil/pmstep-sil .venv/bin/python -m unittest -v test_monte_carlo_cluster   (from tools/)
 """
+
 import glob
 import json
 import os
@@ -27,7 +28,7 @@ ROOT = os.path.dirname(TOOLS)
 SCRIPT = os.path.join(TOOLS, "monte_carlo.py")
 SCENARIO = os.path.join(ROOT, "sil", "scenarios", "robust.ini")
 CASES = 4
-DURATION_S = "1.2"    # alignment, commissioning and the start of RUN: short, and still the firmware's run
+DURATION_S = "1.2"  # alignment, commissioning and the start of RUN: short, and still the firmware's run
 START_TIMEOUT_S = 60  # the scheduler writing its file, the two workers joining
 CAMPAIGN_TIMEOUT_S = 120
 
@@ -111,13 +112,35 @@ class PlainCluster(unittest.TestCase):
             with open(cls.logs[name], "w") as log:
                 # Its own session: stop_group() ends it with all its children. --idle-timeout and
                 # --death-timeout end them too should this test itself be killed.
-                proc = subprocess.Popen(dask_command() + args, cwd=home, env=plain, stdin=subprocess.DEVNULL,
-                                        stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
+                proc = subprocess.Popen(
+                    dask_command() + args,
+                    cwd=home,
+                    env=plain,
+                    stdin=subprocess.DEVNULL,
+                    stdout=log,
+                    stderr=subprocess.STDOUT,
+                    start_new_session=True,
+                )
             cls.started.append(proc)
             return proc
 
-        scheduler = start("scheduler", ["scheduler", "--host", "127.0.0.1", "--port", "0", "--dashboard-address",
-                                        ":0", "--scheduler-file", scheduler_file, "--idle-timeout", "300"])
+        scheduler = start(
+            "scheduler",
+            [
+                "scheduler",
+                "--host",
+                "127.0.0.1",
+                "--port",
+                "0",
+                "--dashboard-address",
+                ":0",
+                "--scheduler-file",
+                scheduler_file,
+                "--idle-timeout",
+                "300",
+            ],
+        )
+
         def scheduler_address():
             try:
                 with open(scheduler_file) as f:
@@ -127,8 +150,7 @@ class PlainCluster(unittest.TestCase):
                 return False
 
         wait_for(scheduler_address, START_TIMEOUT_S, "the scheduler", [scheduler])
-        worker = start("worker", ["worker", cls.address, "--nthreads", "1", "--nworkers", "2",
-                                  "--death-timeout", "60"])
+        worker = start("worker", ["worker", cls.address, "--nthreads", "1", "--nworkers", "2", "--death-timeout", "60"])
         from distributed import Client  # only to wait for the two workers
 
         with Client(cls.address, timeout="30s") as client:
@@ -157,19 +179,47 @@ class PlainCluster(unittest.TestCase):
         """Runs a campaign of CASES cases on the cluster from a temporary folder; returns (stdout, results)."""
         out = os.path.join(self.tmp.name, name)
         env = {key: value for key, value in os.environ.items() if key != "PYTHONPATH"}
-        cmd = [sys.executable, SCRIPT, "--sil", self.sil, "--scenario", SCENARIO, "--cases", str(CASES),
-               "--seed", "7", "--duration", DURATION_S, "--no-plots", "--out", out, "--scheduler", self.address,
-               *extra]
-        proc = subprocess.Popen(cmd, cwd=self.tmp.name, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                text=True, start_new_session=True)
+        cmd = [
+            sys.executable,
+            SCRIPT,
+            "--sil",
+            self.sil,
+            "--scenario",
+            SCENARIO,
+            "--cases",
+            str(CASES),
+            "--seed",
+            "7",
+            "--duration",
+            DURATION_S,
+            "--no-plots",
+            "--out",
+            out,
+            "--scheduler",
+            self.address,
+            *extra,
+        ]
+        proc = subprocess.Popen(
+            cmd,
+            cwd=self.tmp.name,
+            env=env,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            start_new_session=True,
+        )
         try:
             stdout, stderr = proc.communicate(timeout=CAMPAIGN_TIMEOUT_S)
         finally:
             if proc.poll() is None:
                 stop_group(proc)
-        self.assertEqual(proc.returncode, 0, f"the campaign failed:\n{stdout}\n{stderr}\n--- scheduler log (tail):\n"
-                                             f"{tail(self.logs['scheduler'])}\n--- worker log (tail):\n"
-                                             f"{tail(self.logs['worker'])}")
+        self.assertEqual(
+            proc.returncode,
+            0,
+            f"the campaign failed:\n{stdout}\n{stderr}\n--- scheduler log (tail):\n"
+            f"{tail(self.logs['scheduler'])}\n--- worker log (tail):\n"
+            f"{tail(self.logs['worker'])}",
+        )
         self.assertEqual(stdout.strip().splitlines()[-1], f"{CASES} passed, 0 failed", stdout)
         self.assertIn(f"dask {self.address}, 2 workers: {CASES} cases run", stdout)
         results = []

@@ -12,6 +12,7 @@
 Needs dask.distributed (tools/requirements.txt, e.g. in .venv). Usage:
   PMSTEP_SIL=build/host/sil/pmstep-sil .venv/bin/python -m unittest -v test_monte_carlo_dask   (from tools/)
 """
+
 import csv
 import glob
 import json
@@ -28,14 +29,30 @@ ROOT = os.path.dirname(TOOLS)
 SCRIPT = os.path.join(TOOLS, "monte_carlo.py")
 SCENARIO = os.path.join(ROOT, "sil", "scenarios", "robust.ini")
 CASES = 8
-DURATION_S = "1.2"   # alignment, commissioning and the start of RUN: a short case that still runs the firmware
+DURATION_S = "1.2"  # alignment, commissioning and the start of RUN: a short case that still runs the firmware
 TIMEOUT_S = 600
 
 
 def campaign(out, *extra, sil=None):
     """The command line of a campaign of CASES cases."""
-    return [sys.executable, SCRIPT, "--sil", sil or os.environ["PMSTEP_SIL"], "--scenario", SCENARIO,
-            "--cases", str(CASES), "--seed", "7", "--duration", DURATION_S, "--no-plots", "--out", out, *extra]
+    return [
+        sys.executable,
+        SCRIPT,
+        "--sil",
+        sil or os.environ["PMSTEP_SIL"],
+        "--scenario",
+        SCENARIO,
+        "--cases",
+        str(CASES),
+        "--seed",
+        "7",
+        "--duration",
+        DURATION_S,
+        "--no-plots",
+        "--out",
+        out,
+        *extra,
+    ]
 
 
 def finished(out):
@@ -81,8 +98,12 @@ class DaskCampaigns(unittest.TestCase):
             raise AssertionError("set PMSTEP_SIL to the pmstep-sil to test (see the module docstring)")
         cls.tmp = tempfile.TemporaryDirectory()
         cls.reference_out = os.path.join(cls.tmp.name, "reference")
-        proc = subprocess.run(campaign(cls.reference_out, "--engine", "threads", "--jobs", "1"),
-                              capture_output=True, text=True, timeout=TIMEOUT_S)
+        proc = subprocess.run(
+            campaign(cls.reference_out, "--engine", "threads", "--jobs", "1"),
+            capture_output=True,
+            text=True,
+            timeout=TIMEOUT_S,
+        )
         if proc.returncode != 0:
             raise AssertionError(f"reference campaign failed:\n{proc.stdout}\n{proc.stderr}")
         cls.reference = results(cls.reference_out)
@@ -119,21 +140,54 @@ class DaskCampaigns(unittest.TestCase):
         dask_cli = [sys.executable, "-m", "distributed.cli.dask_scheduler"]
         started = []
         try:
-            started.append(subprocess.Popen(dask_cli + ["--scheduler-file", scheduler_file, "--host", "127.0.0.1",
-                                                        "--port", "0", "--dashboard-address", ":0"],
-                                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+            started.append(
+                subprocess.Popen(
+                    dask_cli
+                    + [
+                        "--scheduler-file",
+                        scheduler_file,
+                        "--host",
+                        "127.0.0.1",
+                        "--port",
+                        "0",
+                        "--dashboard-address",
+                        ":0",
+                    ],
+                    stdout=subprocess.DEVNULL,
+                    stderr=subprocess.DEVNULL,
+                )
+            )
             wait_for(lambda: os.path.exists(scheduler_file), 60, "the scheduler")
             with open(scheduler_file) as f:
                 address = json.load(f)["address"]
-            workers = [subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_worker", address,
-                                         "--nthreads", "1", "--no-nanny", "--name", f"w{k}",
-                                         "--local-directory", os.path.join(self.tmp.name, f"w{k}")],
-                                        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-                       for k in range(2)]
+            workers = [
+                subprocess.Popen(
+                    [
+                        sys.executable,
+                        "-m",
+                        "distributed.cli.dask_worker",
+                        address,
+                        "--nthreads",
+                        "1",
+                        "--no-nanny",
+                        "--name",
+                        f"w{k}",
+                        "--local-directory",
+                        os.path.join(self.tmp.name, f"w{k}"),
+                    ],
+                    stdout=subprocess.DEVNULL,
+                    stderr=subprocess.DEVNULL,
+                )
+                for k in range(2)
+            ]
             started += workers
             # pmstep-sil reaches the workers by upload (--ship-sil), not by its path.
-            client = subprocess.Popen(campaign(out, "--scheduler", address, "--ship-sil"), stdout=subprocess.PIPE,
-                                      stderr=subprocess.PIPE, text=True)
+            client = subprocess.Popen(
+                campaign(out, "--scheduler", address, "--ship-sil"),
+                stdout=subprocess.PIPE,
+                stderr=subprocess.PIPE,
+                text=True,
+            )
             started.append(client)
             wait_for(lambda: len(finished(out)) >= 2 or client.poll() is not None, TIMEOUT_S, "two finished cases")
             self.assertIsNone(client.poll(), "the campaign ended before a worker could be killed")

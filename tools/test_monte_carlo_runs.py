@@ -7,6 +7,7 @@ index). Its pure functions are test_monte_carlo.py.
 Usage: python3 -m unittest -v test_monte_carlo_runs     (from tools/)
        python3 tools/test_monte_carlo_runs.py           (from anywhere)
 """
+
 import csv
 import json
 import math
@@ -60,15 +61,22 @@ class PresetDistributions(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         import configparser
+
         cls.preset = mc.read_preset(PRESET_17HS)
         cls.paper_holding = mc_preset.paper_holding_torque()
         cls.peak = 55.2
         cls.table = mc.preset_distributions(cls.preset, cls.peak, cls.paper_holding)
         ini = configparser.ConfigParser(inline_comment_prefixes=(";",))
         ini.read(PRESET_17HS)
-        cls.motor = {key: ini.getfloat("motor", key.split(".")[1]) for key in
-                     ("motor.resistance_Ohm", "motor.inductance_H", "motor.torque_constant_Nm_A",
-                      "motor.inertia_kgm2")}
+        cls.motor = {
+            key: ini.getfloat("motor", key.split(".")[1])
+            for key in (
+                "motor.resistance_Ohm",
+                "motor.inductance_H",
+                "motor.torque_constant_Nm_A",
+                "motor.inertia_kgm2",
+            )
+        }
         cls.load = 2.0 * 0.40 / cls.paper_holding  # the paper's 2 N m of its 22.6 N m holding torque
         cls.base = dict(cls.motor, **{"load.torque_Nm": cls.load})
 
@@ -80,25 +88,38 @@ class PresetDistributions(unittest.TestCase):
     def test_same_rows_as_the_paper_table(self):
         self.assertEqual([row[0] for row in self.table], [row[0] for row in mc.DISTRIBUTIONS])
         paper = {row[0]: row for row in mc.DISTRIBUTIONS}
-        for key in ("sensors.offset_a_A", "sensors.offset_b_A", "sensors.gain_error_a", "sensors.gain_error_b",
-                    "sensors.noise_rms_A", "inverter.dead_time_s", "controller.inverter.dead_time_s",
-                    "run.theta0_deg"):
+        for key in (
+            "sensors.offset_a_A",
+            "sensors.offset_b_A",
+            "sensors.gain_error_a",
+            "sensors.gain_error_b",
+            "sensors.noise_rms_A",
+            "inverter.dead_time_s",
+            "controller.inverter.dead_time_s",
+            "run.theta0_deg",
+        ):
             self.assertIn(paper[key], self.table, key)  # the chain's rows unchanged
 
     def test_draws_scaled_to_the_preset(self):
         drawn = [mc.draw_parameters(seed, self.base, self.table) for seed in range(2000)]
-        factors = {"motor.resistance_Ohm": (0.9, 1.1), "motor.inductance_H": (0.9, 1.1),
-                   "motor.torque_constant_Nm_A": (0.9, 1.1), "motor.inertia_kgm2": (0.8, 1.2)}
+        factors = {
+            "motor.resistance_Ohm": (0.9, 1.1),
+            "motor.inductance_H": (0.9, 1.1),
+            "motor.torque_constant_Nm_A": (0.9, 1.1),
+            "motor.inertia_kgm2": (0.8, 1.2),
+        }
         for key, (low, high) in factors.items():
             ratios = [p[key] / self.motor[key] for p in drawn]
             self.assertGreaterEqual(min(ratios), low, key)
             self.assertLess(max(ratios), high, key)
-            self.assertLess(min(ratios), low + 0.01 * (high - low), key)   # the whole range is used
+            self.assertLess(min(ratios), low + 0.01 * (high - low), key)  # the whole range is used
             self.assertGreater(max(ratios), high - 0.01 * (high - low), key)
-        limits = {"load.torque_Nm": self.load,                     # 8.8 % of 0.40 N m, not 2 N m
-                  "bus.ripple_V": 2.0 * 24.0 / 48.0,               # 1 V on 24 V, not 2 V
-                  "bus.source_resistance_Ohm": 0.2 * 1.5 / 3.0,    # 0.1 Ohm, not 0.2 Ohm
-                  "motor.friction_Nms_rad": 2.0 * 1e-4}            # twice the preset's assumed friction
+        limits = {
+            "load.torque_Nm": self.load,  # 8.8 % of 0.40 N m, not 2 N m
+            "bus.ripple_V": 2.0 * 24.0 / 48.0,  # 1 V on 24 V, not 2 V
+            "bus.source_resistance_Ohm": 0.2 * 1.5 / 3.0,  # 0.1 Ohm, not 0.2 Ohm
+            "motor.friction_Nms_rad": 2.0 * 1e-4,
+        }  # twice the preset's assumed friction
         for key, limit in limits.items():
             values = [p[key] for p in drawn]
             self.assertGreaterEqual(min(values), 0.0, key)
@@ -139,8 +160,12 @@ class PresetDistributions(unittest.TestCase):
         self.assertAlmostEqual(float(scenario["run.loss_speed_error_rad_s"]), 2.0 * 69.0 / 9.6, places=12)
         command = info["tune_command"]
         self.assertIn("--robust", command)
-        for item in ("sensors.current_full_scale_A=5.1",   # 3 x the rated 1.7 A
-                     "inverter.model=switching", "sensors.noise_rms_A=0.005", "run.delay_periods=1"):
+        for item in (
+            "sensors.current_full_scale_A=5.1",  # 3 x the rated 1.7 A
+            "inverter.model=switching",
+            "sensors.noise_rms_A=0.005",
+            "run.delay_periods=1",
+        ):
             self.assertEqual(command[command.index(item) - 1], "--set", item)
         self.assertTrue(all(len(line) < 197 for line in text.splitlines()))  # the INI reader's limit
 
@@ -150,8 +175,10 @@ class PresetDistributions(unittest.TestCase):
             tune = write_fake_tune(tmp)
             scenario = os.path.join(tmp, "moves.ini")
             with open(scenario, "w") as f:
-                f.write("[speed]\npoints = 0:0\n[load]\ntype = step\ntorque_Nm = 0.0849\nstep_time_s = 87.8\n"
-                        "[position]\npoints = 0.33:-45.9, 2.17:43.7\nv_max_rad_s = 34.5\n")
+                f.write(
+                    "[speed]\npoints = 0:0\n[load]\ntype = step\ntorque_Nm = 0.0849\nstep_time_s = 87.8\n"
+                    "[position]\npoints = 0.33:-45.9, 2.17:43.7\nv_max_rad_s = 34.5\n"
+                )
             info = mc_preset.scenario_info(tune, PRESET_17HS, scenario)
             self.assertEqual(sorted(os.listdir(tmp)), ["fake-tune", "moves.ini"])  # nothing designed or written
         self.assertEqual(info["peak_speed_rad_s"], 34.5)
@@ -159,8 +186,12 @@ class PresetDistributions(unittest.TestCase):
         self.assertEqual(info["load_Nm"], 0.0849)
         self.assertIsNone(info["run_start_s"])
         self.assertAlmostEqual(info["speed_bound_rad_s"], 0.5 * 69.0 / 9.6, places=12)
-        table = {row[0]: row for row in mc.preset_distributions(info["figures"], info["peak_speed_rad_s"],
-                                                                 info["paper_holding_torque_Nm"])}
+        table = {
+            row[0]: row
+            for row in mc.preset_distributions(
+                info["figures"], info["peak_speed_rad_s"], info["paper_holding_torque_Nm"]
+            )
+        }
         self.assertEqual(table["load.torque_Nm"][1:], ("scale", 0.0, 1.0))  # of the scenario's 0.0849 N m
         self.assertEqual(table["motor.inertia_kgm2"][1:], ("scale", 0.8, 1.2))
 
@@ -171,8 +202,12 @@ class PresetDistributions(unittest.TestCase):
                 f.write("[datasheet]\nrated_current_A = 1.7\n[motor]\nresistance_Ohm = 1.5\n")
             with self.assertRaises(mc.ToolError):
                 mc.read_preset(bad)
-        proc = subprocess.run([sys.executable, SCRIPT, "--sil", sys.executable, "--out", "unused"],
-                              capture_output=True, text=True, timeout=60)
+        proc = subprocess.run(
+            [sys.executable, SCRIPT, "--sil", sys.executable, "--out", "unused"],
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
         self.assertEqual(proc.returncode, 2)
         self.assertIn("give --scenario, --preset or both", proc.stderr)
 
@@ -265,8 +300,20 @@ class EndToEnd(unittest.TestCase):
         cls.tmp.cleanup()
 
     def run_tool(self, *extra):
-        cmd = [sys.executable, SCRIPT, "--sil", self.sil, "--scenario", self.scenario, "--out", self.out,
-               "--no-plots", "--engine", "threads", *extra]
+        cmd = [
+            sys.executable,
+            SCRIPT,
+            "--sil",
+            self.sil,
+            "--scenario",
+            self.scenario,
+            "--out",
+            self.out,
+            "--no-plots",
+            "--engine",
+            "threads",
+            *extra,
+        ]
         return subprocess.run(cmd, capture_output=True, text=True, timeout=120)
 
     def test_run_and_check(self):
@@ -298,16 +345,24 @@ class EndToEnd(unittest.TestCase):
         self.assertEqual(rows[5]["class"], "crashed")
         self.assertIn("exited with status 139", rows[5]["reason"])
         self.assertEqual(rows[2]["false_trip"], "1")
-        self.assertEqual(float(rows[0]["motor.resistance_Ohm"]),
-                         mc.draw_parameters(300000, {"motor.resistance_Ohm": 3.0, "motor.inductance_H": 0.006,
-                                                     "motor.torque_constant_Nm_A": 2.0,
-                                                     "motor.inertia_kgm2": 0.01,
-                                                     "load.torque_Nm": 2.0})["motor.resistance_Ohm"])
+        self.assertEqual(
+            float(rows[0]["motor.resistance_Ohm"]),
+            mc.draw_parameters(
+                300000,
+                {
+                    "motor.resistance_Ohm": 3.0,
+                    "motor.inductance_H": 0.006,
+                    "motor.torque_constant_Nm_A": 2.0,
+                    "motor.inertia_kgm2": 0.01,
+                    "load.torque_Nm": 2.0,
+                },
+            )["motor.resistance_Ohm"],
+        )
 
         with open(os.path.join(self.out, "report.md")) as f:
             report = f.read()
         self.assertIn("Success rate: 4/16 = 25.0 %", report)
-        self.assertIn("fake: segmentation fault", report)     # the crashed case's stderr tail
+        self.assertIn("fake: segmentation fault", report)  # the crashed case's stderr tail
         self.assertIn("--case 300005", report)
         for key, _kind, _a, _b in mc.DISTRIBUTIONS:
             self.assertIn(f"`{key}`", report)
@@ -327,8 +382,24 @@ class EndToEnd(unittest.TestCase):
         with open(paper, "w") as f:
             f.write(f"#!{sys.executable}\nprint('[motor]\\nresistance_Ohm = 3\\n')\n")
         os.chmod(paper, 0o755)
-        proc = subprocess.run([sys.executable, SCRIPT, "--sil", paper, "--scenario", self.scenario, "--out",
-                               self.out, "--cases", "2", "--no-plots"], capture_output=True, text=True, timeout=60)
+        proc = subprocess.run(
+            [
+                sys.executable,
+                SCRIPT,
+                "--sil",
+                paper,
+                "--scenario",
+                self.scenario,
+                "--out",
+                self.out,
+                "--cases",
+                "2",
+                "--no-plots",
+            ],
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
         self.assertEqual(proc.returncode, 2)
         self.assertIn("does not know 16 of the keys", proc.stderr)
         self.assertIn("sensors.noise_rms_A", proc.stderr)

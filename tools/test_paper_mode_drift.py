@@ -1,4 +1,5 @@
 """Unit tests of tools/paper_mode_drift.py's pure functions (python3 -m unittest test_paper_mode_drift)."""
+
 import math
 import unittest
 
@@ -22,7 +23,7 @@ class Series(unittest.TestCase):
     errors = [0.0, -0.02, 0.03, -0.06, 0.7, 0.1]
 
     def test_window_max(self):
-        self.assertEqual(drift.window_max(self.times, self.errors, 1.0), 0.06)   # (0.9, 1.0]
+        self.assertEqual(drift.window_max(self.times, self.errors, 1.0), 0.06)  # (0.9, 1.0]
         self.assertEqual(drift.window_max(self.times, self.errors, 2.0), 0.1)
         self.assertIsNone(drift.window_max(self.times, self.errors, 1.5))
 
@@ -33,9 +34,16 @@ class Series(unittest.TestCase):
 
 
 class Cases(unittest.TestCase):
-    values = {"sensors.adc_bits": "12", "sensors.offset_a_A": "0.02", "sensors.offset_b_A": "-0.02",
-              "sensors.noise_rms_A": "0.005", "run.delay_periods": "1", "inverter.dead_time_s": "1e-06",
-              "motor.resistance_Ohm": "3.6", "controller.commissioning.offset_calibration_time_s": "0.05"}
+    values = {
+        "sensors.adc_bits": "12",
+        "sensors.offset_a_A": "0.02",
+        "sensors.offset_b_A": "-0.02",
+        "sensors.noise_rms_A": "0.005",
+        "run.delay_periods": "1",
+        "inverter.dead_time_s": "1e-06",
+        "motor.resistance_Ohm": "3.6",
+        "controller.commissioning.offset_calibration_time_s": "0.05",
+    }
 
     def test_composition(self):
         runs = dict(drift.cases(self.values, 0.6))

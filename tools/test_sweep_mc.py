@@ -1,6 +1,7 @@
 """Tests of tools/sweep_mc.py (python3 -m unittest test_sweep_mc): the Monte Carlo sample's totals,
 summary line and report section on made-up campaign results, and a campaign that did not run.
 Standard library only; no campaign is run."""
+
 import unittest
 
 import sweep_mc
@@ -11,13 +12,24 @@ def motor(name):
 
 
 def campaign(name, success, detected, silent, out_of_spec, crashed=0):
-    return {"motor": motor(name), "nonfinite": 0,
-            "counts": {"success": success, "detected": detected, "silent": silent, "out_of_spec": out_of_spec,
-                       "crashed": crashed}}
+    return {
+        "motor": motor(name),
+        "nonfinite": 0,
+        "counts": {
+            "success": success,
+            "detected": detected,
+            "silent": silent,
+            "out_of_spec": out_of_spec,
+            "crashed": crashed,
+        },
+    }
 
 
-RESULTS = [campaign("m0002", 18, 2, 0, 0), campaign("m0001", 10, 3, 4, 3),
-           {"motor": motor("m0003"), "error": "exit 2: pmstep-tune: cannot design"}]
+RESULTS = [
+    campaign("m0002", 18, 2, 0, 0),
+    campaign("m0001", 10, 3, 4, 3),
+    {"motor": motor("m0003"), "error": "exit 2: pmstep-tune: cannot design"},
+]
 
 
 class SweepMcTest(unittest.TestCase):

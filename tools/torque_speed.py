@@ -34,11 +34,11 @@ usage: tools/torque_speed.py [--sil PATH] [--tune PATH] [--motors paper,17hs4401
                              [--buses 12,24,48] [--speeds 0.01,0.25,0.5,0.75,1.0] [--iterations 7]
                              [--quick] [--check] [--jobs 2] [--out DIR] [--json FILE] [--report FILE]
 """
+
 import argparse
 import concurrent.futures
 import configparser
 import json
-import math
 import os
 import subprocess
 import sys
@@ -54,12 +54,12 @@ BUSES = [12.0, 24.0, 48.0]
 SPEED_FRACTIONS = [0.01, 0.25, 0.5, 0.75, 1.0]
 QUICK_FRACTIONS = [0.25, 0.75]
 DRIVES = ["pmstep", "microstep"]
-LEAD_S = 0.1         # from RUN's start to the speed ramp
-SETTLE_S = 0.1       # at the speed before the load ramp
-LOAD_RAMP_S = 1.0    # the load from 0 to T: quasi-static (a ramp of 0.1 s measured the speed loop's tracking of it)
-HOLD_S = 0.5         # T held to the end
-LOAD_BOUND = 1.5     # the bracket: [0, 1.5 x the datasheet holding torque]
-ITERATIONS = 7       # 1.5 T_H / 128: 1.2 % of the holding torque
+LEAD_S = 0.1  # from RUN's start to the speed ramp
+SETTLE_S = 0.1  # at the speed before the load ramp
+LOAD_RAMP_S = 1.0  # the load from 0 to T: quasi-static (a ramp of 0.1 s measured the speed loop's tracking of it)
+HOLD_S = 0.5  # T held to the end
+LOAD_BOUND = 1.5  # the bracket: [0, 1.5 x the datasheet holding torque]
+ITERATIONS = 7  # 1.5 T_H / 128: 1.2 % of the holding torque
 ITERATIONS_QUICK = 4  # 1.5 T_H / 16: 9.4 % of it
 
 
@@ -79,7 +79,7 @@ def bisect(held, lo, hi, iterations):
 
 def copper_loss_W(rms_phase_current_A, resistance_Ohm):
     """Both phases' copper loss, 2 R I_rms^2, from the per-phase RMS current."""
-    return 2.0 * resistance_Ohm * rms_phase_current_A ** 2
+    return 2.0 * resistance_Ohm * rms_phase_current_A**2
 
 
 def timeline(motor, top, run_start, fraction):
@@ -89,8 +89,7 @@ def timeline(motor, top, run_start, fraction):
     ramp = run_start + LEAD_S
     reached = ramp + v / a
     load = reached + SETTLE_S
-    return {"v": v, "a": a, "ramp_s": ramp, "reached_s": reached, "load_s": load,
-            "end_s": load + LOAD_RAMP_S + HOLD_S}
+    return {"v": v, "a": a, "ramp_s": ramp, "reached_s": reached, "load_s": load, "end_s": load + LOAD_RAMP_S + HOLD_S}
 
 
 def held_failures(s, bound_rad_s):
@@ -111,11 +110,15 @@ def one_run(args, case, drive, torque, out_dir):
     tl = case["timeline"]
     # The metrics' t_c: RUN's start for pmstep, the end of the hold (the ramp's start) for microstepping.
     t_c = case["run_start"] if drive == "pmstep" else tl["ramp_s"]
-    sets = [f"run.controller={drive}", "load.type=table",
-            f"speed.points=0:0, {tl['ramp_s']:.6f}:0, {tl['reached_s']:.6f}:{tl['v']:.9g}",
-            f"load.points=0:0, {tl['load_s']:.6f}:0, {tl['load_s'] + LOAD_RAMP_S:.6f}:{torque:.9g}",
-            f"run.duration_s={tl['end_s']:.6f}", f"run.transient_window_s={tl['load_s'] - t_c:.6f}",
-            f"run.metrics_start_s={tl['load_s'] + LOAD_RAMP_S:.6f}"]
+    sets = [
+        f"run.controller={drive}",
+        "load.type=table",
+        f"speed.points=0:0, {tl['ramp_s']:.6f}:0, {tl['reached_s']:.6f}:{tl['v']:.9g}",
+        f"load.points=0:0, {tl['load_s']:.6f}:0, {tl['load_s'] + LOAD_RAMP_S:.6f}:{torque:.9g}",
+        f"run.duration_s={tl['end_s']:.6f}",
+        f"run.transient_window_s={tl['load_s'] - t_c:.6f}",
+        f"run.metrics_start_s={tl['load_s'] + LOAD_RAMP_S:.6f}",
+    ]
     _, s = run_sil(args.sil, case["scenario"], sets, out_dir, False)
     return s
 
@@ -130,22 +133,36 @@ def search(args, case, drive):
         runs[torque] = (s, held_failures(s, case["loss_speed_rad_s"]))
         return not runs[torque][1]
 
-    row = {"motor": case["motor"], "bus_V": case["bus"], "fraction": case["fraction"], "drive": drive,
-           "speed_rad_s": case["timeline"]["v"], "holding_Nm": case["preset"]["holding_Nm"],
-           "bound_Nm": LOAD_BOUND * case["preset"]["holding_Nm"], "iterations": args.iterations,
-           "error": None, "held_Nm": None, "failed_Nm": None, "failed_why": []}
+    row = {
+        "motor": case["motor"],
+        "bus_V": case["bus"],
+        "fraction": case["fraction"],
+        "drive": drive,
+        "speed_rad_s": case["timeline"]["v"],
+        "holding_Nm": case["preset"]["holding_Nm"],
+        "bound_Nm": LOAD_BOUND * case["preset"]["holding_Nm"],
+        "iterations": args.iterations,
+        "error": None,
+        "held_Nm": None,
+        "failed_Nm": None,
+        "failed_why": [],
+    }
     try:
         lo, hi = bisect(held, 0.0, row["bound_Nm"], args.iterations)
     except (RuntimeError, KeyError, ValueError) as e:
         row["error"] = str(e)
         return row
-    row.update({"held_Nm": lo, "failed_Nm": hi, "failed_why": runs[hi][1] if hi is not None else [],
-                "runs": len(runs)})
+    row.update({"held_Nm": lo, "failed_Nm": hi, "failed_why": runs[hi][1] if hi is not None else [], "runs": len(runs)})
     if lo is not None:
         s = runs[lo][0]
-        row.update({"held_fraction": lo / row["holding_Nm"], "rms_phase_current_A": s["rms_phase_current_A"],
-                    "copper_loss_W": copper_loss_W(s["rms_phase_current_A"], case["preset"]["R"]),
-                    "max_speed_error_rad_s": s["robustness"]["max_speed_error_rad_s"]})
+        row.update(
+            {
+                "held_fraction": lo / row["holding_Nm"],
+                "rms_phase_current_A": s["rms_phase_current_A"],
+                "copper_loss_W": copper_loss_W(s["rms_phase_current_A"], case["preset"]["R"]),
+                "max_speed_error_rad_s": s["robustness"]["max_speed_error_rad_s"],
+            }
+        )
     else:
         row["none_why"] = row["failed_why"]
     return row
@@ -169,9 +186,19 @@ def cases(args):
             ini.read(scenario)
             bound = float(ini["run"]["loss_speed_error_rad_s"])
             for fraction in args.fraction_list:
-                out.append({"motor": motor, "bus": bus, "fraction": fraction, "preset": preset, "scenario": scenario,
-                            "top_rad_s": top, "run_start": run_start, "loss_speed_rad_s": bound,
-                            "timeline": timeline(preset, top, run_start, fraction)})
+                out.append(
+                    {
+                        "motor": motor,
+                        "bus": bus,
+                        "fraction": fraction,
+                        "preset": preset,
+                        "scenario": scenario,
+                        "top_rad_s": top,
+                        "run_start": run_start,
+                        "loss_speed_rad_s": bound,
+                        "timeline": timeline(preset, top, run_start, fraction),
+                    }
+                )
     return out, refused
 
 
@@ -204,42 +231,71 @@ def _loss(r):
 
 
 def table(rows, refused, markdown):
-    head = ["motor", "bus V", "speed", "rad/s", "pmstep N·m (× T_H)", "microstep N·m (× T_H)", "ratio",
-            "pmstep Cu W", "microstep Cu W"]
+    head = [
+        "motor",
+        "bus V",
+        "speed",
+        "rad/s",
+        "pmstep N·m (× T_H)",
+        "microstep N·m (× T_H)",
+        "ratio",
+        "pmstep Cu W",
+        "microstep Cu W",
+    ]
     out = []
     if markdown:
         out += ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     else:
-        out.append(f"{'motor':9s} {'bus':>4s} {'speed':>5s} {'rad/s':>7s} {'pmstep Nm (xT_H)':>18s} "
-                   f"{'microstep Nm (xT_H)':>20s} {'ratio':>6s} {'pm Cu W':>8s} {'ms Cu W':>8s}")
+        out.append(
+            f"{'motor':9s} {'bus':>4s} {'speed':>5s} {'rad/s':>7s} {'pmstep Nm (xT_H)':>18s} "
+            f"{'microstep Nm (xT_H)':>20s} {'ratio':>6s} {'pm Cu W':>8s} {'ms Cu W':>8s}"
+        )
     for (motor, bus, fraction), pm, ms in pair_rows(rows):
         r = ratio(pm["held_Nm"] if pm else None, ms["held_Nm"] if ms else None)
         speed = (pm or ms)["speed_rad_s"]
-        cells = [motor, f"{bus:g}", f"{fraction:g}", f"{speed:.1f}", _load(pm), _load(ms),
-                 "-" if r is None else f"{r:.2f}", _loss(pm), _loss(ms)]
+        cells = [
+            motor,
+            f"{bus:g}",
+            f"{fraction:g}",
+            f"{speed:.1f}",
+            _load(pm),
+            _load(ms),
+            "-" if r is None else f"{r:.2f}",
+            _loss(pm),
+            _loss(ms),
+        ]
         if markdown:
             out.append("| " + " | ".join(cells) + " |")
         else:
-            out.append(f"{cells[0]:9s} {cells[1]:>4s} {cells[2]:>5s} {cells[3]:>7s} {cells[4]:>18s} {cells[5]:>20s} "
-                       f"{cells[6]:>6s} {cells[7]:>8s} {cells[8]:>8s}")
+            out.append(
+                f"{cells[0]:9s} {cells[1]:>4s} {cells[2]:>5s} {cells[3]:>7s} {cells[4]:>18s} {cells[5]:>20s} "
+                f"{cells[6]:>6s} {cells[7]:>8s} {cells[8]:>8s}"
+            )
     for d in refused:
         cells = [d["motor"], f"{d['bus_V']:g}", "-", "-", "no design", "no design", "-", "-", "-"]
-        out.append("| " + " | ".join(cells) + " |" if markdown else
-                   f"{d['motor']:9s} {d['bus_V']:4g}  no design: {d['why']}")
+        out.append(
+            "| " + " | ".join(cells) + " |" if markdown else f"{d['motor']:9s} {d['bus_V']:4g}  no design: {d['why']}"
+        )
     return "\n".join(out)
 
 
 def unevaluated(rows):
     """--check: the cases that could not be evaluated (the SIL failed or gave no summary)."""
-    return [f"{r['motor']} {r['bus_V']:g} V {r['fraction']:g} x top {r['drive']}: {r['error']}"
-            for r in rows if r["error"]]
+    return [
+        f"{r['motor']} {r['bus_V']:g} V {r['fraction']:g} x top {r['drive']}: {r['error']}" for r in rows if r["error"]
+    ]
 
 
 def limits(rows):
     """What stopped each drive above its largest held load: Markdown list lines, one per case where the drive
     held no load (its reason at no load), then per drive a count of the first failures' kinds."""
-    lines = [f"- {r['motor']} {r['bus_V']:g} V, {r['fraction']:g} × top, {r['drive']}: holds no load ("
-             + "; ".join(r["failed_why"]) + ")" for r in rows if not r["error"] and r["held_Nm"] is None]
+    lines = [
+        f"- {r['motor']} {r['bus_V']:g} V, {r['fraction']:g} × top, {r['drive']}: holds no load ("
+        + "; ".join(r["failed_why"])
+        + ")"
+        for r in rows
+        if not r["error"] and r["held_Nm"] is None
+    ]
     for drive in DRIVES:
         kinds = {}
         for r in rows:
@@ -248,8 +304,10 @@ def limits(rows):
                 kind = "speed error" if kind.startswith("speed error") else kind
                 kinds[kind] = kinds.get(kind, 0) + 1
         if kinds:
-            lines.append(f"- {drive}, first failure above the largest held load: "
-                         + ", ".join(f"{k} in {n}" for k, n in sorted(kinds.items())))
+            lines.append(
+                f"- {drive}, first failure above the largest held load: "
+                + ", ".join(f"{k} in {n}" for k, n in sorted(kinds.items()))
+            )
     return lines
 
 
@@ -260,13 +318,16 @@ def summary(rows):
     if not rs:
         return "no case with both drives' figures."
     less = sum(1 for x in rs if x < 1.0)
-    return (f"pmstep / microstepping largest held load {min(rs):.2f}–{max(rs):.2f} over {len(rs)} cases; "
-            f"pmstep holds less than microstepping in {less} of them.")
+    return (
+        f"pmstep / microstepping largest held load {min(rs):.2f}–{max(rs):.2f} over {len(rs)} cases; "
+        f"pmstep holds less than microstepping in {less} of them."
+    )
 
 
 def plot(rows, motor, path):
     try:
         import matplotlib
+
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError:
@@ -275,12 +336,20 @@ def plot(rows, motor, path):
     drawn = False
     for i, bus in enumerate(sorted({r["bus_V"] for r in rows if r["motor"] == motor})):
         for drive, style in (("pmstep", "-"), ("microstep", "--")):
-            pts = sorted((r["speed_rad_s"], r["held_Nm"]) for r in rows
-                         if r["motor"] == motor and r["bus_V"] == bus and r["drive"] == drive
-                         and r["held_Nm"] is not None)
+            pts = sorted(
+                (r["speed_rad_s"], r["held_Nm"])
+                for r in rows
+                if r["motor"] == motor and r["bus_V"] == bus and r["drive"] == drive and r["held_Nm"] is not None
+            )
             if pts:
-                ax.plot([p[0] for p in pts], [p[1] for p in pts], style, marker="o", color=f"C{i}",
-                        label=f"{drive}, {bus:g} V")
+                ax.plot(
+                    [p[0] for p in pts],
+                    [p[1] for p in pts],
+                    style,
+                    marker="o",
+                    color=f"C{i}",
+                    label=f"{drive}, {bus:g} V",
+                )
                 drawn = True
     if not drawn:
         plt.close(fig)
@@ -296,26 +365,35 @@ def plot(rows, motor, path):
     return path
 
 
-WHAT = ("Per public preset and bus voltage, pmstep-tune's design for that bus, and at fractions of its top speed the "
-        "largest constant load torque each drive holds: pmstep in speed mode and open-loop microstepping at rated "
-        f"current (`run.controller = microstep`) on the same plant and scenario. The speed ramps at min(¼ k_M I / J, "
-        f"{A_AXIS:g} rad/s²) from RUN's start + {LEAD_S:g} s; {SETTLE_S:g} s after it is reached the load (opposing "
-        f"the motion) ramps from 0 over {LOAD_RAMP_S:g} s and is held {HOLD_S:g} s to the end. **Held**, the same "
-        "rule for both drives: no fault, the summary's `loss_of_synchronism` false (microstepping: load angle beyond "
-        "π; pmstep: angle estimate off by more than `run.loss_angle_error_rad`), and |ω − ω*| within "
-        "`run.loss_speed_error_rad_s` from the load ramp's start to the end. Bisection on [0, "
-        f"{LOAD_BOUND:g} × the datasheet holding torque T_H]; \"≥\": held at the bracket's top. Copper loss: "
-        "2 R I_rms² at the largest held load, I_rms per phase over the hold (the load at its full value). "
-        "Currents differ: microstepping drives rated current whatever the load (pull-out torque k_M I); pmstep's "
-        "current follows the load up to its overcurrent trip (`controller.limits.max_phase_current_A`, above rated "
-        "current), so its largest held load may need more than rated current: compare the copper losses.")
+WHAT = (
+    "Per public preset and bus voltage, pmstep-tune's design for that bus, and at fractions of its top speed the "
+    "largest constant load torque each drive holds: pmstep in speed mode and open-loop microstepping at rated "
+    f"current (`run.controller = microstep`) on the same plant and scenario. The speed ramps at min(¼ k_M I / J, "
+    f"{A_AXIS:g} rad/s²) from RUN's start + {LEAD_S:g} s; {SETTLE_S:g} s after it is reached the load (opposing "
+    f"the motion) ramps from 0 over {LOAD_RAMP_S:g} s and is held {HOLD_S:g} s to the end. **Held**, the same "
+    "rule for both drives: no fault, the summary's `loss_of_synchronism` false (microstepping: load angle beyond "
+    "π; pmstep: angle estimate off by more than `run.loss_angle_error_rad`), and |ω − ω*| within "
+    "`run.loss_speed_error_rad_s` from the load ramp's start to the end. Bisection on [0, "
+    f'{LOAD_BOUND:g} × the datasheet holding torque T_H]; "≥": held at the bracket\'s top. Copper loss: '
+    "2 R I_rms² at the largest held load, I_rms per phase over the hold (the load at its full value). "
+    "Currents differ: microstepping drives rated current whatever the load (pull-out torque k_M I); pmstep's "
+    "current follows the load up to its overcurrent trip (`controller.limits.max_phase_current_A`, above rated "
+    "current), so its largest held load may need more than rated current: compare the copper losses."
+)
 
 
 def report_text(rows, refused, args, argv, pictures):
-    what = WHAT + (f" {args.iterations} halvings: resolution {LOAD_BOUND:g} T_H / {2 ** args.iterations} = "
-                   f"{LOAD_BOUND / 2 ** args.iterations * 100:.2g} % of T_H.")
-    lines = [report.header("Torque against speed: pmstep and open-loop microstepping", "tools/torque_speed.py",
-                           argv, what), table(rows, refused, True), "", summary(rows), ""]
+    what = WHAT + (
+        f" {args.iterations} halvings: resolution {LOAD_BOUND:g} T_H / {2**args.iterations} = "
+        f"{LOAD_BOUND / 2**args.iterations * 100:.2g} % of T_H."
+    )
+    lines = [
+        report.header("Torque against speed: pmstep and open-loop microstepping", "tools/torque_speed.py", argv, what),
+        table(rows, refused, True),
+        "",
+        summary(rows),
+        "",
+    ]
     if limits(rows):
         lines += limits(rows) + [""]
     for motor, picture in pictures:
@@ -341,8 +419,12 @@ def main(argv=None):
     args = ap.parse_args(argv[1:])
     args.motors = args.motors or ("17hs4401" if args.quick else ",".join(MOTORS))
     args.bus_list = [float(x) for x in (args.buses or ("24" if args.quick else "12,24,48")).split(",")]
-    args.fraction_list = [float(x) for x in (args.speeds or ",".join(
-        str(f) for f in (QUICK_FRACTIONS if args.quick else SPEED_FRACTIONS))).split(",")]
+    args.fraction_list = [
+        float(x)
+        for x in (args.speeds or ",".join(str(f) for f in (QUICK_FRACTIONS if args.quick else SPEED_FRACTIONS))).split(
+            ","
+        )
+    ]
     if args.iterations is None:
         args.iterations = ITERATIONS_QUICK if args.quick else ITERATIONS
     for m in args.motors.split(","):
@@ -353,8 +435,10 @@ def main(argv=None):
         futures = [pool.submit(search, args, c, d) for c in all_cases for d in DRIVES]
         rows = [f.result() for f in futures]
     print(table(rows, refused, False))
-    print(f"torque_speed: load N m (x datasheet holding torque), resolution {LOAD_BOUND:g} T_H / "
-          f"{2 ** args.iterations}; Cu W: 2 R I_rms^2 at the largest held load")
+    print(
+        f"torque_speed: load N m (x datasheet holding torque), resolution {LOAD_BOUND:g} T_H / "
+        f"{2**args.iterations}; Cu W: 2 R I_rms^2 at the largest held load"
+    )
     print("torque_speed: " + summary(rows))
     for line in limits(rows):
         print("torque_speed: " + line[2:])

@@ -7,6 +7,7 @@ electrical rad of the plant's p theta.
 
 usage: check_commissioning.py SUMMARY SCENARIO --max-inductance-error E --max-torque-constant-error E
                               [--max-resistance-error E] [--alignment-repeats N] [--max-rest-angle-error RAD]"""
+
 import argparse
 import configparser
 import json
@@ -35,9 +36,11 @@ def main():
     c = s["commissioning"]
     l_ratio = c["inductance_H"] / motor_inductance_H
     k_error = c["torque_constant_Nm_A"] / motor_torque_constant - 1.0
-    print(f"fault {s['fault']['name']}; measured L {c['inductance_H']:.6g} H ({l_ratio:.3f} x the motor's), "
-          f"k_M {c['torque_constant_Nm_A']:.6g} N m/A ({100 * k_error:+.2f} %), R {c['resistance_Ohm']:.6g} Ohm, "
-          f"alignments repeated {c['alignment_repeats']:g} time(s)")
+    print(
+        f"fault {s['fault']['name']}; measured L {c['inductance_H']:.6g} H ({l_ratio:.3f} x the motor's), "
+        f"k_M {c['torque_constant_Nm_A']:.6g} N m/A ({100 * k_error:+.2f} %), R {c['resistance_Ohm']:.6g} Ohm, "
+        f"alignments repeated {c['alignment_repeats']:g} time(s)"
+    )
     failures = []
     if s["fault"]["name"] != "NONE":
         failures.append(f"fault {s['fault']['name']} latched")
@@ -58,10 +61,14 @@ def main():
     if a.max_rest_angle_error is not None:
         checks += 1
         t = s["alignment"]
-        rest_error = math.atan2(c["equilibrium_sin"] * t["cos_ptheta_at_tc"] - c["equilibrium_cos"] * t["sin_ptheta_at_tc"],
-                                c["equilibrium_cos"] * t["cos_ptheta_at_tc"] + c["equilibrium_sin"] * t["sin_ptheta_at_tc"])
-        print(f"rest at t_c {math.atan2(c['equilibrium_sin'], c['equilibrium_cos']):+.4f} electrical rad, "
-              f"plant {math.atan2(t['sin_ptheta_at_tc'], t['cos_ptheta_at_tc']):+.4f} ({rest_error:+.4f} off)")
+        rest_error = math.atan2(
+            c["equilibrium_sin"] * t["cos_ptheta_at_tc"] - c["equilibrium_cos"] * t["sin_ptheta_at_tc"],
+            c["equilibrium_cos"] * t["cos_ptheta_at_tc"] + c["equilibrium_sin"] * t["sin_ptheta_at_tc"],
+        )
+        print(
+            f"rest at t_c {math.atan2(c['equilibrium_sin'], c['equilibrium_cos']):+.4f} electrical rad, "
+            f"plant {math.atan2(t['sin_ptheta_at_tc'], t['cos_ptheta_at_tc']):+.4f} ({rest_error:+.4f} off)"
+        )
         if not abs(rest_error) <= a.max_rest_angle_error:
             failures.append(f"rest at t_c {rest_error:+.4f} rad off, bound {a.max_rest_angle_error} rad")
     for f in failures:

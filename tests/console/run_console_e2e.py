@@ -27,14 +27,12 @@ mean per mode (-icount shift=0). Writes OUT/report.txt.
 usage: run_console_e2e.py --qemu Q --image ELF --sil PMSTEP_SIL --compare PIL_SUMMARY_COMPARE --out DIR
        [--duration 0.9] [--substeps 10] [--decimation 200] [--plugin pil_insn_plugin.so]
 """
+
 import argparse
 import csv
-import json
 import math
-import os
 import random
 import re
-import shutil
 import socket
 import struct
 import subprocess
@@ -48,10 +46,16 @@ import pmstep_console as pc  # noqa: E402
 
 # Per-sample tolerances: those of pil-summary-compare for the same quantities (float32
 # resolution of the signals, x10; see tests/pil/pil_summary_compare.c), and 1e-5 A on currents.
-TOLERANCE = {"speed_hat_rad_s": ("omega_hat_rad_s", 1e-5), "load_hat_Nm": ("load_hat_Nm", 2e-6),
-             "cos_hat": ("cos_hat", 1e-6), "sin_hat": ("sin_hat", 1e-6), "speed_ref_rad_s": ("omega_ref_rad_s", 1e-5),
-             "i_a_A": ("i_a_meas_A", 1e-5), "i_b_A": ("i_b_meas_A", 1e-5),
-             "bus_voltage_V": ("bus_voltage_meas_V", 1e-5)}
+TOLERANCE = {
+    "speed_hat_rad_s": ("omega_hat_rad_s", 1e-5),
+    "load_hat_Nm": ("load_hat_Nm", 2e-6),
+    "cos_hat": ("cos_hat", 1e-6),
+    "sin_hat": ("sin_hat", 1e-6),
+    "speed_ref_rad_s": ("omega_ref_rad_s", 1e-5),
+    "i_a_A": ("i_a_meas_A", 1e-5),
+    "i_b_A": ("i_b_meas_A", 1e-5),
+    "bus_voltage_V": ("bus_voltage_meas_V", 1e-5),
+}
 
 
 # The position run's move and its bound: the issue's final-error criterion, 0.1 electrical rad
@@ -84,8 +88,17 @@ class Fuzzer(threading.Thread):
         self.link = link
         self.rng = random.Random(seed)
         self.frames = frames
-        self.sent = {"garbage": 0, "bad_crc": 0, "bad_len": 0, "truncated": 0, "unknown": 0, "wrong_length": 0,
-                     "nan": 0, "config_while_running": 0, "hello_flood": 0}
+        self.sent = {
+            "garbage": 0,
+            "bad_crc": 0,
+            "bad_len": 0,
+            "truncated": 0,
+            "unknown": 0,
+            "wrong_length": 0,
+            "nan": 0,
+            "config_while_running": 0,
+            "hello_flood": 0,
+        }
 
     def run(self):
         r = self.rng
@@ -102,9 +115,11 @@ class Fuzzer(threading.Thread):
                 data = bytes([pc.SYNC, r.choice([0, 1, pc.MAX_PAYLOAD + 1, 200, 255])])
             elif kind == "truncated":
                 f = pc.encode(pc.START, 0xEE)
-                data = f[:r.randint(1, len(f) - 1)]
+                data = f[: r.randint(1, len(f) - 1)]
             elif kind == "unknown":
-                data = pc.encode(r.choice([0x00, 0x11, 0x3F, 0x42, 0x7F, 0x90, 0xFE]), 0xEE, r.randbytes(r.randint(0, 8)))
+                data = pc.encode(
+                    r.choice([0x00, 0x11, 0x3F, 0x42, 0x7F, 0x90, 0xFE]), 0xEE, r.randbytes(r.randint(0, 8))
+                )
             elif kind == "wrong_length":
                 data = pc.encode(pc.SPEED_TARGET, 0xEE, r.randbytes(r.choice([0, 3, 7, 9])))
             elif kind == "nan":
@@ -142,8 +157,9 @@ def step_addresses(elf):
     tools/bench_target.py)."""
     nm = subprocess.run(["arm-none-eabi-nm", elf], stdout=subprocess.PIPE, text=True, check=True).stdout
     entry = next(int(l.split()[0], 16) for l in nm.splitlines() if l.split()[-1] == "pmstep_step")
-    dis = subprocess.run(["arm-none-eabi-objdump", "-d", "--no-show-raw-insn", elf], stdout=subprocess.PIPE,
-                         text=True, check=True).stdout
+    dis = subprocess.run(
+        ["arm-none-eabi-objdump", "-d", "--no-show-raw-insn", elf], stdout=subprocess.PIPE, text=True, check=True
+    ).stdout
     lines = [l for l in dis.split("<Irq10_Handler>:", 1)[1].splitlines() if re.match(r"^\s+[0-9a-f]+:", l)]
     for i, l in enumerate(lines):
         if re.search(r"\bbl\s+[0-9a-f]+ <pmstep_step>", l):
@@ -158,12 +174,39 @@ def run_target(a, out, mode, period_s, k_speed, steps):
     for f in (summary, cost):
         if f.exists():
             f.unlink()
-    semi = ",".join(["enable=on", "target=native", "arg=pil-console", "arg=--duration", f"arg={a.duration}",
-                     "arg=--substeps", f"arg={a.substeps}", f"arg=--summary", f"arg={summary}", "arg=--cost",
-                     f"arg={cost}"])
-    cmdline = [a.qemu, "-M", "mps2-an386", "-cpu", "cortex-m4", "-nographic", "-monitor", "none", "-icount",
-               "shift=0", "-serial", f"tcp:127.0.0.1:{port},server=on,wait=on", "-semihosting-config", semi,
-               "-kernel", a.image]
+    semi = ",".join(
+        [
+            "enable=on",
+            "target=native",
+            "arg=pil-console",
+            "arg=--duration",
+            f"arg={a.duration}",
+            "arg=--substeps",
+            f"arg={a.substeps}",
+            "arg=--summary",
+            f"arg={summary}",
+            "arg=--cost",
+            f"arg={cost}",
+        ]
+    )
+    cmdline = [
+        a.qemu,
+        "-M",
+        "mps2-an386",
+        "-cpu",
+        "cortex-m4",
+        "-nographic",
+        "-monitor",
+        "none",
+        "-icount",
+        "shift=0",
+        "-serial",
+        f"tcp:127.0.0.1:{port},server=on,wait=on",
+        "-semihosting-config",
+        semi,
+        "-kernel",
+        a.image,
+    ]
     steps_file = out / f"{mode}_steps.txt"
     if a.plugin:
         entry, ret = step_addresses(a.image)
@@ -196,7 +239,7 @@ def run_target(a, out, mode, period_s, k_speed, steps):
         assert con.sim_advance(k_run) == k_run
         if mode == "position":
             assert con.move_to(POSITION_TARGET_RAD, 5.0, 50.0) == k_run
-        for stop_at in ((steps,) if mode == "position" else (k_speed, steps)):
+        for stop_at in (steps,) if mode == "position" else (k_speed, steps):
             fz = None
             now = con.status()["period"] + 1
             seq = con.send(pc.SIM_ADVANCE, struct.pack("<I", stop_at - now))
@@ -217,8 +260,12 @@ def run_target(a, out, mode, period_s, k_speed, steps):
             log["position"] = con.position()
         counters = con.counters()
         con.sim_finish()
-        log.update(status=status, counters=counters, telemetry=con.telemetry,
-                   fuzz={k: sum(f.sent[k] for f in fuzzers) for k in fuzzers[0].sent} if fuzzers else {})
+        log.update(
+            status=status,
+            counters=counters,
+            telemetry=con.telemetry,
+            fuzz={k: sum(f.sent[k] for f in fuzzers) for k in fuzzers[0].sent} if fuzzers else {},
+        )
     finally:
         link.close()
     try:
@@ -263,8 +310,21 @@ def main():
     failures = []
 
     # The host SIL, same scenario and settings; a CSV row every DECIMATION periods.
-    subprocess.run([a.sil, "--quiet", "--out", str(out / "sil"), "--set", f"run.duration_s={a.duration}",
-                    "--set", f"run.substeps={a.substeps}", "--set", f"run.decimation={a.decimation}"], check=True)
+    subprocess.run(
+        [
+            a.sil,
+            "--quiet",
+            "--out",
+            str(out / "sil"),
+            "--set",
+            f"run.duration_s={a.duration}",
+            "--set",
+            f"run.substeps={a.substeps}",
+            "--set",
+            f"run.decimation={a.decimation}",
+        ],
+        check=True,
+    )
     period_s = f32(50e-6)
     steps = int(math.floor(a.duration / period_s + 0.5))
     k_speed = next(k for k in range(steps) if k * period_s >= 0.65)  # sil_scenario_speed_command's test
@@ -282,22 +342,33 @@ def main():
     pos = runs.pop("position")
     p = pos["position"]
     pos_error = abs(p["position_rad"] - POSITION_TARGET_RAD)
-    if not (p["status"] == 0 and p["tracked"] and p["position_mode"] and not p["moving"]
-            and pos_error <= POSITION_BOUND_RAD):
-        failures.append(f"position: read-back {p} (|theta-hat - target| {pos_error:.3g} rad, bound {POSITION_BOUND_RAD:.3g})")
+    if not (
+        p["status"] == 0 and p["tracked"] and p["position_mode"] and not p["moving"] and pos_error <= POSITION_BOUND_RAD
+    ):
+        failures.append(
+            f"position: read-back {p} (|theta-hat - target| {pos_error:.3g} rad, bound {POSITION_BOUND_RAD:.3g})"
+        )
     if pos["status"]["mode"] != "RUN" or pos["status"]["fault"] != 0:
         failures.append(f"position: final status {pos['status']['mode']} fault {pos['status']['fault']}")
-    report_position = (f"[position] wall {pos['wall_s']:.1f} s; move to {POSITION_TARGET_RAD} rad at period "
-                       f"{int(0.6 / period_s) + 100}; read-back at period {p['period']}: theta-hat "
-                       f"{p['position_rad']:.6f} rad (|error| {pos_error:.3g} rad = {6 * pos_error:.3g} electrical, "
-                       f"bound {POSITION_BOUND_RAD:.3g}), theta* {p['position_ref_rad']:.6f}, flags tracked "
-                       f"{p['tracked']} position_mode {p['position_mode']} moving {p['moving']}")
+    report_position = (
+        f"[position] wall {pos['wall_s']:.1f} s; move to {POSITION_TARGET_RAD} rad at period "
+        f"{int(0.6 / period_s) + 100}; read-back at period {p['period']}: theta-hat "
+        f"{p['position_rad']:.6f} rad (|error| {pos_error:.3g} rad = {6 * pos_error:.3g} electrical, "
+        f"bound {POSITION_BOUND_RAD:.3g}), theta* {p['position_ref_rad']:.6f}, flags tracked "
+        f"{p['tracked']} position_mode {p['position_mode']} moving {p['moving']}"
+    )
 
-    report = [f"pmstep console end to end on QEMU mps2-an386: {a.duration} s of the paper scenario, "
-              f"{steps} periods, speed command at period {k_speed}, telemetry every {a.decimation} periods"]
+    report = [
+        f"pmstep console end to end on QEMU mps2-an386: {a.duration} s of the paper scenario, "
+        f"{steps} periods, speed command at period {k_speed}, telemetry every {a.decimation} periods"
+    ]
     for mode, run in runs.items():
-        rc = subprocess.run([a.compare, str(out / "sil" / "summary.json"), str(run["summary"])],
-                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        rc = subprocess.run(
+            [a.compare, str(out / "sil" / "summary.json"), str(run["summary"])],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+        )
         (out / f"{mode}_compare.txt").write_text(rc.stdout)
         if rc.returncode != 0:
             failures.append(f"{mode}: the target's summary differs from the host SIL's beyond the PIL tolerances")
@@ -306,8 +377,10 @@ def main():
         periods = [int(t["period"]) for t in run["telemetry"]]
         expected = list(range(a.decimation, steps, a.decimation))
         if periods != expected:
-            failures.append(f"{mode}: telemetry periods {periods[:3]}..{periods[-3:]} (n={len(periods)}), "
-                            f"expected every {a.decimation} from {a.decimation} (n={len(expected)})")
+            failures.append(
+                f"{mode}: telemetry periods {periods[:3]}..{periods[-3:]} (n={len(periods)}), "
+                f"expected every {a.decimation} from {a.decimation} (n={len(expected)})"
+            )
         for t in run["telemetry"]:
             row = sil_rows.get(int(t["period"]))
             if row is None:
@@ -319,18 +392,25 @@ def main():
                 d = abs(t[key] - float(row[col]))
                 worst[key] = max(worst[key], d)
                 if not d <= tol:
-                    failures.append(f"{mode}: period {t['period']}: {key} {t[key]!r} vs SIL {row[col]} (|d| {d:.3g} > {tol})")
+                    failures.append(
+                        f"{mode}: period {t['period']}: {key} {t[key]!r} vs SIL {row[col]} (|d| {d:.3g} > {tol})"
+                    )
         st = run["status"]
         if st["mode"] != "RUN" or st["fault"] != 0:
             failures.append(f"{mode}: final status {st['mode']} fault {st['fault']}")
         modes = run["cost"]["modes"]
-        report.append(f"[{mode}] wall {run['wall_s']:.1f} s; {len(periods)} telemetry frames; final status: period "
-                      f"{st['period']} {st['mode']} fault {st['fault']} speed_hat {st['speed_hat_rad_s']:.6f} rad/s "
-                      f"load_hat {st['load_hat_Nm']:.6f} Nm")
-        report.append(f"[{mode}] telemetry vs SIL, largest |difference|: "
-                      + ", ".join(f"{k} {v:.3g}" for k, v in worst.items()))
-        report.append(f"[{mode}] control step (SysTick, -icount shift=0), mean instructions per mode: "
-                      + ", ".join(f"{m} {v['instructions_mean']:.2f} ({v['steps']} steps)" for m, v in modes.items()))
+        report.append(
+            f"[{mode}] wall {run['wall_s']:.1f} s; {len(periods)} telemetry frames; final status: period "
+            f"{st['period']} {st['mode']} fault {st['fault']} speed_hat {st['speed_hat_rad_s']:.6f} rad/s "
+            f"load_hat {st['load_hat_Nm']:.6f} Nm"
+        )
+        report.append(
+            f"[{mode}] telemetry vs SIL, largest |difference|: " + ", ".join(f"{k} {v:.3g}" for k, v in worst.items())
+        )
+        report.append(
+            f"[{mode}] control step (SysTick, -icount shift=0), mean instructions per mode: "
+            + ", ".join(f"{m} {v['instructions_mean']:.2f} ({v['steps']} steps)" for m, v in modes.items())
+        )
         report.append(f"[{mode}] console counters: " + ", ".join(f"{k} {v}" for k, v in run["cost"]["console"].items()))
         if run["fuzz"]:
             report.append(f"[{mode}] bad input sent: " + ", ".join(f"{k} {v}" for k, v in run["fuzz"].items()))
@@ -362,15 +442,23 @@ def main():
     if a.plugin:
         ca, fa = clean["insns"], fuzz["insns"]
         if len(ca) != steps or ca != fa:
-            failures.append(f"exact instruction counts of the control step differ (clean {len(ca)} steps, fuzz {len(fa)})")
+            failures.append(
+                f"exact instruction counts of the control step differ (clean {len(ca)} steps, fuzz {len(fa)})"
+            )
         else:
-            report.append(f"control step, exact instructions (plugin), identical step by step in both runs ({steps} steps):")
+            report.append(
+                f"control step, exact instructions (plugin), identical step by step in both runs ({steps} steps):"
+            )
             t_s, t_c = 0.3, 0.6  # the paper scenario's alignment times
-            for name, lo, hi in (("S_ALIGN", 0, int(round(t_s / period_s))),
-                                 ("C_ALIGN", int(round(t_s / period_s)), int(round(t_c / period_s))),
-                                 ("RUN", int(round(t_c / period_s)), steps)):
+            for name, lo, hi in (
+                ("S_ALIGN", 0, int(round(t_s / period_s))),
+                ("C_ALIGN", int(round(t_s / period_s)), int(round(t_c / period_s))),
+                ("RUN", int(round(t_c / period_s)), steps),
+            ):
                 seg = ca[lo:hi]
-                report.append(f"  periods {lo}..{hi - 1} ({name}): min {min(seg)} mean {sum(seg) / len(seg):.1f} max {max(seg)}")
+                report.append(
+                    f"  periods {lo}..{hi - 1} ({name}): min {min(seg)} mean {sum(seg) / len(seg):.1f} max {max(seg)}"
+                )
     ta = [(t["period"], t["speed_hat_rad_s"], t["load_hat_Nm"]) for t in clean["telemetry"]]
     tb = [(t["period"], t["speed_hat_rad_s"], t["load_hat_Nm"]) for t in fuzz["telemetry"]]
     if ta != tb:

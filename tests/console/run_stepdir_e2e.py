@@ -35,6 +35,7 @@ Writes OUT/report.txt (the figures of each case) and each case's telemetry CSV.
 
 usage: run_stepdir_e2e.py --qemu Q --image ELF --sil PMSTEP_SIL --out DIR [--substeps 1] [--decimation 200]
 """
+
 import argparse
 import csv
 import json
@@ -51,8 +52,8 @@ from run_console_e2e import TOLERANCE  # noqa: E402
 from run_store_e2e import Board  # noqa: E402
 
 PERIOD_S = pc.f32(50e-6)  # the paper scenario's period (float32, as the firmware keeps it)
-POLE_PAIRS = 6            # the paper's motor
-MICROSTEPS = 256          # a microstep of the paper's motor moves the tracker's speed by less than the stall
+POLE_PAIRS = 6  # the paper's motor
+MICROSTEPS = 256  # a microstep of the paper's motor moves the tracker's speed by less than the stall
 #                           detection's bound at 256 (tools/stepdir_compare.py); 2 pi / 6144 rad
 FULL_STEP_RAD = 0.5 * math.pi / POLE_PAIRS
 
@@ -61,16 +62,26 @@ FULL_STEP_RAD = 0.5 * math.pi / POLE_PAIRS
 # torque's acceleration k_M I / J = 1600 rad/s^2 (less the 2 N m load: 200 rad/s^2); the last move ends
 # 0.2 s before the run does (1.68 s and 1.54 s): the final dwell.
 CASES = {
-    "s-curve": {"points": "0.61:1.0,0.95:-0.5,1.35:-0.3,1.5:0.4", "v_max": 4.8, "a_max": 300.0, "j_max": 15000.0,
-                "duration_s": 1.9},
-    "trapezoid": {"points": "0.61:1.5,0.95:-1.0,1.3:0.6", "v_max": 7.6, "a_max": 300.0, "j_max": 0.0,
-                  "duration_s": 1.75},
+    "s-curve": {
+        "points": "0.61:1.0,0.95:-0.5,1.35:-0.3,1.5:0.4",
+        "v_max": 4.8,
+        "a_max": 300.0,
+        "j_max": 15000.0,
+        "duration_s": 1.9,
+    },
+    "trapezoid": {
+        "points": "0.61:1.5,0.95:-1.0,1.3:0.6",
+        "v_max": 7.6,
+        "a_max": 300.0,
+        "j_max": 0.0,
+        "duration_s": 1.75,
+    },
 }
 # Before following, from PRE_FOLLOW_AT: forward two turns of the counter and more, back across a wrap;
 # the counter ends at -200 mod 65536, so that every move through the start crosses the wrap.
 PRE_FOLLOW_AT = 2000
 PRE_FOLLOW_EDGES = (150000, -19128)
-BURST = 127                # edges a period in the bursts (SIM_STEPS carries i8 edges)
+BURST = 127  # edges a period in the bursts (SIM_STEPS carries i8 edges)
 
 # The bound on the following error, moving or at rest, on the firmware's estimate and on the plant:
 # a quarter of a full step (0.065 rad). The SIL's runs of these cases (substeps 1) reach 0.12 and 0.14
@@ -88,12 +99,35 @@ def sil_run(a, out, case):
     """The host SIL's run of @p case, a CSV row every period: (rows by period, summary)."""
     c = CASES[case]
     sil_out = out / f"sil-{case}"
-    subprocess.run([a.sil, "--quiet", "--out", str(sil_out), "--set", f"run.duration_s={c['duration_s']}",
-                    "--set", f"run.substeps={a.substeps}", "--set", "run.decimation=1", "--set", "speed.points=0:0",
-                    "--set", "position.source=stepdir", "--set", f"position.points={c['points']}",
-                    "--set", f"position.v_max_rad_s={c['v_max']}", "--set", f"position.a_max_rad_s2={c['a_max']}",
-                    "--set", f"position.j_max_rad_s3={c['j_max']}", "--set", f"stepdir.microsteps={MICROSTEPS}"],
-                   check=True)
+    subprocess.run(
+        [
+            a.sil,
+            "--quiet",
+            "--out",
+            str(sil_out),
+            "--set",
+            f"run.duration_s={c['duration_s']}",
+            "--set",
+            f"run.substeps={a.substeps}",
+            "--set",
+            "run.decimation=1",
+            "--set",
+            "speed.points=0:0",
+            "--set",
+            "position.source=stepdir",
+            "--set",
+            f"position.points={c['points']}",
+            "--set",
+            f"position.v_max_rad_s={c['v_max']}",
+            "--set",
+            f"position.a_max_rad_s2={c['a_max']}",
+            "--set",
+            f"position.j_max_rad_s3={c['j_max']}",
+            "--set",
+            f"stepdir.microsteps={MICROSTEPS}",
+        ],
+        check=True,
+    )
     with open(sil_out / "run.csv", newline="") as f:
         rows = [r for r in csv.DictReader(f)]
     summary = json.loads((sil_out / "summary.json").read_text())
@@ -101,7 +135,7 @@ def sil_run(a, out, case):
 
 
 def chunks(edges, size=pc.SIM_STEPS_MAX):
-    return [edges[i:i + size] for i in range(0, len(edges), size)]
+    return [edges[i : i + size] for i in range(0, len(edges), size)]
 
 
 def parse_figures(path):
@@ -130,8 +164,7 @@ def run_case(a, out, case):
     figures_path = out / f"{case}_stepdir.txt"
     figures_path.unlink(missing_ok=True)
     t0 = time.monotonic()
-    board = Board(a, None, c["duration_s"], substeps=a.substeps, extra=["--stepdir", str(figures_path)],
-                  nodelay=True)
+    board = Board(a, None, c["duration_s"], substeps=a.substeps, extra=["--stepdir", str(figures_path)], nodelay=True)
     con = board.con
     reads = []  # (SIM_STEPDIR, GET_POSITION, edges sent since following began) after each chunk
     try:
@@ -156,9 +189,11 @@ def run_case(a, out, case):
         pre_sum = sum(PRE_FOLLOW_EDGES)
         if not (pre["steps"] == pre_sum == pre["edges"] and pre["counter"] == pre_sum % 65536 and not pre["following"]):
             failures.append(f"{case}: before following, {pre} after {pre_sum} edges")
-        report.append(f"[{case}] before following: {len(burst)} periods of bursts ({len(chunks(burst))} SIM_STEPS, "
-                      f"{sum(abs(e) for e in burst)} edges, the counter wrapped {wraps_before} times): the input "
-                      f"counted {pre['steps']} (sent {pre_sum}), counter {pre['counter']}")
+        report.append(
+            f"[{case}] before following: {len(burst)} periods of bursts ({len(chunks(burst))} SIM_STEPS, "
+            f"{sum(abs(e) for e in burst)} edges, the counter wrapped {wraps_before} times): the input "
+            f"counted {pre['steps']} (sent {pre_sum}), counter {pre['counter']}"
+        )
         # Following from the SIL's period, then the SIL's count period by period.
         con.sim_advance(k_follow - PRE_FOLLOW_AT - len(burst))
         if con.sim_follow_steps() != k_follow:
@@ -169,13 +204,13 @@ def run_case(a, out, case):
         chunks_sent = 0
         while k < steps:
             i = k - k_follow
-            chunk = edges[i:i + pc.SIM_STEPS_MAX]
+            chunk = edges[i : i + pc.SIM_STEPS_MAX]
             if any(chunk):
                 con.sim_steps(chunk)
                 chunks_sent += 1
             else:  # a dwell: to the next edge
                 n = next((j for j in range(i, len(edges)) if edges[j]), len(edges)) - i
-                chunk = edges[i:i + n]
+                chunk = edges[i : i + n]
             counter_before = pre_sum + sent
             sent += sum(chunk)
             wraps += abs((pre_sum + sent) // 65536 - counter_before // 65536)
@@ -197,9 +232,15 @@ def run_case(a, out, case):
     worst_fw = 0.0
     worst_hat = worst_ref = 0.0
     for sd, pos, sent_then in reads:
-        if sd["steps"] != sent_then or sd["edges"] != pre_sum + sent_then or sd["counter"] != (pre_sum + sent_then) % 65536:
-            failures.append(f"{case}: period {sd['period']}: counted {sd['steps']}, edges {sd['edges']}, counter "
-                            f"{sd['counter']}; sent {sent_then} since following, {pre_sum + sent_then} in all")
+        if (
+            sd["steps"] != sent_then
+            or sd["edges"] != pre_sum + sent_then
+            or sd["counter"] != (pre_sum + sent_then) % 65536
+        ):
+            failures.append(
+                f"{case}: period {sd['period']}: counted {sd['steps']}, edges {sd['edges']}, counter "
+                f"{sd['counter']}; sent {sent_then} since following, {pre_sum + sent_then} in all"
+            )
         if sd["diag"] or not sd["following"]:
             failures.append(f"{case}: period {sd['period']}: DIAG {sd['diag']}, following {sd['following']}")
         worst_fw = max(worst_fw, abs(sd["following_error_rad"]))
@@ -210,24 +251,33 @@ def run_case(a, out, case):
     if worst_fw > bound_rad:
         failures.append(f"{case}: the firmware's following error reached {worst_fw / FULL_STEP_RAD:.4f} full steps")
     if max(worst_hat, worst_ref) > POSITION_TOLERANCE_RAD:
-        failures.append(f"{case}: theta-hat / theta* read back differ from the SIL's by {worst_hat:.3g} / "
-                        f"{worst_ref:.3g} rad (tolerance {POSITION_TOLERANCE_RAD:g})")
+        failures.append(
+            f"{case}: theta-hat / theta* read back differ from the SIL's by {worst_hat:.3g} / "
+            f"{worst_ref:.3g} rad (tolerance {POSITION_TOLERANCE_RAD:g})"
+        )
     final_offset = abs(last_pos["position_rad"] - last_sd["commanded_rad"])
     if final_offset > bound_rad:
         failures.append(f"{case}: at the end theta-hat is {final_offset / FULL_STEP_RAD:.4f} full steps from the count")
-    if not (figures["edges_sent"] == figures["steps_counted"] == sent and figures["following_periods"] == steps - k_follow
-            and figures["microsteps"] == MICROSTEPS):
+    if not (
+        figures["edges_sent"] == figures["steps_counted"] == sent
+        and figures["following_periods"] == steps - k_follow
+        and figures["microsteps"] == MICROSTEPS
+    ):
         failures.append(f"{case}: the image's figures {figures}, sent {sent} over {steps - k_follow} periods")
     if figures["diag_periods"] != 0:
         failures.append(f"{case}: DIAG asserted in {figures['diag_periods']} periods")
     if figures["max_error_full_steps"] > BOUND_FULL_STEPS or abs(figures["final_error_full_steps"]) > BOUND_FULL_STEPS:
-        failures.append(f"{case}: the following error on the plant reached {figures['max_error_full_steps']:.4f} full "
-                        f"steps (final {figures['final_error_full_steps']:+.4f})")
+        failures.append(
+            f"{case}: the following error on the plant reached {figures['max_error_full_steps']:.4f} full "
+            f"steps (final {figures['final_error_full_steps']:+.4f})"
+        )
     sil_sd = summary["stepdir"]
     d_error = abs(figures["max_error_full_steps"] - sil_sd["max_error_full_steps"])
     if d_error > ERROR_TOLERANCE_FULL_STEPS:
-        failures.append(f"{case}: the largest following error on the plant {figures['max_error_full_steps']:.6f} full "
-                        f"steps, the SIL's {sil_sd['max_error_full_steps']:.6f}")
+        failures.append(
+            f"{case}: the largest following error on the plant {figures['max_error_full_steps']:.6f} full "
+            f"steps, the SIL's {sil_sd['max_error_full_steps']:.6f}"
+        )
     if status["mode"] != "RUN" or status["fault"] != 0:
         failures.append(f"{case}: final status {status['mode']} fault {status['fault']}")
     if counters["rx_error_replies"] != 0 or counters["tx_dropped"] != 0:
@@ -246,7 +296,9 @@ def run_case(a, out, case):
             d = abs(t[key] - float(row[col]))
             worst[key] = max(worst[key], d)
             if not d <= tol:
-                failures.append(f"{case}: period {t['period']}: {key} {t[key]!r} vs SIL {row[col]} (|d| {d:.3g} > {tol})")
+                failures.append(
+                    f"{case}: period {t['period']}: {key} {t[key]!r} vs SIL {row[col]} (|d| {d:.3g} > {tol})"
+                )
 
     absolute = sum(abs(e) for e in edges)
     report += [
@@ -258,7 +310,8 @@ def run_case(a, out, case):
         f"{figures['diag_periods']}; final {status['mode']} fault {status['fault']}",
         f"[{case}] following error, full steps (bound {BOUND_FULL_STEPS}): firmware's at read-backs max "
         f"{worst_fw / FULL_STEP_RAD:.4f}; plant's (every period) max {figures['max_error_full_steps']:.4f}, final "
-        f"{figures['final_error_full_steps']:+.4f}, SIL's max {sil_sd['max_error_full_steps']:.4f} (|d| {d_error:.2g}); "
+        f"{figures['final_error_full_steps']:+.4f}, "
+        f"SIL's max {sil_sd['max_error_full_steps']:.4f} (|d| {d_error:.2g}); "
         f"theta-hat at the end {final_offset / FULL_STEP_RAD:.4f} from the count",
         f"[{case}] against the SIL: theta-hat, theta* read back within {worst_hat:.3g}, {worst_ref:.3g} rad; telemetry "
         f"({len(periods)} frames), largest |difference|: " + ", ".join(f"{k} {v:.3g}" for k, v in worst.items()),
@@ -276,8 +329,10 @@ def main():
     a = ap.parse_args()
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
-    report = [f"pmstep STEP/DIR end to end on QEMU mps2-an386: the paper scenario, {a.substeps} plant steps a period, "
-              f"the host's step stream on the emulated counter"]
+    report = [
+        f"pmstep STEP/DIR end to end on QEMU mps2-an386: the paper scenario, {a.substeps} plant steps a period, "
+        f"the host's step stream on the emulated counter"
+    ]
     failures = []
     for case in a.cases.split(","):
         r, f = run_case(a, out, case)

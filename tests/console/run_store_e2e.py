@@ -16,7 +16,8 @@ of the board; the image stopping in a flash write (--power-cut-after N) is a pow
   power cut  a save of another design cut at its erase, its first and a middle program and its CRC's
              program: after each reset the previous record is in force, value for value
   calibrate  an erased flash, the motor free (no load), `calibrate --current 8 --pole-pairs 6
-             --detent-fraction 0` (the paper's motor: 8 A, 6 pole pairs, no detent): done and saved; a reset: configured with the
+             --detent-fraction 0` (the paper's motor: 8 A, 6 pole pairs, no detent): done and saved; a reset:
+             configured with the
              calibrated design; START and 5 rad/s: RUN at the speed, no fault. The measured R, L, k_M, J,
              F are set beside the plant's and the datasheet design's in the report.
 
@@ -27,9 +28,9 @@ STM32G4's flash controller (hal/stm32g4's behavioural model tests its driver).
 usage: run_store_e2e.py --qemu Q --image ELF --sil PMSTEP_SIL --tune PMSTEP_TUNE --compare PIL_SUMMARY_COMPARE
                         --out DIR
 """
+
 import argparse
 import atexit
-import json
 import math
 import os
 import shlex
@@ -45,11 +46,16 @@ from run_console_e2e import free_port  # noqa: E402
 
 PAPER = ROOT / "sil" / "scenarios" / "motors" / "paper.ini"
 PERIOD_S = 50e-6
-RUN_DURATION_S = 0.9      # the paper scenario, as run_console_e2e.py
+RUN_DURATION_S = 0.9  # the paper scenario, as run_console_e2e.py
 CALIBRATE_DURATION_S = 9.0
 SUBSTEPS = 2
-PAPER_MOTOR = {"resistance_Ohm": 3.0, "inductance_H": 0.006, "torque_constant_Nm_A": 2.0, "inertia_kgm2": 0.01,
-               "friction_Nms_rad": 0.0}
+PAPER_MOTOR = {
+    "resistance_Ohm": 3.0,
+    "inductance_H": 0.006,
+    "torque_constant_Nm_A": 2.0,
+    "inertia_kgm2": 0.01,
+    "friction_Nms_rad": 0.0,
+}
 
 
 BOARDS = []  # every QEMU started, so that none outlives this script when a step fails
@@ -68,8 +74,18 @@ class Board:
     connected. @p extra: more of the image's options; @p nodelay: QEMU sends each byte of the image's
     replies at once (TCP_NODELAY; without it the host's delayed ACK holds a reply back some 40 ms)."""
 
-    def __init__(self, a, flash, duration_s, summary=None, cut_after=None, no_load=False, substeps=SUBSTEPS,
-                 extra=(), nodelay=False):
+    def __init__(
+        self,
+        a,
+        flash,
+        duration_s,
+        summary=None,
+        cut_after=None,
+        no_load=False,
+        substeps=SUBSTEPS,
+        extra=(),
+        nodelay=False,
+    ):
         self.port = free_port()
         args = ["pil-console", "--duration", str(duration_s), "--substeps", str(substeps)]
         args += ["--flash", str(flash)] if flash is not None else []
@@ -81,9 +97,22 @@ class Board:
         if no_load:
             args.append("--no-load")
         semi = ",".join(["enable=on", "target=native"] + [f"arg={x}" for x in args])
-        self.cmd = [a.qemu, "-M", "mps2-an386", "-cpu", "cortex-m4", "-nographic", "-monitor", "none", "-serial",
-                    f"tcp:127.0.0.1:{self.port},server=on,wait=on" + (",nodelay=on" if nodelay else ""),
-                    "-semihosting-config", semi, "-kernel", a.image]
+        self.cmd = [
+            a.qemu,
+            "-M",
+            "mps2-an386",
+            "-cpu",
+            "cortex-m4",
+            "-nographic",
+            "-monitor",
+            "none",
+            "-serial",
+            f"tcp:127.0.0.1:{self.port},server=on,wait=on" + (",nodelay=on" if nodelay else ""),
+            "-semihosting-config",
+            semi,
+            "-kernel",
+            a.image,
+        ]
         self.qemu = subprocess.Popen(self.cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
         BOARDS.append(self)
         self.link = None
@@ -151,8 +180,10 @@ def main():
     flash.unlink(missing_ok=True)
     b = Board(a, flash, RUN_DURATION_S)
     hello = b.con.hello()
-    check(hello["store"] and not hello["configured"], f"empty: HELLO says store {hello['store']}, "
-                                                     f"configured {hello['configured']}")
+    check(
+        hello["store"] and not hello["configured"],
+        f"empty: HELLO says store {hello['store']}, configured {hello['configured']}",
+    )
     try:
         b.con.start()
         check(False, "empty: START accepted with no motor configured")
@@ -187,8 +218,10 @@ def main():
     b.con.sim_advance(steps - k_speed, timeout=600.0)
     status = b.con.status()
     rc, err = b.finish()
-    check(status["mode"] == "RUN" and status["fault"] == 0, f"reset: after the scenario {status['mode']}, "
-                                                            f"fault {status['fault']}")
+    check(
+        status["mode"] == "RUN" and status["fault"] == 0,
+        f"reset: after the scenario {status['mode']}, fault {status['fault']}",
+    )
     sets = []
     for e in b_table:
         if e["read_only"]:
@@ -196,13 +229,31 @@ def main():
         if e["name"].startswith("stepdir."):
             continue  # the STEP/DIR input's settings: the console's, not the core configuration the SIL runs
         sets += ["--set", f"controller.{e['name']}={scenario_value(e['type'], after[e['name']])}"]
-    subprocess.run([a.sil, "--quiet", "--no-csv", "--out", str(out / "sil"), "--set", f"run.duration_s={RUN_DURATION_S}",
-                    "--set", f"run.substeps={SUBSTEPS}"] + sets, check=True)
-    cmp = subprocess.run([a.compare, str(out / "sil" / "summary.json"), str(summary)], stdout=subprocess.PIPE,
-                         stderr=subprocess.STDOUT, text=True)
+    subprocess.run(
+        [
+            a.sil,
+            "--quiet",
+            "--no-csv",
+            "--out",
+            str(out / "sil"),
+            "--set",
+            f"run.duration_s={RUN_DURATION_S}",
+            "--set",
+            f"run.substeps={SUBSTEPS}",
+        ]
+        + sets,
+        check=True,
+    )
+    cmp = subprocess.run(
+        [a.compare, str(out / "sil" / "summary.json"), str(summary)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
     (out / "reset_compare.txt").write_text(cmp.stdout)
-    check(cmp.returncode == 0, "reset: the target's run of the stored design matches the host SIL's "
-                               "(pil-summary-compare)")
+    check(
+        cmp.returncode == 0, "reset: the target's run of the stored design matches the host SIL's (pil-summary-compare)"
+    )
 
     # ---- power cuts in a save ----
     unit_ops = 1 + (pc.RECORD_HEADER.size + 4 * len(after) + 4 * len(pc.MEASURED_FIELDS) + 4 + 7) // 8
@@ -215,14 +266,17 @@ def main():
         except pc.ConsoleError:
             pass
         rc, err = b.lost()
-        check(rc == 5 and "power cut" in err, f"power cut at operation {cut} of {unit_ops}: the image stopped "
-                                               f"(exit {rc})")
+        check(
+            rc == 5 and "power cut" in err, f"power cut at operation {cut} of {unit_ops}: the image stopped (exit {rc})"
+        )
         b = Board(a, flash, RUN_DURATION_S)
         now = values(b.con)
         diff = [k for k in designed if designed[k] != now[k]]
-        check(not diff and b.con.hello()["configured"],
-              f"power cut at operation {cut}: after the reset the previous record is in force"
-              + (f" (differ: {diff})" if diff else ""))
+        check(
+            not diff and b.con.hello()["configured"],
+            f"power cut at operation {cut}: after the reset the previous record is in force"
+            + (f" (differ: {diff})" if diff else ""),
+        )
         b.finish()
 
     # ---- calibrate from the rated current ----
@@ -232,8 +286,19 @@ def main():
     t0 = time.monotonic()
     calibrated = None
     try:
-        b.command("calibrate", "--current", "8", "--pole-pairs", "6", "--detent-fraction", "0", "--advance", "4000",
-                  "--timeout", "1200")
+        b.command(
+            "calibrate",
+            "--current",
+            "8",
+            "--pole-pairs",
+            "6",
+            "--detent-fraction",
+            "0",
+            "--advance",
+            "4000",
+            "--timeout",
+            "1200",
+        )
         calibrated = b.con.calibrate_status()
         check(True, f"calibrate: done in {calibrated['runs']} runs ({time.monotonic() - t0:.0f} s wall)")
     except pc.ConsoleError as e:
@@ -251,19 +316,29 @@ def main():
         b.con.sim_advance(int(1.0 / PERIOD_S), timeout=900.0)
         status = b.con.status()
         b.finish()
-        check(status["mode"] == "RUN" and status["fault"] == 0 and abs(status["speed_hat_rad_s"] - 5.0) < 0.25,
-              f"calibrate: the motor runs: {status['mode']}, fault {status['fault']}, speed_hat "
-              f"{status['speed_hat_rad_s']:.4f} rad/s (5 commanded)")
+        check(
+            status["mode"] == "RUN" and status["fault"] == 0 and abs(status["speed_hat_rad_s"] - 5.0) < 0.25,
+            f"calibrate: the motor runs: {status['mode']}, fault {status['fault']}, speed_hat "
+            f"{status['speed_hat_rad_s']:.4f} rad/s (5 commanded)",
+        )
         rows = []
         for key, plant in PAPER_MOTOR.items():
             drive = calibrated[key]
             ds = designed[f"motor.{key}"]
             rel = f"{100.0 * (drive / plant - 1.0):+.2f} %" if plant else f"{drive:.3g}"
             rows.append(f"  {key:22s} plant {plant:<10.5g} datasheet design {ds:<10.5g} drive {drive:<10.5g} ({rel})")
-        for name in ("gains.speed_gain_per_s", "gains.observer_gain_per_s", "gains.current_gain_per_s",
-                     "alignment.s_align_voltage_V", "alignment.c_align_time_s", "limits.max_phase_current_A"):
+        for name in (
+            "gains.speed_gain_per_s",
+            "gains.observer_gain_per_s",
+            "gains.current_gain_per_s",
+            "alignment.s_align_voltage_V",
+            "alignment.c_align_time_s",
+            "limits.max_phase_current_A",
+        ):
             ds, drive = designed[name], cal_values[name]
-            rows.append(f"  {name:30s} datasheet {ds:<10.5g} drive {drive:<10.5g} ({100.0 * (drive / ds - 1.0):+.1f} %)")
+            rows.append(
+                f"  {name:30s} datasheet {ds:<10.5g} drive {drive:<10.5g} ({100.0 * (drive / ds - 1.0):+.1f} %)"
+            )
         report.append("calibrate on the target, the paper's motor (robust mode; the datasheet design: paper mode):")
         report.extend(rows)
     report += [f"FAIL: {f}" for f in failures] or ["PASS"]

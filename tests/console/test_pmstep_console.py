@@ -10,6 +10,7 @@ on the same file): setup, backup, erase, restore, refusals, power cuts in a save
 usage: [PMSTEP_TUNE=PATH/TO/pmstep-tune] test_pmstep_console.py PATH/TO/console-host-drive
 (the tests that run setup need PMSTEP_TUNE, and are skipped without it)
 """
+
 import configparser
 import contextlib
 import io
@@ -35,13 +36,14 @@ DRIVE = None
 TOOL = Path(pc.__file__).resolve()
 
 
-
 def firmware_config_entries():
     """How many configuration values the firmware's table (pmstep_console_config.c) lists."""
-    source = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "firmware", "console", "src",
-                          "pmstep_console_config.c")
+    source = os.path.join(
+        os.path.dirname(os.path.abspath(__file__)), "..", "..", "firmware", "console", "src", "pmstep_console_config.c"
+    )
     with open(source, encoding="utf-8") as f:
         return len(re.findall(r"^\s+(?:F32|U32|I32|BOOL|F32_RO|U32_RO|SD_F32|SD_U32|SD_BOOL)\(", f.read(), flags=re.M))
+
 
 class Framing(unittest.TestCase):
     def test_crc_check_value(self):
@@ -55,7 +57,7 @@ class Framing(unittest.TestCase):
         d = pc.Decoder()
         got = []
         for i in range(0, len(stream), 3):  # fed in pieces
-            got += d.feed(stream[i:i + 3])
+            got += d.feed(stream[i : i + 3])
         self.assertEqual([(t, s) for t, s, _ in got], [(1, 1), (5, 2)])
         self.assertEqual(struct.unpack("<ff", got[1][2]), (10.0, 50.0))
         self.assertGreater(d.bad, 0)
@@ -74,6 +76,7 @@ class Framing(unittest.TestCase):
 
 class AgainstTheFirmwareConsole(unittest.TestCase):
     """The tool on one side of a pty, console-host-drive (the C console and the core) on the other."""
+
     DRIVE_ARGS = []
 
     def setUp(self):
@@ -125,15 +128,22 @@ class AgainstTheFirmwareConsole(unittest.TestCase):
         with self.assertRaisesRegex(pc.DeviceError, "status -20"):  # PMSTEP_ERR_RESISTANCE
             c.set_config("motor.resistance_Ohm", -1.0)
         # The STEP/DIR settings: by name like the rest, each value out of range refused with its own code.
-        for name in ("stepdir.microsteps", "stepdir.invert_direction", "stepdir.enable_active_high",
-                     "stepdir.diag_active_high", "stepdir.diag_mode", "stepdir.following_error_limit_full_steps"):
+        for name in (
+            "stepdir.microsteps",
+            "stepdir.invert_direction",
+            "stepdir.enable_active_high",
+            "stepdir.diag_active_high",
+            "stepdir.diag_mode",
+            "stepdir.following_error_limit_full_steps",
+        ):
             self.assertIn(name, names)
         self.assertEqual(c.get_config("stepdir.microsteps")["value"], 16.0)
-        for name, value, code in (("stepdir.microsteps", 0, r"status -135 \(PMSTEP_ERR_STEPDIR_MICROSTEPS"),
-                                  ("stepdir.microsteps", 257, r"status -135 \(PMSTEP_ERR_STEPDIR_MICROSTEPS"),
-                                  ("stepdir.diag_mode", 2, r"status -138 \(PMSTEP_ERR_STEPDIR_DIAG_MODE"),
-                                  ("stepdir.following_error_limit_full_steps", 0.0,
-                                   r"status -137 \(PMSTEP_ERR_STEPDIR_LIMIT")):
+        for name, value, code in (
+            ("stepdir.microsteps", 0, r"status -135 \(PMSTEP_ERR_STEPDIR_MICROSTEPS"),
+            ("stepdir.microsteps", 257, r"status -135 \(PMSTEP_ERR_STEPDIR_MICROSTEPS"),
+            ("stepdir.diag_mode", 2, r"status -138 \(PMSTEP_ERR_STEPDIR_DIAG_MODE"),
+            ("stepdir.following_error_limit_full_steps", 0.0, r"status -137 \(PMSTEP_ERR_STEPDIR_LIMIT"),
+        ):
             with self.subTest(name=name, value=value), self.assertRaisesRegex(pc.DeviceError, code):
                 c.set_config(name, value)
         self.assertEqual(c.get_config("stepdir.microsteps")["value"], 16.0)
@@ -198,7 +208,7 @@ class AgainstTheFirmwareConsole(unittest.TestCase):
         shell = pc.Shell(self.con)
         with contextlib.redirect_stdout(out):
             shell.onecmd("hello")
-            shell.onecmd("speed nan")         # refused by the drive: an error line, the shell goes on
+            shell.onecmd("speed nan")  # refused by the drive: an error line, the shell goes on
             shell.onecmd("id 0.5")
             shell.onecmd("no_such_command")
             self.assertTrue(shell.onecmd("quit"))
@@ -228,6 +238,7 @@ class AgainstAPositionDrive(AgainstTheFirmwareConsole):
     """console-host-drive --position: position control attached. Its constant samples never reach
     RUN, so the position requests come back with the core's status (the encoding of a move's
     read-back in RUN is checked end to end on QEMU, console.qemu_e2e)."""
+
     DRIVE_ARGS = ["--position"]
 
     def test_position_requests_without_position_control(self):
@@ -239,8 +250,10 @@ class AgainstAPositionDrive(AgainstTheFirmwareConsole):
     def test_sim_stepdir(self):
         c = self.con
         s = c.sim_stepdir()
-        self.assertEqual((s["steps"], s["edges"], s["counter"], s["following"], s["moving"], s["diag"]),
-                         (0, 0, 0, False, False, False))
+        self.assertEqual(
+            (s["steps"], s["edges"], s["counter"], s["following"], s["moving"], s["diag"]),
+            (0, 0, 0, False, False, False),
+        )
         self.assertEqual(c.sim_steps([-128] * pc.SIM_STEPS_MAX), 0)
         with self.assertRaisesRegex(pc.DeviceError, "busy"):  # the first's edges not out yet
             c.sim_steps([1])
@@ -319,8 +332,7 @@ REPO = Path(__file__).resolve().parents[2]
 MOTOR = REPO / "sil" / "scenarios" / "motors" / "17hs4401.ini"
 MOTOR_DB = REPO / "tests" / "closed_loop" / "data" / "klipper_motors.cfg"
 TUNE = os.environ.get("PMSTEP_TUNE")  # pmstep-tune of the same build (the CMake test passes it)
-needs_tune = unittest.skipUnless(TUNE and os.access(TUNE, os.X_OK),
-                                 "PMSTEP_TUNE does not name a pmstep-tune binary")
+needs_tune = unittest.skipUnless(TUNE and os.access(TUNE, os.X_OK), "PMSTEP_TUNE does not name a pmstep-tune binary")
 
 
 class CodeNames(unittest.TestCase):
@@ -329,6 +341,7 @@ class CodeNames(unittest.TestCase):
 
     def parse_header_enum(self, header, name):
         import gen_reference  # tools/, on the path above
+
         return {v.value: v.name for v in gen_reference.parse_enum(gen_reference.Source(REPO, header), name)}
 
     def test_store_codes_match_the_header(self):
@@ -353,13 +366,21 @@ class CodeNames(unittest.TestCase):
         self.assertEqual(pc.describe_code(-9999), "status -9999")  # no name: the number
 
     def test_record_round_trip(self):
-        rec = pc.Record(pc.RECORD_FORMAT, 0x1234, 0xABCD, 0, [pc.f32(0.1), 2.0, -3.5],
-                        dict(zip(pc.MEASURED_FIELDS, [6] + [pc.f32(0.01 * k) for k in range(7)])))
+        rec = pc.Record(
+            pc.RECORD_FORMAT,
+            0x1234,
+            0xABCD,
+            0,
+            [pc.f32(0.1), 2.0, -3.5],
+            dict(zip(pc.MEASURED_FIELDS, [6] + [pc.f32(0.01 * k) for k in range(7)])),
+        )
         data = rec.encode()
         self.assertEqual(len(data), 32 + 4 * 3 + 4 * 8 + 4)
         back = pc.Record.decode(data)
-        self.assertEqual((back.board_id, back.layout_id, back.values, back.measured),
-                         (rec.board_id, rec.layout_id, rec.values, rec.measured))
+        self.assertEqual(
+            (back.board_id, back.layout_id, back.values, back.measured),
+            (rec.board_id, rec.layout_id, rec.values, rec.measured),
+        )
         bad = bytearray(data)
         bad[40] ^= 1
         with self.assertRaisesRegex(pc.MalformedReply, "CRC"):
@@ -370,6 +391,7 @@ class AgainstAStoredConfiguration(unittest.TestCase):
     """console-host-drive --flash FILE: the stored configuration on a flash kept in a file. A reset of
     the board is the process killed (a power cut) and started again on the same file; the tool runs
     as on the command line (pc.main) on the pty's other side."""
+
     BOARD_ID = 0x0B0A4D17
 
     def setUp(self):
@@ -407,8 +429,12 @@ class AgainstAStoredConfiguration(unittest.TestCase):
                 pass
         except OSError:  # nothing more (EAGAIN), or the tool's side is not open (EIO)
             pass
-        self.drive = subprocess.Popen([DRIVE, "--flash", self.flash, "--board-id", hex(self.BOARD_ID), *args],
-                                      stdin=self.master, stdout=self.master, stderr=subprocess.PIPE)
+        self.drive = subprocess.Popen(
+            [DRIVE, "--flash", self.flash, "--board-id", hex(self.BOARD_ID), *args],
+            stdin=self.master,
+            stdout=self.master,
+            stderr=subprocess.PIPE,
+        )
 
     def cli(self, *args):
         """The command line against the drive: (exit status, stdout, stderr)."""
@@ -452,15 +478,17 @@ class AgainstAStoredConfiguration(unittest.TestCase):
         for section in cp.sections():
             if section.startswith("controller"):
                 for key, text in cp.items(section):
-                    name = (section[len("controller."):] + "." if section != "controller" else "") + key
+                    name = (section[len("controller.") :] + "." if section != "controller" else "") + key
                     out[name] = {"true": 1.0, "false": 0.0}.get(text, None)
                     out[name] = out[name] if out[name] is not None else float(text)
         return out
 
     def test_empty_store_refuses_start(self):
         h = self.hello()
-        self.assertEqual((h["protocol"], h["record_format"], h["store"], h["configured"]),
-                         (str(pc.PROTOCOL_VERSION), str(pc.RECORD_FORMAT), "True", "False"))
+        self.assertEqual(
+            (h["protocol"], h["record_format"], h["store"], h["configured"]),
+            (str(pc.PROTOCOL_VERSION), str(pc.RECORD_FORMAT), "True", "False"),
+        )
         code, _, err = self.cli("start")
         self.assertEqual(code, 1)
         self.assertIn("no motor configured", err)
@@ -477,12 +505,16 @@ class AgainstAStoredConfiguration(unittest.TestCase):
             self.assertEqual(f.read(), b"\xff" * 4096)
 
     def test_setup_errors_write_nothing(self):
-        for args, code, message in ((["setup"], 2, "give --motor"),
-                                    (["setup", "--motor", str(MOTOR), "--tune", "/nonexistent/pmstep-tune"], 2,
-                                     "pmstep-tune not found at /nonexistent/pmstep-tune"),
-                                    (["setup", "--motor", str(MOTOR), "--set", "run.period_s=1e-4"], 2,
-                                     "read-only"),
-                                    (["setup", "--motor", "/nonexistent.ini"], 2, "no such file")):
+        for args, code, message in (
+            (["setup"], 2, "give --motor"),
+            (
+                ["setup", "--motor", str(MOTOR), "--tune", "/nonexistent/pmstep-tune"],
+                2,
+                "pmstep-tune not found at /nonexistent/pmstep-tune",
+            ),
+            (["setup", "--motor", str(MOTOR), "--set", "run.period_s=1e-4"], 2, "read-only"),
+            (["setup", "--motor", "/nonexistent.ini"], 2, "no such file"),
+        ):
             with self.subTest(args=args):
                 got, _, err = self.cli(*args)
                 self.assertEqual(got, code, err)
@@ -499,8 +531,10 @@ class AgainstAStoredConfiguration(unittest.TestCase):
         self.boot()  # reset
         h = self.hello()
         self.assertEqual(h["configured"], "True")
-        self.assertIn(f"motor.resistance_Ohm = {pc.f32_text(pc.f32(design['motor.resistance_Ohm']))} ",
-                      self.ok("get", "motor.resistance_Ohm"))
+        self.assertIn(
+            f"motor.resistance_Ohm = {pc.f32_text(pc.f32(design['motor.resistance_Ohm']))} ",
+            self.ok("get", "motor.resistance_Ohm"),
+        )
         path, saved = self.take_backup("setup.json")
         # Every value the design gives and the board has is the design's (float32); the rest the board's.
         for name, value in saved["values"].items():
@@ -532,8 +566,11 @@ class AgainstAStoredConfiguration(unittest.TestCase):
         code, _, err = self.cli("restore", path)
         self.assertEqual(code, 1, err)
         # S_ALIGN, or FAULT: the host drive's constant 48 V bus is above the trip designed for 24 V
-        self.assertRegex(err, r"restore needs the motor stopped \(IDLE\), it is in "
-                              r"(S_ALIGN: `stop`|FAULT: `clear`) first")
+        self.assertRegex(
+            err,
+            r"restore needs the motor stopped \(IDLE\), it is in "
+            r"(S_ALIGN: `stop`|FAULT: `clear`) first",
+        )
 
     @needs_tune
     def test_stepdir_settings_saved_backed_up_and_restored(self):
@@ -560,8 +597,11 @@ class AgainstAStoredConfiguration(unittest.TestCase):
             json.dump(older, f)
         self.ok("defaults")
         out = self.ok("restore", old_path, "--save")
-        self.assertRegex(out, r"not in the backup, the value in force kept: stepdir\.microsteps, "
-                              r"stepdir\.invert_direction, ")
+        self.assertRegex(
+            out,
+            r"not in the backup, the value in force kept: stepdir\.microsteps, "
+            r"stepdir\.invert_direction, ",
+        )
         self.boot()
         self.assertEqual(self.hello()["configured"], "True")
         self.assertIn("stepdir.microsteps = 16 ", self.ok("get", "stepdir.microsteps"))
@@ -582,15 +622,29 @@ class AgainstAStoredConfiguration(unittest.TestCase):
                 json.dump(data, f)
             return p
 
-        cases = [(edited("inertia.json", lambda d: d["values"].update({"motor.inertia_kgm2": -1e-5})), 1,
-                  r"refused the record: status -\d+ \(PMSTEP_ERR_INERTIA: "),  # the core's code, by name
-                 (edited("unknown.json", lambda d: d["values"].update({"no.such_value": 1.0})), 1,
-                  r"values this board does not: no\.such_value;"),
-                 (edited("period.json", lambda d: d["values"].update({"timing.period_s": 1e-4})), 1,
-                  r"other read-only values: timing\.period_s \(backup 0\.0001, board "),
-                 (edited("pole_pairs.json", lambda d: d["values"].update({"motor.pole_pairs": 50.5})), 1,
-                  r"motor\.pole_pairs = 50\.5: not a whole number"),
-                 (edited("novalues.json", lambda d: d.pop("values")), 2, r"no \"values\" by name")]
+        cases = [
+            (
+                edited("inertia.json", lambda d: d["values"].update({"motor.inertia_kgm2": -1e-5})),
+                1,
+                r"refused the record: status -\d+ \(PMSTEP_ERR_INERTIA: ",
+            ),  # the core's code, by name
+            (
+                edited("unknown.json", lambda d: d["values"].update({"no.such_value": 1.0})),
+                1,
+                r"values this board does not: no\.such_value;",
+            ),
+            (
+                edited("period.json", lambda d: d["values"].update({"timing.period_s": 1e-4})),
+                1,
+                r"other read-only values: timing\.period_s \(backup 0\.0001, board ",
+            ),
+            (
+                edited("pole_pairs.json", lambda d: d["values"].update({"motor.pole_pairs": 50.5})),
+                1,
+                r"motor\.pole_pairs = 50\.5: not a whole number",
+            ),
+            (edited("novalues.json", lambda d: d.pop("values")), 2, r"no \"values\" by name"),
+        ]
         for p, code, message in cases:
             with self.subTest(os.path.basename(p)):
                 got, _, err = self.cli("restore", p, "--save")
@@ -607,10 +661,13 @@ class AgainstAStoredConfiguration(unittest.TestCase):
         out = self.ok("setup", "--motor-db", str(MOTOR_DB), "--name", "ldo-42sth48-2504ah", "--bus-voltage", "36")
         self.assertIn("bus 36 V (--bus-voltage)", out)
         self.assertIn("saved: slot 0, sequence 1", out)
-        design = self.design("--motor-db", str(MOTOR_DB), "--name", "ldo-42sth48-2504ah",
-                             "--set", "run.bus_voltage_V=36")
-        self.assertIn(f"limits.max_bus_voltage_V = {pc.f32_text(pc.f32(design['limits.max_bus_voltage_V']))} ",
-                      self.ok("get", "limits.max_bus_voltage_V"))  # the trip designed for 36 V
+        design = self.design(
+            "--motor-db", str(MOTOR_DB), "--name", "ldo-42sth48-2504ah", "--set", "run.bus_voltage_V=36"
+        )
+        self.assertIn(
+            f"limits.max_bus_voltage_V = {pc.f32_text(pc.f32(design['limits.max_bus_voltage_V']))} ",
+            self.ok("get", "limits.max_bus_voltage_V"),
+        )  # the trip designed for 36 V
         _, before = self.take_backup("before.json")
         code, out, err = self.cli("setup", "--motor-db", str(MOTOR_DB), "--name", "ncm-as-nm")  # N cm as N m
         self.assertEqual(code, 1, err)
@@ -652,17 +709,20 @@ class AgainstABadLine(unittest.TestCase):
     comes back then and fails the timing assertion instead of hanging the run. Timing bounds are
     generous (the deadline plus seconds): they tell "ended at the deadline" from "ended when the
     line went quiet", nothing finer."""
+
     REPLY_TIMEOUT_S = 0.3
-    WAIT_BOUND_S = 2.0      # a wait of REPLY_TIMEOUT_S must end within this
-    PEER_LIFETIME_S = 6.0   # > WAIT_BOUND_S: a hanging tool is seen as one
+    WAIT_BOUND_S = 2.0  # a wait of REPLY_TIMEOUT_S must end within this
+    PEER_LIFETIME_S = 6.0  # > WAIT_BOUND_S: a hanging tool is seen as one
     # The short reply the peer sends to each request, in DATA bytes (the right length in brackets).
-    SHORT_REPLY_BYTES = {pc.HELLO: 1,                # (2 or more)
-                         pc.START: 5,                # ACK (6)
-                         pc.GET_STATUS: 3,           # (60)
-                         pc.GET_CONFIG: 6,           # (7 or more)
-                         pc.GET_COMMISSIONING: 9,    # (41)
-                         pc.GET_COUNTERS: 43,        # (44)
-                         pc.GET_POSITION: 18}        # (19)
+    SHORT_REPLY_BYTES = {
+        pc.HELLO: 1,  # (2 or more)
+        pc.START: 5,  # ACK (6)
+        pc.GET_STATUS: 3,  # (60)
+        pc.GET_CONFIG: 6,  # (7 or more)
+        pc.GET_COMMISSIONING: 9,  # (41)
+        pc.GET_COUNTERS: 43,  # (44)
+        pc.GET_POSITION: 18,
+    }  # (19)
 
     def setUp(self):
         self.master, self.slave = os.openpty()  # the slave stays open: the master reads no EIO
@@ -696,7 +756,7 @@ class AgainstABadLine(unittest.TestCase):
         """Writes @p data to the master unless the peer's life ends first (a full pty: retried)."""
         while data and self.alive():
             try:
-                data = data[os.write(self.master, data):]
+                data = data[os.write(self.master, data) :]
             except BlockingIOError:
                 time.sleep(0.001)
 
@@ -771,15 +831,16 @@ class AgainstABadLine(unittest.TestCase):
     def test_short_replies_are_malformed_reply_errors(self):
         c = self.con
         self.start_peer(self.short_replies)
-        for call, message in ((c.hello, "HELLO reply: 1 bytes, expected 2 or more"),
-                              (c.start, "START reply: 5 bytes, expected 6"),
-                              (c.status, "STATUS reply: 3 bytes, expected 60"),
-                              (lambda: c.get_config("gains.speed_gain_per_s"),
-                               "CONFIG reply: 6 bytes, expected 7 or more"),
-                              (c.list_config, "CONFIG reply: 6 bytes"),  # not taken for the table's end
-                              (c.commissioning, "COMMISSIONING reply: 9 bytes, expected 41"),
-                              (c.counters, "COUNTERS reply: 43 bytes, expected 44"),
-                              (c.position, "POSITION reply: 18 bytes, expected 19")):
+        for call, message in (
+            (c.hello, "HELLO reply: 1 bytes, expected 2 or more"),
+            (c.start, "START reply: 5 bytes, expected 6"),
+            (c.status, "STATUS reply: 3 bytes, expected 60"),
+            (lambda: c.get_config("gains.speed_gain_per_s"), "CONFIG reply: 6 bytes, expected 7 or more"),
+            (c.list_config, "CONFIG reply: 6 bytes"),  # not taken for the table's end
+            (c.commissioning, "COMMISSIONING reply: 9 bytes, expected 41"),
+            (c.counters, "COUNTERS reply: 43 bytes, expected 44"),
+            (c.position, "POSITION reply: 18 bytes, expected 19"),
+        ):
             with self.subTest(message):
                 with self.assertRaisesRegex(Exception, "^malformed " + message) as raised:
                     call()
@@ -792,8 +853,9 @@ class AgainstABadLine(unittest.TestCase):
         with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(err):
             code = pc.main(["--port", self.slave_name, "status"])
         self.assertEqual(code, 4)
-        self.assertEqual(err.getvalue().splitlines(),
-                         ["pmstep_console: error: malformed STATUS reply: 3 bytes, expected 60"])
+        self.assertEqual(
+            err.getvalue().splitlines(), ["pmstep_console: error: malformed STATUS reply: 3 bytes, expected 60"]
+        )
 
     def test_short_reply_in_the_shell_keeps_the_shell(self):
         self.start_peer(self.short_replies)
@@ -803,9 +865,13 @@ class AgainstABadLine(unittest.TestCase):
             self.assertFalse(shell.onecmd("status"))
             self.assertFalse(shell.onecmd("counters"))
             self.assertTrue(shell.onecmd("quit"))
-        self.assertEqual(out.getvalue().splitlines(),
-                         ["error: malformed STATUS reply: 3 bytes, expected 60",
-                          "error: malformed COUNTERS reply: 43 bytes, expected 44"])
+        self.assertEqual(
+            out.getvalue().splitlines(),
+            [
+                "error: malformed STATUS reply: 3 bytes, expected 60",
+                "error: malformed COUNTERS reply: 43 bytes, expected 44",
+            ],
+        )
 
     # ---- a line that fails: LinkError ----
     def test_line_closed_mid_wait_is_a_link_error(self):
@@ -823,8 +889,14 @@ class AgainstABadLine(unittest.TestCase):
     def run_tool(self, *args, stdin=""):
         """The command line in a subprocess against the pty: (exit status, stdout, stderr)."""
         self.link.close()
-        r = subprocess.run([sys.executable, str(TOOL), "--port", self.slave_name, *args], input=stdin,
-                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=60)
+        r = subprocess.run(
+            [sys.executable, str(TOOL), "--port", self.slave_name, *args],
+            input=stdin,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            timeout=60,
+        )
         return r.returncode, r.stdout, r.stderr
 
     def test_line_closed_mid_wait_on_the_command_line_is_one_line(self):
@@ -861,8 +933,13 @@ class CommandLineFailures(unittest.TestCase):
     def test_missing_port_is_one_line(self):
         for port in ("/dev/does-not-exist", "bogus://nowhere"):
             with self.subTest(port):
-                r = subprocess.run([sys.executable, str(TOOL), "--port", port, "status"], stdout=subprocess.PIPE,
-                                   stderr=subprocess.PIPE, text=True, timeout=60)
+                r = subprocess.run(
+                    [sys.executable, str(TOOL), "--port", port, "status"],
+                    stdout=subprocess.PIPE,
+                    stderr=subprocess.PIPE,
+                    text=True,
+                    timeout=60,
+                )
                 self.assertEqual(r.returncode, 6)
                 self.assertEqual(r.stdout, "")
                 self.assertEqual(len(r.stderr.splitlines()), 1, r.stderr)

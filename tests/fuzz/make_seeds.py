@@ -6,6 +6,7 @@ configuration fields below are those of pmstep_config_t when the seeds were made
 change of the struct they point at other fields, and the seeds stay valid inputs.
 Usage: tests/fuzz/make_seeds.py   (rewrites the seeds; the fuzz.*_replay tests replay them)
 """
+
 import os
 import struct
 
@@ -51,14 +52,28 @@ core = {
     # the same in known-load mode
     "known_load_run": head(2, []) + bytes([START]) + speed(88, 20) + run(4) + plant(4095, load=180) + run(2),
     # short alignments; a NaN sample latches a fault, commands in FAULT, clear, again
-    "short_fault_clear": head(3, []) + bytes([START]) + plant(600) + meas_raw(nan, 0.0, 48.0, 0.0)
-    + bytes([START, STOP]) + plant(10) + bytes([CLEAR, START]) + speed(140, 50) + plant(2000)
-    + bytes([JUMP, 200, 255, 128]) + plant(3000) + bytes([STOP, RESET, START]) + plant(500),
+    "short_fault_clear": head(3, [])
+    + bytes([START])
+    + plant(600)
+    + meas_raw(nan, 0.0, 48.0, 0.0)
+    + bytes([START, STOP])
+    + plant(10)
+    + bytes([CLEAR, START])
+    + speed(140, 50)
+    + plant(2000)
+    + bytes([JUMP, 200, 255, 128])
+    + plant(3000)
+    + bytes([STOP, RESET, START])
+    + plant(500),
     # every measurement edge in each mode of the short configuration
-    "short_edges": head(3, []) + bytes([START])
+    "short_edges": head(3, [])
+    + bytes([START])
     + b"".join(plant(90) + edge(w, k) + bytes([CLEAR, START]) for w in range(5) for k in range(12)),
     # the rotor pushed in RUN until detection trips or re-aligns (features: 2 re-alignments)
-    "features_push": head(1, []) + bytes([START]) + speed(200, 100) + run(2)
+    "features_push": head(1, [])
+    + bytes([START])
+    + speed(200, 100)
+    + run(2)
     + b"".join(bytes([JUMP, 40 * k, 0, 128]) + plant(1500) for k in range(6)),
     # issue 15 F1: a dead-time band of 1e-40 A (init must refuse it)
     "f1_band": head(0, [perturb(30, 0, 1e-6), perturb(31, 0, 1e-40)]) + bytes([START]) + plant(100),
@@ -69,12 +84,22 @@ core = {
     "f3_inertia": head(0, [perturb(2, 0, 1e28)]) + bytes([START]) + plant(100),
     "f3_friction": head(0, [perturb(3, 0, 3.4e38)]) + bytes([START]) + plant(100),
     # raw commands: non-finite and huge targets
-    "commands": head(3, []) + bytes([SPEED_RAW]) + struct.pack("<ff", inf, 1.0) + bytes([SPEED_RAW])
-    + struct.pack("<ff", 3e38, 3e38) + bytes([ID_RAW]) + struct.pack("<f", 14.0) + bytes([START]) + plant(2000),
+    "commands": head(3, [])
+    + bytes([SPEED_RAW])
+    + struct.pack("<ff", inf, 1.0)
+    + bytes([SPEED_RAW])
+    + struct.pack("<ff", 3e38, 3e38)
+    + bytes([ID_RAW])
+    + struct.pack("<f", 14.0)
+    + bytes([START])
+    + plant(2000),
     # a raw configuration: the paper's bytes are not needed, any 156 bytes are an input
     "raw_config": bytes([0x80]) + bytes(range(156)) + bytes([START]) + plant(100),
     # R from one steady state per phase (voltage bias off), and missing arguments
-    "features_no_bias": head(1, [perturb(29, 0, 0.0)]) + bytes([NULLS, START]) + speed(168, 10) + run(4)
+    "features_no_bias": head(1, [perturb(29, 0, 0.0)])
+    + bytes([NULLS, START])
+    + speed(168, 10)
+    + run(4)
     + plant(4095, load=90),
     # 100 us period and the longest alignment the paper allows for it
     "period_100us": head(3, [perturb(6, 2)]) + bytes([START]) + speed(168, 10) + run(3),
@@ -128,41 +153,87 @@ def set_config(ident, value):
 
 console = {
     # the review's finding: SET_CONFIG max bus then GET_CONFIG of the trip in one receive call
-    "busy_set_then_get": bytes([1, C_TWO]) + c_frame(SET_CONFIG, 1, set_config(MAX_BUS, 60.0))
-    + c_frame(GET_CONFIG, 2, bytes([TRIP])) + c_periods(4),
-    "busy_set_then_speed": bytes([1, C_TWO]) + c_frame(SET_CONFIG, 1, set_config(TRIP, 10.0))
-    + c_frame(SPEED_TARGET, 2, struct.pack("<ff", 1e30, 50.0)) + c_periods(4),
+    "busy_set_then_get": bytes([1, C_TWO])
+    + c_frame(SET_CONFIG, 1, set_config(MAX_BUS, 60.0))
+    + c_frame(GET_CONFIG, 2, bytes([TRIP]))
+    + c_periods(4),
+    "busy_set_then_speed": bytes([1, C_TWO])
+    + c_frame(SET_CONFIG, 1, set_config(TRIP, 10.0))
+    + c_frame(SPEED_TARGET, 2, struct.pack("<ff", 1e30, 50.0))
+    + c_periods(4),
     # unbounded limits: refused by the validation
-    "huge_limits": bytes([0, C_FRAME]) + c_frame(SET_CONFIG, 1, set_config(TRIP, 3.4e38)) + c_periods(2)
-    + bytes([C_FRAME]) + c_frame(SET_CONFIG, 2, set_config(MAX_BUS, 3.4e38)) + c_periods(2),
+    "huge_limits": bytes([0, C_FRAME])
+    + c_frame(SET_CONFIG, 1, set_config(TRIP, 3.4e38))
+    + c_periods(2)
+    + bytes([C_FRAME])
+    + c_frame(SET_CONFIG, 2, set_config(MAX_BUS, 3.4e38))
+    + c_periods(2),
     # START then SET_CONFIG at the next boundary, before a step ran
-    "start_then_set": bytes([0, C_FRAME]) + c_frame(START) + bytes([C_FRAME])
-    + c_frame(SET_CONFIG, 2, set_config(12, 90.0)) + c_periods(3),
+    "start_then_set": bytes([0, C_FRAME])
+    + c_frame(START)
+    + bytes([C_FRAME])
+    + c_frame(SET_CONFIG, 2, set_config(12, 90.0))
+    + c_periods(3),
     # into RUN, a speed command, telemetry, a busy ID_TARGET behind it, a stop
-    "run_speed": bytes([1, C_FRAME]) + c_frame(START) + c_periods(1000) + bytes([C_TWO])
-    + c_frame(SPEED_TARGET, 2, struct.pack("<ff", 10.0, 50.0)) + c_frame(ID_TARGET, 3, struct.pack("<f", 300.0))
-    + bytes([C_FRAME]) + c_frame(TELEMETRY, 4, struct.pack("<I", 7)) + c_periods(3000) + bytes([C_FRAME])
-    + c_frame(STOP, 5) + c_periods(10),
+    "run_speed": bytes([1, C_FRAME])
+    + c_frame(START)
+    + c_periods(1000)
+    + bytes([C_TWO])
+    + c_frame(SPEED_TARGET, 2, struct.pack("<ff", 10.0, 50.0))
+    + c_frame(ID_TARGET, 3, struct.pack("<f", 300.0))
+    + bytes([C_FRAME])
+    + c_frame(TELEMETRY, 4, struct.pack("<I", 7))
+    + c_periods(3000)
+    + bytes([C_FRAME])
+    + c_frame(STOP, 5)
+    + c_periods(10),
     # a position move, a status, a hold
-    "position_move": bytes([1, C_FRAME]) + c_frame(START) + c_periods(1000) + bytes([C_FRAME])
-    + c_frame(MOVE_TO, 2, struct.pack("<fff", 1.0, 5.0, 50.0)) + c_periods(4000) + bytes([C_FRAME])
-    + c_frame(GET_STATUS, 3) + c_periods(2),
+    "position_move": bytes([1, C_FRAME])
+    + c_frame(START)
+    + c_periods(1000)
+    + bytes([C_FRAME])
+    + c_frame(MOVE_TO, 2, struct.pack("<fff", 1.0, 5.0, 50.0))
+    + c_periods(4000)
+    + bytes([C_FRAME])
+    + c_frame(GET_STATUS, 3)
+    + c_periods(2),
     # special floats of every typed request, a fault, a refused SET_CONFIG in FAULT, CLEAR_FAULT
-    "specials": bytes([3]) + b"".join(bytes([C_SPECIAL, t, v, 21]) + c_periods(2) for t in range(6) for v in range(16))
-    + bytes([C_FRAME]) + c_frame(START) + c_periods(50) + bytes([C_FRAME]) + c_frame(CLEAR_FAULT) + c_periods(2),
+    "specials": bytes([3])
+    + b"".join(bytes([C_SPECIAL, t, v, 21]) + c_periods(2) for t in range(6) for v in range(16))
+    + bytes([C_FRAME])
+    + c_frame(START)
+    + c_periods(50)
+    + bytes([C_FRAME])
+    + c_frame(CLEAR_FAULT)
+    + c_periods(2),
     # bytes outside frames, a frame cut short, silence
-    "garbage": bytes([0, C_RAW, 12]) + bytes([0xA5, 3, 1, 2, 0xA5, 0xA5, 70, 1, 0, 0xFF, 0x12, 0xA5])
-    + bytes([C_SILENCE, 50, C_FRAME]) + c_frame(HELLO) + c_periods(1),
+    "garbage": bytes([0, C_RAW, 12])
+    + bytes([0xA5, 3, 1, 2, 0xA5, 0xA5, 70, 1, 0, 0xFF, 0x12, 0xA5])
+    + bytes([C_SILENCE, 50, C_FRAME])
+    + c_frame(HELLO)
+    + c_periods(1),
     # the simulation requests on a simulation console
-    "simulation": bytes([2, C_FRAME]) + c_frame(SIM_ADVANCE, 1, struct.pack("<I", 5)) + bytes([C_FRAME])
-    + c_frame(SIM_ADVANCE, 2, struct.pack("<I", 5)) + c_periods(2),
+    "simulation": bytes([2, C_FRAME])
+    + c_frame(SIM_ADVANCE, 1, struct.pack("<I", 5))
+    + bytes([C_FRAME])
+    + c_frame(SIM_ADVANCE, 2, struct.pack("<I", 5))
+    + c_periods(2),
     # the emulated STEP/DIR input: bursts through the counter's wrap, into RUN, following, edges both ways,
     # a read-back, a second SIM_STEPS refused while the first's edges remain
-    "stepdir": bytes([7, C_FRAME]) + c_frame(START) + b"".join(
-        bytes([C_FRAME]) + c_frame(SIM_STEPS, 2, bytes([127]) * 60) + c_periods(60) for _ in range(9))
-    + c_periods(1000) + bytes([C_FRAME]) + c_frame(SIM_FOLLOW_STEPS, 3) + c_periods(1) + bytes([C_TWO])
-    + c_frame(SIM_STEPS, 4, bytes([1, 0, 0xFF, 2]) * 15) + c_frame(SIM_STEPS, 5, bytes([1])) + c_periods(60)
-    + bytes([C_FRAME]) + c_frame(SIM_STEPDIR, 6) + c_periods(2),
+    "stepdir": bytes([7, C_FRAME])
+    + c_frame(START)
+    + b"".join(bytes([C_FRAME]) + c_frame(SIM_STEPS, 2, bytes([127]) * 60) + c_periods(60) for _ in range(9))
+    + c_periods(1000)
+    + bytes([C_FRAME])
+    + c_frame(SIM_FOLLOW_STEPS, 3)
+    + c_periods(1)
+    + bytes([C_TWO])
+    + c_frame(SIM_STEPS, 4, bytes([1, 0, 0xFF, 2]) * 15)
+    + c_frame(SIM_STEPS, 5, bytes([1]))
+    + c_periods(60)
+    + bytes([C_FRAME])
+    + c_frame(SIM_STEPDIR, 6)
+    + c_periods(2),
 }
 
 for folder, seeds in (("core", core), ("scenario", scenario), ("console", console)):
