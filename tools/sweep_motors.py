@@ -31,6 +31,7 @@ import argparse
 import collections
 import csv
 import json
+import math
 import os
 import random
 import subprocess
@@ -55,6 +56,7 @@ MODES = {
     # presence, then its design validated as the others
     "self-commission-realistic": {"robust": True, "realistic": True, "self_commission": True},
 }
+LOAD_STEP_OF_HOLDING = 0.5  # the validation's load step (sil/tune/tune_validate.c)
 NOISE_A = 0.005  # the realistic chain's current noise (mc_preset.REALISTIC_CHAIN)
 
 
@@ -153,6 +155,15 @@ def groups(result):
             m["torque_constant_Nm_A"] * m["rated_current_A"] / m["inertia_kgm2"] / top / d["observer_bandwidth_rad_s"]
         )
         out["I_align / noise"] = d["alignment_current_A"] / NOISE_A
+        # the validation's load step T = T_H / 2 against the bus (docs/design/09-validation.md):
+        # the speed it takes off the rotor while the current builds, T^2 L / (J k_M V), over w_top
+        step_Nm = LOAD_STEP_OF_HOLDING * m["holding_torque_Nm"]
+        out["load step G"] = (
+            step_Nm
+            * step_Nm
+            * m["inductance_H"]
+            / (m["inertia_kgm2"] * m["torque_constant_Nm_A"] * m["bus_voltage_V"] * top)
+        )
     return out
 
 
@@ -211,7 +222,15 @@ def write_csv(path, results):
         "envelope_pass",
         "seconds",
     ]
-    group_names = ["R/L T_s", "F/J T_s", "p w_top T_s", "k_M w_top / V_bus", "k_M I / (J w_top w_o)", "I_align / noise"]
+    group_names = [
+        "R/L T_s",
+        "F/J T_s",
+        "p w_top T_s",
+        "k_M w_top / V_bus",
+        "k_M I / (J w_top w_o)",
+        "I_align / noise",
+        "load step G",
+    ]
     with open(path, "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(fields + group_names)
@@ -339,20 +358,27 @@ def report_text(results, modes, argv, seconds, jobs, population_note, mc=None):
                 cells.append(f"{p} / {n}" if n else "-")
             out.append(f"| {k} | " + " | ".join(cells) + " |")
     out += ["", "## Failures", ""]
+    # load step G: the validation's step against the bus (docs/design/09-validation.md#load-step-bus-limit)
+    for mode in modes:
+        gs = [groups(r).get("load step G") for r in results if r["mode"] == mode and outcome(r) == "pass"]
+        gs = [g for g in gs if g is not None]
+        if gs:
+            out.append(f"- {mode}: the largest load step G of a motor that passes is {max(gs):.3g}.")
+    out.append("")
     failures = [r for r in results if outcome(r) != "pass"]
     if not failures:
         out.append("None.")
     else:
         out += [
-            "| motor | mode | outcome | R (Ohm) | L (mH) | I (A) | T_H (N m) | p | bus (V) |",
-            "|---|---|---|---|---|---|---|---|---|",
+            "| motor | mode | outcome | R (Ohm) | L (mH) | I (A) | T_H (N m) | p | bus (V) | load step G |",
+            "|---|---|---|---|---|---|---|---|---|---|",
         ]
         for r in sorted(failures, key=lambda r: (r["mode"], r["motor"]["name"])):
             m = r["motor"]
             out.append(
                 f"| {m['name']} | {r['mode']} | {outcome(r)} | {m['resistance_Ohm']:.3g} | "
                 f"{1e3 * m['inductance_H']:.3g} | {m['rated_current_A']:.3g} | {m['holding_torque_Nm']:.3g} | "
-                f"{m['pole_pairs']} | {m['bus_voltage_V']:g} |"
+                f"{m['pole_pairs']} | {m['bus_voltage_V']:g} | {groups(r).get('load step G', math.nan):.3g} |"
             )
     if mc is not None:
         out += sweep_mc.report_lines(mc["results"], mc["cases"])
