@@ -27,17 +27,11 @@ void pmstep_actuate_reset(pmstep_actuator_t *actuator)
     actuator->compensation_pending_b_V = 0.0f;
 }
 
-/* x within [-limit, limit]. */
-static float clamp_f(float x, float limit)
-{
-    return x > limit ? limit : (x < -limit ? -limit : x);
-}
-
 /* (2 V_bus t_d / T_s + bias) sign(i), linear in i within the band. */
 static float dead_time_voltage(const pmstep_actuate_coeffs_t *coeffs, float current_A, float bus_voltage_V,
                                float bias_V)
 {
-    const float share = clamp_f(current_A * coeffs->inv_band_per_A, 1.0f);
+    const float share = pmstep_limit(current_A * coeffs->inv_band_per_A, 1.0f);
     return (coeffs->dead_time_duty * bus_voltage_V + bias_V) * share;
 }
 
@@ -50,8 +44,8 @@ float pmstep_actuate_mean_loss_current(const pmstep_actuate_coeffs_t *coeffs, fl
      * A command beyond the bus (d > 1, limited later) gives h < 0: the share stays within +-1. */
     const float ripple_A = 4.0f * coeffs->sign_threshold_A_per_V * pmstep_abs(u_V) * (1.0f - duty);
     /* the parts of the range beyond +h and below -h, each less half the range */
-    const float above_A = clamp_f(current_A - ripple_A, range_A);
-    const float below_A = clamp_f(-current_A - ripple_A, range_A);
+    const float above_A = pmstep_limit(current_A - ripple_A, range_A);
+    const float below_A = pmstep_limit(-current_A - ripple_A, range_A);
     return (above_A - below_A) * band_A / (2.0f * range_A);
 }
 
@@ -61,8 +55,8 @@ static bool limit_to_bus(float *u_a_V, float *u_b_V, float bus_voltage_V)
     const float largest = pmstep_abs(*u_a_V) > pmstep_abs(*u_b_V) ? pmstep_abs(*u_a_V) : pmstep_abs(*u_b_V);
     if (largest > bus_voltage_V) {
         const float scale = bus_voltage_V / largest;
-        *u_a_V = clamp_f(*u_a_V * scale, bus_voltage_V);
-        *u_b_V = clamp_f(*u_b_V * scale, bus_voltage_V);
+        *u_a_V = pmstep_limit(*u_a_V * scale, bus_voltage_V);
+        *u_b_V = pmstep_limit(*u_b_V * scale, bus_voltage_V);
         return true;
     }
     return false;
