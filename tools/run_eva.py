@@ -27,6 +27,7 @@ CORE = [
     "pmstep_core",
     "pmstep_lifecycle",
     "pmstep_config",
+    "pmstep_derive",
     "pmstep_control",
     "pmstep_detect",
     "pmstep_actuate",

@@ -335,7 +335,7 @@ static pmstep_status_t validate_standstill(const pmstep_config_t *cfg)
     return (current_A > 0.0f && cfg->known_load_mode) ? PMSTEP_ERR_STANDSTILL_KNOWN_LOAD : PMSTEP_OK;
 }
 
-pmstep_status_t pmstep_validate_config(const pmstep_config_t *cfg)
+pmstep_status_t pmstep_check_settings(const pmstep_config_t *cfg)
 {
     pmstep_status_t status;
     if (cfg == NULL) {
@@ -368,8 +368,18 @@ pmstep_status_t pmstep_validate_config(const pmstep_config_t *cfg)
     if (status == PMSTEP_OK) {
         status = validate_standstill(cfg);
     }
-    if (status == PMSTEP_OK && !pmstep_derived_coefficients_finite(cfg)) {
-        status = PMSTEP_ERR_DERIVED_NONFINITE;
+    return status;
+}
+
+pmstep_status_t pmstep_validate_config(const pmstep_config_t *cfg)
+{
+    pmstep_derived_t derived; /* what init derives into its instance */
+    pmstep_status_t status = pmstep_check_settings(cfg);
+    if (status == PMSTEP_OK) {
+        pmstep_derive(&derived, cfg);
+        if (!pmstep_derived_finite(&derived)) {
+            status = PMSTEP_ERR_DERIVED_NONFINITE;
+        }
     }
     return status;
 }

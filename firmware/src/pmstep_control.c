@@ -9,7 +9,7 @@ static void start_run(pmstep_t *inst, const pmstep_meas_t *sample)
     const pmstep_ref_t speed_cmd = inst->speed_ref;
     const pmstep_ref_t i_d_cmd = inst->i_d_ref;
     pmstep_angle_start(&inst->angle, sample->i_a_A, sample->i_b_A);
-    pmstep_angle_set(&inst->angle, &inst->angle_coeffs, inst->commissioning.equilibrium_cos,
+    pmstep_angle_set(&inst->angle, &inst->derived.angle_coeffs, inst->commissioning.equilibrium_cos,
                      inst->commissioning.equilibrium_sin); /* c-alignment's equilibrium (1, 0 unless measured) */
     pmstep_angle_smoother_set(&inst->scratch.run.smoother, inst->commissioning.equilibrium_cos,
                               inst->commissioning.equilibrium_sin);
@@ -33,7 +33,7 @@ static void start_run(pmstep_t *inst, const pmstep_meas_t *sample)
 static void sensed_period_voltage(pmstep_t *inst, const pmstep_meas_t *sample, float *u_a_V, float *u_b_V)
 {
     pmstep_sensed_voltages(inst, sample, u_a_V, u_b_V);
-    pmstep_observer_correct_voltage(&inst->observer, &inst->observer_coeffs, *u_a_V - inst->actuator.u_applied_a_V,
+    pmstep_observer_correct_voltage(&inst->observer, &inst->derived.observer_coeffs, *u_a_V - inst->actuator.u_applied_a_V,
                                     *u_b_V - inst->actuator.u_applied_b_V);
 }
 
@@ -53,7 +53,7 @@ static void kept_estimate_in(pmstep_t *inst, const pmstep_meas_t *sample, const 
     obs_in->sin_hat = *sin_hat;
     obs_in->i_d_A = *i_d;
     obs_in->i_q_A = *i_q;
-    detent = pmstep_law_detent(&inst->law_coeffs, *cos_hat, *sin_hat, inst->observer.speed_hat_rad_s);
+    detent = pmstep_law_detent(&inst->derived.law_coeffs, *cos_hat, *sin_hat, inst->observer.speed_hat_rad_s);
     pmstep_law_fade_detent(inst->cfg->gains.detent_fade_speed_rad_s, inst->observer.speed_hat_rad_s,
                            refs->speed_ref_rate_rad_s2, &detent);
     obs_in->detent_torque_Nm = detent.torque_Nm;
@@ -80,9 +80,9 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
     } else {
         float u_a_V = inst->actuator.u_applied_a_V;
         float u_b_V = inst->actuator.u_applied_b_V;
-        if (!inst->voltage_corrected) {
+        if (!inst->derived.voltage_corrected) {
             /* the command is the period's voltage: tested first, as the most common case */
-        } else if (inst->actuate_coeffs.sensed) {
+        } else if (inst->derived.actuate_coeffs.sensed) {
             sensed_period_voltage(inst, sample, &u_a_V, &u_b_V);
         } else { /* compensated: the dead time's loss, where the samples fix it */
             pmstep_period_currents_t currents;
@@ -92,28 +92,28 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
             currents.i_end_b_A = sample->i_b_A;
             currents.bias_a_V = inst->commissioning.voltage_bias_a_V;
             currents.bias_b_V = inst->commissioning.voltage_bias_b_V;
-            pmstep_actuate_voltage_over_period(&inst->actuator, &inst->actuate_coeffs, &currents,
+            pmstep_actuate_voltage_over_period(&inst->actuator, &inst->derived.actuate_coeffs, &currents,
                                                sample->bus_voltage_V, &u_a_V, &u_b_V);
         }
-        pmstep_angle_update(&inst->angle, &inst->angle_coeffs, sample->i_a_A, sample->i_b_A, u_a_V, u_b_V);
+        pmstep_angle_update(&inst->angle, &inst->derived.angle_coeffs, sample->i_a_A, sample->i_b_A, u_a_V, u_b_V);
     }
-    pmstep_angle_estimate(&inst->angle, &inst->angle_coeffs, sample->i_a_A, sample->i_b_A, &cos_hat, &sin_hat);
-    if (inst->angle_smoothing) { /* docs/design/16-angle-smoothing.md */
+    pmstep_angle_estimate(&inst->angle, &inst->derived.angle_coeffs, sample->i_a_A, sample->i_b_A, &cos_hat, &sin_hat);
+    if (inst->derived.angle_smoothing) { /* docs/design/16-angle-smoothing.md */
         pmstep_angle_smooth(inst->cfg->gains.angle_smoothing,
-                            inst->law_coeffs.pole_pairs * inst->cfg->timing.period_s * inst->observer.speed_hat_rad_s,
+                            inst->derived.law_coeffs.pole_pairs * inst->cfg->timing.period_s * inst->observer.speed_hat_rad_s,
                             &inst->scratch.run.smoother, &cos_hat, &sin_hat);
     }
     pmstep_park(cos_hat, sin_hat, sample->i_a_A, sample->i_b_A, &i_d, &i_q);
 
-    ref = pmstep_ref_output(&inst->ref_coeffs, &inst->speed_ref);
+    ref = pmstep_ref_output(&inst->derived.ref_coeffs, &inst->speed_ref);
     refs.speed_ref_rad_s = ref.value;
     refs.speed_ref_rate_rad_s2 = ref.rate;
     refs.speed_ref_accel_rad_s3 = ref.accel;
-    ref = pmstep_ref_output(&inst->ref_coeffs, &inst->i_d_ref);
+    ref = pmstep_ref_output(&inst->derived.ref_coeffs, &inst->i_d_ref);
     refs.i_d_ref_A = ref.value;
     refs.i_d_ref_rate_A_s = ref.rate;
     if (known_load) {
-        ref = pmstep_ref_output(&inst->ref_coeffs, &inst->scratch.run.known_load_filter); /* T_L*, Remark 1 */
+        ref = pmstep_ref_output(&inst->derived.ref_coeffs, &inst->scratch.run.known_load_filter); /* T_L*, Remark 1 */
         load_Nm = ref.value;
     } else {
         ref.value = 0.0f; /* (6): no T_L* */
@@ -121,7 +121,7 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
         load_Nm = inst->observer.load_hat_Nm;
     }
     /* The detent torque is known in form: the law supplies it, the observer expects it (both faded with w-hat). */
-    detent = pmstep_law_detent(&inst->law_coeffs, cos_hat, sin_hat, inst->observer.speed_hat_rad_s);
+    detent = pmstep_law_detent(&inst->derived.law_coeffs, cos_hat, sin_hat, inst->observer.speed_hat_rad_s);
     pmstep_law_fade_detent(inst->cfg->gains.detent_fade_speed_rad_s, inst->observer.speed_hat_rad_s,
                            refs.speed_ref_rate_rad_s2, &detent);
     obs_in->i_a_A = sample->i_a_A;
@@ -139,26 +139,26 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
         i_q_ref = 0.0f;
         pmstep_hold_voltages(inst, obs_in, out);
     } else {
-        speed = pmstep_law_speed_term(&inst->law_coeffs, inst->observer.speed_hat_rad_s - refs.speed_ref_rad_s);
-        i_q_ref = pmstep_law_iq_ref(&inst->law_coeffs, &refs, speed.term, load_Nm - detent.torque_Nm);
+        speed = pmstep_law_speed_term(&inst->derived.law_coeffs, inst->observer.speed_hat_rad_s - refs.speed_ref_rad_s);
+        i_q_ref = pmstep_law_iq_ref(&inst->derived.law_coeffs, &refs, speed.term, load_Nm - detent.torque_Nm);
         obs_in->i_d_err_A = i_d - refs.i_d_ref_A;
         obs_in->i_q_err_A = i_q - i_q_ref;
     }
-    scratch->mech_rates = pmstep_observer_mech_rates(&inst->observer, &inst->observer_coeffs, obs_in, known_load);
+    scratch->mech_rates = pmstep_observer_mech_rates(&inst->observer, &inst->derived.observer_coeffs, obs_in, known_load);
 
     if (!inst->hold.active) {
         float load_rate;
         float i_q_ref_rate;
         /* outside the vector holds, whose vector is not the law's (docs/design/18-transient-observer-boost.md) */
-        if (inst->robust_corrections && (inst->cfg->gains.transient_observer_boost > 0.0f) && !known_load) {
-            pmstep_observer_boost_in_transient(&inst->observer, &inst->observer_coeffs, obs_in,
+        if (inst->derived.robust_corrections && (inst->cfg->gains.transient_observer_boost > 0.0f) && !known_load) {
+            pmstep_observer_boost_in_transient(&inst->observer, &inst->derived.observer_coeffs, obs_in,
                                                inst->cfg->gains.transient_observer_boost,
                                                inst->cfg->detection.observer_residual_bound_A, &scratch->mech_rates);
         }
         load_rate = known_load ? ref.rate : scratch->mech_rates.load_hat_rate_Nm_s;
-        i_q_ref_rate = pmstep_law_iq_ref_rate(&inst->law_coeffs, &refs, speed.slope,
+        i_q_ref_rate = pmstep_law_iq_ref_rate(&inst->derived.law_coeffs, &refs, speed.slope,
                                               scratch->mech_rates.speed_hat_rate_rad_s2, load_rate - detent.rate_Nm_s);
-        pmstep_law_voltages(&inst->law_coeffs, &refs, cos_hat, sin_hat, i_d, i_q, inst->observer.speed_hat_rad_s,
+        pmstep_law_voltages(&inst->derived.law_coeffs, &refs, cos_hat, sin_hat, i_d, i_q, inst->observer.speed_hat_rad_s,
                             i_q_ref, i_q_ref_rate, &inst->current_integral, &out->u_a_V, &out->u_b_V);
     }
 
@@ -181,16 +181,16 @@ pmstep_fault_t pmstep_control_advance(pmstep_t *inst, const pmstep_control_scrat
 {
     const pmstep_config_t *cfg = inst->cfg;
     const float period_s = cfg->timing.period_s;
-    if (inst->robust_corrections) { /* one test a period where none is on (the paper's estimate) */
-        if (inst->angle_coeffs.correction_gain > 0.0f) {
-            pmstep_angle_correct(&inst->angle, &inst->angle_coeffs, out->cos_hat, out->sin_hat);
+    if (inst->derived.robust_corrections) { /* one test a period where none is on (the paper's estimate) */
+        if (inst->derived.angle_coeffs.correction_gain > 0.0f) {
+            pmstep_angle_correct(&inst->angle, &inst->derived.angle_coeffs, out->cos_hat, out->sin_hat);
         }
         /* outside the vector holds, whose vector sets the angle; in the position library's moves
          * too, where without it the current loop at 0.2/T_s rang at the electrical frequency
          * (docs/design/15-back-emf-angle-correction.md) */
-        if ((inst->angle_coeffs.emf_turn_gain > 0.0f) && !inst->hold.active) {
+        if ((inst->derived.angle_coeffs.emf_turn_gain > 0.0f) && !inst->hold.active) {
             const pmstep_observer_input_t *in = &scratch->observer_input;
-            const pmstep_observer_coeffs_t *obs = &inst->observer_coeffs;
+            const pmstep_observer_coeffs_t *obs = &inst->derived.observer_coeffs;
             const float err_a = in->i_a_A - inst->observer.i_a_hat_A;
             const float err_b = in->i_b_A - inst->observer.i_b_hat_A;
             /* Park written out, not pmstep_park(): a second caller makes -Os keep it out of line
@@ -206,25 +206,25 @@ pmstep_fault_t pmstep_control_advance(pmstep_t *inst, const pmstep_control_scrat
                                    < PMSTEP_EMF_ANGLE_MAX_READING_RAD * obs->km_over_l
                                          * pmstep_abs(out->speed_hat_rad_s);
             if (settled_q && settled_d) {
-                pmstep_angle_follow_emf(&inst->angle, &inst->angle_coeffs, out->cos_hat, out->sin_hat,
+                pmstep_angle_follow_emf(&inst->angle, &inst->derived.angle_coeffs, out->cos_hat, out->sin_hat,
                                         i_d_residual_A, out->speed_hat_rad_s);
             }
         }
     }
-    pmstep_observer_advance(&inst->observer, &inst->observer_coeffs, &scratch->observer_input, &scratch->mech_rates,
+    pmstep_observer_advance(&inst->observer, &inst->derived.observer_coeffs, &scratch->observer_input, &scratch->mech_rates,
                             inst->actuator.u_applied_a_V, inst->actuator.u_applied_b_V, period_s);
     if (!out->voltage_limited) { /* anti-windup: the integral holds while the bus limits the voltage */
-        pmstep_law_integrate(&inst->current_integral, &inst->law_coeffs, scratch->observer_input.i_d_err_A,
+        pmstep_law_integrate(&inst->current_integral, &inst->derived.law_coeffs, scratch->observer_input.i_d_err_A,
                              scratch->observer_input.i_q_err_A, period_s);
     }
-    pmstep_ref_advance(&inst->ref_coeffs, &inst->speed_ref, period_s);
-    pmstep_ref_advance(&inst->ref_coeffs, &inst->i_d_ref, period_s);
+    pmstep_ref_advance(&inst->derived.ref_coeffs, &inst->speed_ref, period_s);
+    pmstep_ref_advance(&inst->derived.ref_coeffs, &inst->i_d_ref, period_s);
     if (inst->hold.standstill_armed) {
         pmstep_standstill_advance(inst, out);
     }
     if (cfg->known_load_mode) {
         pmstep_ref_set_target(&inst->scratch.run.known_load_filter, meas->load_torque_Nm, 0.0f);
-        pmstep_ref_advance(&inst->ref_coeffs, &inst->scratch.run.known_load_filter, period_s);
+        pmstep_ref_advance(&inst->derived.ref_coeffs, &inst->scratch.run.known_load_filter, period_s);
     }
     /* The current integrals need no check here: they enter the next voltage, which actuate checks. */
     return pmstep_all_finite6(inst->observer.speed_hat_rad_s, inst->observer.load_hat_Nm, inst->observer.i_a_hat_A,

@@ -81,7 +81,7 @@ static pmstep_fault_t check_measurements(const pmstep_t *inst, const pmstep_meas
     if (meas->bus_voltage_V > cfg->limits.max_bus_voltage_V) {
         return PMSTEP_FAULT_BUS_OVERVOLTAGE;
     }
-    return inst->optional_inputs ? check_optional_inputs(cfg, meas) : PMSTEP_FAULT_NONE;
+    return inst->derived.optional_inputs ? check_optional_inputs(cfg, meas) : PMSTEP_FAULT_NONE;
 }
 
 /* Bridge off and the mode of this period; the offset calibration's samples. */
@@ -92,7 +92,7 @@ static void offset_calibration_stage(pmstep_t *inst, const pmstep_meas_t *meas, 
     pmstep_commission_add_bridge_off(&inst->scratch.sums, meas->i_a_A, meas->i_b_A,
                                      sensing ? meas->phase_voltage_a_V : 0.0f,
                                      sensing ? meas->phase_voltage_b_V : 0.0f);
-    if (++inst->mode_step >= inst->offset_cal_steps) {
+    if (++inst->mode_step >= inst->derived.offset_cal_steps) {
         /* Offsets for the alignment: the dead-time compensation needs the sign of small currents. */
         pmstep_commission_take_bridge_off(&inst->scratch.sums, &inst->commissioning);
         inst->mode = PMSTEP_MODE_S_ALIGN;
@@ -124,16 +124,16 @@ static pmstep_fault_t finish_commissioning(pmstep_t *inst, const pmstep_meas_t *
 {
     pmstep_commissioning_t *result = &inst->commissioning;
     pmstep_electrical_t model;
-    const pmstep_fault_t fault = pmstep_commission_finish(&inst->scratch.sums, &inst->commission_plan, inst->cfg,
+    const pmstep_fault_t fault = pmstep_commission_finish(&inst->scratch.sums, &inst->derived.commission_plan, inst->cfg,
                                                           raw->i_a_A, inst->actuator.u_applied_a_V, result);
     if (fault != PMSTEP_FAULT_NONE) {
         return fault;
     }
-    if (inst->commission_plan.identification_steps > 0u) {
+    if (inst->derived.commission_plan.identification_steps > 0u) {
         result->identification = PMSTEP_IDENT_RUNNING; /* RUN's start clears the sums */
     }
     commissioned_model(inst, &model);
-    pmstep_apply_model(inst, &model);
+    pmstep_apply_model(&inst->derived, inst->cfg, &model);
     return PMSTEP_FAULT_NONE;
 }
 
@@ -144,7 +144,7 @@ static pmstep_fault_t finish_commissioning(pmstep_t *inst, const pmstep_meas_t *
 static void identify_stage(pmstep_t *inst, const pmstep_output_t *out)
 {
     if (pmstep_identify_sample(&inst->scratch.run.identify, &inst->cfg->commissioning,
-                               inst->commission_plan.identification_steps, out)) {
+                               inst->derived.commission_plan.identification_steps, out)) {
         pmstep_electrical_t model;
         float friction_Nms_rad;
         commissioned_model(inst, &model);
@@ -153,7 +153,7 @@ static void identify_stage(pmstep_t *inst, const pmstep_output_t *out)
             /* Bumpless: T_L-hat takes over the friction torque the new F no longer leaves to it,
              * so F w-hat + T_L-hat, the torque the law asks for at constant speed, is unchanged. */
             inst->observer.load_hat_Nm += (friction_Nms_rad - model.friction_Nms_rad) * inst->observer.speed_hat_rad_s;
-            pmstep_apply_model(inst, &model);
+            pmstep_apply_model(&inst->derived, inst->cfg, &model);
         }
     }
 }
@@ -166,9 +166,9 @@ static void identify_stage(pmstep_t *inst, const pmstep_output_t *out)
  * no assumption). */
 static bool phase_a_voltage_known(const pmstep_t *inst, const pmstep_meas_t *meas)
 {
-    return inst->cfg->inverter.phase_voltage_sensing || !inst->actuate_coeffs.compensate
+    return inst->cfg->inverter.phase_voltage_sensing || !inst->derived.actuate_coeffs.compensate
            || (meas->i_a_A - inst->commissioning.offset_a_A)
-                  >= -pmstep_actuate_sign_threshold(&inst->actuate_coeffs, meas->bus_voltage_V);
+                  >= -pmstep_actuate_sign_threshold(&inst->derived.actuate_coeffs, meas->bus_voltage_V);
 }
 
 /* Commission stage: the mode of this period from the alignment timing; the alignment's samples
@@ -176,7 +176,7 @@ static bool phase_a_voltage_known(const pmstep_t *inst, const pmstep_meas_t *mea
  * steady-state windows has the alignments repeated from s-alignment (this period its first). */
 static pmstep_fault_t commission_stage(pmstep_t *inst, const pmstep_meas_t *meas)
 {
-    const pmstep_commission_plan_t *plan = &inst->commission_plan;
+    const pmstep_commission_plan_t *plan = &inst->derived.commission_plan;
     float u_a_V;
     float u_b_V;
     if (inst->mode_step >= plan->c_align_end_step) {
@@ -227,7 +227,7 @@ static pmstep_meas_t calibrated_sample(const pmstep_t *inst, const pmstep_meas_t
 static void alignment_stage(const pmstep_t *inst, pmstep_output_t *out)
 {
     const pmstep_config_t *cfg = inst->cfg;
-    const pmstep_commission_plan_t *plan = &inst->commission_plan;
+    const pmstep_commission_plan_t *plan = &inst->derived.commission_plan;
     output_off(out, inst);
     if ((inst->mode == PMSTEP_MODE_S_ALIGN) && (inst->mode_step < plan->s_lead_in_steps)) {
         out->u_a_V = cfg->alignment.c_align_voltage_V; /* the lead-in, (5)'s vector: away from (3)'s unstable
@@ -256,11 +256,11 @@ static pmstep_fault_t supervise_stage(pmstep_t *inst, const pmstep_output_t *out
     if ((inst->step_count % PMSTEP_DETECTION_DECIMATION) != 0u) {
         return PMSTEP_FAULT_NONE;
     }
-    if ((pmstep_abs(inst->observer.speed_hat_rad_s) >= inst->observer_coeffs.speed_bound_rad_s)
-        || (pmstep_abs(inst->observer.load_hat_Nm) >= inst->observer_coeffs.load_bound_Nm)) {
+    if ((pmstep_abs(inst->observer.speed_hat_rad_s) >= inst->derived.observer_coeffs.speed_bound_rad_s)
+        || (pmstep_abs(inst->observer.load_hat_Nm) >= inst->derived.observer_coeffs.load_bound_Nm)) {
         return PMSTEP_FAULT_ESTIMATE_RANGE;
     }
-    return pmstep_detect_check(&inst->scratch.run.detector, &inst->detect_coeffs, &inst->cfg->detection, out, sample);
+    return pmstep_detect_check(&inst->scratch.run.detector, &inst->derived.detect_coeffs, &inst->cfg->detection, out, sample);
 }
 
 /* Dead-time compensation in RUN: the current references (i_d*, i_q*) in the stator frame at the
@@ -271,7 +271,7 @@ static void reference_current_over_period(const pmstep_t *inst, const pmstep_mea
                                           const pmstep_output_t *out, pmstep_compensation_input_t *in)
 {
     const float band_A = inst->cfg->inverter.dead_time_current_band_A;
-    const float half_turn = 0.5f * inst->law_coeffs.pole_pairs * inst->cfg->timing.period_s
+    const float half_turn = 0.5f * inst->derived.law_coeffs.pole_pairs * inst->cfg->timing.period_s
                             * pmstep_abs(out->speed_hat_rad_s);
     /* the command's voltage sets the ripple; a bridge without ripple is handed 0 V (h = 0), as a
      * factor rather than a branch (no branch in the period) */
@@ -280,13 +280,13 @@ static void reference_current_over_period(const pmstep_t *inst, const pmstep_mea
     float sin_act;
     float current_a_A;
     float current_b_A;
-    pmstep_law_acting_angle(&inst->law_coeffs, out->cos_hat, out->sin_hat, out->speed_hat_rad_s, &cos_act, &sin_act);
+    pmstep_law_acting_angle(&inst->derived.law_coeffs, out->cos_hat, out->sin_hat, out->speed_hat_rad_s, &cos_act, &sin_act);
     current_a_A = cos_act * out->i_d_ref_A - sin_act * out->i_q_ref_A;
     current_b_A = sin_act * out->i_d_ref_A + cos_act * out->i_q_ref_A;
-    in->sign_current_a_A = pmstep_actuate_mean_loss_current(&inst->actuate_coeffs, band_A, current_a_A,
+    in->sign_current_a_A = pmstep_actuate_mean_loss_current(&inst->derived.actuate_coeffs, band_A, current_a_A,
                                                             pmstep_abs(current_b_A) * half_turn,
                                                             ripple_voltage_factor * out->u_a_V, sample->bus_voltage_V);
-    in->sign_current_b_A = pmstep_actuate_mean_loss_current(&inst->actuate_coeffs, band_A, current_b_A,
+    in->sign_current_b_A = pmstep_actuate_mean_loss_current(&inst->derived.actuate_coeffs, band_A, current_b_A,
                                                             pmstep_abs(current_a_A) * half_turn,
                                                             ripple_voltage_factor * out->u_b_V, sample->bus_voltage_V);
 }
@@ -327,7 +327,7 @@ static pmstep_compensation_input_t compensation_input(const pmstep_t *inst, cons
  * the ends of the alignments. A fault here latches (a re-alignment cannot mend a winding). */
 static pmstep_fault_t continuity_align_stage(pmstep_t *inst, const pmstep_meas_t *sample)
 {
-    const pmstep_commission_plan_t *plan = &inst->commission_plan;
+    const pmstep_commission_plan_t *plan = &inst->derived.commission_plan;
     const bool a_driven = (inst->mode == PMSTEP_MODE_C_ALIGN) || (inst->mode_step < plan->s_lead_in_steps);
     return pmstep_continuity_align(&inst->scratch.sums.continuity, inst->cfg, a_driven, sample->i_a_A, sample->i_b_A,
                                    (inst->mode_step + 1u) == plan->s_align_steps,
@@ -346,7 +346,7 @@ static pmstep_fault_t continuity_run_stage(pmstep_t *inst, const pmstep_meas_t *
         ref_a_A = (out->cos_hat * out->i_d_ref_A) - (out->sin_hat * out->i_q_ref_A);
         ref_b_A = (out->sin_hat * out->i_d_ref_A) + (out->cos_hat * out->i_q_ref_A);
     }
-    return pmstep_continuity_check(&inst->scratch.run.continuity, &inst->continuity_coeffs, ref_a_A, ref_b_A,
+    return pmstep_continuity_check(&inst->scratch.run.continuity, &inst->derived.continuity_coeffs, ref_a_A, ref_b_A,
                                    sample->i_a_A, sample->i_b_A)
                ? pmstep_continuity_judge(&inst->scratch.run.continuity, inst->cfg)
                : PMSTEP_FAULT_NONE;
@@ -380,10 +380,10 @@ static pmstep_fault_t bridge_on_stages(pmstep_t *inst, const pmstep_meas_t *meas
     } else {
         alignment_stage(inst, out);
     }
-    if (inst->actuate_coeffs.compensate) {
+    if (inst->derived.actuate_coeffs.compensate) {
         compensation = compensation_input(inst, &sample, out);
     }
-    if (!pmstep_actuate(&inst->actuator, &inst->actuate_coeffs, &compensation, meas->bus_voltage_V, out)) {
+    if (!pmstep_actuate(&inst->actuator, &inst->derived.actuate_coeffs, &compensation, meas->bus_voltage_V, out)) {
         return PMSTEP_FAULT_STATE_NONFINITE; /* every mode: never the bridge on with such a voltage */
     }
     out->mode = inst->mode;

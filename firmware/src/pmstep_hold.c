@@ -49,7 +49,7 @@ bool pmstep_hold_aim_ahead(const pmstep_law_coeffs_t *law, float c, float s, flo
  * without a division: (1 - share) |P|^2 >= Re(M conj P) = -w^2 (a_e Re P + w Im P). */
 static bool observer_follows_swing(const pmstep_t *inst, float w)
 {
-    const pmstep_observer_coeffs_t *obs = &inst->observer_coeffs;
+    const pmstep_observer_coeffs_t *obs = &inst->derived.observer_coeffs;
     const float a_e = obs->r_over_l_per_s + obs->observer_gain_per_s;
     const float b_squared = obs->km_over_l * obs->km_over_l;
     const float w2 = w * w;
@@ -84,7 +84,7 @@ pmstep_status_t pmstep_hold_engage(pmstep_t *inst, float cos_rest, float sin_res
     if (!(current_A > 0.0f && current_A < inst->cfg->limits.max_phase_current_A)) {
         return PMSTEP_ERR_HOLD_CURRENT;
     }
-    law = &inst->law_coeffs;
+    law = &inst->derived.law_coeffs;
     hold = &inst->hold;
     detent = pmstep_law_detent(law, cos_rest, sin_rest, 0.0f);
     if (!pmstep_hold_aim_ahead(law, cos_rest, sin_rest, current_A, load_Nm, 0.0f, &detent, &aim)) {
@@ -146,7 +146,7 @@ pmstep_status_t pmstep_set_angle_estimate(pmstep_t *inst, float cos_hat, float s
     if (!pmstep_all_finite4(cos_hat, sin_hat, 0.0f, 0.0f)) {
         return PMSTEP_ERR_BAD_COMMAND_VALUE;
     }
-    pmstep_angle_set(&inst->angle, &inst->angle_coeffs, cos_hat, sin_hat);
+    pmstep_angle_set(&inst->angle, &inst->derived.angle_coeffs, cos_hat, sin_hat);
     pmstep_angle_smoother_set(&inst->scratch.run.smoother, cos_hat, sin_hat); /* and the smoothing's */
     return PMSTEP_OK;
 }
@@ -157,7 +157,7 @@ pmstep_status_t pmstep_set_angle_estimate(pmstep_t *inst, float cos_hat, float s
 void pmstep_hold_voltages(pmstep_t *inst, pmstep_observer_input_t *obs_in, pmstep_output_t *out)
 {
     pmstep_vector_hold_t *hold = &inst->hold;
-    const pmstep_law_coeffs_t *law = &inst->law_coeffs;
+    const pmstep_law_coeffs_t *law = &inst->derived.law_coeffs;
     const float vector_speed = hold->vector_speed_rad_s;
     const float speed_change = inst->observer.speed_hat_rad_s - vector_speed - hold->speed_bias_rad_s;
     /* the frame's own speed: the rotor's w_v plus the load angle's rate (the detent torque's); 0

@@ -50,12 +50,19 @@ static inline uint32_t pmstep_periods_in(float duration_s, float period_s)
     return (uint32_t)(duration_s / period_s + 0.5f);
 }
 
-/* True if every coefficient pmstep_init() derives from @p cfg (an already range-checked
- * configuration) is finite in float32. */
-bool pmstep_derived_coefficients_finite(const pmstep_config_t *cfg);
+/* The rules of every setting, without the derivation (pmstep_config.c): pmstep_validate_config()
+ * less its check of the derived coefficients. */
+pmstep_status_t pmstep_check_settings(const pmstep_config_t *cfg);
 
-/* Coefficients of the angle, observer and law for the model @p model (pmstep_lifecycle.c). */
-void pmstep_apply_model(pmstep_t *inst, const pmstep_electrical_t *model);
+/* Everything init derives from @p cfg, a configuration pmstep_check_settings() accepts
+ * (pmstep_derive.c). */
+void pmstep_derive(pmstep_derived_t *derived, const pmstep_config_t *cfg);
+
+/* True if every coefficient of @p derived is finite in float32 (pmstep_derive.c). */
+bool pmstep_derived_finite(const pmstep_derived_t *derived);
+
+/* Coefficients of the angle, observer and law for the model @p model (pmstep_derive.c). */
+void pmstep_apply_model(pmstep_derived_t *derived, const pmstep_config_t *cfg, const pmstep_electrical_t *model);
 
 /* Clears the dynamic state of the strategy; keeps commands (targets) untouched (pmstep_lifecycle.c). */
 void pmstep_clear_dynamic_state(pmstep_t *inst);

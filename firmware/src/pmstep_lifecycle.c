@@ -1,4 +1,4 @@
-/* Lifecycle and commands: init (validation, every coefficient derived from the configuration),
+/* Lifecycle and commands: init (the settings checked, the coefficients derived: pmstep_derive.c),
  * reset, start, stop, clear_fault and the set-points; the step is in pmstep_core.c. */
 #include "pmstep/pmstep.h"
 #include "pmstep_internal.h"
@@ -6,83 +6,26 @@
 #include <stddef.h>
 #include <string.h>
 
-/* Coefficients of the angle, observer and law for the model @p model. */
-void pmstep_apply_model(pmstep_t *inst, const pmstep_electrical_t *model)
-{
-    pmstep_angle_coeffs_init(&inst->angle_coeffs, inst->cfg, model);
-    pmstep_observer_coeffs_init(&inst->observer_coeffs, inst->cfg, model);
-    pmstep_law_coeffs_init(&inst->law_coeffs, inst->cfg, model);
-}
-
-/* Everything init derives from @p cfg: the coefficients of each block for the configured model,
- * period counts, the detection and actuation constants. */
-static void derive(pmstep_t *inst, const pmstep_config_t *cfg)
-{
-    const pmstep_electrical_t configured = pmstep_configured_electrical(cfg);
-    const float period_s = cfg->timing.period_s;
-    pmstep_commission_plan_t *plan = &inst->commission_plan;
-    inst->cfg = cfg;
-    pmstep_ref_coeffs_init(&inst->ref_coeffs, cfg->gains.reference_bandwidth_rad_s, period_s);
-    pmstep_apply_model(inst, &configured);
-    plan->s_lead_in_steps = pmstep_periods_in(cfg->alignment.s_lead_in_time_s, period_s);
-    plan->s_align_steps = pmstep_periods_in(cfg->alignment.s_align_time_s, period_s);
-    plan->c_align_end_step = pmstep_periods_in(cfg->alignment.c_align_time_s, period_s);
-    plan->window_steps = pmstep_periods_in(cfg->commissioning.steady_state_window_s, period_s);
-    plan->inductance_steps = pmstep_periods_in(cfg->commissioning.inductance_window_s, period_s);
-    plan->inductance_start_step = plan->s_lead_in_steps + 2u + cfg->timing.computational_delay_periods;
-    plan->offsets_from_alignment = cfg->commissioning.alignment_offset_calibration;
-    plan->bias_estimation = cfg->commissioning.voltage_bias_level_fraction > 0.0f;
-    plan->identification_steps = pmstep_periods_in(cfg->commissioning.identification_time_s, period_s);
-    inst->offset_cal_steps = pmstep_periods_in(cfg->commissioning.offset_calibration_time_s, period_s);
-    inst->optional_inputs = cfg->known_load_mode || cfg->inverter.phase_voltage_sensing;
-    inst->robust_corrections = (cfg->gains.angle_correction_gain_per_s > 0.0f) || (cfg->gains.emf_angle_gain_per_s > 0.0f)
-                               || (cfg->gains.transient_observer_boost > 0.0f);
-    inst->angle_smoothing = cfg->gains.angle_smoothing > 0.0f;
-    pmstep_detect_coeffs_init(&inst->detect_coeffs, cfg);
-    pmstep_continuity_coeffs_init(&inst->continuity_coeffs, cfg);
-    pmstep_actuate_coeffs_init(&inst->actuate_coeffs, cfg);
-    inst->voltage_corrected = inst->actuate_coeffs.sensed || inst->actuate_coeffs.compensate;
-}
-
-/* True if the @p count floats stored from @p first on (a run of float members) are all finite. */
-static bool floats_finite(const void *first, size_t count)
-{
-    const unsigned char *bytes = (const unsigned char *)first;
-    float sum = 0.0f;
-    size_t n;
-    for (n = 0; n < count; ++n) {
-        float value;
-        memcpy(&value, bytes + n * sizeof value, sizeof value);
-        sum += value - value; /* 0 for finite values, NaN otherwise */
-    }
-    return sum == 0.0f;
-}
-
-bool pmstep_derived_coefficients_finite(const pmstep_config_t *cfg)
-{
-    pmstep_t scratch; /* init's derivation, on the stack of the caller of init/validate */
-    derive(&scratch, cfg);
-    return floats_finite(&scratch.ref_coeffs, sizeof scratch.ref_coeffs / sizeof(float))
-           && floats_finite(&scratch.angle_coeffs, sizeof scratch.angle_coeffs / sizeof(float))
-           && floats_finite(&scratch.observer_coeffs, sizeof scratch.observer_coeffs / sizeof(float))
-           && floats_finite(&scratch.law_coeffs, offsetof(pmstep_law_coeffs_t, linear_speed_term) / sizeof(float))
-           && floats_finite(&scratch.detect_coeffs.alpha, 3u)          /* alpha, angle step, consistency bound */
-           && floats_finite(&scratch.actuate_coeffs.dead_time_duty, 2u); /* duty, 1/band */
-}
-
 pmstep_status_t pmstep_init(pmstep_t *inst, const pmstep_config_t *cfg)
 {
+    pmstep_derived_t derived;
     pmstep_status_t status;
     if (inst == NULL) {
         return PMSTEP_ERR_NULL_ARGUMENT;
     }
-    status = pmstep_validate_config(cfg);
-    if (status != PMSTEP_OK) {
-        return status;
+    /* The settings' rules, then the one derivation, checked as validation checks its own; the
+     * instance is written only once both hold (a refused init leaves a running one as it was). */
+    status = pmstep_check_settings(cfg);
+    if (status == PMSTEP_OK) {
+        pmstep_derive(&derived, cfg);
+        status = pmstep_derived_finite(&derived) ? PMSTEP_OK : PMSTEP_ERR_DERIVED_NONFINITE;
     }
-    derive(inst, cfg);
-    pmstep_reset(inst);
-    return PMSTEP_OK;
+    if (status == PMSTEP_OK) {
+        inst->cfg = cfg;
+        inst->derived = derived;
+        pmstep_reset(inst);
+    }
+    return status;
 }
 
 /* Forgets what the last alignment measured: offsets 0, the configured model, sums cleared. */
@@ -93,7 +36,7 @@ static void clear_commissioning(pmstep_t *inst)
     inst->commissioning.phase_a_current_scale = 1.0f;
     inst->commissioning.equilibrium_cos = 1.0f;
     pmstep_commission_clear(&inst->scratch.sums);
-    pmstep_apply_model(inst, &configured);
+    pmstep_apply_model(&inst->derived, inst->cfg, &configured);
 }
 
 /* Clears the dynamic state of the strategy; keeps commands (targets) untouched. */
@@ -134,7 +77,7 @@ pmstep_status_t pmstep_start(pmstep_t *inst)
     }
     pmstep_clear_dynamic_state(inst);
     clear_commissioning(inst);
-    inst->mode = inst->offset_cal_steps > 0u ? PMSTEP_MODE_OFFSET_CAL : PMSTEP_MODE_S_ALIGN;
+    inst->mode = inst->derived.offset_cal_steps > 0u ? PMSTEP_MODE_OFFSET_CAL : PMSTEP_MODE_S_ALIGN;
     return PMSTEP_OK;
 }
 

@@ -132,7 +132,7 @@ pmstep_status_t pmstep_position_init(pmstep_position_t *pos, pmstep_t *inst, con
     pos->frozen_sin = 0.0f;
     pos->inv_pole_pairs = 1.0f / (float)core->motor.pole_pairs;
     pos->period_s = core->timing.period_s;
-    pos->inv_bandwidth_s = 1.0f / inst->ref_coeffs.bandwidth_rad_s;
+    pos->inv_bandwidth_s = 1.0f / inst->derived.ref_coeffs.bandwidth_rad_s;
     pos->cos_hat = 1.0f;
     pos->sin_hat = 0.0f;
     pos->speed_hat_rad_s = 0.0f;
@@ -151,7 +151,7 @@ pmstep_status_t pmstep_position_init(pmstep_position_t *pos, pmstep_t *inst, con
     pmstep_motion_reset(&pos->motion, 0.0f, (float)PMSTEP_POSITION_DECIMATION * pos->period_s);
     pos->now = pmstep_motion_peek(&pos->motion);
     pos->ahead = pos->now;
-    hold_coefficients(pos, inst->ref_coeffs.bandwidth_rad_s * pos->motion.period_s);
+    hold_coefficients(pos, inst->derived.ref_coeffs.bandwidth_rad_s * pos->motion.period_s);
     return PMSTEP_OK;
 }
 
@@ -288,7 +288,7 @@ POSITION_OUT_OF_LINE static void update(pmstep_position_t *pos, float i_q_ref_A)
         }
         /* the push: i_q* beyond what the tracker's own acceleration asks */
         if (pmstep_stepdir_stall(pos->steps, position_rad,
-                                 i_q_ref_A - pos->inst->law_coeffs.j_over_km * pos->steps->accel_rad_s2)) {
+                                 i_q_ref_A - pos->inst->derived.law_coeffs.j_over_km * pos->steps->accel_rad_s2)) {
             /* the loop stops pressing the block: no integral, and the block's reaction out of T_L-hat */
             pos->error_integral_rad_s = 0.0f;
             pos->inst->observer.load_hat_Nm = pos->steps->rest_load_Nm;

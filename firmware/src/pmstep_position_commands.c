@@ -39,7 +39,7 @@ static pmstep_motion_sample_t profile_start(const pmstep_position_t *pos)
     if (pos->out.position_mode) {
         start = pos->ahead; /* the next update's sample */
     } else {
-        const pmstep_ref_out_t ref = pmstep_ref_output(&pos->inst->ref_coeffs, &pos->inst->speed_ref);
+        const pmstep_ref_out_t ref = pmstep_ref_output(&pos->inst->derived.ref_coeffs, &pos->inst->speed_ref);
         float position_rad;
         (void)pmstep_get_position(pos, &position_rad); /* tracked: every command checks it first */
         start.position = position_rad + pos->period_s * pos->speed_hat_rad_s;
@@ -60,7 +60,7 @@ static void enter_position_mode(pmstep_position_t *pos)
     const bool was_position_mode = pos->out.position_mode;
     pmstep_leave_speed_mode(pos->inst); /* the loop's reference from now: no standstill hold of speed mode */
     if (!was_position_mode) {
-        const pmstep_ref_out_t ref = pmstep_ref_output(&pos->inst->ref_coeffs, &pos->inst->speed_ref);
+        const pmstep_ref_out_t ref = pmstep_ref_output(&pos->inst->derived.ref_coeffs, &pos->inst->speed_ref);
         const float step_s = pos->motion.period_s;
         /* the next period reads (w*, w*', w*''); the update after it puts the loop's own */
         pmstep_position_put_speed_reference(pos, ref.value, ref.rate, ref.accel,

@@ -108,7 +108,7 @@ static void correct_aim(pmstep_position_t *pos)
  * instructions on the mean (pil.position_cost). */
 static void put_back_kept_estimate(pmstep_position_t *pos)
 {
-    pmstep_angle_set(&pos->inst->angle, &pos->inst->angle_coeffs, pos->frozen_cos, pos->frozen_sin);
+    pmstep_angle_set(&pos->inst->angle, &pos->inst->derived.angle_coeffs, pos->frozen_cos, pos->frozen_sin);
 }
 
 /* Whether the flux integrals' reading is within POSITION_READING_MOTION_BANDS quiet bands' turn

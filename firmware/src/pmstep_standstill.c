@@ -26,7 +26,7 @@ void pmstep_standstill_start(pmstep_t *inst)
     standstill->quiet_band_rad_s = 0.0f;
     standstill->engage_periods = 0u;
     if (inst->hold.standstill_armed) {
-        const pmstep_law_coeffs_t *law = &inst->law_coeffs;
+        const pmstep_law_coeffs_t *law = &inst->derived.law_coeffs;
         standstill->quiet_band_rad_s = PMSTEP_HOLD_QUIET_FRACTION * pmstep_hold_natural_rad_s(law, current_A, 1.0f)
                                        / law->pole_pairs;
         standstill->engage_periods = pmstep_hold_period_count(PMSTEP_STANDSTILL_ENGAGE_TIME_CONSTANTS
@@ -64,7 +64,7 @@ static void aim_clear_of_phase_axes(float *c, float *s, float min_sin)
  * Unchanged where the load is beyond the vector's pull (pmstep_hold_vector refuses it). */
 static void rest_for_clear_vector(const pmstep_t *inst, float *c, float *s, float load_Nm)
 {
-    const pmstep_law_coeffs_t *law = &inst->law_coeffs;
+    const pmstep_law_coeffs_t *law = &inst->derived.law_coeffs;
     const float current_A = inst->cfg->standstill.hold_current_A;
     const float clear_sin = PMSTEP_HOLD_PHASE_CLEARANCE_BANDS * inst->cfg->inverter.dead_time_current_band_A
                             / current_A;
@@ -159,7 +159,7 @@ static sensed_angle_t sensed_angle(const pmstep_t *inst, const pmstep_output_t *
 {
     sensed_angle_t sensed = {out->cos_hat, out->sin_hat};
     if (inst->estimate_kept) {
-        pmstep_angle_estimate(&inst->angle, &inst->angle_coeffs, inst->angle.i_a_prev_A, inst->angle.i_b_prev_A,
+        pmstep_angle_estimate(&inst->angle, &inst->derived.angle_coeffs, inst->angle.i_a_prev_A, inst->angle.i_b_prev_A,
                               &sensed.cos_hat, &sensed.sin_hat);
     }
     return sensed;
@@ -193,7 +193,7 @@ static float hold_acceleration_A(const pmstep_law_coeffs_t *law, const pmstep_ve
  * (PMSTEP_HOLD_MAX_TORQUE_FRACTION): the law takes over. */
 static bool turn_vector(pmstep_t *inst, pmstep_standstill_t *standstill, const pmstep_output_t *out)
 {
-    const pmstep_law_coeffs_t *law = &inst->law_coeffs;
+    const pmstep_law_coeffs_t *law = &inst->derived.law_coeffs;
     pmstep_vector_hold_t *hold = &inst->hold;
     const float turn = law->pole_pairs * out->speed_ref_rad_s * inst->cfg->timing.period_s;
     float c;
@@ -228,7 +228,7 @@ static bool turn_vector(pmstep_t *inst, pmstep_standstill_t *standstill, const p
  * J w_v' + F w_v where the vector turns (pmstep_hold_vector's relation solved for the load). */
 static float held_balance_Nm(const pmstep_t *inst, float c, float s, const pmstep_output_t *out)
 {
-    const pmstep_law_coeffs_t *law = &inst->law_coeffs;
+    const pmstep_law_coeffs_t *law = &inst->derived.law_coeffs;
     const pmstep_vector_hold_t *hold = &inst->hold;
     const pmstep_detent_t detent = pmstep_law_detent(law, c, s, 0.0f);
     return law->km_over_l * law->inductance_H
@@ -244,7 +244,7 @@ static void follow_held_rotor(pmstep_t *inst, pmstep_standstill_t *standstill, c
     float c;
     float s;
     pmstep_turn(standstill->keep_cos, standstill->keep_sin, 1.0f - 0.5f * turn * turn, turn, &c, &s);
-    pmstep_angle_set(&inst->angle, &inst->angle_coeffs, c, s);
+    pmstep_angle_set(&inst->angle, &inst->derived.angle_coeffs, c, s);
     inst->observer.load_hat_Nm = held_balance_Nm(inst, c, s, out);
     standstill->aim_load_Nm = inst->observer.load_hat_Nm;
     standstill->rest_periods = 0u;
@@ -262,7 +262,7 @@ static void standstill_hold_period(pmstep_t *inst, pmstep_standstill_t *standsti
     if (turning && (inst->hold.standstill_settled || standstill->rest_periods < inst->hold.settle_periods)) {
         /* Turning: the flux integrals' phase is not the rotor's at low speed (the voltage errors
          * against a back-EMF of the same order), the estimate is the vector's aim throughout. */
-        pmstep_angle_set(&inst->angle, &inst->angle_coeffs, standstill->keep_cos, standstill->keep_sin);
+        pmstep_angle_set(&inst->angle, &inst->derived.angle_coeffs, standstill->keep_cos, standstill->keep_sin);
         inst->estimate_kept = true;
     } else if (!inst->hold.standstill_settled) {
         inst->estimate_kept = false;
@@ -299,7 +299,7 @@ static void standstill_hold_period(pmstep_t *inst, pmstep_standstill_t *standsti
                 follow_held_rotor(inst, standstill, out);
                 inst->estimate_kept = false;
             } else {
-                pmstep_angle_set(&inst->angle, &inst->angle_coeffs, standstill->keep_cos, standstill->keep_sin);
+                pmstep_angle_set(&inst->angle, &inst->derived.angle_coeffs, standstill->keep_cos, standstill->keep_sin);
                 inst->estimate_kept = true;
             }
         }

@@ -105,7 +105,7 @@ static bool quarter_turn(const sil_sample_t *x, void *user)
     kick_t *kick = (kick_t *)user;
     if (!kick->done && x->t_s >= kick->at_s && x->out->mode == PMSTEP_MODE_RUN) {
         pmstep_t *inst = x->inst;
-        const float k = inst->angle_coeffs.flux_to_angle;
+        const float k = inst->derived.angle_coeffs.flux_to_angle;
         const float c = x->out->cos_hat;
         const float s = x->out->sin_hat;
         /* c-hat grows by k per unit of phi1, s-hat by k per unit of phi2: (c, s) -> (-s, c). */

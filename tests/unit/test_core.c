@@ -378,7 +378,7 @@ static void nonfinite_voltage_never_leaves_with_the_bridge_on(void **state)
     cfg.inverter.dead_time_s = 1e-6f;
     cfg.inverter.dead_time_current_band_A = 0.01f;
     assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
-    inst.actuate_coeffs.inv_band_per_A = INFINITY;
+    inst.derived.actuate_coeffs.inv_band_per_A = INFINITY;
     assert_int_equal(pmstep_start(&inst), PMSTEP_OK);
     pmstep_step(&inst, &meas, &out);
     assert_int_equal(out.mode, PMSTEP_MODE_FAULT);

@@ -254,6 +254,27 @@ static void every_invalid_configuration_has_its_code(void **state)
     }
 }
 
+/* Validation without an instance and init agree on every case, and a refused init leaves a
+ * prepared instance byte for byte as it was (its derivation is checked before the instance is
+ * written). */
+static void refused_init_leaves_the_instance_as_it_was(void **state)
+{
+    size_t n;
+    static pmstep_t inst;
+    static pmstep_t before;
+    const pmstep_config_t good = pmstep_paper_config();
+    (void)state;
+    assert_int_equal(pmstep_init(&inst, &good), PMSTEP_OK);
+    memcpy(&before, &inst, sizeof before);
+    for (n = 0; n < sizeof validation_cases / sizeof validation_cases[0]; ++n) {
+        pmstep_config_t cfg = pmstep_paper_config();
+        validation_cases[n].edit(&cfg);
+        assert_int_equal(pmstep_validate_config(&cfg), validation_cases[n].expected);
+        assert_int_equal(pmstep_init(&inst, &cfg), validation_cases[n].expected);
+        assert_memory_equal(&inst, &before, sizeof inst);
+    }
+}
+
 /* The validation causes this file does not provoke, and the file that does: test_commission.c
  * (commissioning, inverter, detection and angle-correction settings). */
 static const pmstep_status_t codes_tested_in_test_commission[] = {
@@ -374,6 +395,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(every_invalid_configuration_has_its_code),
+        cmocka_unit_test(refused_init_leaves_the_instance_as_it_was),
         cmocka_unit_test(current_integral_within_its_bound_is_accepted),
         cmocka_unit_test(limits_at_their_bounds_are_accepted),
         cmocka_unit_test(emf_gain_under_the_residual_rate_is_accepted),

@@ -18,8 +18,8 @@ static void hold_to_run(pmstep_t *inst, pmstep_output_t *out)
     const pmstep_meas_t c_aligned = {8.0f, 0.0f, 48.0f, 0.0f, 0.0f, 0.0f};
     uint32_t k;
     assert_int_equal(pmstep_start(inst), PMSTEP_OK);
-    for (k = 0; k <= inst->commission_plan.c_align_end_step; ++k) {
-        pmstep_step(inst, k < inst->commission_plan.s_align_steps ? &s_aligned : &c_aligned, out);
+    for (k = 0; k <= inst->derived.commission_plan.c_align_end_step; ++k) {
+        pmstep_step(inst, k < inst->derived.commission_plan.s_align_steps ? &s_aligned : &c_aligned, out);
     }
     assert_int_equal(out->mode, PMSTEP_MODE_RUN);
 }
@@ -43,7 +43,7 @@ static void lost_angle_faults_or_realigns_after_the_detection_time(void **state)
         /* Hold c-hat at 1.5 (|c^2 + s^2 - 1| = 1.25): with i_a = i_a(t_c), c-hat = 1 + (L p/k_M) phi1. */
         jump_step = inst.step_count;
         for (k = 0; k < 1000u && out.mode == PMSTEP_MODE_RUN; ++k) {
-            inst.angle.phi_a = 0.5f / inst.angle_coeffs.flux_to_angle;
+            inst.angle.phi_a = 0.5f / inst.derived.angle_coeffs.flux_to_angle;
             inst.angle.phi_a_compensation = 0.0f;
             inst.angle.phi_b = 0.0f;
             inst.angle.phi_b_compensation = 0.0f;
@@ -88,8 +88,8 @@ static void estimate_out_of_range_faults(void **state)
         cfg.alignment.c_align_time_s = 0.04f;
         assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
         hold_to_run(&inst, &out);
-        assert_float_equal(inst.observer_coeffs.speed_bound_rad_s, 4.0f * 60.0f / 2.0f, 1e-3f);
-        assert_float_equal(inst.observer_coeffs.load_bound_Nm, 4.0f * 2.0f * 15.0f, 1e-3f);
+        assert_float_equal(inst.derived.observer_coeffs.speed_bound_rad_s, 4.0f * 60.0f / 2.0f, 1e-3f);
+        assert_float_equal(inst.derived.observer_coeffs.load_bound_Nm, 4.0f * 2.0f * 15.0f, 1e-3f);
         for (k = 0; k < 8u && out.mode == PMSTEP_MODE_RUN; ++k) {
             if (which == 0u) {
                 inst.observer.speed_hat_rad_s = -121.0f;

@@ -94,7 +94,7 @@ static void hold_damps_only_where_the_estimate_follows_the_swing(void **state)
         double w_o, f_j, a_e, c0, c1, c2, re;
         double complex s_jw, n, p;
         fixture_in_run(&f);
-        obs = &f.inst.observer_coeffs;
+        obs = &f.inst.derived.observer_coeffs;
         w_o = w_n / ratios[k];
         f_j = obs->f_over_j_per_s;
         a_e = paper_observer_at_triple_pole(obs, w_o);
@@ -180,9 +180,9 @@ static void angle_estimate_set_gives_that_estimate(void **state)
     pmstep_t idle;
     (void)state;
     fixture_in_run(&f);
-    pmstep_angle_update(&f.inst.angle, &f.inst.angle_coeffs, 1.5f, -0.5f, 10.0f, 3.0f); /* some history */
+    pmstep_angle_update(&f.inst.angle, &f.inst.derived.angle_coeffs, 1.5f, -0.5f, 10.0f, 3.0f); /* some history */
     assert_int_equal(pmstep_set_angle_estimate(&f.inst, 0.6f, -0.8f), PMSTEP_OK);
-    pmstep_angle_estimate(&f.inst.angle, &f.inst.angle_coeffs, 1.5f, -0.5f, &c, &s);
+    pmstep_angle_estimate(&f.inst.angle, &f.inst.derived.angle_coeffs, 1.5f, -0.5f, &c, &s);
     assert_float_equal(c, 0.6f, 1e-6f);
     assert_float_equal(s, -0.8f, 1e-6f);
     assert_int_equal(pmstep_set_angle_estimate(NULL, 1.0f, 0.0f), PMSTEP_ERR_NULL_ARGUMENT);
@@ -204,7 +204,7 @@ static void hold_settling_count_defined_for_any_model(void **state)
     for (n = 0; n < sizeof j_over_km / sizeof j_over_km[0]; ++n) {
         paper_run_t f;
         fixture_in_run(&f);
-        f.inst.law_coeffs.j_over_km = j_over_km[n];
+        f.inst.derived.law_coeffs.j_over_km = j_over_km[n];
         assert_int_equal(pmstep_hold_vector(&f.inst, 1.0f, 0.0f, 7.5f, 0.0f), PMSTEP_OK);
         assert_int_equal(f.inst.hold.settle_periods, 1000000u);
     }

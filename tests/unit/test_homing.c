@@ -72,7 +72,7 @@ static pmstep_homing_state_t run(fixture_t *f, long periods)
     pmstep_homing_state_t state = f->homing.state;
     long n;
     for (n = 0; n < periods; ++n) {
-        const pmstep_ref_out_t ref = pmstep_ref_output(&f->inst.ref_coeffs, &f->inst.speed_ref);
+        const pmstep_ref_out_t ref = pmstep_ref_output(&f->inst.derived.ref_coeffs, &f->inst.speed_ref);
         double speed = (double)ref.value;
         pmstep_output_t out;
         pmstep_position_output_t pos_out;
@@ -81,7 +81,7 @@ static pmstep_homing_state_t run(fixture_t *f, long periods)
             f->theta_rad = f->stop_rad;
             speed = 0.0;
         }
-        pmstep_ref_advance(&f->inst.ref_coeffs, &f->inst.speed_ref, f->cfg.timing.period_s);
+        pmstep_ref_advance(&f->inst.derived.ref_coeffs, &f->inst.speed_ref, f->cfg.timing.period_s);
         out = run_output(f, speed);
         pmstep_position_update(&f->pos, &out, &pos_out);
         state = pmstep_homing_update(&f->homing, &f->pos, &out, &pos_out);

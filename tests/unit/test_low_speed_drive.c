@@ -132,7 +132,7 @@ static void low_speed_drive_vector_rate_follows_the_detent(void **state)
     uint32_t n;
     (void)state;
     engaged_turning(&f, &out);
-    f.inst.law_coeffs.detent_torque_Nm = 1.5f; /* 10 % of k_M I */
+    f.inst.derived.law_coeffs.detent_torque_Nm = 1.5f; /* 10 % of k_M I */
     pmstep_standstill_advance(&f.inst, &out);
     for (n = 0; n < 2000u; ++n) {
         const float before_rad = angle_of(f.inst.hold.cos_vector, f.inst.hold.sin_vector);

@@ -298,11 +298,11 @@ static void kinematic_run(fixture_t *f, kinematic_t *k, long periods, double tar
     const double direction = target >= start ? 1.0 : -1.0;
     long n;
     for (n = 0; n < periods; ++n) {
-        const pmstep_ref_out_t ref = pmstep_ref_output(&f->inst.ref_coeffs, &f->inst.speed_ref);
+        const pmstep_ref_out_t ref = pmstep_ref_output(&f->inst.derived.ref_coeffs, &f->inst.speed_ref);
         pmstep_output_t out;
         pmstep_position_output_t pos_out;
         k->theta_rad += period * (double)ref.value;
-        pmstep_ref_advance(&f->inst.ref_coeffs, &f->inst.speed_ref, f->cfg.timing.period_s); /* as pmstep_step */
+        pmstep_ref_advance(&f->inst.derived.ref_coeffs, &f->inst.speed_ref, f->cfg.timing.period_s); /* as pmstep_step */
         out = run_output(6.0 * k->theta_rad, 1.0, (double)ref.value + speed_bias);
         out.speed_ref_rad_s = ref.value;
         pmstep_position_update(&f->pos, &out, &pos_out);
@@ -376,7 +376,7 @@ static void speed_command_leaves_position_mode_and_hold_stops(void **state)
     kinematic_run(&f, &k, 1, 30.0, 0.0, 0.0);
     assert_false(f.pos.out.position_mode);
     kinematic_run(&f, &k, 20000, 30.0, 0.0, 0.0);
-    ref = pmstep_ref_output(&f.inst.ref_coeffs, &f.inst.speed_ref);
+    ref = pmstep_ref_output(&f.inst.derived.ref_coeffs, &f.inst.speed_ref);
     assert_float_equal(ref.value, -1.0f, 1e-4f); /* the speed command, ramped from where the move was */
     /* hold from speed mode: stops at 10 rad/s^2 and stays where the stop ends */
     assert_int_equal(pmstep_position_hold(&f.pos, 10.0f), PMSTEP_OK);

@@ -30,7 +30,7 @@ static void standstill_period(paper_run_t *f, const pmstep_output_t *reading)
 {
     pmstep_output_t out = *reading;
     if (f->inst.estimate_kept) {
-        pmstep_angle_set(&f->inst.angle, &f->inst.angle_coeffs, reading->cos_hat, reading->sin_hat);
+        pmstep_angle_set(&f->inst.angle, &f->inst.derived.angle_coeffs, reading->cos_hat, reading->sin_hat);
         pmstep_standstill_estimate(&f->inst, &out.cos_hat, &out.sin_hat);
     }
     pmstep_standstill_advance(&f->inst, &out);
@@ -89,7 +89,7 @@ static void standstill_keeps_its_damping_where_the_estimate_lags(void **state)
     uint32_t n;
     (void)state;
     fixture_with_standstill(&f);
-    (void)paper_observer_at_triple_pole(&f.inst.observer_coeffs, 0.5 * w_n);
+    (void)paper_observer_at_triple_pole(&f.inst.derived.observer_coeffs, 0.5 * w_n);
     for (n = 0; n < f.inst.scratch.run.standstill.engage_periods; ++n) {
         standstill_period(&f, &out);
     }
@@ -181,7 +181,7 @@ static void standstill_keeps_the_estimate_while_the_rotor_rests(void **state)
     out = at_rest_output(0.8f, 0.6f); /* the integrals' reading */
     f.inst.observer.speed_hat_rad_s = 2.0f * f.inst.hold.quiet_band_rad_s; /* the observer's, after the period */
     standstill_period(&f, &out);
-    pmstep_angle_estimate(&f.inst.angle, &f.inst.angle_coeffs, f.inst.angle.i_a_prev_A, f.inst.angle.i_b_prev_A, &c,
+    pmstep_angle_estimate(&f.inst.angle, &f.inst.derived.angle_coeffs, f.inst.angle.i_a_prev_A, f.inst.angle.i_b_prev_A, &c,
                           &s);
     assert_float_equal(c, 0.8f, 1e-6f);
     assert_float_equal(s, 0.6f, 1e-6f);
@@ -209,7 +209,7 @@ static void standstill_puts_out_the_kept_rotor(void **state)
         float s = sinf(noise_rad);
         pmstep_output_t out;
         assert_true(f.inst.estimate_kept);
-        pmstep_angle_set(&f.inst.angle, &f.inst.angle_coeffs, c, s); /* what the integrals read */
+        pmstep_angle_set(&f.inst.angle, &f.inst.derived.angle_coeffs, c, s); /* what the integrals read */
         pmstep_standstill_estimate(&f.inst, &c, &s);
         assert_float_equal(c, 1.0f, 0.0f);
         assert_float_equal(s, 0.0f, 0.0f);

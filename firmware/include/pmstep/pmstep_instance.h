@@ -23,12 +23,10 @@
 extern "C" {
 #endif
 
-/** One controller instance; all state lives here. */
+/** Everything init derives from the configuration (pmstep_derive.c): the angle, observer and law
+ * coefficients again at t_c, for the commissioned model. Validation derives it as init does and
+ * checks every float of it finite. */
 typedef struct {
-    const pmstep_config_t *cfg;
-
-    /* Derived from the configuration at init (the angle, observer and law coefficients again
-     * at t_c, for the commissioned model); init checks every float of them finite. */
     pmstep_commission_plan_t commission_plan; /**< alignment timing (t_s, t_c in periods) and windows */
     uint32_t offset_cal_steps;                /**< periods of bridge-off offset calibration */
     bool optional_inputs;                     /**< a load torque or phase voltages to check each period */
@@ -43,6 +41,12 @@ typedef struct {
     pmstep_angle_coeffs_t angle_coeffs;
     pmstep_observer_coeffs_t observer_coeffs;
     pmstep_law_coeffs_t law_coeffs;
+} pmstep_derived_t;
+
+/** One controller instance; all state lives here. */
+typedef struct {
+    const pmstep_config_t *cfg;
+    pmstep_derived_t derived; /**< from cfg at init */
 
     /* Mode machine. */
     pmstep_mode_t mode;
