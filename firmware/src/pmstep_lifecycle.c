@@ -18,12 +18,13 @@ pmstep_status_t pmstep_init(pmstep_t *inst, const pmstep_config_t *cfg)
     status = pmstep_check_settings(cfg);
     if (status == PMSTEP_OK) {
         pmstep_derive(&derived, cfg);
-        status = pmstep_derived_finite(&derived) ? PMSTEP_OK : PMSTEP_ERR_DERIVED_NONFINITE;
-    }
-    if (status == PMSTEP_OK) {
-        inst->cfg = cfg;
-        inst->derived = derived;
-        pmstep_reset(inst);
+        if (pmstep_derived_finite(&derived)) {
+            inst->cfg = cfg;
+            inst->derived = derived;
+            pmstep_reset(inst);
+        } else {
+            status = PMSTEP_ERR_DERIVED_NONFINITE;
+        }
     }
     return status;
 }
