@@ -225,6 +225,26 @@ static pmstep_status_t validate_alignment(const pmstep_config_t *cfg)
  * compared with the alignments in whole periods, as the commissioning plan counts them
  * (pmstep_periods_in()): a difference of two float times can fall a rounding step short of a
  * window that fits exactly. */
+/* What is used must be measured: offsets, R and k_M need the steady-state windows (@p window), L its
+ * rise window or the level drops of the voltage-bias option. */
+static pmstep_status_t validate_measured_uses(const pmstep_commissioning_config_t *comm, bool window)
+{
+    pmstep_status_t status = PMSTEP_OK;
+    if (comm->alignment_offset_calibration && !window) {
+        status = PMSTEP_ERR_ALIGNMENT_OFFSETS_UNMEASURED;
+    } else if (comm->use_measured_resistance && !window) {
+        status = PMSTEP_ERR_RESISTANCE_UNMEASURED;
+    } else if (comm->use_measured_inductance && !(comm->inductance_window_s > 0.0f)
+               && !(window && comm->voltage_bias_level_fraction > 0.0f)) {
+        status = PMSTEP_ERR_INDUCTANCE_UNMEASURED;
+    } else if (comm->use_measured_torque_constant && !window) {
+        status = PMSTEP_ERR_TORQUE_CONSTANT_UNMEASURED;
+    } else {
+        /* every constant used is measured */
+    }
+    return status;
+}
+
 static pmstep_status_t validate_commissioning(const pmstep_config_t *cfg)
 {
     const pmstep_commissioning_config_t *comm = &cfg->commissioning;
@@ -235,6 +255,7 @@ static pmstep_status_t validate_commissioning(const pmstep_config_t *cfg)
                                    - pmstep_periods_in(cfg->alignment.s_align_time_s, period_s);
     const uint32_t shorter_steps = s_align_steps < c_align_steps ? s_align_steps : c_align_steps;
     const bool window = comm->steady_state_window_s > 0.0f;
+    pmstep_status_t status;
     if (!duration_ok(comm->offset_calibration_time_s, cfg->timing.period_s)) {
         return PMSTEP_ERR_OFFSET_CALIBRATION_TIME;
     }
@@ -248,20 +269,9 @@ static pmstep_status_t validate_commissioning(const pmstep_config_t *cfg)
         || (2u * pmstep_periods_in(comm->inductance_window_s, period_s)) > s_align_steps) {
         return PMSTEP_ERR_INDUCTANCE_WINDOW;
     }
-    /* What is used must be measured: offsets, R and k_M need the windows, L its rise window or the
-     * level drops of the voltage-bias option. */
-    if (comm->alignment_offset_calibration && !window) {
-        return PMSTEP_ERR_ALIGNMENT_OFFSETS_UNMEASURED;
-    }
-    if (comm->use_measured_resistance && !window) {
-        return PMSTEP_ERR_RESISTANCE_UNMEASURED;
-    }
-    if (comm->use_measured_inductance && !(comm->inductance_window_s > 0.0f)
-        && !(window && comm->voltage_bias_level_fraction > 0.0f)) {
-        return PMSTEP_ERR_INDUCTANCE_UNMEASURED;
-    }
-    if (comm->use_measured_torque_constant && !window) {
-        return PMSTEP_ERR_TORQUE_CONSTANT_UNMEASURED;
+    status = validate_measured_uses(comm, window);
+    if (status != PMSTEP_OK) {
+        return status;
     }
     if (comm->voltage_bias_level_fraction >= 1.0f) {
         return PMSTEP_ERR_VOLTAGE_BIAS_FRACTION;

@@ -185,6 +185,38 @@ static void builder_start(builder_t *b, pmstep_motion_t *m, float position, floa
     m->cursor = b->end;
 }
 
+/* The peak speed of a move of @p remaining (>= the stopping distance) from speed @p toward, and the
+ * time cruised at it: v_max with a cruise where the move is long enough, else the highest peak whose
+ * distance is not above the remaining one (by bisection), the rest cruised at it. */
+static void peak_and_cruise(float toward, float remaining, float v_max, float a_max, float j_max, float *peak_out,
+                            float *cruise_s_out)
+{
+    float peak = v_max;
+    float cruise_s = 0.0f;
+    const float full = peak_distance(toward, v_max, a_max, j_max);
+    if (full <= remaining) {
+        cruise_s = (remaining - full) / v_max;
+    } else {
+        float low = toward;
+        float high = v_max;
+        int n;
+        for (n = 0; n < MOTION_BISECTION_STEPS; ++n) {
+            const float mid = 0.5f * (low + high);
+            if (peak_distance(toward, mid, a_max, j_max) <= remaining) {
+                low = mid;
+            } else {
+                high = mid;
+            }
+        }
+        peak = low;
+        if (peak > 0.0f) {
+            cruise_s = (remaining - peak_distance(toward, peak, a_max, j_max)) / peak;
+        }
+    }
+    *peak_out = peak;
+    *cruise_s_out = cruise_s;
+}
+
 void pmstep_motion_plan(pmstep_motion_t *m, float position, float speed, float accel, float target,
                         float v_max, float a_max, float j_max)
 {
@@ -219,30 +251,9 @@ void pmstep_motion_plan(pmstep_motion_t *m, float position, float speed, float a
     }
     remaining *= direction; /* >= the stopping distance from here */
     {
-        float peak = v_max;
-        float cruise_s = 0.0f;
-        const float full = peak_distance(toward, v_max, a_max, j_max);
-        if (full <= remaining) {
-            cruise_s = (remaining - full) / v_max;
-        } else {
-            /* Short move: the distance grows with the peak from toward up; keep the bracket's low
-             * end (its distance is not above the remaining one) and cruise the rest at it. */
-            float low = toward;
-            float high = v_max;
-            int n;
-            for (n = 0; n < MOTION_BISECTION_STEPS; ++n) {
-                const float mid = 0.5f * (low + high);
-                if (peak_distance(toward, mid, a_max, j_max) <= remaining) {
-                    low = mid;
-                } else {
-                    high = mid;
-                }
-            }
-            peak = low;
-            if (peak > 0.0f) {
-                cruise_s = (remaining - peak_distance(toward, peak, a_max, j_max)) / peak;
-            }
-        }
+        float peak;
+        float cruise_s;
+        peak_and_cruise(toward, remaining, v_max, a_max, j_max, &peak, &cruise_s);
         add_speed_change(&b, direction * (peak - toward), a_max, j_max);
         add_segment(&b, cruise_s, 0.0f);
         add_speed_change(&b, -direction * peak, a_max, j_max);

@@ -172,18 +172,58 @@ static pmstep_store_status_t check_header(const uint8_t *in, uint32_t n, uint32_
     return PMSTEP_STORE_OK;
 }
 
+/* The settings of a record, one float per row of the console's table from @p p on, over @p trial's
+ * (the board's, the STEP/DIR defaults): a read-only one must equal the board's own. */
+static pmstep_store_status_t decode_settings(const uint8_t *p, const pmstep_config_t *board,
+                                             pmstep_store_record_t *trial)
+{
+    uint32_t count;
+    const pmstep_console_config_entry_t *t = pmstep_console_config_table(&count);
+    pmstep_store_status_t st = PMSTEP_STORE_OK;
+    uint32_t id;
+    for (id = 0; id < count && st == PMSTEP_STORE_OK; ++id) {
+        const float value = get_float(p + 4u * id);
+        if ((t[id].flags & PMSTEP_CONSOLE_CFG_READ_ONLY) != 0u) {
+            float own = 0.0f;
+            (void)pmstep_console_config_get(board, &trial->stepdir, id, &own);
+            if (value != own) {
+                st = PMSTEP_STORE_ERR_BOARD; /* made for another period, delay or sensing */
+            }
+        } else if (pmstep_console_config_set(&trial->config, &trial->stepdir, id, value) != 0) {
+            st = PMSTEP_STORE_ERR_INVALID;
+        } else {
+            /* taken */
+        }
+    }
+    return st;
+}
+
+/* The measured constants of a record from @p p on: their flags, then the values in their order. */
+static void decode_measured(const uint8_t *p, pmstep_store_measured_t *m)
+{
+    float measured[PMSTEP_STORE_MEASURED_VALUES - 1u];
+    uint32_t id;
+    m->flags = get32(p);
+    for (id = 0; id < PMSTEP_STORE_MEASURED_VALUES - 1u; ++id) {
+        measured[id] = get_float(p + 4u + 4u * id);
+    }
+    m->offset_a_A = measured[0];
+    m->offset_b_A = measured[1];
+    m->resistance_Ohm = measured[2];
+    m->inductance_H = measured[3];
+    m->torque_constant_Nm_A = measured[4];
+    m->inertia_kgm2 = measured[5];
+    m->friction_Nms_rad = measured[6];
+}
+
 pmstep_store_status_t pmstep_store_decode(const uint8_t *in, uint32_t n, uint32_t board_id,
                                           const pmstep_config_t *board, pmstep_store_record_t *rec,
                                           pmstep_status_t *validation, uint32_t *sequence)
 {
     uint32_t count;
-    const pmstep_console_config_entry_t *t = pmstep_console_config_table(&count);
     pmstep_store_record_t trial;
-    const uint8_t *p = in + PMSTEP_STORE_HEADER_BYTES;
     pmstep_store_status_t st;
     pmstep_status_t valid;
-    float measured[PMSTEP_STORE_MEASURED_VALUES - 1u];
-    uint32_t id;
     if (validation != NULL) {
         *validation = PMSTEP_OK;
     }
@@ -196,32 +236,12 @@ pmstep_store_status_t pmstep_store_decode(const uint8_t *in, uint32_t n, uint32_
     }
     trial.config = *board;
     trial.stepdir = pmstep_console_stepdir_defaults(); /* every one of them is in the record */
-    for (id = 0; id < count; ++id) {
-        const float value = get_float(p);
-        p += 4;
-        if ((t[id].flags & PMSTEP_CONSOLE_CFG_READ_ONLY) != 0u) {
-            float own = 0.0f;
-            (void)pmstep_console_config_get(board, &trial.stepdir, id, &own);
-            if (value != own) {
-                return PMSTEP_STORE_ERR_BOARD; /* made for another period, delay or sensing */
-            }
-        } else if (pmstep_console_config_set(&trial.config, &trial.stepdir, id, value) != 0) {
-            return PMSTEP_STORE_ERR_INVALID;
-        }
+    st = decode_settings(in + PMSTEP_STORE_HEADER_BYTES, board, &trial);
+    if (st != PMSTEP_STORE_OK) {
+        return st;
     }
-    trial.measured.flags = get32(p);
-    p += 4;
-    for (id = 0; id < PMSTEP_STORE_MEASURED_VALUES - 1u; ++id) {
-        measured[id] = get_float(p);
-        p += 4;
-    }
-    trial.measured.offset_a_A = measured[0];
-    trial.measured.offset_b_A = measured[1];
-    trial.measured.resistance_Ohm = measured[2];
-    trial.measured.inductance_H = measured[3];
-    trial.measured.torque_constant_Nm_A = measured[4];
-    trial.measured.inertia_kgm2 = measured[5];
-    trial.measured.friction_Nms_rad = measured[6];
+    (void)pmstep_console_config_table(&count);
+    decode_measured(in + PMSTEP_STORE_HEADER_BYTES + 4u * count, &trial.measured);
     valid = pmstep_validate_config(&trial.config);
     if (valid == PMSTEP_OK) {
         pmstep_stepdir_config_t in_force;
