@@ -59,13 +59,119 @@ static void kept_estimate_in(pmstep_t *inst, const pmstep_meas_t *sample, const 
     obs_in->detent_torque_Nm = detent.torque_Nm;
 }
 
+/* The flux integrals (phi_1, phi_2) over the period just ended, with the voltage the bridge applied
+ * over it: the command, the sensed voltage, or the command less the dead time's loss where the
+ * samples fix it. */
+static void integrate_period(pmstep_t *inst, const pmstep_meas_t *sample)
+{
+    float u_a_V = inst->actuator.u_applied_a_V;
+    float u_b_V = inst->actuator.u_applied_b_V;
+    if (!inst->derived.voltage_corrected) {
+        /* the command is the period's voltage: tested first, as the most common case */
+    } else if (inst->derived.actuate_coeffs.sensed) {
+        sensed_period_voltage(inst, sample, &u_a_V, &u_b_V);
+    } else { /* compensated: the dead time's loss, where the samples fix it */
+        pmstep_period_currents_t currents;
+        currents.i_start_a_A = inst->angle.i_a_prev_A;
+        currents.i_start_b_A = inst->angle.i_b_prev_A;
+        currents.i_end_a_A = sample->i_a_A;
+        currents.i_end_b_A = sample->i_b_A;
+        currents.bias_a_V = inst->commissioning.voltage_bias_a_V;
+        currents.bias_b_V = inst->commissioning.voltage_bias_b_V;
+        pmstep_actuate_voltage_over_period(&inst->actuator, &inst->derived.actuate_coeffs, &currents,
+                                           sample->bus_voltage_V, &u_a_V, &u_b_V);
+    }
+    pmstep_angle_update(&inst->angle, &inst->derived.angle_coeffs, sample->i_a_A, sample->i_b_A, u_a_V, u_b_V);
+}
+
+/* The period's angle estimate from the integrals (smoothed where configured:
+ * docs/design/16-angle-smoothing.md) and the sampled currents in its frame. */
+static void angle_of_period(pmstep_t *inst, const pmstep_meas_t *sample, float *cos_hat, float *sin_hat, float *i_d,
+                            float *i_q)
+{
+    pmstep_angle_estimate(&inst->angle, &inst->derived.angle_coeffs, sample->i_a_A, sample->i_b_A, cos_hat, sin_hat);
+    if (inst->derived.angle_smoothing) {
+        pmstep_angle_smooth(inst->cfg->gains.angle_smoothing,
+                            inst->derived.law_coeffs.pole_pairs * inst->cfg->timing.period_s * inst->observer.speed_hat_rad_s,
+                            &inst->scratch.run.smoother, cos_hat, sin_hat);
+    }
+    pmstep_park(*cos_hat, *sin_hat, sample->i_a_A, sample->i_b_A, i_d, i_q);
+}
+
+/* The filtered references of the period (speed, i_d* and, in known-load mode, T_L* of Remark 1) into
+ * @p refs; @p known_out is T_L*'s filter output (0 in (6)), and the load the law works against is
+ * returned: T_L* or T_L-hat. */
+static float period_references(pmstep_t *inst, bool known_load, pmstep_law_refs_t *refs, pmstep_ref_out_t *known_out)
+{
+    pmstep_ref_out_t ref = pmstep_ref_output(&inst->derived.ref_coeffs, &inst->speed_ref);
+    float load_Nm;
+    refs->speed_ref_rad_s = ref.value;
+    refs->speed_ref_rate_rad_s2 = ref.rate;
+    refs->speed_ref_accel_rad_s3 = ref.accel;
+    ref = pmstep_ref_output(&inst->derived.ref_coeffs, &inst->i_d_ref);
+    refs->i_d_ref_A = ref.value;
+    refs->i_d_ref_rate_A_s = ref.rate;
+    if (known_load) {
+        ref = pmstep_ref_output(&inst->derived.ref_coeffs, &inst->scratch.run.known_load_filter); /* T_L*, Remark 1 */
+        load_Nm = ref.value;
+    } else {
+        ref.value = 0.0f; /* (6): no T_L* */
+        ref.rate = 0.0f;
+        load_Nm = inst->observer.load_hat_Nm;
+    }
+    *known_out = ref;
+    return load_Nm;
+}
+
+/* What the observer takes of the period: the samples, the angle estimate and the currents in its
+ * frame, T_L* (Remark 1; 0 in (6)) and the detent torque. */
+static void observer_input_of_period(const pmstep_meas_t *sample, float cos_hat, float sin_hat, float i_d, float i_q,
+                                     float known_load_Nm, float detent_torque_Nm, pmstep_observer_input_t *obs_in)
+{
+    obs_in->i_a_A = sample->i_a_A;
+    obs_in->i_b_A = sample->i_b_A;
+    obs_in->cos_hat = cos_hat;
+    obs_in->sin_hat = sin_hat;
+    obs_in->i_d_A = i_d;
+    obs_in->i_q_A = i_q;
+    obs_in->known_load_Nm = known_load_Nm;
+    obs_in->detent_torque_Nm = detent_torque_Nm;
+}
+
+/* Robust mode's transient observer boost on the rates (docs/design/18-transient-observer-boost.md). */
+static void boost_in_transient(pmstep_t *inst, const pmstep_observer_input_t *obs_in,
+                               pmstep_observer_mech_rates_t *rates)
+{
+    pmstep_observer_boost_in_transient(&inst->observer, &inst->derived.observer_coeffs, obs_in,
+                                       inst->cfg->gains.transient_observer_boost,
+                                       inst->cfg->detection.observer_residual_bound_A, rates);
+}
+
+/* The period's estimates, references and currents into @p out. */
+static void report_period(const pmstep_t *inst, const pmstep_law_refs_t *refs, float cos_hat, float sin_hat, float i_d,
+                          float i_q, float load_Nm, float i_q_ref, pmstep_output_t *out)
+{
+    out->cos_hat = cos_hat;
+    out->sin_hat = sin_hat;
+    out->speed_hat_rad_s = inst->observer.speed_hat_rad_s;
+    out->load_hat_Nm = load_Nm;
+    out->i_a_hat_A = inst->observer.i_a_hat_A;
+    out->i_b_hat_A = inst->observer.i_b_hat_A;
+    out->speed_ref_rad_s = refs->speed_ref_rad_s;
+    out->speed_ref_rate_rad_s2 = refs->speed_ref_rate_rad_s2;
+    out->i_d_A = i_d;
+    out->i_q_A = i_q;
+    out->i_d_ref_A = refs->i_d_ref_A;
+    out->i_q_ref_A = i_q_ref;
+}
+
 void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_output_t *out,
                             pmstep_control_scratch_t *scratch)
 {
     const bool known_load = inst->cfg->known_load_mode;
     pmstep_observer_input_t *obs_in = &scratch->observer_input;
     pmstep_law_refs_t refs;
-    pmstep_ref_out_t ref; /* each filter's output in turn */
+    pmstep_ref_out_t ref; /* T_L*'s filter output (Remark 1) */
     float cos_hat;
     float sin_hat;
     float i_d;
@@ -78,60 +184,15 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
     if (!inst->run_started) {
         start_run(inst, sample);
     } else {
-        float u_a_V = inst->actuator.u_applied_a_V;
-        float u_b_V = inst->actuator.u_applied_b_V;
-        if (!inst->derived.voltage_corrected) {
-            /* the command is the period's voltage: tested first, as the most common case */
-        } else if (inst->derived.actuate_coeffs.sensed) {
-            sensed_period_voltage(inst, sample, &u_a_V, &u_b_V);
-        } else { /* compensated: the dead time's loss, where the samples fix it */
-            pmstep_period_currents_t currents;
-            currents.i_start_a_A = inst->angle.i_a_prev_A;
-            currents.i_start_b_A = inst->angle.i_b_prev_A;
-            currents.i_end_a_A = sample->i_a_A;
-            currents.i_end_b_A = sample->i_b_A;
-            currents.bias_a_V = inst->commissioning.voltage_bias_a_V;
-            currents.bias_b_V = inst->commissioning.voltage_bias_b_V;
-            pmstep_actuate_voltage_over_period(&inst->actuator, &inst->derived.actuate_coeffs, &currents,
-                                               sample->bus_voltage_V, &u_a_V, &u_b_V);
-        }
-        pmstep_angle_update(&inst->angle, &inst->derived.angle_coeffs, sample->i_a_A, sample->i_b_A, u_a_V, u_b_V);
+        integrate_period(inst, sample);
     }
-    pmstep_angle_estimate(&inst->angle, &inst->derived.angle_coeffs, sample->i_a_A, sample->i_b_A, &cos_hat, &sin_hat);
-    if (inst->derived.angle_smoothing) { /* docs/design/16-angle-smoothing.md */
-        pmstep_angle_smooth(inst->cfg->gains.angle_smoothing,
-                            inst->derived.law_coeffs.pole_pairs * inst->cfg->timing.period_s * inst->observer.speed_hat_rad_s,
-                            &inst->scratch.run.smoother, &cos_hat, &sin_hat);
-    }
-    pmstep_park(cos_hat, sin_hat, sample->i_a_A, sample->i_b_A, &i_d, &i_q);
-
-    ref = pmstep_ref_output(&inst->derived.ref_coeffs, &inst->speed_ref);
-    refs.speed_ref_rad_s = ref.value;
-    refs.speed_ref_rate_rad_s2 = ref.rate;
-    refs.speed_ref_accel_rad_s3 = ref.accel;
-    ref = pmstep_ref_output(&inst->derived.ref_coeffs, &inst->i_d_ref);
-    refs.i_d_ref_A = ref.value;
-    refs.i_d_ref_rate_A_s = ref.rate;
-    if (known_load) {
-        ref = pmstep_ref_output(&inst->derived.ref_coeffs, &inst->scratch.run.known_load_filter); /* T_L*, Remark 1 */
-        load_Nm = ref.value;
-    } else {
-        ref.value = 0.0f; /* (6): no T_L* */
-        ref.rate = 0.0f;
-        load_Nm = inst->observer.load_hat_Nm;
-    }
+    angle_of_period(inst, sample, &cos_hat, &sin_hat, &i_d, &i_q);
+    load_Nm = period_references(inst, known_load, &refs, &ref);
     /* The detent torque is known in form: the law supplies it, the observer expects it (both faded with w-hat). */
     detent = pmstep_law_detent(&inst->derived.law_coeffs, cos_hat, sin_hat, inst->observer.speed_hat_rad_s);
     pmstep_law_fade_detent(inst->cfg->gains.detent_fade_speed_rad_s, inst->observer.speed_hat_rad_s,
                            refs.speed_ref_rate_rad_s2, &detent);
-    obs_in->i_a_A = sample->i_a_A;
-    obs_in->i_b_A = sample->i_b_A;
-    obs_in->cos_hat = cos_hat;
-    obs_in->sin_hat = sin_hat;
-    obs_in->i_d_A = i_d;
-    obs_in->i_q_A = i_q;
-    obs_in->known_load_Nm = ref.value;
-    obs_in->detent_torque_Nm = detent.torque_Nm;
+    observer_input_of_period(sample, cos_hat, sin_hat, i_d, i_q, ref.value, detent.torque_Nm, obs_in);
     if (inst->hold.active) { /* a vector hold: its own voltage, the law's speed loop paused */
         if (inst->estimate_kept) { /* tested in the hold's branch: the law's periods pay nothing for it */
             kept_estimate_in(inst, sample, &refs, obs_in, &cos_hat, &sin_hat, &i_d, &i_q);
@@ -151,9 +212,7 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
         float i_q_ref_rate;
         /* outside the vector holds, whose vector is not the law's (docs/design/18-transient-observer-boost.md) */
         if (inst->derived.robust_corrections && (inst->cfg->gains.transient_observer_boost > 0.0f) && !known_load) {
-            pmstep_observer_boost_in_transient(&inst->observer, &inst->derived.observer_coeffs, obs_in,
-                                               inst->cfg->gains.transient_observer_boost,
-                                               inst->cfg->detection.observer_residual_bound_A, &scratch->mech_rates);
+            boost_in_transient(inst, obs_in, &scratch->mech_rates);
         }
         load_rate = known_load ? ref.rate : scratch->mech_rates.load_hat_rate_Nm_s;
         i_q_ref_rate = pmstep_law_iq_ref_rate(&inst->derived.law_coeffs, &refs, speed.slope,
@@ -162,18 +221,7 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
                             i_q_ref, i_q_ref_rate, &inst->current_integral, &out->u_a_V, &out->u_b_V);
     }
 
-    out->cos_hat = cos_hat;
-    out->sin_hat = sin_hat;
-    out->speed_hat_rad_s = inst->observer.speed_hat_rad_s;
-    out->load_hat_Nm = load_Nm;
-    out->i_a_hat_A = inst->observer.i_a_hat_A;
-    out->i_b_hat_A = inst->observer.i_b_hat_A;
-    out->speed_ref_rad_s = refs.speed_ref_rad_s;
-    out->speed_ref_rate_rad_s2 = refs.speed_ref_rate_rad_s2;
-    out->i_d_A = i_d;
-    out->i_q_A = i_q;
-    out->i_d_ref_A = refs.i_d_ref_A;
-    out->i_q_ref_A = i_q_ref;
+    report_period(inst, &refs, cos_hat, sin_hat, i_d, i_q, load_Nm, i_q_ref, out);
 }
 
 pmstep_fault_t pmstep_control_advance(pmstep_t *inst, const pmstep_control_scratch_t *scratch, const pmstep_meas_t *meas,
