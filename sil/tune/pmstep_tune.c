@@ -51,277 +51,384 @@ static void usage(FILE *f)
             "  --summary    the design's status and figures and each validation run's outcome as JSON\n");
 }
 
-int main(int argc, char **argv)
-{
-    static sil_scenario_t sc;
-    pmstep_design_input_t in;
-    pmstep_design_report_t report;
-    pmstep_status_t status;
-    const char *motor_path = NULL;
-    const char *motor_db_path = NULL;
-    const char *motor_db_name = NULL;
-    bool force = false;
-    const char *ini_path = NULL;
-    const char *c_path = NULL;
-    const char *summary_path = NULL;
-    tune_check_t checks[TUNE_CHECKS] = {{0}};
-    bool robust = false;
-    bool low_speed_drive = false;
-    bool run_validation = false;
-    bool run_identification = false;
-    bool identify_in_run = false;
-    bool self_commission = false;
-    double detent_per_holding = (double)PMSTEP_CALIBRATE_DETENT_PER_HOLDING;
-    static tune_calibration_t calibration;
-    double told_inertia = -1.0;
-    double told_friction = -1.0;
-    double max_inertia_error_pct = -1.0;
-    char err[SIL_ERROR_MAX];
-    int k;
+/* main()'s steps: each returns PROCEED, or the exit status to end with. */
+#define PROCEED (-1)
 
-    sil_scenario_paper(&sc);
-    for (k = 1; k < argc; ++k) {
-        if (strcmp(argv[k], "--motor") == 0 && k + 1 < argc) {
-            motor_path = argv[++k];
-            if (sil_scenario_load(&sc, motor_path, err, sizeof err) != 0) {
-                fprintf(stderr, "pmstep-tune: %s\n", err);
-                return 2;
-            }
-        } else if (strcmp(argv[k], "--motor-db") == 0 && k + 1 < argc) {
-            motor_db_path = argv[++k];
-        } else if (strcmp(argv[k], "--name") == 0 && k + 1 < argc) {
-            motor_db_name = argv[++k];
-            if (motor_db_path == NULL) {
-                fprintf(stderr, "pmstep-tune: --name needs --motor-db before it\n");
-                return 2;
-            }
-            if (load_motor_db(&sc, motor_db_path, motor_db_name, err, sizeof err) != 0) {
-                fprintf(stderr, "pmstep-tune: %s\n", err);
-                return 2;
-            }
-            motor_path = motor_db_path;
-            told_inertia = 0.0; /* the database has none: the designer estimates it */
-        } else if (strcmp(argv[k], "--force") == 0) {
-            force = true;
-        } else if (strcmp(argv[k], "--set") == 0 && k + 1 < argc) {
-            if (sil_scenario_set_assignment(&sc, argv[++k], err, sizeof err) != 0) {
-                fprintf(stderr, "pmstep-tune: %s\n", err);
-                return 2;
-            }
-        } else if (strcmp(argv[k], "--robust") == 0) {
-            robust = true;
-        } else if (strcmp(argv[k], "--low-speed-drive") == 0) {
-            low_speed_drive = true;
-        } else if (strcmp(argv[k], "--write-ini") == 0 && k + 1 < argc) {
-            ini_path = argv[++k];
-        } else if (strcmp(argv[k], "--write-c") == 0 && k + 1 < argc) {
-            c_path = argv[++k];
-        } else if (strcmp(argv[k], "--summary") == 0 && k + 1 < argc) {
-            summary_path = argv[++k];
-        } else if (strcmp(argv[k], "--validate") == 0) {
-            run_validation = true;
-        } else if (strcmp(argv[k], "--identify") == 0) {
-            run_identification = true;
-        } else if (strcmp(argv[k], "--identify-in-run") == 0) {
-            identify_in_run = true;
-        } else if (strcmp(argv[k], "--self-commission") == 0) {
-            self_commission = true;
-        } else if ((strcmp(argv[k], "--told-inertia") == 0 || strcmp(argv[k], "--told-friction") == 0
-                    || strcmp(argv[k], "--max-inertia-error") == 0 || strcmp(argv[k], "--detent-fraction") == 0)
-                   && k + 1 < argc) {
-            char *end = NULL;
-            const char *name = argv[k];
-            const double value = strtod(argv[++k], &end);
-            if (end == argv[k] || *end != '\0' || !isfinite(value) || value < 0.0) {
-                fprintf(stderr, "pmstep-tune: %s needs a finite number >= 0, not '%s'\n", name, argv[k]);
-                return 2;
-            }
-            if (strcmp(name, "--told-inertia") == 0) {
-                told_inertia = value;
-            } else if (strcmp(name, "--told-friction") == 0) {
-                told_friction = value;
-            } else if (strcmp(name, "--detent-fraction") == 0) {
-                detent_per_holding = value;
-            } else {
-                max_inertia_error_pct = value;
-            }
-        } else if (strcmp(argv[k], "--help") == 0) {
-            usage(stdout);
-            return 0;
-        } else {
-            usage(stderr);
+/* What the command line asks. */
+typedef struct {
+    const char *motor_path;
+    const char *motor_db_path;
+    const char *motor_db_name;
+    const char *ini_path;
+    const char *c_path;
+    const char *summary_path;
+    bool force;
+    bool robust;
+    bool low_speed_drive;
+    bool run_validation;
+    bool run_identification;
+    bool identify_in_run;
+    bool self_commission;
+    double detent_per_holding;
+    double told_inertia;          /* < 0: the preset's */
+    double told_friction;         /* < 0: the preset's */
+    double max_inertia_error_pct; /* < 0: no bound */
+} request_t;
+
+/* One of the options that take a finite number >= 0 (argv[*k], its value at argv[*k + 1]). */
+static int number_option(char **argv, int *k, request_t *q)
+{
+    char *end = NULL;
+    const char *name = argv[*k];
+    const double value = strtod(argv[++*k], &end);
+    if (end == argv[*k] || *end != '\0' || !isfinite(value) || value < 0.0) {
+        fprintf(stderr, "pmstep-tune: %s needs a finite number >= 0, not '%s'\n", name, argv[*k]);
+        return 2;
+    }
+    if (strcmp(name, "--told-inertia") == 0) {
+        q->told_inertia = value;
+    } else if (strcmp(name, "--told-friction") == 0) {
+        q->told_friction = value;
+    } else if (strcmp(name, "--detent-fraction") == 0) {
+        q->detent_per_holding = value;
+    } else {
+        q->max_inertia_error_pct = value;
+    }
+    return PROCEED;
+}
+
+/* The motor: --motor's preset, or --motor-db's section --name (then J estimated). */
+static int motor_option(char **argv, int *k, sil_scenario_t *sc, request_t *q)
+{
+    char err[SIL_ERROR_MAX];
+    if (strcmp(argv[*k], "--motor") == 0) {
+        q->motor_path = argv[++*k];
+        if (sil_scenario_load(sc, q->motor_path, err, sizeof err) != 0) {
+            fprintf(stderr, "pmstep-tune: %s\n", err);
             return 2;
         }
+    } else if (strcmp(argv[*k], "--motor-db") == 0) {
+        q->motor_db_path = argv[++*k];
+    } else {
+        q->motor_db_name = argv[++*k];
+        if (q->motor_db_path == NULL) {
+            fprintf(stderr, "pmstep-tune: --name needs --motor-db before it\n");
+            return 2;
+        }
+        if (load_motor_db(sc, q->motor_db_path, q->motor_db_name, err, sizeof err) != 0) {
+            fprintf(stderr, "pmstep-tune: %s\n", err);
+            return 2;
+        }
+        q->motor_path = q->motor_db_path;
+        q->told_inertia = 0.0; /* the database has none: the designer estimates it */
     }
-    if (motor_db_path != NULL && motor_db_name == NULL) {
-        fprintf(stderr, "pmstep-tune: --motor-db needs --name NAME (its [motor_constants NAME] section)\n");
-        return 2;
-    }
-    if (motor_path == NULL) {
-        usage(stderr);
-        return 2;
-    }
+    return PROCEED;
+}
 
-    /* The drive is told the datasheet's motor: the preset's [motor], J and F as --told-* say. */
-    design_input(&sc, robust, low_speed_drive, &in);
-    if (told_inertia >= 0.0) {
-        in.motor.inertia_kgm2 = (float)told_inertia;
+/* A flag option: true where argv[k] is one (and set in @p q). */
+static bool flag_option(const char *arg, request_t *q)
+{
+    bool *flag = NULL;
+    if (strcmp(arg, "--force") == 0) {
+        flag = &q->force;
+    } else if (strcmp(arg, "--robust") == 0) {
+        flag = &q->robust;
+    } else if (strcmp(arg, "--low-speed-drive") == 0) {
+        flag = &q->low_speed_drive;
+    } else if (strcmp(arg, "--validate") == 0) {
+        flag = &q->run_validation;
+    } else if (strcmp(arg, "--identify") == 0) {
+        flag = &q->run_identification;
+    } else if (strcmp(arg, "--identify-in-run") == 0) {
+        flag = &q->identify_in_run;
+    } else if (strcmp(arg, "--self-commission") == 0) {
+        flag = &q->self_commission;
+    } else {
+        /* not a flag */
     }
-    if (told_friction >= 0.0) {
-        in.motor.friction_Nms_rad = (float)told_friction;
+    if (flag != NULL) {
+        *flag = true;
     }
-    in.accept_implausible = force;
+    return flag != NULL;
+}
+
+/* An option that names a file to write (argv[*k], the name at argv[*k + 1]): true where it is one. */
+static bool path_option(char **argv, int *k, request_t *q)
+{
+    const char **path = NULL;
+    if (strcmp(argv[*k], "--write-ini") == 0) {
+        path = &q->ini_path;
+    } else if (strcmp(argv[*k], "--write-c") == 0) {
+        path = &q->c_path;
+    } else if (strcmp(argv[*k], "--summary") == 0) {
+        path = &q->summary_path;
+    } else {
+        /* not a path */
+    }
+    if (path != NULL) {
+        *path = argv[++*k];
+    }
+    return path != NULL;
+}
+
+static bool is_number_option(const char *arg)
+{
+    return strcmp(arg, "--told-inertia") == 0 || strcmp(arg, "--told-friction") == 0
+           || strcmp(arg, "--max-inertia-error") == 0 || strcmp(arg, "--detent-fraction") == 0;
+}
+
+/* Every option in order; the motor loaded and each --set applied as they come. */
+static int parse_request(int argc, char **argv, sil_scenario_t *sc, request_t *q)
+{
+    char err[SIL_ERROR_MAX];
+    int status = PROCEED;
+    int k;
+    for (k = 1; k < argc && status == PROCEED; ++k) {
+        const bool has_value = k + 1 < argc;
+        if ((strcmp(argv[k], "--motor") == 0 || strcmp(argv[k], "--motor-db") == 0 || strcmp(argv[k], "--name") == 0)
+            && has_value) {
+            status = motor_option(argv, &k, sc, q);
+        } else if (strcmp(argv[k], "--set") == 0 && has_value) {
+            if (sil_scenario_set_assignment(sc, argv[++k], err, sizeof err) != 0) {
+                fprintf(stderr, "pmstep-tune: %s\n", err);
+                status = 2;
+            }
+        } else if (flag_option(argv[k], q) || (has_value && path_option(argv, &k, q))) {
+            /* taken */
+        } else if (is_number_option(argv[k]) && has_value) {
+            status = number_option(argv, &k, q);
+        } else if (strcmp(argv[k], "--help") == 0) {
+            usage(stdout);
+            status = 0;
+        } else {
+            usage(stderr);
+            status = 2;
+        }
+    }
+    if (status == PROCEED && q->motor_db_path != NULL && q->motor_db_name == NULL) {
+        fprintf(stderr, "pmstep-tune: --motor-db needs --name NAME (its [motor_constants NAME] section)\n");
+        status = 2;
+    }
+    if (status == PROCEED && q->motor_path == NULL) {
+        usage(stderr);
+        status = 2;
+    }
+    return status;
+}
+
+/* The validation profile through +-0.8 and +-0.05 of the design's top speed. */
+static void validation_profile(sil_scenario_t *sc, const pmstep_design_report_t *report)
+{
+    const double top = (double)report->top_speed_rad_s;
+    const double levels[] = {0.8 * top, -0.8 * top, 0.05 * top, -0.05 * top, 0.0};
+    set_profile(sc, levels, 5);
+}
+
+/* The design for the datasheet's motor: the preset's [motor], J and F as --told-* say. */
+static int design_from_datasheet(sil_scenario_t *sc, request_t *q, pmstep_design_input_t *in,
+                                 pmstep_design_report_t *report, pmstep_status_t *status, tune_check_t *checks)
+{
+    design_input(sc, q->robust, q->low_speed_drive, in);
+    if (q->told_inertia >= 0.0) {
+        in->motor.inertia_kgm2 = (float)q->told_inertia;
+    }
+    if (q->told_friction >= 0.0) {
+        in->motor.friction_Nms_rad = (float)q->told_friction;
+    }
+    in->accept_implausible = q->force;
     {
-        const pmstep_status_t datasheet = pmstep_design_check_datasheet(&in);
-        if (datasheet != PMSTEP_OK && force) {
-            fprintf(stderr, "pmstep-tune: %s: warning: %s (%d); designing anyway (--force)\n", motor_path,
+        const pmstep_status_t datasheet = pmstep_design_check_datasheet(in);
+        if (datasheet != PMSTEP_OK && q->force) {
+            fprintf(stderr, "pmstep-tune: %s: warning: %s (%d); designing anyway (--force)\n", q->motor_path,
                     pmstep_status_str(datasheet), (int)datasheet);
         }
     }
-    status = pmstep_design(&in, &sc.controller, &report);
-    if (status != PMSTEP_OK) {
-        fprintf(stderr, "pmstep-tune: %s: cannot design: %s (%d)\n", motor_path, pmstep_status_str(status),
-                (int)status);
-        if (summary_path != NULL) {
-            (void)write_summary(summary_path, motor_path, robust, status, &report, checks, 0, NULL);
+    *status = pmstep_design(in, &sc->controller, report);
+    if (*status != PMSTEP_OK) {
+        fprintf(stderr, "pmstep-tune: %s: cannot design: %s (%d)\n", q->motor_path, pmstep_status_str(*status),
+                (int)*status);
+        if (q->summary_path != NULL) {
+            (void)write_summary(q->summary_path, q->motor_path, q->robust, *status, report, checks, 0, NULL);
         }
         return 1;
     }
-    sc.id_target_A = (double)report.magnetising_current_A;
-    if (report.inertia_estimated) {
+    sc->id_target_A = (double)report->magnetising_current_A;
+    if (report->inertia_estimated) {
         printf("pmstep-tune: no rotor inertia given: %.3g kg m^2 estimated from the holding torque; the firmware "
                "identifies J and F in RUN's first window (--identify-in-run)\n",
-               (double)report.inertia_kgm2);
-        identify_in_run = true;
+               (double)report->inertia_kgm2);
+        q->identify_in_run = true;
     }
-    (void)pmstep_position_design(&sc.controller, &sc.position); /* position loop (docs/design/11-position-loop.md) */
-    {
-        const double top = (double)report.top_speed_rad_s;
-        const double levels[] = {0.8 * top, -0.8 * top, 0.05 * top, -0.05 * top, 0.0};
-        set_profile(&sc, levels, 5);
+    (void)pmstep_position_design(&sc->controller, &sc->position); /* position loop (docs/design/11-position-loop.md) */
+    validation_profile(sc, report);
+    sc->load.kind = PLANT_LOAD_NONE;
+    print_design(sc, report, q->robust);
+    return PROCEED;
+}
+
+/* --identify: commissioning and the identification window in the SIL, then the design again for the
+ * identified J and F (exit 1 beyond --max-inertia-error). */
+static int design_from_identification(sil_scenario_t *sc, const request_t *q, pmstep_design_input_t *in,
+                                      pmstep_design_report_t *report, pmstep_status_t *status)
+{
+    pmstep_commissioning_t ident;
+    const double j_plant = sc->motor.inertia_kgm2;
+    const double f_plant = sc->motor.friction_Nms_rad;
+    double j_error_pct;
+    if (identify(sc, (double)report->top_speed_rad_s, &ident) != 0) {
+        return 1;
     }
-    sc.load.kind = PLANT_LOAD_NONE;
-    print_design(&sc, &report, robust);
-    if (run_identification) {
-        pmstep_commissioning_t ident;
-        const double j_plant = sc.motor.inertia_kgm2;
-        const double f_plant = sc.motor.friction_Nms_rad;
-        double j_error_pct;
-        if (identify(&sc, (double)report.top_speed_rad_s, &ident) != 0) {
-            return 1;
-        }
-        j_error_pct = 100.0 * ((double)ident.inertia_kgm2 / j_plant - 1.0);
-        printf("  told:       J %.4g kg m^2 (%+.1f %% off the plant's %.4g), F %.4g N m s/rad (plant %.4g)\n",
-               (double)in.motor.inertia_kgm2, 100.0 * ((double)in.motor.inertia_kgm2 / j_plant - 1.0), j_plant,
-               (double)in.motor.friction_Nms_rad, f_plant);
-        printf("  identified: J %.4g kg m^2 (%+.2f %% off the plant's), F %.4g N m s/rad (%+.3g off the plant's)\n",
-               (double)ident.inertia_kgm2, j_error_pct, (double)ident.friction_Nms_rad,
-               (double)ident.friction_Nms_rad - f_plant);
-        in.motor.inertia_kgm2 = ident.inertia_kgm2;
-        in.motor.friction_Nms_rad = ident.friction_Nms_rad > 0.0f ? ident.friction_Nms_rad : 0.0f;
-        status = pmstep_design(&in, &sc.controller, &report);
-        if (status != PMSTEP_OK) {
-            fprintf(stderr, "pmstep-tune: cannot design for the identified J, F: %s (%d)\n",
-                    pmstep_status_str(status), (int)status);
-            return 1;
-        }
-        printf("pmstep-tune: design for the identified J and F\n");
-        {
-            const double top = (double)report.top_speed_rad_s;
-            const double levels[] = {0.8 * top, -0.8 * top, 0.05 * top, -0.05 * top, 0.0};
-            set_profile(&sc, levels, 5);
-        }
-        print_design(&sc, &report, robust);
-        if (max_inertia_error_pct >= 0.0 && !(fabs(j_error_pct) <= max_inertia_error_pct)) {
-            printf("pmstep-tune: identified J %+.2f %% off the plant's: over the %.1f %% bound\n", j_error_pct,
-                   max_inertia_error_pct);
-            return 1;
-        }
+    j_error_pct = 100.0 * ((double)ident.inertia_kgm2 / j_plant - 1.0);
+    printf("  told:       J %.4g kg m^2 (%+.1f %% off the plant's %.4g), F %.4g N m s/rad (plant %.4g)\n",
+           (double)in->motor.inertia_kgm2, 100.0 * ((double)in->motor.inertia_kgm2 / j_plant - 1.0), j_plant,
+           (double)in->motor.friction_Nms_rad, f_plant);
+    printf("  identified: J %.4g kg m^2 (%+.2f %% off the plant's), F %.4g N m s/rad (%+.3g off the plant's)\n",
+           (double)ident.inertia_kgm2, j_error_pct, (double)ident.friction_Nms_rad,
+           (double)ident.friction_Nms_rad - f_plant);
+    in->motor.inertia_kgm2 = ident.inertia_kgm2;
+    in->motor.friction_Nms_rad = ident.friction_Nms_rad > 0.0f ? ident.friction_Nms_rad : 0.0f;
+    *status = pmstep_design(in, &sc->controller, report);
+    if (*status != PMSTEP_OK) {
+        fprintf(stderr, "pmstep-tune: cannot design for the identified J, F: %s (%d)\n", pmstep_status_str(*status),
+                (int)*status);
+        return 1;
     }
-    if (identify_in_run) {
-        /* The firmware identifies over the window of the ramps to +-0.8 top, and uses J and F. */
-        static sil_scenario_t window;
-        window = sc;
-        set_identification(&window, (double)report.top_speed_rad_s, true);
-        sc.controller.commissioning.identification_time_s = window.controller.commissioning.identification_time_s;
-        sc.controller.commissioning.identification_min_speed_rad_s =
-            window.controller.commissioning.identification_min_speed_rad_s;
-        sc.controller.commissioning.use_identified_mechanics = true;
-        printf("  identification in RUN: %.3f s from t_c, |w*| >= %.1f rad/s, identified J and F used\n",
-               (double)sc.controller.commissioning.identification_time_s,
-               (double)sc.controller.commissioning.identification_min_speed_rad_s);
+    printf("pmstep-tune: design for the identified J and F\n");
+    validation_profile(sc, report);
+    print_design(sc, report, q->robust);
+    if (q->max_inertia_error_pct >= 0.0 && !(fabs(j_error_pct) <= q->max_inertia_error_pct)) {
+        printf("pmstep-tune: identified J %+.2f %% off the plant's: over the %.1f %% bound\n", j_error_pct,
+               q->max_inertia_error_pct);
+        return 1;
     }
-    if (self_commission) {
-        /* The drive's own design, from the rated current and p: it replaces the datasheet's. */
-        static pmstep_calibrate_t cal;
-        static pmstep_config_t drive;
-        const int rc = calibrate_on_drive(&sc, robust, detent_per_holding, &cal, &drive, &calibration.simulated_s);
-        calibration.ran = true;
-        calibration.status = cal.status;
-        calibration.fault = (int)cal.fault;
-        calibration.runs = cal.runs;
-        calibration.datasheet = sc.controller;
-        calibration.datasheet_report = report;
-        calibration.drive = drive;
-        calibration.drive_report = cal.report;
-        if (rc != 0) {
-            if (summary_path != NULL) {
-                (void)write_summary(summary_path, motor_path, robust, status, &report, checks, 0, &calibration);
-            }
-            return rc;
-        }
-        print_calibration(&sc, &calibration.datasheet, &calibration.datasheet_report, &drive, &cal.report);
-        sc.controller = drive;
-        report = cal.report;
-        sc.id_target_A = (double)report.magnetising_current_A;
-        (void)pmstep_position_design(&sc.controller, &sc.position);
-        {
-            const double top = (double)report.top_speed_rad_s;
-            const double levels[] = {0.8 * top, -0.8 * top, 0.05 * top, -0.05 * top, 0.0};
-            set_profile(&sc, levels, 5);
-        }
-        printf("pmstep-tune: the drive's own design replaces the datasheet's from here on\n");
-    }
-    printf("  position loop: k_theta %g 1/s, k_I %g 1/s^2; vector hold at %g A\n", (double)sc.position.gain_per_s,
-           (double)sc.position.integral_gain_per_s2, (double)sc.position.hold_current_A);
-    {
-        pmstep_homing_config_t homing;
-        (void)pmstep_homing_design(&sc.controller, &homing);
-        printf("  homing: %g rad/s (%.0f rpm) at %g rad/s^2, stall current %g A, stall error %g rad\n",
-               (double)homing.speed_rad_s, (double)homing.speed_rad_s * 60.0 / (2.0 * 3.14159265358979),
-               (double)homing.accel_rad_s2, (double)homing.stall_current_A, (double)homing.stall_error_rad);
-    }
-    if (ini_path != NULL) {
-        FILE *f = fopen(ini_path, "w");
-        if (f == NULL) {
-            fprintf(stderr, "pmstep-tune: cannot write %s\n", ini_path);
-            return 2;
-        }
-        fprintf(f, "; Designed by pmstep-tune from %s%s (docs/design).\n", motor_path,
-                robust ? " --robust" : "");
-        sil_scenario_print(&sc, f);
-        if (fclose(f) != 0) {
-            fprintf(stderr, "pmstep-tune: error writing %s\n", ini_path);
-            return 2;
-        }
-        printf("pmstep-tune: wrote %s\n", ini_path);
-    }
-    if (c_path != NULL) {
-        if (write_c(c_path, &sc) != 0) {
-            return 2;
-        }
-        printf("pmstep-tune: wrote %s\n", c_path);
-    }
-    if (run_validation) {
-        const int rc = validate(&sc, (double)report.top_speed_rad_s, max_inertia_error_pct, checks);
-        if (summary_path != NULL && write_summary(summary_path, motor_path, robust, status, &report, checks,
-                                                  TUNE_CHECKS, &calibration) != 0) {
-            return 2;
+    return PROCEED;
+}
+
+/* The firmware identifies J and F over the window of the ramps to +-0.8 top, and uses them. */
+static void identification_in_run(sil_scenario_t *sc, const pmstep_design_report_t *report)
+{
+    static sil_scenario_t window;
+    window = *sc;
+    set_identification(&window, (double)report->top_speed_rad_s, true);
+    sc->controller.commissioning.identification_time_s = window.controller.commissioning.identification_time_s;
+    sc->controller.commissioning.identification_min_speed_rad_s =
+        window.controller.commissioning.identification_min_speed_rad_s;
+    sc->controller.commissioning.use_identified_mechanics = true;
+    printf("  identification in RUN: %.3f s from t_c, |w*| >= %.1f rad/s, identified J and F used\n",
+           (double)sc->controller.commissioning.identification_time_s,
+           (double)sc->controller.commissioning.identification_min_speed_rad_s);
+}
+
+/* --self-commission: the drive's own design, from the rated current and p, replaces the datasheet's. */
+static int design_on_drive(sil_scenario_t *sc, const request_t *q, pmstep_design_report_t *report,
+                           pmstep_status_t status, tune_check_t *checks, tune_calibration_t *calibration)
+{
+    static pmstep_calibrate_t cal;
+    static pmstep_config_t drive;
+    const int rc = calibrate_on_drive(sc, q->robust, q->detent_per_holding, &cal, &drive, &calibration->simulated_s);
+    calibration->ran = true;
+    calibration->status = cal.status;
+    calibration->fault = (int)cal.fault;
+    calibration->runs = cal.runs;
+    calibration->datasheet = sc->controller;
+    calibration->datasheet_report = *report;
+    calibration->drive = drive;
+    calibration->drive_report = cal.report;
+    if (rc != 0) {
+        if (q->summary_path != NULL) {
+            (void)write_summary(q->summary_path, q->motor_path, q->robust, status, report, checks, 0, calibration);
         }
         return rc;
     }
-    if (summary_path != NULL && write_summary(summary_path, motor_path, robust, status, &report, checks, 0, &calibration) != 0) {
+    print_calibration(sc, &calibration->datasheet, &calibration->datasheet_report, &drive, &cal.report);
+    sc->controller = drive;
+    *report = cal.report;
+    sc->id_target_A = (double)report->magnetising_current_A;
+    (void)pmstep_position_design(&sc->controller, &sc->position);
+    validation_profile(sc, report);
+    printf("pmstep-tune: the drive's own design replaces the datasheet's from here on\n");
+    return PROCEED;
+}
+
+/* The position loop's and the homing's figures. */
+static void print_position_and_homing(const sil_scenario_t *sc)
+{
+    pmstep_homing_config_t homing;
+    printf("  position loop: k_theta %g 1/s, k_I %g 1/s^2; vector hold at %g A\n", (double)sc->position.gain_per_s,
+           (double)sc->position.integral_gain_per_s2, (double)sc->position.hold_current_A);
+    (void)pmstep_homing_design(&sc->controller, &homing);
+    printf("  homing: %g rad/s (%.0f rpm) at %g rad/s^2, stall current %g A, stall error %g rad\n",
+           (double)homing.speed_rad_s, (double)homing.speed_rad_s * 60.0 / (2.0 * 3.14159265358979),
+           (double)homing.accel_rad_s2, (double)homing.stall_current_A, (double)homing.stall_error_rad);
+}
+
+/* --write-ini and --write-c. */
+static int write_design(const sil_scenario_t *sc, const request_t *q)
+{
+    if (q->ini_path != NULL) {
+        FILE *f = fopen(q->ini_path, "w");
+        if (f == NULL) {
+            fprintf(stderr, "pmstep-tune: cannot write %s\n", q->ini_path);
+            return 2;
+        }
+        fprintf(f, "; Designed by pmstep-tune from %s%s (docs/design).\n", q->motor_path, q->robust ? " --robust" : "");
+        sil_scenario_print(sc, f);
+        if (fclose(f) != 0) {
+            fprintf(stderr, "pmstep-tune: error writing %s\n", q->ini_path);
+            return 2;
+        }
+        printf("pmstep-tune: wrote %s\n", q->ini_path);
+    }
+    if (q->c_path != NULL) {
+        if (write_c(q->c_path, sc) != 0) {
+            return 2;
+        }
+        printf("pmstep-tune: wrote %s\n", q->c_path);
+    }
+    return PROCEED;
+}
+
+int main(int argc, char **argv)
+{
+    static sil_scenario_t sc;
+    static tune_calibration_t calibration;
+    pmstep_design_input_t in;
+    pmstep_design_report_t report;
+    pmstep_status_t status = PMSTEP_OK;
+    tune_check_t checks[TUNE_CHECKS] = {{0}};
+    request_t q;
+    int rc;
+    memset(&q, 0, sizeof q);
+    q.detent_per_holding = (double)PMSTEP_CALIBRATE_DETENT_PER_HOLDING;
+    q.told_inertia = -1.0;
+    q.told_friction = -1.0;
+    q.max_inertia_error_pct = -1.0;
+    sil_scenario_paper(&sc);
+    rc = parse_request(argc, argv, &sc, &q);
+    if (rc == PROCEED) {
+        rc = design_from_datasheet(&sc, &q, &in, &report, &status, checks);
+    }
+    if (rc == PROCEED && q.run_identification) {
+        rc = design_from_identification(&sc, &q, &in, &report, &status);
+    }
+    if (rc == PROCEED && q.identify_in_run) {
+        identification_in_run(&sc, &report);
+    }
+    if (rc == PROCEED && q.self_commission) {
+        rc = design_on_drive(&sc, &q, &report, status, checks, &calibration);
+    }
+    if (rc != PROCEED) {
+        return rc;
+    }
+    print_position_and_homing(&sc);
+    rc = write_design(&sc, &q);
+    if (rc != PROCEED) {
+        return rc;
+    }
+    rc = q.run_validation ? validate(&sc, (double)report.top_speed_rad_s, q.max_inertia_error_pct, checks) : 0;
+    if (q.summary_path != NULL && write_summary(q.summary_path, q.motor_path, q.robust, status, &report, checks,
+                                                q.run_validation ? TUNE_CHECKS : 0, &calibration) != 0) {
         return 2;
     }
-    return 0;
+    return rc;
 }
