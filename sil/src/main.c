@@ -277,21 +277,22 @@ static void announce(const sil_scenario_t *sc)
 /* The run's own status (sil_run_record()) and run.csv's closing. */
 static int check_run(int run_status, const char *record_path, const sil_summary_t *summary, csv_ctx_t *csv)
 {
+    if (run_status == 0) {
+        const bool failed = csv->file != NULL && (ferror(csv->file) != 0) + (fclose(csv->file) != 0) != 0;
+        csv->file = NULL;
+        if (failed) {
+            fprintf(stderr, "pmstep-sil: error writing run.csv\n");
+            return 2;
+        }
+        return PROCEED;
+    }
     if (run_status == -2) {
         fprintf(stderr, "pmstep-sil: error writing the record '%s'\n", record_path);
     } else if (run_status == -3) {
         fprintf(stderr, "pmstep-sil: out of memory for the measurement chain's random number generator\n");
-    } else if (run_status != 0) {
+    } else {
         fprintf(stderr, "pmstep-sil: the firmware rejected the configuration: %s (status %d)\n",
                 pmstep_status_str(summary->init_status), (int)summary->init_status);
-    } else {
-        if (csv->file != NULL && (ferror(csv->file) != 0) + (fclose(csv->file) != 0) != 0) {
-            csv->file = NULL;
-            fprintf(stderr, "pmstep-sil: error writing run.csv\n");
-            return 2;
-        }
-        csv->file = NULL;
-        return PROCEED;
     }
     close_csv(csv);
     return 2;

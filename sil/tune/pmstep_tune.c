@@ -75,26 +75,32 @@ typedef struct {
     double max_inertia_error_pct; /* < 0: no bound */
 } request_t;
 
-/* One of the options that take a finite number >= 0 (argv[*k], its value at argv[*k + 1]). */
-static int number_option(char **argv, int *k, request_t *q)
+/* An option that takes a finite number >= 0 (argv[*k], its value at argv[*k + 1]): true where it is
+ * one; @p status is 2 for a value that is not such a number. */
+static bool number_option(char **argv, int *k, request_t *q, int *status)
 {
-    char *end = NULL;
-    const char *name = argv[*k];
-    const double value = strtod(argv[++*k], &end);
-    if (end == argv[*k] || *end != '\0' || !isfinite(value) || value < 0.0) {
-        fprintf(stderr, "pmstep-tune: %s needs a finite number >= 0, not '%s'\n", name, argv[*k]);
-        return 2;
+    const struct {
+        const char *name;
+        double *value;
+    } options[] = {{"--told-inertia", &q->told_inertia},
+                   {"--told-friction", &q->told_friction},
+                   {"--max-inertia-error", &q->max_inertia_error_pct},
+                   {"--detent-fraction", &q->detent_per_holding}};
+    size_t n;
+    for (n = 0; n < sizeof options / sizeof options[0]; ++n) {
+        if (strcmp(argv[*k], options[n].name) == 0) {
+            char *end = NULL;
+            const double value = strtod(argv[++*k], &end);
+            if (end == argv[*k] || *end != '\0' || !isfinite(value) || value < 0.0) {
+                fprintf(stderr, "pmstep-tune: %s needs a finite number >= 0, not '%s'\n", options[n].name, argv[*k]);
+                *status = 2;
+            } else {
+                *options[n].value = value;
+            }
+            return true;
+        }
     }
-    if (strcmp(name, "--told-inertia") == 0) {
-        q->told_inertia = value;
-    } else if (strcmp(name, "--told-friction") == 0) {
-        q->told_friction = value;
-    } else if (strcmp(name, "--detent-fraction") == 0) {
-        q->detent_per_holding = value;
-    } else {
-        q->max_inertia_error_pct = value;
-    }
-    return PROCEED;
+    return false;
 }
 
 /* The motor: --motor's preset, or --motor-db's section --name (then J estimated). */
@@ -125,56 +131,44 @@ static int motor_option(char **argv, int *k, sil_scenario_t *sc, request_t *q)
     return PROCEED;
 }
 
-/* A flag option: true where argv[k] is one (and set in @p q). */
+/* A flag option: true where @p arg is one (and set in @p q). */
 static bool flag_option(const char *arg, request_t *q)
 {
-    bool *flag = NULL;
-    if (strcmp(arg, "--force") == 0) {
-        flag = &q->force;
-    } else if (strcmp(arg, "--robust") == 0) {
-        flag = &q->robust;
-    } else if (strcmp(arg, "--low-speed-drive") == 0) {
-        flag = &q->low_speed_drive;
-    } else if (strcmp(arg, "--validate") == 0) {
-        flag = &q->run_validation;
-    } else if (strcmp(arg, "--identify") == 0) {
-        flag = &q->run_identification;
-    } else if (strcmp(arg, "--identify-in-run") == 0) {
-        flag = &q->identify_in_run;
-    } else if (strcmp(arg, "--self-commission") == 0) {
-        flag = &q->self_commission;
-    } else {
-        /* not a flag */
+    const struct {
+        const char *name;
+        bool *flag;
+    } flags[] = {{"--force", &q->force},
+                 {"--robust", &q->robust},
+                 {"--low-speed-drive", &q->low_speed_drive},
+                 {"--validate", &q->run_validation},
+                 {"--identify", &q->run_identification},
+                 {"--identify-in-run", &q->identify_in_run},
+                 {"--self-commission", &q->self_commission}};
+    size_t n;
+    for (n = 0; n < sizeof flags / sizeof flags[0]; ++n) {
+        if (strcmp(arg, flags[n].name) == 0) {
+            *flags[n].flag = true;
+            return true;
+        }
     }
-    if (flag != NULL) {
-        *flag = true;
-    }
-    return flag != NULL;
+    return false;
 }
 
 /* An option that names a file to write (argv[*k], the name at argv[*k + 1]): true where it is one. */
 static bool path_option(char **argv, int *k, request_t *q)
 {
-    const char **path = NULL;
-    if (strcmp(argv[*k], "--write-ini") == 0) {
-        path = &q->ini_path;
-    } else if (strcmp(argv[*k], "--write-c") == 0) {
-        path = &q->c_path;
-    } else if (strcmp(argv[*k], "--summary") == 0) {
-        path = &q->summary_path;
-    } else {
-        /* not a path */
+    const struct {
+        const char *name;
+        const char **path;
+    } paths[] = {{"--write-ini", &q->ini_path}, {"--write-c", &q->c_path}, {"--summary", &q->summary_path}};
+    size_t n;
+    for (n = 0; n < sizeof paths / sizeof paths[0]; ++n) {
+        if (strcmp(argv[*k], paths[n].name) == 0) {
+            *paths[n].path = argv[++*k];
+            return true;
+        }
     }
-    if (path != NULL) {
-        *path = argv[++*k];
-    }
-    return path != NULL;
-}
-
-static bool is_number_option(const char *arg)
-{
-    return strcmp(arg, "--told-inertia") == 0 || strcmp(arg, "--told-friction") == 0
-           || strcmp(arg, "--max-inertia-error") == 0 || strcmp(arg, "--detent-fraction") == 0;
+    return false;
 }
 
 /* Every option in order; the motor loaded and each --set applied as they come. */
@@ -193,10 +187,9 @@ static int parse_request(int argc, char **argv, sil_scenario_t *sc, request_t *q
                 fprintf(stderr, "pmstep-tune: %s\n", err);
                 status = 2;
             }
-        } else if (flag_option(argv[k], q) || (has_value && path_option(argv, &k, q))) {
+        } else if (flag_option(argv[k], q)
+                   || (has_value && (path_option(argv, &k, q) || number_option(argv, &k, q, &status)))) {
             /* taken */
-        } else if (is_number_option(argv[k]) && has_value) {
-            status = number_option(argv, &k, q);
         } else if (strcmp(argv[k], "--help") == 0) {
             usage(stdout);
             status = 0;

@@ -6,8 +6,8 @@
 
 #include <stdbool.h>
 
-/* A winding faster than the control rate's bandwidths (pmstep_design.c): the current loop at this many times R/L, the observer's current pole
- * 3 w_o at this many times R/L + F/J; and the fastest winding designed for, (R/L + F/J) T_s, which
+/* A winding faster than the control rate's bandwidths (pmstep_design.c): the current loop at this
+ * many times R/L, the observer's current pole 3 w_o at this many times R/L + F/J; and the fastest winding designed for, (R/L + F/J) T_s, which
  * keeps (R/L + K_i) T_s and (R/L + K_e) T_s under the 0.5 init accepts. */
 #define WINDING_RATE_MARGIN 1.25f
 #define MAX_WINDING_RATE_X_PERIOD 0.35f
