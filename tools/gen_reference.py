@@ -101,6 +101,7 @@ UNSUFFIXED_FIELDS = {
     "gains.angle_smoothing",
     "gains.transient_observer_boost",
     "commissioning.voltage_bias_level_fraction",
+    "field_weakening.modulation",
     "detection.angle_magnitude_bound",
     "detection.max_realignments",
     "stepdir.microsteps",

@@ -40,6 +40,7 @@ CORE = [
     "pmstep_law",
     "pmstep_hold",
     "pmstep_standstill",
+    "pmstep_weakening",
     "pmstep_presets",
 ]
 # Precision: loops of the configuration check unrolled (init evaluates the configuration exactly),

@@ -244,6 +244,7 @@ class RealSources(unittest.TestCase):
                 "inverter",
                 "detection",
                 "standstill",
+                "field_weakening",
                 "Top level",
                 "stepdir",
             ],

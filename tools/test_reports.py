@@ -763,8 +763,10 @@ class TorqueSpeed(ReportCase):
     def test_report(self):
         rows = [
             self.row("17hs4401", 24.0, 0.25, "pmstep", 0.525, 0.5625),
+            self.row("17hs4401", 24.0, 0.25, "pmstep-no-fw", 0.5, 0.5125),
             self.row("17hs4401", 24.0, 0.25, "microstep", 0.225, 0.2625),
             self.row("17hs4401", 24.0, 0.75, "pmstep", 0.6, None),
+            self.row("17hs4401", 24.0, 0.75, "pmstep-no-fw", None, 0.0),
             self.row("17hs4401", 24.0, 0.75, "microstep", None, 0.0),
             self.row("17hs4401", 12.0, 0.25, "pmstep", None, None, error="pmstep-sil failed (1): x"),
             self.row("17hs4401", 12.0, 0.25, "microstep", 0.1, 0.11),
@@ -778,10 +780,19 @@ class TorqueSpeed(ReportCase):
         text = torque_speed.report_text(rows, refused, args, argv, [("17hs4401", "x-17hs4401.png")])
         self.assert_header(text, "tools/torque_speed.py --report x.md")
         self.assert_tables(text)
-        self.assertIn("| 17hs4401 | 24 | 0.25 | 17.2 | 0.525 (1.31) | 0.225 (0.56) | 2.33 | 6.75 | 6.75 |", text)
-        self.assertIn("| ≥ 0.600 (1.50) | none | - |", text)
-        self.assertIn("| n/a | 0.100 (0.25) |", text)
-        self.assertIn("| paper | 12 | - | - | no design | no design |", text)
+        self.assertIn(
+            "| 17hs4401 | 24 | 0.25 | 17.2 | 0.525 (1.31) | 0.500 (1.25) | 0.225 (0.56) | 2.33 | 6.75 | 6.75 | 6.75 |",
+            text,
+        )
+        self.assertIn("| ≥ 0.600 (1.50) | none | none | - |", text)
+        self.assertIn("| n/a | n/a | 0.100 (0.25) |", text)
+        self.assertIn("| paper | 12 | - | - | no design | no design | no design |", text)
+        # top speeds: pmstep holds 30 % of T_H (0.12 N m) at 0.75 x top, without FW at 0.25 x, microstepping too
+        self.assertIn(
+            "| 17hs4401 | 24 | 69.0 | 51.8 (0.75×) | 51.8 (0.75×) | 17.2 (0.25×) | 17.2 (0.25×) | 17.2 (0.25×) "
+            "| 17.2 (0.25×) |",
+            text,
+        )
         self.assertIn("resolution 1.5 T_H / 128", text)
         self.assertIn("2.33–2.33 over 1 cases; pmstep holds less than microstepping in 0 of them", text)
         self.assertIn("![17hs4401: largest held load against speed](x-17hs4401.png)", text)

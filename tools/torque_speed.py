@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-"""The torque-speed curve, measured: the largest constant load torque pmstep (speed mode) and open-loop
-microstepping at rated current hold at a set of speeds, per public preset and bus voltage.
+"""The torque-speed curve, measured: the largest constant load torque pmstep (speed mode, with and without
+field weakening) and open-loop microstepping at rated current hold at a set of speeds, per public preset and bus
+voltage.
 
 For each public preset (sil/scenarios/motors/*.ini) and bus voltage (run.bus_voltage_V: 12, 24, 48 V)
 pmstep-tune designs the drive for that bus (--set run.bus_voltage_V=V); a preset the designer refuses at a
@@ -27,7 +28,7 @@ preset's R, the summary's per-phase RMS current over the hold, the load at its f
 
 --check exits 1 only when a case could not be evaluated (the SIL failed or gave no summary); a drive that
 holds not even no load ("none") and pmstep holding less than microstepping are reported, not failed. --quick: one
-preset (17hs4401), 24 V, speeds 0.25 and 0.75 of the top, 4 halvings (CI). --report FILE writes Markdown
+preset (17hs4401), 24 V, speeds 0.25 and 1.5 of the top, 4 halvings (CI). --report FILE writes Markdown
 (tools/report.py), with a plot per motor beside it when matplotlib is installed.
 
 usage: tools/torque_speed.py [--sil PATH] [--tune PATH] [--motors paper,17hs4401,bj42d29,as1050]
@@ -51,9 +52,15 @@ from stepdir_compare import A_AXIS, design, run_sil  # noqa: E402  (the tune's d
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 MOTORS = ["paper", "17hs4401", "bj42d29", "as1050"]
 BUSES = [12.0, 24.0, 48.0]
-SPEED_FRACTIONS = [0.01, 0.25, 0.5, 0.75, 1.0]
-QUICK_FRACTIONS = [0.25, 0.75]
-DRIVES = ["pmstep", "microstep"]
+# Fractions of the design's top speed (i_d = 0, rated current in 90 % of the bus): beyond 1, where field
+# weakening takes over, up to the control rate's limit and past it.
+SPEED_FRACTIONS = [0.01, 0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 2.5]
+QUICK_FRACTIONS = [0.25, 1.5]
+# pmstep as designed (field weakening on), pmstep with it off, open-loop microstepping at rated current
+DRIVES = ["pmstep", "pmstep-no-fw", "microstep"]
+DRIVE_LABELS = {"pmstep": "pmstep", "pmstep-no-fw": "pmstep without field weakening", "microstep": "microstepping"}
+# The share of the holding torque a top speed keeps (PMSTEP_DESIGN_WEAKENED_TORQUE_SHARE).
+TOP_TORQUE_SHARE = 0.3
 LEAD_S = 0.1  # from RUN's start to the speed ramp
 SETTLE_S = 0.1  # at the speed before the load ramp
 LOAD_RAMP_S = 1.0  # the load from 0 to T: quasi-static (a ramp of 0.1 s measured the speed loop's tracking of it)
@@ -109,9 +116,9 @@ def held_failures(s, bound_rad_s):
 def one_run(args, case, drive, torque, out_dir):
     tl = case["timeline"]
     # The metrics' t_c: RUN's start for pmstep, the end of the hold (the ramp's start) for microstepping.
-    t_c = case["run_start"] if drive == "pmstep" else tl["ramp_s"]
+    t_c = tl["ramp_s"] if drive == "microstep" else case["run_start"]
     sets = [
-        f"run.controller={drive}",
+        f"run.controller={'microstep' if drive == 'microstep' else 'pmstep'}",
         "load.type=table",
         f"speed.points=0:0, {tl['ramp_s']:.6f}:0, {tl['reached_s']:.6f}:{tl['v']:.9g}",
         f"load.points=0:0, {tl['load_s']:.6f}:0, {tl['load_s'] + LOAD_RAMP_S:.6f}:{torque:.9g}",
@@ -119,6 +126,8 @@ def one_run(args, case, drive, torque, out_dir):
         f"run.transient_window_s={tl['load_s'] - t_c:.6f}",
         f"run.metrics_start_s={tl['load_s'] + LOAD_RAMP_S:.6f}",
     ]
+    if drive == "pmstep-no-fw":
+        sets.append("controller.field_weakening.max_current_A=0")
     _, s = run_sil(args.sil, case["scenario"], sets, out_dir, False)
     return s
 
@@ -211,10 +220,15 @@ def ratio(pm, ms):
 
 def pair_rows(rows):
     """The rows joined per case: [(case key, pmstep row, microstep row)] in the rows' order."""
+    return [(k, d.get("pmstep"), d.get("microstep")) for k, d in case_rows(rows)]
+
+
+def case_rows(rows):
+    """The rows joined per case: [(case key, {drive: row})] in the rows' order."""
     by = {}
     for r in rows:
         by.setdefault((r["motor"], r["bus_V"], r["fraction"]), {})[r["drive"]] = r
-    return [(k, d.get("pmstep"), d.get("microstep")) for k, d in by.items()]
+    return list(by.items())
 
 
 def _load(r):
@@ -230,52 +244,81 @@ def _loss(r):
     return "-" if r is None or r.get("copper_loss_W") is None else f"{r['copper_loss_W']:.2f}"
 
 
-def table(rows, refused, markdown):
-    head = [
-        "motor",
-        "bus V",
-        "speed",
-        "rad/s",
-        "pmstep N·m (× T_H)",
-        "microstep N·m (× T_H)",
-        "ratio",
-        "pmstep Cu W",
-        "microstep Cu W",
-    ]
-    out = []
+TABLE_HEAD = [
+    "motor",
+    "bus V",
+    "speed",
+    "rad/s",
+    "pmstep N·m (× T_H)",
+    "without FW N·m (× T_H)",
+    "microstep N·m (× T_H)",
+    "ratio",
+    "pmstep Cu W",
+    "without FW Cu W",
+    "microstep Cu W",
+]
+TEXT_WIDTHS = [9, 4, 5, 7, 16, 16, 16, 6, 8, 8, 8]
+
+
+def _line(cells, markdown):
     if markdown:
-        out += ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
-    else:
-        out.append(
-            f"{'motor':9s} {'bus':>4s} {'speed':>5s} {'rad/s':>7s} {'pmstep Nm (xT_H)':>18s} "
-            f"{'microstep Nm (xT_H)':>20s} {'ratio':>6s} {'pm Cu W':>8s} {'ms Cu W':>8s}"
-        )
-    for (motor, bus, fraction), pm, ms in pair_rows(rows):
+        return "| " + " | ".join(cells) + " |"
+    return " ".join(c.ljust(w) if i == 0 else c.rjust(w) for i, (c, w) in enumerate(zip(cells, TEXT_WIDTHS)))
+
+
+def table(rows, refused, markdown):
+    out = [_line(TABLE_HEAD, markdown)]
+    if markdown:
+        out.append("|" + "---|" * len(TABLE_HEAD))
+    for (motor, bus, fraction), d in case_rows(rows):
+        pm, nofw, ms = d.get("pmstep"), d.get("pmstep-no-fw"), d.get("microstep")
         r = ratio(pm["held_Nm"] if pm else None, ms["held_Nm"] if ms else None)
-        speed = (pm or ms)["speed_rad_s"]
-        cells = [
-            motor,
-            f"{bus:g}",
-            f"{fraction:g}",
-            f"{speed:.1f}",
-            _load(pm),
-            _load(ms),
-            "-" if r is None else f"{r:.2f}",
-            _loss(pm),
-            _loss(ms),
-        ]
-        if markdown:
-            out.append("| " + " | ".join(cells) + " |")
-        else:
-            out.append(
-                f"{cells[0]:9s} {cells[1]:>4s} {cells[2]:>5s} {cells[3]:>7s} {cells[4]:>18s} {cells[5]:>20s} "
-                f"{cells[6]:>6s} {cells[7]:>8s} {cells[8]:>8s}"
-            )
+        speed = next(x for x in (pm, nofw, ms) if x)["speed_rad_s"]
+        cells = [motor, f"{bus:g}", f"{fraction:g}", f"{speed:.1f}", _load(pm), _load(nofw), _load(ms)]
+        cells += ["-" if r is None else f"{r:.2f}", _loss(pm), _loss(nofw), _loss(ms)]
+        out.append(_line(cells, markdown))
     for d in refused:
-        cells = [d["motor"], f"{d['bus_V']:g}", "-", "-", "no design", "no design", "-", "-", "-"]
-        out.append(
-            "| " + " | ".join(cells) + " |" if markdown else f"{d['motor']:9s} {d['bus_V']:4g}  no design: {d['why']}"
-        )
+        if markdown:
+            out.append(_line([d["motor"], f"{d['bus_V']:g}", "-", "-"] + ["no design"] * 3 + ["-"] * 4, True))
+        else:
+            out.append(f"{d['motor']:9s} {d['bus_V']:4g}  no design: {d['why']}")
+    return "\n".join(out)
+
+
+def top_speeds(rows):
+    """Per motor and bus: the design's top speed and, per drive, the highest speed of the grid at which it holds
+    TOP_TORQUE_SHARE of the holding torque and the highest at which it holds a load: [(motor, bus, design top,
+    {drive: (speed at the share or None, speed with a load or None)})]."""
+    out = {}
+    for r in rows:
+        if r["error"]:
+            continue
+        key = (r["motor"], r["bus_V"])
+        top = r["speed_rad_s"] / r["fraction"]
+        entry = out.setdefault(key, (top, {}))[1].setdefault(r["drive"], [None, None])
+        if r["held_Nm"] is not None:
+            if r["held_Nm"] >= TOP_TORQUE_SHARE * r["holding_Nm"]:
+                entry[0] = max(entry[0] or 0.0, r["speed_rad_s"])
+            entry[1] = max(entry[1] or 0.0, r["speed_rad_s"])
+    return [(m, b, top, drives) for (m, b), (top, drives) in out.items()]
+
+
+def top_speed_table(rows):
+    """Markdown: top_speeds() with each speed also as a multiple of the design's top speed."""
+
+    def cell(v, top):
+        return "none" if v is None else f"{v:.1f} ({v / top:.2f}×)"
+
+    head = ["motor", "bus V", "design top rad/s"]
+    for drive in DRIVES:
+        head += [f"{DRIVE_LABELS[drive]}: at {TOP_TORQUE_SHARE * 100:.0f} % T_H", f"{DRIVE_LABELS[drive]}: any load"]
+    out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for motor, bus, top, drives in top_speeds(rows):
+        cells = [motor, f"{bus:g}", f"{top:.1f}"]
+        for drive in DRIVES:
+            share, any_load = drives.get(drive, (None, None))
+            cells += [cell(share, top), cell(any_load, top)]
+        out.append("| " + " | ".join(cells) + " |")
     return "\n".join(out)
 
 
@@ -335,7 +378,7 @@ def plot(rows, motor, path):
     fig, ax = plt.subplots(figsize=(7, 4.5))
     drawn = False
     for i, bus in enumerate(sorted({r["bus_V"] for r in rows if r["motor"] == motor})):
-        for drive, style in (("pmstep", "-"), ("microstep", "--")):
+        for drive, style in (("pmstep", "-"), ("pmstep-no-fw", ":"), ("microstep", "--")):
             pts = sorted(
                 (r["speed_rad_s"], r["held_Nm"])
                 for r in rows
@@ -348,7 +391,7 @@ def plot(rows, motor, path):
                     style,
                     marker="o",
                     color=f"C{i}",
-                    label=f"{drive}, {bus:g} V",
+                    label=f"{DRIVE_LABELS[drive]}, {bus:g} V",
                 )
                 drawn = True
     if not drawn:
@@ -366,9 +409,12 @@ def plot(rows, motor, path):
 
 
 WHAT = (
-    "Per public preset and bus voltage, pmstep-tune's design for that bus, and at fractions of its top speed the "
-    "largest constant load torque each drive holds: pmstep in speed mode and open-loop microstepping at rated "
-    f"current (`run.controller = microstep`) on the same plant and scenario. The speed ramps at min(¼ k_M I / J, "
+    "Per public preset and bus voltage, pmstep-tune's design for that bus, and at fractions of its top speed (the "
+    "speed at which rated current fills 90 % of the bus with i_d = 0) the largest constant load torque each "
+    "drive holds: pmstep in speed mode as designed (field weakening on), the same design with field weakening "
+    "off (`controller.field_weakening.max_current_A = 0`), and open-loop microstepping at rated current "
+    "(`run.controller = microstep`) on the same plant and scenario; *ratio* is pmstep's over microstepping's. "
+    "The speed ramps at min(¼ k_M I / J, "
     f"{A_AXIS:g} rad/s²) from RUN's start + {LEAD_S:g} s; {SETTLE_S:g} s after it is reached the load (opposing "
     f"the motion) ramps from 0 over {LOAD_RAMP_S:g} s and is held {HOLD_S:g} s to the end. **Held**, the same "
     "rule for both drives: no fault, the summary's `loss_of_synchronism` false (microstepping: load angle beyond "
@@ -393,6 +439,12 @@ def report_text(rows, refused, args, argv, pictures):
         "",
         summary(rows),
         "",
+        f"## Top speeds\n\nPer drive, the highest speed of the grid at which it holds {TOP_TORQUE_SHARE * 100:.0f} % "
+        "of the datasheet holding torque, and the highest at which it holds a load at all; in parentheses as a "
+        "multiple of the design's top speed (the grid's unit). A drive's curve between grid speeds is not measured.",
+        "",
+        top_speed_table(rows),
+        "",
     ]
     if limits(rows):
         lines += limits(rows) + [""]
@@ -410,7 +462,7 @@ def main(argv=None):
     ap.add_argument("--buses", help="bus voltages, V (default 12,24,48; 24 with --quick)")
     ap.add_argument("--speeds", help="fractions of the design's top speed")
     ap.add_argument("--iterations", type=int, help=f"halvings (default {ITERATIONS}, {ITERATIONS_QUICK} with --quick)")
-    ap.add_argument("--quick", action="store_true", help="17hs4401, 24 V, speeds 0.25 and 0.75, 4 halvings (CI)")
+    ap.add_argument("--quick", action="store_true", help="17hs4401, 24 V, speeds 0.25 and 1.5, 4 halvings (CI)")
     ap.add_argument("--check", action="store_true", help="exit 1 if a case could not be evaluated")
     ap.add_argument("--jobs", type=int, default=2, help="searches at once (threads, each running pmstep-sil)")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "torque_speed"))

@@ -82,6 +82,7 @@ static pmstep_status_t validate_signs(const pmstep_config_t *cfg)
         SIGN_RULE(detection.stall_speed_error_rad_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_BOUND),
         SIGN_RULE(detection.observer_residual_bound_A, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_BOUND),
         SIGN_RULE(detection.persistence_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_TIME),
+        SIGN_RULE(field_weakening.max_current_A, SIGN_NON_NEGATIVE, PMSTEP_ERR_FIELD_WEAKENING),
         /* Checked by range below. */
         SIGN_RULE(timing.period_s, SIGN_ANY, PMSTEP_OK),
         SIGN_RULE(alignment.s_align_time_s, SIGN_ANY, PMSTEP_OK),
@@ -89,6 +90,8 @@ static pmstep_status_t validate_signs(const pmstep_config_t *cfg)
         SIGN_RULE(limits.max_bus_voltage_V, SIGN_ANY, PMSTEP_OK),
         SIGN_RULE(standstill.hold_current_A, SIGN_ANY, PMSTEP_OK), /* its code is below a signed char's range */
         SIGN_RULE(standstill.vector_speed_rad_s, SIGN_ANY, PMSTEP_OK), /* so is this one's */
+        SIGN_RULE(field_weakening.modulation, SIGN_ANY, PMSTEP_OK),
+        SIGN_RULE(field_weakening.gain_A_per_s, SIGN_ANY, PMSTEP_OK),
     };
     size_t n;
     for (n = 0; n < sizeof sign_rules / sizeof sign_rules[0]; ++n) {
@@ -345,6 +348,20 @@ static pmstep_status_t validate_standstill(const pmstep_config_t *cfg)
     return (current_A > 0.0f && cfg->known_load_mode) ? PMSTEP_ERR_STANDSTILL_KNOWN_LOAD : PMSTEP_OK;
 }
 
+/* Field weakening (pmstep_weakening.h): within the trip current, and when on, a share of the bus
+ * and a rate to reach it. */
+static pmstep_status_t validate_field_weakening(const pmstep_field_weakening_config_t *fw, float max_phase_current_A)
+{
+    if (!(fw->max_current_A < max_phase_current_A)) {
+        return PMSTEP_ERR_FIELD_WEAKENING;
+    }
+    if ((fw->max_current_A > 0.0f)
+        && !((fw->modulation > 0.0f) && (fw->modulation <= 1.0f) && (fw->gain_A_per_s > 0.0f))) {
+        return PMSTEP_ERR_FIELD_WEAKENING;
+    }
+    return PMSTEP_OK;
+}
+
 pmstep_status_t pmstep_check_settings(const pmstep_config_t *cfg)
 {
     pmstep_status_t status;
@@ -377,6 +394,9 @@ pmstep_status_t pmstep_check_settings(const pmstep_config_t *cfg)
     }
     if (status == PMSTEP_OK) {
         status = validate_standstill(cfg);
+    }
+    if (status == PMSTEP_OK) {
+        status = validate_field_weakening(&cfg->field_weakening, cfg->limits.max_phase_current_A);
     }
     return status;
 }

@@ -7,7 +7,6 @@
 static void start_run(pmstep_t *inst, const pmstep_meas_t *sample)
 {
     const pmstep_ref_t speed_cmd = inst->speed_ref;
-    const pmstep_ref_t i_d_cmd = inst->i_d_ref;
     pmstep_angle_start(&inst->angle, sample->i_a_A, sample->i_b_A);
     pmstep_angle_set(&inst->angle, &inst->derived.angle_coeffs, inst->commissioning.equilibrium_cos,
                      inst->commissioning.equilibrium_sin); /* c-alignment's equilibrium (1, 0 unless measured) */
@@ -19,7 +18,8 @@ static void start_run(pmstep_t *inst, const pmstep_meas_t *sample)
     pmstep_ref_reset(&inst->speed_ref, 0.0f);
     pmstep_ref_set_target(&inst->speed_ref, speed_cmd.target, speed_cmd.ramp_rate_per_s);
     pmstep_ref_reset(&inst->i_d_ref, 0.0f);
-    pmstep_ref_set_target(&inst->i_d_ref, i_d_cmd.target, 0.0f);
+    inst->weakening.weakening_A = 0.0f; /* from the command alone: the weakening starts again */
+    pmstep_ref_set_target(&inst->i_d_ref, inst->weakening.command_A, 0.0f);
     pmstep_ref_reset(&inst->scratch.run.known_load_filter, inst->cfg->known_load_mode ? sample->load_torque_Nm : 0.0f);
     pmstep_detect_start(&inst->scratch.run.detector); /* the sums are spent */
     pmstep_continuity_start(&inst->scratch.run.continuity);

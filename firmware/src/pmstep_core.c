@@ -248,13 +248,30 @@ static void alignment_stage(const pmstep_t *inst, pmstep_output_t *out)
     }
 }
 
-/* Supervise stage, in RUN, every PMSTEP_DETECTION_DECIMATION periods: the observer's estimates
+/* Field weakening on the law's voltage (pmstep_weakening.h): i_d*'s target from the command and i_w. */
+static void weakening_stage(pmstep_t *inst, const pmstep_output_t *out, float bus_voltage_V)
+{
+    const pmstep_observer_coeffs_t *obs = &inst->derived.observer_coeffs;
+    /* Park written out, not pmstep_park(): another caller makes -Os keep it out of line in the period */
+    const float u_d_V = (out->cos_hat * out->u_a_V) + (out->sin_hat * out->u_b_V);
+    const float u_q_V = (out->cos_hat * out->u_b_V) - (out->sin_hat * out->u_a_V);
+    const bool helps = pmstep_weakening_helps(obs->r_over_l_per_s, obs->pole_pairs, out->speed_hat_rad_s, u_d_V, u_q_V);
+    pmstep_ref_set_target(&inst->i_d_ref,
+                          pmstep_weakening_update(&inst->weakening, &inst->derived.weakening_coeffs, out->u_a_V,
+                                                  out->u_b_V, bus_voltage_V, helps),
+                          0.0f);
+}
+
+/* Supervise stage, in RUN, every PMSTEP_DETECTION_DECIMATION periods: field weakening, the observer's estimates
  * within what the motor and the bus allow (the observer holds them at that range's edge, so an
  * estimate at it is a lost observer), then detection. */
 static pmstep_fault_t supervise_stage(pmstep_t *inst, const pmstep_output_t *out, const pmstep_meas_t *sample)
 {
     if ((inst->step_count % PMSTEP_DETECTION_DECIMATION) != 0u) {
         return PMSTEP_FAULT_NONE;
+    }
+    if (inst->derived.weakening_coeffs.max_current_A > 0.0f) {
+        weakening_stage(inst, out, sample->bus_voltage_V);
     }
     if ((pmstep_abs(inst->observer.speed_hat_rad_s) >= inst->derived.observer_coeffs.speed_bound_rad_s)
         || (pmstep_abs(inst->observer.load_hat_Nm) >= inst->derived.observer_coeffs.load_bound_Nm)) {

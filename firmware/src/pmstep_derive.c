@@ -38,6 +38,7 @@ void pmstep_derive(pmstep_derived_t *derived, const pmstep_config_t *cfg)
     pmstep_detect_coeffs_init(&derived->detect_coeffs, cfg);
     pmstep_continuity_coeffs_init(&derived->continuity_coeffs, cfg);
     pmstep_actuate_coeffs_init(&derived->actuate_coeffs, cfg);
+    pmstep_weakening_coeffs_init(&derived->weakening_coeffs, cfg);
     derived->voltage_corrected = derived->actuate_coeffs.sensed || derived->actuate_coeffs.compensate;
 }
 
@@ -62,5 +63,6 @@ bool pmstep_derived_finite(const pmstep_derived_t *derived)
            && floats_finite(&derived->observer_coeffs, sizeof derived->observer_coeffs / sizeof(float))
            && floats_finite(&derived->law_coeffs, offsetof(pmstep_law_coeffs_t, linear_speed_term) / sizeof(float))
            && floats_finite(&derived->detect_coeffs.alpha, 3u)           /* alpha, angle step, consistency bound */
-           && floats_finite(&derived->actuate_coeffs.dead_time_duty, 2u); /* duty, 1/band */
+           && floats_finite(&derived->actuate_coeffs.dead_time_duty, 2u) /* duty, 1/band */
+           && floats_finite(&derived->weakening_coeffs.modulation_squared, 3u); /* m^2, g T_c, I_w */
 }

@@ -64,6 +64,8 @@ void pmstep_reset(pmstep_t *inst)
     inst->step_count = 0u;
     pmstep_ref_reset(&inst->speed_ref, 0.0f);
     pmstep_ref_reset(&inst->i_d_ref, 0.0f);
+    inst->weakening.command_A = 0.0f;
+    inst->weakening.weakening_A = 0.0f;
     pmstep_clear_dynamic_state(inst);
     clear_commissioning(inst); /* the scratch union holds the sums until t_c; RUN's start sets up the rest */
 }
@@ -130,6 +132,7 @@ pmstep_status_t pmstep_set_id_target(pmstep_t *inst, float target_A)
     if (!pmstep_all_finite4(target_A, 0.0f, 0.0f, 0.0f)) {
         return PMSTEP_ERR_BAD_COMMAND_VALUE;
     }
-    pmstep_ref_set_target(&inst->i_d_ref, target_A, 0.0f);
+    inst->weakening.command_A = target_A;
+    pmstep_ref_set_target(&inst->i_d_ref, target_A + inst->weakening.weakening_A, 0.0f);
     return PMSTEP_OK;
 }

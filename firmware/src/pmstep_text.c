@@ -35,6 +35,7 @@ const char *pmstep_status_str(pmstep_status_t status)
     case PMSTEP_ERR_DETENT_FADE_SPEED: return "detent fade speed < 0";
     case PMSTEP_ERR_ANGLE_SMOOTHING: return "need 0 <= angle smoothing < 1";
     case PMSTEP_ERR_OBSERVER_BOOST: return "need transient observer boost 0, or within [1, 4] with an observer residual bound";
+    case PMSTEP_ERR_FIELD_WEAKENING: return "need field weakening current >= 0 below the trip, and if > 0 modulation in (0, 1] and gain > 0";
     case PMSTEP_ERR_EMF_ANGLE_GAIN: return "need 0 <= K_theta < R/L + K_e, w_theta >= 0, and w_theta > 0 with K_theta";
     case PMSTEP_ERR_MAX_CURRENT: return "current limit must be > 0";
     case PMSTEP_ERR_MIN_BUS: return "min bus must be > 0";

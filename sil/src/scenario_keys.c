@@ -82,6 +82,9 @@ const key_t_ scenario_keys[] = {
     {"controller.standstill.hold_current_A", KEY_FLOAT, OFF(controller.standstill.hold_current_A), -BIG, 0, BIG, 0, "speed mode: a zero command, reached, held by a stator-frame vector of this current with the estimate kept (A, below max_phase_current_A); 0 = off"},
     {"controller.standstill.vector_speed_rad_s", KEY_FLOAT, OFF(controller.standstill.vector_speed_rad_s), -BIG, 0, BIG, 0, "speed mode: below this |command| (rad/s) the hold's vector turns at the reference speed in place of the law (low-speed drive; needs hold_current_A); 0 = standstill only"},
     {"controller.standstill.stops_only", KEY_BOOL, OFF(controller.standstill.stops_only), 0, 0, 1, 0, "with a vector speed: the vector turns only on the way to a zero command (the last of a stop), the law drives every other speed (true/false)"},
+    {"controller.field_weakening.max_current_A", KEY_FLOAT, OFF(controller.field_weakening.max_current_A), -BIG, 0, BIG, 0, "field weakening: the most it takes off i_d* (A, below max_phase_current_A); 0 = off"},
+    {"controller.field_weakening.modulation", KEY_FLOAT, OFF(controller.field_weakening.modulation), -BIG, 0, BIG, 0, "field weakening: the share of the measured bus the law's voltage may take, in (0, 1]"},
+    {"controller.field_weakening.gain_A_per_s", KEY_FLOAT, OFF(controller.field_weakening.gain_A_per_s), -BIG, 0, BIG, 0, "field weakening: the weakening current's rate per unit of the voltage's relative excess (A/s)"},
     {"controller.known_load_mode", KEY_BOOL, OFF(controller.known_load_mode), 0, 0, 1, 0, "Remark 1: load torque measured (true/false)"},
 
     /* 3600 s / 1 us = 3.6e9 periods: the core's uint32 step counter does not wrap. */

@@ -14,7 +14,7 @@ static void usage(FILE *f)
 {
     fprintf(f,
             "usage: pmstep-tune (--motor FILE | --motor-db FILE --name NAME) [--robust [--low-speed-drive]]\n"
-            "                   [--force] [--set section.key=value]...\n"
+            "                   [--force] [--no-field-weakening] [--set section.key=value]...\n"
             "                   [--write-ini FILE] [--write-c FILE] [--validate]\n"
             "                   [--told-inertia J] [--told-friction F] [--identify [--max-inertia-error PCT]]\n"
             "                   [--identify-in-run] [--self-commission [--detent-fraction D]] [--summary FILE]\n"
@@ -30,6 +30,7 @@ static void usage(FILE *f)
             "  --low-speed-drive  robust mode without phase-voltage sensing: below 2 V_bus t_d / (T_s k_M)\n"
             "               the standstill hold's vector turns at the reference speed (a load step there is\n"
             "               not learnt)\n"
+            "  --no-field-weakening  no field weakening: i_d* stays at its command at every speed\n"
             "  --set        override a key of the preset before designing (e.g. run.period_s=25e-6)\n"
             "  --write-ini  the whole scenario with the designed [controller.*] and a validation profile\n"
             "  --write-c    the design as a C99 initialiser of pmstep_config_t\n"
@@ -65,6 +66,7 @@ typedef struct {
     bool force;
     bool robust;
     bool low_speed_drive;
+    bool no_field_weakening;
     bool run_validation;
     bool run_identification;
     bool identify_in_run;
@@ -140,6 +142,7 @@ static bool flag_option(const char *arg, request_t *q)
     } flags[] = {{"--force", &q->force},
                  {"--robust", &q->robust},
                  {"--low-speed-drive", &q->low_speed_drive},
+                 {"--no-field-weakening", &q->no_field_weakening},
                  {"--validate", &q->run_validation},
                  {"--identify", &q->run_identification},
                  {"--identify-in-run", &q->identify_in_run},
@@ -222,6 +225,7 @@ static int design_from_datasheet(sil_scenario_t *sc, request_t *q, pmstep_design
                                  pmstep_design_report_t *report, pmstep_status_t *status, tune_check_t *checks)
 {
     design_input(sc, q->robust, q->low_speed_drive, in);
+    in->field_weakening_off = q->no_field_weakening;
     if (q->told_inertia >= 0.0) {
         in->motor.inertia_kgm2 = (float)q->told_inertia;
     }

@@ -46,6 +46,11 @@ void print_design(const sil_scenario_t *sc, const pmstep_design_report_t *r, boo
            (double)r->top_electrical_step_rad, r->bus_speed_rad_s <= r->rate_speed_rad_s ? "bus" : "control rate",
            sc->bus_voltage_V, (double)r->bus_speed_rad_s, (double)PMSTEP_DESIGN_MAX_ELECTRICAL_STEP_RAD,
            (double)r->rate_speed_rad_s);
+    printf("  field weakening: up to %.3f A off i_d* (0 = off), bus share %.2f, gain %.1f A/s; top speed with it %.1f rad/s "
+           "(%.0f rpm) at %.0f %% of the holding torque\n",
+           (double)c->field_weakening.max_current_A, (double)c->field_weakening.modulation,
+           (double)c->field_weakening.gain_A_per_s, (double)r->weakened_speed_rad_s,
+           (double)r->weakened_speed_rad_s * 60.0 / (2.0 * M_PI), 100.0 * (double)PMSTEP_DESIGN_WEAKENED_TORQUE_SHARE);
     printf("  bandwidths: current %.0f rad/s, observer %.0f rad/s (triple pole), speed %.0f rad/s\n",
            (double)r->current_bandwidth_rad_s, (double)r->observer_bandwidth_rad_s,
            (double)r->speed_bandwidth_rad_s);

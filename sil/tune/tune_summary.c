@@ -57,6 +57,8 @@ int write_summary(const char *path, const char *motor_path, bool robust, pmstep_
         cJSON_AddNumberToObject(design, "detent_margin", (double)r->detent_margin);
         cJSON_AddNumberToObject(design, "magnetising_current_A", (double)r->magnetising_current_A);
         cJSON_AddNumberToObject(design, "rated_torque_Nm", (double)r->rated_torque_Nm);
+        cJSON_AddNumberToObject(design, "weakening_current_A", (double)r->weakening_current_A);
+        cJSON_AddNumberToObject(design, "weakened_speed_rad_s", (double)r->weakened_speed_rad_s);
     }
     cJSON_AddItemToObject(root, "design", design);
     for (k = 0; k < n_checks; ++k) {

@@ -116,6 +116,9 @@ static void eva_any_config(pmstep_config_t *cfg)
     cfg->standstill.hold_current_A = eva_any_finite();
     cfg->standstill.vector_speed_rad_s = eva_any_finite();
     cfg->standstill.stops_only = Frama_C_nondet(0, 1) != 0;
+    cfg->field_weakening.max_current_A = eva_any_finite();
+    cfg->field_weakening.modulation = eva_any_finite();
+    cfg->field_weakening.gain_A_per_s = eva_any_finite();
 }
 
 #endif /* PMSTEP_EVA_CONFIGS_H */

@@ -9,7 +9,7 @@
  * inductance window, commissioned R, L, k_M used, J and F identified over 20 ms of RUN and
  * used, dead-time compensation, drift-free angle, detent compensation (faded with the speed), PI current loop,
  * every detector (the paper's bounds), two re-alignments, one period of delay, the standstill hold
- * of speed mode at 7.5 A (half the current trip). */
+ * of speed mode at 7.5 A (half the current trip), field weakening (up to 7 A at the designer's gain). */
 static inline pmstep_config_t pmstep_test_features_config(void)
 {
     pmstep_config_t cfg = pmstep_paper_config();
@@ -35,6 +35,9 @@ static inline pmstep_config_t pmstep_test_features_config(void)
     cfg.standstill.hold_current_A = 7.5f;
     cfg.standstill.vector_speed_rad_s = 2.0f; /* the low-speed drive below 2 rad/s */
     cfg.inverter.ripple_dead_zone = true;     /* the compensation's ripple dead zone */
+    cfg.field_weakening.max_current_A = 7.0f;
+    cfg.field_weakening.modulation = 0.9f;
+    cfg.field_weakening.gain_A_per_s = 7850.0f;
     return cfg;
 }
 

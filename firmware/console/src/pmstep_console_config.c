@@ -93,6 +93,9 @@ static const pmstep_console_config_entry_t table[] = {
     SD_U32(diag_mode),
     SD_F32(following_error_limit_full_steps),
     SD_F32(stall_current_A),
+    F32(field_weakening.max_current_A),
+    F32(field_weakening.modulation),
+    F32(field_weakening.gain_A_per_s),
 };
 
 #define HALF_PI 1.5707963f

@@ -40,6 +40,11 @@
 #define SETTLING_DECAY 13.8155f
 #define CURRENT_RISE_TIME_CONSTANTS 5.0f
 #define TIME_GRANULARITY_S 0.01f
+/* Field weakening (docs/design/22-field-weakening.md): at most half the magnet's flux taken off in
+ * current, k_M / (2 p L); the loop's rate an eighth of the reference filter's bandwidth. */
+#define WEAKENING_FLUX_SHARE 0.5f
+#define WEAKENING_PER_REFERENCE_BANDWIDTH (1.0f / 8.0f)
+#define SQRT2 1.41421356f
 /* Protections. */
 #define TRIP_CURRENT_PER_RATED 2.0f
 #define MIN_BUS_FRACTION 0.625f
@@ -333,6 +338,43 @@ static void design_commissioning(const pmstep_design_input_t *in, float window_s
     cfg->standstill.stops_only = cfg->standstill.vector_speed_rad_s > 0.0f && !in->low_speed_drive;
 }
 
+/* The speed at which (R i_d - p w L i_q)^2 + (R i_q + (k_M + p L i_d) w)^2 = (0.9 V)^2: the steady
+ * state of (2) in the rotor frame with the currents (i_d, i_q). */
+static float bus_speed_at(const pmstep_design_input_t *in, float i_d_A, float i_q_A)
+{
+    const pmstep_motor_config_t *m = &in->motor;
+    const float x = (float)m->pole_pairs * m->inductance_H * i_q_A;
+    const float flux = m->torque_constant_Nm_A + (float)m->pole_pairs * m->inductance_H * i_d_A;
+    const float usable_V = USABLE_BUS_FRACTION * in->bus_voltage_V;
+    const float a = x * x + flux * flux;
+    const float b = 2.0f * m->resistance_Ohm * (i_q_A * flux - i_d_A * x);
+    const float c = m->resistance_Ohm * m->resistance_Ohm * (i_d_A * i_d_A + i_q_A * i_q_A) - usable_V * usable_V;
+    return (-b + sqrtf(b * b - 4.0f * a * c)) / (2.0f * a);
+}
+
+/* Field weakening: I_w within half the magnet's flux in current and the rated current's circle beside
+ * the q current of PMSTEP_DESIGN_WEAKENED_TORQUE_SHARE of the holding torque (sqrt(2) k_M I); the
+ * bus share of the top speed's definition; the gain g = w_fw m V / (2 p L w_b) sets the loop's rate
+ * 2 g p w L / (m V) to w_fw = varpi_0 / 8 where weakening starts, w_b (pmstep_weakening.h). */
+static void design_field_weakening(const pmstep_design_input_t *in, pmstep_config_t *cfg, pmstep_design_report_t *report)
+{
+    const pmstep_motor_config_t *m = &in->motor;
+    const float p_l = (float)m->pole_pairs * m->inductance_H;
+    const float rated_A = in->motor.rated_current_A;
+    const float q_A = PMSTEP_DESIGN_WEAKENED_TORQUE_SHARE * SQRT2 * rated_A;
+    const float flux_A = WEAKENING_FLUX_SHARE * m->torque_constant_Nm_A / p_l;
+    const float circle_A = sqrtf(rated_A * rated_A - q_A * q_A);
+    const float current_A = in->field_weakening_off ? 0.0f : min2(flux_A, circle_A);
+    cfg->field_weakening.max_current_A = current_A;
+    cfg->field_weakening.modulation = USABLE_BUS_FRACTION;
+    cfg->field_weakening.gain_A_per_s = WEAKENING_PER_REFERENCE_BANDWIDTH * cfg->gains.reference_bandwidth_rad_s
+                                        * USABLE_BUS_FRACTION * in->bus_voltage_V
+                                        / (2.0f * p_l * report->bus_speed_rad_s);
+    report->weakening_current_A = current_A;
+    report->weakened_speed_rad_s = current_A > 0.0f ? min2(bus_speed_at(in, -current_A, q_A), report->rate_speed_rad_s)
+                                                    : report->top_speed_rad_s;
+}
+
 static void design_protection(const pmstep_design_input_t *in, pmstep_config_t *cfg, float top_speed_rad_s)
 {
     const float usable_current_A = PMSTEP_SENSE_RANGE_USABLE_FRACTION * in->current_sense_range_A;
@@ -399,5 +441,6 @@ pmstep_status_t pmstep_design(const pmstep_design_input_t *given, pmstep_config_
     window_s = design_alignment(in, cfg, report);
     design_commissioning(in, window_s, cfg, report);
     design_protection(in, cfg, report->top_speed_rad_s);
+    design_field_weakening(in, cfg, report);
     return pmstep_validate_config(cfg);
 }

@@ -18,6 +18,7 @@
 #include "pmstep/pmstep_actuate.h"
 #include "pmstep/pmstep_hold.h"
 #include "pmstep/pmstep_continuity.h"
+#include "pmstep/pmstep_weakening.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -41,6 +42,7 @@ typedef struct {
     pmstep_angle_coeffs_t angle_coeffs;
     pmstep_observer_coeffs_t observer_coeffs;
     pmstep_law_coeffs_t law_coeffs;
+    pmstep_weakening_coeffs_t weakening_coeffs;
 } pmstep_derived_t;
 
 /** One controller instance; all state lives here. */
@@ -80,6 +82,7 @@ typedef struct {
     } scratch;
 
     pmstep_vector_hold_t hold;            /**< standstill hold by a stator-frame vector (pmstep_hold.h) */
+    pmstep_weakening_t weakening;         /**< the commanded i_d* and field weakening's share of it */
 } pmstep_t;
 
 #ifdef __cplusplus

@@ -55,6 +55,9 @@ typedef enum {
     PMSTEP_ERR_EMF_ANGLE_GAIN = -53,        /**< back-EMF angle correction: gain < 0 or not below R/L + K_e, corner
                                                  < 0, or a gain without a corner */
     PMSTEP_ERR_ANGLE_SMOOTHING = -54,       /**< angle smoothing a < 0 or >= 1 */
+    PMSTEP_ERR_FIELD_WEAKENING = -56,       /**< field weakening: its max_current_A < 0 or not below
+                                                 max_phase_current_A, or > 0 with a modulation outside (0, 1] or a
+                                                 gain_A_per_s <= 0 */
     PMSTEP_ERR_OBSERVER_BOOST = -55,        /**< transient observer boost k not 0 and not within [1, 4], or k > 0
                                                  without detection.observer_residual_bound_A */
     /* limits */
@@ -368,6 +371,14 @@ typedef struct {
                                    the low-speed drive */
 } pmstep_standstill_config_t;
 
+/** Field weakening in RUN (pmstep_weakening.h): i_d* goes below its command where the law's voltage
+ *  would take more than a share of the bus. */
+typedef struct {
+    float max_current_A; /**< I_w: the most the weakening takes off i_d*, 0 <= I_w < max_phase_current_A; 0 = off */
+    float modulation;    /**< m in (0, 1]: the share of the measured bus the law's voltage may take */
+    float gain_A_per_s;  /**< g > 0: the weakening current's rate per unit of the voltage's relative excess */
+} pmstep_field_weakening_config_t;
+
 /** Constant configuration (may live in flash; must outlive the instance). */
 typedef struct {
     pmstep_motor_config_t motor;
@@ -379,6 +390,7 @@ typedef struct {
     pmstep_inverter_config_t inverter;
     pmstep_detection_config_t detection;
     pmstep_standstill_config_t standstill;
+    pmstep_field_weakening_config_t field_weakening;
     bool known_load_mode; /**< Remark 1: load torque known, given each period in pmstep_meas_t */
 } pmstep_config_t;
 

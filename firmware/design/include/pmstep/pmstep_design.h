@@ -40,6 +40,7 @@ typedef struct {
                                                (pmstep_design_check_datasheet()), and a rotor inertia of 0 is
                                                estimated from it (PMSTEP_DESIGN_INERTIA_PER_TORQUE) */
     bool accept_implausible;              /**< design for data the datasheet check refuses (the caller warns) */
+    bool field_weakening_off;             /**< no field weakening (i_d* stays at its command at every speed) */
 } pmstep_design_input_t;
 
 /** The design's figures, for people and for the SIL's validation. */
@@ -60,6 +61,10 @@ typedef struct {
                                           the rotor across the detent (0: no detent) */
     float magnetising_current_A;     /**< i_d* the robust mode should run with (0 in paper mode) */
     float rated_torque_Nm;           /**< k_M x rated current (torque of one phase at rated current) */
+    float weakening_current_A;       /**< I_w: the most field weakening takes off i_d* (0: off) */
+    float weakened_speed_rad_s;      /**< with field weakening, the speed at which PMSTEP_DESIGN_WEAKENED_TORQUE_SHARE
+                                          of the holding torque still fits in the bus (i_d* = -I_w), at most
+                                          rate_speed_rad_s; top_speed_rad_s without it */
     float inertia_kgm2;              /**< the rotor inertia designed for: the input's, or its estimate */
     bool inertia_estimated;          /**< the input gave no inertia: estimated from the holding torque, to be
                                           identified in RUN (commissioning.identification_*) */
@@ -69,6 +74,9 @@ typedef struct {
  *  check turns its estimate over PMSTEP_DETECTION_DECIMATION = 4 periods by pmstep_small_rotation(),
  *  whose polynomials stay within 0.023 of cos and sin up to 1.6 rad (docs/design/06-top-speed.md). */
 #define PMSTEP_DESIGN_MAX_ELECTRICAL_STEP_RAD 0.4f
+/** The share of the holding torque the field-weakened top speed keeps (the q current's room in the
+ *  rated current's circle beside I_w, and weakened_speed_rad_s). */
+#define PMSTEP_DESIGN_WEAKENED_TORQUE_SHARE 0.3f
 
 /** Rotor inertia of a stepper from its holding torque T_H, where the datasheet gives none:
  *  J = PMSTEP_DESIGN_INERTIA_PER_TORQUE x (T_H / 1 N m)^1.5 kg m^2, a fit to NEMA 8-34 datasheets
