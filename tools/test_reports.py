@@ -775,6 +775,21 @@ class TorqueSpeed(ReportCase):
         self.assertAlmostEqual(torque_speed.ratio(0.525, 0.225), 2.3333333)
         self.assertIsNone(torque_speed.ratio(0.5, 0.0))
         self.assertEqual(len(torque_speed.unevaluated(rows)), 1)
+        # 0.225 N m at 0.25 x top is over 30 % of 0.4 N m and over microstepping's; at 0.75 x top pmstep holds
+        # 0.6: no shortfall. A row under both marks is named twice.
+        self.assertEqual(torque_speed.shortfalls(rows), [])
+        short = rows + [
+            self.row("as1050", 24.0, 1.5, "pmstep", 0.1, 0.11),
+            self.row("as1050", 24.0, 1.5, "microstep", 0.2, 0.21),
+            self.row("as1050", 24.0, 2.0, "pmstep", None, 0.0),
+        ]
+        self.assertEqual(
+            torque_speed.shortfalls(short),
+            [
+                "as1050 24 V 1.5 x top: pmstep holds 0.100 N m, microstepping 0.200",
+                "as1050 24 V 1.5 x top: pmstep holds 0.100 N m, under 30 % of the holding torque",
+            ],
+        )
         args = argparse.Namespace(iterations=7)
         argv = ["tools/torque_speed.py", "--report", "x.md"]
         text = torque_speed.report_text(rows, refused, args, argv, [("17hs4401", "x-17hs4401.png")])

@@ -26,8 +26,10 @@ The largest held load by bisection on [0, LOAD_BOUND x the datasheet holding tor
 end: ITERATIONS halvings (resolution LOAD_BOUND T_H / 2^n). Copper loss at it: 2 R I_rms^2 (two phases, the
 preset's R, the summary's per-phase RMS current over the hold, the load at its full value).
 
---check exits 1 only when a case could not be evaluated (the SIL failed or gave no summary); a drive that
-holds not even no load ("none") and pmstep holding less than microstepping are reported, not failed. --quick: one
+--check exits 1 when a case could not be evaluated (the SIL failed or gave no summary) or pmstep misses its
+targets: it holds less than microstepping where microstepping holds a load, or less than TOP_TORQUE_SHARE of
+the holding torque up to CHECK_TOP_FRACTION x the design's top speed. A drive that holds not even no load
+("none") is reported. --quick: one
 preset (17hs4401), 24 V, speeds 0.25 and 1.5 of the top, 4 halvings (CI). --report FILE writes Markdown
 (tools/report.py), with a plot per motor beside it when matplotlib is installed.
 
@@ -59,8 +61,10 @@ QUICK_FRACTIONS = [0.25, 1.5]
 # pmstep as designed (field weakening on), pmstep with it off, open-loop microstepping at rated current
 DRIVES = ["pmstep", "pmstep-no-fw", "microstep"]
 DRIVE_LABELS = {"pmstep": "pmstep", "pmstep-no-fw": "pmstep without field weakening", "microstep": "microstepping"}
-# The share of the holding torque a top speed keeps (PMSTEP_DESIGN_WEAKENED_TORQUE_SHARE).
+# The share of the holding torque a top speed keeps (PMSTEP_DESIGN_WEAKENED_TORQUE_SHARE); --check wants pmstep
+# to hold it up to CHECK_TOP_FRACTION x the design's top speed (field weakening's target).
 TOP_TORQUE_SHARE = 0.3
+CHECK_TOP_FRACTION = 1.5
 LEAD_S = 0.1  # from RUN's start to the speed ramp
 SETTLE_S = 0.1  # at the speed before the load ramp
 LOAD_RAMP_S = 1.0  # the load from 0 to T: quasi-static (a ramp of 0.1 s measured the speed loop's tracking of it)
@@ -329,6 +333,24 @@ def unevaluated(rows):
     ]
 
 
+def shortfalls(rows):
+    """--check: the cases where pmstep (as designed) misses its targets: it holds less than microstepping where
+    microstepping holds a load, or less than TOP_TORQUE_SHARE of the holding torque at up to CHECK_TOP_FRACTION x
+    the design's top speed."""
+    out = []
+    for (motor, bus, fraction), d in case_rows(rows):
+        pm, ms = d.get("pmstep"), d.get("microstep")
+        if not pm or pm["error"]:
+            continue
+        held = pm["held_Nm"] or 0.0
+        where = f"{motor} {bus:g} V {fraction:g} x top: pmstep holds {held:.3f} N m"
+        if ms and not ms["error"] and ms["held_Nm"] is not None and held < ms["held_Nm"]:
+            out.append(f"{where}, microstepping {ms['held_Nm']:.3f}")
+        if fraction <= CHECK_TOP_FRACTION and held < TOP_TORQUE_SHARE * pm["holding_Nm"]:
+            out.append(f"{where}, under {TOP_TORQUE_SHARE * 100:.0f} % of the holding torque")
+    return out
+
+
 def limits(rows):
     """What stopped each drive above its largest held load: Markdown list lines, one per case where the drive
     held no load (its reason at no load), then per drive a count of the first failures' kinds."""
@@ -463,7 +485,9 @@ def main(argv=None):
     ap.add_argument("--speeds", help="fractions of the design's top speed")
     ap.add_argument("--iterations", type=int, help=f"halvings (default {ITERATIONS}, {ITERATIONS_QUICK} with --quick)")
     ap.add_argument("--quick", action="store_true", help="17hs4401, 24 V, speeds 0.25 and 1.5, 4 halvings (CI)")
-    ap.add_argument("--check", action="store_true", help="exit 1 if a case could not be evaluated")
+    ap.add_argument(
+        "--check", action="store_true", help="exit 1 if a case could not be evaluated or pmstep misses its targets"
+    )
     ap.add_argument("--jobs", type=int, default=2, help="searches at once (threads, each running pmstep-sil)")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "torque_speed"))
     ap.add_argument("--json", help="also write every search's figures to this file")
@@ -497,6 +521,9 @@ def main(argv=None):
     bad = unevaluated(rows)
     for b in bad:
         print("torque_speed: not evaluated: " + b)
+    short = shortfalls(rows)
+    for b in short:
+        print("torque_speed: short: " + b)
     if args.json:
         with open(args.json, "w") as f:
             json.dump({"cases": rows, "no_design": refused}, f, indent=1)
@@ -510,7 +537,7 @@ def main(argv=None):
         if not pictures:
             print("torque_speed: matplotlib not installed, no plots", file=sys.stderr)
         print(f"torque_speed: wrote {report.write(args.report, report_text(rows, refused, args, argv, pictures))}")
-    return 1 if bad and args.check else 0
+    return 1 if (bad or short) and args.check else 0
 
 
 if __name__ == "__main__":

@@ -49,10 +49,14 @@ typedef struct {
 void pmstep_weakening_coeffs_init(pmstep_weakening_coeffs_t *coeffs, const pmstep_config_t *cfg);
 
 /**
- * One check: i_w from the law's voltage (@p u_a_V, @p u_b_V) against the bus @p bus_voltage_V.
- * A non-finite voltage leaves i_w as it was.
- * @param helps  a lower i_d lowers |u| at this operating point (pmstep_weakening_helps); where it
- *               does not, an excess takes i_w back toward 0 as a margin does
+ * One check: i_w from the law's voltage against the bus. A non-finite voltage leaves i_w as it was.
+ * @param[in,out] weakening      the command and i_w
+ * @param[in]     coeffs         from pmstep_weakening_coeffs_init()
+ * @param[in]     u_a_V          the law's voltage, phase a (before compensation and bus limit)
+ * @param[in]     u_b_V          the same, phase b
+ * @param[in]     bus_voltage_V  the measured bus
+ * @param[in]     helps          a lower i_d lowers |u| at this operating point (pmstep_weakening_helps());
+ *                               where it does not, an excess takes i_w back toward 0 as a margin does
  * @return the new i_d* target: the command plus i_w
  */
 float pmstep_weakening_update(pmstep_weakening_t *weakening, const pmstep_weakening_coeffs_t *coeffs, float u_a_V,
@@ -60,7 +64,12 @@ float pmstep_weakening_update(pmstep_weakening_t *weakening, const pmstep_weaken
 
 /**
  * Whether a lower i_d lowers |u|: d|u|^2 / d i_d = 2 (R u_d + p w L u_q) > 0, tested as
- * (R/L) u_d + p w u_q > 0 with (u_d, u_q) the law's voltage in the estimate's frame.
+ * (R/L) u_d + p w u_q > 0.
+ * @param r_over_l_per_s  R/L of the model
+ * @param pole_pairs      p
+ * @param speed_rad_s     the estimated speed w-hat
+ * @param u_d_V           the law's voltage in the estimate's frame, d axis
+ * @param u_q_V           the same, q axis
  */
 bool pmstep_weakening_helps(float r_over_l_per_s, float pole_pairs, float speed_rad_s, float u_d_V, float u_q_V);
 
