@@ -76,7 +76,7 @@ def design(args, name, chain, out_dir):
     r = run(cmd)
     if r.returncode != 0:
         raise SystemExit("pmstep-tune failed: %s\n%s" % (" ".join(cmd), r.stderr))
-    top = float(re.search(r"V\): ([0-9.]+) rad/s", r.stdout).group(1))
+    top = float(re.search(r"top speed: ([0-9.]+) rad/s", r.stdout).group(1))
     t_c = float(re.search(r"t_c ([0-9.]+) s", r.stdout).group(1))
     start = t_c + (0.05 if robust else 0.0) + 0.1
     return ini, top, start, preset
