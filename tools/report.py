@@ -12,14 +12,19 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 REPORTS = os.path.join(ROOT, "docs", "reports")
 
 
+# The reports themselves: a run of several tools (tools/write_reports.sh) changes them one after
+# another, which is no change of what they measure.
+REPORTS_PATHSPEC = ":(exclude)docs/reports"
+
+
 def commit():
-    """The commit of the working tree (with '+' when it has changes), or 'unknown'."""
+    """The commit of the working tree (with '+' when it has changes outside docs/reports), or 'unknown'."""
     try:
         head = subprocess.run(
             ["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=True
         ).stdout.strip()
         dirty = subprocess.run(
-            ["git", "-C", ROOT, "status", "--porcelain", "--untracked-files=no"],
+            ["git", "-C", ROOT, "status", "--porcelain", "--untracked-files=no", "--", ".", REPORTS_PATHSPEC],
             capture_output=True,
             text=True,
             check=True,
