@@ -150,6 +150,8 @@ static float target_after_a_check(float speed_rad_s)
     pmstep_meas_t meas = {0};
     pmstep_output_t out;
     assert_int_equal(paper_instance_in_run(&f.cfg, &f.inst), PMSTEP_OK);
+    /* the fixture inits with the paper's configuration: the weakening's settings (valid ones, as
+     * its_settings_are_checked shows) and their coefficients set after it */
     f.cfg.field_weakening.max_current_A = 2.0f;
     f.cfg.field_weakening.modulation = 0.9f;
     f.cfg.field_weakening.gain_A_per_s = 1000.0f;

@@ -102,18 +102,26 @@ static float round_up_time(float t_s)
     return (float)whole * TIME_GRANULARITY_S;
 }
 
-/* The bus's speed: (R I + k_M w)^2 + (p w L I)^2 = (0.9 V)^2 at rated current, i_d = 0
- * (docs/design/06-top-speed.md). */
-static float bus_speed(const pmstep_design_input_t *in)
+/* The speed at which (R i_d - p w L i_q)^2 + (R i_q + (k_M + p L i_d) w)^2 = (0.9 V)^2: the steady
+ * state of (2) in the rotor frame with the currents (i_d, i_q) (docs/design/06-top-speed.md; with
+ * field weakening, section 22). Written so that i_d = 0 adds exact zeros only. */
+static float bus_speed_at(const pmstep_design_input_t *in, float i_d_A, float i_q_A)
 {
     const pmstep_motor_config_t *m = &in->motor;
-    const float i = in->motor.rated_current_A;
-    const float x = (float)m->pole_pairs * m->inductance_H * i;
-    const float a = m->torque_constant_Nm_A * m->torque_constant_Nm_A + x * x;
-    const float b = 2.0f * m->resistance_Ohm * i * m->torque_constant_Nm_A;
+    const float x = (float)m->pole_pairs * m->inductance_H * i_q_A;
+    const float flux = m->torque_constant_Nm_A + (float)m->pole_pairs * m->inductance_H * i_d_A;
+    const float a = flux * flux + x * x;
+    const float b = 2.0f * m->resistance_Ohm * i_q_A * flux - 2.0f * m->resistance_Ohm * i_d_A * x;
     const float usable_V = USABLE_BUS_FRACTION * in->bus_voltage_V;
-    const float c = m->resistance_Ohm * i * m->resistance_Ohm * i - usable_V * usable_V;
+    const float c = m->resistance_Ohm * i_q_A * m->resistance_Ohm * i_q_A
+                    + m->resistance_Ohm * i_d_A * m->resistance_Ohm * i_d_A - usable_V * usable_V;
     return (-b + sqrtf(b * b - 4.0f * a * c)) / (2.0f * a);
+}
+
+/* The bus's speed: rated current, i_d = 0. */
+static float bus_speed(const pmstep_design_input_t *in)
+{
+    return bus_speed_at(in, 0.0f, in->motor.rated_current_A);
 }
 
 /* The observer's bandwidth from the control rate and the rotor's full-step time under the rated
@@ -336,20 +344,6 @@ static void design_commissioning(const pmstep_design_input_t *in, float window_s
     /* Not asked for, the vector takes the stops only: there the law's rotor comes to rest with a
      * phase current in the dead-time band often enough to cost the estimate 0.05 rad (section 14). */
     cfg->standstill.stops_only = cfg->standstill.vector_speed_rad_s > 0.0f && !in->low_speed_drive;
-}
-
-/* The speed at which (R i_d - p w L i_q)^2 + (R i_q + (k_M + p L i_d) w)^2 = (0.9 V)^2: the steady
- * state of (2) in the rotor frame with the currents (i_d, i_q). */
-static float bus_speed_at(const pmstep_design_input_t *in, float i_d_A, float i_q_A)
-{
-    const pmstep_motor_config_t *m = &in->motor;
-    const float x = (float)m->pole_pairs * m->inductance_H * i_q_A;
-    const float flux = m->torque_constant_Nm_A + (float)m->pole_pairs * m->inductance_H * i_d_A;
-    const float usable_V = USABLE_BUS_FRACTION * in->bus_voltage_V;
-    const float a = x * x + flux * flux;
-    const float b = 2.0f * m->resistance_Ohm * (i_q_A * flux - i_d_A * x);
-    const float c = m->resistance_Ohm * m->resistance_Ohm * (i_d_A * i_d_A + i_q_A * i_q_A) - usable_V * usable_V;
-    return (-b + sqrtf(b * b - 4.0f * a * c)) / (2.0f * a);
 }
 
 /* Field weakening: I_w within half the magnet's flux in current and the rated current's circle beside
