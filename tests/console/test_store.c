@@ -14,6 +14,7 @@
 #include "fake_flash.h"
 #include "pmstep_console.h"
 #include "pmstep_store.h"
+#include "pmstep/pmstep_text.h"
 #include "stepdir_settings_equal.h"
 
 #define BOARD_ID 0x47343331u
@@ -386,6 +387,17 @@ static void test_empty_store(void **state)
     assert_int_equal(store.slot, -1);
 }
 
+/* The store's outcomes and the core's status codes share an ACK's status field: no store
+ * code is a core status (pmstep_status_str() knows none of them). */
+static void test_codes_disjoint_from_core_status(void **state)
+{
+    int code;
+    (void)state;
+    for (code = (int)PMSTEP_STORE_EMPTY; code >= (int)PMSTEP_STORE_ERR_NULL; code--) {
+        assert_string_equal(pmstep_status_str((pmstep_status_t)code), "unknown status");
+    }
+}
+
 static void test_saves_alternate_slots(void **state)
 {
     pmstep_store_record_t a = record_with(1.0f);
@@ -580,6 +592,7 @@ int main(void)
         cmocka_unit_test_setup(test_stepdir_settings_refused_by_cause, setup),
         cmocka_unit_test_setup(test_record_before_stepdir_settings_refused, setup),
         cmocka_unit_test_setup(test_empty_store, setup),
+        cmocka_unit_test(test_codes_disjoint_from_core_status),
         cmocka_unit_test_setup(test_saves_alternate_slots, setup),
         cmocka_unit_test_setup(test_power_cut_at_every_save_step, setup),
         cmocka_unit_test_setup(test_power_cut_in_first_save, setup),

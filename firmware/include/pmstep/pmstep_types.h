@@ -137,8 +137,8 @@ typedef enum {
     PMSTEP_ERR_STEPDIR_LIMIT = -137,        /**< the following-error limit or the stop time not > 0, or a DIAG pulse
                                                  of 0 periods */
     PMSTEP_ERR_STEPDIR_DIAG_MODE = -138,    /**< DIAG's mode neither PMSTEP_DIAG_LEVEL (0) nor PMSTEP_DIAG_PULSE (1) */
-    PMSTEP_ERR_STEPDIR_STALL_CURRENT = -140, /**< the STEP/DIR stall current < 0, not finite, or not below
-                                                  max_phase_current_A */
+    PMSTEP_ERR_STEPDIR_STALL_CURRENT = -129, /**< the STEP/DIR stall current < 0, not finite, or not below
+                                                  max_phase_current_A (-140 to -151: pmstep_store_status_t) */
     /* homing (pmstep_homing.h) */
     PMSTEP_ERR_HOMING = -139                /**< a homing speed, acceleration, travel or stall error not > 0, a back-off
                                                  < 0, a stall current not in (0, max_phase_current_A), or a direction
@@ -461,7 +461,7 @@ typedef enum {
     PMSTEP_IDENT_POOR_EXCITATION = 4,  /**< the window held too little acceleration or speed variation (the fit's
                                             determinant below PMSTEP_IDENTIFICATION_MIN_DETERMINANT): nothing
                                             identified, the configured J and F stay */
-    PMSTEP_IDENT_IMPLAUSIBLE = 5       /**< J outside [1/2, 2] x the configured one, or |F|/J not below 0.5/T_s
+    PMSTEP_IDENT_IMPLAUSIBLE = 5       /**< J outside [1/10, 10] x the configured one, or |F|/J not below 0.5/T_s
                                             (or either not finite): reported, not used */
 } pmstep_identification_t;
 
