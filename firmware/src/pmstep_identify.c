@@ -82,7 +82,8 @@ bool pmstep_identify_finish(const pmstep_identify_sums_t *sums, const pmstep_con
     result->inertia_kgm2 = j;
     result->friction_Nms_rad = f;
     result->identification = PMSTEP_IDENT_IMPLAUSIBLE;
-    if (!(j >= 0.5f * cfg->motor.inertia_kgm2 && j <= 2.0f * cfg->motor.inertia_kgm2
+    if (!(j * PMSTEP_IDENTIFICATION_INERTIA_RANGE >= cfg->motor.inertia_kgm2
+          && j <= PMSTEP_IDENTIFICATION_INERTIA_RANGE * cfg->motor.inertia_kgm2
           && fabsf(f) * cfg->timing.period_s < 0.5f * j)) {
         return false; /* also J or F not finite */
     }

@@ -222,13 +222,25 @@ static void finish_judges_the_result(void **state)
     assert_true(pmstep_identify_finish(&sums, &cfg, &model, &result));
     assert_int_equal(result.identification, PMSTEP_IDENT_FRICTION_NEGATIVE);
     assert_true(result.friction_Nms_rad < 0.0f && model.friction_Nms_rad == 0.0f);
-    /* J three times the configured one: implausible, reported, not used. */
+    /* J four times the configured one (a load of three rotors): plausible, used. */
     model = pmstep_configured_electrical(&cfg);
     model.torque_constant_Nm_A = k_m;
-    sums = synthetic(16000u, 0.05f, 3.0f * 1.2f * j / k_m, 1e-4f / k_m, 0.0f);
+    sums = synthetic(16000u, 0.05f, 4.0f * 1.2f * j / k_m, 1e-4f / k_m, 0.0f);
+    assert_true(pmstep_identify_finish(&sums, &cfg, &model, &result));
+    assert_int_equal(result.identification, PMSTEP_IDENT_DONE);
+    assert_float_equal(model.inertia_kgm2, 4.8f * j, 4.8f * j * 1e-3f);
+    /* J beyond PMSTEP_IDENTIFICATION_INERTIA_RANGE either way of the configured one: implausible,
+     * reported, not used. */
+    model = pmstep_configured_electrical(&cfg);
+    model.torque_constant_Nm_A = k_m;
+    sums = synthetic(16000u, 0.05f, 11.0f * 1.2f * j / k_m, 1e-4f / k_m, 0.0f);
     assert_false(pmstep_identify_finish(&sums, &cfg, &model, &result));
     assert_int_equal(result.identification, PMSTEP_IDENT_IMPLAUSIBLE);
-    assert_float_equal(result.inertia_kgm2, 3.6f * j, 3.6f * j * 1e-3f);
+    assert_float_equal(result.inertia_kgm2, 13.2f * j, 13.2f * j * 1e-3f);
+    assert_true(model.inertia_kgm2 == cfg.motor.inertia_kgm2);
+    sums = synthetic(16000u, 0.05f, 0.09f * 1.2f * j / k_m, 1e-4f / k_m, 0.0f);
+    assert_false(pmstep_identify_finish(&sums, &cfg, &model, &result));
+    assert_int_equal(result.identification, PMSTEP_IDENT_IMPLAUSIBLE);
     assert_true(model.inertia_kgm2 == cfg.motor.inertia_kgm2);
     /* F/J at the control rate, and a sum that is not finite: implausible. */
     sums = synthetic(16000u, 0.05f, j / k_m, j / PERIOD_S / k_m, 0.0f);

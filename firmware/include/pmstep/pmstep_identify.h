@@ -31,6 +31,14 @@
 extern "C" {
 #endif
 
+/** Identification of J and F: an identified J within [1/this, this] x the configured one is
+ *  plausible (PMSTEP_IDENT_IMPLAUSIBLE beyond). The configured J may be the rotor's alone, or the
+ *  designer's estimate from the holding torque (within 2x of the rotor's), while the shaft carries
+ *  a load: a printer's belt carriage reflects several times a NEMA 17 rotor's inertia. The range
+ *  is the designer's own for a datasheet J (pmstep_design_check_datasheet(): 1/10 to 10 x its
+ *  estimate). */
+#define PMSTEP_IDENTIFICATION_INERTIA_RANGE 10.0f
+
 /** Sums of the normal equations of the fit y = c_0 + c_a a + c_w w (a = w*', w = w*, y = i_q). */
 typedef struct {
     float n;                  /**< samples */
@@ -76,8 +84,9 @@ bool pmstep_identify_solve(const pmstep_identify_sums_t *sums, float min_determi
  * At the end of the window: J and F from the fit of i_q, with the k_M of @p model (the model RUN
  * uses), judged against the configured J of @p cfg and its control period. Writes
  * result->inertia_kgm2, friction_Nms_rad and identification (PMSTEP_IDENT_DONE,
- * _FRICTION_NEGATIVE, _POOR_EXCITATION or _IMPLAUSIBLE: J outside [1/2, 2] x the configured
- * one, or |F|/J T_s >= 1/2, which also catches J or F not finite; see pmstep_identification_t).
+ * _FRICTION_NEGATIVE, _POOR_EXCITATION or _IMPLAUSIBLE: J outside PMSTEP_IDENTIFICATION_INERTIA_RANGE
+ * of the configured one, or |F|/J T_s >= 1/2, which also catches J or F not finite; see
+ * pmstep_identification_t).
  * When J is usable, puts J and F (0 for F < 0) into @p model.
  * @return true when @p model was updated and cfg->commissioning.use_identified_mechanics asks
  *         for it to be used.
