@@ -26,7 +26,6 @@ typedef struct {
 
 #define SIGN_RULE(field, sign, status) {(unsigned char)offsetof(pmstep_config_t, field), sign, (signed char)(status)}
 
-
 /* The float at @p rule's offset. */
 static float rule_value(const pmstep_config_t *cfg, const sign_rule_t *rule)
 {
@@ -35,64 +34,66 @@ static float rule_value(const pmstep_config_t *cfg, const sign_rule_t *rule)
     return value;
 }
 
+/* Every float setting of the configuration with its sign and the code of a wrong one. */
+static const sign_rule_t sign_rules[] = {
+    SIGN_RULE(motor.resistance_Ohm, SIGN_POSITIVE, PMSTEP_ERR_RESISTANCE),
+    SIGN_RULE(motor.inductance_H, SIGN_POSITIVE, PMSTEP_ERR_INDUCTANCE),
+    SIGN_RULE(motor.inertia_kgm2, SIGN_POSITIVE, PMSTEP_ERR_INERTIA),
+    SIGN_RULE(motor.torque_constant_Nm_A, SIGN_POSITIVE, PMSTEP_ERR_TORQUE_CONSTANT),
+    SIGN_RULE(motor.friction_Nms_rad, SIGN_NON_NEGATIVE, PMSTEP_ERR_FRICTION),
+    SIGN_RULE(motor.detent_torque_Nm, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETENT_TORQUE),
+    SIGN_RULE(motor.rated_current_A, SIGN_POSITIVE, PMSTEP_ERR_RATED_CURRENT),
+    SIGN_RULE(gains.speed_gain_per_s, SIGN_POSITIVE, PMSTEP_ERR_SPEED_GAIN),
+    SIGN_RULE(gains.observer_gain_per_s, SIGN_POSITIVE, PMSTEP_ERR_OBSERVER_GAIN),
+    SIGN_RULE(gains.current_gain_per_s, SIGN_POSITIVE, PMSTEP_ERR_CURRENT_GAIN),
+    SIGN_RULE(gains.adapt_gamma, SIGN_POSITIVE, PMSTEP_ERR_ADAPT_GAMMA),
+    SIGN_RULE(gains.adapt_lambda, SIGN_POSITIVE, PMSTEP_ERR_ADAPT_LAMBDA),
+    SIGN_RULE(gains.adapt_r, SIGN_POSITIVE, PMSTEP_ERR_ADAPT_R),
+    SIGN_RULE(gains.sat_kappa_rad_s, SIGN_POSITIVE, PMSTEP_ERR_SAT_KAPPA),
+    SIGN_RULE(gains.reference_bandwidth_rad_s, SIGN_POSITIVE, PMSTEP_ERR_REFERENCE_BANDWIDTH),
+    SIGN_RULE(gains.angle_correction_gain_per_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_ANGLE_CORRECTION_GAIN),
+    SIGN_RULE(gains.current_integral_gain_per_s2, SIGN_NON_NEGATIVE, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN),
+    SIGN_RULE(gains.current_integral_gain_q_per_s2, SIGN_NON_NEGATIVE, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN),
+    SIGN_RULE(gains.detent_fade_speed_rad_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETENT_FADE_SPEED),
+    SIGN_RULE(gains.emf_angle_gain_per_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_EMF_ANGLE_GAIN),
+    SIGN_RULE(gains.emf_angle_corner_rad_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_EMF_ANGLE_GAIN),
+    SIGN_RULE(gains.angle_smoothing, SIGN_NON_NEGATIVE, PMSTEP_ERR_ANGLE_SMOOTHING),
+    SIGN_RULE(gains.transient_observer_boost, SIGN_NON_NEGATIVE, PMSTEP_ERR_OBSERVER_BOOST),
+    SIGN_RULE(limits.max_phase_current_A, SIGN_POSITIVE, PMSTEP_ERR_MAX_CURRENT),
+    SIGN_RULE(limits.min_bus_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_MIN_BUS),
+    SIGN_RULE(limits.current_sense_range_A, SIGN_POSITIVE, PMSTEP_ERR_SENSE_RANGE),
+    SIGN_RULE(limits.bus_sense_range_V, SIGN_POSITIVE, PMSTEP_ERR_SENSE_RANGE),
+    SIGN_RULE(alignment.s_align_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_ALIGNMENT_VOLTAGE),
+    SIGN_RULE(alignment.c_align_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_ALIGNMENT_VOLTAGE),
+    SIGN_RULE(alignment.s_lead_in_time_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_S_LEAD_IN_TIME),
+    SIGN_RULE(commissioning.offset_calibration_time_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_OFFSET_CALIBRATION_TIME),
+    SIGN_RULE(commissioning.steady_state_window_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_STEADY_STATE_WINDOW),
+    SIGN_RULE(commissioning.inductance_window_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_INDUCTANCE_WINDOW),
+    SIGN_RULE(commissioning.voltage_bias_level_fraction, SIGN_NON_NEGATIVE, PMSTEP_ERR_VOLTAGE_BIAS_FRACTION),
+    SIGN_RULE(commissioning.identification_time_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_IDENTIFICATION_WINDOW),
+    SIGN_RULE(commissioning.identification_min_speed_rad_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_IDENTIFICATION_SPEED),
+    SIGN_RULE(inverter.dead_time_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DEAD_TIME),
+    SIGN_RULE(inverter.dead_time_current_band_A, SIGN_NON_NEGATIVE, PMSTEP_ERR_DEAD_TIME_BAND),
+    SIGN_RULE(detection.angle_magnitude_bound, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_BOUND),
+    SIGN_RULE(detection.speed_consistency_bound_rad_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_BOUND),
+    SIGN_RULE(detection.stall_speed_error_rad_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_BOUND),
+    SIGN_RULE(detection.observer_residual_bound_A, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_BOUND),
+    SIGN_RULE(detection.persistence_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_TIME),
+    SIGN_RULE(field_weakening.max_current_A, SIGN_NON_NEGATIVE, PMSTEP_ERR_FIELD_WEAKENING),
+    /* Checked by range below. */
+    SIGN_RULE(timing.period_s, SIGN_ANY, PMSTEP_OK),
+    SIGN_RULE(alignment.s_align_time_s, SIGN_ANY, PMSTEP_OK),
+    SIGN_RULE(alignment.c_align_time_s, SIGN_ANY, PMSTEP_OK),
+    SIGN_RULE(limits.max_bus_voltage_V, SIGN_ANY, PMSTEP_OK),
+    SIGN_RULE(standstill.hold_current_A, SIGN_ANY, PMSTEP_OK), /* its code is below a signed char's range */
+    SIGN_RULE(standstill.vector_speed_rad_s, SIGN_ANY, PMSTEP_OK), /* so is this one's */
+    SIGN_RULE(field_weakening.modulation, SIGN_ANY, PMSTEP_OK),
+    SIGN_RULE(field_weakening.gain_A_per_s, SIGN_ANY, PMSTEP_OK),
+};
+
 /* Every float finite first (whatever its place), then the signs in table order. */
 static pmstep_status_t validate_signs(const pmstep_config_t *cfg)
 {
-    static const sign_rule_t sign_rules[] = {
-        SIGN_RULE(motor.resistance_Ohm, SIGN_POSITIVE, PMSTEP_ERR_RESISTANCE),
-        SIGN_RULE(motor.inductance_H, SIGN_POSITIVE, PMSTEP_ERR_INDUCTANCE),
-        SIGN_RULE(motor.inertia_kgm2, SIGN_POSITIVE, PMSTEP_ERR_INERTIA),
-        SIGN_RULE(motor.torque_constant_Nm_A, SIGN_POSITIVE, PMSTEP_ERR_TORQUE_CONSTANT),
-        SIGN_RULE(motor.friction_Nms_rad, SIGN_NON_NEGATIVE, PMSTEP_ERR_FRICTION),
-        SIGN_RULE(motor.detent_torque_Nm, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETENT_TORQUE),
-        SIGN_RULE(motor.rated_current_A, SIGN_POSITIVE, PMSTEP_ERR_RATED_CURRENT),
-        SIGN_RULE(gains.speed_gain_per_s, SIGN_POSITIVE, PMSTEP_ERR_SPEED_GAIN),
-        SIGN_RULE(gains.observer_gain_per_s, SIGN_POSITIVE, PMSTEP_ERR_OBSERVER_GAIN),
-        SIGN_RULE(gains.current_gain_per_s, SIGN_POSITIVE, PMSTEP_ERR_CURRENT_GAIN),
-        SIGN_RULE(gains.adapt_gamma, SIGN_POSITIVE, PMSTEP_ERR_ADAPT_GAMMA),
-        SIGN_RULE(gains.adapt_lambda, SIGN_POSITIVE, PMSTEP_ERR_ADAPT_LAMBDA),
-        SIGN_RULE(gains.adapt_r, SIGN_POSITIVE, PMSTEP_ERR_ADAPT_R),
-        SIGN_RULE(gains.sat_kappa_rad_s, SIGN_POSITIVE, PMSTEP_ERR_SAT_KAPPA),
-        SIGN_RULE(gains.reference_bandwidth_rad_s, SIGN_POSITIVE, PMSTEP_ERR_REFERENCE_BANDWIDTH),
-        SIGN_RULE(gains.angle_correction_gain_per_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_ANGLE_CORRECTION_GAIN),
-        SIGN_RULE(gains.current_integral_gain_per_s2, SIGN_NON_NEGATIVE, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN),
-        SIGN_RULE(gains.current_integral_gain_q_per_s2, SIGN_NON_NEGATIVE, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN),
-        SIGN_RULE(gains.detent_fade_speed_rad_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETENT_FADE_SPEED),
-        SIGN_RULE(gains.emf_angle_gain_per_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_EMF_ANGLE_GAIN),
-        SIGN_RULE(gains.emf_angle_corner_rad_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_EMF_ANGLE_GAIN),
-        SIGN_RULE(gains.angle_smoothing, SIGN_NON_NEGATIVE, PMSTEP_ERR_ANGLE_SMOOTHING),
-        SIGN_RULE(gains.transient_observer_boost, SIGN_NON_NEGATIVE, PMSTEP_ERR_OBSERVER_BOOST),
-        SIGN_RULE(limits.max_phase_current_A, SIGN_POSITIVE, PMSTEP_ERR_MAX_CURRENT),
-        SIGN_RULE(limits.min_bus_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_MIN_BUS),
-        SIGN_RULE(limits.current_sense_range_A, SIGN_POSITIVE, PMSTEP_ERR_SENSE_RANGE),
-        SIGN_RULE(limits.bus_sense_range_V, SIGN_POSITIVE, PMSTEP_ERR_SENSE_RANGE),
-        SIGN_RULE(alignment.s_align_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_ALIGNMENT_VOLTAGE),
-        SIGN_RULE(alignment.c_align_voltage_V, SIGN_POSITIVE, PMSTEP_ERR_ALIGNMENT_VOLTAGE),
-        SIGN_RULE(alignment.s_lead_in_time_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_S_LEAD_IN_TIME),
-        SIGN_RULE(commissioning.offset_calibration_time_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_OFFSET_CALIBRATION_TIME),
-        SIGN_RULE(commissioning.steady_state_window_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_STEADY_STATE_WINDOW),
-        SIGN_RULE(commissioning.inductance_window_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_INDUCTANCE_WINDOW),
-        SIGN_RULE(commissioning.voltage_bias_level_fraction, SIGN_NON_NEGATIVE, PMSTEP_ERR_VOLTAGE_BIAS_FRACTION),
-        SIGN_RULE(commissioning.identification_time_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_IDENTIFICATION_WINDOW),
-        SIGN_RULE(commissioning.identification_min_speed_rad_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_IDENTIFICATION_SPEED),
-        SIGN_RULE(inverter.dead_time_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DEAD_TIME),
-        SIGN_RULE(inverter.dead_time_current_band_A, SIGN_NON_NEGATIVE, PMSTEP_ERR_DEAD_TIME_BAND),
-        SIGN_RULE(detection.angle_magnitude_bound, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_BOUND),
-        SIGN_RULE(detection.speed_consistency_bound_rad_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_BOUND),
-        SIGN_RULE(detection.stall_speed_error_rad_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_BOUND),
-        SIGN_RULE(detection.observer_residual_bound_A, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_BOUND),
-        SIGN_RULE(detection.persistence_s, SIGN_NON_NEGATIVE, PMSTEP_ERR_DETECTION_TIME),
-        SIGN_RULE(field_weakening.max_current_A, SIGN_NON_NEGATIVE, PMSTEP_ERR_FIELD_WEAKENING),
-        /* Checked by range below. */
-        SIGN_RULE(timing.period_s, SIGN_ANY, PMSTEP_OK),
-        SIGN_RULE(alignment.s_align_time_s, SIGN_ANY, PMSTEP_OK),
-        SIGN_RULE(alignment.c_align_time_s, SIGN_ANY, PMSTEP_OK),
-        SIGN_RULE(limits.max_bus_voltage_V, SIGN_ANY, PMSTEP_OK),
-        SIGN_RULE(standstill.hold_current_A, SIGN_ANY, PMSTEP_OK), /* its code is below a signed char's range */
-        SIGN_RULE(standstill.vector_speed_rad_s, SIGN_ANY, PMSTEP_OK), /* so is this one's */
-        SIGN_RULE(field_weakening.modulation, SIGN_ANY, PMSTEP_OK),
-        SIGN_RULE(field_weakening.gain_A_per_s, SIGN_ANY, PMSTEP_OK),
-    };
     size_t n;
     for (n = 0; n < sizeof sign_rules / sizeof sign_rules[0]; ++n) {
         if (!isfinite(rule_value(cfg, &sign_rules[n]))) {
