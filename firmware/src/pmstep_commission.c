@@ -283,30 +283,34 @@ static pmstep_rest_t alignment_rest(const pmstep_window_currents_t *currents, bo
     return rest;
 }
 
-COMMISSION_OUT_OF_LINE pmstep_fault_t pmstep_commission_finish(const pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
-                                        const pmstep_config_t *cfg, float i_a_A, float u_a_V,
-                                        pmstep_commissioning_t *result)
+/* What the finish's stages hand on (see pmstep_commission_finish()). */
+typedef struct {
+    float offset_a_A, offset_b_A; /* the current offsets, the alignments' samples included */
+    float r_a_Ohm, r_b_Ohm;       /* each phase's R: the configured one until the windows measure it */
+    float inductance_H;           /* the L that RUN takes: the configured one, or the measured one */
+    float drop_turn_per_A;        /* m of the drops' L (0: L not from the drops) */
+    pmstep_rest_t s_rest, c_rest; /* where the rotor rested in each alignment */
+} pmstep_finish_t;
+
+/* Offsets from every sample with a true current of 0; the result's measured values cleared. */
+static void finish_offsets(const pmstep_commission_sums_t *sums, const pmstep_config_t *cfg, pmstep_finish_t *fin,
+                           pmstep_commissioning_t *result)
 {
-    const float period_s = cfg->timing.period_s;
     const pmstep_alignment_sums_t *alignment = &sums->alignment;
-    const float offset_a = mean_or_zero(sums->zero_sum_a_A + alignment->zero_sum_a_A,
-                                        sums->zero_count_a + alignment->zero_count_a);
-    const float offset_b = mean_or_zero(sums->zero_sum_b_A + alignment->zero_sum_b_A,
-                                        sums->zero_count_b + alignment->zero_count_b);
-    const bool windows = plan->window_steps > 0u;
+    fin->offset_a_A = mean_or_zero(sums->zero_sum_a_A + alignment->zero_sum_a_A,
+                                   sums->zero_count_a + alignment->zero_count_a);
+    fin->offset_b_A = mean_or_zero(sums->zero_sum_b_A + alignment->zero_sum_b_A,
+                                   sums->zero_count_b + alignment->zero_count_b);
     /* Both phases start at the configured R on purpose; each is then measured apart. */
     /* cppcheck-suppress duplicateAssignExpression ; the same start value for both phases, intended */
-    float r_a = cfg->motor.resistance_Ohm;
-    float r_b = cfg->motor.resistance_Ohm;
-    float inductance_H = cfg->motor.inductance_H;
-    const float n_full = (float)plan->window_steps;
-    const float n_low = (float)(plan->window_steps / 2u);
-    pmstep_rest_t s_rest = {0.0f, 1.0f, 0.0f, 1.0f};
-    pmstep_rest_t c_rest = {1.0f, 0.0f, 1.0f, 0.0f};
-    float drop_turn_per_A = 0.0f; /* m of the drops' L (0: L not from the drops) */
-
-    result->offset_a_A = offset_a;
-    result->offset_b_A = offset_b;
+    fin->r_a_Ohm = cfg->motor.resistance_Ohm;
+    fin->r_b_Ohm = cfg->motor.resistance_Ohm;
+    fin->inductance_H = cfg->motor.inductance_H;
+    fin->drop_turn_per_A = 0.0f;
+    fin->s_rest = (pmstep_rest_t){0.0f, 1.0f, 0.0f, 1.0f};
+    fin->c_rest = (pmstep_rest_t){1.0f, 0.0f, 1.0f, 0.0f};
+    result->offset_a_A = fin->offset_a_A;
+    result->offset_b_A = fin->offset_b_A;
     result->offset_samples = sums->zero_count_a + sums->zero_count_b + alignment->zero_count_a
                              + alignment->zero_count_b;
     result->resistance_Ohm = 0.0f;
@@ -318,97 +322,149 @@ COMMISSION_OUT_OF_LINE pmstep_fault_t pmstep_commission_finish(const pmstep_comm
     result->voltage_bias_a_V = 0.0f;
     result->voltage_bias_b_V = 0.0f;
     result->measured = true;
-    if (windows && plan->bias_estimation) {
-        /* Two steady states per phase: R and the voltage bias. */
-        r_b = two_level_resistance(alignment->s_full.voltage_sum_V / n_full,
-                                   alignment->s_full.current_sum_A / n_full - offset_b,
-                                   alignment->s_low.voltage_sum_V / n_low,
-                                   alignment->s_low.current_sum_A / n_low - offset_b, &result->voltage_bias_b_V);
-        r_a = two_level_resistance(alignment->c_full.voltage_sum_V / n_full,
-                                   alignment->c_full.current_sum_A / n_full - offset_a,
-                                   alignment->c_low.voltage_sum_V / n_low,
-                                   alignment->c_low.current_sum_A / n_low - offset_a, &result->voltage_bias_a_V);
-    } else if (windows) {
+}
+
+/* Each phase's R from its steady states: two levels give R and the voltage bias, one level u/i. */
+static void finish_resistance(const pmstep_alignment_sums_t *alignment, const pmstep_commission_plan_t *plan,
+                              pmstep_finish_t *fin, pmstep_commissioning_t *result)
+{
+    const float n_full = (float)plan->window_steps;
+    const float n_low = (float)(plan->window_steps / 2u);
+    if (plan->bias_estimation) {
+        fin->r_b_Ohm = two_level_resistance(alignment->s_full.voltage_sum_V / n_full,
+                                            alignment->s_full.current_sum_A / n_full - fin->offset_b_A,
+                                            alignment->s_low.voltage_sum_V / n_low,
+                                            alignment->s_low.current_sum_A / n_low - fin->offset_b_A,
+                                            &result->voltage_bias_b_V);
+        fin->r_a_Ohm = two_level_resistance(alignment->c_full.voltage_sum_V / n_full,
+                                            alignment->c_full.current_sum_A / n_full - fin->offset_a_A,
+                                            alignment->c_low.voltage_sum_V / n_low,
+                                            alignment->c_low.current_sum_A / n_low - fin->offset_a_A,
+                                            &result->voltage_bias_a_V);
+    } else {
         /* Steady states of (3) and (5): R = u/i on each phase. */
-        r_b = window_resistance(alignment->s_full.voltage_sum_V, alignment->s_full.current_sum_A, plan->window_steps,
-                                offset_b);
-        r_a = window_resistance(alignment->c_full.voltage_sum_V, alignment->c_full.current_sum_A, plan->window_steps,
-                                offset_a);
+        fin->r_b_Ohm = window_resistance(alignment->s_full.voltage_sum_V, alignment->s_full.current_sum_A,
+                                         plan->window_steps, fin->offset_b_A);
+        fin->r_a_Ohm = window_resistance(alignment->c_full.voltage_sum_V, alignment->c_full.current_sum_A,
+                                         plan->window_steps, fin->offset_a_A);
     }
+}
+
+/* The phases' apparent R differ by their sensors' gains: phase b is the reference. Then where the
+ * rotor rests in each alignment. */
+static void finish_rests(const pmstep_alignment_sums_t *alignment, const pmstep_commission_plan_t *plan,
+                         const pmstep_config_t *cfg, pmstep_finish_t *fin, pmstep_commissioning_t *result)
+{
+    const float n_full = (float)plan->window_steps;
+    const float n_low = (float)(plan->window_steps / 2u);
+    const float scale_a = fin->r_a_Ohm / fin->r_b_Ohm;
+    const pmstep_window_currents_t s_currents = {
+        (alignment->s_full.undriven_sum_A / n_full - fin->offset_a_A) * scale_a,
+        alignment->s_full.current_sum_A / n_full - fin->offset_b_A,
+        (alignment->s_low.undriven_sum_A / n_low - fin->offset_a_A) * scale_a,
+        alignment->s_low.current_sum_A / n_low - fin->offset_b_A};
+    const pmstep_window_currents_t c_currents = {
+        (alignment->c_full.current_sum_A / n_full - fin->offset_a_A) * scale_a,
+        alignment->c_full.undriven_sum_A / n_full - fin->offset_b_A,
+        (alignment->c_low.current_sum_A / n_low - fin->offset_a_A) * scale_a,
+        alignment->c_low.undriven_sum_A / n_low - fin->offset_b_A};
+    result->resistance_Ohm = fin->r_b_Ohm;
+    result->phase_a_current_scale = scale_a;
+    fin->s_rest = alignment_rest(&s_currents, plan->bias_estimation, &cfg->motor, 0.0f, 1.0f);
+    fin->c_rest = alignment_rest(&c_currents, plan->bias_estimation, &cfg->motor, 1.0f, 0.0f);
+    result->equilibrium_cos = fin->c_rest.cos_end;
+    result->equilibrium_sin = fin->c_rest.sin_end;
+}
+
+/* L from the drops (see the header), over the step between the steady states' means: phase b's,
+ * and phase a's on phase b's scale (a's current is scaled by r_a / r_b in RUN, so its apparent L
+ * is divided by that). The rotor follows its equilibrium down, so each drop's flux also holds
+ * k_M / p times the change of the driven phase's flux direction (sin on b, cos on a):
+ * L = L_0 - (k_M / p) m, L_0 here, m's share once k_M is known (finish_torque_constant()). */
+static void finish_drop_inductance(const pmstep_alignment_sums_t *alignment, const pmstep_commission_plan_t *plan,
+                                   float period_s, pmstep_finish_t *fin, pmstep_commissioning_t *result)
+{
+    const float n_full = (float)plan->window_steps;
+    const float n_low = (float)(plan->window_steps / 2u);
+    const float step_b_A = alignment->s_low.current_sum_A / n_low - alignment->s_full.current_sum_A / n_full;
+    const float step_a_A = (alignment->c_low.current_sum_A / n_low - alignment->c_full.current_sum_A / n_full)
+                           * result->phase_a_current_scale;
+    result->inductance_H = 0.5f * (window_flux(&alignment->s_drop, plan->window_steps, fin->offset_b_A,
+                                               fin->r_b_Ohm, result->voltage_bias_b_V, period_s)
+                                       / step_b_A
+                                   + window_flux(&alignment->c_drop, plan->window_steps, fin->offset_a_A,
+                                                 fin->r_a_Ohm, result->voltage_bias_a_V, period_s)
+                                         / step_a_A);
+    fin->drop_turn_per_A = 0.5f * ((fin->s_rest.sin_end - fin->s_rest.sin_full) / step_b_A
+                                   + (fin->c_rest.cos_end - fin->c_rest.cos_full) / step_a_A);
+}
+
+/* Flux swing of c-alignment (see the header), samples from the first with phase a's current not
+ * negative (t_s, or a few periods later) to t_c, on the driven phase a: its current then rises from
+ * there and stays far from zero, so its voltage is known (bias included). The rotor turns from its
+ * rest at t_s to its rest at t_c:
+ * F = L delta i_a + (k_M / p) (cos(p theta_c) - cos(p theta_s)), delta i_a on phase b's scale, L the
+ * one RUN takes (the drops' L_0 - (k_M / p) m: solved with k_M). */
+static void finish_torque_constant(const pmstep_alignment_sums_t *alignment, const pmstep_commission_plan_t *plan,
+                                   const pmstep_config_t *cfg, float i_a_A, float u_a_V, pmstep_finish_t *fin,
+                                   pmstep_commissioning_t *result)
+{
+    const float run_turn_per_A = cfg->commissioning.use_measured_inductance ? fin->drop_turn_per_A : 0.0f;
+    pmstep_flux_sums_t swing = alignment->swing;
+    float step_a_A;
+    float flux_per_pole_pair;
+    add_flux_sample(&swing, false, i_a_A, u_a_V); /* t_c's sample closes it */
+    step_a_A = result->phase_a_current_scale * (swing.end_A - swing.start_A);
+    flux_per_pole_pair = (window_flux(&swing, plan->c_align_end_step - alignment->swing_start_step,
+                                      fin->offset_a_A, fin->r_a_Ohm, result->voltage_bias_a_V, cfg->timing.period_s)
+                          - fin->inductance_H * step_a_A)
+                         / (fin->c_rest.cos_end - fin->s_rest.cos_end - run_turn_per_A * step_a_A);
+    result->torque_constant_Nm_A = flux_per_pole_pair * (float)cfg->motor.pole_pairs;
+    result->inductance_H -= flux_per_pole_pair * fin->drop_turn_per_A;
+    fin->inductance_H -= flux_per_pole_pair * run_turn_per_A;
+}
+
+/* The measured R of both phases, k_M, and the L that RUN takes, each within [1/2, 2] x its
+ * configured value (see plausible()). */
+static bool finish_plausible(bool windows, const pmstep_config_t *cfg, const pmstep_finish_t *fin,
+                             const pmstep_commissioning_t *result)
+{
+    return (!windows
+            || (plausible(fin->r_a_Ohm, cfg->motor.resistance_Ohm) && plausible(fin->r_b_Ohm, cfg->motor.resistance_Ohm)
+                && plausible(result->torque_constant_Nm_A, cfg->motor.torque_constant_Nm_A)))
+           && (!cfg->commissioning.use_measured_inductance || plausible(fin->inductance_H, cfg->motor.inductance_H));
+}
+
+COMMISSION_OUT_OF_LINE pmstep_fault_t pmstep_commission_finish(const pmstep_commission_sums_t *sums,
+                                                               const pmstep_commission_plan_t *plan,
+                                                               const pmstep_config_t *cfg, float i_a_A, float u_a_V,
+                                                               pmstep_commissioning_t *result)
+{
+    const pmstep_alignment_sums_t *alignment = &sums->alignment;
+    const bool windows = plan->window_steps > 0u;
+    pmstep_finish_t fin;
+    finish_offsets(sums, cfg, &fin, result);
     if (windows) {
-        /* The phases' apparent R differ by their sensors' gains: phase b is the reference. Then
-         * where the rotor rests in each alignment. */
-        const float scale_a = r_a / r_b;
-        const pmstep_window_currents_t s_currents = {
-            (alignment->s_full.undriven_sum_A / n_full - offset_a) * scale_a,
-            alignment->s_full.current_sum_A / n_full - offset_b,
-            (alignment->s_low.undriven_sum_A / n_low - offset_a) * scale_a,
-            alignment->s_low.current_sum_A / n_low - offset_b};
-        const pmstep_window_currents_t c_currents = {
-            (alignment->c_full.current_sum_A / n_full - offset_a) * scale_a,
-            alignment->c_full.undriven_sum_A / n_full - offset_b,
-            (alignment->c_low.current_sum_A / n_low - offset_a) * scale_a,
-            alignment->c_low.undriven_sum_A / n_low - offset_b};
-        result->resistance_Ohm = r_b;
-        result->phase_a_current_scale = scale_a;
-        s_rest = alignment_rest(&s_currents, plan->bias_estimation, &cfg->motor, 0.0f, 1.0f);
-        c_rest = alignment_rest(&c_currents, plan->bias_estimation, &cfg->motor, 1.0f, 0.0f);
-        result->equilibrium_cos = c_rest.cos_end;
-        result->equilibrium_sin = c_rest.sin_end;
-    }
-    if (windows && plan->bias_estimation && plan->inductance_steps == 0u) {
-        /* L from the drops (see the header), over the step between the steady states' means:
-         * phase b's, and phase a's on phase b's scale (a's current is scaled by r_a / r_b in RUN,
-         * so its apparent L is divided by that). The rotor follows its equilibrium down, so each
-         * drop's flux also holds k_M / p times the change of the driven phase's flux direction
-         * (sin on b, cos on a): L = L_0 - (k_M / p) m, L_0 here, m's share once k_M is known. */
-        const float step_b_A = alignment->s_low.current_sum_A / n_low - alignment->s_full.current_sum_A / n_full;
-        const float step_a_A = (alignment->c_low.current_sum_A / n_low - alignment->c_full.current_sum_A / n_full)
-                               * result->phase_a_current_scale;
-        result->inductance_H = 0.5f * (window_flux(&alignment->s_drop, plan->window_steps, offset_b, r_b,
-                                                   result->voltage_bias_b_V, period_s) / step_b_A
-                                       + window_flux(&alignment->c_drop, plan->window_steps, offset_a, r_a,
-                                                     result->voltage_bias_a_V, period_s) / step_a_A);
-        drop_turn_per_A = 0.5f * ((s_rest.sin_end - s_rest.sin_full) / step_b_A
-                                  + (c_rest.cos_end - c_rest.cos_full) / step_a_A);
+        finish_resistance(alignment, plan, &fin, result);
+        finish_rests(alignment, plan, cfg, &fin, result);
+        if (plan->bias_estimation && plan->inductance_steps == 0u) {
+            finish_drop_inductance(alignment, plan, cfg->timing.period_s, &fin, result);
+        }
     }
     if (plan->inductance_steps > 0u) {
         /* L delta i = integral(u - R i) over the rise; the rotor has not moved yet. */
-        result->inductance_H = window_flux(&alignment->rise, plan->inductance_steps, offset_b, r_b,
-                                           result->voltage_bias_b_V, period_s)
+        result->inductance_H = window_flux(&alignment->rise, plan->inductance_steps, fin.offset_b_A, fin.r_b_Ohm,
+                                           result->voltage_bias_b_V, cfg->timing.period_s)
                                / (alignment->rise.end_A - alignment->rise.start_A);
     }
     if (cfg->commissioning.use_measured_inductance) {
-        inductance_H = result->inductance_H;
+        fin.inductance_H = result->inductance_H;
     }
     if (windows && (alignment->swing_start_step > 0u)) {
-        /* Flux swing of c-alignment (see the header), samples from the first with phase a's
-         * current not negative (t_s, or a few periods later) to t_c, on the driven phase a: its
-         * current then rises from there and stays far from zero, so its voltage is known (bias
-         * included). The rotor turns from its rest at t_s to its rest at t_c:
-         * F = L delta i_a + (k_M / p) (cos(p theta_c) - cos(p theta_s)), delta i_a on phase b's
-         * scale, L the one RUN takes (the drops' L_0 - (k_M / p) m: solved with k_M). */
-        const float run_turn_per_A = cfg->commissioning.use_measured_inductance ? drop_turn_per_A : 0.0f;
-        pmstep_flux_sums_t swing = alignment->swing;
-        float step_a_A;
-        float flux_per_pole_pair;
-        add_flux_sample(&swing, false, i_a_A, u_a_V); /* t_c's sample closes it */
-        step_a_A = result->phase_a_current_scale * (swing.end_A - swing.start_A);
-        flux_per_pole_pair = (window_flux(&swing, plan->c_align_end_step - alignment->swing_start_step, offset_a, r_a,
-                                          result->voltage_bias_a_V, period_s)
-                              - inductance_H * step_a_A)
-                             / (c_rest.cos_end - s_rest.cos_end - run_turn_per_A * step_a_A);
-        result->torque_constant_Nm_A = flux_per_pole_pair * (float)cfg->motor.pole_pairs;
-        result->inductance_H -= flux_per_pole_pair * drop_turn_per_A;
-        inductance_H -= flux_per_pole_pair * run_turn_per_A;
+        finish_torque_constant(alignment, plan, cfg, i_a_A, u_a_V, &fin, result);
     }
-    if (windows && !alignments_steady(alignment, plan, offset_a, offset_b)) {
+    if (windows && !alignments_steady(alignment, plan, fin.offset_a_A, fin.offset_b_A)) {
         return PMSTEP_FAULT_ALIGNMENT_MOTION;
     }
-    if ((windows && !(plausible(r_a, cfg->motor.resistance_Ohm) && plausible(r_b, cfg->motor.resistance_Ohm)
-                      && plausible(result->torque_constant_Nm_A, cfg->motor.torque_constant_Nm_A)))
-        || (cfg->commissioning.use_measured_inductance && !plausible(inductance_H, cfg->motor.inductance_H))) {
-        return PMSTEP_FAULT_COMMISSIONING;
-    }
-    return PMSTEP_FAULT_NONE;
+    return finish_plausible(windows, cfg, &fin, result) ? PMSTEP_FAULT_NONE : PMSTEP_FAULT_COMMISSIONING;
 }
