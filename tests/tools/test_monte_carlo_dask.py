@@ -10,7 +10,7 @@
 3. a folder of another campaign is refused.
 
 Needs dask.distributed (tools/requirements.txt, e.g. in .venv). Usage:
-  PMSTEP_SIL=build/host/sil/pmstep-sil .venv/bin/python -m unittest -v test_monte_carlo_dask   (from tools/)
+  PMSTEP_SIL=build/host/sil/pmstep-sil .venv/bin/python -m unittest -v test_monte_carlo_dask   (from tests/tools/)
 """
 
 import csv
@@ -24,8 +24,10 @@ import tempfile
 import time
 import unittest
 
-TOOLS = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(TOOLS)
+import tools_path
+
+TOOLS = tools_path.TOOLS
+ROOT = tools_path.ROOT
 SCRIPT = os.path.join(TOOLS, "monte_carlo.py")
 SCENARIO = os.path.join(ROOT, "sil", "scenarios", "robust.ini")
 CASES = 8

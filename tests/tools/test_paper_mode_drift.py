@@ -3,6 +3,7 @@
 import math
 import unittest
 
+import tools_path  # noqa: F401  (tools/ on the import path)
 import paper_mode_drift as drift
 
 

@@ -4,8 +4,8 @@ stand-in for pmstep-tune, and one small end-to-end run against a stand-in for pm
 Python script written to a temporary folder, whose outcome per case is fixed by the case
 index). Its pure functions are test_monte_carlo.py.
 
-Usage: python3 -m unittest -v test_monte_carlo_runs     (from tools/)
-       python3 tools/test_monte_carlo_runs.py           (from anywhere)
+Usage: python3 -m unittest -v test_monte_carlo_runs     (from tests/tools/)
+       python3 tests/tools/test_monte_carlo_runs.py           (from anywhere)
 """
 
 import csv
@@ -18,12 +18,12 @@ import tempfile
 import textwrap
 import unittest
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import monte_carlo as mc  # noqa: E402  (after the path is set)
-import mc_preset  # noqa: E402
+import tools_path  # tools/ on the import path
+import monte_carlo as mc
+import mc_preset
 
-SCRIPT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "monte_carlo.py")
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SCRIPT = os.path.join(tools_path.TOOLS, "monte_carlo.py")
+ROOT = tools_path.ROOT
 PRESET_17HS = os.path.join(ROOT, "sil", "scenarios", "motors", "17hs4401.ini")
 
 FAKE_TUNE = textwrap.dedent('''\

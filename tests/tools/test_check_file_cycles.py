@@ -5,6 +5,7 @@ allowance of a known one. Standard library only; nm is not run."""
 import io
 import unittest
 
+import tools_path  # noqa: F401  (tools/ on the import path)
 import check_file_cycles as cfc
 
 NM_TEXT = """\

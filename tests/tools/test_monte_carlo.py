@@ -4,17 +4,15 @@ each case's classification and metrics, and the campaign's statistics. The tool 
 (--preset against a stand-in pmstep-tune, and a small campaign against a stand-in pmstep-sil)
 is test_monte_carlo_runs.py.
 
-Usage: python3 -m unittest -v test_monte_carlo     (from tools/)
-       python3 tools/test_monte_carlo.py           (from anywhere)
+Usage: python3 -m unittest -v test_monte_carlo     (from tests/tools/)
+       python3 tests/tools/test_monte_carlo.py           (from anywhere)
 """
 
-import os
-import sys
 import textwrap
 import unittest
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import monte_carlo as mc  # noqa: E402  (after the path is set)
+import tools_path  # noqa: F401  (tools/ on the import path)
+import monte_carlo as mc
 
 
 def summary(

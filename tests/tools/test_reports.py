@@ -14,6 +14,7 @@ import tempfile
 import unittest
 from unittest import mock
 
+import tools_path  # noqa: F401  (tools/ on the import path)
 import bench_position_target
 import bench_sil
 import bench_target

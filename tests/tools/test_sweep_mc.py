@@ -4,6 +4,7 @@ Standard library only; no campaign is run."""
 
 import unittest
 
+import tools_path  # noqa: F401  (tools/ on the import path)
 import sweep_mc
 
 

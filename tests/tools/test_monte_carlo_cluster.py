@@ -10,7 +10,7 @@ a module of these tools (it did: "No module named 'mc_execution'" on the schedul
 Needs dask.distributed (tools/requirements.txt, e.g. in .venv; its `dask` command beside the
 Python running this) and the real pmstep-sil: $PMSTEP_SIL, else build/host-release/sil/pmstep-sil
 or build/host/sil/pmstep-sil. Usage:
-  PMSTEP_SIL=build/host/sil/pmstep-sil .venv/bin/python -m unittest -v test_monte_carlo_cluster   (from tools/)
+  PMSTEP_SIL=build/host/sil/pmstep-sil .venv/bin/python -m unittest -v test_monte_carlo_cluster   (from tests/tools/)
 """
 
 import glob
@@ -23,8 +23,10 @@ import tempfile
 import time
 import unittest
 
-TOOLS = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(TOOLS)
+import tools_path
+
+TOOLS = tools_path.TOOLS
+ROOT = tools_path.ROOT
 SCRIPT = os.path.join(TOOLS, "monte_carlo.py")
 SCENARIO = os.path.join(ROOT, "sil", "scenarios", "robust.ini")
 CASES = 4

@@ -15,9 +15,10 @@ import tempfile
 import unittest
 from pathlib import Path
 
+import tools_path  # tools/ on the import path
 import gen_reference as gen
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(tools_path.ROOT)
 GEN = ROOT / "tools" / "gen_reference.py"
 
 
