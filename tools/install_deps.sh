@@ -15,6 +15,7 @@ packages=(
   clang llvm                               # libFuzzer harnesses (tests/fuzz), llvm-cov for their coverage
   frama-c-base                             # proof of absence of runtime errors (Frama-C EVA, tests/eva)
   cppcheck                                 # static analysis and the MISRA C:2012 addon (tests/static)
+  clang-format-14                          # the C sources' format (.clang-format; ctest static.clang_format): one major, one output
   doxygen                                  # C API reference of the public headers (docs/Doxyfile, tools/build_docs.sh)
   chromium                                 # headless screenshots of the built documentation site (tests/docs: docs.render)
   "$@"

@@ -70,10 +70,10 @@ bool pmstep_actuate(pmstep_actuator_t *actuator, const pmstep_actuate_coeffs_t *
     float next_a_V;
     float next_b_V;
     if (coeffs->compensate) {
-        dead_time_a_V = dead_time_voltage(coeffs, compensation->sign_current_a_A, bus_voltage_V,
-                                          compensation->bias_a_V);
-        dead_time_b_V = dead_time_voltage(coeffs, compensation->sign_current_b_A, bus_voltage_V,
-                                          compensation->bias_b_V);
+        dead_time_a_V =
+            dead_time_voltage(coeffs, compensation->sign_current_a_A, bus_voltage_V, compensation->bias_a_V);
+        dead_time_b_V =
+            dead_time_voltage(coeffs, compensation->sign_current_b_A, bus_voltage_V, compensation->bias_b_V);
         /* The compensation goes down the delay line beside its voltage (a non-finite one latches
          * a fault, and the line is cleared before the bridge is on again). */
         if (!coeffs->delayed) {
@@ -137,18 +137,16 @@ float pmstep_actuate_sign_threshold(const pmstep_actuate_coeffs_t *coeffs, float
 }
 
 void pmstep_actuate_voltage_over_period(const pmstep_actuator_t *actuator, const pmstep_actuate_coeffs_t *coeffs,
-                                        const pmstep_period_currents_t *currents, float bus_voltage_V,
-                                        float *u_a_V, float *u_b_V)
+                                        const pmstep_period_currents_t *currents, float bus_voltage_V, float *u_a_V,
+                                        float *u_b_V)
 {
     const float threshold_A = pmstep_actuate_sign_threshold(coeffs, bus_voltage_V);
     const float dead_V = coeffs->dead_time_duty * bus_voltage_V;
     const float switching_limit_V = bus_voltage_V - dead_V;
-    *u_a_V = phase_voltage_over_period(actuator->u_applied_a_V, actuator->compensation_applied_a_V,
-                                       dead_V + currents->bias_a_V,
-                                       certain_sign(currents->i_start_a_A, currents->i_end_a_A, threshold_A),
-                                       switching_limit_V);
-    *u_b_V = phase_voltage_over_period(actuator->u_applied_b_V, actuator->compensation_applied_b_V,
-                                       dead_V + currents->bias_b_V,
-                                       certain_sign(currents->i_start_b_A, currents->i_end_b_A, threshold_A),
-                                       switching_limit_V);
+    *u_a_V = phase_voltage_over_period(
+        actuator->u_applied_a_V, actuator->compensation_applied_a_V, dead_V + currents->bias_a_V,
+        certain_sign(currents->i_start_a_A, currents->i_end_a_A, threshold_A), switching_limit_V);
+    *u_b_V = phase_voltage_over_period(
+        actuator->u_applied_b_V, actuator->compensation_applied_b_V, dead_V + currents->bias_b_V,
+        certain_sign(currents->i_start_b_A, currents->i_end_b_A, threshold_A), switching_limit_V);
 }

@@ -39,8 +39,8 @@ static void compensated_add(float *sum, float *compensation, float increment)
     *sum = total;
 }
 
-void pmstep_angle_update(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs,
-                         float i_a_A, float i_b_A, float u_a_V, float u_b_V)
+void pmstep_angle_update(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs, float i_a_A, float i_b_A,
+                         float u_a_V, float u_b_V)
 {
     /* phi' = -(R/L) i + u/L over one period: u held (exact), i by the trapezoid rule. */
     const float increment_a = coeffs->voltage_gain * u_a_V - coeffs->current_gain * (angle->i_a_prev_A + i_a_A);
@@ -51,8 +51,8 @@ void pmstep_angle_update(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coe
     angle->i_b_prev_A = i_b_A;
 }
 
-void pmstep_angle_estimate(const pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs,
-                           float i_a_A, float i_b_A, float *cos_hat, float *sin_hat)
+void pmstep_angle_estimate(const pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs, float i_a_A, float i_b_A,
+                           float *cos_hat, float *sin_hat)
 {
     const float flux_a = (i_a_A - angle->i_a_start_A) - (angle->phi_a - angle->phi_a_compensation);
     const float flux_b = (i_b_A - angle->i_b_start_A) - (angle->phi_b - angle->phi_b_compensation);
@@ -67,8 +67,8 @@ void pmstep_angle_correct(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *co
     compensated_add(&angle->phi_b, &angle->phi_b_compensation, radial_step * sin_hat);
 }
 
-void pmstep_angle_follow_emf(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs, float cos_hat,
-                             float sin_hat, float i_d_residual_A, float speed_hat_rad_s)
+void pmstep_angle_follow_emf(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs, float cos_hat, float sin_hat,
+                             float i_d_residual_A, float speed_hat_rad_s)
 {
     /* the turn -K_theta T_s delta-hat, over flux_to_angle: phi's step along (-s-hat, c-hat). Plain sums:
      * the correction's own loop takes up their round-off. */
@@ -84,8 +84,7 @@ void pmstep_angle_smoother_set(pmstep_angle_smoother_t *smoother, float cos_hat,
     smoother->sin_hat = sin_hat;
 }
 
-void pmstep_angle_smooth(float share, float turn_rad, pmstep_angle_smoother_t *smoother, float *cos_hat,
-                         float *sin_hat)
+void pmstep_angle_smooth(float share, float turn_rad, pmstep_angle_smoother_t *smoother, float *cos_hat, float *sin_hat)
 {
     float cos_turn;
     float sin_turn;

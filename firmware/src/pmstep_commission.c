@@ -91,9 +91,8 @@ static void add_window_sample(pmstep_window_sums_t *sums, uint32_t sample, uint3
 
 /* The samples of an alignment ending at @p end, phase @p driven driven: its steady-state windows,
  * the undriven phase's offset at the full level's, the drop to the lower level. */
-static void add_alignment_sample(pmstep_alignment_sums_t *sums, const pmstep_commission_plan_t *plan,
-                                 uint32_t sample, uint32_t end, bool phase_b_driven, float driven_A,
-                                 float voltage_V, float undriven_A)
+static void add_alignment_sample(pmstep_alignment_sums_t *sums, const pmstep_commission_plan_t *plan, uint32_t sample,
+                                 uint32_t end, bool phase_b_driven, float driven_A, float voltage_V, float undriven_A)
 {
     pmstep_window_sums_t *full = phase_b_driven ? &sums->s_full : &sums->c_full;
     pmstep_window_sums_t *low = phase_b_driven ? &sums->s_low : &sums->c_low;
@@ -115,9 +114,10 @@ static void add_alignment_sample(pmstep_alignment_sums_t *sums, const pmstep_com
     add_drop_sample(phase_b_driven ? &sums->s_drop : &sums->c_drop, plan, sample, end, driven_A, voltage_V);
 }
 
-COMMISSION_OUT_OF_LINE void pmstep_commission_add_alignment(pmstep_commission_sums_t *sums, const pmstep_commission_plan_t *plan,
-                                     uint32_t sample, float i_a_A, float i_b_A, float u_a_V, float u_b_V,
-                                     bool u_a_known)
+COMMISSION_OUT_OF_LINE void pmstep_commission_add_alignment(pmstep_commission_sums_t *sums,
+                                                            const pmstep_commission_plan_t *plan, uint32_t sample,
+                                                            float i_a_A, float i_b_A, float u_a_V, float u_b_V,
+                                                            bool u_a_known)
 {
     pmstep_alignment_sums_t *alignment = &sums->alignment;
     if (sample >= plan->inductance_start_step && sample - plan->inductance_start_step <= plan->inductance_steps) {
@@ -190,8 +190,8 @@ static float two_level_resistance(float u_1, float i_1, float u_2, float i_2, fl
 static float window_flux(const pmstep_flux_sums_t *flux, uint32_t periods, float offset_A, float resistance_Ohm,
                          float bias_V, float period_s)
 {
-    const float charge_A_s = current_integral(flux->current_sum_A, flux->start_A, flux->end_A, periods, offset_A,
-                                              period_s);
+    const float charge_A_s =
+        current_integral(flux->current_sum_A, flux->start_A, flux->end_A, periods, offset_A, period_s);
     return period_s * (flux->voltage_sum_V - (float)periods * bias_V) - resistance_Ohm * charge_A_s;
 }
 
@@ -219,8 +219,8 @@ static bool alignments_steady(const pmstep_alignment_sums_t *sums, const pmstep_
     const uint32_t low_window = plan->window_steps / 2u;
     const float s_level_A = sums->s_full.current_sum_A / (float)plan->window_steps - offset_b_A;
     const float c_level_A = sums->c_full.current_sum_A / (float)plan->window_steps - offset_a_A;
-    bool all = steady(&sums->s_full, plan->window_steps, s_level_A)
-               && steady(&sums->c_full, plan->window_steps, c_level_A);
+    bool all =
+        steady(&sums->s_full, plan->window_steps, s_level_A) && steady(&sums->c_full, plan->window_steps, c_level_A);
     if (plan->bias_estimation) {
         all = all && steady(&sums->s_low, low_window, s_level_A) && steady(&sums->c_low, low_window, c_level_A);
     }
@@ -241,8 +241,8 @@ static void rest_angle(float i_a_A, float i_b_A, const pmstep_motor_config_t *mo
         const float s = *sin_io;
         const float cos_2 = c * c - s * s;
         const float sin_2 = 2.0f * c * s;
-        const float torque_Nm = motor->torque_constant_Nm_A * (i_b_A * c - i_a_A * s)
-                                - motor->detent_torque_Nm * 2.0f * sin_2 * cos_2;
+        const float torque_Nm =
+            motor->torque_constant_Nm_A * (i_b_A * c - i_a_A * s) - motor->detent_torque_Nm * 2.0f * sin_2 * cos_2;
         const float stiffness_Nm = motor->torque_constant_Nm_A * (i_a_A * c + i_b_A * s)
                                    + 4.0f * motor->detent_torque_Nm * (cos_2 * cos_2 - sin_2 * sin_2);
         const float turn = torque_Nm / stiffness_Nm;
@@ -297,10 +297,10 @@ static void finish_offsets(const pmstep_commission_sums_t *sums, const pmstep_co
                            pmstep_commissioning_t *result)
 {
     const pmstep_alignment_sums_t *alignment = &sums->alignment;
-    fin->offset_a_A = mean_or_zero(sums->zero_sum_a_A + alignment->zero_sum_a_A,
-                                   sums->zero_count_a + alignment->zero_count_a);
-    fin->offset_b_A = mean_or_zero(sums->zero_sum_b_A + alignment->zero_sum_b_A,
-                                   sums->zero_count_b + alignment->zero_count_b);
+    fin->offset_a_A =
+        mean_or_zero(sums->zero_sum_a_A + alignment->zero_sum_a_A, sums->zero_count_a + alignment->zero_count_a);
+    fin->offset_b_A =
+        mean_or_zero(sums->zero_sum_b_A + alignment->zero_sum_b_A, sums->zero_count_b + alignment->zero_count_b);
     /* Both phases start at the configured R on purpose; each is then measured apart. */
     /* cppcheck-suppress duplicateAssignExpression ; the same start value for both phases, intended */
     fin->r_a_Ohm = cfg->motor.resistance_Ohm;
@@ -311,8 +311,8 @@ static void finish_offsets(const pmstep_commission_sums_t *sums, const pmstep_co
     fin->c_rest = (pmstep_rest_t){1.0f, 0.0f, 1.0f, 0.0f};
     result->offset_a_A = fin->offset_a_A;
     result->offset_b_A = fin->offset_b_A;
-    result->offset_samples = sums->zero_count_a + sums->zero_count_b + alignment->zero_count_a
-                             + alignment->zero_count_b;
+    result->offset_samples =
+        sums->zero_count_a + sums->zero_count_b + alignment->zero_count_a + alignment->zero_count_b;
     result->resistance_Ohm = 0.0f;
     result->phase_a_current_scale = 1.0f;
     result->inductance_H = 0.0f;
@@ -331,16 +331,14 @@ static void finish_resistance(const pmstep_alignment_sums_t *alignment, const pm
     const float n_full = (float)plan->window_steps;
     const float n_low = (float)(plan->window_steps / 2u);
     if (plan->bias_estimation) {
-        fin->r_b_Ohm = two_level_resistance(alignment->s_full.voltage_sum_V / n_full,
-                                            alignment->s_full.current_sum_A / n_full - fin->offset_b_A,
-                                            alignment->s_low.voltage_sum_V / n_low,
-                                            alignment->s_low.current_sum_A / n_low - fin->offset_b_A,
-                                            &result->voltage_bias_b_V);
-        fin->r_a_Ohm = two_level_resistance(alignment->c_full.voltage_sum_V / n_full,
-                                            alignment->c_full.current_sum_A / n_full - fin->offset_a_A,
-                                            alignment->c_low.voltage_sum_V / n_low,
-                                            alignment->c_low.current_sum_A / n_low - fin->offset_a_A,
-                                            &result->voltage_bias_a_V);
+        fin->r_b_Ohm = two_level_resistance(
+            alignment->s_full.voltage_sum_V / n_full, alignment->s_full.current_sum_A / n_full - fin->offset_b_A,
+            alignment->s_low.voltage_sum_V / n_low, alignment->s_low.current_sum_A / n_low - fin->offset_b_A,
+            &result->voltage_bias_b_V);
+        fin->r_a_Ohm = two_level_resistance(
+            alignment->c_full.voltage_sum_V / n_full, alignment->c_full.current_sum_A / n_full - fin->offset_a_A,
+            alignment->c_low.voltage_sum_V / n_low, alignment->c_low.current_sum_A / n_low - fin->offset_a_A,
+            &result->voltage_bias_a_V);
     } else {
         /* Steady states of (3) and (5): R = u/i on each phase. */
         fin->r_b_Ohm = window_resistance(alignment->s_full.voltage_sum_V, alignment->s_full.current_sum_A,
@@ -358,16 +356,15 @@ static void finish_rests(const pmstep_alignment_sums_t *alignment, const pmstep_
     const float n_full = (float)plan->window_steps;
     const float n_low = (float)(plan->window_steps / 2u);
     const float scale_a = fin->r_a_Ohm / fin->r_b_Ohm;
-    const pmstep_window_currents_t s_currents = {
-        (alignment->s_full.undriven_sum_A / n_full - fin->offset_a_A) * scale_a,
-        alignment->s_full.current_sum_A / n_full - fin->offset_b_A,
-        (alignment->s_low.undriven_sum_A / n_low - fin->offset_a_A) * scale_a,
-        alignment->s_low.current_sum_A / n_low - fin->offset_b_A};
-    const pmstep_window_currents_t c_currents = {
-        (alignment->c_full.current_sum_A / n_full - fin->offset_a_A) * scale_a,
-        alignment->c_full.undriven_sum_A / n_full - fin->offset_b_A,
-        (alignment->c_low.current_sum_A / n_low - fin->offset_a_A) * scale_a,
-        alignment->c_low.undriven_sum_A / n_low - fin->offset_b_A};
+    const pmstep_window_currents_t s_currents = {(alignment->s_full.undriven_sum_A / n_full - fin->offset_a_A)
+                                                     * scale_a,
+                                                 alignment->s_full.current_sum_A / n_full - fin->offset_b_A,
+                                                 (alignment->s_low.undriven_sum_A / n_low - fin->offset_a_A) * scale_a,
+                                                 alignment->s_low.current_sum_A / n_low - fin->offset_b_A};
+    const pmstep_window_currents_t c_currents = {(alignment->c_full.current_sum_A / n_full - fin->offset_a_A) * scale_a,
+                                                 alignment->c_full.undriven_sum_A / n_full - fin->offset_b_A,
+                                                 (alignment->c_low.current_sum_A / n_low - fin->offset_a_A) * scale_a,
+                                                 alignment->c_low.undriven_sum_A / n_low - fin->offset_b_A};
     result->resistance_Ohm = fin->r_b_Ohm;
     result->phase_a_current_scale = scale_a;
     fin->s_rest = alignment_rest(&s_currents, plan->bias_estimation, &cfg->motor, 0.0f, 1.0f);
@@ -389,14 +386,16 @@ static void finish_drop_inductance(const pmstep_alignment_sums_t *alignment, con
     const float step_b_A = alignment->s_low.current_sum_A / n_low - alignment->s_full.current_sum_A / n_full;
     const float step_a_A = (alignment->c_low.current_sum_A / n_low - alignment->c_full.current_sum_A / n_full)
                            * result->phase_a_current_scale;
-    result->inductance_H = 0.5f * (window_flux(&alignment->s_drop, plan->window_steps, fin->offset_b_A,
-                                               fin->r_b_Ohm, result->voltage_bias_b_V, period_s)
-                                       / step_b_A
-                                   + window_flux(&alignment->c_drop, plan->window_steps, fin->offset_a_A,
-                                                 fin->r_a_Ohm, result->voltage_bias_a_V, period_s)
-                                         / step_a_A);
-    fin->drop_turn_per_A = 0.5f * ((fin->s_rest.sin_end - fin->s_rest.sin_full) / step_b_A
-                                   + (fin->c_rest.cos_end - fin->c_rest.cos_full) / step_a_A);
+    result->inductance_H = 0.5f
+                           * (window_flux(&alignment->s_drop, plan->window_steps, fin->offset_b_A, fin->r_b_Ohm,
+                                          result->voltage_bias_b_V, period_s)
+                                  / step_b_A
+                              + window_flux(&alignment->c_drop, plan->window_steps, fin->offset_a_A, fin->r_a_Ohm,
+                                            result->voltage_bias_a_V, period_s)
+                                    / step_a_A);
+    fin->drop_turn_per_A = 0.5f
+                           * ((fin->s_rest.sin_end - fin->s_rest.sin_full) / step_b_A
+                              + (fin->c_rest.cos_end - fin->c_rest.cos_full) / step_a_A);
 }
 
 /* Flux swing of c-alignment (see the header), samples from the first with phase a's current not
@@ -415,8 +414,8 @@ static void finish_torque_constant(const pmstep_alignment_sums_t *alignment, con
     float flux_per_pole_pair;
     add_flux_sample(&swing, false, i_a_A, u_a_V); /* t_c's sample closes it */
     step_a_A = result->phase_a_current_scale * (swing.end_A - swing.start_A);
-    flux_per_pole_pair = (window_flux(&swing, plan->c_align_end_step - alignment->swing_start_step,
-                                      fin->offset_a_A, fin->r_a_Ohm, result->voltage_bias_a_V, cfg->timing.period_s)
+    flux_per_pole_pair = (window_flux(&swing, plan->c_align_end_step - alignment->swing_start_step, fin->offset_a_A,
+                                      fin->r_a_Ohm, result->voltage_bias_a_V, cfg->timing.period_s)
                           - fin->inductance_H * step_a_A)
                          / (fin->c_rest.cos_end - fin->s_rest.cos_end - run_turn_per_A * step_a_A);
     result->torque_constant_Nm_A = flux_per_pole_pair * (float)cfg->motor.pole_pairs;

@@ -58,8 +58,8 @@ static void judge(const pmstep_continuity_sums_t *sums, float checks, float min_
     const float ref_spread = sums->ref_square_sum_A2 - ((sums->ref_sum_A * sums->ref_sum_A) / checks);
     const float read_spread = sums->read_square_sum_A2 - ((sums->read_sum_A * sums->read_sum_A) / checks);
     if (sums->ref_square_sum_A2 >= min_square_sum) {
-        *missing_windows = (sums->read_square_sum_A2 < (f2 * sums->ref_square_sum_A2)) ? (uint8_t)(*missing_windows + 1u)
-                                                                                         : 0u;
+        *missing_windows =
+            (sums->read_square_sum_A2 < (f2 * sums->ref_square_sum_A2)) ? (uint8_t)(*missing_windows + 1u) : 0u;
     }
     if (ref_spread >= min_square_sum) {
         *stuck_windows = (read_spread < (f2 * ref_spread)) ? (uint8_t)(*stuck_windows + 1u) : 0u;

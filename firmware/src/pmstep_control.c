@@ -33,8 +33,8 @@ static void start_run(pmstep_t *inst, const pmstep_meas_t *sample)
 static void sensed_period_voltage(pmstep_t *inst, const pmstep_meas_t *sample, float *u_a_V, float *u_b_V)
 {
     pmstep_sensed_voltages(inst, sample, u_a_V, u_b_V);
-    pmstep_observer_correct_voltage(&inst->observer, &inst->derived.observer_coeffs, *u_a_V - inst->actuator.u_applied_a_V,
-                                    *u_b_V - inst->actuator.u_applied_b_V);
+    pmstep_observer_correct_voltage(&inst->observer, &inst->derived.observer_coeffs,
+                                    *u_a_V - inst->actuator.u_applied_a_V, *u_b_V - inst->actuator.u_applied_b_V);
 }
 
 /* The standstill's kept rotor in place of the integrals' reading (pmstep_hold.h), and the
@@ -92,7 +92,8 @@ static void angle_of_period(pmstep_t *inst, const pmstep_meas_t *sample, float *
     pmstep_angle_estimate(&inst->angle, &inst->derived.angle_coeffs, sample->i_a_A, sample->i_b_A, cos_hat, sin_hat);
     if (inst->derived.angle_smoothing) {
         pmstep_angle_smooth(inst->cfg->gains.angle_smoothing,
-                            inst->derived.law_coeffs.pole_pairs * inst->cfg->timing.period_s * inst->observer.speed_hat_rad_s,
+                            inst->derived.law_coeffs.pole_pairs * inst->cfg->timing.period_s
+                                * inst->observer.speed_hat_rad_s,
                             &inst->scratch.run.smoother, cos_hat, sin_hat);
     }
     pmstep_park(*cos_hat, *sin_hat, sample->i_a_A, sample->i_b_A, i_d, i_q);
@@ -193,7 +194,7 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
     pmstep_law_fade_detent(inst->cfg->gains.detent_fade_speed_rad_s, inst->observer.speed_hat_rad_s,
                            refs.speed_ref_rate_rad_s2, &detent);
     observer_input_of_period(sample, cos_hat, sin_hat, i_d, i_q, ref.value, detent.torque_Nm, obs_in);
-    if (inst->hold.active) { /* a vector hold: its own voltage, the law's speed loop paused */
+    if (inst->hold.active) {       /* a vector hold: its own voltage, the law's speed loop paused */
         if (inst->estimate_kept) { /* tested in the hold's branch: the law's periods pay nothing for it */
             kept_estimate_in(inst, sample, &refs, obs_in, &cos_hat, &sin_hat, &i_d, &i_q);
         }
@@ -205,7 +206,8 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
         obs_in->i_d_err_A = i_d - refs.i_d_ref_A;
         obs_in->i_q_err_A = i_q - i_q_ref;
     }
-    scratch->mech_rates = pmstep_observer_mech_rates(&inst->observer, &inst->derived.observer_coeffs, obs_in, known_load);
+    scratch->mech_rates =
+        pmstep_observer_mech_rates(&inst->observer, &inst->derived.observer_coeffs, obs_in, known_load);
 
     if (!inst->hold.active) {
         float load_rate;
@@ -217,15 +219,16 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
         load_rate = known_load ? ref.rate : scratch->mech_rates.load_hat_rate_Nm_s;
         i_q_ref_rate = pmstep_law_iq_ref_rate(&inst->derived.law_coeffs, &refs, speed.slope,
                                               scratch->mech_rates.speed_hat_rate_rad_s2, load_rate - detent.rate_Nm_s);
-        pmstep_law_voltages(&inst->derived.law_coeffs, &refs, cos_hat, sin_hat, i_d, i_q, inst->observer.speed_hat_rad_s,
-                            i_q_ref, i_q_ref_rate, &inst->current_integral, &out->u_a_V, &out->u_b_V);
+        pmstep_law_voltages(&inst->derived.law_coeffs, &refs, cos_hat, sin_hat, i_d, i_q,
+                            inst->observer.speed_hat_rad_s, i_q_ref, i_q_ref_rate, &inst->current_integral, &out->u_a_V,
+                            &out->u_b_V);
     }
 
     report_period(inst, &refs, cos_hat, sin_hat, i_d, i_q, load_Nm, i_q_ref, out);
 }
 
-pmstep_fault_t pmstep_control_advance(pmstep_t *inst, const pmstep_control_scratch_t *scratch, const pmstep_meas_t *meas,
-                            const pmstep_output_t *out)
+pmstep_fault_t pmstep_control_advance(pmstep_t *inst, const pmstep_control_scratch_t *scratch,
+                                      const pmstep_meas_t *meas, const pmstep_output_t *out)
 {
     const pmstep_config_t *cfg = inst->cfg;
     const float period_s = cfg->timing.period_s;
@@ -250,17 +253,17 @@ pmstep_fault_t pmstep_control_advance(pmstep_t *inst, const pmstep_control_scrat
              * q residual beyond the detection's bound (a transient: a load step, w-hat lagging),
              * or a d residual that would mean more than PMSTEP_EMF_ANGLE_MAX_READING_RAD. */
             const bool settled_q = !(bound_A > 0.0f) || (pmstep_abs(i_q_residual_A) < bound_A);
-            const bool settled_d = pmstep_abs(i_d_residual_A) * (obs->r_over_l_per_s + obs->observer_gain_per_s)
-                                   < PMSTEP_EMF_ANGLE_MAX_READING_RAD * obs->km_over_l
-                                         * pmstep_abs(out->speed_hat_rad_s);
+            const bool settled_d =
+                pmstep_abs(i_d_residual_A) * (obs->r_over_l_per_s + obs->observer_gain_per_s)
+                < PMSTEP_EMF_ANGLE_MAX_READING_RAD * obs->km_over_l * pmstep_abs(out->speed_hat_rad_s);
             if (settled_q && settled_d) {
                 pmstep_angle_follow_emf(&inst->angle, &inst->derived.angle_coeffs, out->cos_hat, out->sin_hat,
                                         i_d_residual_A, out->speed_hat_rad_s);
             }
         }
     }
-    pmstep_observer_advance(&inst->observer, &inst->derived.observer_coeffs, &scratch->observer_input, &scratch->mech_rates,
-                            inst->actuator.u_applied_a_V, inst->actuator.u_applied_b_V, period_s);
+    pmstep_observer_advance(&inst->observer, &inst->derived.observer_coeffs, &scratch->observer_input,
+                            &scratch->mech_rates, inst->actuator.u_applied_a_V, inst->actuator.u_applied_b_V, period_s);
     if (!out->voltage_limited) { /* anti-windup: the integral holds while the bus limits the voltage */
         pmstep_law_integrate(&inst->current_integral, &inst->derived.law_coeffs, scratch->observer_input.i_d_err_A,
                              scratch->observer_input.i_q_err_A, period_s);

@@ -16,7 +16,6 @@
 #include "pmstep/pmstep.h"
 #include "pmstep_internal.h"
 
-
 static void output_off(pmstep_output_t *out, const pmstep_t *inst)
 {
     static const pmstep_output_t zero_output = {0};
@@ -124,8 +123,8 @@ static pmstep_fault_t finish_commissioning(pmstep_t *inst, const pmstep_meas_t *
 {
     pmstep_commissioning_t *result = &inst->commissioning;
     pmstep_electrical_t model;
-    const pmstep_fault_t fault = pmstep_commission_finish(&inst->scratch.sums, &inst->derived.commission_plan, inst->cfg,
-                                                          raw->i_a_A, inst->actuator.u_applied_a_V, result);
+    const pmstep_fault_t fault = pmstep_commission_finish(&inst->scratch.sums, &inst->derived.commission_plan,
+                                                          inst->cfg, raw->i_a_A, inst->actuator.u_applied_a_V, result);
     if (fault != PMSTEP_FAULT_NONE) {
         return fault;
     }
@@ -207,8 +206,8 @@ static pmstep_fault_t commission_stage(pmstep_t *inst, const pmstep_meas_t *meas
     if (inst->cfg->inverter.phase_voltage_sensing) {
         pmstep_sensed_voltages(inst, meas, &u_a_V, &u_b_V);
     }
-    pmstep_commission_add_alignment(&inst->scratch.sums, plan, inst->mode_step, meas->i_a_A, meas->i_b_A, u_a_V,
-                                    u_b_V, phase_a_voltage_known(inst, meas));
+    pmstep_commission_add_alignment(&inst->scratch.sums, plan, inst->mode_step, meas->i_a_A, meas->i_b_A, u_a_V, u_b_V,
+                                    phase_a_voltage_known(inst, meas));
     return PMSTEP_FAULT_NONE;
 }
 
@@ -277,19 +276,20 @@ static pmstep_fault_t supervise_stage(pmstep_t *inst, const pmstep_output_t *out
         || (pmstep_abs(inst->observer.load_hat_Nm) >= inst->derived.observer_coeffs.load_bound_Nm)) {
         return PMSTEP_FAULT_ESTIMATE_RANGE;
     }
-    return pmstep_detect_check(&inst->scratch.run.detector, &inst->derived.detect_coeffs, &inst->cfg->detection, out, sample);
+    return pmstep_detect_check(&inst->scratch.run.detector, &inst->derived.detect_coeffs, &inst->cfg->detection, out,
+                               sample);
 }
 
 /* Dead-time compensation in RUN: the current references (i_d*, i_q*) in the stator frame at the
  * angle the voltage acts at (the law's turn, p w-hat T_s (delay + 1/2)); over the period a phase
  * current sweeps +-s = |the other phase's current| p |w-hat| T_s / 2 about that value, and its
  * PWM ripple straddles zero near it (pmstep_actuate_mean_loss_current; inverter.ripple_dead_zone). */
-static void reference_current_over_period(const pmstep_t *inst, const pmstep_meas_t *sample,
-                                          const pmstep_output_t *out, pmstep_compensation_input_t *in)
+static void reference_current_over_period(const pmstep_t *inst, const pmstep_meas_t *sample, const pmstep_output_t *out,
+                                          pmstep_compensation_input_t *in)
 {
     const float band_A = inst->cfg->inverter.dead_time_current_band_A;
-    const float half_turn = 0.5f * inst->derived.law_coeffs.pole_pairs * inst->cfg->timing.period_s
-                            * pmstep_abs(out->speed_hat_rad_s);
+    const float half_turn =
+        0.5f * inst->derived.law_coeffs.pole_pairs * inst->cfg->timing.period_s * pmstep_abs(out->speed_hat_rad_s);
     /* the command's voltage sets the ripple; a bridge without ripple is handed 0 V (h = 0), as a
      * factor rather than a branch (no branch in the period) */
     const float ripple_voltage_factor = inst->cfg->inverter.ripple_dead_zone ? 1.0f : 0.0f;
@@ -297,7 +297,8 @@ static void reference_current_over_period(const pmstep_t *inst, const pmstep_mea
     float sin_act;
     float current_a_A;
     float current_b_A;
-    pmstep_law_acting_angle(&inst->derived.law_coeffs, out->cos_hat, out->sin_hat, out->speed_hat_rad_s, &cos_act, &sin_act);
+    pmstep_law_acting_angle(&inst->derived.law_coeffs, out->cos_hat, out->sin_hat, out->speed_hat_rad_s, &cos_act,
+                            &sin_act);
     current_a_A = cos_act * out->i_d_ref_A - sin_act * out->i_q_ref_A;
     current_b_A = sin_act * out->i_d_ref_A + cos_act * out->i_q_ref_A;
     in->sign_current_a_A = pmstep_actuate_mean_loss_current(&inst->derived.actuate_coeffs, band_A, current_a_A,

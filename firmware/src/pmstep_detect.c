@@ -57,13 +57,14 @@ pmstep_fault_t pmstep_detect_check(pmstep_detector_t *detector, const pmstep_det
         detector->rotation_gap_rad += coeffs->alpha * (gap - detector->rotation_gap_rad);
         detector->prev_cos_hat = out->cos_hat;
         detector->prev_sin_hat = out->sin_hat;
-        if (persists(&detector->consistency_count, pmstep_abs(detector->rotation_gap_rad) > coeffs->consistency_bound_rad, limit)) {
+        if (persists(&detector->consistency_count,
+                     pmstep_abs(detector->rotation_gap_rad) > coeffs->consistency_bound_rad, limit)) {
             found = PMSTEP_FAULT_SPEED_INCONSISTENT;
         }
     }
     if (cfg->stall_speed_error_rad_s > 0.0f
-        && persists(&detector->stall_count, pmstep_abs(out->speed_hat_rad_s - out->speed_ref_rad_s) > cfg->stall_speed_error_rad_s,
-                    limit)) {
+        && persists(&detector->stall_count,
+                    pmstep_abs(out->speed_hat_rad_s - out->speed_ref_rad_s) > cfg->stall_speed_error_rad_s, limit)) {
         found = PMSTEP_FAULT_STALL;
     }
     if (cfg->observer_residual_bound_A > 0.0f) {

@@ -30,8 +30,8 @@ float pmstep_hold_natural_rad_s(const pmstep_law_coeffs_t *law, float current_A,
 bool pmstep_hold_aim_ahead(const pmstep_law_coeffs_t *law, float c, float s, float current_A, float load_Nm,
                            float extra_A, const pmstep_detent_t *detent, pmstep_hold_aim_t *aim)
 {
-    const float sin_delta = ((load_Nm - detent->torque_Nm) / (law->km_over_l * law->inductance_H) + extra_A)
-                            / current_A;
+    const float sin_delta =
+        ((load_Nm - detent->torque_Nm) / (law->km_over_l * law->inductance_H) + extra_A) / current_A;
     if (!(pmstep_abs(sin_delta) <= PMSTEP_HOLD_MAX_TORQUE_FRACTION)) {
         return false;
     }
@@ -56,7 +56,8 @@ static bool observer_follows_swing(const pmstep_t *inst, float w)
     const float p_re = (obs->load_injection_gain * b_squared * obs->inv_j) - ((a_e + obs->f_over_j_per_s) * w2);
     const float p_im = ((a_e * obs->f_over_j_per_s) + (obs->speed_injection_gain * b_squared) - w2) * w;
     return ((1.0f - PMSTEP_HOLD_MIN_IN_PHASE_SHARE) * ((p_re * p_re) + (p_im * p_im)))
-           + (w2 * ((a_e * p_re) + (w * p_im))) >= 0.0f;
+               + (w2 * ((a_e * p_re) + (w * p_im)))
+           >= 0.0f;
 }
 
 /* pmstep_hold_vector's, with the damping term kept whatever the observer's phase where
@@ -201,13 +202,15 @@ void pmstep_hold_voltages(pmstep_t *inst, pmstep_observer_input_t *obs_in, pmste
     obs_in->i_d_err_A = i_d_err; /* the PI integral's errors (the observer of (6) reads none) */
     obs_in->i_q_err_A = i_q_err;
     /* the law's current loop (pmstep_law_voltages) at zero speed: u = L [(R/L) i* - K_i e - K_I z] */
-    u_d = law->inductance_H * (law->r_over_l_per_s * hold->current_A - law->current_gain_per_s * i_d_err
-                               - law->current_integral_gain_per_s2 * inst->current_integral.i_d_error_integral_As);
+    u_d = law->inductance_H
+          * (law->r_over_l_per_s * hold->current_A - law->current_gain_per_s * i_d_err
+             - law->current_integral_gain_per_s2 * inst->current_integral.i_d_error_integral_As);
     /* turning: L I p w_frame for the vector's rotation and the back-EMF k_M w_v, on q (the load
      * angle's share on d is left to the integral) */
-    u_q = law->inductance_H * (frame_speed * law->pole_pairs * hold->current_A + vector_speed * law->km_over_l
-                               - law->current_gain_per_s * i_q_err
-                               - law->current_integral_gain_per_s2 * inst->current_integral.i_q_error_integral_As);
+    u_q = law->inductance_H
+          * (frame_speed * law->pole_pairs * hold->current_A + vector_speed * law->km_over_l
+             - law->current_gain_per_s * i_q_err
+             - law->current_integral_gain_per_s2 * inst->current_integral.i_q_error_integral_As);
     out->u_a_V = c_act * u_d - s_act * u_q;
     out->u_b_V = s_act * u_d + c_act * u_q;
 }

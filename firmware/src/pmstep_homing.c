@@ -42,7 +42,7 @@ pmstep_status_t pmstep_homing_design(const pmstep_config_t *cfg, pmstep_homing_c
     homing->accel_rad_s2 = ACCEL_TORQUE_SHARE * k_m * homing->stall_current_A / j;
     homing->max_travel_rad = TWO_PI;
     homing->stall_error_rad = 0.5f * HALF_PI / (float)cfg->motor.pole_pairs; /* half a full step */
-    homing->back_off_rad = HALF_PI / (float)cfg->motor.pole_pairs;          /* one full step */
+    homing->back_off_rad = HALF_PI / (float)cfg->motor.pole_pairs;           /* one full step */
     return PMSTEP_OK;
 }
 
@@ -51,8 +51,8 @@ static bool finite(float x)
     return (x - x) == 0.0f; /* NaN and Inf give NaN */
 }
 
-pmstep_status_t pmstep_homing_start(pmstep_homing_t *homing, pmstep_position_t *pos,
-                                    const pmstep_homing_config_t *cfg, int32_t direction)
+pmstep_status_t pmstep_homing_start(pmstep_homing_t *homing, pmstep_position_t *pos, const pmstep_homing_config_t *cfg,
+                                    int32_t direction)
 {
     float position_rad;
     float target_rad;
@@ -112,7 +112,8 @@ pmstep_homing_state_t pmstep_homing_update(pmstep_homing_t *homing, pmstep_posit
     if (!active) {
         return homing->state;
     }
-    if (!pos_out->tracked || !pos_out->position_mode || pos->steps != NULL || pos->motion.target != homing->target_rad) {
+    if (!pos_out->tracked || !pos_out->position_mode || pos->steps != NULL
+        || pos->motion.target != homing->target_rad) {
         /* left RUN, or another command took the loop: a speed command, STEP/DIR, a move, a stop or a zero */
         homing->state = PMSTEP_HOMING_ABORTED;
         return homing->state;

@@ -36,8 +36,7 @@ static inline bool pmstep_all_finite6(float a, float b, float c, float d, float 
 
 /* With phase-voltage sensing: the sensed mean voltages of the period that ends at @p meas, their
  * bridge-off offsets taken off. */
-static inline void pmstep_sensed_voltages(const pmstep_t *inst, const pmstep_meas_t *meas, float *u_a_V,
-                                          float *u_b_V)
+static inline void pmstep_sensed_voltages(const pmstep_t *inst, const pmstep_meas_t *meas, float *u_a_V, float *u_b_V)
 {
     *u_a_V = meas->phase_voltage_a_V - inst->commissioning.phase_voltage_offset_a_V;
     *u_b_V = meas->phase_voltage_b_V - inst->commissioning.phase_voltage_offset_b_V;
@@ -84,8 +83,8 @@ void pmstep_control_compute(pmstep_t *inst, const pmstep_meas_t *sample, pmstep_
 /* Advance stage: the drift-free correction, the observer over the coming period with the
  * voltage the bridge applies (inst->actuator), the reference filters.
  * @return PMSTEP_FAULT_STATE_NONFINITE if an internal estimate is no longer finite, else NONE. */
-pmstep_fault_t pmstep_control_advance(pmstep_t *inst, const pmstep_control_scratch_t *scratch, const pmstep_meas_t *meas,
-                            const pmstep_output_t *out);
+pmstep_fault_t pmstep_control_advance(pmstep_t *inst, const pmstep_control_scratch_t *scratch,
+                                      const pmstep_meas_t *meas, const pmstep_output_t *out);
 
 /* Vector hold (pmstep_hold.c), in place of the law's voltage: the vector turned back by the
  * damping, the PI current loop's errors in its frame into @p obs_in, the voltage into @p out. */

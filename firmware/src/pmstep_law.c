@@ -5,8 +5,7 @@
 
 #include <math.h> /* sqrtf: one vsqrt.f32 / sqrtss with -fno-math-errno, no libm call */
 
-void pmstep_law_coeffs_init(pmstep_law_coeffs_t *coeffs, const pmstep_config_t *cfg,
-                            const pmstep_electrical_t *model)
+void pmstep_law_coeffs_init(pmstep_law_coeffs_t *coeffs, const pmstep_config_t *cfg, const pmstep_electrical_t *model)
 {
     coeffs->j_over_km = model->inertia_kgm2 / model->torque_constant_Nm_A;
     coeffs->f_over_j_per_s = model->friction_Nms_rad / model->inertia_kgm2;
@@ -65,34 +64,37 @@ pmstep_speed_term_t pmstep_law_speed_term(const pmstep_law_coeffs_t *coeffs, flo
     return speed;
 }
 
-float pmstep_law_iq_ref(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs,
-                        float speed_term, float load_Nm)
+float pmstep_law_iq_ref(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs, float speed_term,
+                        float load_Nm)
 {
-    return coeffs->j_over_km * (coeffs->f_over_j_per_s * refs->speed_ref_rad_s - speed_term
-                                + load_Nm * coeffs->inv_j + refs->speed_ref_rate_rad_s2);
+    return coeffs->j_over_km
+           * (coeffs->f_over_j_per_s * refs->speed_ref_rad_s - speed_term + load_Nm * coeffs->inv_j
+              + refs->speed_ref_rate_rad_s2);
 }
 
-float pmstep_law_iq_ref_rate(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs,
-                             float speed_slope, float speed_hat_rate, float load_rate)
+float pmstep_law_iq_ref_rate(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs, float speed_slope,
+                             float speed_hat_rate, float load_rate)
 {
-    return coeffs->j_over_km * (coeffs->f_over_j_per_s * refs->speed_ref_rate_rad_s2
-                                - speed_slope * (speed_hat_rate - refs->speed_ref_rate_rad_s2)
-                                + load_rate * coeffs->inv_j + refs->speed_ref_accel_rad_s3);
+    return coeffs->j_over_km
+           * (coeffs->f_over_j_per_s * refs->speed_ref_rate_rad_s2
+              - speed_slope * (speed_hat_rate - refs->speed_ref_rate_rad_s2) + load_rate * coeffs->inv_j
+              + refs->speed_ref_accel_rad_s3);
 }
 
-void pmstep_law_voltages(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs,
-                         float cos_hat, float sin_hat, float i_d_A, float i_q_A,
-                         float speed_hat_rad_s, float i_q_ref_A, float i_q_ref_rate,
+void pmstep_law_voltages(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs, float cos_hat, float sin_hat,
+                         float i_d_A, float i_q_A, float speed_hat_rad_s, float i_q_ref_A, float i_q_ref_rate,
                          const pmstep_law_integral_t *integral, float *u_a_V, float *u_b_V)
 {
     const float pw = coeffs->pole_pairs * speed_hat_rad_s;
     const float phi_d = -coeffs->r_over_l_per_s * refs->i_d_ref_A + pw * i_q_A - refs->i_d_ref_rate_A_s;
-    const float phi_q = -coeffs->r_over_l_per_s * i_q_ref_A - pw * i_d_A
-                        - coeffs->km_over_l * speed_hat_rad_s - i_q_ref_rate;
-    const float u_d = coeffs->inductance_H * (-phi_d - coeffs->current_gain_per_s * (i_d_A - refs->i_d_ref_A)
-                                              - coeffs->current_integral_gain_per_s2 * integral->i_d_error_integral_As);
-    const float u_q = coeffs->inductance_H * (-phi_q - coeffs->current_gain_per_s * (i_q_A - i_q_ref_A)
-                                              - coeffs->current_integral_gain_q_per_s2 * integral->i_q_error_integral_As);
+    const float phi_q =
+        -coeffs->r_over_l_per_s * i_q_ref_A - pw * i_d_A - coeffs->km_over_l * speed_hat_rad_s - i_q_ref_rate;
+    const float u_d = coeffs->inductance_H
+                      * (-phi_d - coeffs->current_gain_per_s * (i_d_A - refs->i_d_ref_A)
+                         - coeffs->current_integral_gain_per_s2 * integral->i_d_error_integral_As);
+    const float u_q = coeffs->inductance_H
+                      * (-phi_q - coeffs->current_gain_per_s * (i_q_A - i_q_ref_A)
+                         - coeffs->current_integral_gain_q_per_s2 * integral->i_q_error_integral_As);
     float cos_act;
     float sin_act;
     /* Inverse Park at the angle the voltage acts at, shortened for the hold. */
@@ -101,8 +103,7 @@ void pmstep_law_voltages(const pmstep_law_coeffs_t *coeffs, const pmstep_law_ref
     *u_b_V = sin_act * u_d + cos_act * u_q;
 }
 
-void pmstep_law_fade_detent(float fade_speed_rad_s, float speed_hat_rad_s, float accel_rad_s2,
-                            pmstep_detent_t *detent)
+void pmstep_law_fade_detent(float fade_speed_rad_s, float speed_hat_rad_s, float accel_rad_s2, pmstep_detent_t *detent)
 {
     if (fade_speed_rad_s > 0.0f) {
         const float fade_sq = fade_speed_rad_s * fade_speed_rad_s;

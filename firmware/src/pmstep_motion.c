@@ -217,8 +217,8 @@ static void peak_and_cruise(float toward, float remaining, float v_max, float a_
     *cruise_s_out = cruise_s;
 }
 
-void pmstep_motion_plan(pmstep_motion_t *m, float position, float speed, float accel, float target,
-                        float v_max, float a_max, float j_max)
+void pmstep_motion_plan(pmstep_motion_t *m, float position, float speed, float accel, float target, float v_max,
+                        float a_max, float j_max)
 {
     builder_t b;
     float remaining;

@@ -26,8 +26,10 @@ void pmstep_observer_coeffs_init(pmstep_observer_coeffs_t *coeffs, const pmstep_
     coeffs->speed_injection_gain = (2.0f * g * g + r * f * l * j * j) / den;
     coeffs->load_injection_gain = (2.0f * g * g * f + l * j * g + l * j * j * r * f * f) / den;
     coeffs->inv_lambda = 1.0f / l;
-    coeffs->speed_bound_rad_s = PMSTEP_ESTIMATE_RANGE_FACTOR * cfg->limits.max_bus_voltage_V / model->torque_constant_Nm_A;
-    coeffs->load_bound_Nm = PMSTEP_ESTIMATE_RANGE_FACTOR * model->torque_constant_Nm_A * cfg->limits.max_phase_current_A;
+    coeffs->speed_bound_rad_s =
+        PMSTEP_ESTIMATE_RANGE_FACTOR * cfg->limits.max_bus_voltage_V / model->torque_constant_Nm_A;
+    coeffs->load_bound_Nm =
+        PMSTEP_ESTIMATE_RANGE_FACTOR * model->torque_constant_Nm_A * cfg->limits.max_phase_current_A;
     {
         const float half_z = 0.5f * coeffs->r_over_l_per_s * cfg->timing.period_s;
         coeffs->current_decay = (1.0f - half_z) / (1.0f + half_z);
@@ -51,8 +53,7 @@ void pmstep_observer_start(pmstep_observer_t *obs, float i_a_A, float i_b_A)
 
 pmstep_observer_mech_rates_t pmstep_observer_mech_rates(const pmstep_observer_t *obs,
                                                         const pmstep_observer_coeffs_t *coeffs,
-                                                        const pmstep_observer_input_t *in,
-                                                        bool known_load)
+                                                        const pmstep_observer_input_t *in, bool known_load)
 {
     pmstep_observer_mech_rates_t rates;
     const float drive = -coeffs->f_over_j_per_s * obs->speed_hat_rad_s + coeffs->km_over_j * in->i_q_A
@@ -80,7 +81,8 @@ void pmstep_observer_boost_in_transient(const pmstep_observer_t *obs, const pmst
                                         pmstep_observer_mech_rates_t *rates)
 {
     /* (6)'s residual s-hat i~_a - c-hat i~_b, the q axis's (with its sign reversed) */
-    const float residual_A = (in->sin_hat * (in->i_a_A - obs->i_a_hat_A)) - (in->cos_hat * (in->i_b_A - obs->i_b_hat_A));
+    const float residual_A =
+        (in->sin_hat * (in->i_a_A - obs->i_a_hat_A)) - (in->cos_hat * (in->i_b_A - obs->i_b_hat_A));
     if ((residual_A > residual_bound_A) || (residual_A < -residual_bound_A)) {
         const float eps = coeffs->km_over_l * residual_A;
         rates->speed_hat_rate_rad_s2 += (boost - 1.0f) * coeffs->speed_injection_gain * eps;
@@ -88,8 +90,8 @@ void pmstep_observer_boost_in_transient(const pmstep_observer_t *obs, const pmst
     }
 }
 
-void pmstep_observer_correct_voltage(pmstep_observer_t *obs, const pmstep_observer_coeffs_t *coeffs,
-                                     float du_a_V, float du_b_V)
+void pmstep_observer_correct_voltage(pmstep_observer_t *obs, const pmstep_observer_coeffs_t *coeffs, float du_a_V,
+                                     float du_b_V)
 {
     const float input_gain = coeffs->current_step_s * coeffs->inv_l_per_H;
     obs->i_a_hat_A += input_gain * du_a_V;
@@ -97,9 +99,8 @@ void pmstep_observer_correct_voltage(pmstep_observer_t *obs, const pmstep_observ
 }
 
 void pmstep_observer_advance(pmstep_observer_t *obs, const pmstep_observer_coeffs_t *coeffs,
-                             const pmstep_observer_input_t *in,
-                             const pmstep_observer_mech_rates_t *mech,
-                             float u_a_V, float u_b_V, float period_s)
+                             const pmstep_observer_input_t *in, const pmstep_observer_mech_rates_t *mech, float u_a_V,
+                             float u_b_V, float period_s)
 {
     const float err_a = in->i_a_A - obs->i_a_hat_A;
     const float err_b = in->i_b_A - obs->i_b_hat_A;
@@ -124,7 +125,7 @@ void pmstep_observer_advance(pmstep_observer_t *obs, const pmstep_observer_coeff
      * own speed's powers (the back EMF's mean over the period), and between two checks they would
      * take it to overflow. With w-hat bounded the current estimates are a stable filter of bounded
      * inputs, and T_L-hat grows at most linearly until the check. */
-    obs->speed_hat_rad_s = pmstep_limit(obs->speed_hat_rad_s + period_s * mech->speed_hat_rate_rad_s2,
-                                        coeffs->speed_bound_rad_s);
+    obs->speed_hat_rad_s =
+        pmstep_limit(obs->speed_hat_rad_s + period_s * mech->speed_hat_rate_rad_s2, coeffs->speed_bound_rad_s);
     obs->load_hat_Nm += period_s * mech->load_hat_rate_Nm_s;
 }

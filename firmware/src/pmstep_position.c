@@ -63,7 +63,8 @@ pmstep_status_t pmstep_position_design(const pmstep_config_t *cfg, pmstep_positi
     }
     pos_cfg->gain_per_s = 0.25f * cfg->gains.speed_gain_per_s;
     pos_cfg->integral_gain_per_s2 = pos_cfg->gain_per_s * pos_cfg->gain_per_s / 8.0f;
-    pos_cfg->hold_current_A = 0.5f * cfg->limits.max_phase_current_A; /* half the trip (docs/design/12-position-hold.md) */
+    pos_cfg->hold_current_A =
+        0.5f * cfg->limits.max_phase_current_A; /* half the trip (docs/design/12-position-hold.md) */
     return PMSTEP_OK;
 }
 
@@ -193,8 +194,9 @@ static inline void loop_output(pmstep_position_t *pos, float position_rad, const
     feedback = k_p * error_rad + k_i * pos->error_integral_rad_s;
     feedback_rate = k_p * speed_error + k_i * error_rad;
     feedback_accel = (k_i - k_p * k_p) * speed_error;
-    pmstep_position_put_speed_reference(pos, ref->speed + feedback, ref->accel + feedback_rate, ref->jerk + feedback_accel,
-                        ahead_speed + feedback + step_s * (feedback_rate + 0.5f * step_s * feedback_accel));
+    pmstep_position_put_speed_reference(
+        pos, ref->speed + feedback, ref->accel + feedback_rate, ref->jerk + feedback_accel,
+        ahead_speed + feedback + step_s * (feedback_rate + 0.5f * step_s * feedback_accel));
     pos->out.moving = running;
     pos->out.position_ref_rad = ref->position;
     pos->out.position_error_rad = error_rad;
@@ -368,8 +370,8 @@ pmstep_status_t pmstep_position_reference(const pmstep_position_t *pos, float *p
         const pmstep_motion_sample_t *now = &pos->now;
         const int32_t periods_on = PMSTEP_POSITION_DECIMATION - pos->loop_countdown - 1;
         const float t_s = (float)periods_on * pos->period_s;
-        *position_ref_rad = now->position
-                            + t_s * (now->speed + t_s * (0.5f * now->accel + t_s * (now->jerk * (1.0f / 6.0f))));
+        *position_ref_rad =
+            now->position + t_s * (now->speed + t_s * (0.5f * now->accel + t_s * (now->jerk * (1.0f / 6.0f))));
     }
     return PMSTEP_OK;
 }

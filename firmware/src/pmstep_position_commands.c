@@ -64,7 +64,7 @@ static void enter_position_mode(pmstep_position_t *pos)
         const float step_s = pos->motion.period_s;
         /* the next period reads (w*, w*', w*''); the update after it puts the loop's own */
         pmstep_position_put_speed_reference(pos, ref.value, ref.rate, ref.accel,
-                            ref.value + step_s * (ref.rate + 0.5f * step_s * ref.accel));
+                                            ref.value + step_s * (ref.rate + 0.5f * step_s * ref.accel));
         pos->error_integral_rad_s = 0.0f;
         pos->loop_countdown = 1; /* the loop's first update after the next period */
     }
@@ -76,8 +76,8 @@ static void enter_position_mode(pmstep_position_t *pos)
     }
 }
 
-pmstep_status_t pmstep_position_move_to(pmstep_position_t *pos, float target_rad, float v_max_rad_s,
-                                        float a_max_rad_s2, float j_max_rad_s3)
+pmstep_status_t pmstep_position_move_to(pmstep_position_t *pos, float target_rad, float v_max_rad_s, float a_max_rad_s2,
+                                        float j_max_rad_s3)
 {
     pmstep_motion_sample_t start;
     float electrical;

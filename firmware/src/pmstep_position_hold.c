@@ -18,8 +18,9 @@
  * pos->aim_load_Nm; false (the stage refused, no vector) for a load beyond the vector's pull. */
 static bool aim_core_vector(pmstep_position_t *pos)
 {
-    const bool aimed = pmstep_hold_vector(pos->inst, pos->rest_cos, pos->rest_sin, pos->cfg.hold_current_A,
-                                          pos->aim_load_Nm) == PMSTEP_OK;
+    const bool aimed =
+        pmstep_hold_vector(pos->inst, pos->rest_cos, pos->rest_sin, pos->cfg.hold_current_A, pos->aim_load_Nm)
+        == PMSTEP_OK;
     if (!aimed) {
         pmstep_release_vector(pos->inst); /* the loop holds on */
         pos->hold_stage = POSITION_HOLD_REFUSED;
@@ -202,4 +203,3 @@ void pmstep_position_release_hold(pmstep_position_t *pos)
         pos->hold_stage = POSITION_HOLD_NONE;
     }
 }
-

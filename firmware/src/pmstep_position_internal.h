@@ -38,8 +38,7 @@ void pmstep_position_release_hold(pmstep_position_t *pos);
 
 /* Puts the speed reference channel at (w*, w*', w*'') for the coming N periods, its set-point held so
  * that w* ends them at @p end_speed (pmstep_position.c). */
-void pmstep_position_put_speed_reference(pmstep_position_t *pos, float speed, float rate, float accel,
-                                         float end_speed);
+void pmstep_position_put_speed_reference(pmstep_position_t *pos, float speed, float rate, float accel, float end_speed);
 
 /* The loop no longer follows a STEP/DIR input (a move, a stop, a speed command, leaving RUN). */
 void pmstep_position_stop_following(pmstep_position_t *pos);

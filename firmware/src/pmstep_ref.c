@@ -17,10 +17,10 @@ void pmstep_ref_coeffs_init(pmstep_ref_coeffs_t *coeffs, float bandwidth_rad_s, 
     /* power[j] = a^j / j!; every sum below has positive terms only (no cancellation). */
     float power[REF_SERIES_TERMS];
     float exp_a = 0.0f;
-    float g2 = 0.0f;        /* sum_{j>=3} a^j/j!           -> G_2 = e^-a * g2 */
-    float h0 = 0.0f;        /* sum_{j>=1} a^j/(j+1)!       */
-    float h1 = 0.0f;        /* sum_{j>=2} a^j/(j+1)!       */
-    float h2 = 0.0f;        /* sum_{j>=3} a^j/j! (j-2)/(j+1) */
+    float g2 = 0.0f; /* sum_{j>=3} a^j/j!           -> G_2 = e^-a * g2 */
+    float h0 = 0.0f; /* sum_{j>=1} a^j/(j+1)!       */
+    float h1 = 0.0f; /* sum_{j>=2} a^j/(j+1)!       */
+    float h2 = 0.0f; /* sum_{j>=3} a^j/j! (j-2)/(j+1) */
     int j;
 
     power[0] = 1.0f;
@@ -140,12 +140,12 @@ void pmstep_ref_advance(const pmstep_ref_coeffs_t *coeffs, pmstep_ref_t *ref, fl
     change = next - start;
 
     error = (start - ref->value) + ref->value_compensation;
-    d1 = coeffs->phi[0][0] * ref->diff12 + coeffs->phi[0][1] * ref->diff23
-         + coeffs->gamma0[0] * error + coeffs->gamma1[0] * change;
-    d2 = coeffs->phi[1][0] * ref->diff12 + coeffs->phi[1][1] * ref->diff23
-         + coeffs->gamma0[1] * error + coeffs->gamma1[1] * change;
-    increment = coeffs->phi[2][0] * ref->diff12 + coeffs->phi[2][1] * ref->diff23
-                + coeffs->gamma0[2] * error + coeffs->gamma1[2] * change;
+    d1 = coeffs->phi[0][0] * ref->diff12 + coeffs->phi[0][1] * ref->diff23 + coeffs->gamma0[0] * error
+         + coeffs->gamma1[0] * change;
+    d2 = coeffs->phi[1][0] * ref->diff12 + coeffs->phi[1][1] * ref->diff23 + coeffs->gamma0[1] * error
+         + coeffs->gamma1[1] * change;
+    increment = coeffs->phi[2][0] * ref->diff12 + coeffs->phi[2][1] * ref->diff23 + coeffs->gamma0[2] * error
+                + coeffs->gamma1[2] * change;
     {
         const float corrected = increment - ref->value_compensation;
         y = ref->value + corrected;

@@ -27,10 +27,10 @@ void pmstep_standstill_start(pmstep_t *inst)
     standstill->engage_periods = 0u;
     if (inst->hold.standstill_armed) {
         const pmstep_law_coeffs_t *law = &inst->derived.law_coeffs;
-        standstill->quiet_band_rad_s = PMSTEP_HOLD_QUIET_FRACTION * pmstep_hold_natural_rad_s(law, current_A, 1.0f)
-                                       / law->pole_pairs;
-        standstill->engage_periods = pmstep_hold_period_count(PMSTEP_STANDSTILL_ENGAGE_TIME_CONSTANTS
-                                                  / (inst->cfg->gains.speed_gain_per_s * inst->cfg->timing.period_s));
+        standstill->quiet_band_rad_s =
+            PMSTEP_HOLD_QUIET_FRACTION * pmstep_hold_natural_rad_s(law, current_A, 1.0f) / law->pole_pairs;
+        standstill->engage_periods = pmstep_hold_period_count(
+            PMSTEP_STANDSTILL_ENGAGE_TIME_CONSTANTS / (inst->cfg->gains.speed_gain_per_s * inst->cfg->timing.period_s));
     }
 }
 
@@ -66,8 +66,8 @@ static void rest_for_clear_vector(const pmstep_t *inst, float *c, float *s, floa
 {
     const pmstep_law_coeffs_t *law = &inst->derived.law_coeffs;
     const float current_A = inst->cfg->standstill.hold_current_A;
-    const float clear_sin = PMSTEP_HOLD_PHASE_CLEARANCE_BANDS * inst->cfg->inverter.dead_time_current_band_A
-                            / current_A;
+    const float clear_sin =
+        PMSTEP_HOLD_PHASE_CLEARANCE_BANDS * inst->cfg->inverter.dead_time_current_band_A / current_A;
     const float min_sin = (clear_sin < HOLD_MAX_CLEAR_SIN) ? clear_sin : HOLD_MAX_CLEAR_SIN;
     const pmstep_detent_t detent = pmstep_law_detent(law, *c, *s, 0.0f);
     pmstep_hold_aim_t aim = {1.0f, 0.0f, 1.0f};
@@ -105,9 +105,8 @@ static void standstill_engage(pmstep_t *inst, pmstep_standstill_t *standstill, c
     const pmstep_ref_t *ref = &inst->speed_ref;
     const bool stops_only = inst->cfg->standstill.stops_only;
     /* 0: the standstill only; in stops only, the band while the set-point is on its way down */
-    const float band_rad_s = (stops_only && !(pmstep_abs(ref->setpoint) > 0.0f))
-                                 ? 0.0f
-                                 : inst->cfg->standstill.vector_speed_rad_s;
+    const float band_rad_s =
+        (stops_only && !(pmstep_abs(ref->setpoint) > 0.0f)) ? 0.0f : inst->cfg->standstill.vector_speed_rad_s;
     const float target_band_rad_s = command_band_rad_s(inst);
     const float vector_speed = band_rad_s > 0.0f ? out->speed_ref_rad_s : 0.0f;
     const bool at_rest = !(pmstep_abs(ref->target) > target_band_rad_s) && !(pmstep_abs(ref->setpoint) > band_rad_s)
@@ -135,9 +134,8 @@ static void standstill_engage(pmstep_t *inst, pmstep_standstill_t *standstill, c
             }
         }
         /* refused (a load beyond the vector's pull, an estimate at the origin): the law holds on */
-        inst->hold.standstill_engaged = length > 0.0f
-                                        && pmstep_hold_engage(inst, c, s, current_A, inst->observer.load_hat_Nm, true)
-                                               == PMSTEP_OK;
+        inst->hold.standstill_engaged =
+            length > 0.0f && pmstep_hold_engage(inst, c, s, current_A, inst->observer.load_hat_Nm, true) == PMSTEP_OK;
         standstill->keep_cos = c; /* where the vector will hold the rotor: T_L-hat's load angle behind it */
         standstill->keep_sin = s;
         standstill->aim_load_Nm = inst->observer.load_hat_Nm;
@@ -210,17 +208,16 @@ static bool turn_vector(pmstep_t *inst, pmstep_standstill_t *standstill, const p
     standstill->keep_sin = s;
     hold->vector_speed_rad_s = out->speed_ref_rad_s;
     detent = pmstep_law_detent(law, c, s, out->speed_ref_rad_s);
-    if (!pmstep_hold_aim_ahead(law, c, s, hold->current_A, standstill->aim_load_Nm,
-                               hold_acceleration_A(law, hold, out), &detent, &aim)) {
+    if (!pmstep_hold_aim_ahead(law, c, s, hold->current_A, standstill->aim_load_Nm, hold_acceleration_A(law, hold, out),
+                               &detent, &aim)) {
         return false;
     }
     hold->cos_vector = aim.cos_vector;
     hold->sin_vector = aim.sin_vector;
     /* d delta / dt = -(d T_detent / dt) / (k_M I cos delta) */
-    standstill->vector_rate_rad_s = out->speed_ref_rad_s
-                                    - detent.rate_Nm_s
-                                          / (law->pole_pairs * law->km_over_l * law->inductance_H * hold->current_A
-                                             * aim.cos_delta);
+    standstill->vector_rate_rad_s =
+        out->speed_ref_rad_s
+        - detent.rate_Nm_s / (law->pole_pairs * law->km_over_l * law->inductance_H * hold->current_A * aim.cos_delta);
     return true;
 }
 
@@ -256,8 +253,8 @@ static void standstill_hold_period(pmstep_t *inst, pmstep_standstill_t *standsti
 {
     const sensed_angle_t sensed = sensed_angle(inst, out);
     const bool turning = standstill_turning(inst, standstill, out);
-    const float speed_change = inst->observer.speed_hat_rad_s - inst->hold.vector_speed_rad_s
-                               - inst->hold.speed_bias_rad_s;
+    const float speed_change =
+        inst->observer.speed_hat_rad_s - inst->hold.vector_speed_rad_s - inst->hold.speed_bias_rad_s;
     standstill->rest_periods++;
     if (turning && (inst->hold.standstill_settled || standstill->rest_periods < inst->hold.settle_periods)) {
         /* Turning: the flux integrals' phase is not the rotor's at low speed (the voltage errors
@@ -291,10 +288,10 @@ static void standstill_hold_period(pmstep_t *inst, pmstep_standstill_t *standsti
             /* the period's turn of the integrals off the kept estimate less their learnt drift, summed
              * with the leak */
             const float turn_rad = turn_off_kept(standstill, &sensed);
-            standstill->drift_rad += PMSTEP_HOLD_DRIFT_LEAK_FRACTION * standstill->motion_leak
-                                     * (turn_rad - standstill->drift_rad);
-            standstill->motion_rad += turn_rad - standstill->drift_rad
-                                      - standstill->motion_leak * standstill->motion_rad;
+            standstill->drift_rad +=
+                PMSTEP_HOLD_DRIFT_LEAK_FRACTION * standstill->motion_leak * (turn_rad - standstill->drift_rad);
+            standstill->motion_rad +=
+                turn_rad - standstill->drift_rad - standstill->motion_leak * standstill->motion_rad;
             if (pmstep_abs(standstill->motion_rad) > PMSTEP_HOLD_MOTION_BOUND_RAD) {
                 follow_held_rotor(inst, standstill, out);
                 inst->estimate_kept = false;
@@ -346,8 +343,8 @@ void pmstep_standstill_advance(pmstep_t *inst, const pmstep_output_t *out)
     if (!standstill_turning(inst, standstill, out)) {
         /* stopped for good (a reversal only passes through zero) */
         const bool was_turning = pmstep_abs(inst->hold.vector_speed_rad_s) > 0.0f;
-        const bool zero_command = !(pmstep_abs(inst->speed_ref.target) > 0.0f)
-                                  && !(pmstep_abs(inst->speed_ref.setpoint) > 0.0f);
+        const bool zero_command =
+            !(pmstep_abs(inst->speed_ref.target) > 0.0f) && !(pmstep_abs(inst->speed_ref.setpoint) > 0.0f);
         if (was_turning && zero_command) {
             stop_turning(inst, standstill);
         }

@@ -14,10 +14,10 @@
 
 #define TWO_PI 6.2831853f
 #define HALF_PI 1.5707963f
-#define MAX_POLE_PHASE 4.0f          /* w_t T at most: the tracker's poles at e^-4 or nearer 1 */
-#define STOP_TIME_PER_TRACKER 8.0f   /* the designer's stop time: 8 / w_t, the tracker settled to e^-8 */
-#define DIAG_PULSE_S 1e-3f           /* the designer's DIAG pulse */
-#define STALL_UP ((int32_t)1)        /* stall_direction */
+#define MAX_POLE_PHASE 4.0f        /* w_t T at most: the tracker's poles at e^-4 or nearer 1 */
+#define STOP_TIME_PER_TRACKER 8.0f /* the designer's stop time: 8 / w_t, the tracker settled to e^-8 */
+#define DIAG_PULSE_S 1e-3f         /* the designer's DIAG pulse */
+#define STALL_UP ((int32_t)1)      /* stall_direction */
 #define STALL_DOWN ((int32_t)-1)
 
 /* e^-x for 0 <= x <= MAX_POLE_PHASE without libm: the series of e^-(x/16) to x^5, squared four times

@@ -26,13 +26,13 @@ extern "C" {
 
 /** What the port's "hardware" is. */
 typedef struct {
-    double bus_voltage_V;          /**< nominal bus V0 */
-    unsigned delay_periods;        /**< computational delay of the duty update (0 or 1) */
+    double bus_voltage_V;   /**< nominal bus V0 */
+    unsigned delay_periods; /**< computational delay of the duty update (0 or 1) */
     sil_inverter_config_t inverter;
     sil_bus_config_t bus;
     sil_sensor_config_t sensors;
-    sil_fault_config_t faults;     /**< what fails, and when (sil/faults.h) */
-    unsigned long seed;            /**< of the measurement chain's RNG */
+    sil_fault_config_t faults; /**< what fails, and when (sil/faults.h) */
+    unsigned long seed;        /**< of the measurement chain's RNG */
 } pmstep_hal_host_setup_t;
 
 typedef struct {
@@ -41,8 +41,8 @@ typedef struct {
     sil_sensors_t sensors;
     sil_fault_config_t faults;
     /* The last sample (start of the present period). */
-    pmstep_meas_t meas;            /**< what the core was given */
-    double bus_V;                  /**< actual bus voltage at the sample */
+    pmstep_meas_t meas; /**< what the core was given */
+    double bus_V;       /**< actual bus voltage at the sample */
 } pmstep_hal_host_t;
 
 /**

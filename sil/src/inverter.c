@@ -156,8 +156,8 @@ static int dead_time_branch(const plant_t *plant, int k, double u0_v, double dea
     return 0;
 }
 
-#define DEAD_TIME_EVENTS_MAX 8   /* zero crossings located per substep */
-#define CROSSING_REFINEMENTS 3   /* regula falsi steps on the crossing time */
+#define DEAD_TIME_EVENTS_MAX 8 /* zero crossings located per substep */
+#define CROSSING_REFINEMENTS 3 /* regula falsi steps on the crossing time */
 
 /* Averaged bridge: u = d V_bus - 2 sign(i) V_bus t_d / T. With dead time the voltage jumps
  * where a current crosses zero: the substep is cut at the crossing (located by regula falsi
@@ -293,8 +293,8 @@ void sil_drive_advance(plant_t *plant, sil_inverter_t *inv, double period_s, int
         plant->open_b = false;
         if (inv->cfg.model == SIL_INVERTER_SWITCHING) {
             const plant_load_t *load = &plant->load;
-            const bool load_step_inside = load->kind == PLANT_LOAD_STEP && p.t0_s < load->step_time_s
-                                          && load->step_time_s <= p.t0_s + period_s;
+            const bool load_step_inside =
+                load->kind == PLANT_LOAD_STEP && p.t0_s < load->step_time_s && load->step_time_s <= p.t0_s + period_s;
             sil_inv_switching_period(&p, period_s, substeps,
                                      substeps == 1 && plant->integrator == PLANT_INTEGRATOR_EXPONENTIAL
                                          && !load_step_inside);

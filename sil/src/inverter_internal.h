@@ -13,13 +13,13 @@ typedef struct {
     plant_t *plant;
     sil_inverter_t *inv;
     double t0_s;
-    double bus_V;          /* bus voltage at the period start (held over the period without ripple) */
+    double bus_V; /* bus voltage at the period start (held over the period without ripple) */
     bool started;
-    bool constant_u;       /* every substep had the first substep's voltages */
+    bool constant_u; /* every substep had the first substep's voltages */
     double first_u_V[2];
-    double volt_s[2];      /* integral of the phase voltages */
-    double charge_c[2];    /* integral of the phase currents */
-    double bus_charge_c;   /* integral of i_bus */
+    double volt_s[2];    /* integral of the phase voltages */
+    double charge_c[2];  /* integral of the phase currents */
+    double bus_charge_c; /* integral of i_bus */
     double min_a[2], max_a[2];
 } sil_inv_period_t;
 

@@ -63,7 +63,7 @@ double sil_inv_substep_bus_V(sil_inv_period_t *p, double t_s, double h_s)
  * diode_sign[k] marks a phase conducting through the freewheel diodes: if its current
  * reaches or crosses zero within the substep it is set to exactly 0 and the phase opens. */
 void sil_inv_substep(sil_inv_period_t *p, double t_s, double h_s, const double u_V[2], const double bus_fraction[2],
-                    const int diode_sign[2])
+                     const int diode_sign[2])
 {
     plant_t *plant = p->plant;
     double q_c[2];

@@ -209,7 +209,7 @@ static void one_step(sil_inv_period_t *p, double period_s, segments_t *seg)
     plant_t *plant = p->plant;
     const double inv_l = 1.0 / plant->params.inductance_H;
     const double lambda = -plant->params.resistance_Ohm * inv_l;
-    const double to_offset = inv_l / lambda;  /* voltage to minus the steady ripple current (A/V) */
+    const double to_offset = inv_l / lambda; /* voltage to minus the steady ripple current (A/V) */
     const double inv_t = 1.0 / period_s;
     const double t0 = p->t0_s;
     const double bus_V = sil_inv_substep_bus_V(p, t0, period_s);
@@ -279,7 +279,8 @@ static void one_step(sil_inv_period_t *p, double period_s, segments_t *seg)
         p->first_u_V[k] = n > 0 ? seg->level[0][k] * bus_V : 0.0;
         for (j = 0; j < n; ++j) {
             const double a = seg->start_s[j], b = seg->end_s[j];
-            const double bar_int = c0 * (b - a) + 0.5 * c1 * (b * b - a * a) + c2 * (1.0 / 3.0) * (b * b * b - a * a * a);
+            const double bar_int =
+                c0 * (b - a) + 0.5 * c1 * (b * b - a * a) + c2 * (1.0 / 3.0) * (b * b * b - a * a * a);
             const double at_end = c0 + c1 * b + c2 * b * b + seg_r_end[j][k];
             seg->i_end_A[j][k] = at_end;
             p->bus_charge_c += seg->level[j][k] * (bar_int + seg_r_int[j][k]);

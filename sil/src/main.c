@@ -15,19 +15,18 @@
 
 static void usage(FILE *f)
 {
-    fprintf(f,
-            "usage: pmstep-sil [--scenario FILE|paper] [--set section.key=value]... [--out DIR]\n"
-            "                  [--no-csv] [--quiet] [--print-scenario] [--record FILE]\n"
-            "  --scenario   INI scenario file on top of the built-in paper scenario (default: paper)\n"
-            "  --set        override one key after the file, e.g. --set run.period_s=25e-6\n"
-            "  --out        output folder for run.csv and summary.json (default: out/<scenario name>)\n"
-            "  --no-csv     skip the time series (benchmarks)\n"
-            "  --quiet      no progress line, no printed summary\n"
-            "  --print-scenario  print every key with its value (INI) and exit\n"
-            "  --record     write the core's inputs and outputs of every period to FILE (binary,\n"
-            "               see sil/include/sil/runner.h), for replay on a target (tests/pil/)\n"
-            "exit status: 0 done, 2 bad input or a write error, 3 a fault latched,\n"
-            "             4 run.controller = microstep lost synchronism\n");
+    fprintf(f, "usage: pmstep-sil [--scenario FILE|paper] [--set section.key=value]... [--out DIR]\n"
+               "                  [--no-csv] [--quiet] [--print-scenario] [--record FILE]\n"
+               "  --scenario   INI scenario file on top of the built-in paper scenario (default: paper)\n"
+               "  --set        override one key after the file, e.g. --set run.period_s=25e-6\n"
+               "  --out        output folder for run.csv and summary.json (default: out/<scenario name>)\n"
+               "  --no-csv     skip the time series (benchmarks)\n"
+               "  --quiet      no progress line, no printed summary\n"
+               "  --print-scenario  print every key with its value (INI) and exit\n"
+               "  --record     write the core's inputs and outputs of every period to FILE (binary,\n"
+               "               see sil/include/sil/runner.h), for replay on a target (tests/pil/)\n"
+               "exit status: 0 done, 2 bad input or a write error, 3 a fault latched,\n"
+               "             4 run.controller = microstep lost synchronism\n");
 }
 
 typedef struct {
@@ -188,13 +187,15 @@ static int parse_options(int argc, char **argv, sil_scenario_t *sc, options_t *o
 static int check_request(const sil_scenario_t *sc, const options_t *o, bool stepdir)
 {
     if (sc->drive == SIL_DRIVE_MICROSTEP && o->record_path != NULL) {
-        fprintf(stderr, "pmstep-sil: --record needs run.controller = pmstep (the microstep baseline has no firmware to replay)\n");
+        fprintf(
+            stderr,
+            "pmstep-sil: --record needs run.controller = pmstep (the microstep baseline has no firmware to replay)\n");
         return 2;
     }
     if (o->write_csv) {
         const double rows = sc->duration_s / (double)sc->controller.timing.period_s / (double)sc->decimation;
-        const double csv_MB = rows * (SIL_CSV_ROW_MAX_BYTES + (sc->position_moves > 0 ? 48.0 : 0.0)
-                                      + (stepdir ? 32.0 : 0.0)) / 1e6;
+        const double csv_MB =
+            rows * (SIL_CSV_ROW_MAX_BYTES + (sc->position_moves > 0 ? 48.0 : 0.0) + (stepdir ? 32.0 : 0.0)) / 1e6;
         if (csv_MB > sc->max_csv_MB) {
             fprintf(stderr,
                     "pmstep-sil: run.csv would take up to %.0f MB (%.0f rows), more than run.max_csv_MB = %g: raise "
@@ -234,15 +235,18 @@ static int open_outputs(const sil_scenario_t *sc, options_t *o, bool stepdir, cs
             return 2;
         }
         csv->decimation = sc->decimation;
-        fprintf(csv->file, "t_s,theta_rad,omega_rad_s,omega_ref_rad_s,i_a_A,i_b_A,u_a_V,u_b_V,cos_hat,sin_hat,"
-                           "cos_ptheta,sin_ptheta,omega_hat_rad_s,load_hat_Nm,load_Nm,mode,fault,"
-                           "i_a_meas_A,i_b_meas_A,bus_voltage_V,bus_voltage_meas_V%s%s\n",
-                sc->position_moves > 0 && sc->drive == SIL_DRIVE_PMSTEP ? ",position_ref_rad,position_hat_rad,position_rad"
-                                                                        : "",
+        fprintf(csv->file,
+                "t_s,theta_rad,omega_rad_s,omega_ref_rad_s,i_a_A,i_b_A,u_a_V,u_b_V,cos_hat,sin_hat,"
+                "cos_ptheta,sin_ptheta,omega_hat_rad_s,load_hat_Nm,load_Nm,mode,fault,"
+                "i_a_meas_A,i_b_meas_A,bus_voltage_V,bus_voltage_meas_V%s%s\n",
+                sc->position_moves > 0 && sc->drive == SIL_DRIVE_PMSTEP
+                    ? ",position_ref_rad,position_hat_rad,position_rad"
+                    : "",
                 stepdir ? ",step_count,step_error_full_steps,diag" : "");
     }
     if (o->record_path != NULL && sc->position_moves > 0) {
-        fprintf(stderr, "pmstep-sil: --record replays pmstep_step alone: not for a position scenario (position.points)\n");
+        fprintf(stderr,
+                "pmstep-sil: --record replays pmstep_step alone: not for a position scenario (position.points)\n");
         close_csv(csv);
         return 2;
     }
@@ -260,7 +264,8 @@ static int open_outputs(const sil_scenario_t *sc, options_t *o, bool stepdir, cs
 /* The run's setting in one line (and the baseline's drive). */
 static void announce(const sil_scenario_t *sc)
 {
-    fprintf(stderr, "pmstep-sil: scenario '%s', %.3f s at %.0f Hz, %d %s steps a period, delay %u, %s inverter, seed %lu\n",
+    fprintf(stderr,
+            "pmstep-sil: scenario '%s', %.3f s at %.0f Hz, %d %s steps a period, delay %u, %s inverter, seed %lu\n",
             sc->name, sc->duration_s, 1.0 / (double)sc->controller.timing.period_s, sc->substeps,
             sc->integrator == PLANT_INTEGRATOR_RK4 ? "rk4" : "exponential",
             (unsigned)sc->controller.timing.computational_delay_periods,
@@ -269,8 +274,9 @@ static void announce(const sil_scenario_t *sc)
         fprintf(stderr, "pmstep-sil: microstep baseline at %g A; the drive is told R = %g Ohm, L = %g H, p = %d%s\n",
                 sc->datasheet.rated_current_A, (double)sc->controller.motor.resistance_Ohm,
                 (double)sc->controller.motor.inductance_H, (int)sc->controller.motor.pole_pairs,
-                sc->controller.motor.pole_pairs != sc->motor.pole_pairs ? " (the plant's p differs: set controller.motor.*)"
-                                                                        : "");
+                sc->controller.motor.pole_pairs != sc->motor.pole_pairs
+                    ? " (the plant's p differs: set controller.motor.*)"
+                    : "");
     }
 }
 
@@ -333,8 +339,9 @@ static int report_outcome(const sil_scenario_t *sc, const sil_summary_t *summary
 {
     if (stepdir && !quiet) {
         const sil_stepdir_summary_t *d = &summary->stepdir;
-        fprintf(stderr, "pmstep-sil: STEP/DIR: %ld microsteps put out, %ld counted; following error max %.3f full steps "
-                        "(%.3f while moving), final %+.3f",
+        fprintf(stderr,
+                "pmstep-sil: STEP/DIR: %ld microsteps put out, %ld counted; following error max %.3f full steps "
+                "(%.3f while moving), final %+.3f",
                 (long)d->generator_steps, (long)d->drive_steps, d->max_error_full_steps, d->max_error_moving_full_steps,
                 d->final_error_full_steps);
         if (d->diag_first_s >= 0.0) {
@@ -345,7 +352,8 @@ static int report_outcome(const sil_scenario_t *sc, const sil_summary_t *summary
     }
     if (summary->loss_of_synchronism) {
         fprintf(stderr, "pmstep-sil: LOSS OF SYNCHRONISM at t = %.6f s (%s)\n", summary->loss_of_synchronism_time_s,
-                sc->drive == SIL_DRIVE_MICROSTEP ? "load angle beyond pi" : "angle-estimate error above run.loss_angle_error_rad");
+                sc->drive == SIL_DRIVE_MICROSTEP ? "load angle beyond pi"
+                                                 : "angle-estimate error above run.loss_angle_error_rad");
     }
     if (summary->fault != PMSTEP_FAULT_NONE) {
         fprintf(stderr, "pmstep-sil: FAULT latched at t = %.6f s: %s\n", summary->fault_time_s,

@@ -42,7 +42,8 @@ void sil_metrics_init(sil_metrics_t *m, const sil_scenario_t *sc, sil_summary_t 
     s->fault_step = -1;
     s->fault_time_s = -1.0;
     /* Alignment starts after the bridge-off offset calibration, when there is one. */
-    const long calibration_steps = sil_periods_in((double)sc->controller.commissioning.offset_calibration_time_s, period_s);
+    const long calibration_steps =
+        sil_periods_in((double)sc->controller.commissioning.offset_calibration_time_s, period_s);
     m->ts_step = calibration_steps + sil_periods_in((double)sc->controller.alignment.s_align_time_s, period_s);
     m->tc_step = calibration_steps + sil_periods_in((double)sc->controller.alignment.c_align_time_s, period_s);
     m->transient_end_step = m->tc_step + sil_periods_in(sc->transient_window_s, period_s);
@@ -74,7 +75,8 @@ void sil_metrics_init(sil_metrics_t *m, const sil_scenario_t *sc, sil_summary_t 
         s->run_start_time_s = (double)m->tc_step * period_s;
         s->settle_time_s = (double)m->settle_step * period_s;
     }
-    m->metrics_start_step = sc->metrics_start_s < 0.0 ? m->tc_step : first_step_at_or_after(sc->metrics_start_s, period_s);
+    m->metrics_start_step =
+        sc->metrics_start_s < 0.0 ? m->tc_step : first_step_at_or_after(sc->metrics_start_s, period_s);
     s->metrics_start_time_s = (double)m->metrics_start_step * period_s;
     s->loss_of_synchronism_time_s = -1.0;
 }
@@ -92,10 +94,9 @@ static void angle_error_xy(const pmstep_output_t *out, const sil_sample_t *x, do
 static bool sample_finite(const sil_sample_t *x)
 {
     const pmstep_output_t *o = x->out;
-    const double sum = x->theta_rad + x->omega_rad_s + x->i_a_A + x->i_b_A + x->u_a_V + x->u_b_V
-                       + (double)o->u_a_V + (double)o->u_b_V + (double)o->cos_hat + (double)o->sin_hat
-                       + (double)o->speed_hat_rad_s + (double)o->load_hat_Nm + (double)o->i_a_hat_A
-                       + (double)o->i_b_hat_A;
+    const double sum = x->theta_rad + x->omega_rad_s + x->i_a_A + x->i_b_A + x->u_a_V + x->u_b_V + (double)o->u_a_V
+                       + (double)o->u_b_V + (double)o->cos_hat + (double)o->sin_hat + (double)o->speed_hat_rad_s
+                       + (double)o->load_hat_Nm + (double)o->i_a_hat_A + (double)o->i_b_hat_A;
     return isfinite(sum) != 0;
 }
 

@@ -88,8 +88,8 @@ void sil_microstep_step(sil_microstep_t *drive, const pmstep_meas_t *meas, pmste
     out->sin_hat = (float)s;
     out->speed_ref_rad_s = (float)drive->speed_ref_rad_s;
     if (drive->speed_ref_rad_s != drive->target_rad_s) {
-        out->speed_ref_rate_rad_s2 = (float)(drive->target_rad_s > drive->speed_ref_rad_s ? drive->ramp_rate_rad_s2
-                                                                                          : -drive->ramp_rate_rad_s2);
+        out->speed_ref_rate_rad_s2 =
+            (float)(drive->target_rad_s > drive->speed_ref_rad_s ? drive->ramp_rate_rad_s2 : -drive->ramp_rate_rad_s2);
     }
     out->i_a_hat_A = (float)i_a_ref;
     out->i_b_hat_A = (float)i_b_ref;

@@ -60,15 +60,11 @@ static double varying_load_torque(const plant_load_t *load, double t_s, double o
 PLANT_INLINE double load_torque_at(const plant_load_t *load, double t_s, double omega_rad_s)
 {
     switch (load->kind) {
-    case PLANT_LOAD_NONE:
-        return 0.0;
-    case PLANT_LOAD_CONSTANT:
-        return load->torque_Nm;
-    case PLANT_LOAD_STEP:
-        return t_s >= load->step_time_s ? load->torque_Nm : 0.0;
+    case PLANT_LOAD_NONE: return 0.0;
+    case PLANT_LOAD_CONSTANT: return load->torque_Nm;
+    case PLANT_LOAD_STEP: return t_s >= load->step_time_s ? load->torque_Nm : 0.0;
     case PLANT_LOAD_PROPORTIONAL:
-    case PLANT_LOAD_TABLE:
-        break;
+    case PLANT_LOAD_TABLE: break;
     }
     return varying_load_torque(load, t_s, omega_rad_s);
 }
@@ -120,8 +116,8 @@ static void derivative_at(const plant_params_t *params, const plant_load_t *load
     dx->i_b_A = inv_l * (-params->resistance_Ohm * x->i_b_A - k_m * x->omega_rad_s * c + u_b_V);
 }
 
-void plant_derivative(const plant_params_t *params, const plant_load_t *load, double t_s,
-                      const plant_state_t *x, double u_a_V, double u_b_V, plant_state_t *dx)
+void plant_derivative(const plant_params_t *params, const plant_load_t *load, double t_s, const plant_state_t *x,
+                      double u_a_V, double u_b_V, plant_state_t *dx)
 {
     const double angle = (double)params->pole_pairs * x->theta_rad;
     derivative_at(params, load, t_s, x, sin(angle), cos(angle), u_a_V, u_b_V, dx);
@@ -211,7 +207,8 @@ static void rk4_substep(plant_t *plant, double t_s, double h, double u_a_V, doub
     derivative_at(&plant->params, &plant->load, t_s + h, &y4, s, c, u_a_V, u_b_V, &k4);
     hold_open(&k4, oa, ob);
     plant->x.theta_rad = x.theta_rad + h / 6.0 * (k1.theta_rad + 2.0 * (k2.theta_rad + k3.theta_rad) + k4.theta_rad);
-    plant->x.omega_rad_s = x.omega_rad_s + h / 6.0 * (k1.omega_rad_s + 2.0 * (k2.omega_rad_s + k3.omega_rad_s) + k4.omega_rad_s);
+    plant->x.omega_rad_s =
+        x.omega_rad_s + h / 6.0 * (k1.omega_rad_s + 2.0 * (k2.omega_rad_s + k3.omega_rad_s) + k4.omega_rad_s);
     plant->x.i_a_A = x.i_a_A + h / 6.0 * (k1.i_a_A + 2.0 * (k2.i_a_A + k3.i_a_A) + k4.i_a_A);
     plant->x.i_b_A = x.i_b_A + h / 6.0 * (k1.i_b_A + 2.0 * (k2.i_b_A + k3.i_b_A) + k4.i_b_A);
     if (charge_a_c != NULL && charge_b_c != NULL) {
@@ -258,9 +255,9 @@ static double phi_functions(double z, double phi[3])
     }
     if (fabs(z) < 1.0) {
         /* 1 / (j + 4) for the series' terms (no division in the loop). */
-        static const double inv[PHI_TERMS] = {
-            1.0 / 4,  1.0 / 5,  1.0 / 6,  1.0 / 7,  1.0 / 8,  1.0 / 9,  1.0 / 10, 1.0 / 11, 1.0 / 12, 1.0 / 13,
-            1.0 / 14, 1.0 / 15, 1.0 / 16, 1.0 / 17, 1.0 / 18, 1.0 / 19, 1.0 / 20, 1.0 / 21, 1.0 / 22, 1.0 / 23};
+        static const double inv[PHI_TERMS] = {1.0 / 4,  1.0 / 5,  1.0 / 6,  1.0 / 7,  1.0 / 8,  1.0 / 9,  1.0 / 10,
+                                              1.0 / 11, 1.0 / 12, 1.0 / 13, 1.0 / 14, 1.0 / 15, 1.0 / 16, 1.0 / 17,
+                                              1.0 / 18, 1.0 / 19, 1.0 / 20, 1.0 / 21, 1.0 / 22, 1.0 / 23};
         double term3 = 1.0 / 6.0;
         int j;
         phi[0] = 1.0;
@@ -349,8 +346,8 @@ static void add_extra_torque(const plant_t *plant, int k, double s, double c, pl
 
 /* N at one stage of the exponential step (k: 0 start, 1 middle, 2 end): the coupling, the
  * extra currents' torque, an open phase held. */
-PLANT_INLINE void stage_coupling(const plant_t *plant, int k, double t_s, const plant_state_t *y, double s,
-                                 double c, plant_state_t *n)
+PLANT_INLINE void stage_coupling(const plant_t *plant, int k, double t_s, const plant_state_t *y, double s, double c,
+                                 plant_state_t *n)
 {
     coupling_at(&plant->params, &plant->load, t_s, y, s, c, n);
     add_extra_torque(plant, k, s, c, n);
@@ -359,8 +356,8 @@ PLANT_INLINE void stage_coupling(const plant_t *plant, int k, double t_s, const 
 
 /* Exponential time differencing RK4 on w = y - y* (plant.h). theta has no linear part;
  * an open phase has none either and its N is zero, so it holds. */
-static void exponential_substep(plant_t *plant, double t_s, double h, double u_a_V, double u_b_V,
-                                double *charge_a_c, double *charge_b_c)
+static void exponential_substep(plant_t *plant, double t_s, double h, double u_a_V, double u_b_V, double *charge_a_c,
+                                double *charge_b_c)
 {
     const plant_params_t *par = &plant->params;
     const plant_state_t x = plant->x;

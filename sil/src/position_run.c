@@ -57,10 +57,9 @@ void sil_position_run_command(sil_position_run_t *run, pmstep_position_t *pos, d
     while (run->next_move < sc->position_moves && t_s >= sc->move_time_s[run->next_move] && pos->out.tracked
            && run->origin_set) {
         const int n = run->next_move++;
-        const pmstep_status_t status = pmstep_position_move_to(pos, (float)sc->move_target_rad[n],
-                                                               (float)sc->move_speed_rad_s,
-                                                               (float)sc->move_accel_rad_s2,
-                                                               (float)sc->move_jerk_rad_s3);
+        const pmstep_status_t status =
+            pmstep_position_move_to(pos, (float)sc->move_target_rad[n], (float)sc->move_speed_rad_s,
+                                    (float)sc->move_accel_rad_s2, (float)sc->move_jerk_rad_s3);
         close_move(run, s);
         if (status != PMSTEP_OK) {
             s->position.rejected_moves++;
@@ -123,8 +122,7 @@ void sil_position_run_sample(sil_position_run_t *run, const pmstep_position_t *p
         const double t = sample->t_s - run->sc->hold_start_s;
         const double e = (theta - reference) * p_pairs;
         p->hold_max_error_rad = fmax(p->hold_max_error_rad, fabs(e));
-        p->hold_max_estimate_error_rad = fmax(p->hold_max_estimate_error_rad,
-                                              fabs(estimate - theta) * p_pairs);
+        p->hold_max_estimate_error_rad = fmax(p->hold_max_estimate_error_rad, fabs(estimate - theta) * p_pairs);
         run->hold_n++;
         run->hold_st += t;
         run->hold_sy += e;

@@ -129,12 +129,12 @@ typedef struct {
     const sil_scenario_t *sc;
     sil_summary_t *s;
     pmstep_t *inst;
-    pmstep_position_t *pos;            /* a position scenario's position control of inst */
-    sil_stepdir_run_t *stepdir_run;    /* a STEP/DIR scenario's generator and input */
-    bool microstep;                    /* the open-loop baseline in place of the firmware */
+    pmstep_position_t *pos;         /* a position scenario's position control of inst */
+    sil_stepdir_run_t *stepdir_run; /* a STEP/DIR scenario's generator and input */
+    bool microstep;                 /* the open-loop baseline in place of the firmware */
     bool positional;
-    bool stepdir;                      /* position.source = stepdir: the drive follows the generator's count */
-    bool homing;                       /* position.source = homing: the drive homes against the plant's stop */
+    bool stepdir; /* position.source = stepdir: the drive follows the generator's count */
+    bool homing;  /* position.source = homing: the drive homes against the plant's stop */
     sil_position_run_t position_run;
     sil_homing_run_t homing_run;
     pmstep_position_output_t pos_out;
@@ -146,11 +146,11 @@ typedef struct {
     plant_t plant;
     pmstep_output_t out;
     record_t rec_state;
-    record_t *rec;                     /* NULL: no record */
+    record_t *rec; /* NULL: no record */
     int next_segment;
     int next_progress_decile;
     bool on_terminal;
-    double clock_read_s;               /* the cost of one clock read, taken out of each timed bracket */
+    double clock_read_s; /* the cost of one clock read, taken out of each timed bracket */
     double timed_firmware_s;
     double timed_plant_s;
     long timed_periods;
@@ -370,7 +370,7 @@ static int run_finish(run_t *r, double wall_start, double cpu_start)
 int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user, bool progress, sil_summary_t *s,
                    FILE *record)
 {
-    static pmstep_t inst;                 /* as on the MCU: one static instance */
+    static pmstep_t inst; /* as on the MCU: one static instance */
     static pmstep_position_t pos;
     static sil_stepdir_run_t stepdir_run; /* large: static */
     run_t r;

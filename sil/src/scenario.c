@@ -31,8 +31,8 @@ static int parse_number(const char *text, double *value)
 }
 
 /* "t:v, t:v, ..." with strictly increasing t >= 0. */
-static int parse_points(const char *key, const char *text, double *times, double *values, int max_points,
-                        int *count, char *err, size_t err_size)
+static int parse_points(const char *key, const char *text, double *times, double *values, int max_points, int *count,
+                        char *err, size_t err_size)
 {
     char buffer[4096];
     char *cursor;
@@ -105,7 +105,8 @@ int sil_scenario_set(sil_scenario_t *sc, const char *key, const char *value, cha
                                 &sc->load.table_points, err, err_size);
         case KEY_MOVES:
             if (parse_points(key, value, sc->move_time_s, sc->move_target_rad, SIL_POSITION_MOVES_MAX,
-                             &sc->position_moves, err, err_size) != 0) {
+                             &sc->position_moves, err, err_size)
+                != 0) {
                 return -1;
             }
             if (sc->position_moves == 1 && sc->move_time_s[0] == 0.0 && sc->move_target_rad[0] == 0.0) {
@@ -169,7 +170,8 @@ int sil_scenario_set(sil_scenario_t *sc, const char *key, const char *value, cha
                     return 0;
                 }
             }
-            return fail(err, err_size, "%s: '%s' is not one of %s", key, value, source ? "move, stepdir" : "level, pulse");
+            return fail(err, err_size, "%s: '%s' is not one of %s", key, value,
+                        source ? "move, stepdir" : "level, pulse");
         }
         case KEY_PHASES:
         case KEY_SENSOR_FAULT: {
@@ -199,8 +201,7 @@ int sil_scenario_set(sil_scenario_t *sc, const char *key, const char *value, cha
                 return fail(err, err_size, "%s: '%s' is not true or false", key, value);
             }
             return 0;
-        default:
-            break;
+        default: break;
         }
         if (parse_number(value, &v) != 0) {
             return fail(err, err_size, "%s: '%s' is not a finite number (0 or of magnitude %g to %g)", key, value,
@@ -218,7 +219,8 @@ int sil_scenario_set(sil_scenario_t *sc, const char *key, const char *value, cha
                         value);
         }
         if (k->type == KEY_ADC_BITS && v > 0.0 && v < 8.0) {
-            return fail(err, err_size, "%s = %s is out of range: must be 0 (ideal) or 8 .. 16 (%s)", key, value, k->help);
+            return fail(err, err_size, "%s = %s is out of range: must be 0 (ideal) or 8 .. 16 (%s)", key, value,
+                        k->help);
         }
         switch (k->type) {
         case KEY_DOUBLE: *(double *)(base + k->offset) = v; break;

@@ -13,7 +13,7 @@ typedef struct {
     sil_scenario_t *sc;
     char message[SIL_ERROR_MAX];
     int failed;
-    char points_key[160];  /**< the points key being read: its value may continue on indented lines */
+    char points_key[160]; /**< the points key being read: its value may continue on indented lines */
     char points_text[4096];
 } load_ctx_t;
 
@@ -43,7 +43,7 @@ static const char *join_points(load_ctx_t *ctx, const char *key, const char *val
 static int plain_file_name(const char *name)
 {
     size_t n;
-    if (name[0] == '\0' || name[0] == '.' || strlen(name) >= sizeof ((sil_scenario_t *)0)->name) {
+    if (name[0] == '\0' || name[0] == '.' || strlen(name) >= sizeof((sil_scenario_t *)0)->name) {
         return 0;
     }
     for (n = 0; name[n] != '\0'; ++n) {
@@ -155,8 +155,10 @@ static char *read_scenario_text(const char *path, char *err, size_t err_size)
             }
             if (length > max_line_chars) {
                 free(text);
-                fail(err, err_size, "%s:%d: line of %u characters, longer than the %u the INI reader takes (continue a "
-                     "long value on indented lines)", path, line, (unsigned)length, (unsigned)max_line_chars);
+                fail(err, err_size,
+                     "%s:%d: line of %u characters, longer than the %u the INI reader takes (continue a "
+                     "long value on indented lines)",
+                     path, line, (unsigned)length, (unsigned)max_line_chars);
                 return NULL;
             }
             ++line;
@@ -203,20 +205,23 @@ int sil_scenario_check(const sil_scenario_t *sc, char *err, size_t err_size)
         return fail(err, err_size, "speed.points: no set-point profile");
     }
     if (!(sc->inverter.dead_time_s < 0.25 * (double)sc->controller.timing.period_s)) {
-        return fail(err, err_size, "inverter.dead_time_s = %g is not below run.period_s / 4 = %g", sc->inverter.dead_time_s,
-                    0.25 * (double)sc->controller.timing.period_s);
+        return fail(err, err_size, "inverter.dead_time_s = %g is not below run.period_s / 4 = %g",
+                    sc->inverter.dead_time_s, 0.25 * (double)sc->controller.timing.period_s);
     }
-    if (sc->sensors.adc_bits > 0u && sc->sensors.current_full_scale_A < (double)sc->controller.limits.max_phase_current_A) {
-        return fail(err, err_size,
-                    "sensors.current_full_scale_A = %g is below controller.limits.max_phase_current_A = %g: the ADC would clip "
-                    "before the trip",
-                    sc->sensors.current_full_scale_A, (double)sc->controller.limits.max_phase_current_A);
+    if (sc->sensors.adc_bits > 0u
+        && sc->sensors.current_full_scale_A < (double)sc->controller.limits.max_phase_current_A) {
+        return fail(
+            err, err_size,
+            "sensors.current_full_scale_A = %g is below controller.limits.max_phase_current_A = %g: the ADC would clip "
+            "before the trip",
+            sc->sensors.current_full_scale_A, (double)sc->controller.limits.max_phase_current_A);
     }
     if (sc->sensors.adc_bits > 0u && sc->sensors.bus_full_scale_V < (double)sc->controller.limits.max_bus_voltage_V) {
-        return fail(err, err_size,
-                    "sensors.bus_full_scale_V = %g is below controller.limits.max_bus_voltage_V = %g: the ADC would clip "
-                    "before the overvoltage trip",
-                    sc->sensors.bus_full_scale_V, (double)sc->controller.limits.max_bus_voltage_V);
+        return fail(
+            err, err_size,
+            "sensors.bus_full_scale_V = %g is below controller.limits.max_bus_voltage_V = %g: the ADC would clip "
+            "before the overvoltage trip",
+            sc->sensors.bus_full_scale_V, (double)sc->controller.limits.max_bus_voltage_V);
     }
     if (sc->controller.inverter.phase_voltage_sensing && sc->sensors.phase_voltage_bits > 0u
         && sc->sensors.phase_voltage_full_scale_V < (double)sc->controller.limits.max_bus_voltage_V) {
@@ -240,23 +245,27 @@ int sil_scenario_check(const sil_scenario_t *sc, char *err, size_t err_size)
                                    + (double)sc->controller.alignment.c_align_time_s;
         int n;
         if (sc->drive != SIL_DRIVE_PMSTEP && sc->position_source != SIL_SOURCE_STEPDIR) {
-            return fail(err, err_size, "position.points: moves need run.controller = pmstep, or position.source = "
-                                       "stepdir (a step count the microstep baseline follows too)");
+            return fail(err, err_size,
+                        "position.points: moves need run.controller = pmstep, or position.source = "
+                        "stepdir (a step count the microstep baseline follows too)");
         }
         if (sc->position_source == SIL_SOURCE_STEPDIR) {
             /* The port's 16-bit counter is read once a period: it must turn by less than half its range. */
-            const double microstep_rad = 2.0 * PI / (4.0 * (double)sc->motor.pole_pairs * (double)sc->stepdir_microsteps);
+            const double microstep_rad =
+                2.0 * PI / (4.0 * (double)sc->motor.pole_pairs * (double)sc->stepdir_microsteps);
             const double per_period = sc->move_speed_rad_s * (double)sc->controller.timing.period_s / microstep_rad;
             if (!(per_period < 32767.0)) {
-                return fail(err, err_size, "position.v_max_rad_s = %g with stepdir.microsteps = %u: %.0f microsteps a "
-                            "period, more than the 16-bit step counter's half turn (32767)", sc->move_speed_rad_s,
-                            (unsigned)sc->stepdir_microsteps, per_period);
+                return fail(err, err_size,
+                            "position.v_max_rad_s = %g with stepdir.microsteps = %u: %.0f microsteps a "
+                            "period, more than the 16-bit step counter's half turn (32767)",
+                            sc->move_speed_rad_s, (unsigned)sc->stepdir_microsteps, per_period);
             }
         }
         for (n = 0; n < sc->speed_points; ++n) {
             if (sc->speed_value_rad_s[n] != 0.0) {
-                return fail(err, err_size, "position.points with a speed profile: set speed.points = 0:0 (a speed command "
-                                           "would leave position mode)");
+                return fail(err, err_size,
+                            "position.points with a speed profile: set speed.points = 0:0 (a speed command "
+                            "would leave position mode)");
             }
         }
         if (sc->move_time_s[0] < run_start_s) {
@@ -272,11 +281,14 @@ int sil_scenario_check(const sil_scenario_t *sc, char *err, size_t err_size)
         }
     }
     if (sc->position_source == SIL_SOURCE_STEPDIR && sc->position_moves == 0) {
-        return fail(err, err_size, "position.source = stepdir needs position.points (the moves the step generator plans)");
+        return fail(err, err_size,
+                    "position.source = stepdir needs position.points (the moves the step generator plans)");
     }
     if (sc->position_source == SIL_SOURCE_HOMING && sc->position_moves != 1) {
-        return fail(err, err_size, "position.source = homing needs one position point t:theta (homing starts at t toward "
-                                   "theta's sign, |theta| its largest travel); got %d", sc->position_moves);
+        return fail(err, err_size,
+                    "position.source = homing needs one position point t:theta (homing starts at t toward "
+                    "theta's sign, |theta| its largest travel); got %d",
+                    sc->position_moves);
     }
     if (sc->motor.stop_side != 0) {
         /* the rotor on the stop's spring: sqrt(k_s / J) h within 1 keeps the integrator's step well inside its
@@ -284,18 +296,21 @@ int sil_scenario_check(const sil_scenario_t *sc, char *err, size_t err_size)
         const double h_s = (double)sc->controller.timing.period_s / (double)sc->substeps;
         const double phase = sqrt(sc->motor.stop_stiffness_Nm_rad / sc->motor.inertia_kgm2) * h_s;
         if (!(sc->motor.stop_stiffness_Nm_rad > 0.0)) {
-            return fail(err, err_size, "motor.stop_side = %d needs motor.stop_stiffness_Nm_rad > 0", sc->motor.stop_side);
+            return fail(err, err_size, "motor.stop_side = %d needs motor.stop_stiffness_Nm_rad > 0",
+                        sc->motor.stop_side);
         }
         if (!((double)sc->motor.stop_side * (sc->theta0_rad - sc->motor.stop_position_rad) < 0.0)) {
-            return fail(err, err_size, "motor.stop_position_rad = %g with motor.stop_side = %d: the rotor would start "
-                                       "at or beyond the stop (run.theta0_deg = %g)", sc->motor.stop_position_rad,
-                        sc->motor.stop_side, sc->theta0_rad * 180.0 / PI);
+            return fail(err, err_size,
+                        "motor.stop_position_rad = %g with motor.stop_side = %d: the rotor would start "
+                        "at or beyond the stop (run.theta0_deg = %g)",
+                        sc->motor.stop_position_rad, sc->motor.stop_side, sc->theta0_rad * 180.0 / PI);
         }
         if (phase > 1.0) {
-            return fail(err, err_size,
-                        "motor.stop_stiffness_Nm_rad = %g: sqrt(k_s / J) h = %g with a substep of %g s (at most 1): raise "
-                        "run.substeps to %.0f", sc->motor.stop_stiffness_Nm_rad, phase, h_s,
-                        ceil((double)sc->substeps * phase));
+            return fail(
+                err, err_size,
+                "motor.stop_stiffness_Nm_rad = %g: sqrt(k_s / J) h = %g with a substep of %g s (at most 1): raise "
+                "run.substeps to %.0f",
+                sc->motor.stop_stiffness_Nm_rad, phase, h_s, ceil((double)sc->substeps * phase));
         }
     }
     if (sc->load.kind == PLANT_LOAD_PROPORTIONAL && sc->integrator == PLANT_INTEGRATOR_RK4) {
@@ -311,8 +326,9 @@ int sil_scenario_check(const sil_scenario_t *sc, char *err, size_t err_size)
         }
     }
     if ((sc->faults.sensor != SIL_SENSOR_OK) != (sc->faults.sensor_phase != SIL_PHASES_NONE)) {
-        return fail(err, err_size, "faults.sensor and faults.sensor_phase go together: a failed sensor needs its phase, "
-                                   "a phase needs the failure (got %s on %s)",
+        return fail(err, err_size,
+                    "faults.sensor and faults.sensor_phase go together: a failed sensor needs its phase, "
+                    "a phase needs the failure (got %s on %s)",
                     sensor_fault_names[sc->faults.sensor], phases_names[sc->faults.sensor_phase]);
     }
     if (!(sc->bus.ripple_V < sc->bus_voltage_V)) {

@@ -133,7 +133,9 @@ void sil_scenario_print(const sil_scenario_t *sc, FILE *file)
         case KEY_POSITION_SOURCE:
             fprintf(file, "%s\n", position_source_names[*(const sil_position_source_t *)(base + k->offset)]);
             break;
-        case KEY_DIAG_MODE: fprintf(file, "%s\n", diag_mode_names[*(const pmstep_diag_mode_t *)(base + k->offset)]); break;
+        case KEY_DIAG_MODE:
+            fprintf(file, "%s\n", diag_mode_names[*(const pmstep_diag_mode_t *)(base + k->offset)]);
+            break;
         case KEY_MOVES:
             if (sc->position_moves > 0) {
                 print_points(file, sc->move_time_s, sc->move_target_rad, sc->position_moves);

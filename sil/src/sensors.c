@@ -85,14 +85,13 @@ void sil_sensors_currents(sil_sensors_t *s, double i_a_A, double i_b_A, double *
     *i_b_meas_A = phase_sample(s, i_b_A, &b, &s->clipped_current_samples);
 }
 
-void sil_sensors_phase_voltages(sil_sensors_t *s, double u_a_V, double u_b_V, double *u_a_meas_V,
-                                double *u_b_meas_V)
+void sil_sensors_phase_voltages(sil_sensors_t *s, double u_a_V, double u_b_V, double *u_a_meas_V, double *u_b_meas_V)
 {
     const sil_sensor_config_t *c = &s->cfg;
-    const phase_channel_t a = {c->phase_voltage_gain_error_a, c->phase_voltage_offset_a_V,
-                               c->phase_voltage_noise_rms_V, c->phase_voltage_full_scale_V, c->phase_voltage_bits};
-    const phase_channel_t b = {c->phase_voltage_gain_error_b, c->phase_voltage_offset_b_V,
-                               c->phase_voltage_noise_rms_V, c->phase_voltage_full_scale_V, c->phase_voltage_bits};
+    const phase_channel_t a = {c->phase_voltage_gain_error_a, c->phase_voltage_offset_a_V, c->phase_voltage_noise_rms_V,
+                               c->phase_voltage_full_scale_V, c->phase_voltage_bits};
+    const phase_channel_t b = {c->phase_voltage_gain_error_b, c->phase_voltage_offset_b_V, c->phase_voltage_noise_rms_V,
+                               c->phase_voltage_full_scale_V, c->phase_voltage_bits};
     *u_a_meas_V = phase_sample(s, u_a_V, &a, &s->clipped_voltage_samples);
     *u_b_meas_V = phase_sample(s, u_b_V, &b, &s->clipped_voltage_samples);
 }

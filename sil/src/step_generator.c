@@ -22,8 +22,8 @@ static double speed_up_s(double speed, double accel, double jerk)
 }
 
 /* A segment of @p duration_s at constant jerk, appended if it lasts; the next one's state follows. */
-static void add_segment(sil_step_move_t *m, double *t_s, double *position, double *speed, double accel,
-                        double jerk, double duration_s)
+static void add_segment(sil_step_move_t *m, double *t_s, double *position, double *speed, double accel, double jerk,
+                        double duration_s)
 {
     sil_step_segment_t *seg;
     if (!(duration_s > 0.0)) {
@@ -133,8 +133,8 @@ sil_step_sample_t sil_step_generator_sample(sil_step_generator_t *gen, double t_
         const sil_step_segment_t *seg = &m->segment[k];
         if (t_s < seg->end_s || k + 1 == m->segments) {
             const double h = t_s - seg->start_s;
-            out.position_rad = seg->position_rad
-                               + h * (seg->speed_rad_s + h * (0.5 * seg->accel_rad_s2 + h * seg->jerk_rad_s3 / 6.0));
+            out.position_rad =
+                seg->position_rad + h * (seg->speed_rad_s + h * (0.5 * seg->accel_rad_s2 + h * seg->jerk_rad_s3 / 6.0));
             out.speed_rad_s = seg->speed_rad_s + h * (seg->accel_rad_s2 + 0.5 * h * seg->jerk_rad_s3);
             out.accel_rad_s2 = seg->accel_rad_s2 + h * seg->jerk_rad_s3;
             break;

@@ -7,8 +7,7 @@
 
 #define PI 3.14159265358979323846
 
-pmstep_status_t sil_stepdir_run_init(sil_stepdir_run_t *run, const sil_scenario_t *sc, bool firmware,
-                                     sil_summary_t *s)
+pmstep_status_t sil_stepdir_run_init(sil_stepdir_run_t *run, const sil_scenario_t *sc, bool firmware, sil_summary_t *s)
 {
     sil_stepdir_summary_t *d = &s->stepdir;
     int n;
@@ -42,8 +41,8 @@ pmstep_status_t sil_stepdir_run_init(sil_stepdir_run_t *run, const sil_scenario_
             cfg.stop_time_s *= cfg.tracking_bandwidth_rad_s / sc->stepdir_tracking_bandwidth_rad_s;
             cfg.tracking_bandwidth_rad_s = sc->stepdir_tracking_bandwidth_rad_s;
         }
-        status = pmstep_stepdir_init(&run->input, &cfg, sc->controller.motor.pole_pairs,
-                                     sc->controller.timing.period_s, (uint16_t)SIL_STEPDIR_COUNTER_START);
+        status = pmstep_stepdir_init(&run->input, &cfg, sc->controller.motor.pole_pairs, sc->controller.timing.period_s,
+                                     (uint16_t)SIL_STEPDIR_COUNTER_START);
         if (status != PMSTEP_OK) {
             return status;
         }
@@ -61,8 +60,7 @@ void sil_stepdir_run_command(sil_stepdir_run_t *run, double t_s, pmstep_position
         /* Once: count 0 is put where the reference is now, before this period's count is read (the
          * first step of the first move is counted after it). A drive that leaves RUN loses the
          * position and is not told to follow again: the steps it missed stay missed. */
-        if (!run->following && due && pos->out.tracked
-            && pmstep_position_follow_steps(pos, &run->input) == PMSTEP_OK) {
+        if (!run->following && due && pos->out.tracked && pmstep_position_follow_steps(pos, &run->input) == PMSTEP_OK) {
             run->following = true;
             s->stepdir.following_start_s = t_s;
         }

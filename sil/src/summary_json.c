@@ -181,7 +181,8 @@ static void add_baseline_json(cJSON *root, const sil_scenario_t *sc, const sil_s
         cJSON_AddNumberToObject(drive, "current_A", sc->datasheet.rated_current_A);
         cJSON_AddNumberToObject(drive, "current_gain_per_s",
                                 SIL_MICROSTEP_GAIN_FRACTION / (double)sc->controller.timing.period_s);
-        cJSON_AddNumberToObject(drive, "pull_out_torque_Nm", sc->motor.torque_constant_Nm_A * sc->datasheet.rated_current_A);
+        cJSON_AddNumberToObject(drive, "pull_out_torque_Nm",
+                                sc->motor.torque_constant_Nm_A * sc->datasheet.rated_current_A);
         cJSON_AddItemToObject(root, "microstep", drive);
     }
 }
@@ -265,4 +266,3 @@ cJSON *sil_summary_json(const sil_scenario_t *sc, const sil_summary_t *s)
     cJSON_AddItemToObject(root, "timing", timing);
     return root;
 }
-

@@ -12,44 +12,43 @@
 
 static void usage(FILE *f)
 {
-    fprintf(f,
-            "usage: pmstep-tune (--motor FILE | --motor-db FILE --name NAME) [--robust [--low-speed-drive]]\n"
-            "                   [--force] [--no-field-weakening] [--set section.key=value]...\n"
-            "                   [--write-ini FILE] [--write-c FILE] [--validate]\n"
-            "                   [--told-inertia J] [--told-friction F] [--identify [--max-inertia-error PCT]]\n"
-            "                   [--identify-in-run] [--self-commission [--detent-fraction D]] [--summary FILE]\n"
-            "  --motor      motor preset (sil/scenarios/motors/*.ini): [datasheet], [motor], run.bus_voltage_V;\n"
-            "               run.period_s, run.delay_periods, [inverter] and [sensors] are the drive's\n"
-            "  --robust     robust mode: Remark 2 calibration, commissioned R/L/k_M, drift-free angle,\n"
-            "               dead-time compensation of inverter.dead_time_s\n"
-            "  --motor-db   a motor of a Klipper motor database: its [motor_constants NAME] section (resistance,\n"
-            "               inductance, holding_torque, max_current, steps_per_revolution); J and F, which it\n"
-            "               does not give, are estimated from the holding torque (and J identified in RUN)\n"
-            "  --force      design for data the datasheet check refuses (k_M, L/R or J no stepper has),\n"
-            "               with a warning\n"
-            "  --low-speed-drive  robust mode without phase-voltage sensing: below 2 V_bus t_d / (T_s k_M)\n"
-            "               the standstill hold's vector turns at the reference speed (a load step there is\n"
-            "               not learnt)\n"
-            "  --no-field-weakening  no field weakening: i_d* stays at its command at every speed\n"
-            "  --set        override a key of the preset before designing (e.g. run.period_s=25e-6)\n"
-            "  --write-ini  the whole scenario with the designed [controller.*] and a validation profile\n"
-            "  --write-c    the design as a C99 initialiser of pmstep_config_t\n"
-            "  --validate   run the design in the SIL: speed ramps to +-80 %% and +-5 %% of the top speed,\n"
-            "               load steps of half the holding torque at 50 %% and 5 %% of it; exit 1 on a miss\n"
-            "  --told-inertia, --told-friction  design for this J (kg m^2) / F (N m s/rad) in place of the\n"
-            "               preset's; the plant keeps the preset's (a datasheet that is off)\n"
-            "  --identify   run commissioning and the identification window in the SIL (ramps to +-80 %% of the\n"
-            "               top speed), design again with the identified J and F, print both designs and the\n"
-            "               errors against the plant; --validate then validates the second design\n"
-            "  --max-inertia-error  with --identify: exit 1 unless J is identified within PCT %% of the plant's\n"
-            "  --identify-in-run  the design asks the firmware to identify J and F in each run's first\n"
-            "               window and use them (commissioning.use_identified_mechanics)\n"
-            "  --self-commission  run the drive's own calibration (pmstep_calibrate.h) in the SIL on the\n"
-            "               preset's plant, told only the rated current and the pole pairs; print its design\n"
-            "               beside the datasheet's; --validate, --write-ini, --summary then take its design\n"
-            "  --detent-fraction  with --self-commission: the detent torque the user tells, as a fraction of\n"
-            "               the holding torque (default 0.05, a hybrid stepper's; 0 for a motor without one)\n"
-            "  --summary    the design's status and figures and each validation run's outcome as JSON\n");
+    fprintf(f, "usage: pmstep-tune (--motor FILE | --motor-db FILE --name NAME) [--robust [--low-speed-drive]]\n"
+               "                   [--force] [--no-field-weakening] [--set section.key=value]...\n"
+               "                   [--write-ini FILE] [--write-c FILE] [--validate]\n"
+               "                   [--told-inertia J] [--told-friction F] [--identify [--max-inertia-error PCT]]\n"
+               "                   [--identify-in-run] [--self-commission [--detent-fraction D]] [--summary FILE]\n"
+               "  --motor      motor preset (sil/scenarios/motors/*.ini): [datasheet], [motor], run.bus_voltage_V;\n"
+               "               run.period_s, run.delay_periods, [inverter] and [sensors] are the drive's\n"
+               "  --robust     robust mode: Remark 2 calibration, commissioned R/L/k_M, drift-free angle,\n"
+               "               dead-time compensation of inverter.dead_time_s\n"
+               "  --motor-db   a motor of a Klipper motor database: its [motor_constants NAME] section (resistance,\n"
+               "               inductance, holding_torque, max_current, steps_per_revolution); J and F, which it\n"
+               "               does not give, are estimated from the holding torque (and J identified in RUN)\n"
+               "  --force      design for data the datasheet check refuses (k_M, L/R or J no stepper has),\n"
+               "               with a warning\n"
+               "  --low-speed-drive  robust mode without phase-voltage sensing: below 2 V_bus t_d / (T_s k_M)\n"
+               "               the standstill hold's vector turns at the reference speed (a load step there is\n"
+               "               not learnt)\n"
+               "  --no-field-weakening  no field weakening: i_d* stays at its command at every speed\n"
+               "  --set        override a key of the preset before designing (e.g. run.period_s=25e-6)\n"
+               "  --write-ini  the whole scenario with the designed [controller.*] and a validation profile\n"
+               "  --write-c    the design as a C99 initialiser of pmstep_config_t\n"
+               "  --validate   run the design in the SIL: speed ramps to +-80 %% and +-5 %% of the top speed,\n"
+               "               load steps of half the holding torque at 50 %% and 5 %% of it; exit 1 on a miss\n"
+               "  --told-inertia, --told-friction  design for this J (kg m^2) / F (N m s/rad) in place of the\n"
+               "               preset's; the plant keeps the preset's (a datasheet that is off)\n"
+               "  --identify   run commissioning and the identification window in the SIL (ramps to +-80 %% of the\n"
+               "               top speed), design again with the identified J and F, print both designs and the\n"
+               "               errors against the plant; --validate then validates the second design\n"
+               "  --max-inertia-error  with --identify: exit 1 unless J is identified within PCT %% of the plant's\n"
+               "  --identify-in-run  the design asks the firmware to identify J and F in each run's first\n"
+               "               window and use them (commissioning.use_identified_mechanics)\n"
+               "  --self-commission  run the drive's own calibration (pmstep_calibrate.h) in the SIL on the\n"
+               "               preset's plant, told only the rated current and the pole pairs; print its design\n"
+               "               beside the datasheet's; --validate, --write-ini, --summary then take its design\n"
+               "  --detent-fraction  with --self-commission: the detent torque the user tells, as a fraction of\n"
+               "               the holding torque (default 0.05, a hybrid stepper's; 0 for a motor without one)\n"
+               "  --summary    the design's status and figures and each validation run's outcome as JSON\n");
 }
 
 /* main()'s steps: each returns PROCEED, or the exit status to end with. */
@@ -423,8 +422,10 @@ int main(int argc, char **argv)
         return rc;
     }
     rc = q.run_validation ? validate(&sc, (double)report.top_speed_rad_s, q.max_inertia_error_pct, checks) : 0;
-    if (q.summary_path != NULL && write_summary(q.summary_path, q.motor_path, q.robust, status, &report, checks,
-                                                q.run_validation ? TUNE_CHECKS : 0, &calibration) != 0) {
+    if (q.summary_path != NULL
+        && write_summary(q.summary_path, q.motor_path, q.robust, status, &report, checks,
+                         q.run_validation ? TUNE_CHECKS : 0, &calibration)
+               != 0) {
         return 2;
     }
     return rc;

@@ -14,15 +14,15 @@
 
 /* One run of the validation, for --summary. */
 typedef struct {
-    const char *check;         /* "ramps", "step_50", "step_5" */
-    bool ran;                  /* init accepted the configuration */
-    int fault;                 /* pmstep_fault_t latched, 0 none */
+    const char *check; /* "ramps", "step_50", "step_5" */
+    bool ran;          /* init accepted the configuration */
+    int fault;         /* pmstep_fault_t latched, 0 none */
     double fault_time_s;
-    double angle_error_rad;    /* largest angle-estimate error in RUN after the transients */
-    double speed_error_rad_s;  /* ramps: after the transients; steps: the dip after the load step */
-    double speed_bound_rad_s;  /* the tracking bound (2 % of the top speed) */
-    bool synchronous;          /* no fault, RUN to the end, angle error below SYNC_ANGLE_BOUND_RAD */
-    bool pass;                 /* as --validate judges it */
+    double angle_error_rad;   /* largest angle-estimate error in RUN after the transients */
+    double speed_error_rad_s; /* ramps: after the transients; steps: the dip after the load step */
+    double speed_bound_rad_s; /* the tracking bound (2 % of the top speed) */
+    bool synchronous;         /* no fault, RUN to the end, angle error below SYNC_ANGLE_BOUND_RAD */
+    bool pass;                /* as --validate judges it */
 } tune_check_t;
 
 #define TUNE_CHECKS 3
@@ -63,13 +63,13 @@ int load_motor_db(sil_scenario_t *sc, const char *path, const char *name, char *
 /* --self-commission's outcome beside the datasheet design, for --summary. */
 typedef struct {
     bool ran;
-    int32_t status;                  /* pmstep_calibrate_t::status */
-    int fault;                       /* the fault that ended the last run */
+    int32_t status; /* pmstep_calibrate_t::status */
+    int fault;      /* the fault that ended the last run */
     unsigned runs;
     double simulated_s;
-    pmstep_config_t datasheet;       /* the design from the datasheet */
+    pmstep_config_t datasheet; /* the design from the datasheet */
     pmstep_design_report_t datasheet_report;
-    pmstep_config_t drive;           /* the drive's own design (valid when status is 0) */
+    pmstep_config_t drive; /* the drive's own design (valid when status is 0) */
     pmstep_design_report_t drive_report;
 } tune_calibration_t;
 

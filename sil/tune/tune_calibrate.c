@@ -138,11 +138,13 @@ void print_calibration(const sil_scenario_t *sc, const pmstep_config_t *datashee
                        const pmstep_design_report_t *drive_report)
 {
     printf("  %-28s %-9s %12s %12s %10s\n", "", "", "datasheet", "drive", "drive/ds");
-    row("R", "Ohm", (double)datasheet->motor.resistance_Ohm, (double)drive->motor.resistance_Ohm, sc->motor.resistance_Ohm);
+    row("R", "Ohm", (double)datasheet->motor.resistance_Ohm, (double)drive->motor.resistance_Ohm,
+        sc->motor.resistance_Ohm);
     row("L", "H", (double)datasheet->motor.inductance_H, (double)drive->motor.inductance_H, sc->motor.inductance_H);
     row("k_M", "N m/A", (double)datasheet->motor.torque_constant_Nm_A, (double)drive->motor.torque_constant_Nm_A,
         sc->motor.torque_constant_Nm_A);
-    row("J", "kg m^2", (double)datasheet->motor.inertia_kgm2, (double)drive->motor.inertia_kgm2, sc->motor.inertia_kgm2);
+    row("J", "kg m^2", (double)datasheet->motor.inertia_kgm2, (double)drive->motor.inertia_kgm2,
+        sc->motor.inertia_kgm2);
     row("F", "N m s/rad", (double)datasheet->motor.friction_Nms_rad, (double)drive->motor.friction_Nms_rad,
         sc->motor.friction_Nms_rad);
     row("top speed", "rad/s", (double)datasheet_report->top_speed_rad_s, (double)drive_report->top_speed_rad_s, 0.0);

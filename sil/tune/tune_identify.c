@@ -36,7 +36,6 @@ int identify(const sil_scenario_t *designed, double top_speed_rad_s, pmstep_comm
            (double)sc.controller.commissioning.identification_time_s,
            (double)sc.controller.commissioning.identification_min_speed_rad_s,
            pmstep_identification_str(result->identification));
-    return result->identification == PMSTEP_IDENT_DONE || result->identification == PMSTEP_IDENT_FRICTION_NEGATIVE
-               ? 0
-               : 1;
+    return result->identification == PMSTEP_IDENT_DONE || result->identification == PMSTEP_IDENT_FRICTION_NEGATIVE ? 0
+                                                                                                                   : 1;
 }

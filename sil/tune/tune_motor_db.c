@@ -77,8 +77,10 @@ int load_motor_db(sil_scenario_t *sc, const char *path, const char *name, char *
         }
     }
     if (fmod(ctx.steps_per_revolution, 4.0) != 0.0) {
-        snprintf(err, err_size, "%s: [motor_constants %s] steps_per_revolution %g is not a two-phase motor's (a "
-                                "multiple of 4)", path, name, ctx.steps_per_revolution);
+        snprintf(err, err_size,
+                 "%s: [motor_constants %s] steps_per_revolution %g is not a two-phase motor's (a "
+                 "multiple of 4)",
+                 path, name, ctx.steps_per_revolution);
         return -1;
     }
     snprintf(sc->name, sizeof sc->name, "%s", name);

@@ -17,8 +17,8 @@
 
 static double ramp_time_s(const sil_scenario_t *sc, double speed_change_rad_s)
 {
-    const double accel = RAMP_ACCEL_FRACTION * sc->motor.torque_constant_Nm_A * sc->datasheet.rated_current_A
-                         / sc->motor.inertia_kgm2;
+    const double accel =
+        RAMP_ACCEL_FRACTION * sc->motor.torque_constant_Nm_A * sc->datasheet.rated_current_A / sc->motor.inertia_kgm2;
     const double t = fabs(speed_change_rad_s) / accel;
     return t > MIN_RAMP_S ? t : MIN_RAMP_S;
 }
@@ -76,8 +76,8 @@ static bool watch_load(const sil_sample_t *x, void *user)
 bool run_ok(const char *what, const sil_summary_t *s, int rc)
 {
     if (rc != 0 || s->fault != PMSTEP_FAULT_NONE || s->final_mode != PMSTEP_MODE_RUN || s->nonfinite_seen) {
-        printf("  %-34s FAIL: %s at %.3f s\n", what,
-               rc != 0 ? "init refused" : pmstep_fault_str(s->fault), s->fault_time_s);
+        printf("  %-34s FAIL: %s at %.3f s\n", what, rc != 0 ? "init refused" : pmstep_fault_str(s->fault),
+               s->fault_time_s);
         return false;
     }
     return true;
@@ -104,8 +104,7 @@ static void record(tune_check_t *c, const char *check, const sil_summary_t *s, i
     c->pass = pass;
 }
 
-int validate(const sil_scenario_t *designed, double top_speed_rad_s, double max_inertia_error_pct,
-             tune_check_t *checks)
+int validate(const sil_scenario_t *designed, double top_speed_rad_s, double max_inertia_error_pct, tune_check_t *checks)
 {
     static sil_scenario_t sc;
     sil_summary_t s;
@@ -122,8 +121,8 @@ int validate(const sil_scenario_t *designed, double top_speed_rad_s, double max_
     sc.load.kind = PLANT_LOAD_NONE;
     rc = sil_run(&sc, NULL, NULL, false, &s);
     if (run_ok("ramps to +-80 % and +-5 % of top", &s, rc)) {
-        const bool pass = s.max_speed_error_after_settle_rad_s < tracking_bound
-                          && s.max_angle_error_rad < ANGLE_BOUND_RAD;
+        const bool pass =
+            s.max_speed_error_after_settle_rad_s < tracking_bound && s.max_angle_error_rad < ANGLE_BOUND_RAD;
         record(checks, "ramps", &s, rc, s.max_speed_error_after_settle_rad_s, tracking_bound, pass);
         printf("  %-34s %s: |w - w*| %.3f rad/s (bound %.3f), angle error %.4f rad (bound %.2f)\n",
                "ramps to +-80 % and +-5 % of top", pass ? "pass" : "FAIL", s.max_speed_error_after_settle_rad_s,
@@ -132,8 +131,7 @@ int validate(const sil_scenario_t *designed, double top_speed_rad_s, double max_
             const double j_error_pct = 100.0 * ((double)s.commissioning.inertia_kgm2 / sc.motor.inertia_kgm2 - 1.0);
             const bool used = s.commissioning.identification == PMSTEP_IDENT_DONE
                               || s.commissioning.identification == PMSTEP_IDENT_FRICTION_NEGATIVE;
-            const bool ident_pass = max_inertia_error_pct < 0.0
-                                    || (used && fabs(j_error_pct) <= max_inertia_error_pct);
+            const bool ident_pass = max_inertia_error_pct < 0.0 || (used && fabs(j_error_pct) <= max_inertia_error_pct);
             printf("  %-34s %s: %s, J %.4g kg m^2 (%+.2f %% off the plant's), F %.4g N m s/rad\n", "identified in RUN",
                    ident_pass ? "pass" : "FAIL", pmstep_identification_str(s.commissioning.identification),
                    (double)s.commissioning.inertia_kgm2, j_error_pct, (double)s.commissioning.friction_Nms_rad);
@@ -162,15 +160,15 @@ int validate(const sil_scenario_t *designed, double top_speed_rad_s, double max_
         rc = sil_run(&sc, watch_load, &watch, false, &s);
         if (run_ok(what, &s, rc)) {
             const bool pass = s.max_angle_error_rad < SYNC_ANGLE_BOUND_RAD;
-            record(checks == NULL ? NULL : &checks[1 + k], k == 0 ? "step_50" : "step_5", &s, rc,
-                   watch.max_error_rad_s, tracking_bound, pass);
+            record(checks == NULL ? NULL : &checks[1 + k], k == 0 ? "step_50" : "step_5", &s, rc, watch.max_error_rad_s,
+                   tracking_bound, pass);
             printf("  %-34s %s: dip %.2f rad/s, back within %.3f rad/s after %.1f ms, angle error %.4f rad\n", what,
                    pass ? "pass" : "FAIL", watch.max_error_rad_s, tracking_bound,
                    1e3 * (watch.last_above_s - watch.from_s), s.max_angle_error_rad);
             failures += pass ? 0 : 1;
         } else {
-            record(checks == NULL ? NULL : &checks[1 + k], k == 0 ? "step_50" : "step_5", &s, rc,
-                   watch.max_error_rad_s, tracking_bound, false);
+            record(checks == NULL ? NULL : &checks[1 + k], k == 0 ? "step_50" : "step_5", &s, rc, watch.max_error_rad_s,
+                   tracking_bound, false);
             ++failures;
         }
     }

@@ -14,8 +14,8 @@
 
 typedef struct {
     double t_c;
-    double peak_transient;      /* max |omega - omega*| on [t_c, t_c + 0.1 s] */
-    double max_tracking;        /* max |omega - omega*| on [0.8 s, end] */
+    double peak_transient;           /* max |omega - omega*| on [t_c, t_c + 0.1 s] */
+    double max_tracking;             /* max |omega - omega*| on [0.8 s, end] */
     double max_cos_err, max_sin_err; /* on [t_c, end] */
     double load_hat_end, load_end;
     int saw_run;
@@ -51,9 +51,10 @@ static void run(const sil_scenario_t *sc, metrics_t *m, sil_summary_t *s)
     assert_int_equal(sil_run(sc, collect, m, false, s), 0);
     print_message("  %5.0f Hz delay %u theta0 %6.2f deg: cos(t_s) %.2e, cos(t_c) %.9f, peak %.4f, track %.5f rad/s, "
                   "T_L-hat %.5f Nm, angle err %.2e/%.2e\n",
-                  1.0 / (double)sc->controller.timing.period_s, (unsigned)sc->controller.timing.computational_delay_periods,
-                  sc->theta0_rad * 180.0 / PI, s->cos_ptheta_at_ts, s->cos_ptheta_at_tc, m->peak_transient,
-                  m->max_tracking, m->load_hat_end, m->max_cos_err, m->max_sin_err);
+                  1.0 / (double)sc->controller.timing.period_s,
+                  (unsigned)sc->controller.timing.computational_delay_periods, sc->theta0_rad * 180.0 / PI,
+                  s->cos_ptheta_at_ts, s->cos_ptheta_at_tc, m->peak_transient, m->max_tracking, m->load_hat_end,
+                  m->max_cos_err, m->max_sin_err);
     assert_int_equal(s->fault, PMSTEP_FAULT_NONE);
     assert_int_equal(s->final_mode, PMSTEP_MODE_RUN);
     assert_true(m->saw_run);

@@ -19,8 +19,7 @@ static pmstep_fault_t run_and_check(const char *what, const sil_scenario_t *sc, 
     sil_summary_t s;
     assert_int_equal(sil_run(sc, hook, user, false, &s), 0);
     print_message("  %-40s fault %-18s at %.4f s, loss of control at %.4f s, latency %.1f ms\n", what,
-                  pmstep_fault_str(s.fault), s.fault_time_s, s.loss_of_control_time_s,
-                  1e3 * s.detection_latency_s);
+                  pmstep_fault_str(s.fault), s.fault_time_s, s.loss_of_control_time_s, 1e3 * s.detection_latency_s);
     assert_int_not_equal(s.fault, PMSTEP_FAULT_NONE);
     assert_false(s.nonfinite_seen);
     if (s.loss_of_control_time_s >= 0.0) {

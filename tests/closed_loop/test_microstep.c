@@ -47,7 +47,7 @@ static void load_preset(sil_scenario_t *sc, const char *const *sets, size_t n_se
 typedef struct {
     double t1_s, t2_s;
     double theta1_rad, theta2_rad;
-    double theta_hold_end_rad;   /**< rotor angle when the hold ends */
+    double theta_hold_end_rad; /**< rotor angle when the hold ends */
     double hold_end_s;
     double theta_last_rad, omega_last_rad_s, angle_ref_last_rad;
     bool saw_hold, saw_run, firmware_instance;
@@ -142,9 +142,10 @@ static void load_step(double fraction_of_pull_out, sil_summary_t *s)
     snprintf(torque, sizeof torque, "load.torque_Nm=%.9g", fraction_of_pull_out * 0.16638 * 1.7);
     load_preset(&sc, sets, sizeof sets / sizeof sets[0]);
     run(&sc, &tr, s);
-    print_message("  load step %.2f k_M I = %.4f Nm at 1.6 s: loss of synchronism %d at %.5f s, max load angle %.3g rad\n",
-                  fraction_of_pull_out, sc.load.torque_Nm, (int)s->loss_of_synchronism, s->loss_of_synchronism_time_s,
-                  s->max_load_angle_rad);
+    print_message(
+        "  load step %.2f k_M I = %.4f Nm at 1.6 s: loss of synchronism %d at %.5f s, max load angle %.3g rad\n",
+        fraction_of_pull_out, sc.load.torque_Nm, (int)s->loss_of_synchronism, s->loss_of_synchronism_time_s,
+        s->max_load_angle_rad);
 }
 
 static void loses_synchronism_above_pull_out(void **state)
@@ -231,9 +232,10 @@ static void pmstep_mode_reports_the_same_metrics(void **state)
     sil_scenario_paper(&sc);
     sc.duration_s = 1.0;
     assert_int_equal(sil_run(&sc, NULL, NULL, false, &s), 0);
-    print_message("  pmstep (paper, 1 s): RMS %.4f A from %.4f s, max load angle %.3g rad (angle error %.3g), loss %d\n",
-                  s.rms_phase_current_A, s.metrics_start_time_s, s.max_load_angle_rad, s.max_angle_error_rad,
-                  (int)s.loss_of_synchronism);
+    print_message(
+        "  pmstep (paper, 1 s): RMS %.4f A from %.4f s, max load angle %.3g rad (angle error %.3g), loss %d\n",
+        s.rms_phase_current_A, s.metrics_start_time_s, s.max_load_angle_rad, s.max_angle_error_rad,
+        (int)s.loss_of_synchronism);
     assert_true(s.metrics_start_time_s == s.run_start_time_s);
     assert_true(s.max_load_angle_rad == s.max_angle_error_rad);
     assert_false(s.loss_of_synchronism);

@@ -40,8 +40,9 @@ static bool on_sample(const sil_sample_t *x, void *user)
         tr->samples_tracked++;
         if (x->position_updated) { /* the output's estimate is that of its update's period */
             tr->updates++;
-            tr->max_output_mismatch_rad = fmax(tr->max_output_mismatch_rad,
-                                               fabs((double)x->position->position_rad - x->position_rad) * tr->pole_pairs);
+            tr->max_output_mismatch_rad =
+                fmax(tr->max_output_mismatch_rad,
+                     fabs((double)x->position->position_rad - x->position_rad) * tr->pole_pairs);
         }
     }
     if (x->position->position_mode) {
@@ -70,8 +71,8 @@ static void paper_motor_moves_end_on_target_without_overshoot(void **state)
     assert_int_equal(sil_run(&sc, on_sample, &tr, false, &s), 0);
     print_message("%d moves: final error max %.3g mean %.3g electrical rad (move %d), overshoot %.3g of the move, "
                   "theta* - theta %.3g, estimate %.3g electrical rad\n",
-                  p->moves, p->max_final_error_rad, p->mean_final_error_rad, p->worst_move,
-                  p->max_overshoot_fraction, p->max_tracking_error_rad, p->max_estimate_error_rad);
+                  p->moves, p->max_final_error_rad, p->mean_final_error_rad, p->worst_move, p->max_overshoot_fraction,
+                  p->max_tracking_error_rad, p->max_estimate_error_rad);
     assert_int_equal(s.fault, PMSTEP_FAULT_NONE);
     assert_int_equal(p->moves, sc.position_moves);
     assert_int_equal(p->rejected_moves, 0);

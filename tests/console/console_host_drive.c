@@ -52,8 +52,8 @@ typedef struct {
     /* A unit programmed since its last erase: a second program of it fails. Known only for what this
      * process programmed; a unit of the file that is not all 0xFF counts as programmed too. */
     uint8_t written[2][SLOT_UNITS];
-    long ops;      /* erases and programs so far */
-    long cut_at;   /* the operation cut half-way (0: none) */
+    long ops;    /* erases and programs so far */
+    long cut_at; /* the operation cut half-way (0: none) */
 } file_flash_t;
 
 static uint32_t now_ms(void)
@@ -91,17 +91,14 @@ static void power_check(file_flash_t *f, uint32_t slot, uint32_t offset, uint32_
     f->ops++;
     if (f->cut_at > 0 && f->ops == f->cut_at) {
         (void)write_through(f, slot, offset, n);
-        fprintf(stderr, "console-host-drive: power cut in flash operation %ld (%s of slot %u at %u)\n", f->ops,
-                what, (unsigned)slot, (unsigned)offset);
+        fprintf(stderr, "console-host-drive: power cut in flash operation %ld (%s of slot %u at %u)\n", f->ops, what,
+                (unsigned)slot, (unsigned)offset);
         _exit(3);
     }
 }
 
 /* Whether the operation about to run is the one cut. */
-static int cut_now(const file_flash_t *f)
-{
-    return f->cut_at > 0 && f->ops + 1 == f->cut_at;
-}
+static int cut_now(const file_flash_t *f) { return f->cut_at > 0 && f->ops + 1 == f->cut_at; }
 
 static int32_t flash_erase(void *ctx, uint32_t slot)
 {
@@ -228,8 +225,10 @@ static int parse_u32(const char *text, unsigned long max, unsigned long *value)
 
 static int usage(const char *why)
 {
-    fprintf(stderr, "console-host-drive: %s\nusage: console-host-drive [--position] [--flash FILE "
-                    "[--board-id N] [--power-cut-after N]]\n", why);
+    fprintf(stderr,
+            "console-host-drive: %s\nusage: console-host-drive [--position] [--flash FILE "
+            "[--board-id N] [--power-cut-after N]]\n",
+            why);
     return 2;
 }
 
@@ -302,7 +301,8 @@ int main(int argc, char **argv)
     pmstep_console_attach_simulation(&con);
     if (with_position) {
         pmstep_position_config_t gains;
-        if (pmstep_position_design(&cfg, &gains) != PMSTEP_OK || pmstep_position_init(&position, &motor, &gains) != PMSTEP_OK) {
+        if (pmstep_position_design(&cfg, &gains) != PMSTEP_OK
+            || pmstep_position_init(&position, &motor, &gains) != PMSTEP_OK) {
             return 2;
         }
         pmstep_console_attach_position(&con, &position);

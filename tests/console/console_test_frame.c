@@ -76,7 +76,4 @@ uint32_t console_test_u32(const uint8_t *p)
     return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
 }
 
-int16_t console_test_i16(const uint8_t *p)
-{
-    return (int16_t)(uint16_t)(p[0] | (p[1] << 8));
-}
+int16_t console_test_i16(const uint8_t *p) { return (int16_t)(uint16_t)(p[0] | (p[1] << 8)); }

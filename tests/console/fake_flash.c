@@ -117,10 +117,7 @@ void fake_flash_init(fake_flash_t *f)
     f->ops.ctx = f;
 }
 
-void fake_flash_cut_after(fake_flash_t *f, long n)
-{
-    f->budget = n;
-}
+void fake_flash_cut_after(fake_flash_t *f, long n) { f->budget = n; }
 
 void fake_flash_power_on(fake_flash_t *f)
 {

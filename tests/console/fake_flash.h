@@ -19,9 +19,9 @@
 
 typedef struct {
     uint8_t bytes[2][FAKE_FLASH_SLOT_BYTES];
-    bool torn[2][FAKE_FLASH_UNITS]; /**< unit reads with an uncorrectable error */
+    bool torn[2][FAKE_FLASH_UNITS];    /**< unit reads with an uncorrectable error */
     bool written[2][FAKE_FLASH_UNITS]; /**< unit programmed since its erase */
-    long budget;          /**< operations left before the cut; < 0: no cut planned */
+    long budget;                       /**< operations left before the cut; < 0: no cut planned */
     bool powered;
     unsigned erases;
     unsigned programs;

@@ -35,7 +35,6 @@ static int setup(void **state)
 
 /* ---- host side of the protocol ---- */
 
-
 static void send_request(uint8_t type, uint8_t seq, const void *data, uint32_t n)
 {
     uint8_t buf[80];
@@ -53,15 +52,9 @@ static unsigned replies(reply_t *r, unsigned max)
     return console_test_replies(tx, n, r, max);
 }
 
-static int16_t ack_status(const reply_t *r)
-{
-    return console_test_i16(r->data);
-}
+static int16_t ack_status(const reply_t *r) { return console_test_i16(r->data); }
 
-static void boundary(void)
-{
-    pmstep_console_boundary(&con, &motor, &cfg, &snap);
-}
+static void boundary(void) { pmstep_console_boundary(&con, &motor, &cfg, &snap); }
 
 /* One control period of the core with zero currents on a 48 V bus. */
 static void step(void)
@@ -114,7 +107,7 @@ static void test_command_at_period_boundary(void **state)
     assert_int_equal(r[0].type, 0x82u);
     assert_int_equal(ack_status(&r[0]), PMSTEP_OK);
     assert_int_equal(console_test_u32(&r[0].data[2]), 42u); /* the step after period 41 */
-    assert_int_equal(snap.out.mode, PMSTEP_MODE_S_ALIGN); /* the step after the boundary ran started */
+    assert_int_equal(snap.out.mode, PMSTEP_MODE_S_ALIGN);   /* the step after the boundary ran started */
     send_request(PMSTEP_CONSOLE_SPEED_TARGET, 2u, target, 8u);
     step();
     assert_int_equal(replies(r, 2), 1u);
@@ -146,8 +139,8 @@ static void test_errors_answered(void **state)
     const float inf_id = INFINITY;
     const uint8_t junk[3] = {1u, 2u, 3u};
     (void)state;
-    send_request(0x33u, 9u, NULL, 0u);                          /* unknown */
-    send_request(PMSTEP_CONSOLE_SPEED_TARGET, 9u, junk, 3u);    /* wrong length */
+    send_request(0x33u, 9u, NULL, 0u);                       /* unknown */
+    send_request(PMSTEP_CONSOLE_SPEED_TARGET, 9u, junk, 3u); /* wrong length */
     send_request(PMSTEP_CONSOLE_SPEED_TARGET, 9u, nan_target, 8u);
     send_request(PMSTEP_CONSOLE_ID_TARGET, 9u, &inf_id, 4u);
     assert_int_equal(replies(r, 4), 4u);

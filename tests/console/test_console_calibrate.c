@@ -73,15 +73,9 @@ static int teardown(void **state)
     return 0;
 }
 
-static void send_request(uint8_t type, const void *data, uint32_t n)
-{
-    console_test_send(&con, type, ++seq, data, n);
-}
+static void send_request(uint8_t type, const void *data, uint32_t n) { console_test_send(&con, type, ++seq, data, n); }
 
-static unsigned replies(reply_t *r, unsigned max)
-{
-    return console_test_take_replies(&con, r, max);
-}
+static unsigned replies(reply_t *r, unsigned max) { return console_test_take_replies(&con, r, max); }
 
 /* One period: the boundary (as the application calls it while the console is pending), then the
  * step on the plant. */

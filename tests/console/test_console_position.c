@@ -55,10 +55,7 @@ static reply_t one_reply(void)
     return r;
 }
 
-static int16_t status_of(const reply_t *r)
-{
-    return console_test_i16(r->data);
-}
+static int16_t status_of(const reply_t *r) { return console_test_i16(r->data); }
 
 static void expect_error(uint8_t type, uint8_t code)
 {
@@ -164,7 +161,8 @@ static void test_requests_at_the_boundary(void **state)
     assert_int_equal(status_of(&r), PMSTEP_OK);
     assert_int_equal(r.data[2] | (r.data[3] << 8), 102u); /* the period the values are from */
     assert_float_equal(console_test_f32(&r.data[6]), (float)(angle / (double)cfg.motor.pole_pairs), 1e-5f);
-    assert_float_equal(console_test_f32(&r.data[10]), console_test_f32(&r.data[6]), 0.0f); /* speed mode: theta* = theta-hat */
+    assert_float_equal(console_test_f32(&r.data[10]), console_test_f32(&r.data[6]),
+                       0.0f); /* speed mode: theta* = theta-hat */
     assert_float_equal(console_test_f32(&r.data[14]), 0.0f, 0.0f);
     assert_int_equal(r.data[18], PMSTEP_CONSOLE_POSITION_TRACKED);
 
@@ -184,9 +182,10 @@ static void test_requests_at_the_boundary(void **state)
     pmstep_console_boundary(&con, &motor, &cfg, &snap);
     r = one_reply();
     assert_int_equal(status_of(&r), PMSTEP_OK);
-    assert_int_equal(r.data[18], PMSTEP_CONSOLE_POSITION_TRACKED | PMSTEP_CONSOLE_POSITION_MODE
-                                     | PMSTEP_CONSOLE_POSITION_MOVING);
-    assert_float_equal(console_test_f32(&r.data[14]), console_test_f32(&r.data[10]) - console_test_f32(&r.data[6]), 0.0f);
+    assert_int_equal(r.data[18],
+                     PMSTEP_CONSOLE_POSITION_TRACKED | PMSTEP_CONSOLE_POSITION_MODE | PMSTEP_CONSOLE_POSITION_MOVING);
+    assert_float_equal(console_test_f32(&r.data[14]), console_test_f32(&r.data[10]) - console_test_f32(&r.data[6]),
+                       0.0f);
 
     request(PMSTEP_CONSOLE_SET_POSITION_ZERO, 7u, NULL, 0u);
     pmstep_console_boundary(&con, &motor, &cfg, &snap);

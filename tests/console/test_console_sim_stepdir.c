@@ -117,10 +117,7 @@ static reply_t read_stepdir(void)
     return r;
 }
 
-static int32_t i32_at(const uint8_t *p)
-{
-    return (int32_t)console_test_u32(p);
-}
+static int32_t i32_at(const uint8_t *p) { return (int32_t)console_test_u32(p); }
 
 /* A hardware image, and a simulation image without the input: all three refused, counted, nothing
  * attached without simulation or position control. */
@@ -212,10 +209,10 @@ static void test_every_edge_counted_through_the_wrap(void **state)
     assert_int_equal(stepdir.steps, sum);
     r = read_stepdir();
     assert_int_equal(console_test_u32(&r.data[0]), snap.period);
-    assert_int_equal(i32_at(&r.data[4]), sum);                               /* the input's count */
-    assert_int_equal(i32_at(&r.data[8]), sum);                               /* the counter's edges */
+    assert_int_equal(i32_at(&r.data[4]), sum);                                /* the input's count */
+    assert_int_equal(i32_at(&r.data[8]), sum);                                /* the counter's edges */
     assert_int_equal(r.data[12] | (r.data[13] << 8), (uint32_t)sum % 65536u); /* the counter */
-    assert_int_equal(r.data[14], 0u);                                        /* not following */
+    assert_int_equal(r.data[14], 0u);                                         /* not following */
     assert_float_equal(console_test_f32(&r.data[15]), (float)sum * stepdir.rad_per_microstep, 1e-2f);
     assert_float_equal(console_test_f32(&r.data[19]), 0.0f, 0.0f);
 }
@@ -246,7 +243,7 @@ static void test_follow_at_the_boundary(void **state)
     assert_int_equal(r.type, PMSTEP_CONSOLE_SIM_FOLLOW_STEPS | 0x80u);
     assert_int_equal(console_test_i16(r.data), PMSTEP_OK);
     assert_int_equal(console_test_u32(&r.data[2]), snap.period + 1u); /* the next period */
-    assert_int_equal(stepdir.steps, 0);                              /* afresh: the bursts dropped */
+    assert_int_equal(stepdir.steps, 0);                               /* afresh: the bursts dropped */
     assert_int_equal(stepdir.last_counter, 1000u);
     assert_true(stepdir.following);
     assert_true(position.out.position_mode);

@@ -55,15 +55,9 @@ static int setup(void **state)
     return 0;
 }
 
-static void send_request(uint8_t type, const void *data, uint32_t n)
-{
-    console_test_send(&con, type, ++seq, data, n);
-}
+static void send_request(uint8_t type, const void *data, uint32_t n) { console_test_send(&con, type, ++seq, data, n); }
 
-static unsigned replies(reply_t *r, unsigned max)
-{
-    return console_test_take_replies(&con, r, max);
-}
+static unsigned replies(reply_t *r, unsigned max) { return console_test_take_replies(&con, r, max); }
 
 /* One control period of the core with zero currents on a 48 V bus, the mailbox applied before it. */
 static void step(void)

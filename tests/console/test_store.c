@@ -321,7 +321,7 @@ static uint32_t record_before_stepdir(const pmstep_store_record_t *rec, uint32_t
     }
     n = 32u + 4u * old + 4u * PMSTEP_STORE_MEASURED_VALUES + 4u;
     memcpy(out, full, 32u);
-    memcpy(&out[32], &full[32], 4u * old);                                                  /* the values */
+    memcpy(&out[32], &full[32], 4u * old);                                                    /* the values */
     memcpy(&out[32u + 4u * old], &full[32u + 4u * count], 4u * PMSTEP_STORE_MEASURED_VALUES); /* measured */
     out[12] = (uint8_t)layout;
     out[13] = (uint8_t)(layout >> 8);
@@ -421,10 +421,7 @@ static void test_saves_alternate_slots(void **state)
 }
 
 /* The operations (erases and 8-byte programs) of one save. */
-static long save_operations(void)
-{
-    return 1L + (long)((pmstep_store_record_bytes() + 7u) / 8u);
-}
+static long save_operations(void) { return 1L + (long)((pmstep_store_record_bytes() + 7u) / 8u); }
 
 /* A power cut in the middle of every operation of a save, over a store holding one record and
  * over one holding two: after the reset the previous record is in force, and the next save works. */

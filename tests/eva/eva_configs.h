@@ -11,16 +11,10 @@
 #include "pmstep_test_configs.h"
 
 /* The configurations the step harnesses analyse. */
-static pmstep_config_t eva_paper_config(void)
-{
-    return pmstep_paper_config();
-}
+static pmstep_config_t eva_paper_config(void) { return pmstep_paper_config(); }
 
 /* Every optional feature on (tests/include/pmstep_test_configs.h, shared with the fuzzer). */
-static pmstep_config_t eva_features_config(void)
-{
-    return pmstep_test_features_config();
-}
+static pmstep_config_t eva_features_config(void) { return pmstep_test_features_config(); }
 
 /* As eva_features_config in known-load mode (Remark 1), R from one steady state per phase
  * (no voltage bias level), no offset calibration before the alignment. */
@@ -28,7 +22,7 @@ static pmstep_config_t eva_known_load_config(void)
 {
     pmstep_config_t cfg = eva_features_config();
     cfg.known_load_mode = true;
-    cfg.standstill.hold_current_A = 0.0f; /* a vector hold needs (6) */
+    cfg.standstill.hold_current_A = 0.0f;     /* a vector hold needs (6) */
     cfg.standstill.vector_speed_rad_s = 0.0f; /* and the low-speed drive turns it */
     cfg.commissioning.voltage_bias_level_fraction = 0.0f;
     cfg.commissioning.offset_calibration_time_s = 0.0f;
@@ -46,10 +40,7 @@ static pmstep_config_t eva_sensed_config(void)
 }
 
 /* Any finite float. */
-static float eva_any_finite(void)
-{
-    return Frama_C_float_interval(-FLT_MAX, FLT_MAX);
-}
+static float eva_any_finite(void) { return Frama_C_float_interval(-FLT_MAX, FLT_MAX); }
 
 /* Every field of a configuration arbitrary: floats any finite value, integers any value,
  * bools either. */

@@ -9,8 +9,10 @@ int main(void)
     pmstep_status_t status;
     if (Frama_C_nondet(0, 1)) {
         /* a missing instance or configuration is refused */
-        return pmstep_init(NULL, &cfg) == PMSTEP_ERR_NULL_ARGUMENT && pmstep_init(&inst, NULL) == PMSTEP_ERR_NULL_ARGUMENT
-               ? 2 : 3;
+        return pmstep_init(NULL, &cfg) == PMSTEP_ERR_NULL_ARGUMENT
+                       && pmstep_init(&inst, NULL) == PMSTEP_ERR_NULL_ARGUMENT
+                   ? 2
+                   : 3;
     }
     eva_any_config(&cfg);
     status = pmstep_init(&inst, &cfg);

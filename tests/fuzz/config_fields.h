@@ -42,7 +42,7 @@ static inline pmstep_config_t fuzz_base_config(unsigned which)
         cfg = pmstep_test_features_config(); /* tests/include, shared with the EVA harnesses */
         cfg.known_load_mode = which == 2u;
         if (cfg.known_load_mode) {
-            cfg.standstill.hold_current_A = 0.0f; /* a vector hold needs (6) */
+            cfg.standstill.hold_current_A = 0.0f;     /* a vector hold needs (6) */
             cfg.standstill.vector_speed_rad_s = 0.0f; /* and the low-speed drive turns it */
         }
     } else if (which == 3u) {
@@ -54,38 +54,20 @@ static inline pmstep_config_t fuzz_base_config(unsigned which)
 }
 
 /* Control period, for the harness's plant (read from a configuration init accepted). */
-static inline float fuzz_period_s(const pmstep_config_t *cfg)
-{
-    return cfg->timing.period_s;
-}
+static inline float fuzz_period_s(const pmstep_config_t *cfg) { return cfg->timing.period_s; }
 
 /* Protection limits, for measurements on their edges. */
-static inline float fuzz_current_limit_a(const pmstep_config_t *cfg)
-{
-    return cfg->limits.max_phase_current_A;
-}
+static inline float fuzz_current_limit_a(const pmstep_config_t *cfg) { return cfg->limits.max_phase_current_A; }
 
-static inline float fuzz_min_bus_v(const pmstep_config_t *cfg)
-{
-    return cfg->limits.min_bus_voltage_V;
-}
+static inline float fuzz_min_bus_v(const pmstep_config_t *cfg) { return cfg->limits.min_bus_voltage_V; }
 
-static inline float fuzz_max_bus_v(const pmstep_config_t *cfg)
-{
-    return cfg->limits.max_bus_voltage_V;
-}
+static inline float fuzz_max_bus_v(const pmstep_config_t *cfg) { return cfg->limits.max_bus_voltage_V; }
 
 /* Re-alignments allowed after a detection. */
-static inline uint32_t fuzz_max_realignments(const pmstep_config_t *cfg)
-{
-    return cfg->detection.max_realignments;
-}
+static inline uint32_t fuzz_max_realignments(const pmstep_config_t *cfg) { return cfg->detection.max_realignments; }
 
 /* A float32 value is finite. */
-static inline bool fuzz_finite(float x)
-{
-    return isfinite(x) != 0;
-}
+static inline bool fuzz_finite(float x) { return isfinite(x) != 0; }
 
 /* The first @p count floats of a struct made of floats. */
 static inline bool fuzz_floats_finite(const void *first, size_t count)

@@ -42,10 +42,7 @@ typedef struct {
     size_t pos;
 } reader_t;
 
-static uint8_t read_u8(reader_t *r)
-{
-    return r->pos < r->size ? r->data[r->pos++] : 0u;
-}
+static uint8_t read_u8(reader_t *r) { return r->pos < r->size ? r->data[r->pos++] : 0u; }
 
 typedef struct {
     pmstep_console_t con;
@@ -71,17 +68,14 @@ static void fail(const state_t *st, const char *what)
     abort();
 }
 
-#define CHECK(cond, what)                                                                                              \
-    do {                                                                                                               \
-        if (!(cond)) {                                                                                                 \
-            fail(st, what);                                                                                            \
-        }                                                                                                              \
+#define CHECK(cond, what)   \
+    do {                    \
+        if (!(cond)) {      \
+            fail(st, what); \
+        }                   \
     } while (0)
 
-static bool is_finite(float x)
-{
-    return isfinite(x) != 0;
-}
+static bool is_finite(float x) { return isfinite(x) != 0; }
 
 /* The limits are finite, ordered and bounded, and the whole configuration valid. */
 static void check_config(const state_t *st)
@@ -183,7 +177,8 @@ static void period(state_t *st)
     st->cfg_before = st->cfg;
     pmstep_console_boundary(&st->con, &st->motor, &st->cfg, &st->snap);
     if (memcmp(&st->cfg_before, &st->cfg, sizeof st->cfg) != 0) {
-        CHECK(cmd == PMSTEP_CONSOLE_SET_CONFIG && idle_before, "the configuration changed without a SET_CONFIG in IDLE");
+        CHECK(cmd == PMSTEP_CONSOLE_SET_CONFIG && idle_before,
+              "the configuration changed without a SET_CONFIG in IDLE");
         check_config(st);
     }
     if (cmd == PMSTEP_CONSOLE_CLEAR_FAULT) {
@@ -243,9 +238,9 @@ static void period(state_t *st)
 static uint32_t special_frame(reader_t *r, uint8_t *buf)
 {
     static const uint8_t types[] = {PMSTEP_CONSOLE_SPEED_TARGET, PMSTEP_CONSOLE_ID_TARGET, PMSTEP_CONSOLE_SET_CONFIG,
-                                    PMSTEP_CONSOLE_MOVE_TO, PMSTEP_CONSOLE_HOLD, PMSTEP_CONSOLE_TELEMETRY};
-    static const float specials[] = {NAN, INFINITY, -INFINITY, 0.0f, -0.0f, 1e-40f, 3.4e38f, -3.4e38f, 1e30f,
-                                     60.0f, 10.0f, 300.0f, 0.5f, 1.0f, -1.0f, 16.0f};
+                                    PMSTEP_CONSOLE_MOVE_TO,      PMSTEP_CONSOLE_HOLD,      PMSTEP_CONSOLE_TELEMETRY};
+    static const float specials[] = {NAN,   INFINITY, -INFINITY, 0.0f,   -0.0f, 1e-40f, 3.4e38f, -3.4e38f,
+                                     1e30f, 60.0f,    10.0f,     300.0f, 0.5f,  1.0f,   -1.0f,   16.0f};
     const uint8_t type = types[read_u8(r) % sizeof types];
     const float value = specials[read_u8(r) % (sizeof specials / sizeof specials[0])];
     const uint8_t field = read_u8(r);

@@ -35,10 +35,7 @@ typedef struct {
     size_t pos;
 } reader_t;
 
-static uint8_t read_u8(reader_t *r)
-{
-    return r->pos < r->size ? r->data[r->pos++] : 0u;
-}
+static uint8_t read_u8(reader_t *r) { return r->pos < r->size ? r->data[r->pos++] : 0u; }
 
 static uint16_t read_u16(reader_t *r)
 {
@@ -64,11 +61,11 @@ static void fail(const char *what, unsigned step)
     abort();
 }
 
-#define CHECK(cond, what)                                                                                              \
-    do {                                                                                                               \
-        if (!(cond)) {                                                                                                 \
-            fail(what, st->steps);                                                                                     \
-        }                                                                                                              \
+#define CHECK(cond, what)          \
+    do {                           \
+        if (!(cond)) {             \
+            fail(what, st->steps); \
+        }                          \
     } while (0)
 
 /* Values that sit on the edges of what the core compares against. */
@@ -101,13 +98,13 @@ static void perturb(pmstep_config_t *cfg, reader_t *r)
     float value;
     memcpy(&old, (unsigned char *)cfg + offset, sizeof old);
     switch (kind % 8u) {
-    case 0: value = payload; break;                                          /* raw bits */
+    case 0: value = payload; break; /* raw bits */
     case 1: value = old * 0.5f; break;
     case 2: value = old * 2.0f; break;
     case 3: value = nextafterf(old, INFINITY); break;
     case 4: value = nextafterf(old, -INFINITY); break;
     case 5: value = special_value((uint8_t)(kind >> 3), old, old); break;
-    case 6: value = old * (1.0f + ldexpf((float)(kind >> 3), -6)); break;   /* small scale up */
+    case 6: value = old * (1.0f + ldexpf((float)(kind >> 3), -6)); break; /* small scale up */
     default: {
         /* an integer word (pole pairs, delay, realignments) */
         uint32_t word = (uint32_t)(kind >> 3);
@@ -123,12 +120,12 @@ typedef struct {
     pmstep_config_t cfg;
     pmstep_output_t out;
     unsigned steps;
-    bool in_fault;              /* the last output was FAULT and nothing has cleared it */
+    bool in_fault; /* the last output was FAULT and nothing has cleared it */
     pmstep_fault_t fault;
     uint32_t fault_step;
     /* The motor model (paper's motor, scaled) the core drives. */
     double theta, omega, i_a, i_b;
-    double u_a, u_b;            /* voltage applied over the coming period */
+    double u_a, u_b; /* voltage applied over the coming period */
     double r_Ohm, l_H, j, km;
     uint32_t rng;
 } state_t;
@@ -144,9 +141,9 @@ static double uniform(state_t *st)
 static void check_output(state_t *st, const pmstep_meas_t *meas)
 {
     const pmstep_output_t *o = &st->out;
-    const float floats[] = {o->u_a_V, o->u_b_V, o->cos_hat, o->sin_hat, o->speed_hat_rad_s, o->load_hat_Nm,
-                            o->i_a_hat_A, o->i_b_hat_A, o->speed_ref_rad_s, o->speed_ref_rate_rad_s2, o->i_d_A,
-                            o->i_q_A, o->i_d_ref_A, o->i_q_ref_A};
+    const float floats[] = {o->u_a_V,       o->u_b_V,     o->cos_hat,   o->sin_hat,         o->speed_hat_rad_s,
+                            o->load_hat_Nm, o->i_a_hat_A, o->i_b_hat_A, o->speed_ref_rad_s, o->speed_ref_rate_rad_s2,
+                            o->i_d_A,       o->i_q_A,     o->i_d_ref_A, o->i_q_ref_A};
     size_t n;
     for (n = 0; n < sizeof floats / sizeof floats[0]; ++n) {
         CHECK(fuzz_finite(floats[n]), "an output is not finite");
@@ -214,7 +211,7 @@ static void plant_advance(state_t *st, double period_s, double load_Nm)
 /* @p n periods of the model: measurements with offsets and noise, bus with ripple. */
 static void run_plant(state_t *st, reader_t *r, unsigned n)
 {
-    const double bus = 25.0 + 0.2 * read_u8(r);          /* 25 .. 76 V: both sides of the paper's limits */
+    const double bus = 25.0 + 0.2 * read_u8(r); /* 25 .. 76 V: both sides of the paper's limits */
     const double ripple = 0.02 * read_u8(r);
     const double noise = 0.0005 * read_u8(r);
     const double offset = 0.002 * ((double)read_u8(r) - 128.0);
@@ -329,9 +326,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             CHECK(status == PMSTEP_OK, "a plain speed target refused");
             break;
         }
-        case 6:
-            (void)pmstep_set_id_target(&st->inst, read_f32(&r));
-            break;
+        case 6: (void)pmstep_set_id_target(&st->inst, read_f32(&r)); break;
         case 7:
         case 8:
             /* the bulk of the run: the model for up to 4096 periods */

@@ -19,10 +19,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 static char path[64];
 
-static void remove_scratch(void)
-{
-    remove(path);
-}
+static void remove_scratch(void) { remove(path); }
 
 static void fail(const char *what, const char *detail)
 {

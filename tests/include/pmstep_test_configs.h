@@ -26,7 +26,7 @@ static inline pmstep_config_t pmstep_test_features_config(void)
     cfg.inverter.dead_time_s = 1e-6f;
     cfg.inverter.dead_time_current_band_A = 0.005f;
     cfg.gains.angle_correction_gain_per_s = 20.0f;
-    cfg.gains.current_integral_gain_per_s2 = 33800.0f; /* (R/L + K_i)^2 / 8 = 520^2 / 8 */
+    cfg.gains.current_integral_gain_per_s2 = 33800.0f;   /* (R/L + K_i)^2 / 8 = 520^2 / 8 */
     cfg.gains.current_integral_gain_q_per_s2 = 33800.0f; /* the same on the q axis */
     cfg.motor.detent_torque_Nm = 0.05f;
     cfg.gains.detent_fade_speed_rad_s = 166.7f; /* the designer's: 4 p w_f = 2 x 2000 rad/s, p = 6 */

@@ -71,7 +71,8 @@ int main(int argc, char **argv)
         } else if (tag == SIL_RECORD_TAG_PERIOD) {
             const uint32_t *host = &w[SIL_RECORD_IN_WORDS];
             int any = 0;
-            if (sil_record_read_words(rec, w, SIL_RECORD_PERIOD_WORDS) != 0 || sil_record_read_words(tgt, t, SIL_RECORD_OUT_WORDS) != 0) {
+            if (sil_record_read_words(rec, w, SIL_RECORD_PERIOD_WORDS) != 0
+                || sil_record_read_words(tgt, t, SIL_RECORD_OUT_WORDS) != 0) {
                 fprintf(stderr, "pil-compare: a file ends before period %lu\n", periods);
                 return 1;
             }
@@ -92,8 +93,8 @@ int main(int argc, char **argv)
             periods_differing += (unsigned long)any;
             ++periods;
         } else if (tag == SIL_RECORD_TAG_END) {
-            if (sil_record_read_words(rec, w, 1u) != 0 || w[0] != periods || sil_record_read_words(tgt, t, 2u) != 0 || t[0] != PIL_OUTPUT_END
-                || t[1] != periods) {
+            if (sil_record_read_words(rec, w, 1u) != 0 || w[0] != periods || sil_record_read_words(tgt, t, 2u) != 0
+                || t[0] != PIL_OUTPUT_END || t[1] != periods) {
                 fprintf(stderr, "pil-compare: period counts differ (record %lu)\n", periods);
                 return 1;
             }

@@ -158,8 +158,10 @@ static void averaged_dead_time_converges_across_zero_crossings(void **state)
         const plant_state_t ref = dead_time_crossings_run(200, PLANT_INTEGRATOR_RK4);
         const plant_state_t s1 = dead_time_crossings_run(1, methods[m]);
         const plant_state_t s4 = dead_time_crossings_run(4, methods[m]);
-        const double e1 = fabs(s1.i_a_A - ref.i_a_A) + fabs(s1.i_b_A - ref.i_b_A) + fabs(s1.omega_rad_s - ref.omega_rad_s);
-        const double e4 = fabs(s4.i_a_A - ref.i_a_A) + fabs(s4.i_b_A - ref.i_b_A) + fabs(s4.omega_rad_s - ref.omega_rad_s);
+        const double e1 =
+            fabs(s1.i_a_A - ref.i_a_A) + fabs(s1.i_b_A - ref.i_b_A) + fabs(s1.omega_rad_s - ref.omega_rad_s);
+        const double e4 =
+            fabs(s4.i_a_A - ref.i_a_A) + fabs(s4.i_b_A - ref.i_b_A) + fabs(s4.omega_rad_s - ref.omega_rad_s);
         print_message("%s, dead time across zero crossings: error at 1 and 4 steps a period %.3g, %.3g (ratio %.1f)\n",
                       m == 0 ? "rk4" : "exponential", e1, e4, e1 / e4);
         assert_true(e1 < 1e-5);
@@ -253,8 +255,9 @@ static void switching_in_one_exponential_step_keeps_the_ripple(void **state)
         sil_drive_advance(&sw, &inv, PERIOD_S, 1);
     }
     print_message("one step a period: mean %.12f A (dV/R %.12f), valley %.12f A (analytic %.12f), max %.12f "
-                  "(%.12f), min %.12f (%.12f)\n", inv.mean_current_A[0], u_V / R_OHM, sw.x.i_a_A, i_valley,
-                  inv.max_current_A[0], i_max, inv.min_current_A[0], i_min);
+                  "(%.12f), min %.12f (%.12f)\n",
+                  inv.mean_current_A[0], u_V / R_OHM, sw.x.i_a_A, i_valley, inv.max_current_A[0], i_max,
+                  inv.min_current_A[0], i_min);
     assert_true(fabs(inv.mean_current_A[0] - u_V / R_OHM) < 1e-9);
     assert_true(fabs(sw.x.i_a_A - i_valley) < 1e-9);
     assert_true(fabs(inv.max_current_A[0] - i_max) < 1e-9);
@@ -297,9 +300,11 @@ static void switching_one_step_matches_the_segments(void **state)
     const plant_state_t one = switching_motor_run(PLANT_INTEGRATOR_EXPONENTIAL, 1, &bus_one);
     const plant_state_t ref = switching_motor_run(PLANT_INTEGRATOR_RK4, 20, &bus_ref);
     (void)state;
-    print_message("switching, one exponential step vs segments: d theta %.3g rad, d omega %.3g rad/s, d i %.3g / %.3g A, "
-                  "d i_bus %.3g A (omega %.3f rad/s)\n", one.theta_rad - ref.theta_rad, one.omega_rad_s - ref.omega_rad_s,
-                  one.i_a_A - ref.i_a_A, one.i_b_A - ref.i_b_A, bus_one - bus_ref, ref.omega_rad_s);
+    print_message(
+        "switching, one exponential step vs segments: d theta %.3g rad, d omega %.3g rad/s, d i %.3g / %.3g A, "
+        "d i_bus %.3g A (omega %.3f rad/s)\n",
+        one.theta_rad - ref.theta_rad, one.omega_rad_s - ref.omega_rad_s, one.i_a_A - ref.i_a_A, one.i_b_A - ref.i_b_A,
+        bus_one - bus_ref, ref.omega_rad_s);
     assert_true(fabs(ref.omega_rad_s) > 1.0);
     assert_true(fabs(one.theta_rad - ref.theta_rad) < 1e-8);
     assert_true(fabs(one.omega_rad_s - ref.omega_rad_s) < 1e-7);
@@ -342,8 +347,8 @@ static void switching_dead_time_takes_the_sign_at_each_edge(void **state)
     const double far_V = crossing_period_mean_V(PLANT_INTEGRATOR_EXPONENTIAL, 1, 2.0, &i_end_far);
     (void)state;
     print_message("crossing period: mean u %.9f V (one step), %.9f V (segments), expected %.9f V; i 0.22 -> %.4f A; "
-                  "from 2 A: %.9f V (expected %.9f V)\n", one_V, seg_V, expected_V, i_end_one, far_V,
-                  command_V - 2.0 * one_edge_V);
+                  "from 2 A: %.9f V (expected %.9f V)\n",
+                  one_V, seg_V, expected_V, i_end_one, far_V, command_V - 2.0 * one_edge_V);
     assert_true(i_end_one < -0.1 && i_end_seg < -0.1 && i_end_far > 1.0);
     assert_true(fabs(one_V - expected_V) < 1e-9);
     assert_true(fabs(seg_V - expected_V) < 1e-9);
@@ -455,8 +460,8 @@ static void bus_ripple_and_duty_clip(void **state)
     print_message("command 60 V / -20 V against a 40 V reading, bus ~50 V: mean u = %.6f V, %.6f V; %lu clipped\n",
                   inv.applied_a_V, inv.applied_b_V, inv.limited_periods);
     assert_true(inv.limited_periods == 1u);
-    assert_true(fabs(inv.applied_a_V - (BUS_V + 2.0)) < 1e-3);          /* d = 1 */
-    assert_true(fabs(inv.applied_b_V + 0.5 * (BUS_V + 2.0)) < 1e-3);    /* d = -0.5 */
+    assert_true(fabs(inv.applied_a_V - (BUS_V + 2.0)) < 1e-3);       /* d = 1 */
+    assert_true(fabs(inv.applied_b_V + 0.5 * (BUS_V + 2.0)) < 1e-3); /* d = -0.5 */
 }
 
 int main(void)

@@ -32,8 +32,8 @@ static void locked_rotor_rl_step_response(void **state)
         plant_advance(&plant, u, 0.0, period, 10);
         max_err = fmax(max_err, fabs(plant.x.i_a_A - u / 3.0 * (1.0 - exp(-500.0 * k * period))));
     }
-    print_message("locked rotor: max |i_a - analytic| = %.3g A; theta = %g, i_b = %g\n", max_err,
-                  plant.x.theta_rad, plant.x.i_b_A);
+    print_message("locked rotor: max |i_a - analytic| = %.3g A; theta = %g, i_b = %g\n", max_err, plant.x.theta_rad,
+                  plant.x.i_b_A);
     assert_true(max_err < 1e-9);
     assert_true(plant.x.theta_rad == 0.0 && plant.x.omega_rad_s == 0.0 && plant.x.i_b_A == 0.0);
 }
@@ -124,8 +124,8 @@ static plant_state_t coupled_run(int substeps)
 
 static double distance(const plant_state_t *a, const plant_state_t *b)
 {
-    return fabs(a->theta_rad - b->theta_rad) + fabs(a->omega_rad_s - b->omega_rad_s)
-           + fabs(a->i_a_A - b->i_a_A) + fabs(a->i_b_A - b->i_b_A);
+    return fabs(a->theta_rad - b->theta_rad) + fabs(a->omega_rad_s - b->omega_rad_s) + fabs(a->i_a_A - b->i_a_A)
+           + fabs(a->i_b_A - b->i_b_A);
 }
 
 static void halving_the_substep_cuts_the_error_16_times(void **state)
@@ -224,7 +224,8 @@ static void detent_static_torque(void **state)
             plant_t plant = detent_plant(m < 2 ? methods[m] : PLANT_INTEGRATOR_RK4);
             plant_state_t dx;
             const double i_a = m == 2 ? 0.7 : 0.0, i_b = m == 2 ? -0.4 : 0.0;
-            const double expected = (k_m * (-i_a * sin(p * theta) + i_b * cos(p * theta)) - t_d * sin(4.0 * p * theta)) / j;
+            const double expected =
+                (k_m * (-i_a * sin(p * theta) + i_b * cos(p * theta)) - t_d * sin(4.0 * p * theta)) / j;
             plant.params.torque_constant_Nm_A = m == 2 ? k_m : 0.0;
             plant.x.theta_rad = theta;
             plant.x.i_a_A = i_a;
@@ -238,7 +239,8 @@ static void detent_static_torque(void **state)
         }
     }
     print_message("detent static torque: max |J omega' + T_d sin 4p theta| / T_d = %.3g (derivative), %.3g (one "
-                  "%.0e s step)\n", max_rel, max_rel_step, h);
+                  "%.0e s step)\n",
+                  max_rel, max_rel_step, h);
     assert_true(max_rel < 1e-12);
     assert_true(max_rel_step < 1e-9);
 }
@@ -276,8 +278,8 @@ static double detent_pendulum_period(plant_integrator_t method, double phi0, dou
         plant.time_s = (double)k * h;
         plant_advance(&plant, 0.0, 0.0, h, 1);
         if (x0.theta_rad < 0.0 && plant.x.theta_rad >= 0.0) {
-            const double t = (double)k * h + hermite_zero(x0.theta_rad, x0.omega_rad_s, plant.x.theta_rad,
-                                                          plant.x.omega_rad_s, h);
+            const double t =
+                (double)k * h + hermite_zero(x0.theta_rad, x0.omega_rad_s, plant.x.theta_rad, plant.x.omega_rad_s, h);
             if (crossings == 0) {
                 first = t;
             }
@@ -353,9 +355,12 @@ static void load_profiles(void **state)
     assert_true(fabs(plant_load_torque(&load, 1.0, -5.0) + 0.5) < 1e-15);
     load.kind = PLANT_LOAD_TABLE;
     load.table_points = 3;
-    load.table_time_s[0] = 1.0; load.table_torque_Nm[0] = 0.0;
-    load.table_time_s[1] = 2.0; load.table_torque_Nm[1] = 1.0;
-    load.table_time_s[2] = 3.0; load.table_torque_Nm[2] = -1.0;
+    load.table_time_s[0] = 1.0;
+    load.table_torque_Nm[0] = 0.0;
+    load.table_time_s[1] = 2.0;
+    load.table_torque_Nm[1] = 1.0;
+    load.table_time_s[2] = 3.0;
+    load.table_torque_Nm[2] = -1.0;
     assert_true(plant_load_torque(&load, 0.0, 0.0) == 0.0);
     assert_true(fabs(plant_load_torque(&load, 1.5, 0.0) - 0.5) < 1e-15);
     assert_true(fabs(plant_load_torque(&load, 2.75, 0.0) + 0.5) < 1e-15);

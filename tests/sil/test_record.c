@@ -57,13 +57,17 @@ static void config_round_trips_through_the_words(void **state)
     sil_record_config_to_words(&in, w);
     sil_record_config_from_words(w, &out);
     assert_memory_equal(&in.motor.resistance_Ohm, &out.motor.resistance_Ohm, sizeof(float));
-    assert_true(out.motor.pole_pairs == in.motor.pole_pairs && out.timing.computational_delay_periods == in.timing.computational_delay_periods);
-    assert_true(out.limits.max_bus_voltage_V == in.limits.max_bus_voltage_V && out.known_load_mode == in.known_load_mode);
+    assert_true(out.motor.pole_pairs == in.motor.pole_pairs
+                && out.timing.computational_delay_periods == in.timing.computational_delay_periods);
+    assert_true(out.limits.max_bus_voltage_V == in.limits.max_bus_voltage_V
+                && out.known_load_mode == in.known_load_mode);
     assert_true(out.commissioning.offset_calibration_time_s == in.commissioning.offset_calibration_time_s);
-    assert_true(out.commissioning.alignment_offset_calibration && out.commissioning.use_measured_resistance && !out.commissioning.use_measured_inductance
-                && out.commissioning.use_measured_torque_constant);
-    assert_true(out.commissioning.steady_state_window_s == in.commissioning.steady_state_window_s && out.commissioning.inductance_window_s == in.commissioning.inductance_window_s);
-    assert_true(out.inverter.dead_time_s == in.inverter.dead_time_s && out.inverter.dead_time_current_band_A == in.inverter.dead_time_current_band_A);
+    assert_true(out.commissioning.alignment_offset_calibration && out.commissioning.use_measured_resistance
+                && !out.commissioning.use_measured_inductance && out.commissioning.use_measured_torque_constant);
+    assert_true(out.commissioning.steady_state_window_s == in.commissioning.steady_state_window_s
+                && out.commissioning.inductance_window_s == in.commissioning.inductance_window_s);
+    assert_true(out.inverter.dead_time_s == in.inverter.dead_time_s
+                && out.inverter.dead_time_current_band_A == in.inverter.dead_time_current_band_A);
     assert_true(out.commissioning.voltage_bias_level_fraction == in.commissioning.voltage_bias_level_fraction);
     assert_true(out.gains.angle_correction_gain_per_s == in.gains.angle_correction_gain_per_s);
     assert_true(out.detection.angle_magnitude_bound == in.detection.angle_magnitude_bound);

@@ -174,8 +174,8 @@ static void noise_mean_and_std(void **state)
     corr = (ab / N - mean_a * mean_b) / (std_a * std_b);
     print_message("noise, seed 12345, N = %d: mean a %.3g, b %.3g A (bound %.3g); std a %.6f, b %.6f A (sigma %.3f, "
                   "bound %.3g); corr %.3g (bound %.3g); bus mean %.3g V, std %.5f V\n",
-                  N, mean_a, mean_b, 5.0 * sigma / sqrt((double)N), std_a, std_b, sigma,
-                  5.0 * sigma / sqrt(2.0 * N), corr, 5.0 / sqrt((double)N), mean_v, std_v);
+                  N, mean_a, mean_b, 5.0 * sigma / sqrt((double)N), std_a, std_b, sigma, 5.0 * sigma / sqrt(2.0 * N),
+                  corr, 5.0 / sqrt((double)N), mean_v, std_v);
     assert_true(fabs(mean_a) < 5.0 * sigma / sqrt((double)N));
     assert_true(fabs(mean_b) < 5.0 * sigma / sqrt((double)N));
     assert_true(fabs(std_a - sigma) < 5.0 * sigma / sqrt(2.0 * N));

@@ -9,9 +9,9 @@
 
 typedef struct {
     double r_Ohm, l_H, k_m, pole_pairs;
-    double speed_rad_s;  /* held constant */
-    double theta_rad;    /* theta at the present sample */
-    double i_a, i_b;     /* currents at the present sample */
+    double speed_rad_s; /* held constant */
+    double theta_rad;   /* theta at the present sample */
+    double i_a, i_b;    /* currents at the present sample */
 } exact_plant_t;
 
 /* Advances one period T with (u_a, u_b) held:

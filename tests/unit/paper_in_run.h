@@ -30,7 +30,8 @@ static inline float paper_estimate_angle(const pmstep_t *inst)
 {
     float c;
     float s;
-    pmstep_angle_estimate(&inst->angle, &inst->derived.angle_coeffs, inst->angle.i_a_prev_A, inst->angle.i_b_prev_A, &c, &s);
+    pmstep_angle_estimate(&inst->angle, &inst->derived.angle_coeffs, inst->angle.i_a_prev_A, inst->angle.i_b_prev_A, &c,
+                          &s);
     return atan2f(s, c);
 }
 

@@ -226,9 +226,10 @@ static void the_mean_loss_follows_the_pwm_ripple(void **state)
                     const double x_A = current_A + range_A * (-1.0 + (2.0 * j + 1.0) / points);
                     mean_share += switching_loss_share(&w, x_A) / points;
                 }
-                assert_float_equal(pmstep_actuate_mean_loss_current(&coeffs, BAND_A, current_A, sweeps_A[m],
-                                                                    voltages_V[k], BUS_V) / BAND_A,
-                                   mean_share, 5e-4);
+                assert_float_equal(
+                    pmstep_actuate_mean_loss_current(&coeffs, BAND_A, current_A, sweeps_A[m], voltages_V[k], BUS_V)
+                        / BAND_A,
+                    mean_share, 5e-4);
             }
         }
     }
@@ -251,8 +252,8 @@ static void without_ripple_the_share_is_linear_over_the_sweep(void **state)
     assert_float_equal(pmstep_actuate_mean_loss_current(&coeffs, BAND_A, 0.05f, 0.1f, 0.0f, BUS_V),
                        0.05f * BAND_A / 0.1f, 1e-8f);
     for (int n = -10; n <= 10; ++n) {
-        const float share_A = pmstep_actuate_mean_loss_current(&coeffs, BAND_A, 0.01f * (float)n, 0.02f,
-                                                               1.5f * BUS_V, BUS_V);
+        const float share_A =
+            pmstep_actuate_mean_loss_current(&coeffs, BAND_A, 0.01f * (float)n, 0.02f, 1.5f * BUS_V, BUS_V);
         assert_true(share_A >= -BAND_A && share_A <= BAND_A);
     }
 }

@@ -47,7 +47,8 @@ static void angle_tracks_constant_speed_rotor_for_10s(void **state)
     double sin_err;
     (void)state;
     run_constant_speed(10.0, 10.0, &cos_err, &sin_err);
-    print_message("10 rad/s, 10 s: max |c-hat - cos p theta| = %.3g, max |s-hat - sin p theta| = %.3g\n", cos_err, sin_err);
+    print_message("10 rad/s, 10 s: max |c-hat - cos p theta| = %.3g, max |s-hat - sin p theta| = %.3g\n", cos_err,
+                  sin_err);
     assert_true(cos_err < 1e-4);
     assert_true(sin_err < 1e-4);
 }
@@ -100,9 +101,9 @@ static double emf_turn(double speed_rad_s, double delta_rad, double *magnitude)
     pmstep_angle_coeffs_init(&coeffs, &cfg, &model);
     pmstep_angle_start(&angle, 1.5f, -0.5f);
     pmstep_angle_set(&angle, &coeffs, (float)cos(estimate_rad), (float)sin(estimate_rad));
-    residual_A = -(double)cfg.motor.torque_constant_Nm_A * speed_rad_s * delta_rad
-                 / ((double)cfg.motor.resistance_Ohm
-                    + (double)cfg.motor.inductance_H * (double)cfg.gains.observer_gain_per_s);
+    residual_A =
+        -(double)cfg.motor.torque_constant_Nm_A * speed_rad_s * delta_rad
+        / ((double)cfg.motor.resistance_Ohm + (double)cfg.motor.inductance_H * (double)cfg.gains.observer_gain_per_s);
     pmstep_angle_follow_emf(&angle, &coeffs, (float)cos(estimate_rad), (float)sin(estimate_rad), (float)residual_A,
                             (float)speed_rad_s);
     pmstep_angle_estimate(&angle, &coeffs, 1.5f, -0.5f, &c, &s);
@@ -172,8 +173,8 @@ static smoothing_run_t run_smoothing(float share, double turn_rad, double predic
         const double angle = turn_rad * k;
         float c = (float)(cos(angle) + noise_sample(&lcg, noise));
         float s = (float)(sin(angle) + noise_sample(&lcg, noise));
-        const double reading_err = atan2((double)s * cos(angle) - (double)c * sin(angle),
-                                         (double)c * cos(angle) + (double)s * sin(angle));
+        const double reading_err =
+            atan2((double)s * cos(angle) - (double)c * sin(angle), (double)c * cos(angle) + (double)s * sin(angle));
         double err;
         pmstep_angle_smooth(share, (float)predicted_rad, &smoother, &c, &s);
         err = atan2((double)s * cos(angle) - (double)c * sin(angle), (double)c * cos(angle) + (double)s * sin(angle));

@@ -42,7 +42,7 @@ static pmstep_config_t two_level_config(void)
  * the sensors add an offset. */
 typedef struct {
     double r_Ohm, l_H, i_a_A, i_b_A, offset_a_A, offset_b_A;
-    double bias_V; /* the bridge falls short by this at positive current (a dead time) */
+    double bias_V;  /* the bridge falls short by this at positive current (a dead time) */
     double emf_b_V; /* a rotor's back-EMF on phase b, where a test moves it */
 } rl_plant_t;
 
@@ -62,8 +62,8 @@ static void rl_advance(rl_plant_t *p, const pmstep_output_t *out, double period_
 {
     const double decay = exp(-p->r_Ohm * period_s / p->l_H);
     const double u_a = out->bridge_enable ? (double)out->u_a_V - (p->i_a_A > 0.0 ? p->bias_V : 0.0) : 0.0;
-    const double u_b = (out->bridge_enable ? (double)out->u_b_V - (p->i_b_A > 0.0 ? p->bias_V : 0.0) : 0.0)
-                       - p->emf_b_V;
+    const double u_b =
+        (out->bridge_enable ? (double)out->u_b_V - (p->i_b_A > 0.0 ? p->bias_V : 0.0) : 0.0) - p->emf_b_V;
     p->i_a_A = p->i_a_A * decay + u_a / p->r_Ohm * (1.0 - decay);
     p->i_b_A = p->i_b_A * decay + u_b / p->r_Ohm * (1.0 - decay);
 }
@@ -82,20 +82,56 @@ static void run_rl(pmstep_t *inst, rl_plant_t *plant, pmstep_output_t *out, uint
     }
 }
 
-static void no_window(pmstep_config_t *c) { c->commissioning.steady_state_window_s = 0.0f; c->commissioning.alignment_offset_calibration = true; }
-static void bias_window_too_short(pmstep_config_t *c) { c->commissioning.voltage_bias_level_fraction = 0.5f; c->inverter.dead_time_current_band_A = 0.05f; c->commissioning.steady_state_window_s = 0.005f; }
-static void bias_window_too_long(pmstep_config_t *c) { c->commissioning.voltage_bias_level_fraction = 0.5f; c->inverter.dead_time_current_band_A = 0.05f; c->commissioning.steady_state_window_s = 0.015f; }
-static void bias_fraction_one(pmstep_config_t *c) { c->commissioning.voltage_bias_level_fraction = 1.0f; c->inverter.dead_time_current_band_A = 0.05f; }
+static void no_window(pmstep_config_t *c)
+{
+    c->commissioning.steady_state_window_s = 0.0f;
+    c->commissioning.alignment_offset_calibration = true;
+}
+static void bias_window_too_short(pmstep_config_t *c)
+{
+    c->commissioning.voltage_bias_level_fraction = 0.5f;
+    c->inverter.dead_time_current_band_A = 0.05f;
+    c->commissioning.steady_state_window_s = 0.005f;
+}
+static void bias_window_too_long(pmstep_config_t *c)
+{
+    c->commissioning.voltage_bias_level_fraction = 0.5f;
+    c->inverter.dead_time_current_band_A = 0.05f;
+    c->commissioning.steady_state_window_s = 0.015f;
+}
+static void bias_fraction_one(pmstep_config_t *c)
+{
+    c->commissioning.voltage_bias_level_fraction = 1.0f;
+    c->inverter.dead_time_current_band_A = 0.05f;
+}
 static void long_window(pmstep_config_t *c) { c->commissioning.steady_state_window_s = 0.021f; }
 /* A window no period count holds: refused before it is counted in periods. */
 static void huge_window(pmstep_config_t *c) { c->commissioning.steady_state_window_s = 1e30f; }
 static void long_rise(pmstep_config_t *c) { c->commissioning.inductance_window_s = 0.021f; }
 static void negative_offset_time(pmstep_config_t *c) { c->commissioning.offset_calibration_time_s = -1e-3f; }
-static void use_unmeasured_l(pmstep_config_t *c) { c->commissioning.inductance_window_s = 0.0f; c->commissioning.use_measured_inductance = true; }
-static void use_unmeasured_r(pmstep_config_t *c) { no_window(c); c->commissioning.alignment_offset_calibration = false; c->commissioning.use_measured_resistance = true; }
-static void use_unmeasured_km(pmstep_config_t *c) { no_window(c); c->commissioning.alignment_offset_calibration = false; c->commissioning.use_measured_torque_constant = true; }
+static void use_unmeasured_l(pmstep_config_t *c)
+{
+    c->commissioning.inductance_window_s = 0.0f;
+    c->commissioning.use_measured_inductance = true;
+}
+static void use_unmeasured_r(pmstep_config_t *c)
+{
+    no_window(c);
+    c->commissioning.alignment_offset_calibration = false;
+    c->commissioning.use_measured_resistance = true;
+}
+static void use_unmeasured_km(pmstep_config_t *c)
+{
+    no_window(c);
+    c->commissioning.alignment_offset_calibration = false;
+    c->commissioning.use_measured_torque_constant = true;
+}
 static void dead_time_without_band(pmstep_config_t *c) { c->inverter.dead_time_s = 1e-6f; }
-static void dead_time_too_long(pmstep_config_t *c) { c->inverter.dead_time_s = 13e-6f; c->inverter.dead_time_current_band_A = 0.1f; }
+static void dead_time_too_long(pmstep_config_t *c)
+{
+    c->inverter.dead_time_s = 13e-6f;
+    c->inverter.dead_time_current_band_A = 0.1f;
+}
 static void correction_too_fast(pmstep_config_t *c) { c->gains.angle_correction_gain_per_s = 10000.0f; }
 static void correction_negative(pmstep_config_t *c) { c->gains.angle_correction_gain_per_s = -1.0f; }
 static void negative_bound(pmstep_config_t *c) { c->detection.stall_speed_error_rad_s = -1.0f; }

@@ -11,10 +11,7 @@
 #include "pmstep/pmstep_continuity.h"
 
 /* The paper's configuration: u/R = 8 A in both alignments; +/-16.5 A sensed, so I_min = 0.165 A. */
-static pmstep_config_t paper(void)
-{
-    return pmstep_paper_config();
-}
+static pmstep_config_t paper(void) { return pmstep_paper_config(); }
 
 /* A driven phase that reaches a quarter of u/R passes; one that stays below it is open. */
 static void alignment_peaks_against_u_over_r(void **state)
@@ -24,7 +21,8 @@ static void alignment_peaks_against_u_over_r(void **state)
     (void)state;
     /* s-alignment drives b: its peak is the largest |i_b|; i_a there counts for nothing. */
     assert_int_equal(pmstep_continuity_align(&peaks, &cfg, false, 50.0f, 1.9f, false, false), PMSTEP_FAULT_NONE);
-    assert_int_equal(pmstep_continuity_align(&peaks, &cfg, false, 50.0f, -0.5f, true, false), PMSTEP_FAULT_OPEN_PHASE_B);
+    assert_int_equal(pmstep_continuity_align(&peaks, &cfg, false, 50.0f, -0.5f, true, false),
+                     PMSTEP_FAULT_OPEN_PHASE_B);
     peaks.peak_b_A = 0.0f;
     assert_int_equal(pmstep_continuity_align(&peaks, &cfg, false, 0.0f, -2.01f, false, false), PMSTEP_FAULT_NONE);
     assert_int_equal(pmstep_continuity_align(&peaks, &cfg, false, 0.0f, 0.0f, true, false), PMSTEP_FAULT_NONE);

@@ -151,10 +151,8 @@ static void each_fault_latches_with_zero_output(void **state)
         pmstep_fault_t expected;
         uint32_t at_step;
     } cases[] = {
-        {nan_current, PMSTEP_FAULT_MEASUREMENT_NONFINITE, 10u},
-        {inf_bus, PMSTEP_FAULT_MEASUREMENT_NONFINITE, 7000u},
-        {over_current, PMSTEP_FAULT_OVERCURRENT, 12005u},
-        {under_voltage, PMSTEP_FAULT_BUS_UNDERVOLTAGE, 3u},
+        {nan_current, PMSTEP_FAULT_MEASUREMENT_NONFINITE, 10u}, {inf_bus, PMSTEP_FAULT_MEASUREMENT_NONFINITE, 7000u},
+        {over_current, PMSTEP_FAULT_OVERCURRENT, 12005u},       {under_voltage, PMSTEP_FAULT_BUS_UNDERVOLTAGE, 3u},
         {over_voltage, PMSTEP_FAULT_BUS_OVERVOLTAGE, 12100u},
     };
     size_t n;
@@ -228,7 +226,7 @@ static void phase_voltages_checked_only_with_sensing(void **state)
         {1e9f, -INFINITY, false, PMSTEP_FAULT_NONE},
         {NAN, 0.0f, true, PMSTEP_FAULT_MEASUREMENT_NONFINITE},
         {0.0f, -INFINITY, true, PMSTEP_FAULT_MEASUREMENT_NONFINITE},
-        {60.0f, -60.0f, true, PMSTEP_FAULT_NONE},             /* 1.25 x 48 V: the edge passes */
+        {60.0f, -60.0f, true, PMSTEP_FAULT_NONE}, /* 1.25 x 48 V: the edge passes */
         {0.0f, -60.01f, true, PMSTEP_FAULT_PHASE_VOLTAGE_RANGE},
         {60.01f, 0.0f, true, PMSTEP_FAULT_PHASE_VOLTAGE_RANGE},
     };

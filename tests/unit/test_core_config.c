@@ -12,30 +12,81 @@
 #include "pmstep/pmstep_text.h"
 
 /* Every status code, so the tests below can tell each has its text and its test. */
-static const pmstep_status_t all_status_codes[] = {
-    PMSTEP_OK, PMSTEP_ERR_NULL_ARGUMENT, PMSTEP_ERR_BAD_MODE, PMSTEP_ERR_BAD_COMMAND_VALUE,
-    PMSTEP_ERR_NONFINITE_PARAMETER, PMSTEP_ERR_DERIVED_NONFINITE, PMSTEP_ERR_RESISTANCE, PMSTEP_ERR_INDUCTANCE,
-    PMSTEP_ERR_INERTIA, PMSTEP_ERR_TORQUE_CONSTANT, PMSTEP_ERR_FRICTION, PMSTEP_ERR_POLE_PAIRS, PMSTEP_ERR_DETENT_TORQUE,
-    PMSTEP_ERR_PERIOD,
-    PMSTEP_ERR_DELAY, PMSTEP_ERR_SPEED_GAIN, PMSTEP_ERR_OBSERVER_GAIN, PMSTEP_ERR_CURRENT_GAIN,
-    PMSTEP_ERR_ADAPT_GAMMA, PMSTEP_ERR_ADAPT_LAMBDA, PMSTEP_ERR_ADAPT_R, PMSTEP_ERR_SAT_KAPPA,
-    PMSTEP_ERR_OBSERVER_GAIN_FOR_PERIOD, PMSTEP_ERR_CURRENT_GAIN_FOR_PERIOD, PMSTEP_ERR_REFERENCE_BANDWIDTH,
-    PMSTEP_ERR_ANGLE_CORRECTION_GAIN, PMSTEP_ERR_CURRENT_INTEGRAL_GAIN, PMSTEP_ERR_DETENT_FADE_SPEED,
-    PMSTEP_ERR_EMF_ANGLE_GAIN, PMSTEP_ERR_ANGLE_SMOOTHING, PMSTEP_ERR_OBSERVER_BOOST,
-    PMSTEP_ERR_MAX_CURRENT, PMSTEP_ERR_MIN_BUS,
-    PMSTEP_ERR_BUS_ORDER, PMSTEP_ERR_TRIP_ABOVE_RATED, PMSTEP_ERR_TRIP_ABOVE_SENSE_RANGE,
-    PMSTEP_ERR_BUS_ABOVE_SENSE_RANGE, PMSTEP_ERR_SENSE_RANGE,
-    PMSTEP_ERR_ALIGNMENT_VOLTAGE, PMSTEP_ERR_ALIGNMENT_ABOVE_BUS, PMSTEP_ERR_ALIGNMENT_CURRENT,
-    PMSTEP_ERR_S_ALIGN_TIME, PMSTEP_ERR_C_ALIGN_TIME, PMSTEP_ERR_ALIGNMENT_TOO_LONG, PMSTEP_ERR_ALIGNMENT_CONDITION,
-    PMSTEP_ERR_OFFSET_CALIBRATION_TIME, PMSTEP_ERR_STEADY_STATE_WINDOW, PMSTEP_ERR_INDUCTANCE_WINDOW,
-    PMSTEP_ERR_ALIGNMENT_OFFSETS_UNMEASURED, PMSTEP_ERR_RESISTANCE_UNMEASURED, PMSTEP_ERR_INDUCTANCE_UNMEASURED,
-    PMSTEP_ERR_TORQUE_CONSTANT_UNMEASURED, PMSTEP_ERR_VOLTAGE_BIAS_FRACTION, PMSTEP_ERR_VOLTAGE_BIAS_WINDOW,
-    PMSTEP_ERR_VOLTAGE_BIAS_SETTLING, PMSTEP_ERR_DEAD_TIME, PMSTEP_ERR_DEAD_TIME_BAND, PMSTEP_ERR_DETECTION_BOUND,
-    PMSTEP_ERR_DETECTION_TIME, PMSTEP_ERR_RATED_CURRENT, PMSTEP_ERR_BUS_BELOW_RATED, PMSTEP_ERR_RATE_TOO_SLOW,
-    PMSTEP_ERR_SENSE_RANGE_BELOW_RATED, PMSTEP_ERR_DATASHEET_TORQUE_CONSTANT, PMSTEP_ERR_DATASHEET_TIME_CONSTANT,
-    PMSTEP_ERR_DATASHEET_INERTIA, PMSTEP_ERR_DATASHEET_FLUX_RATIO, PMSTEP_ERR_DETENT_ABOVE_ALIGNMENT,
-    PMSTEP_ERR_IDENTIFICATION_WINDOW, PMSTEP_ERR_IDENTIFICATION_SPEED, PMSTEP_ERR_MECHANICS_UNIDENTIFIED,
-    PMSTEP_ERR_POSITION_GAIN, PMSTEP_ERR_POSITION_INTEGRAL_GAIN, PMSTEP_ERR_HOLD_CURRENT, PMSTEP_ERR_STANDSTILL_KNOWN_LOAD};
+static const pmstep_status_t all_status_codes[] = {PMSTEP_OK,
+                                                   PMSTEP_ERR_NULL_ARGUMENT,
+                                                   PMSTEP_ERR_BAD_MODE,
+                                                   PMSTEP_ERR_BAD_COMMAND_VALUE,
+                                                   PMSTEP_ERR_NONFINITE_PARAMETER,
+                                                   PMSTEP_ERR_DERIVED_NONFINITE,
+                                                   PMSTEP_ERR_RESISTANCE,
+                                                   PMSTEP_ERR_INDUCTANCE,
+                                                   PMSTEP_ERR_INERTIA,
+                                                   PMSTEP_ERR_TORQUE_CONSTANT,
+                                                   PMSTEP_ERR_FRICTION,
+                                                   PMSTEP_ERR_POLE_PAIRS,
+                                                   PMSTEP_ERR_DETENT_TORQUE,
+                                                   PMSTEP_ERR_PERIOD,
+                                                   PMSTEP_ERR_DELAY,
+                                                   PMSTEP_ERR_SPEED_GAIN,
+                                                   PMSTEP_ERR_OBSERVER_GAIN,
+                                                   PMSTEP_ERR_CURRENT_GAIN,
+                                                   PMSTEP_ERR_ADAPT_GAMMA,
+                                                   PMSTEP_ERR_ADAPT_LAMBDA,
+                                                   PMSTEP_ERR_ADAPT_R,
+                                                   PMSTEP_ERR_SAT_KAPPA,
+                                                   PMSTEP_ERR_OBSERVER_GAIN_FOR_PERIOD,
+                                                   PMSTEP_ERR_CURRENT_GAIN_FOR_PERIOD,
+                                                   PMSTEP_ERR_REFERENCE_BANDWIDTH,
+                                                   PMSTEP_ERR_ANGLE_CORRECTION_GAIN,
+                                                   PMSTEP_ERR_CURRENT_INTEGRAL_GAIN,
+                                                   PMSTEP_ERR_DETENT_FADE_SPEED,
+                                                   PMSTEP_ERR_EMF_ANGLE_GAIN,
+                                                   PMSTEP_ERR_ANGLE_SMOOTHING,
+                                                   PMSTEP_ERR_OBSERVER_BOOST,
+                                                   PMSTEP_ERR_MAX_CURRENT,
+                                                   PMSTEP_ERR_MIN_BUS,
+                                                   PMSTEP_ERR_BUS_ORDER,
+                                                   PMSTEP_ERR_TRIP_ABOVE_RATED,
+                                                   PMSTEP_ERR_TRIP_ABOVE_SENSE_RANGE,
+                                                   PMSTEP_ERR_BUS_ABOVE_SENSE_RANGE,
+                                                   PMSTEP_ERR_SENSE_RANGE,
+                                                   PMSTEP_ERR_ALIGNMENT_VOLTAGE,
+                                                   PMSTEP_ERR_ALIGNMENT_ABOVE_BUS,
+                                                   PMSTEP_ERR_ALIGNMENT_CURRENT,
+                                                   PMSTEP_ERR_S_ALIGN_TIME,
+                                                   PMSTEP_ERR_C_ALIGN_TIME,
+                                                   PMSTEP_ERR_ALIGNMENT_TOO_LONG,
+                                                   PMSTEP_ERR_ALIGNMENT_CONDITION,
+                                                   PMSTEP_ERR_OFFSET_CALIBRATION_TIME,
+                                                   PMSTEP_ERR_STEADY_STATE_WINDOW,
+                                                   PMSTEP_ERR_INDUCTANCE_WINDOW,
+                                                   PMSTEP_ERR_ALIGNMENT_OFFSETS_UNMEASURED,
+                                                   PMSTEP_ERR_RESISTANCE_UNMEASURED,
+                                                   PMSTEP_ERR_INDUCTANCE_UNMEASURED,
+                                                   PMSTEP_ERR_TORQUE_CONSTANT_UNMEASURED,
+                                                   PMSTEP_ERR_VOLTAGE_BIAS_FRACTION,
+                                                   PMSTEP_ERR_VOLTAGE_BIAS_WINDOW,
+                                                   PMSTEP_ERR_VOLTAGE_BIAS_SETTLING,
+                                                   PMSTEP_ERR_DEAD_TIME,
+                                                   PMSTEP_ERR_DEAD_TIME_BAND,
+                                                   PMSTEP_ERR_DETECTION_BOUND,
+                                                   PMSTEP_ERR_DETECTION_TIME,
+                                                   PMSTEP_ERR_RATED_CURRENT,
+                                                   PMSTEP_ERR_BUS_BELOW_RATED,
+                                                   PMSTEP_ERR_RATE_TOO_SLOW,
+                                                   PMSTEP_ERR_SENSE_RANGE_BELOW_RATED,
+                                                   PMSTEP_ERR_DATASHEET_TORQUE_CONSTANT,
+                                                   PMSTEP_ERR_DATASHEET_TIME_CONSTANT,
+                                                   PMSTEP_ERR_DATASHEET_INERTIA,
+                                                   PMSTEP_ERR_DATASHEET_FLUX_RATIO,
+                                                   PMSTEP_ERR_DETENT_ABOVE_ALIGNMENT,
+                                                   PMSTEP_ERR_IDENTIFICATION_WINDOW,
+                                                   PMSTEP_ERR_IDENTIFICATION_SPEED,
+                                                   PMSTEP_ERR_MECHANICS_UNIDENTIFIED,
+                                                   PMSTEP_ERR_POSITION_GAIN,
+                                                   PMSTEP_ERR_POSITION_INTEGRAL_GAIN,
+                                                   PMSTEP_ERR_HOLD_CURRENT,
+                                                   PMSTEP_ERR_STANDSTILL_KNOWN_LOAD};
 
 /* ---- validation: each cause has its own code and text ---- */
 
@@ -106,12 +157,18 @@ static void s_align_too_short(pmstep_config_t *c) { c->alignment.s_align_time_s 
 static void alignment_too_long(pmstep_config_t *c) { c->alignment.c_align_time_s = 1000.0f; } /* 2e7 periods > 2^24 */
 static void bad_condition4(pmstep_config_t *c) { c->alignment.c_align_voltage_V = 1.0f; } /* margin 18.5 - 32.1 < 0 */
 static void bad_condition4_slow_motor(pmstep_config_t *c) { c->motor.torque_constant_Nm_A = 0.2f; } /* 44.4 - 64 < 0 */
-static void align_voltage_above_bus(pmstep_config_t *c) { c->alignment.s_align_voltage_V = 40.0f; } /* above min bus 30 V */
+static void align_voltage_above_bus(pmstep_config_t *c)
+{
+    c->alignment.s_align_voltage_V = 40.0f;
+} /* above min bus 30 V */
 static void zero_align_voltage(pmstep_config_t *c) { c->alignment.c_align_voltage_V = 0.0f; }
 static void bad_align_current(pmstep_config_t *c) { c->limits.max_phase_current_A = 7.0f; } /* 24 V / 3 Ohm = 8 A */
 static void bad_align_time(pmstep_config_t *c) { c->alignment.c_align_time_s = c->alignment.s_align_time_s; }
 static void negative_lead_in(pmstep_config_t *c) { c->alignment.s_lead_in_time_s = -1e-3f; }
-static void lead_in_fills_s_alignment(pmstep_config_t *c) { c->alignment.s_lead_in_time_s = c->alignment.s_align_time_s; }
+static void lead_in_fills_s_alignment(pmstep_config_t *c)
+{
+    c->alignment.s_lead_in_time_s = c->alignment.s_align_time_s;
+}
 static void bad_bandwidth(pmstep_config_t *c) { c->gains.reference_bandwidth_rad_s = 20000.0f; }
 static void bad_limits(pmstep_config_t *c) { c->limits.max_bus_voltage_V = 20.0f; }
 static void bad_delay(pmstep_config_t *c) { c->timing.computational_delay_periods = 2u; }
@@ -134,11 +191,19 @@ static void zero_current_sense_range(pmstep_config_t *c) { c->limits.current_sen
 static void negative_bus_sense_range(pmstep_config_t *c) { c->limits.bus_sense_range_V = -66.0f; }
 static void nan_param(pmstep_config_t *c) { c->motor.inertia_kgm2 = NAN; }
 /* Found by fuzzing (issue 15): each was accepted and failed only in the step. */
-static void tiny_dead_time_band(pmstep_config_t *c) { c->inverter.dead_time_s = 1e-6f; c->inverter.dead_time_current_band_A = 1e-40f; }
+static void tiny_dead_time_band(pmstep_config_t *c)
+{
+    c->inverter.dead_time_s = 1e-6f;
+    c->inverter.dead_time_current_band_A = 1e-40f;
+}
 static void huge_detection_time(pmstep_config_t *c) { c->detection.persistence_s = 858993.4592f; }
 static void denormal_period(pmstep_config_t *c) { c->timing.period_s = 1e-40f; }
-static void period_above_range(pmstep_config_t *c) { c->timing.period_s = 0.02f; c->gains.observer_gain_per_s = 1.0f;
-                                                     c->gains.current_gain_per_s = 1.0f; }
+static void period_above_range(pmstep_config_t *c)
+{
+    c->timing.period_s = 0.02f;
+    c->gains.observer_gain_per_s = 1.0f;
+    c->gains.current_gain_per_s = 1.0f;
+}
 static void gamma_squared_underflows(pmstep_config_t *c) { c->gains.adapt_gamma = 1e-30f; }
 static void inertia_squared_overflows(pmstep_config_t *c) { c->motor.inertia_kgm2 = 1e28f; }
 static void friction_overflows_load_gain(pmstep_config_t *c) { c->motor.friction_Nms_rad = 3.4e38f; }
@@ -152,8 +217,14 @@ static void detection_time_below_four_periods_with_detectors_off(pmstep_config_t
 }
 
 static void negative_identification_window(pmstep_config_t *c) { c->commissioning.identification_time_s = -0.1f; }
-static void negative_identification_speed(pmstep_config_t *c) { c->commissioning.identification_min_speed_rad_s = -1.0f; }
-static void identified_mechanics_without_window(pmstep_config_t *c) { c->commissioning.use_identified_mechanics = true; }
+static void negative_identification_speed(pmstep_config_t *c)
+{
+    c->commissioning.identification_min_speed_rad_s = -1.0f;
+}
+static void identified_mechanics_without_window(pmstep_config_t *c)
+{
+    c->commissioning.use_identified_mechanics = true;
+}
 static void measure_only_without_window(pmstep_config_t *c)
 {
     c->commissioning.measure_only = true;
@@ -278,10 +349,11 @@ static void refused_init_leaves_the_instance_as_it_was(void **state)
 /* The validation causes this file does not provoke, and the file that does: test_commission.c
  * (commissioning, inverter, detection and angle-correction settings). */
 static const pmstep_status_t codes_tested_in_test_commission[] = {
-    PMSTEP_ERR_ANGLE_CORRECTION_GAIN, PMSTEP_ERR_OFFSET_CALIBRATION_TIME, PMSTEP_ERR_STEADY_STATE_WINDOW,
-    PMSTEP_ERR_INDUCTANCE_WINDOW, PMSTEP_ERR_ALIGNMENT_OFFSETS_UNMEASURED, PMSTEP_ERR_RESISTANCE_UNMEASURED,
-    PMSTEP_ERR_INDUCTANCE_UNMEASURED, PMSTEP_ERR_TORQUE_CONSTANT_UNMEASURED, PMSTEP_ERR_VOLTAGE_BIAS_FRACTION,
-    PMSTEP_ERR_VOLTAGE_BIAS_WINDOW, PMSTEP_ERR_VOLTAGE_BIAS_SETTLING, PMSTEP_ERR_DEAD_TIME, PMSTEP_ERR_DETECTION_BOUND};
+    PMSTEP_ERR_ANGLE_CORRECTION_GAIN, PMSTEP_ERR_OFFSET_CALIBRATION_TIME,      PMSTEP_ERR_STEADY_STATE_WINDOW,
+    PMSTEP_ERR_INDUCTANCE_WINDOW,     PMSTEP_ERR_ALIGNMENT_OFFSETS_UNMEASURED, PMSTEP_ERR_RESISTANCE_UNMEASURED,
+    PMSTEP_ERR_INDUCTANCE_UNMEASURED, PMSTEP_ERR_TORQUE_CONSTANT_UNMEASURED,   PMSTEP_ERR_VOLTAGE_BIAS_FRACTION,
+    PMSTEP_ERR_VOLTAGE_BIAS_WINDOW,   PMSTEP_ERR_VOLTAGE_BIAS_SETTLING,        PMSTEP_ERR_DEAD_TIME,
+    PMSTEP_ERR_DETECTION_BOUND};
 
 static void current_integral_within_its_bound_is_accepted(void **state)
 {

@@ -100,16 +100,18 @@ static void every_preset_gets_a_valid_design(void **state)
             assert_true(lhs > rhs);
             assert_true(report.condition_4_margin >= 1.99f);
             /* Alignment current at most the rated current. */
-            assert_true(cfg.alignment.s_align_voltage_V / in.motor.resistance_Ohm <= in.motor.rated_current_A * 1.0001f);
-            assert_true(cfg.alignment.c_align_voltage_V / in.motor.resistance_Ohm <= in.motor.rated_current_A * 1.0001f);
+            assert_true(cfg.alignment.s_align_voltage_V / in.motor.resistance_Ohm
+                        <= in.motor.rated_current_A * 1.0001f);
+            assert_true(cfg.alignment.c_align_voltage_V / in.motor.resistance_Ohm
+                        <= in.motor.rated_current_A * 1.0001f);
             assert_true(cfg.limits.max_phase_current_A > in.motor.rated_current_A);
             /* PI current loop: K_I = K^2/8, K = R/L + K_i (poles 0.15 K and 0.85 K, real); on the q
              * axis K k_w / 5, its slow pole a fifth of the speed loop's (docs/design/02-current-and-speed-loops.md). */
             {
                 const float k = in.motor.resistance_Ohm / in.motor.inductance_H + cfg.gains.current_gain_per_s;
                 assert_float_equal(cfg.gains.current_integral_gain_per_s2, 0.125f * k * k, 1e-3f * k * k);
-                assert_float_equal(cfg.gains.current_integral_gain_q_per_s2,
-                                   0.2f * k * cfg.gains.speed_gain_per_s, 1e-4f * k * cfg.gains.speed_gain_per_s);
+                assert_float_equal(cfg.gains.current_integral_gain_q_per_s2, 0.2f * k * cfg.gains.speed_gain_per_s,
+                                   1e-4f * k * cfg.gains.speed_gain_per_s);
             }
             /* Robust: the back-EMF angle correction at twice the observer's bandwidth w_o,
              * half on where the back EMF equals R I + 2 V_bus t_d / T_s (docs/design/15-back-emf-angle-correction.md); off in
@@ -172,8 +174,7 @@ static void detent_compensation_fades_where_the_current_loop_ends(void **state)
         assert_true(cfg.gains.detent_fade_speed_rad_s == 0.0f);
         in.motor.detent_torque_Nm = 0.02f;
         assert_int_equal(pmstep_design(&in, &cfg, &report), PMSTEP_OK);
-        assert_float_equal(cfg.gains.detent_fade_speed_rad_s, 2.0f * 4000.0f / (4.0f * (float)presets[n].p),
-                           1e-3f);
+        assert_float_equal(cfg.gains.detent_fade_speed_rad_s, 2.0f * 4000.0f / (4.0f * (float)presets[n].p), 1e-3f);
     }
 }
 
@@ -219,12 +220,12 @@ static void alignment_current_pulls_the_rotor_across_the_detent(void **state)
 {
     static const struct {
         float detent_Nm;
-        float current_A;  /* expected alignment current */
+        float current_A; /* expected alignment current */
         pmstep_status_t expected;
     } cases[] = {
-        {0.02f, 0.594214f, PMSTEP_OK},   /* the preset's: (4)'s half limit covers it */
-        {0.07f, 0.916057f, PMSTEP_OK},   /* twice the barrier's least current */
-        {0.10f, 0.950742f, PMSTEP_OK},   /* 0.8 of (4)'s limit: margin 1.45 */
+        {0.02f, 0.594214f, PMSTEP_OK}, /* the preset's: (4)'s half limit covers it */
+        {0.07f, 0.916057f, PMSTEP_OK}, /* twice the barrier's least current */
+        {0.10f, 0.950742f, PMSTEP_OK}, /* 0.8 of (4)'s limit: margin 1.45 */
         {0.15f, 0.0f, PMSTEP_ERR_DETENT_ABOVE_ALIGNMENT},
     };
     size_t n;
@@ -244,7 +245,8 @@ static void alignment_current_pulls_the_rotor_across_the_detent(void **state)
             assert_float_equal(cfg.alignment.c_align_voltage_V, in.motor.resistance_Ohm * cases[n].current_A, 1e-4f);
             assert_true(report.condition_4_margin >= 1.2499f);
             assert_float_equal(report.detent_margin,
-                               0.918559f * in.motor.torque_constant_Nm_A * cases[n].current_A / cases[n].detent_Nm, 1e-3f);
+                               0.918559f * in.motor.torque_constant_Nm_A * cases[n].current_A / cases[n].detent_Nm,
+                               1e-3f);
             assert_true(report.detent_margin > 1.0f);
         }
     }
@@ -420,8 +422,8 @@ static void datasheet_check_names_what_no_stepper_has(void **state)
     assert_int_equal(pmstep_design(&in, &cfg, &report), PMSTEP_ERR_DATASHEET_INERTIA);
     in = input_of(&presets[1], false);
     in.holding_torque_Nm = 0.40f;
-    in.motor.inductance_H = 0.3e-3f;  /* p L I / k_M = 50 x 0.3 mH x 1.7 / 0.166 = 0.15 ... */
-    in.motor.resistance_Ohm = 0.15f;  /* (L/R 2 ms) passes; 0.1 mH gives 0.05: refused */
+    in.motor.inductance_H = 0.3e-3f; /* p L I / k_M = 50 x 0.3 mH x 1.7 / 0.166 = 0.15 ... */
+    in.motor.resistance_Ohm = 0.15f; /* (L/R 2 ms) passes; 0.1 mH gives 0.05: refused */
     assert_int_equal(pmstep_design_check_datasheet(&in), PMSTEP_OK);
     in.motor.inductance_H = 0.1e-3f;
     in.motor.resistance_Ohm = 0.05f;
@@ -449,14 +451,22 @@ static void bad_motor_data_gets_a_named_error(void **state)
         input_edit_t edit;
         pmstep_status_t expected;
     } cases[] = {
-        {zero_r, PMSTEP_ERR_RESISTANCE},         {negative_l, PMSTEP_ERR_INDUCTANCE},
-        {zero_j, PMSTEP_ERR_INERTIA},            {zero_km, PMSTEP_ERR_TORQUE_CONSTANT},
-        {negative_f, PMSTEP_ERR_FRICTION},       {zero_p, PMSTEP_ERR_POLE_PAIRS},
-        {nan_r, PMSTEP_ERR_NONFINITE_PARAMETER}, {inf_j, PMSTEP_ERR_NONFINITE_PARAMETER},
-        {zero_rated, PMSTEP_ERR_RATED_CURRENT},  {low_bus, PMSTEP_ERR_BUS_BELOW_RATED},
-        {zero_bus, PMSTEP_ERR_BUS_BELOW_RATED},  {slow_rate, PMSTEP_ERR_RATE_TOO_SLOW},
-        {rate_for_winding, PMSTEP_ERR_RATE_TOO_SLOW}, {heavy_friction, PMSTEP_ERR_RATE_TOO_SLOW},
-        {bad_period, PMSTEP_ERR_PERIOD},         {bad_delay, PMSTEP_ERR_DELAY},
+        {zero_r, PMSTEP_ERR_RESISTANCE},
+        {negative_l, PMSTEP_ERR_INDUCTANCE},
+        {zero_j, PMSTEP_ERR_INERTIA},
+        {zero_km, PMSTEP_ERR_TORQUE_CONSTANT},
+        {negative_f, PMSTEP_ERR_FRICTION},
+        {zero_p, PMSTEP_ERR_POLE_PAIRS},
+        {nan_r, PMSTEP_ERR_NONFINITE_PARAMETER},
+        {inf_j, PMSTEP_ERR_NONFINITE_PARAMETER},
+        {zero_rated, PMSTEP_ERR_RATED_CURRENT},
+        {low_bus, PMSTEP_ERR_BUS_BELOW_RATED},
+        {zero_bus, PMSTEP_ERR_BUS_BELOW_RATED},
+        {slow_rate, PMSTEP_ERR_RATE_TOO_SLOW},
+        {rate_for_winding, PMSTEP_ERR_RATE_TOO_SLOW},
+        {heavy_friction, PMSTEP_ERR_RATE_TOO_SLOW},
+        {bad_period, PMSTEP_ERR_PERIOD},
+        {bad_delay, PMSTEP_ERR_DELAY},
         {long_dead_time, PMSTEP_ERR_DEAD_TIME},
         {no_current_sensing, PMSTEP_ERR_SENSE_RANGE},
         {current_sensing_below_rated, PMSTEP_ERR_SENSE_RANGE_BELOW_RATED},
@@ -514,10 +524,9 @@ static void low_speed_drive_below_twice_the_dead_time_loss(void **state)
         pmstep_design_input_t in = input_of(&presets[n], true);
         pmstep_design_input_t ideal = input_of(&presets[n], false);
         const float emf_band_rad_s = 2.0f * presets[n].bus_V * 1e-6f / (50e-6f * presets[n].k_m);
-        const float resonance_band_rad_s = 0.5f
-                                           * sqrtf((float)presets[n].p * presets[n].k_m * presets[n].rated_A
-                                                   / presets[n].j)
-                                           / (4.0f * (float)presets[n].p);
+        const float resonance_band_rad_s =
+            0.5f * sqrtf((float)presets[n].p * presets[n].k_m * presets[n].rated_A / presets[n].j)
+            / (4.0f * (float)presets[n].p);
         const float expected_rad_s = emf_band_rad_s < resonance_band_rad_s ? emf_band_rad_s : resonance_band_rad_s;
         /* the hybrids' bands are the resonance's, the paper motor's the dead time's */
         assert_true((presets[n].p == 50) == (resonance_band_rad_s < emf_band_rad_s));

@@ -18,10 +18,7 @@
 #include "paper_in_run.h"
 
 /* Paper: k_M = 2 N m/A, J = 0.01 kg m^2, p = 6, R = 3 Ohm, current trip 15 A, 20 kHz. */
-static void fixture_in_run(paper_run_t *f)
-{
-    assert_int_equal(paper_instance_in_run(&f->cfg, &f->inst), PMSTEP_OK);
-}
+static void fixture_in_run(paper_run_t *f) { assert_int_equal(paper_instance_in_run(&f->cfg, &f->inst), PMSTEP_OK); }
 
 static void hold_refuses_with_named_codes(void **state)
 {
@@ -71,8 +68,8 @@ static void hold_derives_vector_spring_and_damping(void **state)
     assert_int_equal(f.inst.hold.settle_periods, (uint32_t)(6.0 / (0.7 * w_n * 5e-5)));
     assert_float_equal(f.inst.current_integral.i_d_error_integral_As, 0.0f, 0.0f); /* restarted */
     assert_float_equal(f.inst.current_integral.i_q_error_integral_As, 0.0f, 0.0f);
-    print_message("paper motor, 7.5 A, 4.8 N m: load angle %.4f rad, w_n %.2f rad/s, settling %u periods\n",
-                  delta, w_n, (unsigned)f.inst.hold.settle_periods);
+    print_message("paper motor, 7.5 A, 4.8 N m: load angle %.4f rad, w_n %.2f rad/s, settling %u periods\n", delta, w_n,
+                  (unsigned)f.inst.hold.settle_periods);
 }
 
 /* The damping term needs a speed estimate in phase with the swing. With the observer placed at a

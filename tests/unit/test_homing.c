@@ -26,9 +26,9 @@ typedef struct {
     pmstep_position_t pos;
     pmstep_homing_t homing;
     pmstep_homing_config_t homing_cfg;
-    double theta_rad;  /* the kinematic rotor, mechanical */
-    double stop_rad;   /* it cannot pass this (+ side); HUGE_VAL: no stop */
-    float i_q_ref_A;   /* the law's i_q* the homing reads */
+    double theta_rad; /* the kinematic rotor, mechanical */
+    double stop_rad;  /* it cannot pass this (+ side); HUGE_VAL: no stop */
+    float i_q_ref_A;  /* the law's i_q* the homing reads */
     bool in_run;
 } fixture_t;
 
@@ -96,7 +96,8 @@ static void designer_rule_from_the_motor_data(void **state)
     const double full_step = 0.5 * M_PI / PAPER_P;
     const double k_m = (double)cfg.motor.torque_constant_Nm_A;
     const double stall = 0.5 * (double)cfg.motor.rated_current_A;
-    const double push_speed = 0.25 * k_m * stall / ((double)cfg.motor.inertia_kgm2 * (double)cfg.gains.speed_gain_per_s);
+    const double push_speed =
+        0.25 * k_m * stall / ((double)cfg.motor.inertia_kgm2 * (double)cfg.gains.speed_gain_per_s);
     const double bus_speed = 0.1 * (double)cfg.limits.min_bus_voltage_V / k_m;
     (void)state;
     assert_int_equal(pmstep_homing_design(NULL, &h), PMSTEP_ERR_NULL_ARGUMENT);

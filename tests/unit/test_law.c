@@ -21,8 +21,8 @@ static void saturation_is_smooth_odd_bounded_with_unit_slope(void **state)
         pmstep_sat(-x, kappa, &s_neg, &ds_neg);
         pmstep_sat(x + h, kappa, &s_plus, &ds_plus);
         pmstep_sat(x - h, kappa, &s_minus, &ds_minus);
-        assert_true(s == -s_neg);              /* odd */
-        assert_true(fabsf(s) < kappa);         /* bounded by kappa */
+        assert_true(s == -s_neg);      /* odd */
+        assert_true(fabsf(s) < kappa); /* bounded by kappa */
         assert_true(ds > 0.0f && ds <= 1.0f);
         /* derivative against a central difference */
         assert_true(fabsf(ds - (s_plus - s_minus) / (2.0f * h)) < 2e-3f);
@@ -30,7 +30,7 @@ static void saturation_is_smooth_odd_bounded_with_unit_slope(void **state)
     {
         float s, ds;
         pmstep_sat(0.0f, kappa, &s, &ds);
-        assert_true(s == 0.0f && ds == 1.0f);  /* slope 1 at 0 */
+        assert_true(s == 0.0f && ds == 1.0f); /* slope 1 at 0 */
         pmstep_sat(1e-3f, kappa, &s, &ds);
         assert_true(fabsf(s - 1e-3f) < 1e-8f);
     }
@@ -147,7 +147,8 @@ static void detent_compensation_fades_with_the_speed(void **state)
         const double t_s = 0.001 * k;
         const pmstep_detent_t d = faded_detent_at(&coeffs, t_s, 20.0f);
         const double slope = ((double)faded_detent_at(&coeffs, t_s + h_s, 20.0f).torque_Nm
-                              - (double)faded_detent_at(&coeffs, t_s - h_s, 20.0f).torque_Nm) / (2.0 * h_s);
+                              - (double)faded_detent_at(&coeffs, t_s - h_s, 20.0f).torque_Nm)
+                             / (2.0 * h_s);
         const pmstep_detent_t whole = faded_detent_at(&coeffs, t_s, 0.0f);
         const double speed = 5.0 + 300.0 * t_s;
         const double gain = 400.0 / (400.0 + speed * speed);

@@ -40,15 +40,9 @@ static pmstep_output_t turning_output(void)
     return out;
 }
 
-static float angle_of(float c, float s)
-{
-    return atan2f(s, c);
-}
+static float angle_of(float c, float s) { return atan2f(s, c); }
 
-static float estimate_angle(const paper_run_t *f)
-{
-    return paper_estimate_angle(&f->inst);
-}
+static float estimate_angle(const paper_run_t *f) { return paper_estimate_angle(&f->inst); }
 
 /* A command of SPEED_RAD_S (within the band) reached: the drive engages after the engage time. */
 static void engaged_turning(paper_run_t *f, const pmstep_output_t *out)
@@ -169,7 +163,7 @@ static void low_speed_drive_voltage_turns_with_the_vector(void **state)
     assert_int_equal(pmstep_hold_vector(&f.inst, 1.0f, 0.0f, HOLD_A, 0.0f), PMSTEP_OK);
     f.inst.hold.vector_speed_rad_s = SPEED_RAD_S;
     f.inst.scratch.run.standstill.vector_rate_rad_s = SPEED_RAD_S; /* no detent torque: no load-angle rate */
-    f.inst.observer.speed_hat_rad_s = SPEED_RAD_S; /* no damping turn */
+    f.inst.observer.speed_hat_rad_s = SPEED_RAD_S;                 /* no damping turn */
     obs_in.i_a_A = HOLD_A;
     obs_in.i_b_A = 0.0f;
     pmstep_hold_voltages(&f.inst, &obs_in, &out);

@@ -15,15 +15,15 @@
 
 /* What a run of the profile to its end showed. */
 typedef struct {
-    long periods;            /* until finished */
-    double max_speed;        /* max |v| */
-    double max_accel;        /* max |a| */
-    double max_jerk;         /* max |j| */
-    double max_overshoot;    /* largest excursion beyond the target, away from the start */
-    double max_rate_error;   /* max of |p[k+1]-p[k] - T (v[k]+v[k+1])/2| over its bound (below) */
-    double max_accel_error;  /* same for v and a */
-    double last_position;    /* the sample before the end */
-    float final_position;    /* the first finished sample */
+    long periods;           /* until finished */
+    double max_speed;       /* max |v| */
+    double max_accel;       /* max |a| */
+    double max_jerk;        /* max |j| */
+    double max_overshoot;   /* largest excursion beyond the target, away from the start */
+    double max_rate_error;  /* max of |p[k+1]-p[k] - T (v[k]+v[k+1])/2| over its bound (below) */
+    double max_accel_error; /* same for v and a */
+    double last_position;   /* the sample before the end */
+    float final_position;   /* the first finished sample */
     double final_speed;
 } run_t;
 
@@ -68,13 +68,13 @@ static run_t run_to_end(pmstep_motion_t *m, pmstep_motion_sample_t first, double
         if (pmstep_motion_finished(m)) {
             break; /* the end: onto the target exactly, checked apart (last_position) */
         }
-        r.max_rate_error = fmax(r.max_rate_error,
-                                rule_ratio((double)s.position - (double)prev.position, mean_speed, (double)prev.position,
-                                           (double)s.position, (double)m->j_max * PERIOD_S * PERIOD_S * PERIOD_S / 6.0,
-                                           t_s));
-        r.max_accel_error = fmax(r.max_accel_error,
-                                 rule_ratio((double)s.speed - (double)prev.speed, mean_accel, (double)prev.speed,
-                                            (double)s.speed, (double)m->j_max * PERIOD_S * PERIOD_S, t_s));
+        r.max_rate_error =
+            fmax(r.max_rate_error,
+                 rule_ratio((double)s.position - (double)prev.position, mean_speed, (double)prev.position,
+                            (double)s.position, (double)m->j_max * PERIOD_S * PERIOD_S * PERIOD_S / 6.0, t_s));
+        r.max_accel_error =
+            fmax(r.max_accel_error, rule_ratio((double)s.speed - (double)prev.speed, mean_accel, (double)prev.speed,
+                                               (double)s.speed, (double)m->j_max * PERIOD_S * PERIOD_S, t_s));
         if (!pmstep_motion_finished(m)) {
             r.last_position = (double)s.position;
         }
@@ -216,9 +216,7 @@ static void retarget_mid_move_is_continuous_and_ends_exactly(void **state)
         /* the speed and acceleration of the moment of the re-target may exceed lower new limits;
          * from there the acceleration only comes down, at j_max, and the speed goes on at most to where
          * that leaves it (|v| + a^2/(2 j)) */
-        check_limits(&r,
-                     fmax(v2, fabs((double)next.speed)
-                                  + (double)next.accel * (double)next.accel / (2.0 * j_max)),
+        check_limits(&r, fmax(v2, fabs((double)next.speed) + (double)next.accel * (double)next.accel / (2.0 * j_max)),
                      fmax(a2, fabs((double)next.accel)), j_max);
         assert_true(r.max_rate_error <= 1.0);
         assert_true(r.max_accel_error <= 1.0);
@@ -242,7 +240,8 @@ static void retarget_behind_reverses_after_a_stop(void **state)
     }
     assert_float_equal(s.speed, 5.0f, 1e-5f);
     next = pmstep_motion_peek(&m);
-    pmstep_motion_plan(&m, next.position, next.speed, next.accel, 4.8f, 5.0f, 50.0f, 5000.0f); /* nearer than the stop */
+    pmstep_motion_plan(&m, next.position, next.speed, next.accel, 4.8f, 5.0f, 50.0f,
+                       5000.0f); /* nearer than the stop */
     r = run_to_end(&m, pmstep_motion_next(&m), (double)next.position);
     assert_true(r.final_position == 4.8f);
     check_limits(&r, 5.0, 50.0, 5000.0);
@@ -267,8 +266,8 @@ static void stop_ends_at_rest_where_it_says(void **state)
     r = run_to_end(&m, pmstep_motion_next(&m), (double)next.position);
     check_limits(&r, 5.0, 50.0, 5000.0);
     assert_true(r.final_position == m.target);
-    assert_true(m.target < next.position);            /* it went on in its direction ... */
-    assert_true(m.target > next.position - 1.0f);     /* ... by about v^2/(2a) + the ramps */
+    assert_true(m.target < next.position);        /* it went on in its direction ... */
+    assert_true(m.target > next.position - 1.0f); /* ... by about v^2/(2a) + the ramps */
     assert_true(fabs(r.last_position - (double)m.target) < 1e-5);
     /* at rest: a later next() stays at the target */
     s = pmstep_motion_next(&m);

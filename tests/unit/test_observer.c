@@ -15,8 +15,8 @@ static void observer_converges_on_exact_samples(void **state)
     const pmstep_config_t cfg = pmstep_paper_config();
     const pmstep_electrical_t model = pmstep_configured_electrical(&cfg);
     const double period_s = cfg.timing.period_s;
-    const double i_q_A = 1.0;   /* q current held by the drive: balances 2 Nm */
-    const double speed = 10.0;  /* rad/s */
+    const double i_q_A = 1.0;  /* q current held by the drive: balances 2 Nm */
+    const double speed = 10.0; /* rad/s */
     exact_plant_t plant = {3.0, 0.006, 2.0, 6.0, 0.0, 0.0, 0.0, 0.0};
     pmstep_observer_coeffs_t coeffs;
     pmstep_observer_t obs;

@@ -40,7 +40,7 @@ static void atan2_poly_axes_and_origin(void **state)
     assert_float_equal(pmstep_atan2_poly(0.0f, 1.0f), 0.0f, 0.0f);
     assert_float_equal(pmstep_atan2_poly(1.0f, 0.0f), 1.5707963f, 2e-6f);
     assert_float_equal(pmstep_atan2_poly(-1.0f, 0.0f), -1.5707963f, 2e-6f);
-    assert_float_equal(pmstep_atan2_poly(0.0f, -1.0f), 3.1415927f, 2e-6f);  /* pi, not -pi */
+    assert_float_equal(pmstep_atan2_poly(0.0f, -1.0f), 3.1415927f, 2e-6f); /* pi, not -pi */
     assert_float_equal(pmstep_atan2_poly(0.0f, 0.0f), 0.0f, 0.0f);
     assert_float_equal(pmstep_atan2_poly(1.0f, 1.0f), 0.7853982f, 1.2e-5f);
 }
@@ -302,7 +302,8 @@ static void kinematic_run(fixture_t *f, kinematic_t *k, long periods, double tar
         pmstep_output_t out;
         pmstep_position_output_t pos_out;
         k->theta_rad += period * (double)ref.value;
-        pmstep_ref_advance(&f->inst.derived.ref_coeffs, &f->inst.speed_ref, f->cfg.timing.period_s); /* as pmstep_step */
+        pmstep_ref_advance(&f->inst.derived.ref_coeffs, &f->inst.speed_ref,
+                           f->cfg.timing.period_s); /* as pmstep_step */
         out = run_output(6.0 * k->theta_rad, 1.0, (double)ref.value + speed_bias);
         out.speed_ref_rad_s = ref.value;
         pmstep_position_update(&f->pos, &out, &pos_out);
@@ -330,8 +331,8 @@ static void loop_drives_the_reference_to_the_target_and_holds(void **state)
     kinematic_run(&f, &k, 60000, 3.0, 0.0, 0.0); /* the move takes 1.6 s; 3 s */
     assert_int_equal(pmstep_get_position(&f.pos, &position), PMSTEP_OK);
     print_message("kinematic move of 3 rad: final error %.3g rad, overshoot %.3g rad, max |theta* - theta-hat| %.3g, "
-                  "|theta* - theta| every period %.3g\n", 3.0 - k.theta_rad, k.max_overshoot, k.max_error,
-                  k.max_reference_gap);
+                  "|theta* - theta| every period %.3g\n",
+                  3.0 - k.theta_rad, k.max_overshoot, k.max_error, k.max_reference_gap);
     assert_true(fabs(k.theta_rad - 3.0) < 1e-4);
     assert_true(k.max_overshoot < 1e-4);
     assert_true(k.max_error < 1e-3);

@@ -155,8 +155,8 @@ static double core_estimate(const fixture_t *f)
 {
     float c;
     float s;
-    pmstep_angle_estimate(&f->inst.angle, &f->inst.derived.angle_coeffs, f->inst.angle.i_a_prev_A, f->inst.angle.i_b_prev_A,
-                          &c, &s);
+    pmstep_angle_estimate(&f->inst.angle, &f->inst.derived.angle_coeffs, f->inst.angle.i_a_prev_A,
+                          f->inst.angle.i_b_prev_A, &c, &s);
     return atan2((double)s, (double)c);
 }
 

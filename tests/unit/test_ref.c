@@ -21,7 +21,7 @@ static void filter_has_unit_steady_state_gain(void **state)
     pmstep_ref_coeffs_init(&coeffs, (float)W0, (float)PERIOD_S);
     pmstep_ref_reset(&ref, 0.0f);
     pmstep_ref_set_target(&ref, 7.5f, 0.0f); /* a step */
-    for (k = 0; k < 20000; ++k) { /* 1 s = 300 time constants */
+    for (k = 0; k < 20000; ++k) {            /* 1 s = 300 time constants */
         pmstep_ref_advance(&coeffs, &ref, (float)PERIOD_S);
     }
     out = pmstep_ref_output(&coeffs, &ref);
@@ -50,20 +50,21 @@ static void chain_period(double x[3], double t0, double (*setpoint)(double))
         double k1[3], k2[3], k3[3], k4[3], tmp[3];
         int n;
         chain_rate(x, setpoint(t), k1);
-        for (n = 0; n < 3; ++n) tmp[n] = x[n] + 0.5 * h * k1[n];
+        for (n = 0; n < 3; ++n)
+            tmp[n] = x[n] + 0.5 * h * k1[n];
         chain_rate(tmp, setpoint(t + 0.5 * h), k2);
-        for (n = 0; n < 3; ++n) tmp[n] = x[n] + 0.5 * h * k2[n];
+        for (n = 0; n < 3; ++n)
+            tmp[n] = x[n] + 0.5 * h * k2[n];
         chain_rate(tmp, setpoint(t + 0.5 * h), k3);
-        for (n = 0; n < 3; ++n) tmp[n] = x[n] + h * k3[n];
+        for (n = 0; n < 3; ++n)
+            tmp[n] = x[n] + h * k3[n];
         chain_rate(tmp, setpoint(t + h), k4);
-        for (n = 0; n < 3; ++n) x[n] += h / 6.0 * (k1[n] + 2.0 * k2[n] + 2.0 * k3[n] + k4[n]);
+        for (n = 0; n < 3; ++n)
+            x[n] += h / 6.0 * (k1[n] + 2.0 * k2[n] + 2.0 * k3[n] + k4[n]);
     }
 }
 
-static double ramp_to_10(double t)
-{
-    return fmin(50.0 * t, 10.0);
-}
+static double ramp_to_10(double t) { return fmin(50.0 * t, 10.0); }
 
 static double held_at_5(double t)
 {
@@ -112,8 +113,8 @@ static void filter_is_exact_for_a_ramp_and_derivatives_match_differences(void **
         max_rate_diff_err = fmax(max_rate_diff_err, fabs(rate[k] - rate_diff));
         max_accel_diff_err = fmax(max_accel_diff_err, fabs(accel[k] - accel_diff));
     }
-    print_message("vs continuous: |dy| %.3g, |dy'| %.3g, |dy''| %.3g (peaks y' %.3g, y'' %.3g)\n",
-                  max_value_err, max_rate_err, max_accel_err, peak_rate, peak_accel);
+    print_message("vs continuous: |dy| %.3g, |dy'| %.3g, |dy''| %.3g (peaks y' %.3g, y'' %.3g)\n", max_value_err,
+                  max_rate_err, max_accel_err, peak_rate, peak_accel);
     print_message("vs central differences: |y' - Dy| %.3g, |y'' - Dy'| %.3g\n", max_rate_diff_err, max_accel_diff_err);
     assert_true(max_value_err < 1e-5 * 10.0);
     assert_true(max_rate_err < 1e-5 * peak_rate);

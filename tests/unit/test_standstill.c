@@ -142,10 +142,7 @@ static uint32_t standstill_settled(paper_run_t *f)
     return settle;
 }
 
-static float estimate_angle(const paper_run_t *f)
-{
-    return paper_estimate_angle(&f->inst);
-}
+static float estimate_angle(const paper_run_t *f) { return paper_estimate_angle(&f->inst); }
 
 /* Settled, the estimate is put back every period: a drift of the integrals whose rate times the
  * settling time is 0.9 x the motion bound is learnt before the sum reaches the bound (the sum
@@ -178,11 +175,11 @@ static void standstill_keeps_the_estimate_while_the_rotor_rests(void **state)
     assert_float_equal(f.inst.scratch.run.standstill.drift_rad, drift_rad, 0.1f * drift_rad);
     assert_true(f.inst.scratch.run.standstill.rest_periods > 10u * settle);
     /* moving (|w-hat - w-bar| over the hold's band): the estimate is left to the integrals */
-    out = at_rest_output(0.8f, 0.6f); /* the integrals' reading */
+    out = at_rest_output(0.8f, 0.6f);                                      /* the integrals' reading */
     f.inst.observer.speed_hat_rad_s = 2.0f * f.inst.hold.quiet_band_rad_s; /* the observer's, after the period */
     standstill_period(&f, &out);
-    pmstep_angle_estimate(&f.inst.angle, &f.inst.derived.angle_coeffs, f.inst.angle.i_a_prev_A, f.inst.angle.i_b_prev_A, &c,
-                          &s);
+    pmstep_angle_estimate(&f.inst.angle, &f.inst.derived.angle_coeffs, f.inst.angle.i_a_prev_A, f.inst.angle.i_b_prev_A,
+                          &c, &s);
     assert_float_equal(c, 0.8f, 1e-6f);
     assert_float_equal(s, 0.6f, 1e-6f);
     assert_int_equal(f.inst.scratch.run.standstill.rest_periods, 0u);
@@ -247,8 +244,8 @@ static void standstill_settles_on_the_aim(void **state)
         const float aim_rad = 0.3f;
         const float load_Nm = 3.0f; /* k_M I = 15 N m: a load angle of asin(0.2) */
         pmstep_output_t out = at_rest_output(cosf(aim_rad), sinf(aim_rad));
-        const float kept_rad = pmstep_abs(drifted_rad[k]) > PMSTEP_HOLD_MOTION_BOUND_RAD ? aim_rad + drifted_rad[k]
-                                                                                         : aim_rad;
+        const float kept_rad =
+            pmstep_abs(drifted_rad[k]) > PMSTEP_HOLD_MOTION_BOUND_RAD ? aim_rad + drifted_rad[k] : aim_rad;
         uint32_t n;
         fixture_with_standstill(&f);
         f.inst.observer.load_hat_Nm = load_Nm;
@@ -322,8 +319,8 @@ static void standstill_aims_clear_of_the_phase_axes(void **state)
         {1.0f, 0.0f, 0.01f, 0.0f, 0.99944427f, 1.0f / 30.0f},
         {-0.9999f, -0.0141418f, 0.01f, 0.0f, -0.99944427f, -1.0f / 30.0f},
         {0.02f, -0.9998f, 0.01f, 0.0f, 1.0f / 30.0f, -0.99944427f},
-        {0.6f, 0.8f, 0.01f, 0.0f, 0.6f, 0.8f},    /* clear already */
-        {1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f},     /* no band: at the estimate */
+        {0.6f, 0.8f, 0.01f, 0.0f, 0.6f, 0.8f},              /* clear already */
+        {1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f},               /* no band: at the estimate */
         {1.0f, 0.0f, 1.0f, 0.0f, 0.70710678f, 0.70710678f}, /* a clearance beyond the diagonal: the diagonal */
         /* the estimate clear, its vector not: at 0.01 rad from phase a's axis */
         {0.9817469f, -0.1901922f, 0.01f, 3.0f, 0.99944427f, 1.0f / 30.0f},
@@ -403,7 +400,8 @@ static void standstill_off_without_a_current_and_validated(void **state)
     assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
     cfg.known_load_mode = true;
     assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_ERR_STANDSTILL_KNOWN_LOAD);
-    assert_string_equal(pmstep_status_str(PMSTEP_ERR_STANDSTILL_KNOWN_LOAD), "standstill hold not with known_load_mode");
+    assert_string_equal(pmstep_status_str(PMSTEP_ERR_STANDSTILL_KNOWN_LOAD),
+                        "standstill hold not with known_load_mode");
     cfg.standstill.hold_current_A = 0.0f;
     assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_OK);
 }

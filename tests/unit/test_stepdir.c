@@ -84,7 +84,7 @@ static void designer_bounds_the_tracker_by_the_microstep(void **state)
     }
     assert_int_equal(pmstep_stepdir_design(&cfg, 1u, &c), PMSTEP_OK);
     assert_true(c.tracking_bandwidth_rad_s < w0); /* one full step per count: the bound acts */
-    cfg.detection.stall_speed_error_rad_s = 0.0f;   /* the stall detection off: no bound */
+    cfg.detection.stall_speed_error_rad_s = 0.0f; /* the stall detection off: no bound */
     assert_int_equal(pmstep_stepdir_design(&cfg, 1u, &c), PMSTEP_OK);
     assert_true(c.tracking_bandwidth_rad_s == w0);
 }
@@ -125,7 +125,8 @@ static void tracker_has_no_steady_lag(void **state)
     pmstep_stepdir_start(&sd, &rest);
     for (k = 1; k <= periods; ++k) {
         const double t = (double)k * (double)PERIOD_S;
-        const double theta = t < t_accel ? 0.5 * accel * t * t : 0.5 * accel * t_accel * t_accel + accel * t_accel * (t - t_accel);
+        const double theta =
+            t < t_accel ? 0.5 * accel * t * t : 0.5 * accel * t_accel * t_accel + accel * t_accel * (t - t_accel);
         const double speed = t < t_accel ? accel * t : accel * t_accel;
         pmstep_stepdir_count(&sd, (uint32_t)(int32_t)floor(theta / (double)sd.rad_per_microstep));
         if (k % PMSTEP_POSITION_DECIMATION == 0) {
@@ -181,9 +182,9 @@ static void diag_level_and_pulse(void **state)
     assert_true(pmstep_stepdir_diag(&sd, PMSTEP_MODE_FAULT, 0.0f, false)); /* a fault, even untracked */
     pmstep_stepdir_start(&sd, &rest);
     assert_false(pmstep_stepdir_diag(&sd, PMSTEP_MODE_RUN, 0.5f * c.following_error_limit_rad, true));
-    assert_true(pmstep_stepdir_diag(&sd, PMSTEP_MODE_RUN, beyond, true));   /* theta-hat ahead: lost steps */
+    assert_true(pmstep_stepdir_diag(&sd, PMSTEP_MODE_RUN, beyond, true)); /* theta-hat ahead: lost steps */
     assert_true(pmstep_stepdir_diag(&sd, PMSTEP_MODE_RUN, -beyond, true));
-    assert_false(pmstep_stepdir_diag(&sd, PMSTEP_MODE_RUN, 0.0f, true));    /* level: released with the cause */
+    assert_false(pmstep_stepdir_diag(&sd, PMSTEP_MODE_RUN, 0.0f, true)); /* level: released with the cause */
     c.diag_mode = PMSTEP_DIAG_PULSE;
     c.diag_pulse_periods = 20u;
     assert_int_equal(pmstep_stepdir_init(&sd, &c, POLE_PAIRS, PERIOD_S, 0u), PMSTEP_OK);
@@ -222,7 +223,7 @@ static void stall_drops_the_steps_toward_the_block(void **state)
     assert_false(pmstep_stepdir_stall(&sd, 0.01f, 0.5f));
     count_and_track(&sd, 140);
     assert_true(pmstep_stepdir_following_error(&sd, 0.01f) > limit);
-    assert_true(pmstep_stepdir_stall(&sd, 0.01f, 0.5f));  /* the following error: a stall */
+    assert_true(pmstep_stepdir_stall(&sd, 0.01f, 0.5f)); /* the following error: a stall */
     assert_true(sd.stalled);
     assert_int_equal(sd.stall_direction, 1);
     assert_float_equal(sd.position_rad, 0.01f, 1e-7f);
@@ -244,7 +245,7 @@ static void stall_drops_the_steps_toward_the_block(void **state)
     /* the push beyond the stall current toward the count is a stall too, with no following error yet */
     count_and_track(&sd, -4);
     assert_true(pmstep_stepdir_following_error(&sd, 0.01f) < 0.0f); /* the count below the rotor */
-    assert_false(pmstep_stepdir_stall(&sd, 0.01f, 1.1f)); /* a push up, away from the count: not a stall */
+    assert_false(pmstep_stepdir_stall(&sd, 0.01f, 1.1f));           /* a push up, away from the count: not a stall */
     count_and_track(&sd, 4);
     assert_true(pmstep_stepdir_following_error(&sd, -0.02f) > 0.0f);
     assert_true(pmstep_stepdir_following_error(&sd, -0.02f) < limit);

@@ -137,8 +137,9 @@ static void its_settings_are_checked(void **state)
     expect_refused(&cfg);
     cfg.field_weakening.gain_A_per_s = NAN;
     assert_int_equal(pmstep_init(&inst, &cfg), PMSTEP_ERR_NONFINITE_PARAMETER);
-    assert_string_equal(pmstep_status_str(PMSTEP_ERR_FIELD_WEAKENING),
-                        "need field weakening current >= 0 below the trip, and if > 0 modulation in (0, 1] and gain > 0");
+    assert_string_equal(
+        pmstep_status_str(PMSTEP_ERR_FIELD_WEAKENING),
+        "need field weakening current >= 0 below the trip, and if > 0 modulation in (0, 1] and gain > 0");
 }
 
 /* The periods of RUN on the paper's motor up to the first supervise stage, w-hat held at

@@ -32,7 +32,7 @@ typedef struct {
 #define PMSTEP_CONSOLE_CFG_I32 2u
 #define PMSTEP_CONSOLE_CFG_BOOL 3u
 #define PMSTEP_CONSOLE_CFG_READ_ONLY 1u
-#define PMSTEP_CONSOLE_CFG_STEPDIR 2u  /**< a STEP/DIR setting (pmstep_stepdir_settings_t), named stepdir.* */
+#define PMSTEP_CONSOLE_CFG_STEPDIR 2u /**< a STEP/DIR setting (pmstep_stepdir_settings_t), named stepdir.* */
 
 /** The table of configuration values: @p count gets its length. */
 const pmstep_console_config_entry_t *pmstep_console_config_table(uint32_t *count);

@@ -79,19 +79,16 @@ static void send_home_status(pmstep_console_t *c, uint8_t seq, int32_t status, c
  * reach a core the calibration drives. */
 static bool allowed_while_calibrating(uint8_t cmd)
 {
-    return cmd == PMSTEP_CONSOLE_GET_STATUS || cmd == PMSTEP_CONSOLE_GET_CONFIG || cmd == PMSTEP_CONSOLE_GET_COMMISSIONING
-           || cmd == PMSTEP_CONSOLE_TELEMETRY || cmd == PMSTEP_CONSOLE_GET_POSITION || cmd == PMSTEP_CONSOLE_CONFIG_READ
+    return cmd == PMSTEP_CONSOLE_GET_STATUS || cmd == PMSTEP_CONSOLE_GET_CONFIG
+           || cmd == PMSTEP_CONSOLE_GET_COMMISSIONING || cmd == PMSTEP_CONSOLE_TELEMETRY
+           || cmd == PMSTEP_CONSOLE_GET_POSITION || cmd == PMSTEP_CONSOLE_CONFIG_READ
            || cmd == PMSTEP_CONSOLE_SIM_STEPDIR;
 }
 
 /* How a request applied at the boundary ended: acknowledged by the boundary with its status, answered
  * by its handler, or refused by its handler (which replied, or whose attachment did) and not counted
  * as applied. */
-typedef enum {
-    APPLY_ACK,
-    APPLY_REPLIED,
-    APPLY_REFUSED
-} apply_end_t;
+typedef enum { APPLY_ACK, APPLY_REPLIED, APPLY_REFUSED } apply_end_t;
 
 /* What a handler works on at the boundary. */
 typedef struct {
@@ -187,8 +184,8 @@ static apply_end_t apply_sim_stepdir(pmstep_console_t *c, const pmstep_console_r
 }
 
 /* MOVE_TO, HOLD, SET_POSITION_ZERO, HOME: the position attachment (checked at parsing). */
-static apply_end_t apply_position_command(pmstep_console_t *c, const pmstep_console_request_t *req,
-                                          const boundary_t *b, int32_t *status)
+static apply_end_t apply_position_command(pmstep_console_t *c, const pmstep_console_request_t *req, const boundary_t *b,
+                                          int32_t *status)
 {
     (void)b;
     *status = c->position_apply(c, req->cmd, req->arg, NULL);
@@ -254,8 +251,8 @@ static apply_end_t apply_get_commissioning(pmstep_console_t *c, const pmstep_con
 
 /* The core's part of SET_CONFIG: the trial configuration validated, the STEP/DIR stall current kept
  * below its trip, then in force and the core initialised with it (the position loop's gains anew). */
-static int32_t put_core_config_in_force(pmstep_console_t *c, const pmstep_console_request_t *req,
-                                        const boundary_t *b, const pmstep_config_t *trial)
+static int32_t put_core_config_in_force(pmstep_console_t *c, const pmstep_console_request_t *req, const boundary_t *b,
+                                        const pmstep_config_t *trial)
 {
     int32_t st = (int32_t)pmstep_validate_config(trial);
     if (st == (int32_t)PMSTEP_OK && !(c->stepdir.stall_current_A < trial->limits.max_phase_current_A)) {
@@ -294,7 +291,8 @@ static apply_end_t apply_set_config(pmstep_console_t *c, const pmstep_console_re
         /* The STEP/DIR input's: checked whole, in force when accepted; the core is not touched (the
          * image applies them when it next starts following). */
         pmstep_stepdir_config_t in_force;
-        *status = (int32_t)pmstep_console_stepdir_config(b->cfg, &stepdir, &in_force); /* the stall current by the trip */
+        *status =
+            (int32_t)pmstep_console_stepdir_config(b->cfg, &stepdir, &in_force); /* the stall current by the trip */
         if (*status == (int32_t)PMSTEP_OK) {
             c->stepdir = stepdir;
         }

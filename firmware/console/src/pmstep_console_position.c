@@ -45,21 +45,11 @@ static int32_t position_apply(pmstep_console_t *c, uint8_t cmd, const float *arg
     pmstep_position_t *pos = c->position;
     pmstep_status_t st;
     switch (cmd) {
-    case PMSTEP_CONSOLE_HOME:
-        st = home(c, args);
-        break;
-    case PMSTEP_CONSOLE_HOME_STATUS:
-        st = home_status(c, reading);
-        break;
-    case PMSTEP_CONSOLE_MOVE_TO:
-        st = pmstep_position_move_to(pos, args[0], args[1], args[2], args[3]);
-        break;
-    case PMSTEP_CONSOLE_HOLD:
-        st = pmstep_position_hold(pos, args[0]);
-        break;
-    case PMSTEP_CONSOLE_SET_POSITION_ZERO:
-        st = pmstep_position_set_zero(pos);
-        break;
+    case PMSTEP_CONSOLE_HOME: st = home(c, args); break;
+    case PMSTEP_CONSOLE_HOME_STATUS: st = home_status(c, reading); break;
+    case PMSTEP_CONSOLE_MOVE_TO: st = pmstep_position_move_to(pos, args[0], args[1], args[2], args[3]); break;
+    case PMSTEP_CONSOLE_HOLD: st = pmstep_position_hold(pos, args[0]); break;
+    case PMSTEP_CONSOLE_SET_POSITION_ZERO: st = pmstep_position_set_zero(pos); break;
     case PMSTEP_CONSOLE_SET_CONFIG: { /* the core took a new configuration: the loop's gains from it */
         pmstep_position_config_t gains;
         st = pmstep_position_design(pos->inst->cfg, &gains);

@@ -95,8 +95,7 @@ static bool sim_stepdir_apply(pmstep_console_t *c, const pmstep_console_request_
     return true;
 }
 
-pmstep_status_t pmstep_console_attach_sim_stepdir(pmstep_console_t *c, pmstep_stepdir_t *sd,
-                                                  const pmstep_config_t *cfg)
+pmstep_status_t pmstep_console_attach_sim_stepdir(pmstep_console_t *c, pmstep_stepdir_t *sd, const pmstep_config_t *cfg)
 {
     pmstep_status_t st;
     if (c == NULL || sd == NULL || cfg == NULL || c->sim_request == NULL || c->position == NULL) {

@@ -128,8 +128,8 @@ static int32_t apply_staged(pmstep_console_t *c, pmstep_t *inst, pmstep_config_t
     return init;
 }
 
-static bool store_apply(pmstep_console_t *c, const pmstep_console_request_t *req, pmstep_t *inst,
-                        pmstep_config_t *cfg, const pmstep_console_snapshot_t *snap)
+static bool store_apply(pmstep_console_t *c, const pmstep_console_request_t *req, pmstep_t *inst, pmstep_config_t *cfg,
+                        const pmstep_console_snapshot_t *snap)
 {
     pmstep_console_store_t *cs = c->store;
     const pmstep_mode_t mode = pmstep_get_mode(inst);
@@ -146,9 +146,7 @@ static bool store_apply(pmstep_console_t *c, const pmstep_console_request_t *req
         return false;
     }
     switch (req->cmd) {
-    case PMSTEP_CONSOLE_CONFIG_APPLY:
-        st = apply_staged(c, inst, cfg);
-        break;
+    case PMSTEP_CONSOLE_CONFIG_APPLY: st = apply_staged(c, inst, cfg); break;
     case PMSTEP_CONSOLE_CONFIG_SAVE: {
         pmstep_store_record_t rec;
         if (!cs->configured) {
@@ -164,9 +162,7 @@ static bool store_apply(pmstep_console_t *c, const pmstep_console_request_t *req
         }
         break;
     }
-    case PMSTEP_CONSOLE_CONFIG_ERASE:
-        st = (int32_t)pmstep_store_erase(cs->store, bridge_off);
-        break;
+    case PMSTEP_CONSOLE_CONFIG_ERASE: st = (int32_t)pmstep_store_erase(cs->store, bridge_off); break;
     default: /* PMSTEP_CONSOLE_CONFIG_DEFAULTS */
         st = pmstep_console_put_in_force(c, inst, cfg, &cs->defaults);
         c->stepdir = pmstep_console_stepdir_defaults();

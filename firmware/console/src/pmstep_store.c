@@ -109,10 +109,9 @@ uint32_t pmstep_store_encode(const pmstep_store_record_t *rec, uint32_t board_id
     const uint32_t count = table_count();
     const uint32_t n = record_bytes(count);
     const pmstep_store_measured_t *m = &rec->measured;
-    const float measured[PMSTEP_STORE_MEASURED_VALUES - 1u] = {m->offset_a_A,           m->offset_b_A,
-                                                                m->resistance_Ohm,       m->inductance_H,
-                                                                m->torque_constant_Nm_A, m->inertia_kgm2,
-                                                                m->friction_Nms_rad};
+    const float measured[PMSTEP_STORE_MEASURED_VALUES - 1u] = {
+        m->offset_a_A,           m->offset_b_A,   m->resistance_Ohm,  m->inductance_H,
+        m->torque_constant_Nm_A, m->inertia_kgm2, m->friction_Nms_rad};
     uint8_t *p = out + PMSTEP_STORE_HEADER_BYTES;
     uint32_t id;
     put32(out + OFF_MAGIC, PMSTEP_STORE_MAGIC);

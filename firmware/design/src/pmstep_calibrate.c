@@ -9,10 +9,10 @@
 #include <string.h>
 
 #define SQRT2 1.41421356f
-#define TIME_CONSTANT_GUESS_S 2e-3f  /* L/R assumed before L is measured (steppers: 0.5-5 ms) */
-#define FLUX_RATIO_GUESS 1.0f        /* p L I / k_M assumed before k_M is measured (steppers: 0.5-3) */
-#define RUN_START_HOLD_S 0.1f        /* RUN at zero speed before identification's first ramp */
-#define ADC_LEVELS 2048.0f           /* current resolution of a 12-bit bipolar measurement: range / 2048 */
+#define TIME_CONSTANT_GUESS_S 2e-3f /* L/R assumed before L is measured (steppers: 0.5-5 ms) */
+#define FLUX_RATIO_GUESS 1.0f       /* p L I / k_M assumed before k_M is measured (steppers: 0.5-3) */
+#define RUN_START_HOLD_S 0.1f       /* RUN at zero speed before identification's first ramp */
+#define ADC_LEVELS 2048.0f          /* current resolution of a 12-bit bipolar measurement: range / 2048 */
 
 static bool finite_positive(float x)
 {
@@ -129,7 +129,8 @@ static plan_t identification_plan(const pmstep_calibrate_t *cal, const pmstep_co
     plan_t p;
     const float j = cal->report.inertia_kgm2;
     p.speed_rad_s = cal->speed_of_top * cal->report.top_speed_rad_s;
-    p.accel_rad_s2 = PMSTEP_CALIBRATE_ACCEL_OF_RATED * cfg->motor.torque_constant_Nm_A * cal->request.rated_current_A / j;
+    p.accel_rad_s2 =
+        PMSTEP_CALIBRATE_ACCEL_OF_RATED * cfg->motor.torque_constant_Nm_A * cal->request.rated_current_A / j;
     p.run_s = cfg->commissioning.offset_calibration_time_s + cfg->alignment.c_align_time_s;
     p.up_s = p.run_s + RUN_START_HOLD_S;
     p.down_s = p.up_s + p.speed_rad_s / p.accel_rad_s2 + PMSTEP_CALIBRATE_HOLD_S;
@@ -161,8 +162,8 @@ static pmstep_status_t identification_config(pmstep_calibrate_t *cal, pmstep_con
 
 static void start_run(pmstep_calibrate_t *cal, pmstep_t *inst, pmstep_config_t *cfg, uint32_t period)
 {
-    const pmstep_status_t st = cal->stage == PMSTEP_CALIBRATE_MEASURING ? measuring_config(cal, cfg)
-                                                                         : identification_config(cal, cfg);
+    const pmstep_status_t st =
+        cal->stage == PMSTEP_CALIBRATE_MEASURING ? measuring_config(cal, cfg) : identification_config(cal, cfg);
     pmstep_status_t init;
     if (st != PMSTEP_OK) {
         fail(cal, inst, (int32_t)st);
@@ -199,8 +200,8 @@ static void end_measuring_run(pmstep_calibrate_t *cal, pmstep_t *inst)
          * up to the largest the drive calibrates and the bus drives at the rated current (the
          * designer's limit, R I at most PMSTEP_CALIBRATE_USABLE_BUS of the bus). */
         const float bus_limit_Ohm = PMSTEP_CALIBRATE_USABLE_BUS * cal->bus_voltage_V / cal->request.rated_current_A;
-        const float largest_Ohm = bus_limit_Ohm < PMSTEP_CALIBRATE_MAX_RESISTANCE_OHM ? bus_limit_Ohm
-                                                                                    : PMSTEP_CALIBRATE_MAX_RESISTANCE_OHM;
+        const float largest_Ohm =
+            bus_limit_Ohm < PMSTEP_CALIBRATE_MAX_RESISTANCE_OHM ? bus_limit_Ohm : PMSTEP_CALIBRATE_MAX_RESISTANCE_OHM;
         const float next_Ohm = designed * PMSTEP_CALIBRATE_PROBE_STEP;
         if (designed >= largest_Ohm) {
             fail(cal, inst, PMSTEP_CALIBRATE_ERR_NO_MOTOR);
@@ -223,8 +224,8 @@ static void end_measuring_run(pmstep_calibrate_t *cal, pmstep_t *inst)
      * current of a larger one would have tripped the open-phase check). */
     cal->resistance_Ohm = cm.resistance_Ohm;
     cal->inductance_H = finite_positive(cm.inductance_H) ? cm.inductance_H : cal->inductance_H;
-    cal->torque_constant_Nm_A = finite_positive(cm.torque_constant_Nm_A) ? cm.torque_constant_Nm_A
-                                                                         : cal->torque_constant_Nm_A;
+    cal->torque_constant_Nm_A =
+        finite_positive(cm.torque_constant_Nm_A) ? cm.torque_constant_Nm_A : cal->torque_constant_Nm_A;
     if (fault == PMSTEP_FAULT_NONE && cm.resistance_Ohm >= (1.0f - PMSTEP_CALIBRATE_R_AGREEMENT) * designed
         && cm.resistance_Ohm <= (1.0f + PMSTEP_CALIBRATE_R_AGREEMENT) * designed) {
         cal->stage = PMSTEP_CALIBRATE_IDENTIFYING; /* R, L, k_M of a run designed for them */

@@ -8,7 +8,7 @@
 #include <stddef.h>
 
 /* Bandwidths as fractions of the control rate 1/T_s (docs/design/02-current-and-speed-loops.md). */
-#define CURRENT_BANDWIDTH_X_PERIOD 0.2f   /* (R/L + K_i) T_s */
+#define CURRENT_BANDWIDTH_X_PERIOD 0.2f /* (R/L + K_i) T_s */
 /* The observer's triple pole w_o: at least OBSERVER_BANDWIDTH_X_PERIOD / T_s, raised to
  * OBSERVER_HALF_RESPONSE / t_step, t_step the time the rated torque takes to turn the told rotor by
  * one full step (a triple pole's step response is half way at w_o t = 2.674: half a load step is
@@ -25,14 +25,14 @@
 /* Robust mode's transient observer boost: beyond the residual bound the observer's mechanical injections
  * as at 3 w_o (docs/design/18-transient-observer-boost.md). */
 #define TRANSIENT_OBSERVER_BOOST 3.0f
-#define SPEED_PER_OBSERVER_BANDWIDTH (1.0f / 3.0f) /* k_w = w_o / 3 */
-#define REFERENCE_PER_SPEED_BANDWIDTH 3.0f         /* varpi_0 = 3 k_w */
+#define SPEED_PER_OBSERVER_BANDWIDTH (1.0f / 3.0f)       /* k_w = w_o / 3 */
+#define REFERENCE_PER_SPEED_BANDWIDTH 3.0f               /* varpi_0 = 3 k_w */
 #define DRIFT_FREE_PER_OBSERVER_BANDWIDTH (1.0f / 30.0f) /* robust mode's angle correction g = w_o / 30 */
 /* Robust mode's back-EMF angle correction: K_theta = 2 w_o, two thirds of the residual's R/L + K_e
  * (damping 0.61; docs/design/15-back-emf-angle-correction.md). */
 #define EMF_ANGLE_PER_OBSERVER_BANDWIDTH 2.0f
-#define CURRENT_INTEGRAL_PER_BANDWIDTH_SQUARED 0.125f   /* K_I = K^2/8, K = R/L + K_i: PI poles 0.15 K, 0.85 K */
-#define Q_INTEGRAL_SPEED_DIVISOR 5.0f /* K_I,q = K k_w / 5: the q PI's slow pole at k_w / 5 */
+#define CURRENT_INTEGRAL_PER_BANDWIDTH_SQUARED 0.125f /* K_I = K^2/8, K = R/L + K_i: PI poles 0.15 K, 0.85 K */
+#define Q_INTEGRAL_SPEED_DIVISOR 5.0f                 /* K_I,q = K k_w / 5: the q PI's slow pole at k_w / 5 */
 #define STILL_ROTOR_SWING_PHASE 0.1f /* RUN takes the measured L, k_M only if w_n x L window is below this */
 /* Speed correction k_w kappa at most this fraction of the rated current's acceleration k_M I / J. */
 #define KAPPA_CURRENT_FRACTION 0.5f
@@ -162,7 +162,8 @@ static void design_gains(const pmstep_design_input_t *in, pmstep_gains_config_t 
     const float current_bandwidth = max2(CURRENT_BANDWIDTH_X_PERIOD / in->period_s, WINDING_RATE_MARGIN * r_over_l);
 
     gains->current_gain_per_s = current_bandwidth - r_over_l;
-    gains->current_integral_gain_per_s2 = CURRENT_INTEGRAL_PER_BANDWIDTH_SQUARED * current_bandwidth * current_bandwidth;
+    gains->current_integral_gain_per_s2 =
+        CURRENT_INTEGRAL_PER_BANDWIDTH_SQUARED * current_bandwidth * current_bandwidth;
     /* The q axis's slow pole K_I,q / K a fifth of the speed loop's k_w: at K^2/8 it sat on k_w (a
      * limit cycle on the AS1050) or, at this K, upset the position loop's moves (docs/design/02-current-and-speed-loops.md). */
     gains->current_integral_gain_q_per_s2 = current_bandwidth * speed_gain / Q_INTEGRAL_SPEED_DIVISOR;
@@ -173,15 +174,15 @@ static void design_gains(const pmstep_design_input_t *in, pmstep_gains_config_t 
     gains->adapt_gamma = b * b / (w_slow * w_slow * w_slow);
     gains->adapt_r = ADAPT_R;
     gains->speed_gain_per_s = speed_gain;
-    gains->sat_kappa_rad_s = KAPPA_CURRENT_FRACTION * in->motor.rated_current_A * m->torque_constant_Nm_A
-                             / (m->inertia_kgm2 * speed_gain);
+    gains->sat_kappa_rad_s =
+        KAPPA_CURRENT_FRACTION * in->motor.rated_current_A * m->torque_constant_Nm_A / (m->inertia_kgm2 * speed_gain);
     gains->reference_bandwidth_rad_s = REFERENCE_PER_SPEED_BANDWIDTH * speed_gain;
     gains->angle_correction_gain_per_s = in->self_commissioning ? DRIFT_FREE_PER_OBSERVER_BANDWIDTH * w_o : 0.0f;
     if (in->self_commissioning) {
         /* Half on where the back EMF equals the voltage the model knows least: the resistive drop at
          * rated current and the dead time's full loss 2 V_bus t_d / T_s. */
-        const float uncertain_V = m->resistance_Ohm * in->motor.rated_current_A
-                                  + 2.0f * in->bus_voltage_V * in->dead_time_s / in->period_s;
+        const float uncertain_V =
+            m->resistance_Ohm * in->motor.rated_current_A + 2.0f * in->bus_voltage_V * in->dead_time_s / in->period_s;
         gains->emf_angle_gain_per_s = EMF_ANGLE_PER_OBSERVER_BANDWIDTH * w_o;
         gains->emf_angle_corner_rad_s = uncertain_V / m->torque_constant_Nm_A;
         gains->angle_smoothing = ANGLE_SMOOTHING;
@@ -193,8 +194,8 @@ static void design_gains(const pmstep_design_input_t *in, pmstep_gains_config_t 
         gains->transient_observer_boost = 0.0f;
     }
     gains->detent_fade_speed_rad_s = m->detent_torque_Nm > 0.0f ? DETENT_FADE_PER_CURRENT_BANDWIDTH * current_bandwidth
-                                                                       / (4.0f * (float)m->pole_pairs)
-                                                                 : 0.0f;
+                                                                      / (4.0f * (float)m->pole_pairs)
+                                                                : 0.0f;
 
     report->current_bandwidth_rad_s = current_bandwidth;
     report->observer_bandwidth_rad_s = w_o;
@@ -236,8 +237,8 @@ static float design_alignment(const pmstep_design_input_t *in, pmstep_config_t *
             n += 1.0f;
             decay_left *= 2.7182818f;
         }
-        window_s = round_up_time(max2(MIN_STEADY_STATE_WINDOW_S,
-                                      max2(STEADY_STATE_WINDOW_TIME_CONSTANTS, 2.0f * n) * l_over_r));
+        window_s = round_up_time(
+            max2(MIN_STEADY_STATE_WINDOW_S, max2(STEADY_STATE_WINDOW_TIME_CONSTANTS, 2.0f * n) * l_over_r));
         align_s = max2(settle_s + 2.0f * window_s, 4.0f * window_s);
     }
     align_s = round_up_time(align_s);
@@ -284,8 +285,8 @@ static float low_speed_band(const pmstep_design_input_t *in)
     const float pole_pairs = (float)m->pole_pairs;
     const float emf_band_rad_s = LOW_SPEED_EMF_PER_DEAD_TIME_LOSS * in->bus_voltage_V * in->dead_time_s
                                  / (in->period_s * m->torque_constant_Nm_A);
-    const float held_natural_rad_s = sqrtf(pole_pairs * m->torque_constant_Nm_A * in->motor.rated_current_A
-                                           / m->inertia_kgm2);
+    const float held_natural_rad_s =
+        sqrtf(pole_pairs * m->torque_constant_Nm_A * in->motor.rated_current_A / m->inertia_kgm2);
     const float resonance_band_rad_s = LOW_SPEED_DETENT_PER_HELD_NATURAL * held_natural_rad_s / (4.0f * pole_pairs);
     return min2(emf_band_rad_s, resonance_band_rad_s);
 }
@@ -300,9 +301,9 @@ static void design_commissioning(const pmstep_design_input_t *in, float window_s
     c->offset_calibration_time_s = robust ? OFFSET_CALIBRATION_S : 0.0f;
     c->alignment_offset_calibration = false;
     c->steady_state_window_s = window_s;
-    c->inductance_window_s = robust ? max2(INDUCTANCE_WINDOW_PER_TIME_CONSTANT * l_over_r,
-                                           MIN_INDUCTANCE_WINDOW_PERIODS * in->period_s)
-                                    : 0.0f;
+    c->inductance_window_s =
+        robust ? max2(INDUCTANCE_WINDOW_PER_TIME_CONSTANT * l_over_r, MIN_INDUCTANCE_WINDOW_PERIODS * in->period_s)
+               : 0.0f;
     /* L comes from the first current rise of s-alignment, with the rotor taken as still; where
      * the alignment swing's natural frequency turns the rotor within that window (hybrid
      * steppers: w_n ~ 1000 rad/s), its back EMF would enter the measurement: there L comes
@@ -350,7 +351,8 @@ static void design_commissioning(const pmstep_design_input_t *in, float window_s
  * the q current of PMSTEP_DESIGN_WEAKENED_TORQUE_SHARE of the holding torque (sqrt(2) k_M I); the
  * bus share of the top speed's definition; the gain g = w_fw m V / (2 p L w_b) sets the loop's rate
  * 2 g p w L / (m V) to w_fw = varpi_0 / 8 where weakening starts, w_b (pmstep_weakening.h). */
-static void design_field_weakening(const pmstep_design_input_t *in, pmstep_config_t *cfg, pmstep_design_report_t *report)
+static void design_field_weakening(const pmstep_design_input_t *in, pmstep_config_t *cfg,
+                                   pmstep_design_report_t *report)
 {
     const pmstep_motor_config_t *m = &in->motor;
     const float p_l = (float)m->pole_pairs * m->inductance_H;
@@ -365,8 +367,8 @@ static void design_field_weakening(const pmstep_design_input_t *in, pmstep_confi
                                         * USABLE_BUS_FRACTION * in->bus_voltage_V
                                         / (2.0f * p_l * report->bus_speed_rad_s);
     report->weakening_current_A = current_A;
-    report->weakened_speed_rad_s = current_A > 0.0f ? min2(bus_speed_at(in, -current_A, q_A), report->rate_speed_rad_s)
-                                                    : report->top_speed_rad_s;
+    report->weakened_speed_rad_s =
+        current_A > 0.0f ? min2(bus_speed_at(in, -current_A, q_A), report->rate_speed_rad_s) : report->top_speed_rad_s;
 }
 
 static void design_protection(const pmstep_design_input_t *in, pmstep_config_t *cfg, float top_speed_rad_s)
@@ -385,9 +387,9 @@ static void design_protection(const pmstep_design_input_t *in, pmstep_config_t *
      * prediction (the compensated voltage) can be off by twice the loss 2 V_bus t_d / T (the
      * sign taken the wrong way), which moves that period's current by 4 V_bus t_d / L
      * (docs/design/05-protections-and-detection.md). */
-    cfg->detection.observer_residual_bound_A = RESIDUAL_PER_RATED_CURRENT * in->motor.rated_current_A
-                                               + 4.0f * in->bus_voltage_V * cfg->inverter.dead_time_s
-                                                     / in->motor.inductance_H;
+    cfg->detection.observer_residual_bound_A =
+        RESIDUAL_PER_RATED_CURRENT * in->motor.rated_current_A
+        + 4.0f * in->bus_voltage_V * cfg->inverter.dead_time_s / in->motor.inductance_H;
     cfg->detection.persistence_s = PERSISTENCE_S;
     cfg->detection.max_realignments = 0u;
 }
@@ -413,7 +415,8 @@ pmstep_status_t pmstep_design(const pmstep_design_input_t *given, pmstep_config_
     }
     report->inertia_kgm2 = in->motor.inertia_kgm2;
     /* Data no stepper has first: a unit typed wrong shows there before it fails a rule below. */
-    status = (!pmstep_design_finite_input(in) || in->accept_implausible) ? PMSTEP_OK : pmstep_design_check_datasheet(in);
+    status =
+        (!pmstep_design_finite_input(in) || in->accept_implausible) ? PMSTEP_OK : pmstep_design_check_datasheet(in);
     if (status == PMSTEP_OK) {
         status = pmstep_design_check_input(in);
     }

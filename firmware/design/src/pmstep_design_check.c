@@ -73,9 +73,10 @@ float pmstep_design_alignment_current(const pmstep_design_input_t *in)
 {
     const pmstep_motor_config_t *m = &in->motor;
     const float condition_limit_A = m->torque_constant_Nm_A / ((float)m->pole_pairs * m->inductance_H);
-    const float detent_A = DETENT_BARRIER_MARGIN * m->detent_torque_Nm / (DETENT_BARRIER_RATIO * m->torque_constant_Nm_A);
-    return min2(in->motor.rated_current_A,
-                max2(CONDITION_4_FRACTION * condition_limit_A, min2(detent_A, MAX_CONDITION_4_FRACTION * condition_limit_A)));
+    const float detent_A =
+        DETENT_BARRIER_MARGIN * m->detent_torque_Nm / (DETENT_BARRIER_RATIO * m->torque_constant_Nm_A);
+    return min2(in->motor.rated_current_A, max2(CONDITION_4_FRACTION * condition_limit_A,
+                                                min2(detent_A, MAX_CONDITION_4_FRACTION * condition_limit_A)));
 }
 
 /* The motor's own data: each constant of its model in range. */

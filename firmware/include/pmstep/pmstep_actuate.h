@@ -38,13 +38,13 @@ typedef struct {
 
 /** Constants derived from the configuration. */
 typedef struct {
-    float dead_time_duty;       /**< 2 t_d / T_s: compensation at full current, fraction of the bus */
-    float inv_band_per_A;       /**< 1 / dead_time_current_band_A (0 without compensation) */
+    float dead_time_duty;         /**< 2 t_d / T_s: compensation at full current, fraction of the bus */
+    float inv_band_per_A;         /**< 1 / dead_time_current_band_A (0 without compensation) */
     float sign_threshold_A_per_V; /**< a current's sign is known beyond this x V_bus + sign_threshold_A */
     float sign_threshold_A;
-    bool compensate;            /**< dead time configured or voltage bias estimated */
-    bool sensed;                /**< the phase voltages are sensed: the period's voltage is measured, not estimated */
-    bool delayed;               /**< one period of computational delay */
+    bool compensate; /**< dead time configured or voltage bias estimated */
+    bool sensed;     /**< the phase voltages are sensed: the period's voltage is measured, not estimated */
+    bool delayed;    /**< one period of computational delay */
 } pmstep_actuate_coeffs_t;
 
 /** Coefficients for @p cfg (already validated). */
@@ -112,8 +112,8 @@ typedef struct {
  * edges sit at the ripple's extremes), plus three compensation bands (the sample noise).
  */
 void pmstep_actuate_voltage_over_period(const pmstep_actuator_t *actuator, const pmstep_actuate_coeffs_t *coeffs,
-                                        const pmstep_period_currents_t *currents, float bus_voltage_V,
-                                        float *u_a_V, float *u_b_V);
+                                        const pmstep_period_currents_t *currents, float bus_voltage_V, float *u_a_V,
+                                        float *u_b_V);
 
 /** The sign threshold above (A) at the bus voltage @p bus_voltage_V. */
 float pmstep_actuate_sign_threshold(const pmstep_actuate_coeffs_t *coeffs, float bus_voltage_V);

@@ -42,23 +42,23 @@ extern "C" {
 #define PMSTEP_EMF_ANGLE_MAX_READING_RAD 0.25f
 
 typedef struct {
-    float phi_a;            /**< phi1, A */
-    float phi_b;            /**< phi2, A */
+    float phi_a;              /**< phi1, A */
+    float phi_b;              /**< phi2, A */
     float phi_a_compensation; /**< Kahan running compensation of phi1 */
     float phi_b_compensation; /**< Kahan running compensation of phi2 */
-    float i_a_start_A;      /**< i_a(t_c) */
-    float i_b_start_A;      /**< i_b(t_c) */
-    float i_a_prev_A;       /**< i_a at the previous sample */
-    float i_b_prev_A;       /**< i_b at the previous sample */
+    float i_a_start_A;        /**< i_a(t_c) */
+    float i_b_start_A;        /**< i_b(t_c) */
+    float i_a_prev_A;         /**< i_a at the previous sample */
+    float i_b_prev_A;         /**< i_b at the previous sample */
 } pmstep_angle_t;
 
 /** Constants derived once from the configuration. */
 typedef struct {
-    float voltage_gain;     /**< T_s / L, A per V */
-    float current_gain;     /**< R T_s / (2 L), trapezoid weight */
-    float flux_to_angle;    /**< L p / k_M, per A */
-    float correction_gain;  /**< g T_s / flux_to_angle of the drift-free option (0 = paper's method), A */
-    float emf_turn_gain;    /**< K_theta T_s (R + L K_e) / (k_M flux_to_angle) of the back-EMF option (0 = off),
+    float voltage_gain;       /**< T_s / L, A per V */
+    float current_gain;       /**< R T_s / (2 L), trapezoid weight */
+    float flux_to_angle;      /**< L p / k_M, per A */
+    float correction_gain;    /**< g T_s / flux_to_angle of the drift-free option (0 = paper's method), A */
+    float emf_turn_gain;      /**< K_theta T_s (R + L K_e) / (k_M flux_to_angle) of the back-EMF option (0 = off),
                                  A s / rad per A of residual */
     float emf_corner_squared; /**< w_theta^2, (rad/s)^2 */
 } pmstep_angle_coeffs_t;
@@ -77,12 +77,12 @@ void pmstep_angle_start(pmstep_angle_t *angle, float i_a_A, float i_b_A);
  * @param[in] i_a_A, i_b_A   currents sampled at the end of the period
  * @param[in] u_a_V, u_b_V   voltages applied during the period
  */
-void pmstep_angle_update(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs,
-                         float i_a_A, float i_b_A, float u_a_V, float u_b_V);
+void pmstep_angle_update(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs, float i_a_A, float i_b_A,
+                         float u_a_V, float u_b_V);
 
 /** c-hat and s-hat for the currents sampled now (the same as given to the last update). */
-void pmstep_angle_estimate(const pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs,
-                           float i_a_A, float i_b_A, float *cos_hat, float *sin_hat);
+void pmstep_angle_estimate(const pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs, float i_a_A, float i_b_A,
+                           float *cos_hat, float *sin_hat);
 
 /**
  * Drift-free option: moves phi1, phi2 so the next estimate is pulled onto the unit
@@ -102,8 +102,8 @@ void pmstep_angle_correct(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *co
  * @param[in] i_d_residual_A    the observer's residual of this sample on cos_hat, sin_hat
  * @param[in] speed_hat_rad_s   the observer's speed
  */
-void pmstep_angle_follow_emf(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs, float cos_hat,
-                             float sin_hat, float i_d_residual_A, float speed_hat_rad_s);
+void pmstep_angle_follow_emf(pmstep_angle_t *angle, const pmstep_angle_coeffs_t *coeffs, float cos_hat, float sin_hat,
+                             float i_d_residual_A, float speed_hat_rad_s);
 
 /** The angle smoothing's gate (rad): a reading this far or further off its prediction is taken as
  *  it is, the prediction having missed a turn (w-hat behind the rotor in a load step: 0.075 rad a

@@ -74,15 +74,15 @@ extern "C" {
 
 /** When each measurement is taken, in samples from the start of s-alignment. */
 typedef struct {
-    uint32_t s_lead_in_steps;   /**< s-alignment's lead-in: its first samples, driven at p theta = 0 */
-    uint32_t s_align_steps;     /**< first sample of c-alignment (t_s) */
-    uint32_t c_align_end_step;  /**< sample at t_c */
-    uint32_t window_steps;      /**< W: steady-state window at the end of each alignment (0 = none) */
-    uint32_t inductance_steps;  /**< N: current-rise window (0 = L from the level drops, with bias_estimation) */
+    uint32_t s_lead_in_steps;       /**< s-alignment's lead-in: its first samples, driven at p theta = 0 */
+    uint32_t s_align_steps;         /**< first sample of c-alignment (t_s) */
+    uint32_t c_align_end_step;      /**< sample at t_c */
+    uint32_t window_steps;          /**< W: steady-state window at the end of each alignment (0 = none) */
+    uint32_t inductance_steps;      /**< N: current-rise window (0 = L from the level drops, with bias_estimation) */
     uint32_t inductance_start_step; /**< m0: first sample of the current-rise window (after the lead-in) */
-    bool offsets_from_alignment;/**< take offsets from the alignment steady states too */
-    bool bias_estimation;       /**< second, lower steady state at the end of each alignment */
-    uint32_t identification_steps; /**< RUN periods of the J and F identification window from t_c (0 = none) */
+    bool offsets_from_alignment;    /**< take offsets from the alignment steady states too */
+    bool bias_estimation;           /**< second, lower steady state at the end of each alignment */
+    uint32_t identification_steps;  /**< RUN periods of the J and F identification window from t_c (0 = none) */
 } pmstep_commission_plan_t;
 
 /** An integral of u - R i over consecutive samples of one phase (raw samples): the first sample's
@@ -97,35 +97,35 @@ typedef struct {
 /** Sums over one steady-state window of an alignment (raw samples). The driven phase's means over
  *  its two halves are compared: a steady state has the same in both (see pmstep_commission_finish()). */
 typedef struct {
-    float current_sum_A;       /**< the driven phase's current */
-    float voltage_sum_V;       /**< the driven phase's voltage */
-    float undriven_sum_A;      /**< the undriven phase's current */
-    float late_current_sum_A;  /**< the driven phase's current over the window's second half */
+    float current_sum_A;      /**< the driven phase's current */
+    float voltage_sum_V;      /**< the driven phase's voltage */
+    float undriven_sum_A;     /**< the undriven phase's current */
+    float late_current_sum_A; /**< the driven phase's current over the window's second half */
 } pmstep_window_sums_t;
 
 /** Running sums of one run of the alignments (raw samples); a repeat of the alignments starts
  *  them afresh. */
 typedef struct {
-    float zero_sum_a_A, zero_sum_b_A;       /**< the undriven phase at the ends of the alignments (true current 0) */
+    float zero_sum_a_A, zero_sum_b_A; /**< the undriven phase at the ends of the alignments (true current 0) */
     uint32_t zero_count_a, zero_count_b;
-    pmstep_flux_sums_t rise;                /**< L from the current rise, phase b */
-    pmstep_window_sums_t s_full;            /**< end of s-alignment (phase b driven) */
-    pmstep_window_sums_t c_full;            /**< end of c-alignment (phase a driven) */
-    pmstep_window_sums_t s_low;             /**< lower steady state of s-alignment (bias option) */
-    pmstep_window_sums_t c_low;             /**< lower steady state of c-alignment */
-    pmstep_flux_sums_t swing;               /**< c-alignment from t_s, phase a: k_M (t_c's sample added at the end) */
-    pmstep_flux_sums_t s_drop;              /**< L from s-alignment's level drop, phase b */
-    pmstep_flux_sums_t c_drop;              /**< L from c-alignment's level drop, phase a */
-    uint32_t swing_start_step;              /**< the swing's first sample (0: not yet) */
+    pmstep_flux_sums_t rise;     /**< L from the current rise, phase b */
+    pmstep_window_sums_t s_full; /**< end of s-alignment (phase b driven) */
+    pmstep_window_sums_t c_full; /**< end of c-alignment (phase a driven) */
+    pmstep_window_sums_t s_low;  /**< lower steady state of s-alignment (bias option) */
+    pmstep_window_sums_t c_low;  /**< lower steady state of c-alignment */
+    pmstep_flux_sums_t swing;    /**< c-alignment from t_s, phase a: k_M (t_c's sample added at the end) */
+    pmstep_flux_sums_t s_drop;   /**< L from s-alignment's level drop, phase b */
+    pmstep_flux_sums_t c_drop;   /**< L from c-alignment's level drop, phase a */
+    uint32_t swing_start_step;   /**< the swing's first sample (0: not yet) */
 } pmstep_alignment_sums_t;
 
 /** Running sums (raw samples; offsets are removed at the end). */
 typedef struct {
-    float zero_sum_a_A, zero_sum_b_A;       /**< bridge off before s-alignment: true currents 0 */
+    float zero_sum_a_A, zero_sum_b_A; /**< bridge off before s-alignment: true currents 0 */
     uint32_t zero_count_a, zero_count_b;
     float zero_voltage_sum_a_V, zero_voltage_sum_b_V; /**< sensed phase voltages with the bridge off (true 0) */
-    pmstep_alignment_sums_t alignment;      /**< the alignments' */
-    pmstep_continuity_peaks_t continuity;   /**< the driven phases' peaks (pmstep_continuity.h) */
+    pmstep_alignment_sums_t alignment;                /**< the alignments' */
+    pmstep_continuity_peaks_t continuity;             /**< the driven phases' peaks (pmstep_continuity.h) */
 } pmstep_commission_sums_t;
 
 void pmstep_commission_clear(pmstep_commission_sums_t *sums);

@@ -70,7 +70,7 @@ typedef struct {
     uint16_t window_checks;    /**< checks summed in the present window */
     uint8_t missing_windows_a; /**< windows in a row phase a carried no current */
     uint8_t missing_windows_b;
-    uint8_t stuck_windows_a;   /**< windows in a row its reading did not move */
+    uint8_t stuck_windows_a; /**< windows in a row its reading did not move */
     uint8_t stuck_windows_b;
 } pmstep_continuity_t;
 

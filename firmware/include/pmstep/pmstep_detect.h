@@ -32,10 +32,10 @@ typedef struct {
 
 /** Constants derived from the configuration. */
 typedef struct {
-    uint32_t persistence_checks;   /**< checks a condition must persist */
-    float alpha;                   /**< check period / time constant of the low-passes */
-    float angle_step_per_speed;    /**< p x check period: electrical rad per check per rad/s */
-    float consistency_bound_rad;   /**< speed_consistency_bound_rad_s x angle_step_per_speed */
+    uint32_t persistence_checks; /**< checks a condition must persist */
+    float alpha;                 /**< check period / time constant of the low-passes */
+    float angle_step_per_speed;  /**< p x check period: electrical rad per check per rad/s */
+    float consistency_bound_rad; /**< speed_consistency_bound_rad_s x angle_step_per_speed */
 } pmstep_detect_coeffs_t;
 
 /** Coefficients for @p cfg (already validated). */

@@ -121,29 +121,29 @@ extern "C" {
 
 /** State of a vector hold (part of pmstep_t). */
 typedef struct {
-    float cos_vector;          /**< cos v of the aimed vector (stator frame) */
-    float sin_vector;          /**< sin v */
-    float current_A;           /**< I */
-    float damping_s;           /**< g = 2 zeta p / w_n, electrical rad per rad/s (0: w-hat lags the swing) */
-    float speed_bias_rad_s;    /**< w-bar, the speed estimate at rest (w-hat low-passed) */
-    float bias_gain;           /**< w_n T_s / PMSTEP_HOLD_BIAS_CORNER_RATIO, w-bar's filter per period */
-    float quiet_band_rad_s;    /**< PMSTEP_HOLD_QUIET_FRACTION w_n / p */
-    float vector_speed_rad_s;  /**< w_v, the speed the vector turns at (the standstill's low-speed drive; else 0) */
-    float cos_frame;           /**< the period's frame: the vector turned by the damping */
+    float cos_vector;         /**< cos v of the aimed vector (stator frame) */
+    float sin_vector;         /**< sin v */
+    float current_A;          /**< I */
+    float damping_s;          /**< g = 2 zeta p / w_n, electrical rad per rad/s (0: w-hat lags the swing) */
+    float speed_bias_rad_s;   /**< w-bar, the speed estimate at rest (w-hat low-passed) */
+    float bias_gain;          /**< w_n T_s / PMSTEP_HOLD_BIAS_CORNER_RATIO, w-bar's filter per period */
+    float quiet_band_rad_s;   /**< PMSTEP_HOLD_QUIET_FRACTION w_n / p */
+    float vector_speed_rad_s; /**< w_v, the speed the vector turns at (the standstill's low-speed drive; else 0) */
+    float cos_frame;          /**< the period's frame: the vector turned by the damping */
     float sin_frame;
-    uint32_t settle_periods;      /**< PMSTEP_HOLD_SETTLE_TIME_CONSTANTS / (zeta w_n), in periods */
+    uint32_t settle_periods; /**< PMSTEP_HOLD_SETTLE_TIME_CONSTANTS / (zeta w_n), in periods */
     bool active;
     /* The standstill hold of speed mode (its counts in pmstep_standstill_t): flags kept out of
      * the RUN scratch union, whose bytes are the commissioning sums until t_c. */
-    bool standstill_armed;        /**< RUN with a hold current, in speed mode (not the position library's) */
-    bool standstill_engaged;      /**< this hold is the standstill's */
-    bool standstill_settled;      /**< the held rotor's settling time has passed */
+    bool standstill_armed;   /**< RUN with a hold current, in speed mode (not the position library's) */
+    bool standstill_engaged; /**< this hold is the standstill's */
+    bool standstill_settled; /**< the held rotor's settling time has passed */
 } pmstep_vector_hold_t;
 
 /** State of the standstill hold in speed mode (part of pmstep_t's RUN scratch). */
 typedef struct {
-    float quiet_band_rad_s;  /**< PMSTEP_HOLD_QUIET_FRACTION w_n / p for the hold's current: at rest below */
-    float keep_cos;          /**< the estimate kept while the held rotor rests */
+    float quiet_band_rad_s; /**< PMSTEP_HOLD_QUIET_FRACTION w_n / p for the hold's current: at rest below */
+    float keep_cos;         /**< the estimate kept while the held rotor rests */
     float keep_sin;
     float motion_rad;        /**< the integrals' turn off the kept estimate, summed with the leak */
     float motion_leak;       /**< 1 / the hold's settling periods: the sum's leak per period */

@@ -63,10 +63,10 @@ typedef enum {
 typedef struct {
     pmstep_homing_config_t cfg;
     pmstep_homing_state_t state;
-    float direction;        /**< +1 or -1: toward the stop */
-    float stop_rad;         /**< theta-hat at the stop, in the frame before the zero was set */
+    float direction;         /**< +1 or -1: toward the stop */
+    float stop_rad;          /**< theta-hat at the stop, in the frame before the zero was set */
     bool stalled_by_current; /**< the stop was found by the current test (else by the following error) */
-    float target_rad;       /**< the target of the homing's own move (another command's moves it: aborted) */
+    float target_rad;        /**< the target of the homing's own move (another command's moves it: aborted) */
 } pmstep_homing_t;
 
 /**
@@ -83,8 +83,8 @@ pmstep_status_t pmstep_homing_design(const pmstep_config_t *cfg, pmstep_homing_c
  * @retval PMSTEP_ERR_NONFINITE_PARAMETER a setting is NaN or Inf
  * @retval PMSTEP_ERR_HOMING              a setting out of its range (above), or @p direction not +1 or -1
  */
-pmstep_status_t pmstep_homing_start(pmstep_homing_t *homing, pmstep_position_t *pos,
-                                    const pmstep_homing_config_t *cfg, int32_t direction);
+pmstep_status_t pmstep_homing_start(pmstep_homing_t *homing, pmstep_position_t *pos, const pmstep_homing_config_t *cfg,
+                                    int32_t direction);
 
 /**
  * Once a period, after pmstep_position_step() (or _update()) with that period's outputs. Never fails.

@@ -41,23 +41,23 @@ extern "C" {
 
 /** Sums of the normal equations of the fit y = c_0 + c_a a + c_w w (a = w*', w = w*, y = i_q). */
 typedef struct {
-    float n;                  /**< samples */
-    float a;                  /**< sum a */
-    float w;                  /**< sum w */
-    float aa;                 /**< sum a^2 */
-    float aw;                 /**< sum a w */
-    float ww;                 /**< sum w^2 */
-    float y;                  /**< sum y */
-    float ay;                 /**< sum a y */
-    float wy;                 /**< sum w y */
-    uint32_t periods;         /**< RUN periods the window has covered (PMSTEP_IDENTIFICATION_DECIMATION a sample) */
+    float n;          /**< samples */
+    float a;          /**< sum a */
+    float w;          /**< sum w */
+    float aa;         /**< sum a^2 */
+    float aw;         /**< sum a w */
+    float ww;         /**< sum w^2 */
+    float y;          /**< sum y */
+    float ay;         /**< sum a y */
+    float wy;         /**< sum w y */
+    uint32_t periods; /**< RUN periods the window has covered (PMSTEP_IDENTIFICATION_DECIMATION a sample) */
 } pmstep_identify_sums_t;
 
 /** Coefficients of the fit, in the units of y per unit of each regressor. */
 typedef struct {
-    float offset;             /**< c_0 */
-    float accel_coeff;        /**< c_a: per rad/s^2 */
-    float speed_coeff;        /**< c_w: per rad/s */
+    float offset;      /**< c_0 */
+    float accel_coeff; /**< c_a: per rad/s^2 */
+    float speed_coeff; /**< c_w: per rad/s */
 } pmstep_identify_fit_t;
 
 void pmstep_identify_clear(pmstep_identify_sums_t *sums);

@@ -53,11 +53,11 @@ typedef struct {
     /* Mode machine. */
     pmstep_mode_t mode;
     pmstep_fault_t fault;
-    uint32_t fault_step;  /**< step_count at which the fault latched */
-    uint32_t step_count;  /**< periods run since init/reset */
-    uint32_t mode_step;   /**< periods since the alignment started */
-    bool run_started;     /**< RUN initialised at t_c */
-    bool estimate_kept;   /**< the standstill's kept rotor is the period's estimate, not the integrals'
+    uint32_t fault_step; /**< step_count at which the fault latched */
+    uint32_t step_count; /**< periods run since init/reset */
+    uint32_t mode_step;  /**< periods since the alignment started */
+    bool run_started;    /**< RUN initialised at t_c */
+    bool estimate_kept;  /**< the standstill's kept rotor is the period's estimate, not the integrals'
                                (pmstep_hold.h; kept here, in the padding of the flags before it) */
 
     /* Controller (6) state and commands. */
@@ -70,19 +70,19 @@ typedef struct {
 
     pmstep_commissioning_t commissioning; /**< offsets (subtracted from every sample once measured), R, L, k_M, J, F */
     union {
-        pmstep_commission_sums_t sums;    /**< until t_c */
+        pmstep_commission_sums_t sums; /**< until t_c */
         struct {
             pmstep_detector_t detector;
-            pmstep_ref_t known_load_filter; /**< T_L* of Remark 1 */
-            pmstep_identify_sums_t identify; /**< J and F fit, while the identification window is open */
-            pmstep_standstill_t standstill;  /**< standstill hold in speed mode (pmstep_hold.h) */
+            pmstep_ref_t known_load_filter;   /**< T_L* of Remark 1 */
+            pmstep_identify_sums_t identify;  /**< J and F fit, while the identification window is open */
+            pmstep_standstill_t standstill;   /**< standstill hold in speed mode (pmstep_hold.h) */
             pmstep_angle_smoother_t smoother; /**< the angle smoothing's (gains.angle_smoothing > 0) */
             pmstep_continuity_t continuity;   /**< the windings' and sensors' continuity (pmstep_continuity.h) */
-        } run;                            /**< from t_c */
+        } run;                                /**< from t_c */
     } scratch;
 
-    pmstep_vector_hold_t hold;            /**< standstill hold by a stator-frame vector (pmstep_hold.h) */
-    pmstep_weakening_t weakening;         /**< the commanded i_d* and field weakening's share of it */
+    pmstep_vector_hold_t hold;    /**< standstill hold by a stator-frame vector (pmstep_hold.h) */
+    pmstep_weakening_t weakening; /**< the commanded i_d* and field weakening's share of it */
 } pmstep_t;
 
 #ifdef __cplusplus

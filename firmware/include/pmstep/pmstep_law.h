@@ -31,22 +31,22 @@ typedef struct {
     /* The voltage's angle and length (see pmstep_law_voltages), as polynomials in w-hat:
      * (1 - x^2/6)(cos d, sin d), d = p T_s (delay + 1/2) w-hat, x = p T_s w-hat / 2, is
      * (1 + c2 w^2 + c4 w^4, w (s1 + s3 w^2)) to fourth and third order. */
-    float turn_cos_w2;        /**< c2 = -(a^2/2 + k), a = p T_s (delay + 1/2), k = (p T_s)^2/24 */
-    float turn_cos_w4;        /**< c4 = a^4/24 + k a^2/2 */
-    float turn_sin_w1;        /**< s1 = a */
-    float turn_sin_w3;        /**< s3 = -(a^3/6 + k a) */
-    float current_integral_gain_per_s2; /**< K_I of the PI current loop, d axis (0 = the paper's law) */
+    float turn_cos_w2;                    /**< c2 = -(a^2/2 + k), a = p T_s (delay + 1/2), k = (p T_s)^2/24 */
+    float turn_cos_w4;                    /**< c4 = a^4/24 + k a^2/2 */
+    float turn_sin_w1;                    /**< s1 = a */
+    float turn_sin_w3;                    /**< s3 = -(a^3/6 + k a) */
+    float current_integral_gain_per_s2;   /**< K_I of the PI current loop, d axis (0 = the paper's law) */
     float current_integral_gain_q_per_s2; /**< K_I,q, its q axis (0 = none) */
-    float detent_torque_Nm;   /**< T_d of the detent model (0 = none) */
-    float detent_order;       /**< 4 p: the detent's harmonic of the mechanical angle */
-    bool linear_speed_term;   /**< Remark 1 (13): k_w (w-hat - w*) without saturation (last: the floats
+    float detent_torque_Nm;               /**< T_d of the detent model (0 = none) */
+    float detent_order;                   /**< 4 p: the detent's harmonic of the mechanical angle */
+    bool linear_speed_term;               /**< Remark 1 (13): k_w (w-hat - w*) without saturation (last: the floats
                                    before it are checked as a run) */
 } pmstep_law_coeffs_t;
 
 /** References at one sample. */
 typedef struct {
     float speed_ref_rad_s, speed_ref_rate_rad_s2, speed_ref_accel_rad_s3; /**< w*, w*', w*'' */
-    float i_d_ref_A, i_d_ref_rate_A_s;                          /**< i_d*, i_d*' */
+    float i_d_ref_A, i_d_ref_rate_A_s;                                    /**< i_d*, i_d*' */
 } pmstep_law_refs_t;
 
 /** Integrals of the current errors, the PI current loop's state (zero with K_I = 0). */
@@ -57,8 +57,8 @@ typedef struct {
 
 /** The detent torque the model expects at the estimated angle, and its rate. */
 typedef struct {
-    float torque_Nm;     /**< -T_d sin(4 p theta-hat) */
-    float rate_Nm_s;     /**< its derivative along w-hat: -4 p T_d w-hat cos(4 p theta-hat) */
+    float torque_Nm; /**< -T_d sin(4 p theta-hat) */
+    float rate_Nm_s; /**< its derivative along w-hat: -4 p T_d w-hat cos(4 p theta-hat) */
 } pmstep_detent_t;
 
 /**
@@ -73,8 +73,8 @@ static inline pmstep_detent_t pmstep_law_detent(const pmstep_law_coeffs_t *coeff
         const float cos_2x = cos_hat * cos_hat - sin_hat * sin_hat;
         const float sin_2x = 2.0f * cos_hat * sin_hat;
         detent.torque_Nm = -coeffs->detent_torque_Nm * 2.0f * sin_2x * cos_2x;
-        detent.rate_Nm_s = -coeffs->detent_torque_Nm * coeffs->detent_order * speed_hat_rad_s
-                           * (cos_2x * cos_2x - sin_2x * sin_2x);
+        detent.rate_Nm_s =
+            -coeffs->detent_torque_Nm * coeffs->detent_order * speed_hat_rad_s * (cos_2x * cos_2x - sin_2x * sin_2x);
     }
     return detent;
 }
@@ -86,8 +86,7 @@ static inline pmstep_detent_t pmstep_law_detent(const pmstep_law_coeffs_t *coeff
  * w-hat follows w*). Beyond w_f the compensation's frequency 4 p w passes the current loop's
  * reach, the angle error enters it 4p-fold, and the inertia filters the torque.
  */
-void pmstep_law_fade_detent(float fade_speed_rad_s, float speed_hat_rad_s, float accel_rad_s2,
-                            pmstep_detent_t *detent);
+void pmstep_law_fade_detent(float fade_speed_rad_s, float speed_hat_rad_s, float accel_rad_s2, pmstep_detent_t *detent);
 
 /**
  * (c-hat, s-hat) turned from the sample to the middle of the period the voltage acts in,
@@ -104,8 +103,7 @@ static inline void pmstep_law_acting_angle(const pmstep_law_coeffs_t *coeffs, fl
 }
 
 /** Coefficients for the gains and mechanics of @p cfg and the electrical model @p model. */
-void pmstep_law_coeffs_init(pmstep_law_coeffs_t *coeffs, const pmstep_config_t *cfg,
-                            const pmstep_electrical_t *model);
+void pmstep_law_coeffs_init(pmstep_law_coeffs_t *coeffs, const pmstep_config_t *cfg, const pmstep_electrical_t *model);
 
 /** Smooth saturation and its derivative. */
 void pmstep_sat(float x, float kappa, float *sat, float *sat_slope);
@@ -125,13 +123,13 @@ pmstep_speed_term_t pmstep_law_speed_term(const pmstep_law_coeffs_t *coeffs, flo
 
 /** i_q* = (J/k_M)[(F/J) w* - k_w sat(w-hat - w*) + T/J + w*'], T = T_L-hat or T_L*;
  *  @p speed_term is k_w sat(w-hat - w*) (pmstep_law_speed_term). */
-float pmstep_law_iq_ref(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs,
-                        float speed_term, float load_Nm);
+float pmstep_law_iq_ref(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs, float speed_term,
+                        float load_Nm);
 
 /** i_q*' = (J/k_M)[(F/J) w*' - k_w sat'(e)(w-hat' - w*') + T'/J + w*''];
  *  @p speed_slope is k_w sat'(e) (pmstep_law_speed_term). */
-float pmstep_law_iq_ref_rate(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs,
-                             float speed_slope, float speed_hat_rate, float load_rate);
+float pmstep_law_iq_ref_rate(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs, float speed_slope,
+                             float speed_hat_rate, float load_rate);
 
 /**
  * phi_d = -(R/L) i_d* + p w-hat i_q - i_d*',  phi_q = -(R/L) i_q* - p w-hat i_d - (k_M/L) w-hat - i_q*',
@@ -144,9 +142,8 @@ float pmstep_law_iq_ref_rate(const pmstep_law_coeffs_t *coeffs, const pmstep_law
  * law's (u_d, u_q) would times 1 + x^2/6 + O(x^3) (steady state of the sampled R-L circuit in the
  * rotor frame; docs/design), so the step stays accurate at p w T_s ~ 0.3 rad.
  */
-void pmstep_law_voltages(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs,
-                         float cos_hat, float sin_hat, float i_d_A, float i_q_A,
-                         float speed_hat_rad_s, float i_q_ref_A, float i_q_ref_rate,
+void pmstep_law_voltages(const pmstep_law_coeffs_t *coeffs, const pmstep_law_refs_t *refs, float cos_hat, float sin_hat,
+                         float i_d_A, float i_q_A, float speed_hat_rad_s, float i_q_ref_A, float i_q_ref_rate,
                          const pmstep_law_integral_t *integral, float *u_a_V, float *u_b_V);
 
 /** Advances the current-error integrals by one period (when K_I > 0; the caller skips periods whose voltage

@@ -49,9 +49,9 @@ typedef struct {
 
 /** Where the profile is in its plan: the present segment, its start and the state there. */
 typedef struct {
-    uint32_t index;        /**< present segment (the plan's count: finished, at the target) */
-    float start_s;         /**< start of the present segment (s from the plan's start) */
-    float position;        /**< state at the start of the present segment */
+    uint32_t index; /**< present segment (the plan's count: finished, at the target) */
+    float start_s;  /**< start of the present segment (s from the plan's start) */
+    float position; /**< state at the start of the present segment */
     float speed;
     float accel;
 } pmstep_motion_cursor_t;
@@ -59,12 +59,12 @@ typedef struct {
 /** A plan and where the profile is in it. */
 typedef struct {
     pmstep_motion_segment_t segment[PMSTEP_MOTION_SEGMENTS];
-    uint32_t count;        /**< segments in the plan */
-    uint32_t periods;      /**< periods since the plan started */
-    float period_s;        /**< T_s */
+    uint32_t count;   /**< segments in the plan */
+    uint32_t periods; /**< periods since the plan started */
+    float period_s;   /**< T_s */
     pmstep_motion_cursor_t cursor;
-    float target;          /**< where the plan ends, at rest */
-    float v_max;           /**< the plan's limits (kept for a stop) */
+    float target; /**< where the plan ends, at rest */
+    float v_max;  /**< the plan's limits (kept for a stop) */
     float a_max;
     float j_max;
 } pmstep_motion_t;
@@ -77,8 +77,8 @@ void pmstep_motion_reset(pmstep_motion_t *m, float position, float period_s);
  * pmstep_motion_next() returns that state. Limits must be > 0 and every value finite (the
  * caller checks).
  */
-void pmstep_motion_plan(pmstep_motion_t *m, float position, float speed, float accel, float target,
-                        float v_max, float a_max, float j_max);
+void pmstep_motion_plan(pmstep_motion_t *m, float position, float speed, float accel, float target, float v_max,
+                        float a_max, float j_max);
 
 /** Plans a stop from the state of @p now with the plan's limits; the target becomes where it ends. */
 void pmstep_motion_stop(pmstep_motion_t *m, const pmstep_motion_sample_t *now);

@@ -35,26 +35,26 @@ typedef struct {
 } pmstep_observer_t;
 
 typedef struct {
-    float r_over_l_per_s;     /**< R/L */
-    float inv_l_per_H;        /**< 1/L */
-    float km_over_l;          /**< k_M/L: (V s/rad)/(V s/A) = A/rad */
-    float km_over_j;          /**< k_M/J */
-    float f_over_j_per_s;     /**< F/J */
-    float inv_j;              /**< 1/J */
-    float observer_gain_per_s;/**< K_e */
-    float pole_pairs;         /**< p */
+    float r_over_l_per_s;       /**< R/L */
+    float inv_l_per_H;          /**< 1/L */
+    float km_over_l;            /**< k_M/L: (V s/rad)/(V s/A) = A/rad */
+    float km_over_j;            /**< k_M/J */
+    float f_over_j_per_s;       /**< F/J */
+    float inv_j;                /**< 1/J */
+    float observer_gain_per_s;  /**< K_e */
+    float pole_pairs;           /**< p */
     float speed_injection_gain; /**< g_w = (2 g^2 + r F l J^2)/(g^2 l + r F l^2 J^2) */
     float load_injection_gain;  /**< g_T = (2 g^2 F + l J g + l J^2 r F^2)/(g^2 l + r F l^2 J^2) */
-    float inv_lambda;         /**< 1/lambda, Remark 1 */
-    float current_decay;      /**< (1 - z/2)/(1 + z/2), z = (R/L) T_s: trapezoid-rule decay of i-hat per period */
-    float current_step_s;     /**< T_s/(1 + z/2): weight of the current rate's other terms */
+    float inv_lambda;           /**< 1/lambda, Remark 1 */
+    float current_decay;        /**< (1 - z/2)/(1 + z/2), z = (R/L) T_s: trapezoid-rule decay of i-hat per period */
+    float current_step_s;       /**< T_s/(1 + z/2): weight of the current rate's other terms */
     /* The back-EMF's mean over a period: the estimate turned by (1 + c2 w^2, w (s1 + s3 w^2)). */
-    float mean_cos_w2;        /**< c2 = -(2/3) h^2, h = p T_s / 2 (per rad/s) */
-    float mean_sin_w1;        /**< s1 = h */
-    float mean_sin_w3;        /**< s3 = -h^3/3 */
-    float speed_bound_rad_s;  /**< |w-hat| beyond this is no motor's speed: PMSTEP_ESTIMATE_RANGE_FACTOR x the speed
+    float mean_cos_w2;       /**< c2 = -(2/3) h^2, h = p T_s / 2 (per rad/s) */
+    float mean_sin_w1;       /**< s1 = h */
+    float mean_sin_w3;       /**< s3 = -h^3/3 */
+    float speed_bound_rad_s; /**< |w-hat| beyond this is no motor's speed: PMSTEP_ESTIMATE_RANGE_FACTOR x the speed
                                    whose back EMF is the highest bus, max_bus_voltage_V / k_M */
-    float load_bound_Nm;      /**< |T_L-hat| beyond this is no load the drive could be holding:
+    float load_bound_Nm;     /**< |T_L-hat| beyond this is no load the drive could be holding:
                                    PMSTEP_ESTIMATE_RANGE_FACTOR x k_M x max_phase_current_A */
 } pmstep_observer_coeffs_t;
 
@@ -66,12 +66,12 @@ typedef struct {
 
 /** Signals the mechanical part of the observer needs at one sample. */
 typedef struct {
-    float i_a_A, i_b_A;       /**< measured currents */
-    float cos_hat, sin_hat;   /**< angle estimate */
-    float i_d_A, i_q_A;       /**< Park of the currents with (c-hat, s-hat) */
+    float i_a_A, i_b_A;         /**< measured currents */
+    float cos_hat, sin_hat;     /**< angle estimate */
+    float i_d_A, i_q_A;         /**< Park of the currents with (c-hat, s-hat) */
     float i_d_err_A, i_q_err_A; /**< i_d - i_d*, i_q - i_q* (Remark 1 only) */
-    float known_load_Nm;      /**< T_L* (Remark 1 only) */
-    float detent_torque_Nm;   /**< the model's detent torque at the estimated angle (0 = none) */
+    float known_load_Nm;        /**< T_L* (Remark 1 only) */
+    float detent_torque_Nm;     /**< the model's detent torque at the estimated angle (0 = none) */
 } pmstep_observer_input_t;
 
 /** Time derivatives of the speed and load estimates. */
@@ -102,20 +102,18 @@ void pmstep_observer_boost_in_transient(const pmstep_observer_t *obs, const pmst
 /** w-hat' and T_L-hat' of (6) (adaptive: known_load = false) or (13) (known_load = true). */
 pmstep_observer_mech_rates_t pmstep_observer_mech_rates(const pmstep_observer_t *obs,
                                                         const pmstep_observer_coeffs_t *coeffs,
-                                                        const pmstep_observer_input_t *in,
-                                                        bool known_load);
+                                                        const pmstep_observer_input_t *in, bool known_load);
 
 /** The last advance redone for the voltage the period really had: the current step is linear
  *  in u, so the estimates move by T/(1 + R T/(2L)) (u_actual - u_assumed)/L. */
-void pmstep_observer_correct_voltage(pmstep_observer_t *obs, const pmstep_observer_coeffs_t *coeffs,
-                                     float du_a_V, float du_b_V);
+void pmstep_observer_correct_voltage(pmstep_observer_t *obs, const pmstep_observer_coeffs_t *coeffs, float du_a_V,
+                                     float du_b_V);
 
 /** Step of all four states over the next period (see the discretisation above), with the
  *  voltage applied over that period. */
 void pmstep_observer_advance(pmstep_observer_t *obs, const pmstep_observer_coeffs_t *coeffs,
-                             const pmstep_observer_input_t *in,
-                             const pmstep_observer_mech_rates_t *mech,
-                             float u_a_V, float u_b_V, float period_s);
+                             const pmstep_observer_input_t *in, const pmstep_observer_mech_rates_t *mech, float u_a_V,
+                             float u_b_V, float period_s);
 
 #ifdef __cplusplus
 }

@@ -108,36 +108,36 @@ typedef struct {
     struct pmstep_stepdir *steps; /**< the STEP/DIR input the loop follows (pmstep_position_follow_steps()),
                                        NULL: the motion profile */
     pmstep_position_config_t cfg;
-    float inv_pole_pairs;     /**< 1/p */
-    float period_s;           /**< T_s */
-    float inv_bandwidth_s;    /**< 1/varpi_0 of the speed reference filter */
-    float cos_hat;            /**< c-hat of the last period */
-    float sin_hat;            /**< s-hat of the last period */
-    float speed_hat_rad_s;    /**< w-hat of the last period */
-    float zero_rad;           /**< electrical angle subtracted (set zero) */
-    int32_t turns;            /**< electrical turns counted since RUN began */
-    int32_t sin_negative;     /**< 1 if s-hat < 0 in the last period, else 0 */
-    int32_t loop_countdown;   /**< periods to the next update (1: after the next period) */
-    float error_integral_rad_s; /**< z, integral of theta* - theta-hat (rad s) */
+    float inv_pole_pairs;         /**< 1/p */
+    float period_s;               /**< T_s */
+    float inv_bandwidth_s;        /**< 1/varpi_0 of the speed reference filter */
+    float cos_hat;                /**< c-hat of the last period */
+    float sin_hat;                /**< s-hat of the last period */
+    float speed_hat_rad_s;        /**< w-hat of the last period */
+    float zero_rad;               /**< electrical angle subtracted (set zero) */
+    int32_t turns;                /**< electrical turns counted since RUN began */
+    int32_t sin_negative;         /**< 1 if s-hat < 0 in the last period, else 0 */
+    int32_t loop_countdown;       /**< periods to the next update (1: after the next period) */
+    float error_integral_rad_s;   /**< z, integral of theta* - theta-hat (rad s) */
     pmstep_position_output_t out; /**< the state's flags (tracked: in RUN since the turn count's reset;
                                        moving: the profile had not ended at the last update or command)
                                        and the last update's positions; each period's output is a copy */
-    pmstep_motion_t motion;   /**< theta* and its derivatives (position mode), sampled every N T_s */
+    pmstep_motion_t motion;       /**< theta* and its derivatives (position mode), sampled every N T_s */
     pmstep_motion_sample_t now;   /**< the profile's sample for the period after the last update */
     pmstep_motion_sample_t ahead; /**< the sample for the period after the next update (one ahead) */
-    float hold_inv_gain;      /**< the reference filter over N periods (put_speed_reference) */
+    float hold_inv_gain;          /**< the reference filter over N periods (put_speed_reference) */
     float hold_c23;
     float hold_c12;
     /* Vector hold when a move ends (hold_current_A > 0; "Vector hold" above, pmstep_position_hold.c) */
-    float rest_cos;           /**< the vector's aim before its load angle (stator frame): the target's
+    float rest_cos; /**< the vector's aim before its load angle (stator frame): the target's
                                    electrical direction, corrected by the displacements at rest */
     float rest_sin;
-    float aim_load_Nm;        /**< the load the aim's load angle is for (T_L-hat when the move ended) */
-    float frozen_cos;         /**< the estimate kept while the held rotor is at rest */
+    float aim_load_Nm; /**< the load the aim's load angle is for (T_L-hat when the move ended) */
+    float frozen_cos;  /**< the estimate kept while the held rotor is at rest */
     float frozen_sin;
-    int32_t hold_stage;       /**< none, waiting, settling, anchored, refused (until the next move) */
-    int32_t hold_periods;     /**< waiting, settling: periods left; anchored: periods at rest */
-    bool reading_turned;      /**< anchored: the last update's reading turned beyond its limit
+    int32_t hold_stage;   /**< none, waiting, settling, anchored, refused (until the next move) */
+    int32_t hold_periods; /**< waiting, settling: periods left; anchored: periods at rest */
+    bool reading_turned;  /**< anchored: the last update's reading turned beyond its limit
                                    (three quiet bands' turn), neither rest nor motion yet */
 } pmstep_position_t;
 
@@ -214,8 +214,8 @@ pmstep_status_t pmstep_position_set_zero(pmstep_position_t *pos);
  * @retval PMSTEP_ERR_BAD_COMMAND_VALUE  a value not finite, a limit not > 0 (j_max < 0), or
  *                                       p |target| above PMSTEP_POSITION_MAX_ELECTRICAL_RAD
  */
-pmstep_status_t pmstep_position_move_to(pmstep_position_t *pos, float target_rad, float v_max_rad_s,
-                                        float a_max_rad_s2, float j_max_rad_s3);
+pmstep_status_t pmstep_position_move_to(pmstep_position_t *pos, float target_rad, float v_max_rad_s, float a_max_rad_s2,
+                                        float j_max_rad_s3);
 
 /**
  * Stops as fast as the last move's limits allow (from speed mode: at the present w* at

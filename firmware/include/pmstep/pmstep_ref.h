@@ -23,31 +23,31 @@ extern "C" {
 
 /** Discretised filter, shared by every channel with the same w0 and T_s. */
 typedef struct {
-    float phi[3][2];     /**< e^{A T_s} in the (d1, d2, y) coordinates, columns of d1 and d2 */
-    float gamma0[3];     /**< response to the held set-point error r - y at the period start */
-    float gamma1[3];     /**< response to the set-point change over the period (linear in time) */
+    float phi[3][2];       /**< e^{A T_s} in the (d1, d2, y) coordinates, columns of d1 and d2 */
+    float gamma0[3];       /**< response to the held set-point error r - y at the period start */
+    float gamma1[3];       /**< response to the set-point change over the period (linear in time) */
     float bandwidth_rad_s; /**< w0 */
 } pmstep_ref_coeffs_t;
 
 /** One filtered set-point channel. */
 typedef struct {
-    float diff12;        /**< x1 - x2 */
-    float diff23;        /**< x2 - x3 */
-    float value;         /**< x3 = y */
+    float diff12;             /**< x1 - x2 */
+    float diff23;             /**< x2 - x3 */
+    float value;              /**< x3 = y */
     float value_compensation; /**< Kahan compensation of y: y increments are far below its ulp near rest */
-    float setpoint;      /**< r at the present sample */
-    float target;        /**< value r ramps towards */
-    float ramp_rate_per_s; /**< |dr/dt| limit; 0 means a step */
-    float ramp_origin;   /**< set-point when the target was set */
-    uint32_t ramp_periods; /**< periods since then: r = origin +/- rate * n T_s, never accumulated */
-    bool settled;        /**< at rest on its target (differences 0, y = r = target): a period changes nothing */
+    float setpoint;           /**< r at the present sample */
+    float target;             /**< value r ramps towards */
+    float ramp_rate_per_s;    /**< |dr/dt| limit; 0 means a step */
+    float ramp_origin;        /**< set-point when the target was set */
+    uint32_t ramp_periods;    /**< periods since then: r = origin +/- rate * n T_s, never accumulated */
+    bool settled;             /**< at rest on its target (differences 0, y = r = target): a period changes nothing */
 } pmstep_ref_t;
 
 /** Filter output at one sample. */
 typedef struct {
-    float value;     /**< y */
-    float rate;      /**< y' per second */
-    float accel;     /**< y'' per second^2 */
+    float value; /**< y */
+    float rate;  /**< y' per second */
+    float accel; /**< y'' per second^2 */
 } pmstep_ref_out_t;
 
 /** Exact discretisation; valid for 0 < w0 T_s <= 0.5 (pmstep_validate_config checks). */

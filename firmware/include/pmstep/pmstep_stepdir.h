@@ -62,34 +62,34 @@ typedef enum {
 
 /** STEP/DIR settings. */
 typedef struct {
-    uint32_t microsteps;               /**< m, microsteps per full step: 1 to PMSTEP_STEPDIR_MAX_MICROSTEPS */
-    bool invert_direction;             /**< DIR's sense reversed */
-    float tracking_bandwidth_rad_s;    /**< w_t of the tracker (designer: the speed reference's varpi_0, at most
+    uint32_t microsteps;             /**< m, microsteps per full step: 1 to PMSTEP_STEPDIR_MAX_MICROSTEPS */
+    bool invert_direction;           /**< DIR's sense reversed */
+    float tracking_bandwidth_rad_s;  /**< w_t of the tracker (designer: the speed reference's varpi_0, at most
                                             stall_speed_error_rad_s / q: a microstep q moves the tracker's speed
                                             by about q w_t) */
-    float following_error_limit_rad;   /**< DIAG beyond this |theta* - theta-hat|, mechanical rad (designer: one
+    float following_error_limit_rad; /**< DIAG beyond this |theta* - theta-hat|, mechanical rad (designer: one
                                             full step, pi / (2 p)) */
-    float stop_time_s;                 /**< no step for this long: the reference is at rest */
+    float stop_time_s;               /**< no step for this long: the reference is at rest */
     pmstep_diag_mode_t diag_mode;
-    uint32_t diag_pulse_periods;       /**< DIAG's pulse in pulse mode (periods, > 0) */
-    float stall_current_A;             /**< > 0: a stall at this q current drops the steps toward the block (header
+    uint32_t diag_pulse_periods; /**< DIAG's pulse in pulse mode (periods, > 0) */
+    float stall_current_A;       /**< > 0: a stall at this q current drops the steps toward the block (header
                                             text), below max_phase_current_A; 0: off (designer: off) */
 } pmstep_stepdir_config_t;
 
 /** The STEP/DIR input's state (allocate it statically beside the position control). */
 typedef struct pmstep_stepdir {
     pmstep_stepdir_config_t cfg;
-    float rad_per_microstep;  /**< 2 pi / (4 p m), mechanical */
-    float update_s;           /**< T = N T_s */
-    float gain_position;      /**< 1 - r^3 */
-    float gain_speed;         /**< 3/2 (1 - r)^2 (1 + r) / T */
-    float gain_accel;         /**< (1 - r)^3 / T^2 */
-    uint32_t stop_updates;    /**< updates without a step that put the reference at rest */
-    uint16_t last_counter;    /**< the counter at the last read */
-    int32_t steps;            /**< microsteps counted since the input was taken (signed) */
-    int32_t steps_at_update;  /**< the count the tracker last saw */
-    float origin_rad;         /**< theta* of step count 0 (mechanical) */
-    float position_rad;       /**< the tracker's theta_f, w_f, a_f after its last update */
+    float rad_per_microstep; /**< 2 pi / (4 p m), mechanical */
+    float update_s;          /**< T = N T_s */
+    float gain_position;     /**< 1 - r^3 */
+    float gain_speed;        /**< 3/2 (1 - r)^2 (1 + r) / T */
+    float gain_accel;        /**< (1 - r)^3 / T^2 */
+    uint32_t stop_updates;   /**< updates without a step that put the reference at rest */
+    uint16_t last_counter;   /**< the counter at the last read */
+    int32_t steps;           /**< microsteps counted since the input was taken (signed) */
+    int32_t steps_at_update; /**< the count the tracker last saw */
+    float origin_rad;        /**< theta* of step count 0 (mechanical) */
+    float position_rad;      /**< the tracker's theta_f, w_f, a_f after its last update */
     float speed_rad_s;
     float accel_rad_s2;
     uint32_t quiet_updates;   /**< updates since the last step */

@@ -34,9 +34,9 @@ extern "C" {
 
 /** Constants derived from the configuration. */
 typedef struct {
-    float modulation_squared;       /**< m^2 */
-    float step_A;                   /**< g T_c: the weakening current's change per check at e = 1 */
-    float max_current_A;            /**< I_w; 0 = off */
+    float modulation_squared; /**< m^2 */
+    float step_A;             /**< g T_c: the weakening current's change per check at e = 1 */
+    float max_current_A;      /**< I_w; 0 = off */
 } pmstep_weakening_coeffs_t;
 
 /** Field weakening's state in RUN. */

@@ -44,8 +44,8 @@ extern "C" {
 /** Cost of the control step per mode of its output, in SysTick ticks. */
 typedef struct {
     uint32_t steps[MPS2_PIL_MODES];
-    uint64_t step_ticks[MPS2_PIL_MODES];  /**< reads around pmstep_step() */
-    uint64_t empty_ticks[MPS2_PIL_MODES]; /**< the same reads around an empty function, same arguments */
+    uint64_t step_ticks[MPS2_PIL_MODES];      /**< reads around pmstep_step() */
+    uint64_t empty_ticks[MPS2_PIL_MODES];     /**< the same reads around an empty function, same arguments */
     uint32_t stack_max_bytes[MPS2_PIL_MODES]; /**< deepest stack below the caller's SP during pmstep_step() */
 } mps2_pil_cost_t;
 

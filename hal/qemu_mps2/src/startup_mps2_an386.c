@@ -27,11 +27,39 @@ void PendSV_Handler(void) __attribute__((weak, alias("Default_Handler")));
 void SysTick_Handler(void) __attribute__((weak, alias("Default_Handler")));
 
 /* External interrupts: weak, so a port or an application defines the ones it uses. */
-#define IRQ_WEAK(n) void Irq##n##_Handler(void) __attribute__((weak, alias("Default_Handler")));
-IRQ_WEAK(0) IRQ_WEAK(1) IRQ_WEAK(2) IRQ_WEAK(3) IRQ_WEAK(4) IRQ_WEAK(5) IRQ_WEAK(6) IRQ_WEAK(7)
-IRQ_WEAK(8) IRQ_WEAK(9) IRQ_WEAK(10) IRQ_WEAK(11) IRQ_WEAK(12) IRQ_WEAK(13) IRQ_WEAK(14) IRQ_WEAK(15)
-IRQ_WEAK(16) IRQ_WEAK(17) IRQ_WEAK(18) IRQ_WEAK(19) IRQ_WEAK(20) IRQ_WEAK(21) IRQ_WEAK(22) IRQ_WEAK(23)
-IRQ_WEAK(24) IRQ_WEAK(25) IRQ_WEAK(26) IRQ_WEAK(27) IRQ_WEAK(28) IRQ_WEAK(29) IRQ_WEAK(30) IRQ_WEAK(31)
+#define IRQ_WEAK(n) void Irq##n##_Handler(void) __attribute__((weak, alias("Default_Handler")))
+IRQ_WEAK(0);
+IRQ_WEAK(1);
+IRQ_WEAK(2);
+IRQ_WEAK(3);
+IRQ_WEAK(4);
+IRQ_WEAK(5);
+IRQ_WEAK(6);
+IRQ_WEAK(7);
+IRQ_WEAK(8);
+IRQ_WEAK(9);
+IRQ_WEAK(10);
+IRQ_WEAK(11);
+IRQ_WEAK(12);
+IRQ_WEAK(13);
+IRQ_WEAK(14);
+IRQ_WEAK(15);
+IRQ_WEAK(16);
+IRQ_WEAK(17);
+IRQ_WEAK(18);
+IRQ_WEAK(19);
+IRQ_WEAK(20);
+IRQ_WEAK(21);
+IRQ_WEAK(22);
+IRQ_WEAK(23);
+IRQ_WEAK(24);
+IRQ_WEAK(25);
+IRQ_WEAK(26);
+IRQ_WEAK(27);
+IRQ_WEAK(28);
+IRQ_WEAK(29);
+IRQ_WEAK(30);
+IRQ_WEAK(31);
 
 typedef void (*vector_t)(void);
 
@@ -44,10 +72,10 @@ typedef struct {
 
 __attribute__((section(".isr_vector"), used)) const vector_table_t mps2_vector_table = {
     &__stack_top,
-    {Reset_Handler, NMI_Handler, HardFault_Handler, MemManage_Handler, BusFault_Handler, UsageFault_Handler,
-     0, 0, 0, 0, SVC_Handler, DebugMon_Handler, 0, PendSV_Handler, SysTick_Handler},
-    {Irq0_Handler, Irq1_Handler, Irq2_Handler, Irq3_Handler, Irq4_Handler, Irq5_Handler, Irq6_Handler,
-     Irq7_Handler, Irq8_Handler, Irq9_Handler, Irq10_Handler, Irq11_Handler, Irq12_Handler, Irq13_Handler,
+    {Reset_Handler, NMI_Handler, HardFault_Handler, MemManage_Handler, BusFault_Handler, UsageFault_Handler, 0, 0, 0, 0,
+     SVC_Handler, DebugMon_Handler, 0, PendSV_Handler, SysTick_Handler},
+    {Irq0_Handler,  Irq1_Handler,  Irq2_Handler,  Irq3_Handler,  Irq4_Handler,  Irq5_Handler,  Irq6_Handler,
+     Irq7_Handler,  Irq8_Handler,  Irq9_Handler,  Irq10_Handler, Irq11_Handler, Irq12_Handler, Irq13_Handler,
      Irq14_Handler, Irq15_Handler, Irq16_Handler, Irq17_Handler, Irq18_Handler, Irq19_Handler, Irq20_Handler,
      Irq21_Handler, Irq22_Handler, Irq23_Handler, Irq24_Handler, Irq25_Handler, Irq26_Handler, Irq27_Handler,
      Irq28_Handler, Irq29_Handler, Irq30_Handler, Irq31_Handler},
@@ -63,7 +91,7 @@ void Default_Handler(void)
 void Reset_Handler(void)
 {
     volatile uint32_t *const cpacr = (volatile uint32_t *)0xE000ED88u; /* SCB->CPACR */
-    *cpacr |= (0xFu << 20);                                              /* CP10, CP11: full access */
+    *cpacr |= (0xFu << 20);                                            /* CP10, CP11: full access */
     __asm volatile("dsb\n\tisb" ::: "memory");
     _start();
 }

@@ -166,8 +166,8 @@ static void on_exit_cb(qemu_plugin_id_t id, void *udata)
 {
     (void)id;
     (void)udata;
-    fprintf(out, "# steps %" PRIu64 " unmatched %" PRIu64 " total_instructions %" PRIu64 "\n", steps_counted,
-            unmatched, total);
+    fprintf(out, "# steps %" PRIu64 " unmatched %" PRIu64 " total_instructions %" PRIu64 "\n", steps_counted, unmatched,
+            total);
     fclose(out);
     if (profiling) {
         FILE *f = fopen(profile_path, "w");

@@ -26,17 +26,17 @@
 #endif
 
 static pmstep_t motor;
-static pmstep_config_t motor_config;       /* must outlive the instance */
-static pmstep_stm32g4_config_t board;      /* must outlive the port */
+static pmstep_config_t motor_config;  /* must outlive the instance */
+static pmstep_stm32g4_config_t board; /* must outlive the port */
 static pmstep_console_t console;
-static pmstep_store_t store;               /* the port's two flash pages (stm32g4_flash.c) */
+static pmstep_store_t store;                 /* the port's two flash pages (stm32g4_flash.c) */
 static pmstep_console_store_t console_store; /* the configuration in force, as the console serves it */
-static pmstep_position_t position;         /* sensorless position control on the same instance */
+static pmstep_position_t position;           /* sensorless position control on the same instance */
 static pmstep_position_output_t position_out;
 #if PMSTEP_STM32G4_STEPDIR
-static pmstep_stepdir_t stepdir;           /* the step count, fed by the control interrupt */
-static bool stepdir_was_tracked;           /* RUN at the last period: following starts on entering RUN */
-static bool en_was_enabled;                /* EN at the last period: its edges start and release the drive */
+static pmstep_stepdir_t stepdir; /* the step count, fed by the control interrupt */
+static bool stepdir_was_tracked; /* RUN at the last period: following starts on entering RUN */
+static bool en_was_enabled;      /* EN at the last period: its edges start and release the drive */
 #endif
 static uint32_t uart_errors;
 static uint8_t tx[64];
@@ -168,9 +168,9 @@ int32_t pmstep_app_init(void)
     /* The board's own configuration (duties load one period later: one period of delay). Then the
      * newest record of the flash over it, if there is one and it is accepted whole; otherwise the
      * board's, the drive not configured until a record is written or CALIBRATE runs (START refused). */
-    defaults = pmstep_console_app_config(pmstep_stm32g4_period_s(&board), 1u,
-                                         pmstep_stm32g4_current_sense_range_A(&board),
-                                         pmstep_stm32g4_bus_sense_range_V(&board));
+    defaults =
+        pmstep_console_app_config(pmstep_stm32g4_period_s(&board), 1u, pmstep_stm32g4_current_sense_range_A(&board),
+                                  pmstep_stm32g4_bus_sense_range_V(&board));
     store_st = pmstep_store_init(&store, pmstep_stm32g4_store_flash(), pmstep_stm32g4_board_id());
     if (store_st != PMSTEP_STORE_OK) {
         return -300 + (int32_t)store_st;

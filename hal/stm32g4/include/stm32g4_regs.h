@@ -120,17 +120,17 @@ STM32G4_STATIC_ASSERT(offsetof(stm32g4_rcc_t, CCIPR2) == 0x9C, rcc_ccipr2);
  * PWR, power control: RM0440 §6.4 "PWR registers", base 0x4000 7000
  * ------------------------------------------------------------------------- */
 typedef struct {
-    volatile uint32_t CR1;      /* 0x00 */
-    volatile uint32_t CR2;      /* 0x04 */
-    volatile uint32_t CR3;      /* 0x08 */
-    volatile uint32_t CR4;      /* 0x0C */
-    volatile uint32_t SR1;      /* 0x10 */
-    volatile uint32_t SR2;      /* 0x14 */
-    volatile uint32_t SCR;      /* 0x18 */
-    uint32_t reserved0;         /* 0x1C */
+    volatile uint32_t CR1;             /* 0x00 */
+    volatile uint32_t CR2;             /* 0x04 */
+    volatile uint32_t CR3;             /* 0x08 */
+    volatile uint32_t CR4;             /* 0x0C */
+    volatile uint32_t SR1;             /* 0x10 */
+    volatile uint32_t SR2;             /* 0x14 */
+    volatile uint32_t SCR;             /* 0x18 */
+    uint32_t reserved0;                /* 0x1C */
     volatile uint32_t PUCRA_PDCRG[14]; /* 0x20 .. 0x54: pull-up/down control A..G */
-    uint32_t reserved1[10];     /* 0x58 .. 0x7C */
-    volatile uint32_t CR5;      /* 0x80 */
+    uint32_t reserved1[10];            /* 0x58 .. 0x7C */
+    volatile uint32_t CR5;             /* 0x80 */
 } stm32g4_pwr_t;
 STM32G4_STATIC_ASSERT(offsetof(stm32g4_pwr_t, SR2) == 0x14, pwr_sr2);
 STM32G4_STATIC_ASSERT(offsetof(stm32g4_pwr_t, CR5) == 0x80, pwr_cr5);
@@ -195,12 +195,14 @@ STM32G4_STATIC_ASSERT(offsetof(stm32g4_flash_t, WRP1BR) == 0x30, flash_wrp1br);
 #define FLASH_SR_RDERR STM32G4_BIT(14)
 #define FLASH_SR_OPTVERR STM32G4_BIT(15)
 #define FLASH_SR_BSY STM32G4_BIT(16)
-#define FLASH_SR_ERRORS (FLASH_SR_OPERR | FLASH_SR_PROGERR | FLASH_SR_WRPERR | FLASH_SR_PGAERR | FLASH_SR_SIZERR \
-                         | FLASH_SR_PGSERR | FLASH_SR_MISERR | FLASH_SR_FASTERR | FLASH_SR_RDERR | FLASH_SR_OPTVERR)
+#define FLASH_SR_ERRORS                                                                                        \
+    (FLASH_SR_OPERR | FLASH_SR_PROGERR | FLASH_SR_WRPERR | FLASH_SR_PGAERR | FLASH_SR_SIZERR | FLASH_SR_PGSERR \
+     | FLASH_SR_MISERR | FLASH_SR_FASTERR | FLASH_SR_RDERR | FLASH_SR_OPTVERR)
 /* The flags of a programming error: while one is set, the next program or erase start is refused
  * with PGSERR (§3.7.5 PGSERR; §3.3.6, §3.3.7 step "check and clear all error programming flags"). */
-#define FLASH_SR_PROGRAMMING_ERRORS (FLASH_SR_PROGERR | FLASH_SR_WRPERR | FLASH_SR_PGAERR | FLASH_SR_SIZERR \
-                                     | FLASH_SR_PGSERR | FLASH_SR_MISERR | FLASH_SR_FASTERR)
+#define FLASH_SR_PROGRAMMING_ERRORS                                                                             \
+    (FLASH_SR_PROGERR | FLASH_SR_WRPERR | FLASH_SR_PGAERR | FLASH_SR_SIZERR | FLASH_SR_PGSERR | FLASH_SR_MISERR \
+     | FLASH_SR_FASTERR)
 /* FLASH_CR (§3.7.6, reset value 0xC000 0000): PG 0, PER 1, MER1 2, PNB[8:3] (the page of a page
  * erase; 6 bits on the category 2 devices, 64 pages), STRT 16 (starts an erase; cleared by
  * hardware when BSY clears), OPTSTRT 17, FSTPG 18, EOPIE 24, ERRIE 25, RDERRIE 26, OBL_LAUNCH 27,
@@ -334,8 +336,8 @@ STM32G4_STATIC_ASSERT(offsetof(stm32g4_tim_t, DCR) == 0x3DC, tim_dcr);
 #define TIM_OCM_PWM1 6u
 #define TIM_OCM_PWM2 7u
 /* TIMx_CCER (§28.6.11): channel n (1..4) at 4(n-1): CCxE, CCxP, CCxNE, CCxNP; CC5E 16, CC5P 17 */
-#define TIM_CCER_CCE(n) STM32G4_BIT(4u * ((n) - 1u))
-#define TIM_CCER_CCNE(n) STM32G4_BIT(4u * ((n) - 1u) + 2u)
+#define TIM_CCER_CCE(n) STM32G4_BIT(4u * ((n)-1u))
+#define TIM_CCER_CCNE(n) STM32G4_BIT(4u * ((n)-1u) + 2u)
 #define TIM_CCER_CC5E STM32G4_BIT(16)
 /* TIMx_BDTR (§28.6.20): DTG[7:0], OSSI 10, OSSR 11, BKE 12, BKP 13 (1: break active high),
  * AOE 14, MOE 15, BKF[19:16] */
@@ -398,37 +400,37 @@ STM32G4_STATIC_ASSERT(offsetof(stm32g4_tim_t, DCR) == 0x3DC, tim_dcr);
  * common registers of ADC1/ADC2 §21.8, at 0x5000 0300
  * ------------------------------------------------------------------------- */
 typedef struct {
-    volatile uint32_t ISR;      /* 0x00 flags, cleared by writing 1 */
-    volatile uint32_t IER;      /* 0x04 */
-    volatile uint32_t CR;       /* 0x08 */
-    volatile uint32_t CFGR;     /* 0x0C */
-    volatile uint32_t CFGR2;    /* 0x10 */
-    volatile uint32_t SMPR1;    /* 0x14 sample time, channels 0..9 (3 bits each) */
-    volatile uint32_t SMPR2;    /* 0x18 channels 10..18 */
-    uint32_t reserved0;         /* 0x1C */
-    volatile uint32_t TR1;      /* 0x20 */
-    volatile uint32_t TR2;      /* 0x24 */
-    volatile uint32_t TR3;      /* 0x28 */
-    uint32_t reserved1;         /* 0x2C */
-    volatile uint32_t SQR1;     /* 0x30 */
-    volatile uint32_t SQR2;     /* 0x34 */
-    volatile uint32_t SQR3;     /* 0x38 */
-    volatile uint32_t SQR4;     /* 0x3C */
-    volatile uint32_t DR;       /* 0x40 */
-    uint32_t reserved2[2];      /* 0x44, 0x48 */
-    volatile uint32_t JSQR;     /* 0x4C injected sequence */
-    uint32_t reserved3[4];      /* 0x50 .. 0x5C */
-    volatile uint32_t OFR[4];   /* 0x60 .. 0x6C */
-    uint32_t reserved4[4];      /* 0x70 .. 0x7C */
-    volatile uint32_t JDR[4];   /* 0x80 .. 0x8C injected data */
-    uint32_t reserved5[4];      /* 0x90 .. 0x9C */
-    volatile uint32_t AWD2CR;   /* 0xA0 */
-    volatile uint32_t AWD3CR;   /* 0xA4 */
-    uint32_t reserved6[2];      /* 0xA8, 0xAC */
-    volatile uint32_t DIFSEL;   /* 0xB0 */
-    volatile uint32_t CALFACT;  /* 0xB4 */
-    uint32_t reserved7[2];      /* 0xB8, 0xBC */
-    volatile uint32_t GCOMP;    /* 0xC0 */
+    volatile uint32_t ISR;     /* 0x00 flags, cleared by writing 1 */
+    volatile uint32_t IER;     /* 0x04 */
+    volatile uint32_t CR;      /* 0x08 */
+    volatile uint32_t CFGR;    /* 0x0C */
+    volatile uint32_t CFGR2;   /* 0x10 */
+    volatile uint32_t SMPR1;   /* 0x14 sample time, channels 0..9 (3 bits each) */
+    volatile uint32_t SMPR2;   /* 0x18 channels 10..18 */
+    uint32_t reserved0;        /* 0x1C */
+    volatile uint32_t TR1;     /* 0x20 */
+    volatile uint32_t TR2;     /* 0x24 */
+    volatile uint32_t TR3;     /* 0x28 */
+    uint32_t reserved1;        /* 0x2C */
+    volatile uint32_t SQR1;    /* 0x30 */
+    volatile uint32_t SQR2;    /* 0x34 */
+    volatile uint32_t SQR3;    /* 0x38 */
+    volatile uint32_t SQR4;    /* 0x3C */
+    volatile uint32_t DR;      /* 0x40 */
+    uint32_t reserved2[2];     /* 0x44, 0x48 */
+    volatile uint32_t JSQR;    /* 0x4C injected sequence */
+    uint32_t reserved3[4];     /* 0x50 .. 0x5C */
+    volatile uint32_t OFR[4];  /* 0x60 .. 0x6C */
+    uint32_t reserved4[4];     /* 0x70 .. 0x7C */
+    volatile uint32_t JDR[4];  /* 0x80 .. 0x8C injected data */
+    uint32_t reserved5[4];     /* 0x90 .. 0x9C */
+    volatile uint32_t AWD2CR;  /* 0xA0 */
+    volatile uint32_t AWD3CR;  /* 0xA4 */
+    uint32_t reserved6[2];     /* 0xA8, 0xAC */
+    volatile uint32_t DIFSEL;  /* 0xB0 */
+    volatile uint32_t CALFACT; /* 0xB4 */
+    uint32_t reserved7[2];     /* 0xB8, 0xBC */
+    volatile uint32_t GCOMP;   /* 0xC0 */
 } stm32g4_adc_t;
 STM32G4_STATIC_ASSERT(offsetof(stm32g4_adc_t, SMPR1) == 0x14, adc_smpr1);
 STM32G4_STATIC_ASSERT(offsetof(stm32g4_adc_t, DR) == 0x40, adc_dr);
@@ -463,8 +465,8 @@ STM32G4_STATIC_ASSERT(offsetof(stm32g4_adc_common_t, CCR) == 0x08, adc_ccr);
 #define ADC_CR_DEEPPWD STM32G4_BIT(29)
 #define ADC_CR_ADCALDIF STM32G4_BIT(30)
 #define ADC_CR_ADCAL STM32G4_BIT(31)
-#define ADC_CR_RS_BITS (ADC_CR_ADCAL | ADC_CR_JADSTP | ADC_CR_ADSTP | ADC_CR_JADSTART | ADC_CR_ADSTART \
-                        | ADC_CR_ADDIS | ADC_CR_ADEN)
+#define ADC_CR_RS_BITS \
+    (ADC_CR_ADCAL | ADC_CR_JADSTP | ADC_CR_ADSTP | ADC_CR_JADSTART | ADC_CR_ADSTART | ADC_CR_ADDIS | ADC_CR_ADEN)
 /* ADC_CFGR (§21.7.4): JQDIS 31 (1 at reset: no injected queue, JSQR written directly) */
 #define ADC_CFGR_JQDIS STM32G4_BIT(31)
 /* ADC_JSQR (§21.7.16): JL[1:0] = conversions - 1, JEXTSEL[6:2], JEXTEN[8:7] (01 rising edge),
@@ -523,17 +525,17 @@ STM32G4_STATIC_ASSERT(offsetof(stm32g4_lpuart_t, PRESC) == 0x2C, lpuart_presc);
 /* NVIC (B3.4.3): ISER 0xE000E100, ICER 0xE000E180, ISPR 0xE000E200, ICPR 0xE000E280,
  * IPR 0xE000E400 (one byte per interrupt; the STM32G4 implements the upper 4 bits) */
 typedef struct {
-    volatile uint32_t ISER[8];  /* 0x000 */
+    volatile uint32_t ISER[8]; /* 0x000 */
     uint32_t reserved0[24];
-    volatile uint32_t ICER[8];  /* 0x080 */
+    volatile uint32_t ICER[8]; /* 0x080 */
     uint32_t reserved1[24];
-    volatile uint32_t ISPR[8];  /* 0x100 */
+    volatile uint32_t ISPR[8]; /* 0x100 */
     uint32_t reserved2[24];
-    volatile uint32_t ICPR[8];  /* 0x180 */
+    volatile uint32_t ICPR[8]; /* 0x180 */
     uint32_t reserved3[24];
-    volatile uint32_t IABR[8];  /* 0x200 */
+    volatile uint32_t IABR[8]; /* 0x200 */
     uint32_t reserved4[56];
-    volatile uint8_t IPR[240];  /* 0x300 */
+    volatile uint8_t IPR[240]; /* 0x300 */
 } stm32g4_nvic_t;
 STM32G4_STATIC_ASSERT(offsetof(stm32g4_nvic_t, ICER) == 0x80, nvic_icer);
 STM32G4_STATIC_ASSERT(offsetof(stm32g4_nvic_t, IPR) == 0x300, nvic_ipr);

@@ -15,7 +15,7 @@ static struct {
     const pmstep_stm32g4_config_t *cfg;
     pmstep_t *inst;
     uint32_t arr;
-    float bus_voltage_V;  /* this period's sample, for the duties */
+    float bus_voltage_V; /* this period's sample, for the duties */
     pmstep_output_t out;
     volatile pmstep_stm32g4_fault_t fault;
     volatile bool step_disabled; /* the STEP/DIR input's EN read disabled at this period's start */
@@ -47,8 +47,8 @@ static void enable_pin(bool on)
 {
     const pmstep_stm32g4_config_t *cfg = port.cfg;
     const bool level = on == cfg->enable_active_high;
-    STM32G4_GPIO(cfg->enable_pin.port)->BSRR = level ? STM32G4_BIT(cfg->enable_pin.pin)
-                                                     : STM32G4_BIT(16u + cfg->enable_pin.pin);
+    STM32G4_GPIO(cfg->enable_pin.port)->BSRR =
+        level ? STM32G4_BIT(cfg->enable_pin.pin) : STM32G4_BIT(16u + cfg->enable_pin.pin);
 }
 
 static void bridge_off(void)
@@ -82,10 +82,10 @@ void pmstep_hal_read_measurements(pmstep_meas_t *meas)
 {
     const pmstep_stm32g4_config_t *cfg = port.cfg;
     meas->i_a_A = pmstep_stm32g4_counts_to_si(STM32G4_ADC1->JDR[0], cfg->i_a_offset_counts, cfg->i_a_gain_a_per_count);
-    meas->bus_voltage_V = pmstep_stm32g4_counts_to_si(STM32G4_ADC1->JDR[1], cfg->bus_offset_counts,
-                                                      cfg->bus_gain_v_per_count);
+    meas->bus_voltage_V =
+        pmstep_stm32g4_counts_to_si(STM32G4_ADC1->JDR[1], cfg->bus_offset_counts, cfg->bus_gain_v_per_count);
     meas->i_b_A = pmstep_stm32g4_counts_to_si(STM32G4_ADC2->JDR[0], cfg->i_b_offset_counts, cfg->i_b_gain_a_per_count);
-    meas->load_torque_Nm = 0.0f; /* no torque sensor on this board (known_load_mode refused at init) */
+    meas->load_torque_Nm = 0.0f;    /* no torque sensor on this board (known_load_mode refused at init) */
     meas->phase_voltage_a_V = 0.0f; /* no phase-voltage sensing (refused at init) */
     meas->phase_voltage_b_V = 0.0f;
     port.bus_voltage_V = meas->bus_voltage_V;
@@ -150,8 +150,8 @@ void TIM1_BRK_TIM15_IRQHandler(void)
 {
     stm32g4_tim_t *const tim = STM32G4_TIM1;
     if ((tim->SR & TIM_SR_BIF) != 0u) {
-        tim->SR = ~TIM_SR_BIF;       /* write 0 to clear */
-        tim->DIER &= ~TIM_DIER_BIE;  /* the flag comes back while the input stays active */
+        tim->SR = ~TIM_SR_BIF;      /* write 0 to clear */
+        tim->DIER &= ~TIM_DIER_BIE; /* the flag comes back while the input stays active */
         latch_fault(PMSTEP_STM32G4_FAULT_BREAK);
         if (port.inst != NULL) {
             stop_core_on_port_fault();
@@ -205,8 +205,8 @@ void pmstep_stm32g4_set_diag(bool asserted)
     }
     in = &port.cfg->step_input;
     /* Open drain: a 1 in ODR releases the line (the pull-up takes it high), a 0 pulls it low. */
-    STM32G4_GPIO(in->diag_pin.port)->BSRR = asserted == in->diag_active_high ? STM32G4_BIT(in->diag_pin.pin)
-                                                                            : STM32G4_BIT(16u + in->diag_pin.pin);
+    STM32G4_GPIO(in->diag_pin.port)->BSRR =
+        asserted == in->diag_active_high ? STM32G4_BIT(in->diag_pin.pin) : STM32G4_BIT(16u + in->diag_pin.pin);
 }
 
 uint32_t pmstep_stm32g4_isr_cycles_max(void)
@@ -353,8 +353,8 @@ void pmstep_stm32g4_last_period(pmstep_output_t *out, pmstep_meas_t *meas, uint8
     }
     /* The injected data registers hold the last period's samples until the next trigger. */
     meas->i_a_A = pmstep_stm32g4_counts_to_si(STM32G4_ADC1->JDR[0], cfg->i_a_offset_counts, cfg->i_a_gain_a_per_count);
-    meas->bus_voltage_V = pmstep_stm32g4_counts_to_si(STM32G4_ADC1->JDR[1], cfg->bus_offset_counts,
-                                                      cfg->bus_gain_v_per_count);
+    meas->bus_voltage_V =
+        pmstep_stm32g4_counts_to_si(STM32G4_ADC1->JDR[1], cfg->bus_offset_counts, cfg->bus_gain_v_per_count);
     meas->i_b_A = pmstep_stm32g4_counts_to_si(STM32G4_ADC2->JDR[0], cfg->i_b_offset_counts, cfg->i_b_gain_a_per_count);
     meas->load_torque_Nm = 0.0f;
     meas->phase_voltage_a_V = 0.0f;

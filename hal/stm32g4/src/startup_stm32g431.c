@@ -40,13 +40,13 @@ typedef struct {
 #define D10 D5, D5
 __attribute__((section(".isr_vector"), used)) const vector_table_t stm32g431_vector_table = {
     &_estack,
-    {Reset_Handler, NMI_Handler, HardFault_Handler, MemManage_Handler, BusFault_Handler, UsageFault_Handler, 0, 0,
-     0, 0, SVC_Handler, DebugMon_Handler, 0, PendSV_Handler, SysTick_Handler},
+    {Reset_Handler, NMI_Handler, HardFault_Handler, MemManage_Handler, BusFault_Handler, UsageFault_Handler, 0, 0, 0, 0,
+     SVC_Handler, DebugMon_Handler, 0, PendSV_Handler, SysTick_Handler},
     {
-        D10, D5, D, D, D,           /* 0 .. 17 */
-        ADC1_2_IRQHandler,          /* 18 */
-        D5,                         /* 19 .. 23 */
-        TIM1_BRK_TIM15_IRQHandler,  /* 24 */
+        D10, D5, D, D, D,                           /* 0 .. 17 */
+        ADC1_2_IRQHandler,                          /* 18 */
+        D5,                                         /* 19 .. 23 */
+        TIM1_BRK_TIM15_IRQHandler,                  /* 24 */
         D10, D10, D10, D10, D10, D10, D10, D5, D, D /* 25 .. 101 */
     },
 };

@@ -66,8 +66,7 @@ pmstep_stm32g4_status_t pmstep_stm32g4_clock_init(const pmstep_stm32g4_clock_t *
     }
 
     /* Flash wait states before the clock rises; prefetch and caches on. */
-    flash->ACR = (flash->ACR & ~FLASH_ACR_LATENCY_MASK) | latency | FLASH_ACR_PRFTEN | FLASH_ACR_ICEN
-                 | FLASH_ACR_DCEN;
+    flash->ACR = (flash->ACR & ~FLASH_ACR_LATENCY_MASK) | latency | FLASH_ACR_PRFTEN | FLASH_ACR_ICEN | FLASH_ACR_DCEN;
     if (!wait_set(&flash->ACR, FLASH_ACR_LATENCY_MASK, latency)) {
         return PMSTEP_STM32G4_ERR_CLOCK_TIMEOUT;
     }
@@ -282,7 +281,8 @@ static bool tim4_channel_pin(const pmstep_stm32g4_pin_t *p, uint8_t channel)
     const uint8_t port_b = 1u;
     const uint8_t pin_b = channel == 1u ? 6u : 7u;
     const uint8_t pin_a = channel == 1u ? 11u : 12u;
-    return (p->port == port_b && p->pin == pin_b && p->af == 2u) || (p->port == port_a && p->pin == pin_a && p->af == 10u);
+    return (p->port == port_b && p->pin == pin_b && p->af == 2u)
+           || (p->port == port_a && p->pin == pin_a && p->af == 10u);
 }
 
 pmstep_stm32g4_status_t pmstep_stm32g4_step_input_init(const pmstep_stm32g4_config_t *cfg, uint32_t tim_clock_Hz)
@@ -318,8 +318,8 @@ pmstep_stm32g4_status_t pmstep_stm32g4_step_input_init(const pmstep_stm32g4_conf
     /* DIAG: deasserted in ODR first (active high: pulled low; active low: released), then an
      * open-drain output with the pin's pull-up (a line nobody else pulls reads high). */
     port_clock_on(in->diag_pin.port);
-    STM32G4_GPIO(in->diag_pin.port)->BSRR = in->diag_active_high ? STM32G4_BIT(16u + in->diag_pin.pin)
-                                                                 : STM32G4_BIT(in->diag_pin.pin);
+    STM32G4_GPIO(in->diag_pin.port)->BSRR =
+        in->diag_active_high ? STM32G4_BIT(16u + in->diag_pin.pin) : STM32G4_BIT(in->diag_pin.pin);
     pin_configure_type(&in->diag_pin, GPIO_MODE_OUTPUT, GPIO_PULL_UP, true);
     /* STEP and DIR: TIM4's inputs, pulled down (an open STEP line counts nothing). */
     pin_configure(&in->step_pin, GPIO_MODE_AF, GPIO_PULL_DOWN);
@@ -339,7 +339,7 @@ pmstep_stm32g4_status_t pmstep_stm32g4_step_input_init(const pmstep_stm32g4_conf
                  | (TIM_CCMR_CCS_INPUT_TI << TIM_CCMR1_CC2S_POS) | ((uint32_t)icf << TIM_CCMR1_IC2F_POS);
     tim->TISEL = 0u; /* tim_ti1, tim_ti2 from the TIM4_CH1, TIM4_CH2 pins (§29.5.25) */
     tim->PSC = 0u;
-    tim->ARR = 0xFFFFu; /* the whole 16 bits: the count wraps 0xFFFF <-> 0, which the core unwraps */
+    tim->ARR = 0xFFFFu;    /* the whole 16 bits: the count wraps 0xFFFF <-> 0, which the core unwraps */
     tim->EGR = TIM_EGR_UG; /* PSC and ARR loaded, the counter to 0 (§29.5.6) */
     tim->SR = 0u;
     tim->CNT = 0u;
@@ -362,8 +362,8 @@ void pmstep_stm32g4_step_polarity(pmstep_stm32g4_config_t *cfg, bool enable_acti
     }
     /* As at set-up: EN pulled to its (new) disabled level, DIAG deasserted at its (new) level. */
     pin_configure(&in->enable_pin, GPIO_MODE_INPUT, enable_active_high ? GPIO_PULL_DOWN : GPIO_PULL_UP);
-    STM32G4_GPIO(in->diag_pin.port)->BSRR = diag_active_high ? STM32G4_BIT(16u + in->diag_pin.pin)
-                                                             : STM32G4_BIT(in->diag_pin.pin);
+    STM32G4_GPIO(in->diag_pin.port)->BSRR =
+        diag_active_high ? STM32G4_BIT(16u + in->diag_pin.pin) : STM32G4_BIT(in->diag_pin.pin);
 }
 
 /* ---- ADC1/ADC2: RM0440 §21.4.6 (regulator), §21.4.8 (calibration), §21.4.9 (enable),
@@ -412,8 +412,8 @@ pmstep_stm32g4_status_t pmstep_stm32g4_adc_init(const pmstep_stm32g4_config_t *c
 {
     stm32g4_adc_t *const adc1 = STM32G4_ADC1;
     stm32g4_adc_t *const adc2 = STM32G4_ADC2;
-    const uint32_t trigger = (ADC12_JEXTSEL_TIM1_TRGO2 << ADC_JSQR_JEXTSEL_POS)
-                             | (ADC_JSQR_JEXTEN_RISING << ADC_JSQR_JEXTEN_POS);
+    const uint32_t trigger =
+        (ADC12_JEXTSEL_TIM1_TRGO2 << ADC_JSQR_JEXTSEL_POS) | (ADC_JSQR_JEXTEN_RISING << ADC_JSQR_JEXTEN_POS);
 
     if (cfg == NULL) {
         return PMSTEP_STM32G4_ERR_NULL_ARGUMENT;

@@ -109,7 +109,8 @@ static int32_t begin(void)
 /* PG, PER and the page number cleared, FLASH_CR locked again (LOCK is set by writing 1). */
 static void end(void)
 {
-    STM32G4_FLASH_REG_WRITE(CR, (STM32G4_FLASH->CR & ~(FLASH_CR_PG | FLASH_CR_PER | FLASH_CR_PNB_MASK)) | FLASH_CR_LOCK);
+    STM32G4_FLASH_REG_WRITE(CR,
+                            (STM32G4_FLASH->CR & ~(FLASH_CR_PG | FLASH_CR_PER | FLASH_CR_PNB_MASK)) | FLASH_CR_LOCK);
 }
 
 /* After an erase: the data cache may hold lines of the page as it was, which a read of the slot
@@ -137,8 +138,7 @@ static int32_t flash_erase(void *ctx, uint32_t slot)
     st = begin();
     if (st == 0) {
         const uint32_t page = PMSTEP_STM32G4_STORE_FIRST_PAGE + slot;
-        const uint32_t cr = STM32G4_FLASH->CR
-                            & ~(FLASH_CR_PG | FLASH_CR_MER1 | FLASH_CR_FSTPG | FLASH_CR_PNB_MASK);
+        const uint32_t cr = STM32G4_FLASH->CR & ~(FLASH_CR_PG | FLASH_CR_MER1 | FLASH_CR_FSTPG | FLASH_CR_PNB_MASK);
         STM32G4_FLASH_REG_WRITE(CR, cr | FLASH_CR_PER | (page << FLASH_CR_PNB_POS));
         STM32G4_FLASH_REG_WRITE(CR, cr | FLASH_CR_PER | (page << FLASH_CR_PNB_POS) | FLASH_CR_STRT);
         st = finish_operation();
@@ -169,9 +169,9 @@ static int32_t flash_program(void *ctx, uint32_t slot, uint32_t offset, const ui
     }
     st = begin();
     if (st == 0) {
-        STM32G4_FLASH_REG_WRITE(CR, (STM32G4_FLASH->CR
-                                     & ~(FLASH_CR_PER | FLASH_CR_MER1 | FLASH_CR_FSTPG | FLASH_CR_PNB_MASK))
-                                        | FLASH_CR_PG);
+        STM32G4_FLASH_REG_WRITE(
+            CR,
+            (STM32G4_FLASH->CR & ~(FLASH_CR_PER | FLASH_CR_MER1 | FLASH_CR_FSTPG | FLASH_CR_PNB_MASK)) | FLASH_CR_PG);
     }
     for (k = 0; st == 0 && k < n; k += STM32G4_FLASH_DOUBLE_WORD_BYTES) {
         const uint32_t addr = slot_addr(slot) + offset + k;

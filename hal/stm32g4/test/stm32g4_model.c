@@ -31,18 +31,18 @@ void stm32g4_model_reset(void)
     unsigned p;
     memset(&stm32g4_fake, 0, sizeof stm32g4_fake);
     memset(&M, 0, sizeof M);
-    stm32g4_fake.rcc.CR = RCC_CR_HSION | RCC_CR_HSIRDY;   /* HSI16 on and ready */
-    stm32g4_fake.rcc.CFGR = 0x5u;                          /* SW = SWS = HSI16 */
+    stm32g4_fake.rcc.CR = RCC_CR_HSION | RCC_CR_HSIRDY; /* HSI16 on and ready */
+    stm32g4_fake.rcc.CFGR = 0x5u;                       /* SW = SWS = HSI16 */
     stm32g4_fake.pwr.CR1 = PWR_CR1_VOS_RANGE1;
-    stm32g4_fake.pwr.CR5 = PWR_CR5_R1MODE;                 /* range 1 normal mode */
+    stm32g4_fake.pwr.CR5 = PWR_CR5_R1MODE;                    /* range 1 normal mode */
     stm32g4_fake.flash.ACR = FLASH_ACR_ICEN | FLASH_ACR_DCEN; /* LATENCY 0 */
     for (p = 0; p < STM32G4_GPIO_PORTS; ++p) {
-        stm32g4_fake.gpio[p].MODER = 0xFFFFFFFFu;          /* analog */
+        stm32g4_fake.gpio[p].MODER = 0xFFFFFFFFu; /* analog */
     }
-    stm32g4_fake.gpio[0].MODER = 0xABFFFFFFu;              /* PA13..15 debug */
-    stm32g4_fake.gpio[1].MODER = 0xFFFFFEBFu;              /* PB3, PB4 debug */
+    stm32g4_fake.gpio[0].MODER = 0xABFFFFFFu; /* PA13..15 debug */
+    stm32g4_fake.gpio[1].MODER = 0xFFFFFEBFu; /* PB3, PB4 debug */
     memcpy(M.gpio_seen, stm32g4_fake.gpio, sizeof M.gpio_seen);
-    stm32g4_fake.tim1.AF1 = TIM_AF1_BKINE;                 /* BKIN pin connected */
+    stm32g4_fake.tim1.AF1 = TIM_AF1_BKINE; /* BKIN pin connected */
     stm32g4_fake.adc1.CR = ADC_CR_DEEPPWD;
     stm32g4_fake.adc2.CR = ADC_CR_DEEPPWD;
     stm32g4_fake.adc1.CFGR = ADC_CFGR_JQDIS;
@@ -614,8 +614,8 @@ static uint32_t jsqr_channel(uint32_t jsqr, unsigned rank)
 
 static uint32_t conversion_ticks(stm32g4_adc_t *adc, uint32_t channel)
 {
-    const uint32_t code = channel < 10u ? (adc->SMPR1 >> (3u * channel)) & 7u
-                                        : (adc->SMPR2 >> (3u * (channel - 10u))) & 7u;
+    const uint32_t code =
+        channel < 10u ? (adc->SMPR1 >> (3u * channel)) & 7u : (adc->SMPR2 >> (3u * (channel - 10u))) & 7u;
     return (smp_half_cycles[code] + 25u) * ADC_CLOCK_DIVIDER / 2u;
 }
 
@@ -674,8 +674,8 @@ static void interrupts(void)
 {
     unsigned guard;
     for (guard = 0; guard < 4u; ++guard) {
-        const bool brk = (M.sr & TIM_SR_BIF) != 0u && (TIM->DIER & TIM_DIER_BIE) != 0u
-                         && irq_enabled(STM32G4_IRQ_TIM1_BRK_TIM15);
+        const bool brk =
+            (M.sr & TIM_SR_BIF) != 0u && (TIM->DIER & TIM_DIER_BIE) != 0u && irq_enabled(STM32G4_IRQ_TIM1_BRK_TIM15);
         const bool adc = (((M.adc[0].isr & ADC_ISR_JEOS) != 0u && (stm32g4_fake.adc1.IER & ADC_IER_JEOSIE) != 0u)
                           || ((M.adc[1].isr & ADC_ISR_JEOS) != 0u && (stm32g4_fake.adc2.IER & ADC_IER_JEOSIE) != 0u))
                          && irq_enabled(STM32G4_IRQ_ADC1_2);

@@ -40,55 +40,55 @@ extern "C" {
 #define STM32G4_MODEL_LOG 4096u
 
 typedef struct {
-    uint64_t tick;      /**< model time of the trigger edge */
-    uint32_t cnt;       /**< TIM1 counter at the trigger */
-    bool down;          /**< TIM1 counting down at the trigger */
+    uint64_t tick; /**< model time of the trigger edge */
+    uint32_t cnt;  /**< TIM1 counter at the trigger */
+    bool down;     /**< TIM1 counting down at the trigger */
 } stm32g4_model_trigger_t;
 
 typedef struct {
     /* ---- inputs the test drives ---- */
-    bool bkin_pin_high;                             /**< electrical level on the TIM1_BKIN pin */
+    bool bkin_pin_high;                              /**< electrical level on the TIM1_BKIN pin */
     uint16_t analog_counts[2][ADC_CHANNEL_MAX + 1u]; /**< what ADC1 [0] / ADC2 [1] convert on each channel */
-    unsigned aden_guard_polls;  /**< driver polls after ADCAL clears during which an ADEN write is reset */
+    unsigned aden_guard_polls; /**< driver polls after ADCAL clears during which an ADEN write is reset */
 
     /* ---- TIM1 state (RM0440 ch. 28) ---- */
     uint32_t cnt;
     bool down;
-    uint32_t rep;               /**< repetition down-counter */
+    uint32_t rep; /**< repetition down-counter */
     uint32_t arr_shadow;
-    uint32_t ccr_shadow[6];     /**< CCR1..CCR6 active (shadow) values */
-    bool ocref[6];              /**< OC1REF..OC6REF */
-    bool dt_out[4][2];          /**< dead-time generator outputs (OCx, OCxN before the output stage) */
-    uint32_t dt_wait[4][2];     /**< ticks left before a pending rising edge passes */
-    bool oc[4];                 /**< TIM1_CHx pin levels */
-    bool ocn[4];                /**< TIM1_CHxN pin levels */
-    bool trgo2;                 /**< TRGO2 level */
-    bool update_pulse;          /**< an update event happened this tick */
+    uint32_t ccr_shadow[6]; /**< CCR1..CCR6 active (shadow) values */
+    bool ocref[6];          /**< OC1REF..OC6REF */
+    bool dt_out[4][2];      /**< dead-time generator outputs (OCx, OCxN before the output stage) */
+    uint32_t dt_wait[4][2]; /**< ticks left before a pending rising edge passes */
+    bool oc[4];             /**< TIM1_CHx pin levels */
+    bool ocn[4];            /**< TIM1_CHxN pin levels */
+    bool trgo2;             /**< TRGO2 level */
+    bool update_pulse;      /**< an update event happened this tick */
     bool break_active;
-    uint32_t sr;                /**< TIM1_SR as the hardware holds it */
-    uint64_t updates;           /**< update events since reset */
+    uint32_t sr;      /**< TIM1_SR as the hardware holds it */
+    uint64_t updates; /**< update events since reset */
     uint64_t tick;
 
     /* ---- ADC1/ADC2 state (RM0440 ch. 21) ---- */
     struct {
-        uint32_t isr;           /**< ADC_ISR as the hardware holds it */
-        uint32_t cr_rs;         /**< the set-only/hardware-cleared CR bits as the hardware holds them */
-        unsigned cal_polls;     /**< polls until the calibration ends (0: not calibrating) */
-        unsigned guard;         /**< polls left during which ADEN is reset by the calibration logic */
+        uint32_t isr;       /**< ADC_ISR as the hardware holds it */
+        uint32_t cr_rs;     /**< the set-only/hardware-cleared CR bits as the hardware holds them */
+        unsigned cal_polls; /**< polls until the calibration ends (0: not calibrating) */
+        unsigned guard;     /**< polls left during which ADEN is reset by the calibration logic */
         bool calibrated;
         bool trgo2_prev;
         bool busy;
         unsigned rank;
         uint32_t ticks_left;
         unsigned triggers;
-        unsigned sequences;     /**< JEOS raised */
+        unsigned sequences; /**< JEOS raised */
         stm32g4_model_trigger_t log[STM32G4_MODEL_LOG];
     } adc[2];
 
     /* ---- GPIO ---- */
     stm32g4_gpio_t gpio_seen[STM32G4_GPIO_PORTS]; /**< register values the model last accepted */
-    uint32_t gpio_floating[STM32G4_GPIO_PORTS]; /**< inputs nobody drives: IDR reads the pin's pull */
-    unsigned unclocked_writes;  /**< writes to a GPIO port whose clock was off (lost) */
+    uint32_t gpio_floating[STM32G4_GPIO_PORTS];   /**< inputs nobody drives: IDR reads the pin's pull */
+    unsigned unclocked_writes;                    /**< writes to a GPIO port whose clock was off (lost) */
 
     /* ---- LPUART1 (the console): bytes from the host, bytes sent ---- */
     uint8_t uart_rx[4096];
@@ -158,16 +158,16 @@ bool stm32g4_model_pin_level(unsigned port, unsigned pin, bool external_pull_up)
  * ------------------------------------------------------------------------- */
 
 typedef struct {
-    uint32_t cnt;             /**< the counter (what CNT reads) */
-    uint32_t cnt_written;     /**< CNT as the model last left it: another value is a software write */
-    uint32_t sr;              /**< TIM4_SR as the hardware holds it */
-    bool ti_filtered[2];      /**< tim_ti1, tim_ti2 after the filter (before the polarity) */
-    uint32_t ti_run[2];       /**< consecutive samples at the other level */
-    bool ti2fp2_prev;         /**< tim_ti2fp2 at the last tick */
-    uint64_t counted_up;      /**< counts up and down since the reset */
+    uint32_t cnt;         /**< the counter (what CNT reads) */
+    uint32_t cnt_written; /**< CNT as the model last left it: another value is a software write */
+    uint32_t sr;          /**< TIM4_SR as the hardware holds it */
+    bool ti_filtered[2];  /**< tim_ti1, tim_ti2 after the filter (before the polarity) */
+    uint32_t ti_run[2];   /**< consecutive samples at the other level */
+    bool ti2fp2_prev;     /**< tim_ti2fp2 at the last tick */
+    uint64_t counted_up;  /**< counts up and down since the reset */
     uint64_t counted_down;
-    uint64_t wraps;           /**< overflows and underflows */
-    uint64_t filtered_edges;  /**< STEP edges the filter passed (both directions of the level) */
+    uint64_t wraps;          /**< overflows and underflows */
+    uint64_t filtered_edges; /**< STEP edges the filter passed (both directions of the level) */
 } stm32g4_model_tim4_t;
 
 extern stm32g4_model_tim4_t stm32g4_model_tim4;
@@ -199,38 +199,38 @@ void stm32g4_model_tim4_tick(void);
 
 typedef struct {
     /* ---- inputs the test drives (stm32g4_model_reset() sets them to the values said) ---- */
-    uint32_t poll_ticks;      /**< ticks one driver poll of FLASH_SR lasts, while the flash is busy (170: 1 us) */
-    uint32_t cut_at_step;     /**< the power is cut in the middle of this program or erase step, counted
+    uint32_t poll_ticks;   /**< ticks one driver poll of FLASH_SR lasts, while the flash is busy (170: 1 us) */
+    uint32_t cut_at_step;  /**< the power is cut in the middle of this program or erase step, counted
                                    from 1 since the reset (0: no cut) */
-    uint32_t cut_erase_dw;    /**< an erase cut short has erased this many double words of its page
+    uint32_t cut_erase_dw; /**< an erase cut short has erased this many double words of its page
                                    before the cut (STM32G4_MODEL_FLASH_PAGE_DW / 2) */
-    uint32_t inject_step;     /**< this program or erase step ends with inject_flags and changes nothing (0: none) */
-    uint32_t inject_flags;    /**< FLASH_SR error flags of the injected failure (FLASH_SR_PROGERR) */
-    bool stuck_busy;          /**< an operation once started never ends (BSY stays set) */
+    uint32_t inject_step;  /**< this program or erase step ends with inject_flags and changes nothing (0: none) */
+    uint32_t inject_flags; /**< FLASH_SR error flags of the injected failure (FLASH_SR_PROGERR) */
+    bool stuck_busy;       /**< an operation once started never ends (BSY stays set) */
 
     /* ---- the controller (RM0440 §3.3.5 .. §3.3.7) ---- */
-    uint32_t sr;              /**< FLASH_SR's flags as the hardware holds them (BSY apart) */
-    unsigned key_step;        /**< 1: KEY1 written, KEY2 expected */
-    bool key_error;           /**< a wrong key sequence: FLASH_CR locked until the reset */
-    bool latched;             /**< the first word of a double word is latched */
+    uint32_t sr;       /**< FLASH_SR's flags as the hardware holds them (BSY apart) */
+    unsigned key_step; /**< 1: KEY1 written, KEY2 expected */
+    bool key_error;    /**< a wrong key sequence: FLASH_CR locked until the reset */
+    bool latched;      /**< the first word of a double word is latched */
     uint32_t latch_addr;
     uint32_t latch_word;
-    unsigned op;              /**< the operation running: 0 none, 1 page erase, 2 program */
-    uint32_t op_index;        /**< its page, or its double word's index in the array */
-    uint32_t op_data[2];      /**< the double word being programmed */
-    uint64_t op_left;         /**< ticks until it ends */
-    bool powered;             /**< false from a power cut until the reset */
+    unsigned op;         /**< the operation running: 0 none, 1 page erase, 2 program */
+    uint32_t op_index;   /**< its page, or its double word's index in the array */
+    uint32_t op_data[2]; /**< the double word being programmed */
+    uint64_t op_left;    /**< ticks until it ends */
+    bool powered;        /**< false from a power cut until the reset */
 
     /* ---- counted since the reset ---- */
-    uint32_t steps;           /**< program and erase steps started (the power cut's count) */
-    uint32_t erases;          /**< page erases completed */
-    uint32_t programs;        /**< double words programmed */
-    uint64_t busy_ticks;      /**< ticks with BSY set */
-    uint32_t bus_errors;      /**< wrong-key bus errors (the hardware raises a hard fault) */
-    uint32_t nmis;            /**< NMIs raised by ECCD */
-    uint32_t nmis_fatal;      /**< of those, the ones the port's handler did not take (the CPU would hang) */
-    uint32_t dcache_resets;   /**< FLASH_ACR.DCRST written 1 while the data cache was disabled */
-    uint32_t stalled_reads;   /**< array reads that waited for a running operation */
+    uint32_t steps;         /**< program and erase steps started (the power cut's count) */
+    uint32_t erases;        /**< page erases completed */
+    uint32_t programs;      /**< double words programmed */
+    uint64_t busy_ticks;    /**< ticks with BSY set */
+    uint32_t bus_errors;    /**< wrong-key bus errors (the hardware raises a hard fault) */
+    uint32_t nmis;          /**< NMIs raised by ECCD */
+    uint32_t nmis_fatal;    /**< of those, the ones the port's handler did not take (the CPU would hang) */
+    uint32_t dcache_resets; /**< FLASH_ACR.DCRST written 1 while the data cache was disabled */
+    uint32_t stalled_reads; /**< array reads that waited for a running operation */
 } stm32g4_model_flash_t;
 
 extern stm32g4_model_flash_t stm32g4_model_flash;

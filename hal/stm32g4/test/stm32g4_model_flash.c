@@ -300,24 +300,17 @@ void stm32g4_fake_flash_reg_write(uint32_t offset, uint32_t value)
         return;
     }
     switch (offset) {
-    case offsetof(stm32g4_flash_t, ACR):
-        acr_write(value);
-        break;
-    case offsetof(stm32g4_flash_t, KEYR):
-        key_write(value);
-        break;
+    case offsetof(stm32g4_flash_t, ACR): acr_write(value); break;
+    case offsetof(stm32g4_flash_t, KEYR): key_write(value); break;
     case offsetof(stm32g4_flash_t, SR): /* §3.7.5: EOP and the error flags cleared by writing 1 */
         F.sr &= ~(value & (FLASH_SR_EOP | FLASH_SR_ERRORS));
         break;
-    case offsetof(stm32g4_flash_t, CR):
-        cr_write(value);
-        break;
+    case offsetof(stm32g4_flash_t, CR): cr_write(value); break;
     case offsetof(stm32g4_flash_t, ECCR): /* §3.7.7: ECCC, ECCD cleared by writing 1; ECCIE read-write */
         REGS->ECCR = (REGS->ECCR & ~(value & (FLASH_ECCR_ECCC | FLASH_ECCR_ECCD)) & ~FLASH_ECCR_ECCIE)
                      | (value & FLASH_ECCR_ECCIE);
         break;
-    default:
-        break;
+    default: break;
     }
     publish();
 }
@@ -418,8 +411,8 @@ uint32_t stm32g4_model_flash_read(uint32_t addr)
     }
     p = &mem[word_addr - STM32G4_FLASH_MEM_BASE];
     if (ecc_bad[dw_of(word_addr)] && (REGS->ECCR & (FLASH_ECCR_ECCC | FLASH_ECCR_ECCD)) == 0u) {
-        REGS->ECCR = (REGS->ECCR & ~FLASH_ECCR_ADDR_ECC_MASK) | FLASH_ECCR_ECCD
-                     | ((word_addr & ~7u) - STM32G4_FLASH_MEM_BASE);
+        REGS->ECCR =
+            (REGS->ECCR & ~FLASH_ECCR_ADDR_ECC_MASK) | FLASH_ECCR_ECCD | ((word_addr & ~7u) - STM32G4_FLASH_MEM_BASE);
         F.nmis++;
         if (!pmstep_stm32g4_flash_ecc_nmi()) {
             F.nmis_fatal++;

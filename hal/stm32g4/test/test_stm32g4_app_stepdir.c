@@ -131,11 +131,12 @@ static void store_record(const pmstep_stepdir_settings_t *sd)
     pmstep_store_t store;
     pmstep_store_record_t rec;
     memset(&rec, 0, sizeof rec);
-    rec.config = pmstep_console_app_config(pmstep_stm32g4_period_s(&board), 1u,
-                                           pmstep_stm32g4_current_sense_range_A(&board),
-                                           pmstep_stm32g4_bus_sense_range_V(&board));
+    rec.config =
+        pmstep_console_app_config(pmstep_stm32g4_period_s(&board), 1u, pmstep_stm32g4_current_sense_range_A(&board),
+                                  pmstep_stm32g4_bus_sense_range_V(&board));
     rec.stepdir = *sd;
-    assert_int_equal(pmstep_store_init(&store, pmstep_stm32g4_store_flash(), pmstep_stm32g4_board_id()), PMSTEP_STORE_OK);
+    assert_int_equal(pmstep_store_init(&store, pmstep_stm32g4_store_flash(), pmstep_stm32g4_board_id()),
+                     PMSTEP_STORE_OK);
     assert_int_equal(pmstep_store_save(&store, &rec, true), PMSTEP_STORE_OK);
 }
 

@@ -20,7 +20,7 @@
 #include "stm32g4_regs.h"
 
 #define F stm32g4_model_flash
-#define SLOT_ADDR(slot) (PMSTEP_STM32G4_STORE_ADDR + (slot) * STM32G4_FLASH_PAGE_BYTES)
+#define SLOT_ADDR(slot) (PMSTEP_STM32G4_STORE_ADDR + (slot)*STM32G4_FLASH_PAGE_BYTES)
 
 static const pmstep_store_flash_t *flash;
 static pmstep_config_t board;
@@ -103,7 +103,8 @@ static void test_flash_codes_have_texts(void **state)
 
 static void test_program_read_erase_sequences(void **state)
 {
-    const uint8_t data[16] = {0x01, 0x23, 0x45, 0x67, 0x89, 0xAB, 0xCD, 0xEF, 0x10, 0x32, 0x54, 0x76, 0x98, 0xBA, 0xDC, 0xFE};
+    const uint8_t data[16] = {0x01, 0x23, 0x45, 0x67, 0x89, 0xAB, 0xCD, 0xEF,
+                              0x10, 0x32, 0x54, 0x76, 0x98, 0xBA, 0xDC, 0xFE};
     uint8_t back[24];
     (void)state;
     assert_true((stm32g4_fake.flash.CR & FLASH_CR_LOCK) != 0u); /* locked out of reset */
@@ -272,12 +273,14 @@ static void test_model_programming_sequence_errors(void **state)
     assert_int_equal(stm32g4_fake.flash.CR & FLASH_CR_STRT, 0u);
     /* An erase start while a programming error flag is set: PGSERR, nothing erased. */
     stm32g4_fake_flash_reg_write(offsetof(stm32g4_flash_t, CR), FLASH_CR_PER | (62u << FLASH_CR_PNB_POS));
-    stm32g4_fake_flash_reg_write(offsetof(stm32g4_flash_t, CR), FLASH_CR_PER | (62u << FLASH_CR_PNB_POS) | FLASH_CR_STRT);
+    stm32g4_fake_flash_reg_write(offsetof(stm32g4_flash_t, CR),
+                                 FLASH_CR_PER | (62u << FLASH_CR_PNB_POS) | FLASH_CR_STRT);
     assert_false(stm32g4_model_flash_busy());
     assert_int_equal(array_word(a), 0x12345678u);
     /* Cleared: the erase starts; a read of the flash meanwhile waits for its end (§3.3.5). */
     clear_flags();
-    stm32g4_fake_flash_reg_write(offsetof(stm32g4_flash_t, CR), FLASH_CR_PER | (62u << FLASH_CR_PNB_POS) | FLASH_CR_STRT);
+    stm32g4_fake_flash_reg_write(offsetof(stm32g4_flash_t, CR),
+                                 FLASH_CR_PER | (62u << FLASH_CR_PNB_POS) | FLASH_CR_STRT);
     assert_true(stm32g4_model_flash_busy());
     assert_int_equal(stm32g4_model_flash_read(a), 0xFFFFFFFFu);
     assert_int_equal(F.stalled_reads, 1u);
@@ -322,7 +325,8 @@ static void test_range_checks(void **state)
     assert_int_equal(flash->program(flash->ctx, 0u, 0u, buf, 12u), PMSTEP_STM32G4_ERR_FLASH_RANGE);
     assert_int_equal(flash->program(flash->ctx, 1u, STM32G4_FLASH_PAGE_BYTES - 8u, buf, 16u),
                      PMSTEP_STM32G4_ERR_FLASH_RANGE);
-    assert_int_equal(flash->read(flash->ctx, 1u, STM32G4_FLASH_PAGE_BYTES - 8u, buf, 9u), PMSTEP_STM32G4_ERR_FLASH_RANGE);
+    assert_int_equal(flash->read(flash->ctx, 1u, STM32G4_FLASH_PAGE_BYTES - 8u, buf, 9u),
+                     PMSTEP_STM32G4_ERR_FLASH_RANGE);
     assert_int_equal(flash->read(flash->ctx, 3u, 0u, buf, 1u), PMSTEP_STM32G4_ERR_FLASH_RANGE);
     assert_int_equal(F.steps, 0u);
     assert_true((stm32g4_fake.flash.CR & FLASH_CR_LOCK) != 0u);
@@ -478,8 +482,8 @@ static void after_cut_b_then_next_save_works(void)
 static void test_store_power_cut_at_every_step(void **state)
 {
     const uint32_t dw = (pmstep_store_record_bytes() + 7u) / 8u;
-    const uint32_t erased_before_cut[] = {0u, 1u, dw / 2u, dw - 1u, dw, STM32G4_MODEL_FLASH_PAGE_DW / 2u,
-                                          STM32G4_MODEL_FLASH_PAGE_DW - 1u};
+    const uint32_t erased_before_cut[] = {
+        0u, 1u, dw / 2u, dw - 1u, dw, STM32G4_MODEL_FLASH_PAGE_DW / 2u, STM32G4_MODEL_FLASH_PAGE_DW - 1u};
     const pmstep_store_record_t c = record_with(3.0f);
     uint32_t step;
     size_t k;

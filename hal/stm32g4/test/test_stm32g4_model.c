@@ -31,9 +31,9 @@ static int setup(void **state)
     stm32g4_model_reset();
     stm32g4_model_flash_erase_all(); /* a fresh part: no stored configuration */
     board = pmstep_stm32g4_default_config();
-    motor_config = pmstep_console_app_config(pmstep_stm32g4_period_s(&board), 1u,
-                                             pmstep_stm32g4_current_sense_range_A(&board),
-                                             pmstep_stm32g4_bus_sense_range_V(&board));
+    motor_config =
+        pmstep_console_app_config(pmstep_stm32g4_period_s(&board), 1u, pmstep_stm32g4_current_sense_range_A(&board),
+                                  pmstep_stm32g4_bus_sense_range_V(&board));
     assert_int_equal(pmstep_init(&motor, &motor_config), PMSTEP_OK);
     return 0;
 }
@@ -51,8 +51,10 @@ static uint16_t bus_counts(float bus_V)
 /* The analog inputs: currents in A, bus in V, as the ADC channels of the board convert them. */
 static void analog(float i_a, float i_b, float bus_V)
 {
-    M.analog_counts[0][board.adc1_channel_i_a] = (uint16_t)lroundf(i_a / board.i_a_gain_a_per_count + board.i_a_offset_counts);
-    M.analog_counts[1][board.adc2_channel_i_b] = (uint16_t)lroundf(i_b / board.i_b_gain_a_per_count + board.i_b_offset_counts);
+    M.analog_counts[0][board.adc1_channel_i_a] =
+        (uint16_t)lroundf(i_a / board.i_a_gain_a_per_count + board.i_a_offset_counts);
+    M.analog_counts[1][board.adc2_channel_i_b] =
+        (uint16_t)lroundf(i_b / board.i_b_gain_a_per_count + board.i_b_offset_counts);
     M.analog_counts[0][board.adc1_channel_bus] = bus_counts(bus_V);
 }
 
@@ -187,9 +189,15 @@ typedef struct {
  * PA13/PA14, the 24 MHz HSE crystal on PF0/PF1, the 32.768 kHz LSE crystal on PC14/PC15,
  * NRST on PG10. */
 static const board_pin_t nucleo_reserved[] = {
-    {0u, 2u, "VCP TX (LPUART1_TX)"}, {0u, 3u, "VCP RX (LPUART1_RX)"}, {0u, 13u, "SWDIO"},
-    {0u, 14u, "SWCLK"},              {5u, 0u, "HSE OSC_IN"},          {5u, 1u, "HSE OSC_OUT"},
-    {2u, 14u, "LSE OSC32_IN"},       {2u, 15u, "LSE OSC32_OUT"},      {6u, 10u, "NRST"},
+    {0u, 2u, "VCP TX (LPUART1_TX)"},
+    {0u, 3u, "VCP RX (LPUART1_RX)"},
+    {0u, 13u, "SWDIO"},
+    {0u, 14u, "SWCLK"},
+    {5u, 0u, "HSE OSC_IN"},
+    {5u, 1u, "HSE OSC_OUT"},
+    {2u, 14u, "LSE OSC32_IN"},
+    {2u, 15u, "LSE OSC32_OUT"},
+    {6u, 10u, "NRST"},
 };
 
 /* ADC1 channel of a pin (STM32G431RB pin data, ST STM32_open_pin_data), 0 if none used here. */
@@ -453,8 +461,8 @@ static void adc_raw(uint32_t edge, bool interrupt)
     adc->CR = ADC_CR_ADVREGEN;
     adc->CR = ADC_CR_ADVREGEN | ADC_CR_ADEN;
     stm32g4_model_sync();
-    adc->JSQR = (ADC12_JEXTSEL_TIM1_TRGO2 << ADC_JSQR_JEXTSEL_POS) | (edge << ADC_JSQR_JEXTEN_POS)
-                | (1u << ADC_JSQR_JSQ1_POS);
+    adc->JSQR =
+        (ADC12_JEXTSEL_TIM1_TRGO2 << ADC_JSQR_JEXTSEL_POS) | (edge << ADC_JSQR_JEXTEN_POS) | (1u << ADC_JSQR_JSQ1_POS);
     adc->IER = interrupt ? ADC_IER_JEOSIE : 0u;
     adc->CR = ADC_CR_ADVREGEN | ADC_CR_JADSTART;
     stm32g4_model_sync();
@@ -476,7 +484,7 @@ static void test_model_trgo2_and_adc_edges(void **state)
     assert_int_equal(M.adc[0].triggers, 10u);
     assert_int_equal(M.adc[0].log[0].cnt, 100u); /* the update at the peak */
     assert_int_equal(M.adc[0].sequences, 10u);
-    assert_int_equal(M.adc_irqs, 10u);           /* the handler cleared JEOS each time */
+    assert_int_equal(M.adc_irqs, 10u); /* the handler cleared JEOS each time */
     assert_int_equal(stm32g4_fake.adc1.JDR[0], 1234u);
     /* TRGO2 = OC5REF, CH5 PWM mode 1 with CCR5 = 20: rising at the valley side, falling at CNT 20. */
     stm32g4_model_reset();
@@ -775,7 +783,8 @@ static void store_record(const pmstep_config_t *cfg)
     memset(&rec, 0, sizeof rec);
     rec.config = *cfg;
     rec.stepdir = pmstep_console_stepdir_defaults();
-    assert_int_equal(pmstep_store_init(&store, pmstep_stm32g4_store_flash(), pmstep_stm32g4_board_id()), PMSTEP_STORE_OK);
+    assert_int_equal(pmstep_store_init(&store, pmstep_stm32g4_store_flash(), pmstep_stm32g4_board_id()),
+                     PMSTEP_STORE_OK);
     assert_int_equal(pmstep_store_save(&store, &rec, true), PMSTEP_STORE_OK);
 }
 
@@ -790,7 +799,8 @@ static void check_hello(uint8_t seq, uint8_t flags)
     assert_true(n > 4);
     assert_int_equal(d[2], PMSTEP_STORE_FORMAT_VERSION);
     assert_int_equal(d[3], flags);
-    assert_memory_equal(&d[4], "pmstep " PMSTEP_VERSION_TEXT " stm32g431", strlen("pmstep  stm32g431") + strlen(PMSTEP_VERSION_TEXT));
+    assert_memory_equal(&d[4], "pmstep " PMSTEP_VERSION_TEXT " stm32g431",
+                        strlen("pmstep  stm32g431") + strlen(PMSTEP_VERSION_TEXT));
 }
 
 /* A fresh part: the application boots with the board's configuration, not configured; START is
@@ -808,10 +818,12 @@ static void test_app_boots_unconfigured_with_empty_flash(void **state)
     /* The default build has no STEP/DIR mode: TIM4 never clocked, its pins and EN/DIAG's untouched
      * (analog, their reset state), STEP pulses count nothing. */
     assert_int_equal(stm32g4_fake.rcc.APB1ENR1 & RCC_APB1ENR1_TIM4EN, 0u);
-    assert_int_equal((stm32g4_fake.gpio[board.step_input.step_pin.port].MODER >> (2u * board.step_input.step_pin.pin)) & 3u,
+    assert_int_equal((stm32g4_fake.gpio[board.step_input.step_pin.port].MODER >> (2u * board.step_input.step_pin.pin))
+                         & 3u,
                      GPIO_MODE_ANALOG);
-    assert_int_equal((stm32g4_fake.gpio[board.step_input.enable_pin.port].MODER >> (2u * board.step_input.enable_pin.pin)) & 3u,
-                     GPIO_MODE_ANALOG);
+    assert_int_equal(
+        (stm32g4_fake.gpio[board.step_input.enable_pin.port].MODER >> (2u * board.step_input.enable_pin.pin)) & 3u,
+        GPIO_MODE_ANALOG);
     stm32g4_model_pin_in(board.step_input.step_pin.port, board.step_input.step_pin.pin, true);
     stm32g4_model_run(100u);
     stm32g4_model_pin_in(board.step_input.step_pin.port, board.step_input.step_pin.pin, false);
@@ -843,7 +855,7 @@ static void test_app_console_on_the_model(void **state)
     int n;
     (void)state;
     store_record(&motor_config); /* the paper's motor, configured from the flash at boot */
-    stm32g4_model_reset();        /* a power cycle: the flash keeps it */
+    stm32g4_model_reset();       /* a power cycle: the flash keeps it */
     stm32g4_model_pin_in(board.fault_pin.port, board.fault_pin.pin, !board.fault_active_high);
     analog(0.0f, 0.0f, 48.0f);
     assert_int_equal(pmstep_app_init(), 0);

@@ -31,13 +31,13 @@ void stm32g4_fake_wait_hook(void)
     if (!hardware_responds) {
         return;
     }
-    stm32g4_fake.rcc.CR = (stm32g4_fake.rcc.CR & ~RCC_CR_PLLRDY)
-                          | ((stm32g4_fake.rcc.CR & RCC_CR_PLLON) ? RCC_CR_PLLRDY : 0u);
+    stm32g4_fake.rcc.CR =
+        (stm32g4_fake.rcc.CR & ~RCC_CR_PLLRDY) | ((stm32g4_fake.rcc.CR & RCC_CR_PLLON) ? RCC_CR_PLLRDY : 0u);
     if (stm32g4_fake.rcc.CR & RCC_CR_HSION) {
         stm32g4_fake.rcc.CR |= RCC_CR_HSIRDY;
     }
-    stm32g4_fake.rcc.CFGR = (stm32g4_fake.rcc.CFGR & ~RCC_CFGR_SWS_MASK)
-                            | ((stm32g4_fake.rcc.CFGR & RCC_CFGR_SW_MASK) << RCC_CFGR_SWS_POS);
+    stm32g4_fake.rcc.CFGR =
+        (stm32g4_fake.rcc.CFGR & ~RCC_CFGR_SWS_MASK) | ((stm32g4_fake.rcc.CFGR & RCC_CFGR_SW_MASK) << RCC_CFGR_SWS_POS);
     stm32g4_fake.adc1.CR &= ~ADC_CR_ADCAL;
     stm32g4_fake.adc2.CR &= ~ADC_CR_ADCAL;
     /* ADRDY only once enabled (a plain-RAM write of ADRDY to clear it would set it here). */
@@ -252,9 +252,9 @@ static void test_dead_time(void **state)
 static void test_clock_arithmetic(void **state)
 {
     const pmstep_stm32g4_clock_t c170 = {4u, 85u, 2u};
-    const pmstep_stm32g4_clock_t too_fast = {4u, 90u, 2u};  /* 180 MHz */
+    const pmstep_stm32g4_clock_t too_fast = {4u, 90u, 2u}; /* 180 MHz */
     const pmstep_stm32g4_clock_t bad_r = {4u, 85u, 3u};
-    const pmstep_stm32g4_clock_t vco_low = {4u, 20u, 2u};   /* VCO 80 MHz */
+    const pmstep_stm32g4_clock_t vco_low = {4u, 20u, 2u}; /* VCO 80 MHz */
     (void)state;
     assert_int_equal(pmstep_stm32g4_sysclk_Hz(&c170), 170000000u);
     assert_int_equal(pmstep_stm32g4_sysclk_Hz(&too_fast), 0u);
@@ -288,8 +288,8 @@ static void test_clock_init(void **state)
     /* PLL: HSI16 / 4 x 85 / 2, R output on */
     assert_int_equal(rcc->PLLCFGR, 2u | (3u << 4) | (85u << 8) | (0u << 25) | (1u << 24));
     assert_true(rcc->CR & RCC_CR_PLLON);
-    assert_int_equal(rcc->CFGR & RCC_CFGR_SW_MASK, 3u);          /* SYSCLK = PLL */
-    assert_int_equal(rcc->CFGR & RCC_CFGR_HPRE_MASK, 0u);        /* HCLK = SYSCLK in the end */
+    assert_int_equal(rcc->CFGR & RCC_CFGR_SW_MASK, 3u);   /* SYSCLK = PLL */
+    assert_int_equal(rcc->CFGR & RCC_CFGR_HPRE_MASK, 0u); /* HCLK = SYSCLK in the end */
     assert_int_equal(rcc->CFGR & (RCC_CFGR_PPRE1_MASK | RCC_CFGR_PPRE2_MASK), 0u);
     assert_int_equal(stm32g4_fake.flash.ACR & FLASH_ACR_LATENCY_MASK, 4u); /* 4 wait states at 170 MHz */
     assert_true(stm32g4_fake.flash.ACR & FLASH_ACR_PRFTEN);
@@ -307,7 +307,7 @@ static void test_clock_init_timeout_and_config(void **state)
     hardware_responds = false; /* the PLL never locks */
     stm32g4_fake.rcc.CR = RCC_CR_HSION | RCC_CR_HSIRDY;
     assert_int_equal(pmstep_stm32g4_clock_init(&board.clock), PMSTEP_STM32G4_ERR_CLOCK_TIMEOUT);
-    assert_true(hook_calls >= 1000000u); /* it waited, boundedly */
+    assert_true(hook_calls >= 1000000u);                            /* it waited, boundedly */
     assert_int_equal(stm32g4_fake.rcc.CFGR & RCC_CFGR_SW_MASK, 1u); /* never switched to a dead PLL */
     assert_int_equal(pmstep_stm32g4_clock_init(&too_fast), PMSTEP_STM32G4_ERR_CLOCK_CONFIG);
     assert_int_equal(pmstep_stm32g4_clock_init(NULL), PMSTEP_STM32G4_ERR_NULL_ARGUMENT);
@@ -320,29 +320,29 @@ static void test_pwm_init(void **state)
     (void)state;
     assert_int_equal(pmstep_stm32g4_pwm_init(&board, 170000000u), PMSTEP_STM32G4_OK);
     assert_true(stm32g4_fake.rcc.APB2ENR & RCC_APB2ENR_TIM1EN);
-    assert_int_equal(tim->CR1 & TIM_CR1_CEN, 0u);                   /* not running yet */
-    assert_int_equal(tim->CR1 & (3u << 5), TIM_CR1_CMS_CENTER1);    /* centre-aligned */
+    assert_int_equal(tim->CR1 & TIM_CR1_CEN, 0u);                /* not running yet */
+    assert_int_equal(tim->CR1 & (3u << 5), TIM_CR1_CMS_CENTER1); /* centre-aligned */
     assert_true(tim->CR1 & TIM_CR1_ARPE);
     assert_int_equal(tim->PSC, 0u);
-    assert_int_equal(tim->ARR, ARR_20KHZ);                          /* 20 kHz at 170 MHz */
-    assert_int_equal(tim->RCR, 1u);                                 /* one update per period */
-    assert_int_equal(tim->CCMR1, pwm1 | (pwm1 << 8));               /* CH1, CH2 PWM mode 1, preload */
-    assert_int_equal(tim->CCMR2, pwm1 | (pwm1 << 8));               /* CH3, CH4 */
-    assert_int_equal(tim->CCMR3, (7u << 4) | (1u << 3));            /* CH5 PWM mode 2: trigger at peak */
-    assert_int_equal(tim->CCR5, ARR_20KHZ - 1u);                    /* reached on the up slope */
-    assert_int_equal(tim->CCR1, ARR_20KHZ / 2u);                    /* 0 V until the first step */
+    assert_int_equal(tim->ARR, ARR_20KHZ);               /* 20 kHz at 170 MHz */
+    assert_int_equal(tim->RCR, 1u);                      /* one update per period */
+    assert_int_equal(tim->CCMR1, pwm1 | (pwm1 << 8));    /* CH1, CH2 PWM mode 1, preload */
+    assert_int_equal(tim->CCMR2, pwm1 | (pwm1 << 8));    /* CH3, CH4 */
+    assert_int_equal(tim->CCMR3, (7u << 4) | (1u << 3)); /* CH5 PWM mode 2: trigger at peak */
+    assert_int_equal(tim->CCR5, ARR_20KHZ - 1u);         /* reached on the up slope */
+    assert_int_equal(tim->CCR1, ARR_20KHZ / 2u);         /* 0 V until the first step */
     assert_int_equal(tim->CCR4, ARR_20KHZ / 2u);
-    assert_int_equal(tim->CCER, 0x5555u | TIM_CCER_CC5E);           /* CHx and CHxN of 1..4, active high */
+    assert_int_equal(tim->CCER, 0x5555u | TIM_CCER_CC5E);                     /* CHx and CHxN of 1..4, active high */
     assert_int_equal((tim->CR2 & TIM_CR2_MMS2_MASK) >> TIM_CR2_MMS2_POS, 8u); /* TRGO2 = OC5REFC */
-    assert_int_equal(tim->CR2 & 0xFF00u, 0u);                       /* idle levels: all off */
-    assert_int_equal(tim->BDTR & TIM_BDTR_DTG_MASK, 85u);           /* 500 ns */
+    assert_int_equal(tim->CR2 & 0xFF00u, 0u);                                 /* idle levels: all off */
+    assert_int_equal(tim->BDTR & TIM_BDTR_DTG_MASK, 85u);                     /* 500 ns */
     assert_true(tim->BDTR & TIM_BDTR_BKE);
-    assert_int_equal(tim->BDTR & TIM_BDTR_BKP, 0u);                 /* break active low */
+    assert_int_equal(tim->BDTR & TIM_BDTR_BKP, 0u); /* break active low */
     assert_true(tim->BDTR & TIM_BDTR_OSSI);
     assert_true(tim->BDTR & TIM_BDTR_OSSR);
-    assert_int_equal(tim->BDTR & TIM_BDTR_MOE, 0u);                 /* bridge off */
+    assert_int_equal(tim->BDTR & TIM_BDTR_MOE, 0u); /* bridge off */
     assert_int_equal(tim->BDTR & TIM_BDTR_AOE, 0u);
-    assert_int_equal((tim->BDTR >> 16) & 0xFu, 4u);                 /* break filter */
+    assert_int_equal((tim->BDTR >> 16) & 0xFu, 4u); /* break filter */
     assert_true(tim->AF1 & TIM_AF1_BKINE);
     assert_true(tim->DIER & TIM_DIER_BIE);
     assert_true(tim->EGR & TIM_EGR_UG);
@@ -411,7 +411,7 @@ static void test_gpio_init(void **state)
     assert_true(enable_pin_reset_last());                                 /* driver off */
     assert_int_equal((gpioc->MODER >> (2u * 6u)) & 3u, GPIO_MODE_INPUT);  /* PC6 fault */
     assert_int_equal((gpioc->PUPDR >> (2u * 6u)) & 3u, GPIO_PULL_UP);
-    assert_int_equal((gpioa->MODER >> (2u * 13u)) & 3u, 2u);              /* SWD pins untouched */
+    assert_int_equal((gpioa->MODER >> (2u * 13u)) & 3u, 2u); /* SWD pins untouched */
     board.fault_pin.pin = 16u;
     assert_int_equal(pmstep_stm32g4_gpio_init(&board), PMSTEP_STM32G4_ERR_PIN);
 }
@@ -567,12 +567,22 @@ typedef struct {
 } pin_signals_t;
 
 static const pin_signals_t g431rb_signals[] = {
-    {0u, 0u, " ADC1_IN1 ADC2_IN1 "},  {0u, 1u, " ADC1_IN2 ADC2_IN2 "},   {0u, 2u, " ADC1_IN3 LPUART1_TX "},
-    {0u, 3u, " ADC1_IN4 LPUART1_RX "}, {0u, 6u, " ADC2_IN3 TIM1_BKIN "},  {0u, 7u, " ADC2_IN4 TIM1_CH1N "},
-    {0u, 8u, " TIM1_CH1 "},            {0u, 9u, " TIM1_CH2 "},            {0u, 10u, " TIM1_CH3 "},
-    {0u, 11u, " TIM1_CH1N TIM1_CH4 "}, {1u, 0u, " ADC1_IN15 TIM1_CH2N "}, {1u, 1u, " ADC1_IN12 TIM1_CH3N "},
-    {2u, 0u, " ADC1_IN6 ADC2_IN6 TIM1_CH1 LPUART1_RX "},                  {2u, 5u, " ADC2_IN11 TIM1_CH4N "},
-    {1u, 5u, " "},                     {2u, 6u, " "},
+    {0u, 0u, " ADC1_IN1 ADC2_IN1 "},
+    {0u, 1u, " ADC1_IN2 ADC2_IN2 "},
+    {0u, 2u, " ADC1_IN3 LPUART1_TX "},
+    {0u, 3u, " ADC1_IN4 LPUART1_RX "},
+    {0u, 6u, " ADC2_IN3 TIM1_BKIN "},
+    {0u, 7u, " ADC2_IN4 TIM1_CH1N "},
+    {0u, 8u, " TIM1_CH1 "},
+    {0u, 9u, " TIM1_CH2 "},
+    {0u, 10u, " TIM1_CH3 "},
+    {0u, 11u, " TIM1_CH1N TIM1_CH4 "},
+    {1u, 0u, " ADC1_IN15 TIM1_CH2N "},
+    {1u, 1u, " ADC1_IN12 TIM1_CH3N "},
+    {2u, 0u, " ADC1_IN6 ADC2_IN6 TIM1_CH1 LPUART1_RX "},
+    {2u, 5u, " ADC2_IN11 TIM1_CH4N "},
+    {1u, 5u, " "},
+    {2u, 6u, " "},
 };
 
 static bool pin_can_carry(const pmstep_stm32g4_pin_use_t *u)
@@ -717,7 +727,7 @@ static void test_lpuart(void **state)
     /* 256 x 170 MHz / 115200 = 377777.8 -> 377778; limits 3x..4096x the baud rate (RM0440 §38.4). */
     assert_int_equal(pmstep_stm32g4_lpuart_brr(170000000u, 115200u), 377778u);
     assert_int_equal(pmstep_stm32g4_lpuart_brr(170000000u, 921600u), 47222u);
-    assert_int_equal(pmstep_stm32g4_lpuart_brr(170000000u, 9600u), 0u);    /* f_ck > 4096 x baud */
+    assert_int_equal(pmstep_stm32g4_lpuart_brr(170000000u, 9600u), 0u);     /* f_ck > 4096 x baud */
     assert_int_equal(pmstep_stm32g4_lpuart_brr(170000000u, 60000000u), 0u); /* f_ck < 3 x baud */
     assert_int_equal(pmstep_stm32g4_lpuart_brr(170000000u, 0u), 0u);
     assert_int_equal(pmstep_stm32g4_lpuart_init(&board, 170000000u), PMSTEP_STM32G4_OK);

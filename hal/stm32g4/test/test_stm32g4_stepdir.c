@@ -26,13 +26,13 @@
 #define SYSCLK_HZ 170000000u
 /* 100 ns at 170 MHz: the default shortest STEP pulse, and the filter the port picks for it. */
 #define PULSE_100NS_TICKS 17u
-#define FILTER_CODE_100NS 4u   /* f_DTS / 2, N = 6 */
-#define FILTER_SPAN_100NS 12u  /* 6 samples 2 clocks apart */
+#define FILTER_CODE_100NS 4u  /* f_DTS / 2, N = 6 */
+#define FILTER_SPAN_100NS 12u /* 6 samples 2 clocks apart */
 
 static pmstep_stm32g4_config_t board;
 static pmstep_config_t motor_config;
 static pmstep_t motor;
-static pmstep_stepdir_t tracker;   /* the core's step count, fed by the control interrupt */
+static pmstep_stepdir_t tracker; /* the core's step count, fed by the control interrupt */
 static unsigned hook_periods;
 
 static void count_steps(const pmstep_output_t *out)
@@ -49,9 +49,9 @@ static int setup(void **state)
     stm32g4_model_flash_erase_all();
     board = pmstep_stm32g4_default_config();
     board.step_input.enabled = true;
-    motor_config = pmstep_console_app_config(pmstep_stm32g4_period_s(&board), 1u,
-                                             pmstep_stm32g4_current_sense_range_A(&board),
-                                             pmstep_stm32g4_bus_sense_range_V(&board));
+    motor_config =
+        pmstep_console_app_config(pmstep_stm32g4_period_s(&board), 1u, pmstep_stm32g4_current_sense_range_A(&board),
+                                  pmstep_stm32g4_bus_sense_range_V(&board));
     assert_int_equal(pmstep_init(&motor, &motor_config), PMSTEP_OK);
     pmstep_stm32g4_set_after_step(NULL);
     hook_periods = 0u;
@@ -135,7 +135,8 @@ static void test_filter_from_min_pulse(void **state)
     /* Every pulse length from 3 clocks up: the chosen span plus the margin fits in it, and the next
      * code's would not. */
     for (k = 0u; k < 16u; ++k) {
-        assert_true(k == 0u || pmstep_stm32g4_step_filter_ticks(k) > pmstep_stm32g4_step_filter_ticks((uint8_t)(k - 1u)));
+        assert_true(k == 0u
+                    || pmstep_stm32g4_step_filter_ticks(k) > pmstep_stm32g4_step_filter_ticks((uint8_t)(k - 1u)));
     }
     {
         uint32_t ns;
@@ -199,8 +200,7 @@ static void test_high_rate_across_wrap(void **state)
         pmstep_stepdir_config_t sdc;
         assert_int_equal(pmstep_stepdir_design(&motor_config, board.step_input.microsteps, &sdc), PMSTEP_OK);
         assert_int_equal(pmstep_stepdir_init(&tracker, &sdc, motor_config.motor.pole_pairs,
-                                             pmstep_stm32g4_period_s(&board),
-                                             (uint16_t)pmstep_stm32g4_step_counter()),
+                                             pmstep_stm32g4_period_s(&board), (uint16_t)pmstep_stm32g4_step_counter()),
                          PMSTEP_OK);
     }
     pmstep_stm32g4_set_after_step(count_steps);

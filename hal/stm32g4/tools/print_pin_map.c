@@ -36,7 +36,10 @@ int main(void)
             snprintf(mode, sizeof mode, "analog");
         } else if (map[k].signal[0] == 'G') {
             /* "GPIO input", "GPIO output", "GPIO open drain" */
-            snprintf(mode, sizeof mode, "%s", map[k].signal[5] == 'i' ? "input" : map[k].signal[6] == 'u' ? "output" : "open drain");
+            snprintf(mode, sizeof mode, "%s",
+                     map[k].signal[5] == 'i'   ? "input"
+                     : map[k].signal[6] == 'u' ? "output"
+                                               : "open drain");
         } else {
             snprintf(mode, sizeof mode, "AF%u", (unsigned)map[k].pin.af);
         }

@@ -28,11 +28,11 @@ typedef enum { SIL_SENSOR_OK = 0, SIL_SENSOR_OPEN = 1, SIL_SENSOR_STUCK = 2 } si
 
 /** [faults] of a scenario. */
 typedef struct {
-    sil_phases_t open_phase;      /**< faults.open_phase: none | a | b | both */
-    double open_phase_time_s;     /**< faults.open_phase_time_s */
-    sil_sensor_fault_t sensor;    /**< faults.sensor: none | open | stuck */
-    sil_phases_t sensor_phase;    /**< faults.sensor_phase: a | b | both */
-    double sensor_time_s;         /**< faults.sensor_time_s */
+    sil_phases_t open_phase;   /**< faults.open_phase: none | a | b | both */
+    double open_phase_time_s;  /**< faults.open_phase_time_s */
+    sil_sensor_fault_t sensor; /**< faults.sensor: none | open | stuck */
+    sil_phases_t sensor_phase; /**< faults.sensor_phase: a | b | both */
+    double sensor_time_s;      /**< faults.sensor_time_s */
 } sil_fault_config_t;
 
 /** Whether @p set takes phase a (@p phase 0) or b (1). */

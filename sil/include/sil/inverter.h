@@ -70,14 +70,14 @@ extern "C" {
 #endif
 
 typedef enum {
-    SIL_INVERTER_AVERAGED = 0,   /**< duty times bus, dead time as a mean voltage error */
-    SIL_INVERTER_SWITCHING = 1   /**< switching edges within the period */
+    SIL_INVERTER_AVERAGED = 0, /**< duty times bus, dead time as a mean voltage error */
+    SIL_INVERTER_SWITCHING = 1 /**< switching edges within the period */
 } sil_inverter_model_t;
 
 /** [inverter] of a scenario. */
 typedef struct {
     sil_inverter_model_t model;
-    double dead_time_s;           /**< per half-bridge (>= 0, < period/4) */
+    double dead_time_s; /**< per half-bridge (>= 0, < period/4) */
 } sil_inverter_config_t;
 
 /** [bus] of a scenario (the nominal V0 is run.bus_voltage_V). */
@@ -90,23 +90,23 @@ typedef struct {
 typedef struct {
     sil_inverter_config_t cfg;
     sil_bus_config_t bus;
-    double nominal_bus_voltage_V;  /**< V0 */
-    unsigned delay_periods;        /**< 0 or 1 */
+    double nominal_bus_voltage_V; /**< V0 */
+    unsigned delay_periods;       /**< 0 or 1 */
     /* MCU side: the last step's command, waiting for the next period (delay 1). */
-    double pending_a_V;            /**< clipped to +/- pending_bus_V */
+    double pending_a_V; /**< clipped to +/- pending_bus_V */
     double pending_b_V;
-    double pending_bus_V;          /**< measured bus the step was given */
+    double pending_bus_V; /**< measured bus the step was given */
     bool pending_clipped;
     /* The bridge over the coming period. */
     bool bridge_enable;
-    double command_a_V;            /**< clipped command; the duty is command / command_bus_V */
+    double command_a_V; /**< clipped command; the duty is command / command_bus_V */
     double command_b_V;
     double command_bus_V;
     /* What the plant received over the last period (set by sil_drive_advance). */
-    double applied_a_V;            /**< mean phase voltage (before the advance: the command) */
+    double applied_a_V; /**< mean phase voltage (before the advance: the command) */
     double applied_b_V;
-    double mean_current_A[2];      /**< mean current of phase a [0] and b [1] (A) */
-    double min_current_A[2];       /**< extremes of the phase currents at the substep ends, start included (A) */
+    double mean_current_A[2]; /**< mean current of phase a [0] and b [1] (A) */
+    double min_current_A[2];  /**< extremes of the phase currents at the substep ends, start included (A) */
     double max_current_A[2];
     double mean_bus_current_A;     /**< mean i_bus, which sets the sag of the next period */
     unsigned long limited_periods; /**< periods the MCU had to clip its duty to +/- 1 */

@@ -40,19 +40,19 @@ extern "C" {
 
 typedef struct {
     /* Settings (sil_microstep_init). */
-    double period_s;          /**< T_s */
-    double current_A;         /**< I: set-point amplitude per phase */
-    double resistance_Ohm;    /**< R the drive is told */
-    double inductance_H;      /**< L the drive is told */
-    double pole_pairs;        /**< p the drive is told (electrical per mechanical angle) */
-    double gain_per_s;        /**< a */
+    double period_s;       /**< T_s */
+    double current_A;      /**< I: set-point amplitude per phase */
+    double resistance_Ohm; /**< R the drive is told */
+    double inductance_H;   /**< L the drive is told */
+    double pole_pairs;     /**< p the drive is told (electrical per mechanical angle) */
+    double gain_per_s;     /**< a */
     /* State: the reference at the present sample t_k. */
-    double speed_ref_rad_s;   /**< omega*(t_k), mechanical */
-    double target_rad_s;      /**< where the ramp goes */
-    double ramp_rate_rad_s2;  /**< its slope (> 0; <= 0: a step) */
-    double angle_ref_rad;     /**< theta_e*(t_k), electrical, unwrapped */
-    bool moving;              /**< a speed command or an angle has been given: the hold is over */
-    bool angle_mode;          /**< following an angle (sil_microstep_set_angle()), not a speed profile */
+    double speed_ref_rad_s;  /**< omega*(t_k), mechanical */
+    double target_rad_s;     /**< where the ramp goes */
+    double ramp_rate_rad_s2; /**< its slope (> 0; <= 0: a step) */
+    double angle_ref_rad;    /**< theta_e*(t_k), electrical, unwrapped */
+    bool moving;             /**< a speed command or an angle has been given: the hold is over */
+    bool angle_mode;         /**< following an angle (sil_microstep_set_angle()), not a speed profile */
 } sil_microstep_t;
 
 /** Settings from @p sc (T_s, datasheet.rated_current_A, controller.motor R, L, p); reference 0. */

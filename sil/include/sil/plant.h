@@ -26,18 +26,18 @@ extern "C" {
 
 /** Physical motor parameters (SI). */
 typedef struct {
-    double resistance_Ohm;          /**< R */
-    double inductance_H;            /**< L */
-    double inertia_kgm2;           /**< J */
-    double friction_Nms_rad;   /**< F */
-    double torque_constant_Nm_A;/**< k_M */
-    int pole_pairs;                 /**< p */
-    double detent_torque_Nm;        /**< T_d >= 0: detent torque amplitude, -T_d sin 4 p theta (0 = none) */
+    double resistance_Ohm;       /**< R */
+    double inductance_H;         /**< L */
+    double inertia_kgm2;         /**< J */
+    double friction_Nms_rad;     /**< F */
+    double torque_constant_Nm_A; /**< k_M */
+    int pole_pairs;              /**< p */
+    double detent_torque_Nm;     /**< T_d >= 0: detent torque amplitude, -T_d sin 4 p theta (0 = none) */
     /* A hard stop (plant_stop_torque()): a one-sided spring and damper the rotor meets at stop_position_rad. */
-    int stop_side;                  /**< 0: none; +1: it blocks motion above stop_position_rad; -1: below */
-    double stop_position_rad;       /**< where the rotor meets it (mechanical rad, the plant's theta) */
-    double stop_stiffness_Nm_rad;   /**< k_s > 0: its torque per rad pressed into it */
-    double stop_damping_Nms_rad;    /**< c_s >= 0: its damping while in contact */
+    int stop_side;                /**< 0: none; +1: it blocks motion above stop_position_rad; -1: below */
+    double stop_position_rad;     /**< where the rotor meets it (mechanical rad, the plant's theta) */
+    double stop_stiffness_Nm_rad; /**< k_s > 0: its torque per rad pressed into it */
+    double stop_damping_Nms_rad;  /**< c_s >= 0: its damping while in contact */
 } plant_params_t;
 
 /**
@@ -49,11 +49,11 @@ double plant_stop_torque(const plant_params_t *params, double theta_rad, double 
 
 /** Load torque T_L(t, omega). */
 typedef enum {
-    PLANT_LOAD_NONE = 0,        /**< T_L = 0 */
-    PLANT_LOAD_CONSTANT = 1,    /**< T_L = torque_Nm */
-    PLANT_LOAD_STEP = 2,        /**< T_L = torque_Nm for t >= step_time_s, else 0 */
-    PLANT_LOAD_PROPORTIONAL = 3,/**< T_L = coefficient * omega (viscous load) */
-    PLANT_LOAD_TABLE = 4        /**< piecewise linear in t through the points, held outside */
+    PLANT_LOAD_NONE = 0,         /**< T_L = 0 */
+    PLANT_LOAD_CONSTANT = 1,     /**< T_L = torque_Nm */
+    PLANT_LOAD_STEP = 2,         /**< T_L = torque_Nm for t >= step_time_s, else 0 */
+    PLANT_LOAD_PROPORTIONAL = 3, /**< T_L = coefficient * omega (viscous load) */
+    PLANT_LOAD_TABLE = 4         /**< piecewise linear in t through the points, held outside */
 } plant_load_kind_t;
 
 #define PLANT_LOAD_TABLE_MAX 32
@@ -64,7 +64,7 @@ typedef struct {
     double step_time_s;
     double coefficient_Nms_rad;
     int table_points;
-    double table_time_s[PLANT_LOAD_TABLE_MAX];   /**< strictly increasing */
+    double table_time_s[PLANT_LOAD_TABLE_MAX]; /**< strictly increasing */
     double table_torque_Nm[PLANT_LOAD_TABLE_MAX];
 } plant_load_t;
 
@@ -97,16 +97,13 @@ typedef struct {
  * error whatever the step; what remains is the error of the back-EMF and torque coupling,
  * which vary at the electrical speed p omega and the electromechanical frequency.
  */
-typedef enum {
-    PLANT_INTEGRATOR_RK4 = 0,
-    PLANT_INTEGRATOR_EXPONENTIAL = 1
-} plant_integrator_t;
+typedef enum { PLANT_INTEGRATOR_RK4 = 0, PLANT_INTEGRATOR_EXPONENTIAL = 1 } plant_integrator_t;
 
 /** Weights of one component in one step of the exponential integrator (plant.c). */
 typedef struct {
-    double decay_half, decay;        /**< e^{z/2}, e^{z} */
-    double half;                     /**< (h/2) phi_1(z/2) */
-    double w_start, w_mid, w_end;    /**< h (phi_1 - 3 phi_2 + 4 phi_3), h (phi_2 - 2 phi_3), h (4 phi_3 - phi_2) */
+    double decay_half, decay;     /**< e^{z/2}, e^{z} */
+    double half;                  /**< (h/2) phi_1(z/2) */
+    double w_start, w_mid, w_end; /**< h (phi_1 - 3 phi_2 + 4 phi_3), h (phi_2 - 2 phi_3), h (4 phi_3 - phi_2) */
 } plant_etd_weights_t;
 
 typedef struct {
@@ -141,8 +138,8 @@ plant_params_t plant_paper_params(void);
 double plant_load_torque(const plant_load_t *load, double t_s, double omega_rad_s);
 
 /** Right-hand side of (1). */
-void plant_derivative(const plant_params_t *params, const plant_load_t *load, double t_s,
-                      const plant_state_t *x, double u_a_V, double u_b_V, plant_state_t *dx);
+void plant_derivative(const plant_params_t *params, const plant_load_t *load, double t_s, const plant_state_t *x,
+                      double u_a_V, double u_b_V, plant_state_t *dx);
 
 /**
  * sin(p theta) and cos(p theta) of the present state: one sincos for a base angle, and

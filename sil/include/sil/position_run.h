@@ -21,18 +21,18 @@ extern "C" {
 typedef struct {
     const sil_scenario_t *sc;
     double pole_pairs;
-    int next_move;            /**< next move to issue */
+    int next_move; /**< next move to issue */
     bool origin_set;
-    double origin_rad;        /**< plant theta of the c-alignment equilibrium RUN began at */
-    bool in_move;             /**< a move has been issued */
-    double move_start_rad;    /**< true position when the present move was issued */
+    double origin_rad;     /**< plant theta of the c-alignment equilibrium RUN began at */
+    bool in_move;          /**< a move has been issued */
+    double move_start_rad; /**< true position when the present move was issued */
     double move_target_rad;
-    double move_overshoot_rad;/**< largest travel beyond the target so far */
-    double last_error_rad;    /**< |theta - target| at the last sample (mechanical) */
-    double last_theta_rad;    /**< true position at the last sample */
+    double move_overshoot_rad; /**< largest travel beyond the target so far */
+    double last_error_rad;     /**< |theta - target| at the last sample (mechanical) */
+    double last_theta_rad;     /**< true position at the last sample */
     bool last_moving;
     double final_error_sum;
-    long hold_n;              /**< least-squares sums of the hold window */
+    long hold_n; /**< least-squares sums of the hold window */
     double hold_st, hold_sy, hold_stt, hold_sty;
 } sil_position_run_t;
 

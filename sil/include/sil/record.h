@@ -40,7 +40,8 @@ extern "C" {
  * then the entries in order.
  */
 #define SIL_RECORD_MAGIC 0x52534D50u /* "PMSR" */
-#define SIL_RECORD_VERSION 16u /* 2: calibration, commissioning, angle, detection; 3: voltage bias; 4: residual;
+#define SIL_RECORD_VERSION \
+    16u /* 2: calibration, commissioning, angle, detection; 3: voltage bias; 4: residual;
                                  5: identification of J and F; 6: phase-voltage sensing; 7: standstill hold;
                                  8: low-speed drive; 9: the compensation's ripple dead zone;
                                  10: detent torque, current integral gain, detent fade;
@@ -55,18 +56,36 @@ extern "C" {
 
 /** Word order of a period's input (pmstep_meas_t). */
 enum {
-    SIL_RECORD_IN_I_A = 0, SIL_RECORD_IN_I_B, SIL_RECORD_IN_BUS, SIL_RECORD_IN_LOAD,
-    SIL_RECORD_IN_U_A, SIL_RECORD_IN_U_B,
+    SIL_RECORD_IN_I_A = 0,
+    SIL_RECORD_IN_I_B,
+    SIL_RECORD_IN_BUS,
+    SIL_RECORD_IN_LOAD,
+    SIL_RECORD_IN_U_A,
+    SIL_RECORD_IN_U_B,
     SIL_RECORD_IN_WORDS
 };
 
 /** Word order of a period's output (pmstep_output_t); integers and bools as integers. */
 enum {
-    SIL_RECORD_OUT_U_A = 0, SIL_RECORD_OUT_U_B, SIL_RECORD_OUT_BRIDGE_ENABLE, SIL_RECORD_OUT_VOLTAGE_LIMITED,
-    SIL_RECORD_OUT_MODE, SIL_RECORD_OUT_FAULT, SIL_RECORD_OUT_FAULT_STEP,
-    SIL_RECORD_OUT_COS_HAT, SIL_RECORD_OUT_SIN_HAT, SIL_RECORD_OUT_SPEED_HAT, SIL_RECORD_OUT_LOAD_HAT,
-    SIL_RECORD_OUT_I_A_HAT, SIL_RECORD_OUT_I_B_HAT, SIL_RECORD_OUT_SPEED_REF, SIL_RECORD_OUT_SPEED_REF_DOT,
-    SIL_RECORD_OUT_I_D, SIL_RECORD_OUT_I_Q, SIL_RECORD_OUT_I_D_REF, SIL_RECORD_OUT_I_Q_REF,
+    SIL_RECORD_OUT_U_A = 0,
+    SIL_RECORD_OUT_U_B,
+    SIL_RECORD_OUT_BRIDGE_ENABLE,
+    SIL_RECORD_OUT_VOLTAGE_LIMITED,
+    SIL_RECORD_OUT_MODE,
+    SIL_RECORD_OUT_FAULT,
+    SIL_RECORD_OUT_FAULT_STEP,
+    SIL_RECORD_OUT_COS_HAT,
+    SIL_RECORD_OUT_SIN_HAT,
+    SIL_RECORD_OUT_SPEED_HAT,
+    SIL_RECORD_OUT_LOAD_HAT,
+    SIL_RECORD_OUT_I_A_HAT,
+    SIL_RECORD_OUT_I_B_HAT,
+    SIL_RECORD_OUT_SPEED_REF,
+    SIL_RECORD_OUT_SPEED_REF_DOT,
+    SIL_RECORD_OUT_I_D,
+    SIL_RECORD_OUT_I_Q,
+    SIL_RECORD_OUT_I_D_REF,
+    SIL_RECORD_OUT_I_Q_REF,
     SIL_RECORD_OUT_WORDS
 };
 
@@ -74,7 +93,8 @@ enum {
 #define SIL_RECORD_HEADER_WORDS (5u + SIL_RECORD_CONFIG_WORDS + 1u)
 #define SIL_RECORD_PERIOD_WORDS ((uint32_t)SIL_RECORD_IN_WORDS + (uint32_t)SIL_RECORD_OUT_WORDS)
 /** Longest run of words read or written at once. */
-#define SIL_RECORD_MAX_WORDS (SIL_RECORD_HEADER_WORDS > 1u + SIL_RECORD_PERIOD_WORDS ? SIL_RECORD_HEADER_WORDS : 1u + SIL_RECORD_PERIOD_WORDS)
+#define SIL_RECORD_MAX_WORDS \
+    (SIL_RECORD_HEADER_WORDS > 1u + SIL_RECORD_PERIOD_WORDS ? SIL_RECORD_HEADER_WORDS : 1u + SIL_RECORD_PERIOD_WORDS)
 
 static inline uint32_t sil_record_le32(const unsigned char *b)
 {

@@ -43,8 +43,8 @@ int sil_run(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user, bool 
  * stream; NULL records nothing; microstep mode records nothing: there is no core). @return 0, -1 when pmstep_init rejected the
  * configuration, -2 when writing the record failed, -3 as sil_run().
  */
-int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user, bool progress,
-                   sil_summary_t *summary, FILE *record);
+int sil_run_record(const sil_scenario_t *sc, sil_sample_fn on_sample, void *user, bool progress, sil_summary_t *summary,
+                   FILE *record);
 
 #ifdef __cplusplus
 }

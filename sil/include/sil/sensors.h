@@ -30,22 +30,22 @@ extern "C" {
 
 /** [sensors] of a scenario. */
 typedef struct {
-    unsigned adc_bits;             /**< 0 = ideal (no quantisation, no clipping), else 8..16 */
-    double current_full_scale_A;   /**< bipolar span +/- this (A) */
-    double offset_a_A;             /**< current-sensor offset, phase a (A) */
+    unsigned adc_bits;           /**< 0 = ideal (no quantisation, no clipping), else 8..16 */
+    double current_full_scale_A; /**< bipolar span +/- this (A) */
+    double offset_a_A;           /**< current-sensor offset, phase a (A) */
     double offset_b_A;
-    double gain_error_a;           /**< relative gain error, phase a (0.01 = reads 1 % high) */
+    double gain_error_a; /**< relative gain error, phase a (0.01 = reads 1 % high) */
     double gain_error_b;
-    double noise_rms_A;            /**< Gaussian noise per phase per sample (A rms) */
-    double bus_full_scale_V;       /**< unipolar span [0, this] (V) */
-    double bus_noise_rms_V;        /**< Gaussian noise on the bus sample (V rms) */
-    unsigned phase_voltage_bits;        /**< 0 = no quantisation, else 8..16 */
-    double phase_voltage_full_scale_V;  /**< phase-voltage span +/- this (V) */
-    double phase_voltage_offset_a_V;    /**< phase-voltage sensor offset, phase a (V) */
+    double noise_rms_A;                /**< Gaussian noise per phase per sample (A rms) */
+    double bus_full_scale_V;           /**< unipolar span [0, this] (V) */
+    double bus_noise_rms_V;            /**< Gaussian noise on the bus sample (V rms) */
+    unsigned phase_voltage_bits;       /**< 0 = no quantisation, else 8..16 */
+    double phase_voltage_full_scale_V; /**< phase-voltage span +/- this (V) */
+    double phase_voltage_offset_a_V;   /**< phase-voltage sensor offset, phase a (V) */
     double phase_voltage_offset_b_V;
-    double phase_voltage_gain_error_a;  /**< relative gain error, phase a */
+    double phase_voltage_gain_error_a; /**< relative gain error, phase a */
     double phase_voltage_gain_error_b;
-    double phase_voltage_noise_rms_V;   /**< Gaussian noise per phase per sample (V rms) */
+    double phase_voltage_noise_rms_V; /**< Gaussian noise per phase per sample (V rms) */
 } sil_sensor_config_t;
 
 typedef struct {
@@ -95,8 +95,7 @@ double sil_sensors_bus(sil_sensors_t *s, double bus_V);
 
 /** Samples both phase voltages (V): what the sensor reports for the mean voltages @p u_a_V,
  *  @p u_b_V of the period just ended. */
-void sil_sensors_phase_voltages(sil_sensors_t *s, double u_a_V, double u_b_V, double *u_a_meas_V,
-                                double *u_b_meas_V);
+void sil_sensors_phase_voltages(sil_sensors_t *s, double u_a_V, double u_b_V, double *u_a_meas_V, double *u_b_meas_V);
 
 /**
  * Mid-tread ADC over [@p low, @p high] with 2^@p bits codes of width q = (high - low)/2^bits;

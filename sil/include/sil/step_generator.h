@@ -50,11 +50,11 @@ typedef struct {
 
 /** One planned move. */
 typedef struct {
-    double start_s;             /**< its start: its point's time, or the end of the move before if later */
-    double end_s;               /**< at rest on the target from here on */
-    double from_rad;            /**< where it starts (the previous target; 0 for the first) */
-    double to_rad;              /**< its target */
-    double peak_speed_rad_s;    /**< |speed| of the cruise (or the peak when there is none) */
+    double start_s;          /**< its start: its point's time, or the end of the move before if later */
+    double end_s;            /**< at rest on the target from here on */
+    double from_rad;         /**< where it starts (the previous target; 0 for the first) */
+    double to_rad;           /**< its target */
+    double peak_speed_rad_s; /**< |speed| of the cruise (or the peak when there is none) */
     int segments;
     sil_step_segment_t segment[SIL_STEP_SEGMENTS_MAX];
 } sil_step_move_t;
@@ -64,7 +64,7 @@ typedef struct {
     double position_rad; /**< theta_cmd, mechanical rad from the count's origin */
     double speed_rad_s;
     double accel_rad_s2;
-    bool moving;         /**< inside a move (between its start and its end) */
+    bool moving; /**< inside a move (between its start and its end) */
 } sil_step_sample_t;
 
 /** The planned moves and where sampling has got to. */

@@ -42,26 +42,25 @@ extern "C" {
 
 typedef struct {
     const sil_scenario_t *sc;
-    bool firmware;                 /**< the pmstep drive (else the microstep baseline) */
-    sil_step_generator_t gen;      /**< the motion controller's plan */
-    pmstep_stepdir_t input;        /**< the firmware's STEP/DIR input (firmware only) */
-    double pole_pairs;             /**< the plant's p */
-    double full_step_rad;          /**< pi / (2 p), mechanical */
-    sil_step_sample_t command;     /**< the generator at the present period's t_k */
-    int32_t count;                 /**< its count, microsteps */
-    bool following;                /**< the drive has begun following the count */
+    bool firmware;             /**< the pmstep drive (else the microstep baseline) */
+    sil_step_generator_t gen;  /**< the motion controller's plan */
+    pmstep_stepdir_t input;    /**< the firmware's STEP/DIR input (firmware only) */
+    double pole_pairs;         /**< the plant's p */
+    double full_step_rad;      /**< pi / (2 p), mechanical */
+    sil_step_sample_t command; /**< the generator at the present period's t_k */
+    int32_t count;             /**< its count, microsteps */
+    bool following;            /**< the drive has begun following the count */
     bool origin_set;
-    double origin_rad;             /**< the plant's theta at the equilibrium count 0 is measured from */
-    double sum_sq_all;             /**< sums of the error's square (full steps^2) since following began */
-    double sum_sq_moving;          /**< the same while a move runs */
+    double origin_rad;    /**< the plant's theta at the equilibrium count 0 is measured from */
+    double sum_sq_all;    /**< sums of the error's square (full steps^2) since following began */
+    double sum_sq_moving; /**< the same while a move runs */
     long n_all, n_moving;
-    bool diag;                     /**< DIAG after the present period */
+    bool diag; /**< DIAG after the present period */
 } sil_stepdir_run_t;
 
 /** Plans the moves and, for the firmware (@p firmware), designs and initialises its STEP/DIR input.
  *  @return PMSTEP_OK, or the status pmstep_stepdir_design()/pmstep_stepdir_init() refused with. */
-pmstep_status_t sil_stepdir_run_init(sil_stepdir_run_t *run, const sil_scenario_t *sc, bool firmware,
-                                     sil_summary_t *s);
+pmstep_status_t sil_stepdir_run_init(sil_stepdir_run_t *run, const sil_scenario_t *sc, bool firmware, sil_summary_t *s);
 
 /** Before the period's step: the generator at @p t_s; the firmware begins following (@p pos) or the
  *  baseline takes the count's angle (@p drive) when due. The other pointer is NULL. */

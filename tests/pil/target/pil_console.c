@@ -119,7 +119,7 @@ static void flush_uart(void)
 
 static struct {
     FILE *file;
-    long cut_after;    /* operations left before the power cut; 0: none planned */
+    long cut_after; /* operations left before the power cut; 0: none planned */
 } flash;
 
 static int32_t flash_io(uint32_t slot, uint32_t offset, void *data, uint32_t n, bool write)
@@ -323,7 +323,8 @@ static void write_cost(FILE *f, double insns_per_tick, long periods)
             const double steps = (double)cost->steps[m];
             const double insns =
                 ((double)cost->step_ticks[m] - (double)cost->empty_ticks[m]) * insns_per_tick / steps + 1.0;
-            fprintf(f, "mode %s steps %lu step_ticks %llu empty_ticks %llu instructions_mean %.2f stack_max_bytes %lu\n",
+            fprintf(f,
+                    "mode %s steps %lu step_ticks %llu empty_ticks %llu instructions_mean %.2f stack_max_bytes %lu\n",
                     mode_names[m], (unsigned long)cost->steps[m], (unsigned long long)cost->step_ticks[m],
                     (unsigned long long)cost->empty_ticks[m], insns, (unsigned long)cost->stack_max_bytes[m]);
         }

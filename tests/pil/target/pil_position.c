@@ -185,8 +185,8 @@ int main(int argc, char **argv)
         plant.time_s = t_s;
         if (stepdir_mode) {
             /* the edges put out by t_k: the counter the port reads after this period's step */
-            count = sil_step_generator_count(&step_generator,
-                                             sil_step_generator_sample(&step_generator, t_s).position_rad);
+            count =
+                sil_step_generator_count(&step_generator, sil_step_generator_sample(&step_generator, t_s).position_rad);
             counter = (uint32_t)(uint16_t)(SIL_STEPDIR_COUNTER_START + (uint32_t)count);
             if (!following && position.out.tracked) {
                 following = pmstep_position_follow_steps(&position, &stepdir) == PMSTEP_OK;
@@ -202,7 +202,7 @@ int main(int argc, char **argv)
         meas.load_torque_Nm = 0.0f;
         meas.phase_voltage_a_V = (float)inv.applied_a_V; /* the mean voltage of the period just ended */
         meas.phase_voltage_b_V = (float)inv.applied_b_V;
-        mps2_pil_control_period(&meas, &out);      /* pmstep_step() in the control interrupt */
+        mps2_pil_control_period(&meas, &out); /* pmstep_step() in the control interrupt */
         if (stepdir_mode) {
             diag_periods += after_step(&out, counter, &pos_out) ? 1 : 0;
         } else {
@@ -236,7 +236,8 @@ int main(int argc, char **argv)
     } else {
         const double target_rad = (double)move_target_rad[MOVES - 1];
         printf("pil-position: %ld periods, fault %s, final position %.6f rad (target %.6f), error %.3g "
-               "electrical rad\n", steps, pmstep_fault_str(out.fault), plant.x.theta_rad - origin_rad, target_rad,
+               "electrical rad\n",
+               steps, pmstep_fault_str(out.fault), plant.x.theta_rad - origin_rad, target_rad,
                fabs(plant.x.theta_rad - origin_rad - target_rad) * (double)sc.motor.pole_pairs);
     }
     return out.fault != PMSTEP_FAULT_NONE ? 3 : 0;

@@ -21,15 +21,17 @@ extern "C" {
 #endif
 
 #define PIL_OUTPUT_MAGIC 0x4F534D50u /* "PMSO" */
-#define PIL_OUTPUT_END 0xFFFFFFFFu   /* cannot start a period: word 0 is u_a's bits, never all-ones (a NaN) from the core */
+#define PIL_OUTPUT_END \
+    0xFFFFFFFFu /* cannot start a period: word 0 is u_a's bits, never all-ones (a NaN) from the core */
 
 /** Names of the output words, for reports. */
 static inline const char *pil_output_word_name(unsigned k)
 {
     static const char *const names[SIL_RECORD_OUT_WORDS] = {
-        "u_a_V", "u_b_V", "bridge_enable", "voltage_limited", "mode", "fault", "fault_step",
-        "cos_hat", "sin_hat", "speed_hat_rad_s", "load_hat_Nm", "i_a_hat_A", "i_b_hat_A",
-        "speed_ref_rad_s", "speed_ref_rate_rad_s2", "i_d_A", "i_q_A", "i_d_ref_A", "i_q_ref_A"};
+        "u_a_V",       "u_b_V",      "bridge_enable", "voltage_limited", "mode",
+        "fault",       "fault_step", "cos_hat",       "sin_hat",         "speed_hat_rad_s",
+        "load_hat_Nm", "i_a_hat_A",  "i_b_hat_A",     "speed_ref_rad_s", "speed_ref_rate_rad_s2",
+        "i_d_A",       "i_q_A",      "i_d_ref_A",     "i_q_ref_A"};
     return k < (unsigned)SIL_RECORD_OUT_WORDS ? names[k] : "?";
 }
 

@@ -36,8 +36,10 @@ static void write_cost(FILE *f, double insns_per_tick, unsigned long periods)
         if (cost->steps[m] > 0u) {
             /* step bracket minus empty bracket, plus the empty function's one instruction (BX LR) */
             const double n = (double)cost->steps[m];
-            const double insns = ((double)cost->step_ticks[m] - (double)cost->empty_ticks[m]) * insns_per_tick / n + 1.0;
-            fprintf(f, "mode %s steps %lu step_ticks %llu empty_ticks %llu instructions_mean %.2f stack_max_bytes %lu\n",
+            const double insns =
+                ((double)cost->step_ticks[m] - (double)cost->empty_ticks[m]) * insns_per_tick / n + 1.0;
+            fprintf(f,
+                    "mode %s steps %lu step_ticks %llu empty_ticks %llu instructions_mean %.2f stack_max_bytes %lu\n",
                     mode_names[m], (unsigned long)cost->steps[m], (unsigned long long)cost->step_ticks[m],
                     (unsigned long long)cost->empty_ticks[m], insns, (unsigned long)cost->stack_max_bytes[m]);
         }

@@ -26,12 +26,14 @@ void pil_write_summary(FILE *f, const char *target, const sil_summary_t *s, doub
     fprintf(f, "  \"final_load_abs_error_Nm\": %.17g,\n", s->final_load_error_Nm);
     fprintf(f, "  \"angle_estimate\": {\n    \"max_abs_cos_error\": %.17g,\n    \"max_abs_sin_error\": %.17g\n  },\n",
             s->max_cos_error, s->max_sin_error);
-    fprintf(f, "  \"max_abs_phase_voltage_V\": %.17g,\n  \"max_abs_phase_current_a\": %.17g,\n",
-            s->max_phase_voltage_V, s->max_phase_current_A);
+    fprintf(f, "  \"max_abs_phase_voltage_V\": %.17g,\n  \"max_abs_phase_current_a\": %.17g,\n", s->max_phase_voltage_V,
+            s->max_phase_current_A);
     fprintf(f, "  \"voltage_limited_periods\": %ld,\n  \"inverter_clipped_periods\": %ld,\n",
             s->voltage_limited_periods, s->inverter_limited_periods);
     fprintf(f, "  \"final_mode\": \"%s\",\n", pmstep_mode_str(s->final_mode));
-    fprintf(f, "  \"fault\": {\n    \"code\": %d,\n    \"text\": \"%s\",\n    \"step\": %ld,\n    \"time_s\": %.17g\n  },\n",
-            (int)s->fault, pmstep_fault_str(s->fault), s->fault_step, s->fault_time_s);
+    fprintf(
+        f,
+        "  \"fault\": {\n    \"code\": %d,\n    \"text\": \"%s\",\n    \"step\": %ld,\n    \"time_s\": %.17g\n  },\n",
+        (int)s->fault, pmstep_fault_str(s->fault), s->fault_step, s->fault_time_s);
     fprintf(f, "  \"timing\": {\n    \"steps\": %ld\n  }\n}\n", s->steps);
 }

@@ -121,8 +121,7 @@ pmstep_status_t pmstep_design_check_datasheet(const pmstep_design_input_t *in);
  *                                         pmstep_design_check_datasheet(), unless accept_implausible
  * @retval other                           the designed configuration fails pmstep_validate_config()
  */
-pmstep_status_t pmstep_design(const pmstep_design_input_t *in, pmstep_config_t *cfg,
-                              pmstep_design_report_t *report);
+pmstep_status_t pmstep_design(const pmstep_design_input_t *in, pmstep_config_t *cfg, pmstep_design_report_t *report);
 
 #ifdef __cplusplus
 }
