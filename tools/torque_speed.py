@@ -26,6 +26,10 @@ The largest held load by bisection on [0, LOAD_BOUND x the datasheet holding tor
 end: ITERATIONS halvings (resolution LOAD_BOUND T_H / 2^n). Copper loss at it: 2 R I_rms^2 (two phases, the
 preset's R, the summary's per-phase RMS current over the hold, the load at its full value).
 
+A second grid (not with --quick): at MICROSTEP_FRACTIONS (25, 50, 75, 100 %) of microstepping's own top speed on
+the first grid (the highest speed there at which it holds a load), pmstep and microstepping again, and their
+ratio; a preset and bus where microstepping holds no load at any speed of the first grid has no second grid.
+
 --check exits 1 when a case could not be evaluated (the SIL failed or gave no summary) or pmstep misses its
 targets: it holds less than microstepping where microstepping holds a load, or less than TOP_TORQUE_SHARE of
 the holding torque up to CHECK_TOP_FRACTION x the design's top speed. A drive that holds not even no load
@@ -60,6 +64,10 @@ SPEED_FRACTIONS = [0.01, 0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 2.5]
 QUICK_FRACTIONS = [0.25, 1.5]
 # pmstep as designed (field weakening on), pmstep with it off, open-loop microstepping at rated current
 DRIVES = ["pmstep", "pmstep-no-fw", "microstep"]
+# The second grid: fractions of microstepping's own top speed (the highest speed of the first grid at which it
+# holds a load), where pmstep and microstepping are compared again.
+MICROSTEP_FRACTIONS = [0.25, 0.5, 0.75, 1.0]
+MICROSTEP_GRID_DRIVES = ["pmstep", "microstep"]
 DRIVE_LABELS = {"pmstep": "pmstep", "pmstep-no-fw": "pmstep without field weakening", "microstep": "microstepping"}
 # The share of the holding torque a top speed keeps (PMSTEP_DESIGN_WEAKENED_TORQUE_SHARE); --check wants pmstep
 # to hold it up to CHECK_TOP_FRACTION x the design's top speed (field weakening's target).
@@ -138,7 +146,8 @@ def one_run(args, case, drive, torque, out_dir):
 
 def search(args, case, drive):
     """The largest load @p drive holds in @p case, with the figures of the run at it."""
-    out_dir = os.path.join(args.out, f"{case['motor']}_{case['bus']:g}V_{case['fraction']:g}_{drive}")
+    grid = f"ms{case['microstep_fraction']:g}" if "microstep_fraction" in case else f"{case['fraction']:g}"
+    out_dir = os.path.join(args.out, f"{case['motor']}_{case['bus']:g}V_{grid}_{drive}")
     runs = {}
 
     def held(torque):
@@ -160,6 +169,8 @@ def search(args, case, drive):
         "failed_Nm": None,
         "failed_why": [],
     }
+    if "microstep_fraction" in case:
+        row["microstep_fraction"] = case["microstep_fraction"]
     try:
         lo, hi = bisect(held, 0.0, row["bound_Nm"], args.iterations)
     except (RuntimeError, KeyError, ValueError) as e:
@@ -215,6 +226,46 @@ def cases(args):
     return out, refused
 
 
+def microstep_cases(all_cases, rows):
+    """The second grid's cases: per preset and bus of @p all_cases, MICROSTEP_FRACTIONS of microstepping's top speed
+    on the first grid (top_speeds() of @p rows: the highest speed at which it holds a load), each case carrying
+    "microstep_fraction"; none where microstepping holds no load at any speed."""
+    tops = {(m, b): drives.get("microstep", (None, None))[1] for m, b, _, drives in top_speeds(rows)}
+    out = []
+    for c in all_cases:
+        ms_top = tops.get((c["motor"], c["bus"]))
+        if ms_top is None or c["fraction"] != max(x["fraction"] for x in all_cases if x["scenario"] == c["scenario"]):
+            continue  # one set of cases per preset and bus (from its last first-grid case)
+        for f in MICROSTEP_FRACTIONS:
+            fraction = f * ms_top / c["top_rad_s"]
+            case = dict(c, fraction=fraction, microstep_fraction=f)
+            case["timeline"] = timeline(c["preset"], c["top_rad_s"], c["run_start"], fraction)
+            out.append(case)
+    return out
+
+
+def microstep_ratio_table(rows):
+    """Markdown: per preset and bus, microstepping's top speed and, at each of MICROSTEP_FRACTIONS of it, the two
+    drives' largest held loads and their ratio (rows of the second grid, which carry "microstep_fraction")."""
+    by = {}
+    for r in rows:
+        key = (r["motor"], r["bus_V"])
+        by.setdefault(key, {}).setdefault(r["microstep_fraction"], {})[r["drive"]] = r
+    head = ["motor", "bus V", "microstepping top rad/s"] + [
+        f"{f * 100:.0f} %: pmstep / microstepping N m (ratio)" for f in MICROSTEP_FRACTIONS
+    ]
+    out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for (motor, bus), fractions in by.items():
+        top = next(iter(fractions[MICROSTEP_FRACTIONS[-1]].values()))["speed_rad_s"]
+        cells = [motor, f"{bus:g}", f"{top:.1f}"]
+        for f in MICROSTEP_FRACTIONS:
+            pm, ms = fractions.get(f, {}).get("pmstep"), fractions.get(f, {}).get("microstep")
+            x = ratio(pm and pm["held_Nm"], ms and ms["held_Nm"])
+            cells.append(f"{_newton_metres(pm)} / {_newton_metres(ms)} ({'-' if x is None else f'{x:.2f}'})")
+        out.append("| " + " | ".join(cells) + " |")
+    return "\n".join(out)
+
+
 def ratio(pm, ms):
     """pmstep's largest held load over microstepping's (None without both, or microstepping's 0)."""
     if pm is None or ms is None or ms <= 0.0:
@@ -242,6 +293,15 @@ def _load(r):
         return "none"
     t = f"{r['held_Nm']:.3f}"
     return ("≥ " if r["failed_Nm"] is None else "") + t + f" ({r['held_fraction']:.2f})"
+
+
+def _newton_metres(r):
+    """A row's largest held load in N m ("≥" at the bracket's top), "none" or "n/a"."""
+    if r is None or r["error"]:
+        return "n/a"
+    if r["held_Nm"] is None:
+        return "none"
+    return ("≥ " if r["failed_Nm"] is None else "") + f"{r['held_Nm']:.3f}"
 
 
 def _loss(r):
@@ -450,7 +510,7 @@ WHAT = (
 )
 
 
-def report_text(rows, refused, args, argv, pictures):
+def report_text(rows, refused, args, argv, pictures, ms_rows=()):
     what = WHAT + (
         f" {args.iterations} halvings: resolution {LOAD_BOUND:g} T_H / {2**args.iterations} = "
         f"{LOAD_BOUND / 2**args.iterations * 100:.2g} % of T_H."
@@ -468,6 +528,19 @@ def report_text(rows, refused, args, argv, pictures):
         top_speed_table(rows),
         "",
     ]
+    if ms_rows:
+        lines += [
+            "## Against microstepping's own top speed\n\nAt "
+            + ", ".join(f"{f * 100:.0f}" for f in MICROSTEP_FRACTIONS)
+            + " % of microstepping's top speed (the highest speed of the grid above at which it holds a load), "
+            "the largest load each drive holds (N m) and the ratio pmstep / microstepping; a preset and bus "
+            "where microstepping holds no load on that grid has no row.",
+            "",
+            microstep_ratio_table(ms_rows),
+            "",
+            summary(ms_rows),
+            "",
+        ]
     if limits(rows):
         lines += limits(rows) + [""]
     for motor, picture in pictures:
@@ -510,33 +583,43 @@ def main(argv=None):
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
         futures = [pool.submit(search, args, c, d) for c in all_cases for d in DRIVES]
         rows = [f.result() for f in futures]
+        ms_rows = []
+        if not args.quick:
+            ms_futures = [
+                pool.submit(search, args, c, d) for c in microstep_cases(all_cases, rows) for d in MICROSTEP_GRID_DRIVES
+            ]
+            ms_rows = [f.result() for f in ms_futures]
     print(table(rows, refused, False))
     print(
         f"torque_speed: load N m (x datasheet holding torque), resolution {LOAD_BOUND:g} T_H / "
         f"{2**args.iterations}; Cu W: 2 R I_rms^2 at the largest held load"
     )
     print("torque_speed: " + summary(rows))
+    if ms_rows:
+        print(microstep_ratio_table(ms_rows))
+        print("torque_speed: at fractions of microstepping's top speed: " + summary(ms_rows))
     for line in limits(rows):
         print("torque_speed: " + line[2:])
-    bad = unevaluated(rows)
+    bad = unevaluated(rows + ms_rows)
     for b in bad:
         print("torque_speed: not evaluated: " + b)
-    short = shortfalls(rows)
+    short = shortfalls(rows) + shortfalls(ms_rows)
     for b in short:
         print("torque_speed: short: " + b)
     if args.json:
         with open(args.json, "w") as f:
-            json.dump({"cases": rows, "no_design": refused}, f, indent=1)
+            json.dump({"cases": rows, "microstep_grid": ms_rows, "no_design": refused}, f, indent=1)
     if args.report:
         pictures = []
         stem = os.path.splitext(args.report)[0]
         for motor in dict.fromkeys(r["motor"] for r in rows):
-            path = plot(rows, motor, f"{stem}-{motor}.png")
+            path = plot(rows + ms_rows, motor, f"{stem}-{motor}.png")
             if path:
                 pictures.append((motor, os.path.basename(path)))
         if not pictures:
             print("torque_speed: matplotlib not installed, no plots", file=sys.stderr)
-        print(f"torque_speed: wrote {report.write(args.report, report_text(rows, refused, args, argv, pictures))}")
+        text = report_text(rows, refused, args, argv, pictures, ms_rows)
+        print(f"torque_speed: wrote {report.write(args.report, text)}")
     return 1 if (bad or short) and args.check else 0
 
 

@@ -815,6 +815,54 @@ class TorqueSpeed(ReportCase):
         self.assertIn("- 17hs4401 24 V, 0.75 × top, microstep: holds no load (fault OVERCURRENT)", text)
         self.assertIn("- pmstep, first failure above the largest held load: fault OVERCURRENT in 1", text)
 
+    def test_microstep_grid(self):
+        """The second grid at fractions of microstepping's own top speed: the cases from the first grid's rows,
+        none where microstepping holds no load; the table of the two drives and their ratio."""
+        motor = {"rated_A": 1.7, "k_M": 0.16638, "J": 5.4e-6, "R": 1.5, "p": 50, "holding_Nm": 0.4}
+        first = [
+            {
+                "motor": m,
+                "bus": 24.0,
+                "fraction": f,
+                "preset": motor,
+                "scenario": m + ".ini",
+                "top_rad_s": 69.0,
+                "run_start": 0.25,
+                "timeline": torque_speed.timeline(motor, 69.0, 0.25, f),
+            }
+            for m in ("17hs4401", "paper")
+            for f in (0.25, 1.25)
+        ]
+        rows = [
+            self.row("17hs4401", 24.0, 0.25, "microstep", 0.225, 0.2625),
+            self.row("17hs4401", 24.0, 1.25, "microstep", 0.05, 0.0625),
+            self.row("paper", 24.0, 0.25, "microstep", None, 0.0),
+            self.row("paper", 24.0, 1.25, "microstep", None, 0.0),
+        ]
+        cases = torque_speed.microstep_cases(first, rows)
+        self.assertEqual([c["microstep_fraction"] for c in cases], torque_speed.MICROSTEP_FRACTIONS)
+        self.assertEqual({c["motor"] for c in cases}, {"17hs4401"})
+        # microstepping's top is 1.25 x 69 rad/s: its quarter is 0.3125 x the design's top
+        self.assertAlmostEqual(cases[0]["fraction"], 0.3125)
+        self.assertAlmostEqual(cases[-1]["timeline"]["v"], 86.25)
+        ms_rows = []
+        for f, pm, ms in ((0.25, 0.5, 0.25), (0.5, 0.45, 0.15), (0.75, 0.3, None), (1.0, 0.2, 0.05)):
+            for drive, held in (("pmstep", pm), ("microstep", ms)):
+                r = self.row("17hs4401", 24.0, 1.25 * f, drive, held, None if held == 0.5 else 0.6)
+                r["microstep_fraction"] = f
+                ms_rows.append(r)
+        table = torque_speed.microstep_ratio_table(ms_rows)
+        self.assertIn(
+            "| 17hs4401 | 24 | 86.2 | ≥ 0.500 / 0.250 (2.00) | 0.450 / 0.150 (3.00) | 0.300 / none (-) "
+            "| 0.200 / 0.050 (4.00) |",
+            table,
+        )
+        args = argparse.Namespace(iterations=7)
+        text = torque_speed.report_text(rows, [], args, ["tools/torque_speed.py"], [], ms_rows)
+        self.assert_tables(text)
+        self.assertIn("## Against microstepping's own top speed", text)
+        self.assertIn("2.00–4.00 over 3 cases; pmstep holds less than microstepping in 0 of them", text)
+
 
 if __name__ == "__main__":
     unittest.main()
