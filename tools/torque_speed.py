@@ -603,7 +603,7 @@ def main(argv=None):
     bad = unevaluated(rows + ms_rows)
     for b in bad:
         print("torque_speed: not evaluated: " + b)
-    short = shortfalls(rows) + shortfalls(ms_rows)
+    short = list(dict.fromkeys(shortfalls(rows) + shortfalls(ms_rows)))  # a speed both grids have, once
     for b in short:
         print("torque_speed: short: " + b)
     if args.json:
