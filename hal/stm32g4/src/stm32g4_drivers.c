@@ -1,11 +1,13 @@
 /*
- * Register drivers of the STM32G431 port: clock tree, GPIO, TIM1 PWM, ADC1/ADC2.
+ * Register drivers of the STM32G431 port: clock tree, TIM1 PWM, the STEP/DIR input, ADC1/ADC2,
+ * LPUART1 (the pins: stm32g4_gpio.c).
  * Every wait on the hardware is bounded and returns a timeout status.
  * Register and bit references: stm32g4_regs.h (RM0440 Rev 8).
  */
 #include <stddef.h>
 
 #include "pmstep_hal_stm32g4.h"
+#include "stm32g4_gpio.h"
 #include "stm32g4_regs.h"
 
 /* Iterations of a wait loop before giving up: far above any documented delay. */
@@ -98,89 +100,6 @@ pmstep_stm32g4_status_t pmstep_stm32g4_clock_init(const pmstep_stm32g4_clock_t *
     delay_cycles(200u);
     rcc->CFGR = (rcc->CFGR & ~(RCC_CFGR_HPRE_MASK | RCC_CFGR_PPRE1_MASK | RCC_CFGR_PPRE2_MASK))
                 | (RCC_CFGR_HPRE_DIV1 << RCC_CFGR_HPRE_POS);
-    return PMSTEP_STM32G4_OK;
-}
-
-/* ---- GPIO: RM0440 §9.4 ---- */
-static bool pin_valid(const pmstep_stm32g4_pin_t *p)
-{
-    return p->port < STM32G4_GPIO_PORTS && p->pin < 16u && p->af < 16u;
-}
-
-/* A GPIO port's clock on: its registers take no write before (RM0440 §7.4.15). */
-static void port_clock_on(uint8_t port)
-{
-    STM32G4_RCC->AHB2ENR |= STM32G4_BIT(RCC_AHB2ENR_GPIOAEN_POS + port);
-    (void)STM32G4_RCC->AHB2ENR; /* the enable takes effect before the port is written */
-}
-
-/* The pin's mode (MODER last, so it takes its function with the rest already set), pull, output
- * type (§9.4.2 OTYPER: push-pull, or open drain) and alternate function. */
-static void pin_configure_type(const pmstep_stm32g4_pin_t *p, uint32_t mode, uint32_t pull, bool open_drain)
-{
-    stm32g4_gpio_t *gpio;
-    const uint32_t shift2 = 2u * p->pin;
-    port_clock_on(p->port);
-    gpio = STM32G4_GPIO(p->port);
-    if (mode == GPIO_MODE_AF) {
-        const uint32_t shift4 = 4u * (p->pin % 8u);
-        gpio->AFR[p->pin / 8u] = (gpio->AFR[p->pin / 8u] & ~(0xFu << shift4)) | ((uint32_t)p->af << shift4);
-        gpio->OSPEEDR = (gpio->OSPEEDR & ~(3u << shift2)) | (GPIO_SPEED_VERY_HIGH << shift2);
-    }
-    if (open_drain) {
-        gpio->OTYPER |= STM32G4_BIT(p->pin);
-    } else {
-        gpio->OTYPER &= ~STM32G4_BIT(p->pin);
-    }
-    gpio->PUPDR = (gpio->PUPDR & ~(3u << shift2)) | (pull << shift2);
-    gpio->MODER = (gpio->MODER & ~(3u << shift2)) | (mode << shift2);
-}
-
-static void pin_configure(const pmstep_stm32g4_pin_t *p, uint32_t mode, uint32_t pull)
-{
-    pin_configure_type(p, mode, pull, false);
-}
-
-/* Drives the enable pin to its inactive level (driver off). */
-static void enable_pin_off(const pmstep_stm32g4_config_t *cfg)
-{
-    stm32g4_gpio_t *const gpio = STM32G4_GPIO(cfg->enable_pin.port);
-    gpio->BSRR = cfg->enable_active_high ? STM32G4_BIT(16u + cfg->enable_pin.pin) : STM32G4_BIT(cfg->enable_pin.pin);
-}
-
-pmstep_stm32g4_status_t pmstep_stm32g4_gpio_init(const pmstep_stm32g4_config_t *cfg)
-{
-    unsigned k;
-    if (cfg == NULL) {
-        return PMSTEP_STM32G4_ERR_NULL_ARGUMENT;
-    }
-    for (k = 0; k < 4u; ++k) {
-        if (!pin_valid(&cfg->pwm_high[k]) || !pin_valid(&cfg->pwm_low[k])) {
-            return PMSTEP_STM32G4_ERR_PIN;
-        }
-    }
-    for (k = 0; k < 3u; ++k) {
-        if (!pin_valid(&cfg->adc_pins[k])) {
-            return PMSTEP_STM32G4_ERR_PIN;
-        }
-    }
-    if (!pin_valid(&cfg->break_input) || !pin_valid(&cfg->enable_pin) || !pin_valid(&cfg->fault_pin)) {
-        return PMSTEP_STM32G4_ERR_PIN;
-    }
-    /* Enable output first, at its off level, so the driver never sees a floating enable: the
-     * port's clock on, the off level in ODR, then the pin made an output. */
-    port_clock_on(cfg->enable_pin.port);
-    enable_pin_off(cfg);
-    pin_configure(&cfg->enable_pin, GPIO_MODE_OUTPUT, 0u);
-    pin_configure(&cfg->fault_pin, GPIO_MODE_INPUT, cfg->fault_active_high ? GPIO_PULL_DOWN : GPIO_PULL_UP);
-    for (k = 0; k < 4u; ++k) {
-        pin_configure(&cfg->pwm_high[k], GPIO_MODE_AF, GPIO_PULL_DOWN);
-        pin_configure(&cfg->pwm_low[k], GPIO_MODE_AF, GPIO_PULL_DOWN);
-    }
-    pin_configure(&cfg->break_input, GPIO_MODE_AF, cfg->break_active_high ? GPIO_PULL_DOWN : GPIO_PULL_UP);
-    for (k = 0; k < 3u; ++k) {
-        pin_configure(&cfg->adc_pins[k], GPIO_MODE_ANALOG, 0u);
-    }
     return PMSTEP_STM32G4_OK;
 }
 
@@ -305,8 +224,8 @@ pmstep_stm32g4_status_t pmstep_stm32g4_step_input_init(const pmstep_stm32g4_conf
     if (st != PMSTEP_STM32G4_OK) {
         return st;
     }
-    if (!pin_valid(&in->step_pin) || !pin_valid(&in->dir_pin) || !pin_valid(&in->enable_pin)
-        || !pin_valid(&in->diag_pin)) {
+    if (!stm32g4_pin_valid(&in->step_pin) || !stm32g4_pin_valid(&in->dir_pin) || !stm32g4_pin_valid(&in->enable_pin)
+        || !stm32g4_pin_valid(&in->diag_pin)) {
         return PMSTEP_STM32G4_ERR_PIN;
     }
     if (!tim4_channel_pin(&in->step_pin, 2u) || !tim4_channel_pin(&in->dir_pin, 1u)) {
@@ -314,16 +233,16 @@ pmstep_stm32g4_status_t pmstep_stm32g4_step_input_init(const pmstep_stm32g4_conf
     }
 
     /* EN: an input pulled to its disabled level, so an open line keeps the bridge off. */
-    pin_configure(&in->enable_pin, GPIO_MODE_INPUT, in->enable_active_high ? GPIO_PULL_DOWN : GPIO_PULL_UP);
+    stm32g4_pin_configure(&in->enable_pin, GPIO_MODE_INPUT, in->enable_active_high ? GPIO_PULL_DOWN : GPIO_PULL_UP);
     /* DIAG: deasserted in ODR first (active high: pulled low; active low: released), then an
      * open-drain output with the pin's pull-up (a line nobody else pulls reads high). */
-    port_clock_on(in->diag_pin.port);
+    stm32g4_port_clock_on(in->diag_pin.port);
     STM32G4_GPIO(in->diag_pin.port)->BSRR =
         in->diag_active_high ? STM32G4_BIT(16u + in->diag_pin.pin) : STM32G4_BIT(in->diag_pin.pin);
-    pin_configure_type(&in->diag_pin, GPIO_MODE_OUTPUT, GPIO_PULL_UP, true);
+    stm32g4_pin_configure_type(&in->diag_pin, GPIO_MODE_OUTPUT, GPIO_PULL_UP, true);
     /* STEP and DIR: TIM4's inputs, pulled down (an open STEP line counts nothing). */
-    pin_configure(&in->step_pin, GPIO_MODE_AF, GPIO_PULL_DOWN);
-    pin_configure(&in->dir_pin, GPIO_MODE_AF, GPIO_PULL_DOWN);
+    stm32g4_pin_configure(&in->step_pin, GPIO_MODE_AF, GPIO_PULL_DOWN);
+    stm32g4_pin_configure(&in->dir_pin, GPIO_MODE_AF, GPIO_PULL_DOWN);
 
     STM32G4_RCC->APB1ENR1 |= RCC_APB1ENR1_TIM4EN; /* §7.4.17; TIM4 runs at PCLK1 = SYSCLK */
     (void)STM32G4_RCC->APB1ENR1;
@@ -361,7 +280,7 @@ void pmstep_stm32g4_step_polarity(pmstep_stm32g4_config_t *cfg, bool enable_acti
         return;
     }
     /* As at set-up: EN pulled to its (new) disabled level, DIAG deasserted at its (new) level. */
-    pin_configure(&in->enable_pin, GPIO_MODE_INPUT, enable_active_high ? GPIO_PULL_DOWN : GPIO_PULL_UP);
+    stm32g4_pin_configure(&in->enable_pin, GPIO_MODE_INPUT, enable_active_high ? GPIO_PULL_DOWN : GPIO_PULL_UP);
     STM32G4_GPIO(in->diag_pin.port)->BSRR =
         diag_active_high ? STM32G4_BIT(16u + in->diag_pin.pin) : STM32G4_BIT(in->diag_pin.pin);
 }
@@ -478,7 +397,7 @@ pmstep_stm32g4_status_t pmstep_stm32g4_lpuart_init(const pmstep_stm32g4_config_t
     if (brr == 0u) {
         return PMSTEP_STM32G4_ERR_UART_CONFIG;
     }
-    if (!pin_valid(&cfg->console_tx) || !pin_valid(&cfg->console_rx)) {
+    if (!stm32g4_pin_valid(&cfg->console_tx) || !stm32g4_pin_valid(&cfg->console_rx)) {
         return PMSTEP_STM32G4_ERR_PIN;
     }
     STM32G4_RCC->CCIPR &= ~RCC_CCIPR_LPUART1SEL_MASK; /* kernel clock PCLK1 */
@@ -488,8 +407,8 @@ pmstep_stm32g4_status_t pmstep_stm32g4_lpuart_init(const pmstep_stm32g4_config_t
     u->PRESC = 0u;
     u->BRR = brr;
     u->CR1 = LPUART_CR1_UE | LPUART_CR1_RE | LPUART_CR1_TE;
-    pin_configure(&cfg->console_tx, GPIO_MODE_AF, 0u);
-    pin_configure(&cfg->console_rx, GPIO_MODE_AF, GPIO_PULL_UP); /* idle high when unconnected */
+    stm32g4_pin_configure(&cfg->console_tx, GPIO_MODE_AF, 0u);
+    stm32g4_pin_configure(&cfg->console_rx, GPIO_MODE_AF, GPIO_PULL_UP); /* idle high when unconnected */
     return PMSTEP_STM32G4_OK;
 }
 

@@ -122,6 +122,14 @@ bool stm32g4_model_flash_ok(uint32_t hclk_Hz);
 /** Dead time in TIM1 clock ticks of a DTG code (RM0440 §28.6.20, CKD = 0). */
 uint32_t stm32g4_model_dead_time_ticks(uint32_t dtg);
 
+/** TIM1 after software wrote its registers (stm32g4_model_sync() calls it): SR flags cleared by
+ *  writing 0, UG's update event, the break (stm32g4_model_tim1.c). */
+void stm32g4_model_tim1_sync(void);
+
+/** One TIM1 clock tick (stm32g4_model_run() gives it each tick): the break, the counter, OCxREF,
+ *  the outputs with their dead time, TRGO2. */
+void stm32g4_model_tim1_tick(void);
+
 /** Queues @p n bytes for LPUART1's receiver (RXNE while any is left); the transmitter takes every
  *  byte at once (TXE always set) into uart_tx. Line timing is not modelled. */
 void stm32g4_model_uart_send(const uint8_t *data, uint32_t n);
