@@ -20,6 +20,9 @@ then runs pmstep-sil:
   tools/envelope.py --sil build/host-release/sil/pmstep-sil --tune build/host-release/sil/pmstep-tune \\
       --out out/envelope [--report docs/reports/envelope.md]
 
+--top weakened scales every speed with the field-weakened top speed in place of the design's (the
+speed at which 30 % of the holding torque still fits in the bus with field weakening).
+
 --report FILE also writes the table as Markdown (command, commit, date; tools/report.py) and the
 plot beside it (FILE with .png for .md), shown in the report.
 """
@@ -77,6 +80,11 @@ def design(args, name, chain, out_dir):
     if r.returncode != 0:
         raise SystemExit("pmstep-tune failed: %s\n%s" % (" ".join(cmd), r.stderr))
     top = float(re.search(r"top speed: ([0-9.]+) rad/s", r.stdout).group(1))
+    if args.top == "weakened":
+        weakened = re.search(r"top speed with it ([0-9.]+) rad/s", r.stdout)
+        if weakened is None:
+            raise SystemExit("pmstep-tune printed no field-weakened top speed: %s" % " ".join(cmd))
+        top = float(weakened.group(1))
     t_c = float(re.search(r"t_c ([0-9.]+) s", r.stdout).group(1))
     start = t_c + (0.05 if robust else 0.0) + 0.1
     return ini, top, start, preset
@@ -337,6 +345,12 @@ def report_text(rows, args, argv, plot_name=None):
         "or a loss of synchronism (bisection, %d steps). Microstepping: the SIL's open-loop baseline at rated "
         "current." % (args.duration, HOLD_S, SETTLE_S, STEP_POSITIONS, BISECTION_STEPS)
     )
+    if getattr(args, "top", "design") == "weakened":
+        what += (
+            " The top speed here is the field-weakened one (pmstep-tune's 'top speed with it': 30 % of the "
+            "holding torque in the bus with i_d* at its most negative, at most the control rate's 0.4 rad a "
+            "period), not the design's i_d = 0 one of envelope.md: every speed above scales with it."
+        )
     if args.set:
         what += " Every run after the design with " + ", ".join("`--set %s`" % item for item in args.set) + "."
     # markdown()'s header has |w-w*| unescaped, which splits its cell in a Markdown table: escaped here,
@@ -392,6 +406,14 @@ def main():
         help="comma-separated: ideal, realistic, sensed (realistic with phase-voltage sensing)",
     )
     ap.add_argument("--duration", type=float, default=20.0, help="RUN time of the ramps run (s)")
+    ap.add_argument(
+        "--top",
+        choices=("design", "weakened"),
+        default="design",
+        help="the speed the profiles scale with: the design's top speed (rated current in the bus with i_d = 0), "
+        "or the field-weakened one (30 %% of the holding torque in the bus with i_d* = -I_w; pmstep-tune's "
+        "'top speed with it')",
+    )
     ap.add_argument(
         "--report",
         metavar="FILE",

@@ -9,6 +9,8 @@
 #   benchmarks           tools/bench_sil.py --runs 9            -> docs/reports/benchmarks.md
 #   envelope             tools/envelope.py, every preset, ideal and realistic chains, 20 s of ramps
 #                                                              -> docs/reports/envelope.md (+ envelope.png)
+#   envelope-weakened    tools/envelope.py --top weakened: the same at the field-weakened top speed
+#                                                              -> docs/reports/envelope-weakened.md (+ .png)
 #   position-acceptance  tools/position_acceptance.py, 50 moves, seed 1, 60 s hold, --write-scenarios
 #                                                              -> docs/reports/position-acceptance.md
 #   mc-presets           tools/monte_carlo.py --preset P --cases 200 --seed 1, P = paper, 17hs4401,
@@ -47,7 +49,7 @@
 set -uo pipefail
 cd "$(dirname "$0")/.."
 
-STEPS_ALL=(cost position-cost benchmarks envelope position-acceptance mc-presets mc-robust mc-position fault-injection
+STEPS_ALL=(cost position-cost benchmarks envelope envelope-weakened position-acceptance mc-presets mc-robust mc-position fault-injection
            motor-sweep self-commissioning step-dir homing torque-speed)
 MC_PRESETS=(paper 17hs4401 bj42d29 as1050)
 MC_POSITION=(17hs4401 bj42d29 as1050)
@@ -128,6 +130,10 @@ for step in "${STEPS[@]}"; do
       need_sil
       run envelope "$REPORTS/envelope.md" "$PYTHON" tools/envelope.py --sil "$SIL" --tune "$TUNE" --out "$OUT/envelope" \
         --report "$REPORTS/envelope.md" ;;
+    envelope-weakened)
+      need_sil
+      run envelope-weakened "$REPORTS/envelope-weakened.md" "$PYTHON" tools/envelope.py --sil "$SIL" --tune "$TUNE" \
+        --out "$OUT/envelope-weakened" --top weakened --report "$REPORTS/envelope-weakened.md" ;;
     position-acceptance)
       need_sil
       run position-acceptance "$REPORTS/position-acceptance.md" "$PYTHON" tools/position_acceptance.py --sil "$SIL" --tune "$TUNE" \

@@ -371,6 +371,9 @@ class Envelope(ReportCase):
         self.assertIn("`--set inverter.dead_time_s=0`", text)
         self.assertNotIn("](", envelope.report_text([self.ROW], args, argv, None))
         self.assertIn("max |w-w*|", envelope.markdown([self.ROW]))  # the tool's own table as it was
+        self.assertNotIn("field-weakened", text)
+        args.top = "weakened"
+        self.assertIn("The top speed here is the field-weakened one", envelope.report_text([self.ROW], args, argv))
 
 
 class PositionAcceptance(ReportCase):
