@@ -356,7 +356,13 @@ def report_text(rows, args, argv, plot_name=None):
     # markdown()'s header has |w-w*| unescaped, which splits its cell in a Markdown table: escaped here,
     # out/.../envelope.md and the printed table left as they are.
     lines = [
-        report.header("Operating envelope against open-loop microstepping", "tools/envelope.py", argv, what),
+        report.header(
+            "Operating envelope against open-loop microstepping"
+            + (" at the field-weakened top speed" if getattr(args, "top", "design") == "weakened" else ""),
+            "tools/envelope.py",
+            argv,
+            what,
+        ),
         markdown(rows).replace("max |w-w*|", "max \\|w-w*\\|", 1),
     ]
     if plot_name:
