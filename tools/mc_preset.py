@@ -176,15 +176,17 @@ def _design(tune, preset_path, chain_sets, low_speed_drive=False):
     return cmd
 
 
-def _run_designer(cmd):
-    """Runs pmstep-tune; returns the top speed (rad/s) it prints."""
+def _run_designer(cmd, weakened=False):
+    """Runs pmstep-tune; returns the top speed (rad/s) it prints: the design's (i_d = 0), or with
+    @p weakened the field-weakened one ("top speed with it")."""
     try:
         proc = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
     except (OSError, subprocess.TimeoutExpired) as e:
         raise ToolError(f"cannot run {cmd[0]}: {e}") from None
     if proc.returncode != 0:
         raise ToolError(f"{' '.join(cmd)} failed (status {proc.returncode}):\n{proc.stderr.strip()}")
-    top = re.search(r"top speed: ([0-9.eE+-]+) rad/s", proc.stdout)
+    pattern = r"top speed with it ([0-9.eE+-]+) rad/s" if weakened else r"top speed: ([0-9.eE+-]+) rad/s"
+    top = re.search(pattern, proc.stdout)
     if top is None:
         raise ToolError(f"cannot read the top speed from the output of {' '.join(cmd)}:\n{proc.stdout}")
     return float(top.group(1))
@@ -197,12 +199,12 @@ def _points_lines(points):
     return ",\n    ".join(rows)
 
 
-def paper_top_speed(tune):
+def paper_top_speed(tune, weakened=False):
     """The paper motor's top speed (rad/s; pmstep-tune --robust behind its realistic chain), which
-    the paper campaign's speed thresholds are relative to."""
+    the paper campaign's speed thresholds are relative to (@p weakened: its field-weakened one)."""
     paper_span = ADC_SPAN_RATED * read_preset(PAPER_PRESET)["rated_current_A"]
     paper_chain = list(REALISTIC_CHAIN) + [f"sensors.current_full_scale_A={paper_span:g}"]
-    return _run_designer(_design(tune, PAPER_PRESET, paper_chain))
+    return _run_designer(_design(tune, PAPER_PRESET, paper_chain), weakened)
 
 
 def loss_speed_error(top_speed_rad_s, paper_top_rad_s):
@@ -255,10 +257,25 @@ def scenario_info(tune, preset_path, scenario_path, phase_voltage_sensing=False,
     }
 
 
-def design_scenario(tune, preset_path, out_dir, phase_voltage_sensing=False, low_speed_drive=False):
+def _stretch(points, run_start, ratio):
+    """speed.points of the validation profile with every speed and every time from @p run_start on
+    scaled by @p ratio: the same accelerations, up to @p ratio times the speeds."""
+    out = []
+    for p in points:
+        t, v = (float(x) for x in p.split(":"))
+        if t > run_start:
+            t = run_start + (t - run_start) * ratio
+        out.append(f"{t:.9g}:{v * ratio:.9g}")
+    return out
+
+
+def design_scenario(tune, preset_path, out_dir, phase_voltage_sensing=False, low_speed_drive=False, weakened=False):
     """Designs the preset with pmstep-tune (robust mode, realistic chain) and writes the
     campaign's scenario to out_dir/preset_scenario.ini. Returns (its path, info) with info =
-    {"preset", "top_speed_rad_s", "run_start_s", "peak_speed_rad_s", "load_Nm", "tune_command", ...}."""
+    {"preset", "top_speed_rad_s", "run_start_s", "peak_speed_rad_s", "load_Nm", "tune_command", ...}.
+    With @p weakened the profile's speeds and its times in RUN are stretched by the field-weakened top
+    speed over the design's (the same ramps' accelerations up to +-80 % of the weakened top speed), and
+    the speed thresholds follow the weakened top speeds (the preset's and the paper motor's)."""
     preset = read_preset(preset_path)
     paper_holding = paper_holding_torque()
     chain = chain_sets(preset, phase_voltage_sensing)
@@ -268,13 +285,21 @@ def design_scenario(tune, preset_path, out_dir, phase_voltage_sensing=False, low
     ini = _ini(design_path)
     try:
         points = [p.strip() for p in ini.get("speed", "points").replace("\n", " ").split(",") if p.strip()]
-        peak = max(abs(float(p.split(":")[1])) for p in points)
         # RUN starts after the offset calibration and the two alignments (t_c counts from their start).
         run_start = float(ini.get("controller.commissioning", "offset_calibration_time_s", fallback="0")) + float(
             ini.get("controller.alignment", "c_align_time_s")
         )
+        if weakened:
+            ratio = _run_designer(cmd, True) / top
+            points = _stretch(points, run_start, ratio)
+            duration = float(ini.get("run", "duration_s"))
+            ini.set("run", "duration_s", repr(run_start + (duration - run_start) * ratio))
+            top, paper_top = top * ratio, paper_top_speed(tune, True)
+        peak = max(abs(float(p.split(":")[1])) for p in points)
     except (configparser.Error, ValueError, IndexError) as e:
-        raise ToolError(f"{design_path}: cannot read speed.points and the alignment times ({e})") from None
+        raise ToolError(
+            f"{design_path}: cannot read speed.points, the duration and the alignment times ({e})"
+        ) from None
     info = {
         "preset": preset["name"],
         "preset_file": preset_path,

@@ -199,6 +199,12 @@ def parse_args(argv):
         help="with --preset: the design turns the standstill hold's vector below 2 V_bus t_d / (T_s k_M) "
         "(pmstep-tune --low-speed-drive)",
     )
+    parser.add_argument(
+        "--weakened",
+        action="store_true",
+        help="with --preset alone: the profile stretched to the field-weakened top speed (pmstep-tune's 'top speed "
+        "with it'), the speed thresholds with it (mc_preset.design_scenario)",
+    )
     parser.add_argument("--out", required=True, help="output folder")
     parser.add_argument("--cases", type=int, default=100, help="number of cases N (default 100)")
     parser.add_argument("--seed", type=int, default=1, help="base seed S: case k has seed S*100000+k (default 1)")
@@ -305,6 +311,8 @@ def parse_args(argv):
         parser.error("--tune is for --preset")
     if args.low_speed_drive and args.preset is None:
         parser.error("--low-speed-drive is for --preset (a scenario file sets controller.standstill itself)")
+    if args.weakened and (args.preset is None or args.scenario is not None):
+        parser.error("--weakened is for --preset alone (the profile is the designer's)")
     if args.phase_voltage_sensing and args.preset is None:
         parser.error("--phase-voltage-sensing is for --preset (a scenario file sets the sensor itself)")
     if args.preset is not None and args.tune is None:
@@ -334,6 +342,7 @@ def parse_args(argv):
                 for flag, suffix in (
                     (args.phase_voltage_sensing, "-sensed"),
                     (args.low_speed_drive, "-low-speed-drive"),
+                    (args.weakened, "-weakened"),
                 )
                 if flag
             )
@@ -383,7 +392,7 @@ def use_preset(args):
         info = scenario_info(args.tune, args.preset, args.scenario, args.phase_voltage_sensing, args.low_speed_drive)
     else:
         args.scenario, info = design_scenario(
-            args.tune, args.preset, args.out, args.phase_voltage_sensing, args.low_speed_drive
+            args.tune, args.preset, args.out, args.phase_voltage_sensing, args.low_speed_drive, args.weakened
         )
     # In place, so every function's default table (the same list object) sees it.
     DISTRIBUTIONS[:] = preset_distributions(

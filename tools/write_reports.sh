@@ -15,6 +15,8 @@
 #                                                              -> docs/reports/position-acceptance.md
 #   mc-presets           tools/monte_carlo.py --preset P --cases 200 --seed 1, P = paper, 17hs4401,
 #                        bj42d29, as1050 (realistic chain)     -> docs/reports/monte-carlo.md, section P
+#   mc-weakened          tools/monte_carlo.py --preset P --weakened --cases 200 --seed 1: the same campaigns with
+#                        the profile up to the field-weakened top speed -> docs/reports/monte-carlo.md, "P-weakened"
 #   mc-robust            tools/monte_carlo.py --scenario sil/scenarios/robust.ini --cases 1000 --seed 1
 #                                                              -> docs/reports/monte-carlo.md, section "robust"
 #   mc-position          tools/monte_carlo.py --preset P --scenario (position-acceptance's P_realistic_run.ini)
@@ -49,7 +51,7 @@
 set -uo pipefail
 cd "$(dirname "$0")/.."
 
-STEPS_ALL=(cost position-cost benchmarks envelope envelope-weakened position-acceptance mc-presets mc-robust mc-position fault-injection
+STEPS_ALL=(cost position-cost benchmarks envelope envelope-weakened position-acceptance mc-presets mc-weakened mc-robust mc-position fault-injection
            motor-sweep self-commissioning step-dir homing torque-speed)
 MC_PRESETS=(paper 17hs4401 bj42d29 as1050)
 MC_POSITION=(17hs4401 bj42d29 as1050)
@@ -142,6 +144,11 @@ for step in "${STEPS[@]}"; do
       need_sil
       for p in "${MC_PRESETS[@]}"; do
         campaign "$p" "$OUT/mc_$p" --preset "sil/scenarios/motors/$p.ini" --cases 200 --seed 1
+      done ;;
+    mc-weakened)
+      need_sil
+      for p in "${MC_PRESETS[@]}"; do
+        campaign "$p-weakened" "$OUT/mc_$p-weakened" --preset "sil/scenarios/motors/$p.ini" --weakened --cases 200 --seed 1
       done ;;
     mc-robust)
       need_sil

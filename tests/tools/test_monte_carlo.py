@@ -8,10 +8,13 @@ Usage: python3 -m unittest -v test_monte_carlo     (from tests/tools/)
        python3 tests/tools/test_monte_carlo.py           (from anywhere)
 """
 
+import contextlib
+import io
 import textwrap
 import unittest
 
 import tools_path  # noqa: F401  (tools/ on the import path)
+import mc_preset
 import monte_carlo as mc
 
 
@@ -415,6 +418,21 @@ class FailureSegments(unittest.TestCase):
                 ["standstill, 1.000-1.300 s", {"detected": 0, "silent": 0, "out_of_spec": 2}],
             ],
         )
+
+
+class WeakenedProfile(unittest.TestCase):
+    def test_stretch_keeps_the_accelerations(self):
+        """Speeds and the times in RUN scaled by the same ratio; the points before RUN stay."""
+        points = ["0:0", "0.5:0", "0.6:55.2", "1.6:55.2", "1.7:-55.2"]
+        out = mc_preset._stretch(points, 0.5, 2.0)
+        self.assertEqual(out, ["0:0", "0.5:0", "0.7:110.4", "2.7:110.4", "2.9:-110.4"])
+        t = [float(p.split(":")[0]) for p in out]
+        v = [float(p.split(":")[1]) for p in out]
+        self.assertAlmostEqual((v[2] - v[1]) / (t[2] - t[1]), 55.2 / 0.1)
+
+    def test_weakened_is_for_a_preset_alone(self):
+        with contextlib.redirect_stderr(io.StringIO()), self.assertRaises(SystemExit):
+            mc.parse_args(["monte_carlo.py", "--sil", "x", "--scenario", "s.ini", "--weakened", "--out", "o"])
 
 
 if __name__ == "__main__":
