@@ -66,12 +66,14 @@ def read_preset(path):
     }
 
 
-def design(tune, motor_ini, ini_out, robust, sets):
+def design(tune, motor_ini, ini_out, robust, sets, weakened=False):
+    """The design's top speed (@p weakened: the field-weakened one), varpi_0 and k_theta."""
     cmd = [tune, "--motor", motor_ini, "--write-ini", ini_out] + (["--robust"] if robust else [])
     for s in sets:
         cmd += ["--set", s]
     out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
-    top = float(re.search(r"top speed: ([0-9.eE+-]+) rad/s", out).group(1))
+    pattern = r"top speed with it ([0-9.eE+-]+) rad/s" if weakened else r"top speed: ([0-9.eE+-]+) rad/s"
+    top = float(re.search(pattern, out).group(1))
     varpi = float(re.search(r"varpi_0 ([0-9.e+-]+) rad/s", out).group(1))
     k_theta = float(re.search(r"position loop: k_theta ([0-9.e+-]+)", out).group(1))
     return top, varpi, k_theta
@@ -128,7 +130,9 @@ def report_text(results, args, argv):
     """The report: the settings of @p args and one row per run of @p results (main()'s --json)."""
     what = (
         f"Per motor preset: the `pmstep-tune` design, {args.moves} random moves (seed {args.seed}, targets uniform "
-        f"in ±10 revolutions of where RUN starts, v_max = {args.speed_fraction:g} of the design's top speed, "
+        f"in ±10 revolutions of where RUN starts, v_max = {args.speed_fraction:g} of the design's "
+        + ("field-weakened " if getattr(args, "top", "design") == "weakened" else "")
+        + "top speed, "
         f"a_max = {args.accel_fraction:g} of k_M I / J, jerk a_max ϖ0; each move given its profile's time plus "
         f"{SETTLE_S:g} s). Ideal: the ideal measurement chain, the plant's detent torque on. Realistic: "
         "`pmstep-tune --robust` behind the presets' realistic chain (tools/mc_preset.py: 12-bit ADC over ±3 rated "
@@ -139,7 +143,13 @@ def report_text(results, args, argv):
         "electrical rad/s over the hold."
     )
     lines = [
-        report.header("Position control: acceptance", "tools/position_acceptance.py", argv, what),
+        report.header(
+            "Position control: acceptance"
+            + (" at the field-weakened top speed" if getattr(args, "top", "design") == "weakened" else ""),
+            "tools/position_acceptance.py",
+            argv,
+            what,
+        ),
         "| motor | chain | moves (unfinished) | final error max / mean | overshoot | estimate | θ* − θ | "
         "hold max, drift | simulated | fault | criteria |",
         "|---|---|---|---|---|---|---|---|---|---|---|",
@@ -183,6 +193,13 @@ def main():
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--hold-s", type=float, default=60.0)
     ap.add_argument("--speed-fraction", type=float, default=0.5, help="v_max as a fraction of the top speed")
+    ap.add_argument(
+        "--top",
+        choices=("design", "weakened"),
+        default="design",
+        help="the top speed v_max is a fraction of: the design's (i_d = 0) or the field-weakened one (pmstep-tune's "
+        "'top speed with it'); with weakened the speed-mode loss bound follows the weakened top speeds too",
+    )
     ap.add_argument("--accel-fraction", type=float, default=0.25, help="a_max as a fraction of k_M I / J")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "position_acceptance"))
     ap.add_argument("--check", action="store_true", help="exit 1 if a criterion fails")
@@ -213,7 +230,7 @@ def main():
             tune_sets = []
             if robust:
                 tune_sets = chain_sets({"rated_current_A": preset["rated_A"]})
-            top, varpi, k_theta = design(args.tune, motor_ini, base, robust, tune_sets)
+            top, varpi, k_theta = design(args.tune, motor_ini, base, robust, tune_sets, args.top == "weakened")
             v_max = args.speed_fraction * top
             a_max = args.accel_fraction * preset["k_M"] * preset["rated_A"] / preset["J"]
             j_max = a_max * varpi
@@ -236,7 +253,7 @@ def main():
             if robust:
                 load = 0.3 * preset["k_M"] * preset["rated_A"]
                 if paper_top is None:
-                    paper_top = paper_top_speed(args.tune)
+                    paper_top = paper_top_speed(args.tune, args.top == "weakened")
                 sets.append(f"run.loss_speed_error_rad_s={loss_speed_error(top, paper_top):.9g}")
                 sets += [
                     f"motor.resistance_Ohm={1.2 * preset['R']:.9g}",  # the plant's; the firmware keeps R

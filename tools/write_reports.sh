@@ -13,6 +13,8 @@
 #                                                              -> docs/reports/envelope-weakened.md (+ .png)
 #   position-acceptance  tools/position_acceptance.py, 50 moves, seed 1, 60 s hold, --write-scenarios
 #                                                              -> docs/reports/position-acceptance.md
+#   position-acceptance-weakened  the same with v_max half the field-weakened top speed (--top weakened)
+#                                                              -> docs/reports/position-acceptance-weakened.md
 #   mc-presets           tools/monte_carlo.py --preset P --cases 200 --seed 1, P = paper, 17hs4401,
 #                        bj42d29, as1050 (realistic chain)     -> docs/reports/monte-carlo.md, section P
 #   mc-weakened          tools/monte_carlo.py --preset P --weakened --cases 200 --seed 1: the same campaigns with
@@ -51,7 +53,7 @@
 set -uo pipefail
 cd "$(dirname "$0")/.."
 
-STEPS_ALL=(cost position-cost benchmarks envelope envelope-weakened position-acceptance mc-presets mc-weakened mc-robust mc-position fault-injection
+STEPS_ALL=(cost position-cost benchmarks envelope envelope-weakened position-acceptance position-acceptance-weakened mc-presets mc-weakened mc-robust mc-position fault-injection
            motor-sweep self-commissioning step-dir homing torque-speed)
 MC_PRESETS=(paper 17hs4401 bj42d29 as1050)
 MC_POSITION=(17hs4401 bj42d29 as1050)
@@ -140,6 +142,11 @@ for step in "${STEPS[@]}"; do
       need_sil
       run position-acceptance "$REPORTS/position-acceptance.md" "$PYTHON" tools/position_acceptance.py --sil "$SIL" --tune "$TUNE" \
         --out "$OUT/position_acceptance" --write-scenarios --report "$REPORTS/position-acceptance.md" ;;
+    position-acceptance-weakened)
+      need_sil
+      run position-acceptance-weakened "$REPORTS/position-acceptance-weakened.md" "$PYTHON" tools/position_acceptance.py \
+        --sil "$SIL" --tune "$TUNE" --out "$OUT/position_acceptance_weakened" --top weakened \
+        --report "$REPORTS/position-acceptance-weakened.md" ;;
     mc-presets)
       need_sil
       for p in "${MC_PRESETS[@]}"; do

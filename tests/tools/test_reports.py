@@ -418,6 +418,11 @@ class PositionAcceptance(ReportCase):
         )
         self.assertIn("| paper | ideal | 3 (-) | - / - | - % | - | - | - | 3 s | STALL | **FAILED** |", text)
         self.assertIn("**1 of 2 runs meet them.**", text)
+        self.assertIn("v_max = 0.5 of the design's top speed", text)
+        args.top = "weakened"
+        text = position_acceptance.report_text(results, args, ["tools/position_acceptance.py", "--top", "weakened"])
+        self.assertIn("# Position control: acceptance at the field-weakened top speed", text)
+        self.assertIn("v_max = 0.5 of the design's field-weakened top speed", text)
 
 
 class MonteCarlo(ReportCase):
