@@ -40,7 +40,8 @@ import sys
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
-from mc_preset import chain_sets, read_preset as read_preset_file  # noqa: E402
+from mc_distributions import ToolError  # noqa: E402
+from mc_preset import chain_sets, read_preset as read_preset_file, tune_top_speed  # noqa: E402
 import report  # noqa: E402
 
 PRESETS = ("paper", "17hs4401", "bj42d29", "as1050")
@@ -79,12 +80,10 @@ def design(args, name, chain, out_dir):
     r = run(cmd)
     if r.returncode != 0:
         raise SystemExit("pmstep-tune failed: %s\n%s" % (" ".join(cmd), r.stderr))
-    top = float(re.search(r"top speed: ([0-9.]+) rad/s", r.stdout).group(1))
-    if args.top == "weakened":
-        weakened = re.search(r"top speed with it ([0-9.]+) rad/s", r.stdout)
-        if weakened is None:
-            raise SystemExit("pmstep-tune printed no field-weakened top speed: %s" % " ".join(cmd))
-        top = float(weakened.group(1))
+    try:
+        top = tune_top_speed(r.stdout, args.top == "weakened")
+    except ToolError as e:
+        raise SystemExit("%s: %s" % (" ".join(cmd), e)) from None
     t_c = float(re.search(r"t_c ([0-9.]+) s", r.stdout).group(1))
     start = t_c + (0.05 if robust else 0.0) + 0.1
     return ini, top, start, preset
@@ -345,7 +344,7 @@ def report_text(rows, args, argv, plot_name=None):
         "or a loss of synchronism (bisection, %d steps). Microstepping: the SIL's open-loop baseline at rated "
         "current." % (args.duration, HOLD_S, SETTLE_S, STEP_POSITIONS, BISECTION_STEPS)
     )
-    if getattr(args, "top", "design") == "weakened":
+    if args.top == "weakened":
         what += (
             " The top speed here is the field-weakened one (pmstep-tune's 'top speed with it': 30 % of the "
             "holding torque in the bus with i_d* at its most negative, at most the control rate's 0.4 rad a "
@@ -358,7 +357,7 @@ def report_text(rows, args, argv, plot_name=None):
     lines = [
         report.header(
             "Operating envelope against open-loop microstepping"
-            + (" at the field-weakened top speed" if getattr(args, "top", "design") == "weakened" else ""),
+            + (" at the field-weakened top speed" if args.top == "weakened" else ""),
             "tools/envelope.py",
             argv,
             what,

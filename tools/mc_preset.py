@@ -176,20 +176,25 @@ def _design(tune, preset_path, chain_sets, low_speed_drive=False):
     return cmd
 
 
-def _run_designer(cmd, weakened=False):
-    """Runs pmstep-tune; returns the top speed (rad/s) it prints: the design's (i_d = 0), or with
-    @p weakened the field-weakened one ("top speed with it")."""
+def tune_top_speed(output, weakened=False):
+    """The top speed (rad/s) pmstep-tune printed in @p output: the design's ("top speed: ", i_d = 0), or
+    with @p weakened the field-weakened one ("top speed with it"); ToolError when it printed none."""
+    pattern = r"top speed with it ([0-9.eE+-]+) rad/s" if weakened else r"top speed: ([0-9.eE+-]+) rad/s"
+    top = re.search(pattern, output)
+    if top is None:
+        raise ToolError(f"pmstep-tune printed no {'field-weakened ' if weakened else ''}top speed:\n{output}")
+    return float(top.group(1))
+
+
+def _run_designer(cmd):
+    """Runs pmstep-tune; returns what it printed."""
     try:
         proc = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
     except (OSError, subprocess.TimeoutExpired) as e:
         raise ToolError(f"cannot run {cmd[0]}: {e}") from None
     if proc.returncode != 0:
         raise ToolError(f"{' '.join(cmd)} failed (status {proc.returncode}):\n{proc.stderr.strip()}")
-    pattern = r"top speed with it ([0-9.eE+-]+) rad/s" if weakened else r"top speed: ([0-9.eE+-]+) rad/s"
-    top = re.search(pattern, proc.stdout)
-    if top is None:
-        raise ToolError(f"cannot read the top speed from the output of {' '.join(cmd)}:\n{proc.stdout}")
-    return float(top.group(1))
+    return proc.stdout
 
 
 def _points_lines(points):
@@ -204,7 +209,7 @@ def paper_top_speed(tune, weakened=False):
     the paper campaign's speed thresholds are relative to (@p weakened: its field-weakened one)."""
     paper_span = ADC_SPAN_RATED * read_preset(PAPER_PRESET)["rated_current_A"]
     paper_chain = list(REALISTIC_CHAIN) + [f"sensors.current_full_scale_A={paper_span:g}"]
-    return _run_designer(_design(tune, PAPER_PRESET, paper_chain), weakened)
+    return tune_top_speed(_run_designer(_design(tune, PAPER_PRESET, paper_chain)), weakened)
 
 
 def loss_speed_error(top_speed_rad_s, paper_top_rad_s):
@@ -213,10 +218,14 @@ def loss_speed_error(top_speed_rad_s, paper_top_rad_s):
     return PAPER_LOSS_SPEED_RAD_S * top_speed_rad_s / paper_top_rad_s
 
 
-def _top_speeds(tune, preset_path, chain, low_speed_drive, extra=()):
-    """(the preset's top speed, the paper motor's; rad/s) from pmstep-tune, and the preset's command."""
+def _top_speeds(tune, preset_path, chain, low_speed_drive, extra=(), weakened=False):
+    """(the preset's top speed, the paper motor's, the preset's field-weakened one; rad/s) from pmstep-tune,
+    and the preset's command. With @p weakened the paper motor's is its field-weakened one, else the preset's
+    field-weakened one is None."""
     cmd = _design(tune, preset_path, chain, low_speed_drive) + list(extra)
-    return _run_designer(cmd), paper_top_speed(tune), cmd
+    output = _run_designer(cmd)
+    weakened_top = tune_top_speed(output, True) if weakened else None
+    return tune_top_speed(output), paper_top_speed(tune, weakened), weakened_top, cmd
 
 
 def _scenario_peak_and_load(ini, path):
@@ -239,7 +248,7 @@ def scenario_info(tune, preset_path, scenario_path, phase_voltage_sensing=False,
     the scenario runs as it is, the preset scales the distributions. Returns the info of
     design_scenario, with the scenario's own peak speed (a position scenario's v_max) and load."""
     preset = read_preset(preset_path)
-    top, paper_top, cmd = _top_speeds(tune, preset_path, chain_sets(preset, phase_voltage_sensing), low_speed_drive)
+    top, paper_top, _, cmd = _top_speeds(tune, preset_path, chain_sets(preset, phase_voltage_sensing), low_speed_drive)
     peak, load = _scenario_peak_and_load(_ini(scenario_path), scenario_path)
     return {
         "preset": preset["name"],
@@ -281,7 +290,9 @@ def design_scenario(tune, preset_path, out_dir, phase_voltage_sensing=False, low
     chain = chain_sets(preset, phase_voltage_sensing)
     os.makedirs(out_dir, exist_ok=True)
     design_path = os.path.join(out_dir, "preset_design.ini")
-    top, paper_top, cmd = _top_speeds(tune, preset_path, chain, low_speed_drive, ["--write-ini", design_path])
+    top, paper_top, weakened_top, cmd = _top_speeds(
+        tune, preset_path, chain, low_speed_drive, ["--write-ini", design_path], weakened
+    )
     ini = _ini(design_path)
     try:
         points = [p.strip() for p in ini.get("speed", "points").replace("\n", " ").split(",") if p.strip()]
@@ -290,11 +301,11 @@ def design_scenario(tune, preset_path, out_dir, phase_voltage_sensing=False, low
             ini.get("controller.alignment", "c_align_time_s")
         )
         if weakened:
-            ratio = _run_designer(cmd, True) / top
+            ratio = weakened_top / top
             points = _stretch(points, run_start, ratio)
             duration = float(ini.get("run", "duration_s"))
             ini.set("run", "duration_s", repr(run_start + (duration - run_start) * ratio))
-            top, paper_top = top * ratio, paper_top_speed(tune, True)
+            top = weakened_top
         peak = max(abs(float(p.split(":")[1])) for p in points)
     except (configparser.Error, ValueError, IndexError) as e:
         raise ToolError(

@@ -42,7 +42,7 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 # the realistic chain (ADC span sized to the motor) and the speed-mode loss bound scaled to its top speed
-from mc_preset import chain_sets, loss_speed_error, paper_top_speed  # noqa: E402
+from mc_preset import chain_sets, loss_speed_error, paper_top_speed, tune_top_speed  # noqa: E402
 import report  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -72,8 +72,7 @@ def design(tune, motor_ini, ini_out, robust, sets, weakened=False):
     for s in sets:
         cmd += ["--set", s]
     out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
-    pattern = r"top speed with it ([0-9.eE+-]+) rad/s" if weakened else r"top speed: ([0-9.eE+-]+) rad/s"
-    top = float(re.search(pattern, out).group(1))
+    top = tune_top_speed(out, weakened)
     varpi = float(re.search(r"varpi_0 ([0-9.e+-]+) rad/s", out).group(1))
     k_theta = float(re.search(r"position loop: k_theta ([0-9.e+-]+)", out).group(1))
     return top, varpi, k_theta
@@ -131,7 +130,7 @@ def report_text(results, args, argv):
     what = (
         f"Per motor preset: the `pmstep-tune` design, {args.moves} random moves (seed {args.seed}, targets uniform "
         f"in ±10 revolutions of where RUN starts, v_max = {args.speed_fraction:g} of the design's "
-        + ("field-weakened " if getattr(args, "top", "design") == "weakened" else "")
+        + ("field-weakened " if args.top == "weakened" else "")
         + "top speed, "
         f"a_max = {args.accel_fraction:g} of k_M I / J, jerk a_max ϖ0; each move given its profile's time plus "
         f"{SETTLE_S:g} s). Ideal: the ideal measurement chain, the plant's detent torque on. Realistic: "
@@ -144,8 +143,7 @@ def report_text(results, args, argv):
     )
     lines = [
         report.header(
-            "Position control: acceptance"
-            + (" at the field-weakened top speed" if getattr(args, "top", "design") == "weakened" else ""),
+            "Position control: acceptance" + (" at the field-weakened top speed" if args.top == "weakened" else ""),
             "tools/position_acceptance.py",
             argv,
             what,

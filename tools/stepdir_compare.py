@@ -72,13 +72,13 @@ import csv
 import json
 import math
 import os
-import re
 import shutil
 import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import report  # noqa: E402
+from mc_preset import tune_top_speed  # noqa: E402
 from position_acceptance import read_preset  # noqa: E402  (the preset's rated current, k_M, J, p)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -104,7 +104,7 @@ def design(tune, motor_ini, ini_out, robust=False, sets=()):
     for item in sets:
         cmd += ["--set", item]
     out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
-    top = float(re.search(r"top speed: ([0-9.eE+-]+) rad/s", out).group(1))
+    top = tune_top_speed(out)
     ini = configparser.ConfigParser(inline_comment_prefixes=(";",))
     ini.read(ini_out)
     run_start = float(ini["controller.commissioning"]["offset_calibration_time_s"]) + float(

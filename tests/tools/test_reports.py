@@ -356,7 +356,7 @@ class Envelope(ReportCase):
     }
 
     def test_table_and_plot(self):
-        args = argparse.Namespace(duration=20.0, set=["inverter.dead_time_s=0"])
+        args = argparse.Namespace(duration=20.0, set=["inverter.dead_time_s=0"], top="design")
         argv = ["tools/envelope.py", "--out", "out/envelope", "--report", "docs/reports/envelope.md"]
         text = envelope.report_text([self.ROW], args, argv, "envelope.png")
         self.assert_header(text, "tools/envelope.py --out out/envelope --report docs/reports/envelope.md")
@@ -378,7 +378,7 @@ class Envelope(ReportCase):
 
 class PositionAcceptance(ReportCase):
     def test_table(self):
-        args = argparse.Namespace(moves=50, seed=1, speed_fraction=0.5, accel_fraction=0.25, hold_s=60.0)
+        args = argparse.Namespace(moves=50, seed=1, speed_fraction=0.5, accel_fraction=0.25, hold_s=60.0, top="design")
         pos = {
             "moves": 50,
             "unfinished_moves": 0,
