@@ -69,6 +69,22 @@ STM32G4_TEXT_C = "hal/stm32g4/src/stm32g4_convert.c"
 STM32G4_BOARD_C = "hal/stm32g4/src/stm32g4_board.c"
 SCENARIO_KEYS_C = "sil/src/scenario_keys.c"
 SCENARIO_KEYS_H = "sil/src/scenario_keys.h"
+# Every C source read above, line by line: its layout is this generator's input (--parsed-sources).
+PARSED_C_SOURCES = (
+    TYPES_H,
+    CONFIG_C,
+    TEXT_C,
+    CONSOLE_H,
+    CONSOLE_CONFIG_C,
+    CONSOLE_REQUEST_C,
+    STORE_H,
+    CALIBRATE_H,
+    STM32G4_H,
+    STM32G4_TEXT_C,
+    STM32G4_BOARD_C,
+    SCENARIO_KEYS_C,
+    SCENARIO_KEYS_H,
+)
 
 # The unit a field name's suffix gives; the longest suffix that ends the name wins (_Nm_A before _A).
 UNIT_SUFFIXES = {
@@ -1948,7 +1964,15 @@ def main(argv: list[str] | None = None) -> int:
         help="a pmstep-sil binary: cross-check the scenario keys against its --print-scenario "
         "and add the paper scenario's values",
     )
+    parser.add_argument(
+        "--parsed-sources",
+        action="store_true",
+        help="print the C sources whose layout this generator parses, one a line, and exit",
+    )
     args = parser.parse_args(argv)
+    if args.parsed_sources:
+        print("\n".join(PARSED_C_SOURCES))
+        return 0
     try:
         ref = load(ROOT, args.sil)
         page_tables = render_page_tables(ROOT, args.docs)  # before any page is written

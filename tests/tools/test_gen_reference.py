@@ -103,6 +103,15 @@ class RealSources(unittest.TestCase):
             self.assertIn("Generated page", page, name)
             self.assertIn("Do not edit", page, name)
 
+    def test_parsed_sources_listed(self):
+        """--parsed-sources (the formatter leaves them as written) names every C source the generator reads."""
+        read = {v for k, v in vars(gen).items() if k.isupper() and isinstance(v, str) and v.endswith((".c", ".h"))}
+        self.assertEqual(set(gen.PARSED_C_SOURCES), read)
+        out = subprocess.run(
+            [sys.executable, str(GEN), "--parsed-sources"], capture_output=True, text=True, check=True
+        ).stdout
+        self.assertEqual(out.split(), list(gen.PARSED_C_SOURCES))
+
     def test_stepdir_pin_table(self):
         """The NUCLEO page's STEP/DIR pin table: one row per STEP/DIR row of pmstep_stm32g4_pin_map(), in its
         order, with the pin pmstep_stm32g4_default_config() gives it, between its markers."""
