@@ -231,11 +231,12 @@ def microstep_cases(all_cases, rows):
     on the first grid (top_speeds() of @p rows: the highest speed at which it holds a load), each case carrying
     "microstep_fraction"; none where microstepping holds no load at any speed."""
     tops = {(m, b): drives.get("microstep", (None, None))[1] for m, b, _, drives in top_speeds(rows)}
+    designs = {(c["motor"], c["bus"]): c for c in all_cases}  # one first-grid case per preset and bus
     out = []
-    for c in all_cases:
-        ms_top = tops.get((c["motor"], c["bus"]))
-        if ms_top is None or c["fraction"] != max(x["fraction"] for x in all_cases if x["scenario"] == c["scenario"]):
-            continue  # one set of cases per preset and bus (from its last first-grid case)
+    for key, c in designs.items():
+        ms_top = tops.get(key)
+        if ms_top is None:
+            continue
         for f in MICROSTEP_FRACTIONS:
             fraction = f * ms_top / c["top_rad_s"]
             case = dict(c, fraction=fraction, microstep_fraction=f)
